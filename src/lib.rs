@@ -1,0 +1,1 @@
+pub use signorini_macros::forms;
