@@ -1,0 +1,289 @@
+//! Static checks: names, arity, shapes, linearity in the test function, geometry in volume
+//! integrals, parameter ranges, imports. All errors of a unit are collected; nothing panics.
+//!
+//! Checking evaluates every form abstractly: user functions are inlined at each call with the
+//! abstract values of their arguments, so a mistake that depends on how a function is used
+//! (a test function passed into `pos`) is reported inside the function, with the call site.
+
+mod builtins;
+mod load;
+mod types;
+
+use std::collections::{BTreeSet, HashMap, HashSet};
+use std::path::Path;
+
+use crate::diagnostic::{self, Diagnostic};
+use crate::source::{FileId, Loader, SourceMap, Span};
+use crate::syntax::ast::{self, Expr, Ident, Shape};
+
+pub use builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES};
+pub use types::{Ty, const_eval};
+
+/// The value of a constant expression, if it is one.
+pub fn const_value(e: &Expr) -> Option<f64> {
+    const_eval(e).ok()
+}
+
+/// A checked compilation unit: the root file and its imports.
+pub struct Program {
+    pub sources: SourceMap,
+    pub root: FileId,
+    pub params: Vec<Param>,
+    pub coefs: Vec<Coef>,
+    pub forms: Vec<Form>,
+    pub globals: HashMap<String, Global>,
+    /// Warnings (errors make `check` return `Err`).
+    pub warnings: Vec<Diagnostic>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Param {
+    pub name: String,
+    pub default: f64,
+    pub range: Option<ParamRange>,
+    pub span: Span,
+    /// The default and range as written; `default` and `range` are their values.
+    pub default_expr: Expr,
+    pub range_expr: Option<ast::Range>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParamRange {
+    pub lo: f64,
+    pub lo_closed: bool,
+    pub hi: f64,
+    pub hi_closed: bool,
+}
+
+impl ParamRange {
+    pub fn contains(&self, v: f64) -> bool {
+        let above = if self.lo_closed { v >= self.lo } else { v > self.lo };
+        let below = if self.hi_closed { v <= self.hi } else { v < self.hi };
+        above && below
+    }
+
+    pub fn describe(&self) -> String {
+        format!(
+            "{}{}, {}{}",
+            if self.lo_closed { "[" } else { "(" },
+            fmt_bound(self.lo),
+            fmt_bound(self.hi),
+            if self.hi_closed { "]" } else { ")" }
+        )
+    }
+}
+
+fn fmt_bound(v: f64) -> String {
+    if v == f64::INFINITY {
+        "inf".into()
+    } else if v == f64::NEG_INFINITY {
+        "-inf".into()
+    } else {
+        format!("{v}")
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Coef {
+    pub name: String,
+    pub shape: Shape,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub struct Form {
+    pub name: String,
+    pub fields: Vec<Ident>,
+    pub test: Ident,
+    pub integrals: Vec<ast::Integral>,
+    pub span: Span,
+}
+
+/// What a global name refers to.
+#[derive(Clone, Debug)]
+pub enum Global {
+    Param(usize),
+    Coef(usize),
+    Let { value: Expr, span: Span },
+    Fn { params: Vec<Ident>, body: Expr, span: Span },
+    Form(usize),
+}
+
+impl Global {
+    fn span(&self, prog_params: &[Param], coefs: &[Coef], forms: &[Form]) -> Span {
+        match self {
+            Global::Param(i) => prog_params[*i].span,
+            Global::Coef(i) => coefs[*i].span,
+            Global::Let { span, .. } | Global::Fn { span, .. } => *span,
+            Global::Form(i) => forms[*i].span,
+        }
+    }
+
+    fn kind(&self) -> &'static str {
+        match self {
+            Global::Param(_) => "param",
+            Global::Coef(_) => "coef",
+            Global::Let { .. } => "let",
+            Global::Fn { .. } => "fn",
+            Global::Form(_) => "form",
+        }
+    }
+}
+
+/// The region name of volume integrals.
+pub const CELL_REGION: &str = "Omega";
+
+/// Result of checking: the program (with warnings) or every diagnostic, errors first in source
+/// order, together with the sources needed to render them.
+pub type Checked = Result<Program, (Vec<Diagnostic>, SourceMap)>;
+
+/// Checks the unit rooted at `path`.
+pub fn check_file(path: &Path, loader: &dyn Loader) -> Result<Checked, String> {
+    let mut diags = Vec::new();
+    let loaded = load::load(path, loader, &mut diags)?;
+    Ok(check_loaded(loaded, diags))
+}
+
+/// Checks `text` as if it were the file `path` (imports resolve through `loader`).
+pub fn check_text(path: &Path, text: &str, loader: &dyn Loader) -> Checked {
+    let mut diags = Vec::new();
+    let loaded = load::load_text(path, text, loader, &mut diags);
+    check_loaded(loaded, diags)
+}
+
+fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
+    let load::Loaded { sources, files, root } = loaded;
+    let mut prog = Program {
+        sources,
+        root,
+        params: Vec::new(),
+        coefs: Vec::new(),
+        forms: Vec::new(),
+        globals: HashMap::new(),
+        warnings: Vec::new(),
+    };
+    let broken: HashSet<String> = files.iter().flat_map(|(_, f)| f.broken_names.iter().cloned()).collect();
+    declare(&mut prog, &files, &mut diags);
+    let used = {
+        let mut c = types::Checker::new(&prog, &broken);
+        let values = c.check_params();
+        c.check_lets_and_fns();
+        c.check_forms();
+        let used = c.used_params.clone();
+        diags.append(&mut c.diags);
+        for (p, (default, range)) in prog.params.iter_mut().zip(values) {
+            p.default = default.unwrap_or(f64::NAN);
+            p.range = range;
+        }
+        used
+    };
+    for (i, p) in prog.params.iter().enumerate() {
+        if p.span.file == prog.root && !used.contains(&i) {
+            diags.push(
+                Diagnostic::warning("W0001", format!("unused param `{}`", p.name), p.span, "no form uses this parameter")
+                    .with_help("remove it, or use it in a form"),
+            );
+        }
+    }
+    diagnostic::normalize(&mut diags);
+    if diags.iter().any(Diagnostic::is_error) {
+        Err((diags, prog.sources))
+    } else {
+        prog.warnings = diags;
+        Ok(prog)
+    }
+}
+
+/// Builds the global name table; duplicate names and built-in names are errors.
+fn declare(prog: &mut Program, files: &[(FileId, ast::File)], diags: &mut Vec<Diagnostic>) {
+    let mut first: HashMap<String, Span> = HashMap::new();
+    for (_, file) in files {
+        for item in &file.items {
+            let Some(name) = item.name() else { continue };
+            if BUILTIN_VALUES.iter().chain(BUILTIN_FUNCTIONS).any(|b| *b == name.name) || name.name == CELL_REGION {
+                diags.push(
+                    Diagnostic::error("E0106", format!("`{}` is a built-in name", name.name), name.span, "cannot be redefined")
+                        .with_help("choose another name"),
+                );
+                continue;
+            }
+            if let Some(prev) = first.get(&name.name) {
+                diags.push(
+                    Diagnostic::error("E0102", format!("`{}` is defined twice", name.name), name.span, "defined again here")
+                        .with_label(*prev, "first defined here"),
+                );
+                continue;
+            }
+            first.insert(name.name.clone(), name.span);
+            let global = match item {
+                ast::Item::Param { name, default, range, span } => {
+                    prog.params.push(Param {
+                        name: name.name.clone(),
+                        default: f64::NAN,
+                        range: None,
+                        span: *span,
+                        default_expr: default.clone(),
+                        range_expr: range.clone(),
+                    });
+                    Global::Param(prog.params.len() - 1)
+                }
+                ast::Item::Coef { name, shape, span } => {
+                    prog.coefs.push(Coef { name: name.name.clone(), shape: *shape, span: *span });
+                    Global::Coef(prog.coefs.len() - 1)
+                }
+                ast::Item::Let { value, span, .. } => Global::Let { value: value.clone(), span: *span },
+                ast::Item::Fn { params, body, span, .. } => {
+                    check_distinct(params, "parameter", diags);
+                    Global::Fn { params: params.clone(), body: body.clone(), span: *span }
+                }
+                ast::Item::Form { name, fields, test, integrals, span } => {
+                    let mut args = fields.clone();
+                    args.push(test.clone());
+                    check_distinct(&args, "argument", diags);
+                    prog.forms.push(Form {
+                        name: name.name.clone(),
+                        fields: fields.clone(),
+                        test: test.clone(),
+                        integrals: integrals.clone(),
+                        span: *span,
+                    });
+                    Global::Form(prog.forms.len() - 1)
+                }
+                ast::Item::Import { .. } => continue,
+            };
+            prog.globals.insert(name.name.clone(), global);
+        }
+    }
+}
+
+fn check_distinct(names: &[Ident], what: &str, diags: &mut Vec<Diagnostic>) {
+    let mut seen: HashMap<&str, Span> = HashMap::new();
+    for n in names {
+        if let Some(prev) = seen.get(n.name.as_str()) {
+            diags.push(
+                Diagnostic::error("E0103", format!("duplicate {what} `{}`", n.name), n.span, "repeated here").with_label(*prev, "first here"),
+            );
+        } else {
+            seen.insert(&n.name, n.span);
+        }
+        if BUILTIN_VALUES.contains(&n.name.as_str()) {
+            diags.push(
+                Diagnostic::error("E0106", format!("`{}` is a built-in name", n.name), n.span, "cannot be used as a name here")
+                    .with_help("choose another name"),
+            );
+        }
+    }
+}
+
+/// Names visible everywhere, for "did you mean" suggestions.
+fn suggest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<String> {
+    candidates
+        .filter(|c| *c != name)
+        .map(|c| (strsim::damerau_levenshtein(name, c), c))
+        .filter(|(d, c)| *d <= 2.max(c.len() / 3) && *d < c.len().max(name.len()))
+        .min()
+        .map(|(_, c)| c.to_string())
+}
+
+/// Used params, as a set of indices.
+pub type ParamSet = BTreeSet<usize>;

@@ -1,0 +1,253 @@
+//! The expression DAG: scalar nodes, hash-consed (equal subexpressions are one node), built
+//! through constructors that fold constants and drop zeros and ones.
+
+use std::collections::HashMap;
+
+pub type NodeId = u32;
+
+/// A leaf the kernel reads: geometry, parameters, case data, and the values and gradients of
+/// the form's arguments at the quadrature point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Sym {
+    Param(u16),
+    /// Component `comp` of field argument `arg`.
+    Field { arg: u8, comp: u8 },
+    /// ∂_dir of component `comp` of field argument `arg`.
+    FieldGrad { arg: u8, comp: u8, dir: u8 },
+    Test { comp: u8 },
+    TestGrad { comp: u8, dir: u8 },
+    /// Outward unit normal of the body at a facet point.
+    Normal(u8),
+    /// Diameter of the cell carrying the facet.
+    CellDiameter,
+    Coord(u8),
+    Time,
+    /// Component `comp` (row-major for tensors) of case datum `id`.
+    Coef { id: u16, comp: u8 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Node {
+    /// The bits of an f64 (so that nodes hash).
+    Const(u64),
+    Sym(Sym),
+    Add(NodeId, NodeId),
+    Mul(NodeId, NodeId),
+    Neg(NodeId),
+    Div(NodeId, NodeId),
+    Powi(NodeId, i32),
+    Sqrt(NodeId),
+    /// H(a) = 1 if a > 0, else 0. Every non-smooth built-in is defined through it.
+    Heaviside(NodeId),
+}
+
+#[derive(Default, Clone)]
+pub struct Graph {
+    nodes: Vec<Node>,
+    index: HashMap<Node, NodeId>,
+    /// Names from the source (`let mu`, `fn sn`), used for readable generated code.
+    pub names: HashMap<NodeId, String>,
+}
+
+impl Graph {
+    pub fn node(&self, id: NodeId) -> Node {
+        self.nodes[id as usize]
+    }
+
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    fn intern(&mut self, n: Node) -> NodeId {
+        if let Some(&id) = self.index.get(&n) {
+            return id;
+        }
+        let id = self.nodes.len() as NodeId;
+        self.nodes.push(n);
+        self.index.insert(n, id);
+        id
+    }
+
+    pub fn constant(&mut self, v: f64) -> NodeId {
+        // -0.0 and 0.0 are one node.
+        let v = if v == 0.0 { 0.0 } else { v };
+        self.intern(Node::Const(v.to_bits()))
+    }
+
+    pub fn sym(&mut self, s: Sym) -> NodeId {
+        self.intern(Node::Sym(s))
+    }
+
+    pub fn as_const(&self, id: NodeId) -> Option<f64> {
+        match self.node(id) {
+            Node::Const(b) => Some(f64::from_bits(b)),
+            _ => None,
+        }
+    }
+
+    pub fn is_zero(&self, id: NodeId) -> bool {
+        self.as_const(id) == Some(0.0)
+    }
+
+    pub fn zero(&mut self) -> NodeId {
+        self.constant(0.0)
+    }
+
+    pub fn one(&mut self) -> NodeId {
+        self.constant(1.0)
+    }
+
+    pub fn add(&mut self, a: NodeId, b: NodeId) -> NodeId {
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => return self.constant(x + y),
+            (Some(z), _) if z == 0.0 => return b,
+            (_, Some(z)) if z == 0.0 => return a,
+            _ => {}
+        }
+        if let Node::Neg(nb) = self.node(b) {
+            if nb == a {
+                return self.zero();
+            }
+        }
+        if let Node::Neg(na) = self.node(a) {
+            if na == b {
+                return self.zero();
+            }
+        }
+        if a == b {
+            let two = self.constant(2.0);
+            return self.mul(two, a);
+        }
+        let (a, b) = if a <= b { (a, b) } else { (b, a) };
+        self.intern(Node::Add(a, b))
+    }
+
+    pub fn sub(&mut self, a: NodeId, b: NodeId) -> NodeId {
+        let nb = self.neg(b);
+        self.add(a, nb)
+    }
+
+    pub fn neg(&mut self, a: NodeId) -> NodeId {
+        match self.node(a) {
+            Node::Const(b) => self.constant(-f64::from_bits(b)),
+            Node::Neg(x) => x,
+            _ => self.intern(Node::Neg(a)),
+        }
+    }
+
+    pub fn mul(&mut self, a: NodeId, b: NodeId) -> NodeId {
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => return self.constant(x * y),
+            (Some(z), _) | (_, Some(z)) if z == 0.0 => return self.zero(),
+            (Some(o), _) if o == 1.0 => return b,
+            (_, Some(o)) if o == 1.0 => return a,
+            (Some(m), _) if m == -1.0 => return self.neg(b),
+            (_, Some(m)) if m == -1.0 => return self.neg(a),
+            _ => {}
+        }
+        // Pull negations out so that -a*b and a*-b are one node.
+        if let Node::Neg(x) = self.node(a) {
+            let p = self.mul(x, b);
+            return self.neg(p);
+        }
+        if let Node::Neg(y) = self.node(b) {
+            let p = self.mul(a, y);
+            return self.neg(p);
+        }
+        // Constants first, then by id: a canonical order for commutative products.
+        let (a, b) = if self.as_const(b).is_some() || (self.as_const(a).is_none() && b < a) { (b, a) } else { (a, b) };
+        self.intern(Node::Mul(a, b))
+    }
+
+    pub fn div(&mut self, a: NodeId, b: NodeId) -> NodeId {
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => return self.constant(x / y),
+            (Some(z), _) if z == 0.0 => return self.zero(),
+            (_, Some(o)) if o == 1.0 => return a,
+            (_, Some(m)) if m == -1.0 => return self.neg(a),
+            _ => {}
+        }
+        if a == b {
+            return self.one();
+        }
+        if let Node::Neg(x) = self.node(a) {
+            let q = self.div(x, b);
+            return self.neg(q);
+        }
+        self.intern(Node::Div(a, b))
+    }
+
+    pub fn powi(&mut self, a: NodeId, k: i32) -> NodeId {
+        match k {
+            0 => return self.one(),
+            1 => return a,
+            -1 => {
+                let one = self.one();
+                return self.div(one, a);
+            }
+            _ => {}
+        }
+        if let Some(x) = self.as_const(a) {
+            return self.constant(x.powi(k));
+        }
+        self.intern(Node::Powi(a, k))
+    }
+
+    pub fn sqrt(&mut self, a: NodeId) -> NodeId {
+        match self.as_const(a) {
+            Some(x) => self.constant(x.sqrt()),
+            None => self.intern(Node::Sqrt(a)),
+        }
+    }
+
+    pub fn heaviside(&mut self, a: NodeId) -> NodeId {
+        match self.as_const(a) {
+            Some(x) => self.constant(if x > 0.0 { 1.0 } else { 0.0 }),
+            None => self.intern(Node::Heaviside(a)),
+        }
+    }
+
+    /// Records a source name for a node (the first name given wins).
+    pub fn name(&mut self, id: NodeId, name: &str) {
+        if matches!(self.node(id), Node::Const(_) | Node::Sym(_)) {
+            return;
+        }
+        self.names.entry(id).or_insert_with(|| name.to_string());
+    }
+
+    /// Children of a node.
+    pub fn children(&self, id: NodeId) -> impl Iterator<Item = NodeId> {
+        let (a, b) = match self.node(id) {
+            Node::Const(_) | Node::Sym(_) => (None, None),
+            Node::Add(x, y) | Node::Mul(x, y) | Node::Div(x, y) => (Some(x), Some(y)),
+            Node::Neg(x) | Node::Powi(x, _) | Node::Sqrt(x) | Node::Heaviside(x) => (Some(x), None),
+        };
+        a.into_iter().chain(b)
+    }
+
+    /// The nodes reachable from `roots`, children before parents (ids are created children
+    /// first, so sorting by id is a topological order).
+    pub fn reachable(&self, roots: impl IntoIterator<Item = NodeId>) -> Vec<NodeId> {
+        let mut seen = vec![false; self.nodes.len()];
+        let mut stack: Vec<NodeId> = roots.into_iter().collect();
+        let mut out = Vec::new();
+        while let Some(id) = stack.pop() {
+            if std::mem::replace(&mut seen[id as usize], true) {
+                continue;
+            }
+            out.push(id);
+            stack.extend(self.children(id));
+        }
+        out.sort_unstable();
+        out
+    }
+
+    /// Whether `id` depends on any symbol accepted by `pred`.
+    pub fn depends_on(&self, id: NodeId, pred: impl Fn(Sym) -> bool) -> bool {
+        self.reachable([id]).into_iter().any(|n| matches!(self.node(n), Node::Sym(s) if pred(s)))
+    }
+}

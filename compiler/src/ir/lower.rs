@@ -1,0 +1,493 @@
+//! Checked AST → scalar DAG for one space dimension. Values are tensors of scalar nodes; each
+//! scalar carries its spatial gradient (forward mode), so `grad` of any smooth expression of
+//! the fields and of `x` is available. User functions and lets are inlined.
+
+use std::collections::HashMap;
+
+use super::graph::{Graph, NodeId, Sym};
+use crate::check::{CELL_REGION, Global, Program};
+use crate::syntax::ast::{BinOp, Expr, ExprKind, Shape};
+
+/// A scalar with its spatial gradient (`None` where no gradient exists: normal, case data,
+/// gradients themselves).
+#[derive(Clone, Debug)]
+pub struct Jet {
+    pub v: NodeId,
+    pub g: Option<Vec<NodeId>>,
+}
+
+/// A lowered value: components in row-major order (1, d or d·d of them).
+#[derive(Clone, Debug)]
+pub struct Val {
+    pub shape: Shape,
+    pub c: Vec<Jet>,
+}
+
+/// One form's integrand over one region, as the coefficients of the test function.
+#[derive(Clone, Debug)]
+pub struct Integrand {
+    pub region: String,
+    /// The integrand itself (scalar, linear in the test function).
+    pub value: NodeId,
+}
+
+#[derive(Clone, Debug)]
+pub struct LoweredForm {
+    pub name: String,
+    pub fields: Vec<String>,
+    pub test: String,
+    /// One per region, in order of first appearance; integrals over one region are summed.
+    pub integrands: Vec<Integrand>,
+}
+
+pub struct Lowerer<'p> {
+    pub g: Graph,
+    prog: &'p Program,
+    d: usize,
+    scope: Vec<(String, Val)>,
+    lets: HashMap<String, Val>,
+}
+
+impl<'p> Lowerer<'p> {
+    pub fn new(prog: &'p Program, d: usize) -> Self {
+        Lowerer { g: Graph::default(), prog, d, scope: Vec::new(), lets: HashMap::new() }
+    }
+
+    pub fn dim(&self) -> usize {
+        self.d
+    }
+
+    pub fn form(&mut self, index: usize) -> LoweredForm {
+        let form = &self.prog.forms[index];
+        let d = self.d;
+        let mut scope = Vec::new();
+        for (a, f) in form.fields.iter().enumerate() {
+            let c = (0..d)
+                .map(|k| Jet {
+                    v: self.g.sym(Sym::Field { arg: a as u8, comp: k as u8 }),
+                    g: Some((0..d).map(|l| self.g.sym(Sym::FieldGrad { arg: a as u8, comp: k as u8, dir: l as u8 })).collect()),
+                })
+                .collect();
+            scope.push((f.name.clone(), Val { shape: Shape::Vector, c }));
+        }
+        let c = (0..d)
+            .map(|k| Jet {
+                v: self.g.sym(Sym::Test { comp: k as u8 }),
+                g: Some((0..d).map(|l| self.g.sym(Sym::TestGrad { comp: k as u8, dir: l as u8 })).collect()),
+            })
+            .collect();
+        scope.push((form.test.name.clone(), Val { shape: Shape::Vector, c }));
+        self.scope = scope;
+        let mut integrands: Vec<Integrand> = Vec::new();
+        for integral in &form.integrals {
+            let v = self.expr(&integral.integrand).c[0].v;
+            let v = if integral.sign < 0.0 { self.g.neg(v) } else { v };
+            match integrands.iter_mut().find(|i| i.region == integral.region.name) {
+                Some(i) => i.value = self.g.add(i.value, v),
+                None => integrands.push(Integrand { region: integral.region.name.clone(), value: v }),
+            }
+        }
+        // Volume integral first: kernels are emitted in this order.
+        integrands.sort_by_key(|i| i.region != CELL_REGION);
+        self.scope.clear();
+        LoweredForm {
+            name: form.name.clone(),
+            fields: form.fields.iter().map(|f| f.name.clone()).collect(),
+            test: form.test.name.clone(),
+            integrands,
+        }
+    }
+
+    fn zero_grad(&mut self) -> Option<Vec<NodeId>> {
+        let z = self.g.zero();
+        Some(vec![z; self.d])
+    }
+
+    fn constant(&mut self, v: f64) -> Jet {
+        let v = self.g.constant(v);
+        Jet { v, g: self.zero_grad() }
+    }
+
+    fn scalar(j: Jet) -> Val {
+        Val { shape: Shape::Scalar, c: vec![j] }
+    }
+
+    fn expr(&mut self, e: &Expr) -> Val {
+        match &e.kind {
+            ExprKind::Number(v) => Self::scalar(self.constant(*v)),
+            ExprKind::Name(id) => self.name(&id.name),
+            ExprKind::Neg(a) => {
+                let a = self.expr(a);
+                self.map(&a, |s, j| s.jneg(j))
+            }
+            ExprKind::Binary(op, a, b) => {
+                let (a, b) = (self.expr(a), self.expr(b));
+                self.binary(*op, a, b, b_const(e))
+            }
+            ExprKind::Call(f, args) => {
+                let args: Vec<Val> = args.iter().map(|a| self.expr(a)).collect();
+                self.call(&f.name, args)
+            }
+        }
+    }
+
+    fn name(&mut self, name: &str) -> Val {
+        if let Some((_, v)) = self.scope.iter().rev().find(|(n, _)| n == name) {
+            return v.clone();
+        }
+        let d = self.d;
+        match self.prog.globals.get(name) {
+            Some(Global::Param(i)) => {
+                let v = self.g.sym(Sym::Param(*i as u16));
+                Self::scalar(Jet { v, g: self.zero_grad() })
+            }
+            Some(Global::Coef(i)) => {
+                let shape = self.prog.coefs[*i].shape;
+                let n = components(shape, d);
+                let c = (0..n).map(|k| Jet { v: self.g.sym(Sym::Coef { id: *i as u16, comp: k as u8 }), g: None }).collect();
+                Val { shape, c }
+            }
+            Some(Global::Let { value, .. }) => {
+                if let Some(v) = self.lets.get(name) {
+                    return v.clone();
+                }
+                let saved = std::mem::take(&mut self.scope);
+                let v = self.expr(&value.clone());
+                self.scope = saved;
+                self.name_val(&v, name);
+                self.lets.insert(name.to_string(), v.clone());
+                v
+            }
+            _ => match name {
+                "I" => {
+                    let c = (0..d * d).map(|k| self.constant(if k / d == k % d { 1.0 } else { 0.0 })).collect();
+                    Val { shape: Shape::Tensor, c }
+                }
+                "x" => {
+                    let c = (0..d)
+                        .map(|k| {
+                            let v = self.g.sym(Sym::Coord(k as u8));
+                            let g = (0..d).map(|l| self.g.constant(if k == l { 1.0 } else { 0.0 })).collect();
+                            Jet { v, g: Some(g) }
+                        })
+                        .collect();
+                    Val { shape: Shape::Vector, c }
+                }
+                "t" => {
+                    let v = self.g.sym(Sym::Time);
+                    Self::scalar(Jet { v, g: self.zero_grad() })
+                }
+                "h" => {
+                    let v = self.g.sym(Sym::CellDiameter);
+                    Self::scalar(Jet { v, g: self.zero_grad() })
+                }
+                "n" => {
+                    let c = (0..d).map(|k| Jet { v: self.g.sym(Sym::Normal(k as u8)), g: None }).collect();
+                    Val { shape: Shape::Vector, c }
+                }
+                "pi" => Self::scalar(self.constant(std::f64::consts::PI)),
+                _ => unreachable!("checked name `{name}`"),
+            },
+        }
+    }
+
+    fn name_val(&mut self, v: &Val, name: &str) {
+        let single = v.c.len() == 1;
+        let d = self.d;
+        for (k, j) in v.c.iter().enumerate() {
+            let n = if single {
+                name.to_string()
+            } else if v.shape == Shape::Vector {
+                format!("{name}_{k}")
+            } else {
+                format!("{name}_{}{}", k / d, k % d)
+            };
+            self.g.name(j.v, &n);
+        }
+    }
+
+    fn call(&mut self, f: &str, args: Vec<Val>) -> Val {
+        if let Some(Global::Fn { params, body, .. }) = self.prog.globals.get(f) {
+            let scope = params.iter().map(|p| p.name.clone()).zip(args).collect();
+            let saved = std::mem::replace(&mut self.scope, scope);
+            let v = self.expr(&body.clone());
+            self.scope = saved;
+            self.name_val(&v, f);
+            return v;
+        }
+        let d = self.d;
+        let mut args = args.into_iter();
+        let mut next = || args.next().expect("checked arity");
+        match f {
+            "grad" => {
+                let a = next();
+                let c: Vec<Jet> = a.c.iter().flat_map(|j| j.g.clone().expect("checked smooth").into_iter().map(|v| Jet { v, g: None })).collect();
+                let shape = if a.shape == Shape::Scalar { Shape::Vector } else { Shape::Tensor };
+                Val { shape, c }
+            }
+            "div" => {
+                let a = next();
+                let rows = if a.shape == Shape::Vector { 1 } else { d };
+                let c = (0..rows)
+                    .map(|i| {
+                        let mut acc = self.g.zero();
+                        for j in 0..d {
+                            let comp = if rows == 1 { j } else { i * d + j };
+                            let dj = a.c[comp].g.as_ref().expect("checked smooth")[j];
+                            acc = self.g.add(acc, dj);
+                        }
+                        Jet { v: acc, g: None }
+                    })
+                    .collect();
+                Val { shape: if rows == 1 { Shape::Scalar } else { Shape::Vector }, c }
+            }
+            "sym" => {
+                let a = next();
+                let half = self.constant(0.5);
+                let c = (0..d * d)
+                    .map(|k| {
+                        let (i, j) = (k / d, k % d);
+                        let s = self.jadd(&a.c[i * d + j], &a.c[j * d + i]);
+                        self.jmul(&half, &s)
+                    })
+                    .collect();
+                Val { shape: Shape::Tensor, c }
+            }
+            "transpose" => {
+                let a = next();
+                let c = (0..d * d).map(|k| a.c[(k % d) * d + k / d].clone()).collect();
+                Val { shape: Shape::Tensor, c }
+            }
+            "tr" => {
+                let a = next();
+                let mut acc = self.constant(0.0);
+                for i in 0..d {
+                    acc = self.jadd(&acc, &a.c[i * d + i]);
+                }
+                Self::scalar(acc)
+            }
+            "dot" => {
+                let (a, b) = (next(), next());
+                self.product(a, b)
+            }
+            "inner" => {
+                let (a, b) = (next(), next());
+                let mut acc = self.constant(0.0);
+                for (x, y) in a.c.iter().zip(&b.c) {
+                    let p = self.jmul(x, y);
+                    acc = self.jadd(&acc, &p);
+                }
+                Self::scalar(acc)
+            }
+            "outer" => {
+                let (a, b) = (next(), next());
+                let c = (0..d * d).map(|k| self.jmul(&a.c[k / d], &b.c[k % d])).collect();
+                Val { shape: Shape::Tensor, c }
+            }
+            "H" => {
+                let a = next();
+                Self::scalar(self.jheaviside(&a.c[0]))
+            }
+            "pos" => {
+                // [a]_+ = a·H(a)
+                let a = next().c.remove(0);
+                let h = self.jheaviside(&a);
+                Self::scalar(self.jmul(&a, &h))
+            }
+            "neg" => {
+                // [a]_- = min(a, 0) = a·H(-a)
+                let a = next().c.remove(0);
+                let m = self.jneg(&a);
+                let h = self.jheaviside(&m);
+                Self::scalar(self.jmul(&a, &h))
+            }
+            "abs" => {
+                // |a| = a·(H(a) − H(−a))
+                let a = next().c.remove(0);
+                let hp = self.jheaviside(&a);
+                let m = self.jneg(&a);
+                let hm = self.jheaviside(&m);
+                let s = self.jsub(&hp, &hm);
+                Self::scalar(self.jmul(&a, &s))
+            }
+            "max" | "min" => {
+                // max(a, b) = b + (a − b)·H(a − b); min(a, b) = b + (a − b)·H(b − a)
+                let (a, b) = (next().c.remove(0), next().c.remove(0));
+                let diff = self.jsub(&a, &b);
+                let arg = if f == "max" { diff.clone() } else { self.jneg(&diff) };
+                let h = self.jheaviside(&arg);
+                let p = self.jmul(&diff, &h);
+                Self::scalar(self.jadd(&b, &p))
+            }
+            "sqrt" => {
+                let a = next().c.remove(0);
+                Self::scalar(self.jsqrt(&a))
+            }
+            _ => unreachable!("checked built-in `{f}`"),
+        }
+    }
+
+    fn binary(&mut self, op: BinOp, a: Val, b: Val, exponent: Option<f64>) -> Val {
+        match op {
+            BinOp::Add => self.zip(&a, &b, |s, x, y| s.jadd(x, y)),
+            BinOp::Sub => self.zip(&a, &b, |s, x, y| s.jsub(x, y)),
+            BinOp::Mul => self.product(a, b),
+            BinOp::Div => {
+                let den = b.c[0].clone();
+                self.map(&a, |s, x| s.jdiv(x, &den))
+            }
+            BinOp::Pow => {
+                let k = exponent.expect("checked constant exponent") as i32;
+                let base = a.c[0].clone();
+                Self::scalar(self.jpowi(&base, k))
+            }
+        }
+    }
+
+    /// `*` and `dot`: scalar scaling, matrix–vector, vector–matrix, matrix–matrix, scalar product.
+    fn product(&mut self, a: Val, b: Val) -> Val {
+        use Shape::*;
+        let d = self.d;
+        match (a.shape, b.shape) {
+            (Scalar, _) => {
+                let s = a.c[0].clone();
+                self.map(&b, |t, x| t.jmul(&s, x))
+            }
+            (_, Scalar) => {
+                let s = b.c[0].clone();
+                self.map(&a, |t, x| t.jmul(x, &s))
+            }
+            (Vector, Vector) => {
+                let c = self.sum_of_products((0..d).map(|k| (k, k)).collect(), &a, &b);
+                Self::scalar(c)
+            }
+            (Tensor, Vector) => {
+                let c = (0..d).map(|i| self.sum_of_products((0..d).map(|j| (i * d + j, j)).collect(), &a, &b)).collect();
+                Val { shape: Vector, c }
+            }
+            (Vector, Tensor) => {
+                let c = (0..d).map(|j| self.sum_of_products((0..d).map(|i| (i, i * d + j)).collect(), &a, &b)).collect();
+                Val { shape: Vector, c }
+            }
+            (Tensor, Tensor) => {
+                let c = (0..d * d)
+                    .map(|k| {
+                        let (i, j) = (k / d, k % d);
+                        self.sum_of_products((0..d).map(|m| (i * d + m, m * d + j)).collect(), &a, &b)
+                    })
+                    .collect();
+                Val { shape: Tensor, c }
+            }
+        }
+    }
+
+    fn sum_of_products(&mut self, pairs: Vec<(usize, usize)>, a: &Val, b: &Val) -> Jet {
+        let mut acc = self.constant(0.0);
+        for (i, j) in pairs {
+            let p = self.jmul(&a.c[i], &b.c[j]);
+            acc = self.jadd(&acc, &p);
+        }
+        acc
+    }
+
+    fn map(&mut self, a: &Val, mut f: impl FnMut(&mut Self, &Jet) -> Jet) -> Val {
+        let c = a.c.iter().map(|x| f(self, x)).collect();
+        Val { shape: a.shape, c }
+    }
+
+    fn zip(&mut self, a: &Val, b: &Val, mut f: impl FnMut(&mut Self, &Jet, &Jet) -> Jet) -> Val {
+        let c = a.c.iter().zip(&b.c).map(|(x, y)| f(self, x, y)).collect();
+        Val { shape: a.shape, c }
+    }
+
+    // Scalar operations on jets (value and gradient together).
+
+    fn grads(&mut self, a: &Jet, b: &Jet, f: impl Fn(&mut Graph, NodeId, NodeId) -> NodeId) -> Option<Vec<NodeId>> {
+        let (ga, gb) = (a.g.as_ref()?, b.g.as_ref()?);
+        Some(ga.iter().zip(gb).map(|(&x, &y)| f(&mut self.g, x, y)).collect())
+    }
+
+    fn jadd(&mut self, a: &Jet, b: &Jet) -> Jet {
+        let v = self.g.add(a.v, b.v);
+        let g = self.grads(a, b, |g, x, y| g.add(x, y));
+        Jet { v, g }
+    }
+
+    fn jsub(&mut self, a: &Jet, b: &Jet) -> Jet {
+        let v = self.g.sub(a.v, b.v);
+        let g = self.grads(a, b, |g, x, y| g.sub(x, y));
+        Jet { v, g }
+    }
+
+    fn jneg(&mut self, a: &Jet) -> Jet {
+        let v = self.g.neg(a.v);
+        let g = a.g.as_ref().map(|ga| ga.iter().map(|&x| self.g.neg(x)).collect());
+        Jet { v, g }
+    }
+
+    fn jmul(&mut self, a: &Jet, b: &Jet) -> Jet {
+        let v = self.g.mul(a.v, b.v);
+        let (av, bv) = (a.v, b.v);
+        let g = self.grads(a, b, |g, x, y| {
+            let l = g.mul(x, bv);
+            let r = g.mul(av, y);
+            g.add(l, r)
+        });
+        Jet { v, g }
+    }
+
+    fn jdiv(&mut self, a: &Jet, b: &Jet) -> Jet {
+        let v = self.g.div(a.v, b.v);
+        let bv = b.v;
+        let g = self.grads(a, b, |g, x, y| {
+            // (a/b)' = (a' − (a/b)·b') / b
+            let q = g.mul(v, y);
+            let num = g.sub(x, q);
+            g.div(num, bv)
+        });
+        Jet { v, g }
+    }
+
+    fn jpowi(&mut self, a: &Jet, k: i32) -> Jet {
+        let v = self.g.powi(a.v, k);
+        let g = a.g.as_ref().map(|ga| {
+            let p = self.g.powi(a.v, k - 1);
+            let c = self.g.constant(k as f64);
+            let cp = self.g.mul(c, p);
+            ga.iter().map(|&x| self.g.mul(cp, x)).collect()
+        });
+        Jet { v, g }
+    }
+
+    fn jsqrt(&mut self, a: &Jet) -> Jet {
+        let v = self.g.sqrt(a.v);
+        let g = a.g.as_ref().map(|ga| {
+            let two = self.g.constant(2.0);
+            let den = self.g.mul(two, v);
+            ga.iter().map(|&x| self.g.div(x, den)).collect()
+        });
+        Jet { v, g }
+    }
+
+    fn jheaviside(&mut self, a: &Jet) -> Jet {
+        let v = self.g.heaviside(a.v);
+        Jet { v, g: self.zero_grad() }
+    }
+}
+
+/// Number of scalar components of a shape in dimension d.
+pub fn components(shape: Shape, d: usize) -> usize {
+    match shape {
+        Shape::Scalar => 1,
+        Shape::Vector => d,
+        Shape::Tensor => d * d,
+    }
+}
+
+/// The constant exponent of a `^` expression (checked to be a constant integer).
+fn b_const(e: &Expr) -> Option<f64> {
+    match &e.kind {
+        ExprKind::Binary(BinOp::Pow, _, b) => crate::check::const_value(b),
+        _ => None,
+    }
+}

@@ -1,0 +1,168 @@
+//! Intermediate representation: per space dimension, each form's integrands reduced to the
+//! pointwise coefficients of the test function and of its gradient, and the tangent as the
+//! derivatives of those coefficients with respect to each field's value and gradient.
+//!
+//! For a residual r(u; v) = ∫ f0(u)·v + f1(u):∇v, the kernels need f0 (d values) and f1 (d×d);
+//! the tangent with respect to u needs ∂f0/∂u, ∂f0/∂∇u, ∂f1/∂u, ∂f1/∂∇u. Everything is a
+//! node of one hash-consed graph, so common subexpressions are shared.
+
+pub mod derive;
+pub mod graph;
+pub mod lower;
+pub mod print;
+
+use derive::Derivative;
+use graph::{Graph, Node, NodeId, Sym};
+
+use crate::check::{CELL_REGION, Program};
+
+/// Space dimensions the kernels are generated for.
+pub const DIMS: [usize; 3] = [1, 2, 3];
+
+pub struct DimIr {
+    pub dim: usize,
+    pub graph: Graph,
+    pub forms: Vec<FormIr>,
+}
+
+pub struct FormIr {
+    pub name: String,
+    pub fields: Vec<String>,
+    pub test: String,
+    pub integrals: Vec<IntegralIr>,
+    /// The tangent does not depend on the fields: assemble once.
+    pub linear: bool,
+}
+
+pub struct IntegralIr {
+    pub region: String,
+    /// Integral over cells (`Omega`); otherwise over facets of a boundary region.
+    pub cell: bool,
+    /// Coefficient of v_k: `f0[k]`.
+    pub f0: Vec<NodeId>,
+    /// Coefficient of ∂_l v_k: `f1[k*d + l]`.
+    pub f1: Vec<NodeId>,
+    /// Derivatives with respect to each field argument.
+    pub tangents: Vec<TangentIr>,
+    /// Suggested quadrature degree for P1 and P2 elements (exact on affine cells when the
+    /// integrand is polynomial).
+    pub degree: [u32; 2],
+}
+
+/// Index conventions: k = test component, l = test derivative direction, m = trial component,
+/// n = trial derivative direction.
+pub struct TangentIr {
+    /// ∂f0[k]/∂u_m at `[k*d + m]`.
+    pub c00: Vec<NodeId>,
+    /// ∂f0[k]/∂(∂_n u_m) at `[(k*d + m)*d + n]`.
+    pub c01: Vec<NodeId>,
+    /// ∂f1[k,l]/∂u_m at `[(k*d + l)*d + m]`.
+    pub c10: Vec<NodeId>,
+    /// ∂f1[k,l]/∂(∂_n u_m) at `[((k*d + l)*d + m)*d + n]`.
+    pub c11: Vec<NodeId>,
+}
+
+impl TangentIr {
+    pub fn nodes(&self) -> impl Iterator<Item = NodeId> + '_ {
+        self.c00.iter().chain(&self.c01).chain(&self.c10).chain(&self.c11).copied()
+    }
+}
+
+/// Lowers every form of the program for dimension `d`, with tangents.
+pub fn build(prog: &Program, d: usize) -> DimIr {
+    let mut lowerer = lower::Lowerer::new(prog, d);
+    let lowered: Vec<_> = (0..prog.forms.len()).map(|i| lowerer.form(i)).collect();
+    let mut g = lowerer.g;
+    let mut forms = Vec::new();
+    for lf in lowered {
+        let mut integrals = Vec::new();
+        for integrand in &lf.integrands {
+            let f0: Vec<NodeId> = (0..d).map(|k| Derivative::new(Sym::Test { comp: k as u8 }).of(&mut g, integrand.value)).collect();
+            let f1: Vec<NodeId> = (0..d * d)
+                .map(|kl| Derivative::new(Sym::TestGrad { comp: (kl / d) as u8, dir: (kl % d) as u8 }).of(&mut g, integrand.value))
+                .collect();
+            let tangents = (0..lf.fields.len()).map(|a| tangent(&mut g, d, a as u8, &f0, &f1)).collect::<Vec<_>>();
+            let degree = [1, 2].map(|p| integral_degree(&g, p, &f0, &f1, &tangents));
+            integrals.push(IntegralIr { region: integrand.region.clone(), cell: integrand.region == CELL_REGION, f0, f1, tangents, degree });
+        }
+        let tangent_nodes = integrals.iter().flat_map(|i| i.tangents.iter().flat_map(TangentIr::nodes));
+        let linear = !g.reachable(tangent_nodes).into_iter().any(|n| matches!(g.node(n), Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. })));
+        forms.push(FormIr { name: lf.name, fields: lf.fields, test: lf.test, integrals, linear });
+    }
+    DimIr { dim: d, graph: g, forms }
+}
+
+fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> TangentIr {
+    let val: Vec<Sym> = (0..d).map(|m| Sym::Field { arg, comp: m as u8 }).collect();
+    let grad: Vec<Sym> = (0..d * d).map(|mn| Sym::FieldGrad { arg, comp: (mn / d) as u8, dir: (mn % d) as u8 }).collect();
+    let mut dval: Vec<Derivative> = val.iter().map(|s| Derivative::new(*s)).collect();
+    let mut dgrad: Vec<Derivative> = grad.iter().map(|s| Derivative::new(*s)).collect();
+    let mut c00 = Vec::new();
+    let mut c01 = Vec::new();
+    for &f in f0 {
+        for dv in dval.iter_mut() {
+            c00.push(dv.of(g, f));
+        }
+        for dg in dgrad.iter_mut() {
+            c01.push(dg.of(g, f));
+        }
+    }
+    let mut c10 = Vec::new();
+    let mut c11 = Vec::new();
+    for &f in f1 {
+        for dv in dval.iter_mut() {
+            c10.push(dv.of(g, f));
+        }
+        for dg in dgrad.iter_mut() {
+            c11.push(dg.of(g, f));
+        }
+    }
+    TangentIr { c00, c01, c10, c11 }
+}
+
+/// Polynomial degree estimate of each node for Lagrange elements of degree p on affine cells
+/// (as UFL estimates it): fields p, gradients p − 1, x 1, case data p, non-polynomial
+/// functions add 2.
+pub fn node_degrees(g: &Graph, p: u32, roots: impl IntoIterator<Item = NodeId>) -> std::collections::HashMap<NodeId, u32> {
+    let mut deg = std::collections::HashMap::new();
+    for id in g.reachable(roots) {
+        let dg = |x: NodeId| deg.get(&x).copied().unwrap_or(0);
+        let v = match g.node(id) {
+            Node::Const(_) => 0,
+            Node::Sym(s) => match s {
+                Sym::Field { .. } | Sym::Test { .. } | Sym::Coef { .. } => p,
+                Sym::FieldGrad { .. } | Sym::TestGrad { .. } => p - 1,
+                Sym::Coord(_) => 1,
+                Sym::Param(_) | Sym::Normal(_) | Sym::CellDiameter | Sym::Time => 0,
+            },
+            Node::Add(a, b) => dg(a).max(dg(b)),
+            Node::Mul(a, b) | Node::Div(a, b) => dg(a) + dg(b),
+            Node::Neg(a) => dg(a),
+            Node::Powi(a, k) if k >= 0 => dg(a) * k as u32,
+            Node::Powi(a, _) | Node::Sqrt(a) => dg(a) + 2,
+            Node::Heaviside(_) => 0,
+        };
+        deg.insert(id, v);
+    }
+    deg
+}
+
+fn integral_degree(g: &Graph, p: u32, f0: &[NodeId], f1: &[NodeId], tangents: &[TangentIr]) -> u32 {
+    let roots: Vec<NodeId> = f0.iter().chain(f1).copied().chain(tangents.iter().flat_map(TangentIr::nodes)).collect();
+    let deg = node_degrees(g, p, roots);
+    let d = |n: &NodeId| if g.is_zero(*n) { None } else { Some(deg[n]) };
+    let mut best = 0;
+    let mut take = |n: &NodeId, extra: u32| {
+        if let Some(v) = d(n) {
+            best = best.max(v + extra);
+        }
+    };
+    f0.iter().for_each(|n| take(n, p));
+    f1.iter().for_each(|n| take(n, p - 1));
+    for t in tangents {
+        t.c00.iter().for_each(|n| take(n, 2 * p));
+        t.c01.iter().chain(&t.c10).for_each(|n| take(n, 2 * p - 1));
+        t.c11.iter().for_each(|n| take(n, 2 * p - 2));
+    }
+    best
+}

@@ -1,0 +1,123 @@
+//! Abstract syntax tree of a .wf file. Every node keeps its span.
+
+use crate::source::Span;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ident {
+    pub name: String,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Pow,
+}
+
+impl BinOp {
+    pub fn symbol(self) -> &'static str {
+        match self {
+            BinOp::Add => "+",
+            BinOp::Sub => "-",
+            BinOp::Mul => "*",
+            BinOp::Div => "/",
+            BinOp::Pow => "^",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExprKind {
+    Number(f64),
+    Name(Ident),
+    Call(Ident, Vec<Expr>),
+    Neg(Box<Expr>),
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    pub kind: ExprKind,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    Scalar,
+    Vector,
+    Tensor,
+}
+
+impl Shape {
+    pub fn name(self) -> &'static str {
+        match self {
+            Shape::Scalar => "scalar",
+            Shape::Vector => "vector",
+            Shape::Tensor => "tensor",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Range {
+    pub lo: Expr,
+    pub lo_closed: bool,
+    pub hi: Expr,
+    pub hi_closed: bool,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Integral {
+    /// +1 or -1: the sign written before `int`.
+    pub sign: f64,
+    pub region: Ident,
+    pub integrand: Expr,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Item {
+    Import { path: String, span: Span },
+    Param { name: Ident, default: Expr, range: Option<Range>, span: Span },
+    Coef { name: Ident, shape: Shape, span: Span },
+    Let { name: Ident, value: Expr, span: Span },
+    Fn { name: Ident, params: Vec<Ident>, body: Expr, span: Span },
+    Form { name: Ident, fields: Vec<Ident>, test: Ident, integrals: Vec<Integral>, span: Span },
+}
+
+impl Item {
+    /// The name the item declares, if any.
+    pub fn name(&self) -> Option<&Ident> {
+        match self {
+            Item::Import { .. } => None,
+            Item::Param { name, .. }
+            | Item::Coef { name, .. }
+            | Item::Let { name, .. }
+            | Item::Fn { name, .. }
+            | Item::Form { name, .. } => Some(name),
+        }
+    }
+
+    pub fn span(&self) -> Span {
+        match self {
+            Item::Import { span, .. }
+            | Item::Param { span, .. }
+            | Item::Coef { span, .. }
+            | Item::Let { span, .. }
+            | Item::Fn { span, .. }
+            | Item::Form { span, .. } => *span,
+        }
+    }
+}
+
+/// A parsed file: the items that parsed, and the names of items that did not (so that later
+/// checks do not report them a second time as unknown).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct File {
+    pub items: Vec<Item>,
+    pub broken_names: Vec<String>,
+}

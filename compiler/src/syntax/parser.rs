@@ -1,0 +1,454 @@
+//! Text → AST. The file is split into chunks at item keywords (outside comments and braces) and
+//! each chunk is parsed on its own, so one syntax error does not hide the others.
+
+use pest::Parser as _;
+use pest::iterators::Pair;
+use pest::pratt_parser::{Assoc, Op, PrattParser};
+use std::sync::LazyLock;
+
+use super::ast::*;
+use crate::diagnostic::Diagnostic;
+use crate::source::{FileId, Span};
+
+#[derive(pest_derive::Parser)]
+#[grammar = "syntax/grammar.pest"]
+struct WfParser;
+
+const ITEM_KEYWORDS: &[&str] = &["import", "param", "coef", "let", "fn", "form", "scheme"];
+
+/// Deepest nesting of parentheses accepted; deeper input is refused before parsing, so that
+/// neither the parser nor the recursive checks can exhaust the stack.
+pub const MAX_NESTING: usize = 64;
+/// Most operators accepted in one item, for the same reason (left-deep sums).
+pub const MAX_OPERATORS: usize = 4096;
+
+static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
+    PrattParser::new()
+        .op(Op::infix(Rule::add, Assoc::Left) | Op::infix(Rule::sub, Assoc::Left))
+        .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
+        .op(Op::prefix(Rule::neg))
+        .op(Op::infix(Rule::pow, Assoc::Right))
+});
+
+/// Parses one file. Returns the items that parsed and one diagnostic per broken chunk.
+pub fn parse(file: FileId, text: &str) -> (File, Vec<Diagnostic>) {
+    pest::set_error_detail(true);
+    let mut out = File::default();
+    let mut diags = Vec::new();
+    for (start, end) in chunks(text) {
+        let chunk = &text[start..end];
+        if let Some(d) = nesting_error(file, chunk, start) {
+            diags.push(d);
+            note_broken_name(chunk, &mut out.broken_names);
+            continue;
+        }
+        match WfParser::parse(Rule::chunk, chunk) {
+            Ok(mut pairs) => {
+                let b = Builder { file, offset: start };
+                let chunk_pair = pairs.next().expect("chunk rule always yields one pair");
+                for p in chunk_pair.into_inner() {
+                    if p.as_rule() != Rule::EOI {
+                        match b.item(p) {
+                            Ok(item) => out.items.push(item),
+                            Err(d) => diags.push(d),
+                        }
+                    }
+                }
+            }
+            Err(e) => {
+                diags.push(syntax_error(file, chunk, start, &e));
+                note_broken_name(chunk, &mut out.broken_names);
+            }
+        }
+    }
+    (out, diags)
+}
+
+/// Byte ranges of the chunks: boundaries at item keywords that start a line, outside comments,
+/// strings and braces.
+fn chunks(text: &str) -> Vec<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let mut starts = vec![0];
+    let (mut i, mut depth, mut line_start) = (0, 0i64, true);
+    while i < bytes.len() {
+        let c = bytes[i];
+        if bytes[i..].starts_with(b"//") {
+            while i < bytes.len() && bytes[i] != b'\n' {
+                i += 1;
+            }
+            continue;
+        }
+        if bytes[i..].starts_with(b"/*") {
+            i += 2;
+            while i < bytes.len() && !bytes[i..].starts_with(b"*/") {
+                i += 1;
+            }
+            i = (i + 2).min(bytes.len());
+            line_start = false;
+            continue;
+        }
+        match c {
+            b'\n' => line_start = true,
+            b' ' | b'\t' | b'\r' => {}
+            _ => {
+                if line_start && depth == 0 && i > 0 && starts_item(&text[i..]) {
+                    starts.push(i);
+                }
+                match c {
+                    b'{' => depth += 1,
+                    b'}' => depth -= 1,
+                    _ => {}
+                }
+                line_start = false;
+            }
+        }
+        i += 1;
+    }
+    starts.push(text.len());
+    starts.windows(2).map(|w| (w[0], w[1])).collect()
+}
+
+fn starts_item(rest: &str) -> bool {
+    ITEM_KEYWORDS.iter().any(|k| {
+        rest.starts_with(k) && rest[k.len()..].chars().next().is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_'))
+    })
+}
+
+fn nesting_error(file: FileId, chunk: &str, offset: usize) -> Option<Diagnostic> {
+    let operators = chunk.bytes().filter(|b| b"+-*/^,".contains(b)).count();
+    if operators > MAX_OPERATORS {
+        let span = Span::new(file, offset, offset + chunk.find('\n').unwrap_or(chunk.len()));
+        return Some(
+            Diagnostic::error("E0002", "item too long", span, format!("more than {MAX_OPERATORS} operators in one item"))
+                .with_help("split it into several `let` or `fn` items"),
+        );
+    }
+    let mut depth = 0usize;
+    for (i, c) in chunk.char_indices() {
+        match c {
+            '(' | '[' | '{' => depth += 1,
+            ')' | ']' | '}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        if depth > MAX_NESTING {
+            let span = Span::new(file, offset + i, offset + i + 1);
+            return Some(
+                Diagnostic::error("E0002", "expression nested too deeply", span, format!("more than {MAX_NESTING} levels of brackets"))
+                    .with_help("name intermediate results with `let` or `fn`"),
+            );
+        }
+    }
+    None
+}
+
+/// Remembers the name a broken item would have declared (`param NAME`, `fn NAME`, ...).
+fn note_broken_name(chunk: &str, names: &mut Vec<String>) {
+    let mut words = chunk
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.starts_with("//"))
+        .flat_map(|l| l.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '\'')))
+        .filter(|w| !w.is_empty());
+    if let (Some(_kw), Some(name)) = (words.next(), words.next()) {
+        names.push(name.to_string());
+    }
+}
+
+fn syntax_error(file: FileId, chunk: &str, offset: usize, e: &pest::error::Error<Rule>) -> Diagnostic {
+    let pos = match e.location {
+        pest::error::InputLocation::Pos(p) => p,
+        pest::error::InputLocation::Span((s, _)) => s,
+    };
+    let mut expected: Vec<String> = Vec::new();
+    if let pest::error::ErrorVariant::ParsingError { positives, .. } = &e.variant {
+        for r in positives {
+            if let Some(name) = rule_name(*r) {
+                expected.push(name.to_string());
+            }
+        }
+    }
+    if let Some(attempts) = e.parse_attempts() {
+        for t in attempts.expected_tokens() {
+            let token = t.to_string();
+            let punctuation = token.chars().all(|c| c.is_ascii_punctuation());
+            if punctuation && !matches!(token.as_str(), "//" | "/*" | "*/" | "\"" | "." | "..") {
+                expected.push(format!("`{token}`"));
+            }
+        }
+    }
+    expected.sort();
+    expected.dedup();
+    let found = found_token(&chunk[pos.min(chunk.len())..]);
+    let span_len = if found.is_empty() { 0 } else { found.len() };
+    let span = Span::new(file, offset + pos, offset + pos + span_len);
+    let found_text = if found.is_empty() { "end of input".to_string() } else { format!("`{found}`") };
+    let message = if expected.is_empty() {
+        format!("unexpected {found_text}")
+    } else {
+        format!("expected {}, found {found_text}", join_or(&expected))
+    };
+    let mut d = Diagnostic::error("E0001", "syntax error", span, message);
+    if found == "=" && expected.iter().any(|e| e == "`(`") {
+        d = d.with_help("a function needs its parameters: `fn name(arg) = ...`");
+    } else if found == ":" {
+        d = d.with_help("declare case data with `coef NAME: vector`; parameters are `param NAME = VALUE`");
+    }
+    d
+}
+
+fn join_or(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [a] => a.clone(),
+        [init @ .., last] => format!("{} or {last}", init.join(", ")),
+    }
+}
+
+/// The token at the start of `rest`: an identifier, a number, or one character.
+fn found_token(rest: &str) -> &str {
+    let rest_trim = rest;
+    let mut chars = rest_trim.char_indices();
+    match chars.next() {
+        None => "",
+        Some((_, c)) if c.is_ascii_alphanumeric() || c == '_' || c == '.' => {
+            let end = rest_trim
+                .char_indices()
+                .find(|(_, c)| !(c.is_ascii_alphanumeric() || *c == '_' || *c == '.' || *c == '\''))
+                .map_or(rest_trim.len(), |(i, _)| i);
+            &rest_trim[..end]
+        }
+        Some((_, c)) => &rest_trim[..c.len_utf8()],
+    }
+}
+
+fn rule_name(r: Rule) -> Option<&'static str> {
+    Some(match r {
+        Rule::ident => "a name",
+        Rule::number => "a number",
+        Rule::expr | Rule::call | Rule::neg => "an expression",
+        Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::pow => "an operator",
+        Rule::import | Rule::param | Rule::coef | Rule::let_decl | Rule::fn_decl | Rule::form_decl => {
+            "an item (`import`, `param`, `coef`, `let`, `fn`, `form`)"
+        }
+        Rule::range => "`in RANGE`",
+        Rule::lbound => "`[` or `(`",
+        Rule::rbound => "`]` or `)`",
+        Rule::shape => "`scalar`, `vector` or `tensor`",
+        Rule::string | Rule::module_name => "a module name",
+        Rule::sign => "`+` or `-`",
+        Rule::integral => "`int(REGION)`",
+        Rule::integrals => "an integral `int(REGION) ...`",
+        Rule::form_args | Rule::ident_list => "argument names",
+        Rule::EOI => return None,
+        _ => return None,
+    })
+}
+
+struct Builder {
+    file: FileId,
+    offset: usize,
+}
+
+impl Builder {
+    fn span(&self, p: &Pair<Rule>) -> Span {
+        let s = p.as_span();
+        Span::new(self.file, self.offset + s.start(), self.offset + s.end())
+    }
+
+    fn ident(&self, p: Pair<Rule>) -> Ident {
+        Ident { name: p.as_str().to_string(), span: self.span(&p) }
+    }
+
+    fn item(&self, p: Pair<Rule>) -> Result<Item, Diagnostic> {
+        let span = self.span(&p);
+        let rule = p.as_rule();
+        let mut it = p.into_inner();
+        let mut next = || it.next().expect("grammar guarantees the child");
+        Ok(match rule {
+            Rule::import => {
+                let target = next();
+                let path = match target.as_rule() {
+                    Rule::string => {
+                        let s = target.as_str();
+                        s[1..s.len() - 1].to_string()
+                    }
+                    _ => format!("{}.wf", target.as_str()),
+                };
+                Item::Import { path, span }
+            }
+            Rule::param => {
+                let name = self.ident(next());
+                let default = self.expr(next())?;
+                let mut range = None;
+                for r in it {
+                    range = Some(self.range(r)?);
+                }
+                Item::Param { name, default, range, span }
+            }
+            Rule::coef => {
+                let name = self.ident(next());
+                let shape = match it.next().map(|s| s.as_str().to_string()) {
+                    None => Shape::Scalar,
+                    Some(s) if s == "vector" => Shape::Vector,
+                    Some(s) if s == "tensor" => Shape::Tensor,
+                    Some(_) => Shape::Scalar,
+                };
+                Item::Coef { name, shape, span }
+            }
+            Rule::let_decl => {
+                let name = self.ident(next());
+                let value = self.expr(next())?;
+                Item::Let { name, value, span }
+            }
+            Rule::fn_decl => {
+                let name = self.ident(next());
+                let mut params = Vec::new();
+                let mut body = None;
+                for q in it {
+                    match q.as_rule() {
+                        Rule::ident_list => params = q.into_inner().map(|i| self.ident(i)).collect(),
+                        _ => body = Some(self.expr(q)?),
+                    }
+                }
+                Item::Fn { name, params, body: body.expect("fn has a body"), span }
+            }
+            Rule::form_decl => {
+                let name = self.ident(next());
+                let args = next();
+                let mut fields = Vec::new();
+                let mut test = None;
+                for a in args.into_inner() {
+                    match a.as_rule() {
+                        Rule::ident_list => fields = a.into_inner().map(|i| self.ident(i)).collect(),
+                        _ => test = Some(self.ident(a)),
+                    }
+                }
+                let integrals = self.integrals(next())?;
+                Item::Form { name, fields, test: test.expect("form has a test function"), integrals, span }
+            }
+            r => unreachable!("not an item: {r:?}"),
+        })
+    }
+
+    fn range(&self, p: Pair<Rule>) -> Result<Range, Diagnostic> {
+        let span = self.span(&p);
+        let mut it = p.into_inner();
+        let lo_closed = it.next().map(|b| b.as_str() == "[").unwrap_or(true);
+        let lo = self.expr(it.next().expect("range lower bound"))?;
+        let hi = self.expr(it.next().expect("range upper bound"))?;
+        let hi_closed = it.next().map(|b| b.as_str() == "]").unwrap_or(true);
+        Ok(Range { lo, lo_closed, hi, hi_closed, span })
+    }
+
+    fn integrals(&self, p: Pair<Rule>) -> Result<Vec<Integral>, Diagnostic> {
+        let mut out = Vec::new();
+        let mut sign = 1.0;
+        let mut sign_span: Option<Span> = None;
+        for q in p.into_inner() {
+            match q.as_rule() {
+                Rule::sign => {
+                    sign = if q.as_str() == "-" { -1.0 } else { 1.0 };
+                    sign_span = Some(self.span(&q));
+                }
+                _ => {
+                    let mut span = self.span(&q);
+                    if let Some(s) = sign_span.take() {
+                        span = s.to(span);
+                    }
+                    let mut it = q.into_inner();
+                    let region = self.ident(it.next().expect("integral region"));
+                    let integrand = self.expr(it.next().expect("integrand"))?;
+                    out.push(Integral { sign, region, integrand, span });
+                    sign = 1.0;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    fn expr(&self, p: Pair<Rule>) -> Result<Expr, Diagnostic> {
+        PRATT
+            .map_primary(|q| self.primary(q))
+            .map_prefix(|op, rhs| {
+                let rhs = rhs?;
+                let span = self.span(&op).to(rhs.span);
+                Ok(Expr { kind: ExprKind::Neg(Box::new(rhs)), span })
+            })
+            .map_infix(|lhs, op, rhs| {
+                let (lhs, rhs) = (lhs?, rhs?);
+                let op = match op.as_rule() {
+                    Rule::add => BinOp::Add,
+                    Rule::sub => BinOp::Sub,
+                    Rule::mul => BinOp::Mul,
+                    Rule::div => BinOp::Div,
+                    _ => BinOp::Pow,
+                };
+                let span = lhs.span.to(rhs.span);
+                Ok(Expr { kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)), span })
+            })
+            .parse(p.into_inner())
+    }
+
+    fn primary(&self, p: Pair<Rule>) -> Result<Expr, Diagnostic> {
+        let span = self.span(&p);
+        Ok(match p.as_rule() {
+            Rule::number => match p.as_str().parse::<f64>() {
+                Ok(v) if v.is_finite() => Expr { kind: ExprKind::Number(v), span },
+                _ => {
+                    return Err(Diagnostic::error("E0003", "number out of range", span, "not a finite double-precision number"));
+                }
+            },
+            Rule::ident => Expr { kind: ExprKind::Name(self.ident(p)), span },
+            Rule::call => {
+                let mut it = p.into_inner();
+                let name = self.ident(it.next().expect("callee"));
+                let args = it.map(|a| self.expr(a)).collect::<Result<Vec<_>, _>>()?;
+                Expr { kind: ExprKind::Call(name, args), span }
+            }
+            Rule::expr => {
+                // Parenthesised: keep the span of the parentheses' content.
+                self.expr(p)?
+            }
+            r => unreachable!("not a primary: {r:?}"),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunks_split_at_item_keywords_only() {
+        let text = "param a = 1\n// let b = 2\nlet c = a\n  + 1\nfn f(x) = x\n";
+        let c = chunks(text);
+        assert_eq!(c.len(), 3);
+        assert!(text[c[1].0..c[1].1].starts_with("let c"));
+    }
+
+    #[test]
+    fn precedence_of_power_and_unary_minus() {
+        let (f, d) = parse(0, "let a = -x^2 + 3*y/2");
+        assert!(d.is_empty(), "{d:?}");
+        let Item::Let { value, .. } = &f.items[0] else { panic!() };
+        let ExprKind::Binary(BinOp::Add, lhs, _) = &value.kind else { panic!("{value:?}") };
+        assert!(matches!(lhs.kind, ExprKind::Neg(_)));
+    }
+
+    #[test]
+    fn integrand_stops_before_next_integral() {
+        let (f, d) = parse(0, "form a(u; v) = int(Omega) dot(u, v) + 1 - int(G) dot(u,v)");
+        assert!(d.is_empty(), "{d:?}");
+        let Item::Form { integrals, .. } = &f.items[0] else { panic!() };
+        assert_eq!(integrals.len(), 2);
+        assert_eq!(integrals[1].sign, -1.0);
+    }
+
+    #[test]
+    fn errors_in_two_items_are_both_reported() {
+        let (f, d) = parse(0, "param a = \nlet b = 1\nfn g(x = x\n");
+        assert_eq!(d.len(), 2);
+        assert_eq!(f.items.len(), 1);
+        assert_eq!(f.broken_names, vec!["a".to_string(), "g".to_string()]);
+    }
+}
