@@ -1,1 +1,13 @@
+//! signorini: dynamic contact mechanics from weak forms.
+//!
+//! `signorini::forms!("forms/contact_nitsche.wf")` compiles a `.wf` file at build time into a
+//! module of kernels (see `signorini-compiler`); the kernels run on `signorini::runtime`.
+
+// Generated code names the runtime `::signorini::runtime`, also inside this crate.
+extern crate self as signorini;
+
+pub use signorini_compiler as compiler;
 pub use signorini_macros::forms;
+pub use signorini_runtime as runtime;
+
+pub mod cli;

@@ -1,1 +1,5 @@
-fn main() {}
+use clap::Parser;
+
+fn main() -> std::process::ExitCode {
+    signorini::cli::run(signorini::cli::Cli::parse())
+}

@@ -30,24 +30,43 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
-    pub fn error(code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
+    pub fn error(
+        code: &'static str,
+        message: impl Into<String>,
+        span: Span,
+        label: impl Into<String>,
+    ) -> Self {
         Diagnostic {
             severity: Severity::Error,
             code,
             message: message.into(),
-            primary: Label { span, message: label.into() },
+            primary: Label {
+                span,
+                message: label.into(),
+            },
             secondary: Vec::new(),
             notes: Vec::new(),
             help: None,
         }
     }
 
-    pub fn warning(code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
-        Diagnostic { severity: Severity::Warning, ..Diagnostic::error(code, message, span, label) }
+    pub fn warning(
+        code: &'static str,
+        message: impl Into<String>,
+        span: Span,
+        label: impl Into<String>,
+    ) -> Self {
+        Diagnostic {
+            severity: Severity::Warning,
+            ..Diagnostic::error(code, message, span, label)
+        }
     }
 
     pub fn with_label(mut self, span: Span, message: impl Into<String>) -> Self {
-        self.secondary.push(Label { span, message: message.into() });
+        self.secondary.push(Label {
+            span,
+            message: message.into(),
+        });
         self
     }
 
@@ -73,11 +92,17 @@ impl Diagnostic {
             Severity::Warning => cs::Severity::Warning,
         };
         let mut labels = vec![
-            cs::Label::primary(self.primary.span.file, self.primary.span.start..self.primary.span.end)
-                .with_message(&self.primary.message),
+            cs::Label::primary(
+                self.primary.span.file,
+                self.primary.span.start..self.primary.span.end,
+            )
+            .with_message(&self.primary.message),
         ];
         for l in &self.secondary {
-            labels.push(cs::Label::secondary(l.span.file, l.span.start..l.span.end).with_message(&l.message));
+            labels.push(
+                cs::Label::secondary(l.span.file, l.span.start..l.span.end)
+                    .with_message(&l.message),
+            );
         }
         let mut notes = self.notes.clone();
         if let Some(help) = &self.help {
@@ -89,8 +114,14 @@ impl Diagnostic {
             .with_labels(labels)
             .with_notes(notes);
         let config = term::Config::default();
-        term::emit_into_string(&config, &sources.files, &diag)
-            .unwrap_or_else(|e| format!("{}[{}]: {} (could not render source: {e})\n", severity_word(self.severity), self.code, self.message))
+        term::emit_into_string(&config, &sources.files, &diag).unwrap_or_else(|e| {
+            format!(
+                "{}[{}]: {} (could not render source: {e})\n",
+                severity_word(self.severity),
+                self.code,
+                self.message
+            )
+        })
     }
 }
 
@@ -119,7 +150,20 @@ pub fn render_all(diags: &[Diagnostic], sources: &SourceMap) -> String {
 /// reports its mistake once).
 pub fn normalize(diags: &mut Vec<Diagnostic>) {
     diags.sort_by(|a, b| {
-        (a.primary.span.file, a.primary.span.start, a.severity, a.code).cmp(&(b.primary.span.file, b.primary.span.start, b.severity, b.code))
+        (
+            a.primary.span.file,
+            a.primary.span.start,
+            a.severity,
+            a.code,
+        )
+            .cmp(&(
+                b.primary.span.file,
+                b.primary.span.start,
+                b.severity,
+                b.code,
+            ))
     });
-    diags.dedup_by(|a, b| a.code == b.code && a.primary.span == b.primary.span && a.message == b.message);
+    diags.dedup_by(|a, b| {
+        a.code == b.code && a.primary.span == b.primary.span && a.message == b.message
+    });
 }

@@ -1,1 +1,7 @@
-pub fn placeholder() {}
+//! The signorini runtime: element catalogue, quadrature, the interface compiled kernels
+//! implement, and (later) meshes, assembly, solvers and time loops.
+
+pub mod element;
+pub mod geometry;
+pub mod kernel;
+pub mod quadrature;

@@ -1,3 +1,101 @@
+//! `forms!("path/to/file.wf")`: compiles a .wf file (and its imports) at build time into a
+//! module of kernels named after the file stem; `forms!(pub mod name = "path")` names it.
+//! Paths are relative to the using crate's manifest directory. Errors become
+//! `compile_error!` with the rendered diagnostics; editing any of the files triggers a
+//! rebuild. The macro never panics: a compiler bug is reported as an error too.
+
+use std::path::{Path, PathBuf};
+
 use proc_macro::TokenStream;
+use proc_macro2::Span;
+use quote::quote;
+use syn::parse::{Parse, ParseStream};
+use syn::{Ident, LitStr, Token, Visibility};
+
+use signorini_compiler::{FsLoader, check_path, codegen};
+
+struct Input {
+    vis: Visibility,
+    name: Option<Ident>,
+    path: LitStr,
+}
+
+impl Parse for Input {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        if input.peek(LitStr) {
+            return Ok(Input {
+                vis: Visibility::Inherited,
+                name: None,
+                path: input.parse()?,
+            });
+        }
+        let vis: Visibility = input.parse()?;
+        input.parse::<Token![mod]>()?;
+        let name: Ident = input.parse()?;
+        input.parse::<Token![=]>()?;
+        let path = input.parse()?;
+        Ok(Input {
+            vis,
+            name: Some(name),
+            path,
+        })
+    }
+}
+
 #[proc_macro]
-pub fn forms(_input: TokenStream) -> TokenStream { TokenStream::new() }
+pub fn forms(input: TokenStream) -> TokenStream {
+    let input = match syn::parse::<Input>(input) {
+        Ok(i) => i,
+        Err(e) => return e.to_compile_error().into(),
+    };
+    let span = input.path.span();
+    let result = std::panic::catch_unwind(|| expand(&input));
+    match result {
+        Ok(Ok(tokens)) => tokens.into(),
+        Ok(Err(msg)) => error(span, &msg),
+        Err(_) => error(
+            span,
+            "internal error in the signorini compiler (please report it with the .wf file)",
+        ),
+    }
+}
+
+fn error(span: Span, msg: &str) -> TokenStream {
+    let msg = format!("signorini: the forms did not compile\n\n{msg}");
+    quote::quote_spanned!(span=> compile_error!(#msg);).into()
+}
+
+fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
+    let manifest = std::env::var("CARGO_MANIFEST_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_default();
+    let rel = input.path.value();
+    let path = manifest.join(&rel);
+    let (prog, _warnings) = check_path(&path, &FsLoader).map_err(|f| f.rendered)?;
+    let module = match &input.name {
+        Some(n) => n.to_string(),
+        None => signorini_compiler::module_name(Path::new(&rel)),
+    };
+    let opts = codegen::Options {
+        runtime: codegen::DEFAULT_RUNTIME.to_string(),
+        module,
+        source_name: rel.clone(),
+    };
+    let mut file = codegen::generate(&prog, &opts)?;
+    if let Some(syn::Item::Mod(m)) = file.items.first_mut() {
+        if input.name.is_some() {
+            m.vis = input.vis.clone();
+        }
+        // Rebuild when any file of the unit changes.
+        let deps: Vec<String> = (0..prog.sources.len())
+            .map(|f| prog.sources.path(f).display().to_string())
+            .collect();
+        let track: syn::Item = syn::parse_quote! {
+            const _: &[&[u8]] = &[#(include_bytes!(#deps)),*];
+        };
+        if let Some((_, items)) = &mut m.content {
+            items.push(track);
+        }
+    }
+    Ok(quote!(#file))
+}

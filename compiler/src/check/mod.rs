@@ -57,8 +57,16 @@ pub struct ParamRange {
 
 impl ParamRange {
     pub fn contains(&self, v: f64) -> bool {
-        let above = if self.lo_closed { v >= self.lo } else { v > self.lo };
-        let below = if self.hi_closed { v <= self.hi } else { v < self.hi };
+        let above = if self.lo_closed {
+            v >= self.lo
+        } else {
+            v > self.lo
+        };
+        let below = if self.hi_closed {
+            v <= self.hi
+        } else {
+            v < self.hi
+        };
         above && below
     }
 
@@ -104,8 +112,15 @@ pub struct Form {
 pub enum Global {
     Param(usize),
     Coef(usize),
-    Let { value: Expr, span: Span },
-    Fn { params: Vec<Ident>, body: Expr, span: Span },
+    Let {
+        value: Expr,
+        span: Span,
+    },
+    Fn {
+        params: Vec<Ident>,
+        body: Expr,
+        span: Span,
+    },
     Form(usize),
 }
 
@@ -152,7 +167,11 @@ pub fn check_text(path: &Path, text: &str, loader: &dyn Loader) -> Checked {
 }
 
 fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
-    let load::Loaded { sources, files, root } = loaded;
+    let load::Loaded {
+        sources,
+        files,
+        root,
+    } = loaded;
     let mut prog = Program {
         sources,
         root,
@@ -162,7 +181,10 @@ fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
         globals: HashMap::new(),
         warnings: Vec::new(),
     };
-    let broken: HashSet<String> = files.iter().flat_map(|(_, f)| f.broken_names.iter().cloned()).collect();
+    let broken: HashSet<String> = files
+        .iter()
+        .flat_map(|(_, f)| f.broken_names.iter().cloned())
+        .collect();
     declare(&mut prog, &files, &mut diags);
     let used = {
         let mut c = types::Checker::new(&prog, &broken);
@@ -180,8 +202,13 @@ fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
     for (i, p) in prog.params.iter().enumerate() {
         if p.span.file == prog.root && !used.contains(&i) {
             diags.push(
-                Diagnostic::warning("W0001", format!("unused param `{}`", p.name), p.span, "no form uses this parameter")
-                    .with_help("remove it, or use it in a form"),
+                Diagnostic::warning(
+                    "W0001",
+                    format!("unused param `{}`", p.name),
+                    p.span,
+                    "no form uses this parameter",
+                )
+                .with_help("remove it, or use it in a form"),
             );
         }
     }
@@ -200,23 +227,43 @@ fn declare(prog: &mut Program, files: &[(FileId, ast::File)], diags: &mut Vec<Di
     for (_, file) in files {
         for item in &file.items {
             let Some(name) = item.name() else { continue };
-            if BUILTIN_VALUES.iter().chain(BUILTIN_FUNCTIONS).any(|b| *b == name.name) || name.name == CELL_REGION {
+            if BUILTIN_VALUES
+                .iter()
+                .chain(BUILTIN_FUNCTIONS)
+                .any(|b| *b == name.name)
+                || name.name == CELL_REGION
+            {
                 diags.push(
-                    Diagnostic::error("E0106", format!("`{}` is a built-in name", name.name), name.span, "cannot be redefined")
-                        .with_help("choose another name"),
+                    Diagnostic::error(
+                        "E0106",
+                        format!("`{}` is a built-in name", name.name),
+                        name.span,
+                        "cannot be redefined",
+                    )
+                    .with_help("choose another name"),
                 );
                 continue;
             }
             if let Some(prev) = first.get(&name.name) {
                 diags.push(
-                    Diagnostic::error("E0102", format!("`{}` is defined twice", name.name), name.span, "defined again here")
-                        .with_label(*prev, "first defined here"),
+                    Diagnostic::error(
+                        "E0102",
+                        format!("`{}` is defined twice", name.name),
+                        name.span,
+                        "defined again here",
+                    )
+                    .with_label(*prev, "first defined here"),
                 );
                 continue;
             }
             first.insert(name.name.clone(), name.span);
             let global = match item {
-                ast::Item::Param { name, default, range, span } => {
+                ast::Item::Param {
+                    name,
+                    default,
+                    range,
+                    span,
+                } => {
                     prog.params.push(Param {
                         name: name.name.clone(),
                         default: f64::NAN,
@@ -228,15 +275,34 @@ fn declare(prog: &mut Program, files: &[(FileId, ast::File)], diags: &mut Vec<Di
                     Global::Param(prog.params.len() - 1)
                 }
                 ast::Item::Coef { name, shape, span } => {
-                    prog.coefs.push(Coef { name: name.name.clone(), shape: *shape, span: *span });
+                    prog.coefs.push(Coef {
+                        name: name.name.clone(),
+                        shape: *shape,
+                        span: *span,
+                    });
                     Global::Coef(prog.coefs.len() - 1)
                 }
-                ast::Item::Let { value, span, .. } => Global::Let { value: value.clone(), span: *span },
-                ast::Item::Fn { params, body, span, .. } => {
+                ast::Item::Let { value, span, .. } => Global::Let {
+                    value: value.clone(),
+                    span: *span,
+                },
+                ast::Item::Fn {
+                    params, body, span, ..
+                } => {
                     check_distinct(params, "parameter", diags);
-                    Global::Fn { params: params.clone(), body: body.clone(), span: *span }
+                    Global::Fn {
+                        params: params.clone(),
+                        body: body.clone(),
+                        span: *span,
+                    }
                 }
-                ast::Item::Form { name, fields, test, integrals, span } => {
+                ast::Item::Form {
+                    name,
+                    fields,
+                    test,
+                    integrals,
+                    span,
+                } => {
                     let mut args = fields.clone();
                     args.push(test.clone());
                     check_distinct(&args, "argument", diags);
@@ -261,15 +327,26 @@ fn check_distinct(names: &[Ident], what: &str, diags: &mut Vec<Diagnostic>) {
     for n in names {
         if let Some(prev) = seen.get(n.name.as_str()) {
             diags.push(
-                Diagnostic::error("E0103", format!("duplicate {what} `{}`", n.name), n.span, "repeated here").with_label(*prev, "first here"),
+                Diagnostic::error(
+                    "E0103",
+                    format!("duplicate {what} `{}`", n.name),
+                    n.span,
+                    "repeated here",
+                )
+                .with_label(*prev, "first here"),
             );
         } else {
             seen.insert(&n.name, n.span);
         }
         if BUILTIN_VALUES.contains(&n.name.as_str()) {
             diags.push(
-                Diagnostic::error("E0106", format!("`{}` is a built-in name", n.name), n.span, "cannot be used as a name here")
-                    .with_help("choose another name"),
+                Diagnostic::error(
+                    "E0106",
+                    format!("`{}` is a built-in name", n.name),
+                    n.span,
+                    "cannot be used as a name here",
+                )
+                .with_help("choose another name"),
             );
         }
     }

@@ -25,15 +25,30 @@ pub struct Ty {
 
 impl Ty {
     fn plain(shape: Shape) -> Ty {
-        Ty { shape, test: false, facet: None, smooth: true, konst: None }
+        Ty {
+            shape,
+            test: false,
+            facet: None,
+            smooth: true,
+            konst: None,
+        }
     }
 
     fn constant(v: f64) -> Ty {
-        Ty { konst: Some(v), ..Ty::plain(Shape::Scalar) }
+        Ty {
+            konst: Some(v),
+            ..Ty::plain(Shape::Scalar)
+        }
     }
 
     fn join(a: &Ty, b: &Ty, shape: Shape) -> Ty {
-        Ty { shape, test: a.test || b.test, facet: a.facet.or(b.facet), smooth: a.smooth && b.smooth, konst: None }
+        Ty {
+            shape,
+            test: a.test || b.test,
+            facet: a.facet.or(b.facet),
+            smooth: a.smooth && b.smooth,
+            konst: None,
+        }
     }
 }
 
@@ -82,19 +97,36 @@ impl<'p> Checker<'p> {
         let mut values = Vec::with_capacity(n);
         for i in 0..n {
             let p = &self.prog.params[i];
-            let default = self.constant(&p.default_expr, "a param default").filter(|v| {
-                let finite = v.is_finite();
-                if !finite {
-                    self.error(Diagnostic::error("E0603", "a param default must be finite", p.default_expr.span, format!("evaluates to {v}")));
-                }
-                finite
-            });
+            let default = self
+                .constant(&p.default_expr, "a param default")
+                .filter(|v| {
+                    let finite = v.is_finite();
+                    if !finite {
+                        self.error(Diagnostic::error(
+                            "E0603",
+                            "a param default must be finite",
+                            p.default_expr.span,
+                            format!("evaluates to {v}"),
+                        ));
+                    }
+                    finite
+                });
             let range = p.range_expr.as_ref().and_then(|r| {
                 let lo = self.constant(&r.lo, "a range bound")?;
                 let hi = self.constant(&r.hi, "a range bound")?;
-                let range = ParamRange { lo, lo_closed: r.lo_closed, hi, hi_closed: r.hi_closed };
+                let range = ParamRange {
+                    lo,
+                    lo_closed: r.lo_closed,
+                    hi,
+                    hi_closed: r.hi_closed,
+                };
                 if lo > hi || (lo == hi && !(r.lo_closed && r.hi_closed)) {
-                    self.error(Diagnostic::error("E0602", "empty parameter range", r.span, format!("no value lies in {}", range.describe())));
+                    self.error(Diagnostic::error(
+                        "E0602",
+                        "empty parameter range",
+                        r.span,
+                        format!("no value lies in {}", range.describe()),
+                    ));
                     return None;
                 }
                 Some(range)
@@ -103,8 +135,16 @@ impl<'p> Checker<'p> {
                 if !r.contains(v) {
                     let name = &self.prog.params[i].name;
                     self.error(
-                        Diagnostic::error("E0601", format!("default of `{name}` is outside its range"), p.default_expr.span, format!("{v} is not in {}", r.describe()))
-                            .with_label(p.range_expr.as_ref().map_or(p.span, |r| r.span), "the declared range"),
+                        Diagnostic::error(
+                            "E0601",
+                            format!("default of `{name}` is outside its range"),
+                            p.default_expr.span,
+                            format!("{v} is not in {}", r.describe()),
+                        )
+                        .with_label(
+                            p.range_expr.as_ref().map_or(p.span, |r| r.span),
+                            "the declared range",
+                        ),
                     );
                 }
             }
@@ -119,8 +159,13 @@ impl<'p> Checker<'p> {
             Ok(v) => Some(v),
             Err(span) => {
                 self.error(
-                    Diagnostic::error("E0603", format!("{what} must be a constant"), span, "not a constant")
-                        .with_help("use numbers, arithmetic, sqrt, pi and inf"),
+                    Diagnostic::error(
+                        "E0603",
+                        format!("{what} must be a constant"),
+                        span,
+                        "not a constant",
+                    )
+                    .with_help("use numbers, arithmetic, sqrt, pi and inf"),
                 );
                 None
             }
@@ -141,7 +186,10 @@ impl<'p> Checker<'p> {
                 }
                 Global::Fn { params, body, .. } => {
                     let saved = std::mem::take(&mut self.used_params);
-                    let scope = params.iter().map(|p| (p.name.clone(), Ty::plain(Shape::Vector))).collect();
+                    let scope = params
+                        .iter()
+                        .map(|p| (p.name.clone(), Ty::plain(Shape::Vector)))
+                        .collect();
                     let old = std::mem::replace(&mut self.scope, scope);
                     // Shapes of parameters are unknown here: check names only.
                     self.names_only(body, params);
@@ -158,12 +206,17 @@ impl<'p> Checker<'p> {
         match &e.kind {
             ExprKind::Number(_) => {}
             ExprKind::Name(id) => {
-                if !params.iter().any(|p| p.name == id.name) && !self.prog.globals.contains_key(&id.name) && !BUILTIN_VALUES.contains(&id.name.as_str()) {
+                if !params.iter().any(|p| p.name == id.name)
+                    && !self.prog.globals.contains_key(&id.name)
+                    && !BUILTIN_VALUES.contains(&id.name.as_str())
+                {
                     self.unknown(id);
                 }
             }
             ExprKind::Call(f, args) => {
-                if !self.prog.globals.contains_key(&f.name) && !BUILTIN_FUNCTIONS.contains(&f.name.as_str()) {
+                if !self.prog.globals.contains_key(&f.name)
+                    && !BUILTIN_FUNCTIONS.contains(&f.name.as_str())
+                {
                     self.unknown(f);
                 }
                 for a in args {
@@ -180,16 +233,35 @@ impl<'p> Checker<'p> {
 
     pub fn check_forms(&mut self) {
         for form in &self.prog.forms {
-            let mut scope: Vec<(String, Ty)> = form.fields.iter().map(|f| (f.name.clone(), Ty::plain(Shape::Vector))).collect();
-            scope.push((form.test.name.clone(), Ty { test: true, ..Ty::plain(Shape::Vector) }));
+            let mut scope: Vec<(String, Ty)> = form
+                .fields
+                .iter()
+                .map(|f| (f.name.clone(), Ty::plain(Shape::Vector)))
+                .collect();
+            scope.push((
+                form.test.name.clone(),
+                Ty {
+                    test: true,
+                    ..Ty::plain(Shape::Vector)
+                },
+            ));
             self.scope = scope;
             for integral in &form.integrals {
-                let Some(ty) = self.ty(&integral.integrand) else { continue };
+                let Some(ty) = self.ty(&integral.integrand) else {
+                    continue;
+                };
                 let span = integral.integrand.span;
                 if ty.shape != Shape::Scalar {
                     self.error(
-                        Diagnostic::error("E0304", "integrand is not a scalar", span, format!("this is a {}", ty.shape.name()))
-                            .with_help("take dot(..., v) or inner(..., grad(v)) with the test function"),
+                        Diagnostic::error(
+                            "E0304",
+                            "integrand is not a scalar",
+                            span,
+                            format!("this is a {}", ty.shape.name()),
+                        )
+                        .with_help(
+                            "take dot(..., v) or inner(..., grad(v)) with the test function",
+                        ),
                     );
                 } else if !ty.test {
                     self.error(
@@ -225,7 +297,12 @@ impl<'p> Checker<'p> {
             .chain(BUILTIN_VALUES.iter().copied())
             .chain(BUILTIN_FUNCTIONS.iter().copied())
             .chain(scope_names.iter().map(String::as_str));
-        let mut d = Diagnostic::error("E0101", format!("unknown name `{}`", id.name), id.span, "not defined");
+        let mut d = Diagnostic::error(
+            "E0101",
+            format!("unknown name `{}`", id.name),
+            id.span,
+            "not defined",
+        );
         if let Some(s) = suggest(&id.name, candidates) {
             d = d.with_help(format!("did you mean `{s}`?"));
         }
@@ -239,16 +316,25 @@ impl<'p> Checker<'p> {
                 return *ty;
             }
             Some(LetState::InProgress) => {
-                let Some(Global::Let { span, .. }) = self.prog.globals.get(name) else { return None };
+                let Some(Global::Let { span, .. }) = self.prog.globals.get(name) else {
+                    return None;
+                };
                 self.error(
-                    Diagnostic::error("E0104", format!("`{name}` is defined in terms of itself"), use_span, "used here")
-                        .with_label(*span, "in this definition"),
+                    Diagnostic::error(
+                        "E0104",
+                        format!("`{name}` is defined in terms of itself"),
+                        use_span,
+                        "used here",
+                    )
+                    .with_label(*span, "in this definition"),
                 );
                 return None;
             }
             None => {}
         }
-        let Some(Global::Let { value, .. }) = self.prog.globals.get(name) else { return None };
+        let Some(Global::Let { value, .. }) = self.prog.globals.get(name) else {
+            return None;
+        };
         self.lets.insert(name.to_string(), LetState::InProgress);
         let saved_scope = std::mem::take(&mut self.scope);
         let saved_used = std::mem::take(&mut self.used_params);
@@ -268,7 +354,10 @@ impl<'p> Checker<'p> {
             ExprKind::Name(id) => self.name_ty(id),
             ExprKind::Neg(a) => {
                 let a = self.ty(a)?;
-                Some(Ty { konst: a.konst.map(|v| -v), ..a })
+                Some(Ty {
+                    konst: a.konst.map(|v| -v),
+                    ..a
+                })
             }
             ExprKind::Binary(op, a, b) => {
                 let (ta, tb) = (self.ty(a), self.ty(b));
@@ -287,13 +376,21 @@ impl<'p> Checker<'p> {
                 self.used_params.insert(*i);
                 Some(Ty::plain(Shape::Scalar))
             }
-            Some(Global::Coef(i)) => Some(Ty { smooth: false, ..Ty::plain(self.prog.coefs[*i].shape) }),
+            Some(Global::Coef(i)) => Some(Ty {
+                smooth: false,
+                ..Ty::plain(self.prog.coefs[*i].shape)
+            }),
             Some(Global::Let { .. }) => self.let_ty(&id.name, id.span),
             Some(g @ (Global::Fn { .. } | Global::Form(_))) => {
                 let kind = g.kind();
                 self.error(
-                    Diagnostic::error("E0205", format!("`{}` is a {kind}, not a value", id.name), id.span, "used as a value")
-                        .with_help(format!("call it: `{}(...)`", id.name)),
+                    Diagnostic::error(
+                        "E0205",
+                        format!("`{}` is a {kind}, not a value", id.name),
+                        id.span,
+                        "used as a value",
+                    )
+                    .with_help(format!("call it: `{}(...)`", id.name)),
                 );
                 None
             }
@@ -302,16 +399,33 @@ impl<'p> Checker<'p> {
                 "x" => Some(Ty::plain(Shape::Vector)),
                 "t" => Some(Ty::plain(Shape::Scalar)),
                 "pi" => Some(Ty::constant(std::f64::consts::PI)),
-                "n" => Some(Ty { facet: Some(id.span), smooth: false, ..Ty::plain(Shape::Vector) }),
-                "h" => Some(Ty { facet: Some(id.span), ..Ty::plain(Shape::Scalar) }),
+                "n" => Some(Ty {
+                    facet: Some(id.span),
+                    smooth: false,
+                    ..Ty::plain(Shape::Vector)
+                }),
+                "h" => Some(Ty {
+                    facet: Some(id.span),
+                    ..Ty::plain(Shape::Scalar)
+                }),
                 "inf" => {
-                    self.error(Diagnostic::error("E0206", "`inf` is only allowed in parameter ranges", id.span, "not a finite value"));
+                    self.error(Diagnostic::error(
+                        "E0206",
+                        "`inf` is only allowed in parameter ranges",
+                        id.span,
+                        "not a finite value",
+                    ));
                     None
                 }
                 _ if BUILTIN_FUNCTIONS.contains(&id.name.as_str()) => {
                     self.error(
-                        Diagnostic::error("E0205", format!("`{}` is a function, not a value", id.name), id.span, "used as a value")
-                            .with_help(format!("call it: `{}(...)`", id.name)),
+                        Diagnostic::error(
+                            "E0205",
+                            format!("`{}` is a function, not a value", id.name),
+                            id.span,
+                            "used as a value",
+                        )
+                        .with_help(format!("call it: `{}(...)`", id.name)),
                     );
                     None
                 }
@@ -338,7 +452,16 @@ impl<'p> Checker<'p> {
         match op {
             BinOp::Add | BinOp::Sub => {
                 if ta.shape != tb.shape {
-                    return mismatch(self, format!("cannot {} a {} and a {}", if op == BinOp::Add { "add" } else { "subtract" }, ta.shape.name(), tb.shape.name()), None);
+                    return mismatch(
+                        self,
+                        format!(
+                            "cannot {} a {} and a {}",
+                            if op == BinOp::Add { "add" } else { "subtract" },
+                            ta.shape.name(),
+                            tb.shape.name()
+                        ),
+                        None,
+                    );
                 }
                 if ta.test != tb.test {
                     let (without, with) = if ta.test { (b, a) } else { (a, b) };
@@ -353,75 +476,128 @@ impl<'p> Checker<'p> {
                     (Some(x), Some(y)) => Some(if op == BinOp::Add { x + y } else { x - y }),
                     _ => None,
                 };
-                Some(Ty { konst, ..Ty::join(&ta, &tb, ta.shape) })
+                Some(Ty {
+                    konst,
+                    ..Ty::join(&ta, &tb, ta.shape)
+                })
             }
             BinOp::Mul => {
                 let shape = match (ta.shape, tb.shape) {
                     (Scalar, s) | (s, Scalar) => s,
                     (Tensor, Vector) | (Vector, Tensor) => Vector,
                     (Tensor, Tensor) => Tensor,
-                    (Vector, Vector) => return mismatch(self, "cannot multiply two vectors".into(), Some("use dot(a, b) for the scalar product, or outer(a, b)")),
+                    (Vector, Vector) => {
+                        return mismatch(
+                            self,
+                            "cannot multiply two vectors".into(),
+                            Some("use dot(a, b) for the scalar product, or outer(a, b)"),
+                        );
+                    }
                 };
                 if ta.test && tb.test {
                     self.self_product(e.span, a.span, b.span);
                     return None;
                 }
                 let konst = ta.konst.zip(tb.konst).map(|(x, y)| x * y);
-                Some(Ty { konst, ..Ty::join(&ta, &tb, shape) })
+                Some(Ty {
+                    konst,
+                    ..Ty::join(&ta, &tb, shape)
+                })
             }
             BinOp::Div => {
                 if tb.shape != Scalar {
-                    return mismatch(self, format!("cannot divide by a {}", tb.shape.name()), None);
+                    return mismatch(
+                        self,
+                        format!("cannot divide by a {}", tb.shape.name()),
+                        None,
+                    );
                 }
                 if tb.test {
                     self.error(
-                        Diagnostic::error("E0403", "test function in a denominator", b.span, "depends on the test function")
-                            .with_note("a form must be linear in its test function"),
+                        Diagnostic::error(
+                            "E0403",
+                            "test function in a denominator",
+                            b.span,
+                            "depends on the test function",
+                        )
+                        .with_note("a form must be linear in its test function"),
                     );
                     return None;
                 }
                 let konst = ta.konst.zip(tb.konst).map(|(x, y)| x / y);
-                Some(Ty { konst, ..Ty::join(&ta, &tb, ta.shape) })
+                Some(Ty {
+                    konst,
+                    ..Ty::join(&ta, &tb, ta.shape)
+                })
             }
             BinOp::Pow => {
                 if ta.shape != Scalar {
-                    return mismatch(self, format!("cannot raise a {} to a power", ta.shape.name()), Some("powers apply to scalars; use dot or inner for products"));
+                    return mismatch(
+                        self,
+                        format!("cannot raise a {} to a power", ta.shape.name()),
+                        Some("powers apply to scalars; use dot or inner for products"),
+                    );
                 }
                 let k = match tb.konst {
                     Some(k) if k.fract() == 0.0 && k.abs() <= 64.0 && !tb.test => k,
                     _ => {
                         self.error(
-                            Diagnostic::error("E0303", "exponent must be a constant integer", b.span, "not a constant integer")
-                                .with_help("use sqrt(x) for x^(1/2); `^` takes integers from -64 to 64"),
+                            Diagnostic::error(
+                                "E0303",
+                                "exponent must be a constant integer",
+                                b.span,
+                                "not a constant integer",
+                            )
+                            .with_help(
+                                "use sqrt(x) for x^(1/2); `^` takes integers from -64 to 64",
+                            ),
                         );
                         return None;
                     }
                 };
                 if ta.test && k != 1.0 {
                     if k < 0.0 {
-                        self.error(Diagnostic::error("E0403", "test function in a denominator", e.span, "negative power of the test function"));
+                        self.error(Diagnostic::error(
+                            "E0403",
+                            "test function in a denominator",
+                            e.span,
+                            "negative power of the test function",
+                        ));
                     } else {
                         self.self_product(e.span, a.span, b.span);
                     }
                     return None;
                 }
-                Some(Ty { konst: ta.konst.map(|x| x.powi(k as i32)), ..ta })
+                Some(Ty {
+                    konst: ta.konst.map(|x| x.powi(k as i32)),
+                    ..ta
+                })
             }
         }
     }
 
     fn self_product(&mut self, span: Span, a: Span, b: Span) {
         self.error(
-            Diagnostic::error("E0404", "test function multiplied by itself", span, "quadratic in the test function")
-                .with_label(a, "contains the test function")
-                .with_label(b, "contains it too")
-                .with_note("a form must be linear in its test function"),
+            Diagnostic::error(
+                "E0404",
+                "test function multiplied by itself",
+                span,
+                "quadratic in the test function",
+            )
+            .with_label(a, "contains the test function")
+            .with_label(b, "contains it too")
+            .with_note("a form must be linear in its test function"),
         );
     }
 
     fn call_ty(&mut self, e: &Expr, f: &Ident, args: &[Expr]) -> Option<Ty> {
         if let Some((_, _)) = self.scope.iter().find(|(n, _)| *n == f.name) {
-            self.error(Diagnostic::error("E0204", format!("`{}` is not a function", f.name), f.span, "a value, not a function"));
+            self.error(Diagnostic::error(
+                "E0204",
+                format!("`{}` is not a function", f.name),
+                f.span,
+                "a value, not a function",
+            ));
             return None;
         }
         let arg_tys: Vec<Option<Ty>> = args.iter().map(|a| self.ty(a)).collect();
@@ -434,16 +610,30 @@ impl<'p> Checker<'p> {
                 let arg_tys: Vec<Ty> = arg_tys.into_iter().collect::<Option<_>>()?;
                 if self.calls.iter().any(|(n, _)| *n == f.name) {
                     self.error(
-                        Diagnostic::error("E0105", format!("`{}` calls itself", f.name), f.span, "recursive call")
-                            .with_note("functions are inlined, so they cannot be recursive"),
+                        Diagnostic::error(
+                            "E0105",
+                            format!("`{}` calls itself", f.name),
+                            f.span,
+                            "recursive call",
+                        )
+                        .with_note("functions are inlined, so they cannot be recursive"),
                     );
                     return None;
                 }
                 if self.calls.len() >= MAX_INLINE_DEPTH {
-                    self.error(Diagnostic::error("E0105", "functions nested too deeply", f.span, format!("more than {MAX_INLINE_DEPTH} nested calls")));
+                    self.error(Diagnostic::error(
+                        "E0105",
+                        "functions nested too deeply",
+                        f.span,
+                        format!("more than {MAX_INLINE_DEPTH} nested calls"),
+                    ));
                     return None;
                 }
-                let scope = params.iter().zip(arg_tys).map(|(p, t)| (p.name.clone(), t)).collect();
+                let scope = params
+                    .iter()
+                    .zip(arg_tys)
+                    .map(|(p, t)| (p.name.clone(), t))
+                    .collect();
                 let saved = std::mem::replace(&mut self.scope, scope);
                 self.calls.push((f.name.clone(), e.span));
                 let ty = self.ty(body);
@@ -453,7 +643,12 @@ impl<'p> Checker<'p> {
             }
             Some(g) => {
                 let kind = g.kind();
-                let mut d = Diagnostic::error("E0204", format!("`{}` is a {kind}, not a function", f.name), f.span, "cannot be called");
+                let mut d = Diagnostic::error(
+                    "E0204",
+                    format!("`{}` is a {kind}, not a function", f.name),
+                    f.span,
+                    "cannot be called",
+                );
                 if kind == "form" {
                     d = d.with_note("forms are applied to time levels in schemes, not called inside expressions");
                 }
@@ -470,7 +665,12 @@ impl<'p> Checker<'p> {
                 self.builtin_ty(e, f, args, &tys)
             }
             None if BUILTIN_VALUES.contains(&f.name.as_str()) => {
-                self.error(Diagnostic::error("E0204", format!("`{}` is a built-in value, not a function", f.name), f.span, "cannot be called"));
+                self.error(Diagnostic::error(
+                    "E0204",
+                    format!("`{}` is a built-in value, not a function", f.name),
+                    f.span,
+                    "cannot be called",
+                ));
                 None
             }
             None => {
@@ -484,7 +684,12 @@ impl<'p> Checker<'p> {
         let plural = |n: usize| if n == 1 { "argument" } else { "arguments" };
         let mut d = Diagnostic::error(
             "E0201",
-            format!("`{}` takes {want} {}, but {got} {} given", f.name, plural(want), if got == 1 { "was" } else { "were" }),
+            format!(
+                "`{}` takes {want} {}, but {got} {} given",
+                f.name,
+                plural(want),
+                if got == 1 { "was" } else { "were" }
+            ),
             e.span,
             format!("{got} {}", plural(got)),
         );
@@ -511,8 +716,15 @@ impl<'p> Checker<'p> {
         if NONLINEAR.contains(&name) {
             if let Some((a, _)) = args.iter().zip(tys).find(|(_, t)| t.test) {
                 self.error(
-                    Diagnostic::error("E0402", format!("test function inside `{name}`"), a.span, "depends on the test function")
-                        .with_note(format!("`{name}` is not linear, and a form must be linear in its test function")),
+                    Diagnostic::error(
+                        "E0402",
+                        format!("test function inside `{name}`"),
+                        a.span,
+                        "depends on the test function",
+                    )
+                    .with_note(format!(
+                        "`{name}` is not linear, and a form must be linear in its test function"
+                    )),
                 );
                 return None;
             }
@@ -521,13 +733,20 @@ impl<'p> Checker<'p> {
             self.self_product(e.span, args[0].span, args[1].span);
             return None;
         }
-        let mut ty = tys.iter().skip(1).fold(tys[0], |acc, t| Ty::join(&acc, t, shape));
+        let mut ty = tys
+            .iter()
+            .skip(1)
+            .fold(tys[0], |acc, t| Ty::join(&acc, t, shape));
         ty.shape = shape;
         ty.konst = None;
         match name {
             "grad" | "div" => {
                 if !tys[0].smooth {
-                    let reason = if tys[0].facet.is_some() { "the normal" } else { "case data or a derivative" };
+                    let reason = if tys[0].facet.is_some() {
+                        "the normal"
+                    } else {
+                        "case data or a derivative"
+                    };
                     self.error(
                         Diagnostic::error("E0502", format!("cannot take `{name}` of this expression"), args[0].span, format!("depends on {reason}"))
                             .with_note("derivatives are available for fields, test functions, x, and smooth functions of them, once"),

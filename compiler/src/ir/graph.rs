@@ -11,11 +11,23 @@ pub type NodeId = u32;
 pub enum Sym {
     Param(u16),
     /// Component `comp` of field argument `arg`.
-    Field { arg: u8, comp: u8 },
+    Field {
+        arg: u8,
+        comp: u8,
+    },
     /// ∂_dir of component `comp` of field argument `arg`.
-    FieldGrad { arg: u8, comp: u8, dir: u8 },
-    Test { comp: u8 },
-    TestGrad { comp: u8, dir: u8 },
+    FieldGrad {
+        arg: u8,
+        comp: u8,
+        dir: u8,
+    },
+    Test {
+        comp: u8,
+    },
+    TestGrad {
+        comp: u8,
+        dir: u8,
+    },
     /// Outward unit normal of the body at a facet point.
     Normal(u8),
     /// Diameter of the cell carrying the facet.
@@ -23,7 +35,10 @@ pub enum Sym {
     Coord(u8),
     Time,
     /// Component `comp` (row-major for tensors) of case datum `id`.
-    Coef { id: u16, comp: u8 },
+    Coef {
+        id: u16,
+        comp: u8,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -149,6 +164,18 @@ impl Graph {
             (_, Some(m)) if m == -1.0 => return self.neg(a),
             _ => {}
         }
+        // Fold constant factors: c1·(c2·x) = (c1·c2)·x.
+        if let Some(c1) = self.as_const(a) {
+            if let Node::Mul(x, y) = self.node(b) {
+                if let Some(c2) = self.as_const(x) {
+                    let c = self.constant(c1 * c2);
+                    return self.mul(c, y);
+                }
+            }
+        }
+        if self.as_const(b).is_some() && self.as_const(a).is_none() {
+            return self.mul(b, a);
+        }
         // Pull negations out so that -a*b and a*-b are one node.
         if let Node::Neg(x) = self.node(a) {
             let p = self.mul(x, b);
@@ -159,7 +186,11 @@ impl Graph {
             return self.neg(p);
         }
         // Constants first, then by id: a canonical order for commutative products.
-        let (a, b) = if self.as_const(b).is_some() || (self.as_const(a).is_none() && b < a) { (b, a) } else { (a, b) };
+        let (a, b) = if self.as_const(b).is_some() || (self.as_const(a).is_none() && b < a) {
+            (b, a)
+        } else {
+            (a, b)
+        };
         self.intern(Node::Mul(a, b))
     }
 
@@ -248,6 +279,8 @@ impl Graph {
 
     /// Whether `id` depends on any symbol accepted by `pred`.
     pub fn depends_on(&self, id: NodeId, pred: impl Fn(Sym) -> bool) -> bool {
-        self.reachable([id]).into_iter().any(|n| matches!(self.node(n), Node::Sym(s) if pred(s)))
+        self.reachable([id])
+            .into_iter()
+            .any(|n| matches!(self.node(n), Node::Sym(s) if pred(s)))
     }
 }

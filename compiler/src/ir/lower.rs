@@ -50,7 +50,13 @@ pub struct Lowerer<'p> {
 
 impl<'p> Lowerer<'p> {
     pub fn new(prog: &'p Program, d: usize) -> Self {
-        Lowerer { g: Graph::default(), prog, d, scope: Vec::new(), lets: HashMap::new() }
+        Lowerer {
+            g: Graph::default(),
+            prog,
+            d,
+            scope: Vec::new(),
+            lets: HashMap::new(),
+        }
     }
 
     pub fn dim(&self) -> usize {
@@ -64,27 +70,71 @@ impl<'p> Lowerer<'p> {
         for (a, f) in form.fields.iter().enumerate() {
             let c = (0..d)
                 .map(|k| Jet {
-                    v: self.g.sym(Sym::Field { arg: a as u8, comp: k as u8 }),
-                    g: Some((0..d).map(|l| self.g.sym(Sym::FieldGrad { arg: a as u8, comp: k as u8, dir: l as u8 })).collect()),
+                    v: self.g.sym(Sym::Field {
+                        arg: a as u8,
+                        comp: k as u8,
+                    }),
+                    g: Some(
+                        (0..d)
+                            .map(|l| {
+                                self.g.sym(Sym::FieldGrad {
+                                    arg: a as u8,
+                                    comp: k as u8,
+                                    dir: l as u8,
+                                })
+                            })
+                            .collect(),
+                    ),
                 })
                 .collect();
-            scope.push((f.name.clone(), Val { shape: Shape::Vector, c }));
+            scope.push((
+                f.name.clone(),
+                Val {
+                    shape: Shape::Vector,
+                    c,
+                },
+            ));
         }
         let c = (0..d)
             .map(|k| Jet {
                 v: self.g.sym(Sym::Test { comp: k as u8 }),
-                g: Some((0..d).map(|l| self.g.sym(Sym::TestGrad { comp: k as u8, dir: l as u8 })).collect()),
+                g: Some(
+                    (0..d)
+                        .map(|l| {
+                            self.g.sym(Sym::TestGrad {
+                                comp: k as u8,
+                                dir: l as u8,
+                            })
+                        })
+                        .collect(),
+                ),
             })
             .collect();
-        scope.push((form.test.name.clone(), Val { shape: Shape::Vector, c }));
+        scope.push((
+            form.test.name.clone(),
+            Val {
+                shape: Shape::Vector,
+                c,
+            },
+        ));
         self.scope = scope;
         let mut integrands: Vec<Integrand> = Vec::new();
         for integral in &form.integrals {
             let v = self.expr(&integral.integrand).c[0].v;
-            let v = if integral.sign < 0.0 { self.g.neg(v) } else { v };
-            match integrands.iter_mut().find(|i| i.region == integral.region.name) {
+            let v = if integral.sign < 0.0 {
+                self.g.neg(v)
+            } else {
+                v
+            };
+            match integrands
+                .iter_mut()
+                .find(|i| i.region == integral.region.name)
+            {
                 Some(i) => i.value = self.g.add(i.value, v),
-                None => integrands.push(Integrand { region: integral.region.name.clone(), value: v }),
+                None => integrands.push(Integrand {
+                    region: integral.region.name.clone(),
+                    value: v,
+                }),
             }
         }
         // Volume integral first: kernels are emitted in this order.
@@ -105,11 +155,17 @@ impl<'p> Lowerer<'p> {
 
     fn constant(&mut self, v: f64) -> Jet {
         let v = self.g.constant(v);
-        Jet { v, g: self.zero_grad() }
+        Jet {
+            v,
+            g: self.zero_grad(),
+        }
     }
 
     fn scalar(j: Jet) -> Val {
-        Val { shape: Shape::Scalar, c: vec![j] }
+        Val {
+            shape: Shape::Scalar,
+            c: vec![j],
+        }
     }
 
     fn expr(&mut self, e: &Expr) -> Val {
@@ -139,12 +195,23 @@ impl<'p> Lowerer<'p> {
         match self.prog.globals.get(name) {
             Some(Global::Param(i)) => {
                 let v = self.g.sym(Sym::Param(*i as u16));
-                Self::scalar(Jet { v, g: self.zero_grad() })
+                Self::scalar(Jet {
+                    v,
+                    g: self.zero_grad(),
+                })
             }
             Some(Global::Coef(i)) => {
                 let shape = self.prog.coefs[*i].shape;
                 let n = components(shape, d);
-                let c = (0..n).map(|k| Jet { v: self.g.sym(Sym::Coef { id: *i as u16, comp: k as u8 }), g: None }).collect();
+                let c = (0..n)
+                    .map(|k| Jet {
+                        v: self.g.sym(Sym::Coef {
+                            id: *i as u16,
+                            comp: k as u8,
+                        }),
+                        g: None,
+                    })
+                    .collect();
                 Val { shape, c }
             }
             Some(Global::Let { value, .. }) => {
@@ -160,30 +227,54 @@ impl<'p> Lowerer<'p> {
             }
             _ => match name {
                 "I" => {
-                    let c = (0..d * d).map(|k| self.constant(if k / d == k % d { 1.0 } else { 0.0 })).collect();
-                    Val { shape: Shape::Tensor, c }
+                    let c = (0..d * d)
+                        .map(|k| self.constant(if k / d == k % d { 1.0 } else { 0.0 }))
+                        .collect();
+                    Val {
+                        shape: Shape::Tensor,
+                        c,
+                    }
                 }
                 "x" => {
                     let c = (0..d)
                         .map(|k| {
                             let v = self.g.sym(Sym::Coord(k as u8));
-                            let g = (0..d).map(|l| self.g.constant(if k == l { 1.0 } else { 0.0 })).collect();
+                            let g = (0..d)
+                                .map(|l| self.g.constant(if k == l { 1.0 } else { 0.0 }))
+                                .collect();
                             Jet { v, g: Some(g) }
                         })
                         .collect();
-                    Val { shape: Shape::Vector, c }
+                    Val {
+                        shape: Shape::Vector,
+                        c,
+                    }
                 }
                 "t" => {
                     let v = self.g.sym(Sym::Time);
-                    Self::scalar(Jet { v, g: self.zero_grad() })
+                    Self::scalar(Jet {
+                        v,
+                        g: self.zero_grad(),
+                    })
                 }
                 "h" => {
                     let v = self.g.sym(Sym::CellDiameter);
-                    Self::scalar(Jet { v, g: self.zero_grad() })
+                    Self::scalar(Jet {
+                        v,
+                        g: self.zero_grad(),
+                    })
                 }
                 "n" => {
-                    let c = (0..d).map(|k| Jet { v: self.g.sym(Sym::Normal(k as u8)), g: None }).collect();
-                    Val { shape: Shape::Vector, c }
+                    let c = (0..d)
+                        .map(|k| Jet {
+                            v: self.g.sym(Sym::Normal(k as u8)),
+                            g: None,
+                        })
+                        .collect();
+                    Val {
+                        shape: Shape::Vector,
+                        c,
+                    }
                 }
                 "pi" => Self::scalar(self.constant(std::f64::consts::PI)),
                 _ => unreachable!("checked name `{name}`"),
@@ -221,8 +312,20 @@ impl<'p> Lowerer<'p> {
         match f {
             "grad" => {
                 let a = next();
-                let c: Vec<Jet> = a.c.iter().flat_map(|j| j.g.clone().expect("checked smooth").into_iter().map(|v| Jet { v, g: None })).collect();
-                let shape = if a.shape == Shape::Scalar { Shape::Vector } else { Shape::Tensor };
+                let c: Vec<Jet> =
+                    a.c.iter()
+                        .flat_map(|j| {
+                            j.g.clone()
+                                .expect("checked smooth")
+                                .into_iter()
+                                .map(|v| Jet { v, g: None })
+                        })
+                        .collect();
+                let shape = if a.shape == Shape::Scalar {
+                    Shape::Vector
+                } else {
+                    Shape::Tensor
+                };
                 Val { shape, c }
             }
             "div" => {
@@ -239,7 +342,14 @@ impl<'p> Lowerer<'p> {
                         Jet { v: acc, g: None }
                     })
                     .collect();
-                Val { shape: if rows == 1 { Shape::Scalar } else { Shape::Vector }, c }
+                Val {
+                    shape: if rows == 1 {
+                        Shape::Scalar
+                    } else {
+                        Shape::Vector
+                    },
+                    c,
+                }
             }
             "sym" => {
                 let a = next();
@@ -251,12 +361,20 @@ impl<'p> Lowerer<'p> {
                         self.jmul(&half, &s)
                     })
                     .collect();
-                Val { shape: Shape::Tensor, c }
+                Val {
+                    shape: Shape::Tensor,
+                    c,
+                }
             }
             "transpose" => {
                 let a = next();
-                let c = (0..d * d).map(|k| a.c[(k % d) * d + k / d].clone()).collect();
-                Val { shape: Shape::Tensor, c }
+                let c = (0..d * d)
+                    .map(|k| a.c[(k % d) * d + k / d].clone())
+                    .collect();
+                Val {
+                    shape: Shape::Tensor,
+                    c,
+                }
             }
             "tr" => {
                 let a = next();
@@ -281,8 +399,13 @@ impl<'p> Lowerer<'p> {
             }
             "outer" => {
                 let (a, b) = (next(), next());
-                let c = (0..d * d).map(|k| self.jmul(&a.c[k / d], &b.c[k % d])).collect();
-                Val { shape: Shape::Tensor, c }
+                let c = (0..d * d)
+                    .map(|k| self.jmul(&a.c[k / d], &b.c[k % d]))
+                    .collect();
+                Val {
+                    shape: Shape::Tensor,
+                    c,
+                }
             }
             "H" => {
                 let a = next();
@@ -314,7 +437,11 @@ impl<'p> Lowerer<'p> {
                 // max(a, b) = b + (a − b)·H(a − b); min(a, b) = b + (a − b)·H(b − a)
                 let (a, b) = (next().c.remove(0), next().c.remove(0));
                 let diff = self.jsub(&a, &b);
-                let arg = if f == "max" { diff.clone() } else { self.jneg(&diff) };
+                let arg = if f == "max" {
+                    diff.clone()
+                } else {
+                    self.jneg(&diff)
+                };
                 let h = self.jheaviside(&arg);
                 let p = self.jmul(&diff, &h);
                 Self::scalar(self.jadd(&b, &p))
@@ -362,18 +489,26 @@ impl<'p> Lowerer<'p> {
                 Self::scalar(c)
             }
             (Tensor, Vector) => {
-                let c = (0..d).map(|i| self.sum_of_products((0..d).map(|j| (i * d + j, j)).collect(), &a, &b)).collect();
+                let c = (0..d)
+                    .map(|i| self.sum_of_products((0..d).map(|j| (i * d + j, j)).collect(), &a, &b))
+                    .collect();
                 Val { shape: Vector, c }
             }
             (Vector, Tensor) => {
-                let c = (0..d).map(|j| self.sum_of_products((0..d).map(|i| (i, i * d + j)).collect(), &a, &b)).collect();
+                let c = (0..d)
+                    .map(|j| self.sum_of_products((0..d).map(|i| (i, i * d + j)).collect(), &a, &b))
+                    .collect();
                 Val { shape: Vector, c }
             }
             (Tensor, Tensor) => {
                 let c = (0..d * d)
                     .map(|k| {
                         let (i, j) = (k / d, k % d);
-                        self.sum_of_products((0..d).map(|m| (i * d + m, m * d + j)).collect(), &a, &b)
+                        self.sum_of_products(
+                            (0..d).map(|m| (i * d + m, m * d + j)).collect(),
+                            &a,
+                            &b,
+                        )
                     })
                     .collect();
                 Val { shape: Tensor, c }
@@ -402,9 +537,19 @@ impl<'p> Lowerer<'p> {
 
     // Scalar operations on jets (value and gradient together).
 
-    fn grads(&mut self, a: &Jet, b: &Jet, f: impl Fn(&mut Graph, NodeId, NodeId) -> NodeId) -> Option<Vec<NodeId>> {
+    fn grads(
+        &mut self,
+        a: &Jet,
+        b: &Jet,
+        f: impl Fn(&mut Graph, NodeId, NodeId) -> NodeId,
+    ) -> Option<Vec<NodeId>> {
         let (ga, gb) = (a.g.as_ref()?, b.g.as_ref()?);
-        Some(ga.iter().zip(gb).map(|(&x, &y)| f(&mut self.g, x, y)).collect())
+        Some(
+            ga.iter()
+                .zip(gb)
+                .map(|(&x, &y)| f(&mut self.g, x, y))
+                .collect(),
+        )
     }
 
     fn jadd(&mut self, a: &Jet, b: &Jet) -> Jet {
@@ -421,7 +566,9 @@ impl<'p> Lowerer<'p> {
 
     fn jneg(&mut self, a: &Jet) -> Jet {
         let v = self.g.neg(a.v);
-        let g = a.g.as_ref().map(|ga| ga.iter().map(|&x| self.g.neg(x)).collect());
+        let g =
+            a.g.as_ref()
+                .map(|ga| ga.iter().map(|&x| self.g.neg(x)).collect());
         Jet { v, g }
     }
 
@@ -471,7 +618,10 @@ impl<'p> Lowerer<'p> {
 
     fn jheaviside(&mut self, a: &Jet) -> Jet {
         let v = self.g.heaviside(a.v);
-        Jet { v, g: self.zero_grad() }
+        Jet {
+            v,
+            g: self.zero_grad(),
+        }
     }
 }
 

@@ -64,7 +64,12 @@ pub struct TangentIr {
 
 impl TangentIr {
     pub fn nodes(&self) -> impl Iterator<Item = NodeId> + '_ {
-        self.c00.iter().chain(&self.c01).chain(&self.c10).chain(&self.c11).copied()
+        self.c00
+            .iter()
+            .chain(&self.c01)
+            .chain(&self.c10)
+            .chain(&self.c11)
+            .copied()
     }
 }
 
@@ -77,24 +82,64 @@ pub fn build(prog: &Program, d: usize) -> DimIr {
     for lf in lowered {
         let mut integrals = Vec::new();
         for integrand in &lf.integrands {
-            let f0: Vec<NodeId> = (0..d).map(|k| Derivative::new(Sym::Test { comp: k as u8 }).of(&mut g, integrand.value)).collect();
-            let f1: Vec<NodeId> = (0..d * d)
-                .map(|kl| Derivative::new(Sym::TestGrad { comp: (kl / d) as u8, dir: (kl % d) as u8 }).of(&mut g, integrand.value))
+            let f0: Vec<NodeId> = (0..d)
+                .map(|k| Derivative::new(Sym::Test { comp: k as u8 }).of(&mut g, integrand.value))
                 .collect();
-            let tangents = (0..lf.fields.len()).map(|a| tangent(&mut g, d, a as u8, &f0, &f1)).collect::<Vec<_>>();
+            let f1: Vec<NodeId> = (0..d * d)
+                .map(|kl| {
+                    Derivative::new(Sym::TestGrad {
+                        comp: (kl / d) as u8,
+                        dir: (kl % d) as u8,
+                    })
+                    .of(&mut g, integrand.value)
+                })
+                .collect();
+            let tangents = (0..lf.fields.len())
+                .map(|a| tangent(&mut g, d, a as u8, &f0, &f1))
+                .collect::<Vec<_>>();
             let degree = [1, 2].map(|p| integral_degree(&g, p, &f0, &f1, &tangents));
-            integrals.push(IntegralIr { region: integrand.region.clone(), cell: integrand.region == CELL_REGION, f0, f1, tangents, degree });
+            integrals.push(IntegralIr {
+                region: integrand.region.clone(),
+                cell: integrand.region == CELL_REGION,
+                f0,
+                f1,
+                tangents,
+                degree,
+            });
         }
-        let tangent_nodes = integrals.iter().flat_map(|i| i.tangents.iter().flat_map(TangentIr::nodes));
-        let linear = !g.reachable(tangent_nodes).into_iter().any(|n| matches!(g.node(n), Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. })));
-        forms.push(FormIr { name: lf.name, fields: lf.fields, test: lf.test, integrals, linear });
+        let tangent_nodes = integrals
+            .iter()
+            .flat_map(|i| i.tangents.iter().flat_map(TangentIr::nodes));
+        let linear = !g.reachable(tangent_nodes).into_iter().any(|n| {
+            matches!(
+                g.node(n),
+                Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. })
+            )
+        });
+        forms.push(FormIr {
+            name: lf.name,
+            fields: lf.fields,
+            test: lf.test,
+            integrals,
+            linear,
+        });
     }
-    DimIr { dim: d, graph: g, forms }
+    DimIr {
+        dim: d,
+        graph: g,
+        forms,
+    }
 }
 
 fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> TangentIr {
     let val: Vec<Sym> = (0..d).map(|m| Sym::Field { arg, comp: m as u8 }).collect();
-    let grad: Vec<Sym> = (0..d * d).map(|mn| Sym::FieldGrad { arg, comp: (mn / d) as u8, dir: (mn % d) as u8 }).collect();
+    let grad: Vec<Sym> = (0..d * d)
+        .map(|mn| Sym::FieldGrad {
+            arg,
+            comp: (mn / d) as u8,
+            dir: (mn % d) as u8,
+        })
+        .collect();
     let mut dval: Vec<Derivative> = val.iter().map(|s| Derivative::new(*s)).collect();
     let mut dgrad: Vec<Derivative> = grad.iter().map(|s| Derivative::new(*s)).collect();
     let mut c00 = Vec::new();
@@ -123,7 +168,11 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> Ta
 /// Polynomial degree estimate of each node for Lagrange elements of degree p on affine cells
 /// (as UFL estimates it): fields p, gradients p − 1, x 1, case data p, non-polynomial
 /// functions add 2.
-pub fn node_degrees(g: &Graph, p: u32, roots: impl IntoIterator<Item = NodeId>) -> std::collections::HashMap<NodeId, u32> {
+pub fn node_degrees(
+    g: &Graph,
+    p: u32,
+    roots: impl IntoIterator<Item = NodeId>,
+) -> std::collections::HashMap<NodeId, u32> {
     let mut deg = std::collections::HashMap::new();
     for id in g.reachable(roots) {
         let dg = |x: NodeId| deg.get(&x).copied().unwrap_or(0);
@@ -148,7 +197,12 @@ pub fn node_degrees(g: &Graph, p: u32, roots: impl IntoIterator<Item = NodeId>) 
 }
 
 fn integral_degree(g: &Graph, p: u32, f0: &[NodeId], f1: &[NodeId], tangents: &[TangentIr]) -> u32 {
-    let roots: Vec<NodeId> = f0.iter().chain(f1).copied().chain(tangents.iter().flat_map(TangentIr::nodes)).collect();
+    let roots: Vec<NodeId> = f0
+        .iter()
+        .chain(f1)
+        .copied()
+        .chain(tangents.iter().flat_map(TangentIr::nodes))
+        .collect();
     let deg = node_degrees(g, p, roots);
     let d = |n: &NodeId| if g.is_zero(*n) { None } else { Some(deg[n]) };
     let mut best = 0;

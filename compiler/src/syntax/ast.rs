@@ -81,12 +81,39 @@ pub struct Integral {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Item {
-    Import { path: String, span: Span },
-    Param { name: Ident, default: Expr, range: Option<Range>, span: Span },
-    Coef { name: Ident, shape: Shape, span: Span },
-    Let { name: Ident, value: Expr, span: Span },
-    Fn { name: Ident, params: Vec<Ident>, body: Expr, span: Span },
-    Form { name: Ident, fields: Vec<Ident>, test: Ident, integrals: Vec<Integral>, span: Span },
+    Import {
+        path: String,
+        span: Span,
+    },
+    Param {
+        name: Ident,
+        default: Expr,
+        range: Option<Range>,
+        span: Span,
+    },
+    Coef {
+        name: Ident,
+        shape: Shape,
+        span: Span,
+    },
+    Let {
+        name: Ident,
+        value: Expr,
+        span: Span,
+    },
+    Fn {
+        name: Ident,
+        params: Vec<Ident>,
+        body: Expr,
+        span: Span,
+    },
+    Form {
+        name: Ident,
+        fields: Vec<Ident>,
+        test: Ident,
+        integrals: Vec<Integral>,
+        span: Span,
+    },
 }
 
 impl Item {

@@ -44,7 +44,10 @@ pub fn parse(file: FileId, text: &str) -> (File, Vec<Diagnostic>) {
         }
         match WfParser::parse(Rule::chunk, chunk) {
             Ok(mut pairs) => {
-                let b = Builder { file, offset: start };
+                let b = Builder {
+                    file,
+                    offset: start,
+                };
                 let chunk_pair = pairs.next().expect("chunk rule always yields one pair");
                 for p in chunk_pair.into_inner() {
                     if p.as_rule() != Rule::EOI {
@@ -110,17 +113,30 @@ fn chunks(text: &str) -> Vec<(usize, usize)> {
 
 fn starts_item(rest: &str) -> bool {
     ITEM_KEYWORDS.iter().any(|k| {
-        rest.starts_with(k) && rest[k.len()..].chars().next().is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_'))
+        rest.starts_with(k)
+            && rest[k.len()..]
+                .chars()
+                .next()
+                .is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_'))
     })
 }
 
 fn nesting_error(file: FileId, chunk: &str, offset: usize) -> Option<Diagnostic> {
     let operators = chunk.bytes().filter(|b| b"+-*/^,".contains(b)).count();
     if operators > MAX_OPERATORS {
-        let span = Span::new(file, offset, offset + chunk.find('\n').unwrap_or(chunk.len()));
+        let span = Span::new(
+            file,
+            offset,
+            offset + chunk.find('\n').unwrap_or(chunk.len()),
+        );
         return Some(
-            Diagnostic::error("E0002", "item too long", span, format!("more than {MAX_OPERATORS} operators in one item"))
-                .with_help("split it into several `let` or `fn` items"),
+            Diagnostic::error(
+                "E0002",
+                "item too long",
+                span,
+                format!("more than {MAX_OPERATORS} operators in one item"),
+            )
+            .with_help("split it into several `let` or `fn` items"),
         );
     }
     let mut depth = 0usize;
@@ -133,8 +149,13 @@ fn nesting_error(file: FileId, chunk: &str, offset: usize) -> Option<Diagnostic>
         if depth > MAX_NESTING {
             let span = Span::new(file, offset + i, offset + i + 1);
             return Some(
-                Diagnostic::error("E0002", "expression nested too deeply", span, format!("more than {MAX_NESTING} levels of brackets"))
-                    .with_help("name intermediate results with `let` or `fn`"),
+                Diagnostic::error(
+                    "E0002",
+                    "expression nested too deeply",
+                    span,
+                    format!("more than {MAX_NESTING} levels of brackets"),
+                )
+                .with_help("name intermediate results with `let` or `fn`"),
             );
         }
     }
@@ -154,7 +175,12 @@ fn note_broken_name(chunk: &str, names: &mut Vec<String>) {
     }
 }
 
-fn syntax_error(file: FileId, chunk: &str, offset: usize, e: &pest::error::Error<Rule>) -> Diagnostic {
+fn syntax_error(
+    file: FileId,
+    chunk: &str,
+    offset: usize,
+    e: &pest::error::Error<Rule>,
+) -> Diagnostic {
     let pos = match e.location {
         pest::error::InputLocation::Pos(p) => p,
         pest::error::InputLocation::Span((s, _)) => s,
@@ -181,7 +207,11 @@ fn syntax_error(file: FileId, chunk: &str, offset: usize, e: &pest::error::Error
     let found = found_token(&chunk[pos.min(chunk.len())..]);
     let span_len = if found.is_empty() { 0 } else { found.len() };
     let span = Span::new(file, offset + pos, offset + pos + span_len);
-    let found_text = if found.is_empty() { "end of input".to_string() } else { format!("`{found}`") };
+    let found_text = if found.is_empty() {
+        "end of input".to_string()
+    } else {
+        format!("`{found}`")
+    };
     let message = if expected.is_empty() {
         format!("unexpected {found_text}")
     } else {
@@ -191,7 +221,9 @@ fn syntax_error(file: FileId, chunk: &str, offset: usize, e: &pest::error::Error
     if found == "=" && expected.iter().any(|e| e == "`(`") {
         d = d.with_help("a function needs its parameters: `fn name(arg) = ...`");
     } else if found == ":" {
-        d = d.with_help("declare case data with `coef NAME: vector`; parameters are `param NAME = VALUE`");
+        d = d.with_help(
+            "declare case data with `coef NAME: vector`; parameters are `param NAME = VALUE`",
+        );
     }
     d
 }
@@ -227,9 +259,12 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::number => "a number",
         Rule::expr | Rule::call | Rule::neg => "an expression",
         Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::pow => "an operator",
-        Rule::import | Rule::param | Rule::coef | Rule::let_decl | Rule::fn_decl | Rule::form_decl => {
-            "an item (`import`, `param`, `coef`, `let`, `fn`, `form`)"
-        }
+        Rule::import
+        | Rule::param
+        | Rule::coef
+        | Rule::let_decl
+        | Rule::fn_decl
+        | Rule::form_decl => "an item (`import`, `param`, `coef`, `let`, `fn`, `form`)",
         Rule::range => "`in RANGE`",
         Rule::lbound => "`[` or `(`",
         Rule::rbound => "`]` or `)`",
@@ -256,7 +291,10 @@ impl Builder {
     }
 
     fn ident(&self, p: Pair<Rule>) -> Ident {
-        Ident { name: p.as_str().to_string(), span: self.span(&p) }
+        Ident {
+            name: p.as_str().to_string(),
+            span: self.span(&p),
+        }
     }
 
     fn item(&self, p: Pair<Rule>) -> Result<Item, Diagnostic> {
@@ -283,7 +321,12 @@ impl Builder {
                 for r in it {
                     range = Some(self.range(r)?);
                 }
-                Item::Param { name, default, range, span }
+                Item::Param {
+                    name,
+                    default,
+                    range,
+                    span,
+                }
             }
             Rule::coef => {
                 let name = self.ident(next());
@@ -306,11 +349,18 @@ impl Builder {
                 let mut body = None;
                 for q in it {
                     match q.as_rule() {
-                        Rule::ident_list => params = q.into_inner().map(|i| self.ident(i)).collect(),
+                        Rule::ident_list => {
+                            params = q.into_inner().map(|i| self.ident(i)).collect()
+                        }
                         _ => body = Some(self.expr(q)?),
                     }
                 }
-                Item::Fn { name, params, body: body.expect("fn has a body"), span }
+                Item::Fn {
+                    name,
+                    params,
+                    body: body.expect("fn has a body"),
+                    span,
+                }
             }
             Rule::form_decl => {
                 let name = self.ident(next());
@@ -319,12 +369,20 @@ impl Builder {
                 let mut test = None;
                 for a in args.into_inner() {
                     match a.as_rule() {
-                        Rule::ident_list => fields = a.into_inner().map(|i| self.ident(i)).collect(),
+                        Rule::ident_list => {
+                            fields = a.into_inner().map(|i| self.ident(i)).collect()
+                        }
                         _ => test = Some(self.ident(a)),
                     }
                 }
                 let integrals = self.integrals(next())?;
-                Item::Form { name, fields, test: test.expect("form has a test function"), integrals, span }
+                Item::Form {
+                    name,
+                    fields,
+                    test: test.expect("form has a test function"),
+                    integrals,
+                    span,
+                }
             }
             r => unreachable!("not an item: {r:?}"),
         })
@@ -337,7 +395,13 @@ impl Builder {
         let lo = self.expr(it.next().expect("range lower bound"))?;
         let hi = self.expr(it.next().expect("range upper bound"))?;
         let hi_closed = it.next().map(|b| b.as_str() == "]").unwrap_or(true);
-        Ok(Range { lo, lo_closed, hi, hi_closed, span })
+        Ok(Range {
+            lo,
+            lo_closed,
+            hi,
+            hi_closed,
+            span,
+        })
     }
 
     fn integrals(&self, p: Pair<Rule>) -> Result<Vec<Integral>, Diagnostic> {
@@ -358,7 +422,12 @@ impl Builder {
                     let mut it = q.into_inner();
                     let region = self.ident(it.next().expect("integral region"));
                     let integrand = self.expr(it.next().expect("integrand"))?;
-                    out.push(Integral { sign, region, integrand, span });
+                    out.push(Integral {
+                        sign,
+                        region,
+                        integrand,
+                        span,
+                    });
                     sign = 1.0;
                 }
             }
@@ -372,7 +441,10 @@ impl Builder {
             .map_prefix(|op, rhs| {
                 let rhs = rhs?;
                 let span = self.span(&op).to(rhs.span);
-                Ok(Expr { kind: ExprKind::Neg(Box::new(rhs)), span })
+                Ok(Expr {
+                    kind: ExprKind::Neg(Box::new(rhs)),
+                    span,
+                })
             })
             .map_infix(|lhs, op, rhs| {
                 let (lhs, rhs) = (lhs?, rhs?);
@@ -384,7 +456,10 @@ impl Builder {
                     _ => BinOp::Pow,
                 };
                 let span = lhs.span.to(rhs.span);
-                Ok(Expr { kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)), span })
+                Ok(Expr {
+                    kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+                    span,
+                })
             })
             .parse(p.into_inner())
     }
@@ -393,17 +468,31 @@ impl Builder {
         let span = self.span(&p);
         Ok(match p.as_rule() {
             Rule::number => match p.as_str().parse::<f64>() {
-                Ok(v) if v.is_finite() => Expr { kind: ExprKind::Number(v), span },
+                Ok(v) if v.is_finite() => Expr {
+                    kind: ExprKind::Number(v),
+                    span,
+                },
                 _ => {
-                    return Err(Diagnostic::error("E0003", "number out of range", span, "not a finite double-precision number"));
+                    return Err(Diagnostic::error(
+                        "E0003",
+                        "number out of range",
+                        span,
+                        "not a finite double-precision number",
+                    ));
                 }
             },
-            Rule::ident => Expr { kind: ExprKind::Name(self.ident(p)), span },
+            Rule::ident => Expr {
+                kind: ExprKind::Name(self.ident(p)),
+                span,
+            },
             Rule::call => {
                 let mut it = p.into_inner();
                 let name = self.ident(it.next().expect("callee"));
                 let args = it.map(|a| self.expr(a)).collect::<Result<Vec<_>, _>>()?;
-                Expr { kind: ExprKind::Call(name, args), span }
+                Expr {
+                    kind: ExprKind::Call(name, args),
+                    span,
+                }
             }
             Rule::expr => {
                 // Parenthesised: keep the span of the parentheses' content.
@@ -430,16 +519,25 @@ mod tests {
     fn precedence_of_power_and_unary_minus() {
         let (f, d) = parse(0, "let a = -x^2 + 3*y/2");
         assert!(d.is_empty(), "{d:?}");
-        let Item::Let { value, .. } = &f.items[0] else { panic!() };
-        let ExprKind::Binary(BinOp::Add, lhs, _) = &value.kind else { panic!("{value:?}") };
+        let Item::Let { value, .. } = &f.items[0] else {
+            panic!()
+        };
+        let ExprKind::Binary(BinOp::Add, lhs, _) = &value.kind else {
+            panic!("{value:?}")
+        };
         assert!(matches!(lhs.kind, ExprKind::Neg(_)));
     }
 
     #[test]
     fn integrand_stops_before_next_integral() {
-        let (f, d) = parse(0, "form a(u; v) = int(Omega) dot(u, v) + 1 - int(G) dot(u,v)");
+        let (f, d) = parse(
+            0,
+            "form a(u; v) = int(Omega) dot(u, v) + 1 - int(G) dot(u,v)",
+        );
         assert!(d.is_empty(), "{d:?}");
-        let Item::Form { integrals, .. } = &f.items[0] else { panic!() };
+        let Item::Form { integrals, .. } = &f.items[0] else {
+            panic!()
+        };
         assert_eq!(integrals.len(), 2);
         assert_eq!(integrals[1].sign, -1.0);
     }

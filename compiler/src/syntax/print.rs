@@ -12,7 +12,12 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
         let head = format!("{line}:{col} ");
         match item {
             Item::Import { path, .. } => out.push_str(&format!("{head}import {path:?}\n")),
-            Item::Param { name, default, range, .. } => {
+            Item::Param {
+                name,
+                default,
+                range,
+                ..
+            } => {
                 out.push_str(&format!("{head}param {} = {}", name.name, expr(default)));
                 if let Some(r) = range {
                     out.push_str(&format!(
@@ -25,18 +30,44 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 }
                 out.push('\n');
             }
-            Item::Coef { name, shape, .. } => out.push_str(&format!("{head}coef {}: {}\n", name.name, shape.name())),
-            Item::Let { name, value, .. } => out.push_str(&format!("{head}let {} = {}\n", name.name, expr(value))),
-            Item::Fn { name, params, body, .. } => {
-                let ps: Vec<_> = params.iter().map(|p| p.name.as_str()).collect();
-                out.push_str(&format!("{head}fn {}({}) = {}\n", name.name, ps.join(", "), expr(body)));
+            Item::Coef { name, shape, .. } => {
+                out.push_str(&format!("{head}coef {}: {}\n", name.name, shape.name()))
             }
-            Item::Form { name, fields, test, integrals, .. } => {
+            Item::Let { name, value, .. } => {
+                out.push_str(&format!("{head}let {} = {}\n", name.name, expr(value)))
+            }
+            Item::Fn {
+                name, params, body, ..
+            } => {
+                let ps: Vec<_> = params.iter().map(|p| p.name.as_str()).collect();
+                out.push_str(&format!(
+                    "{head}fn {}({}) = {}\n",
+                    name.name,
+                    ps.join(", "),
+                    expr(body)
+                ));
+            }
+            Item::Form {
+                name,
+                fields,
+                test,
+                integrals,
+                ..
+            } => {
                 let fs: Vec<_> = fields.iter().map(|p| p.name.as_str()).collect();
-                out.push_str(&format!("{head}form {}({}; {})\n", name.name, fs.join(", "), test.name));
+                out.push_str(&format!(
+                    "{head}form {}({}; {})\n",
+                    name.name,
+                    fs.join(", "),
+                    test.name
+                ));
                 for i in integrals {
                     let sign = if i.sign < 0.0 { "-" } else { "+" };
-                    out.push_str(&format!("  {sign} int({}) {}\n", i.region.name, expr(&i.integrand)));
+                    out.push_str(&format!(
+                        "  {sign} int({}) {}\n",
+                        i.region.name,
+                        expr(&i.integrand)
+                    ));
                 }
             }
         }

@@ -1,0 +1,266 @@
+//! Rust code for a checked unit: a module with `Params` (defaults and ranges from the file),
+//! `Coefficients` (the case data), and one struct per form implementing the runtime's
+//! `Form` and `FormKernel<D, N>` for D = 1, 2, 3 and every node count N.
+//!
+//! Code is built as text, parsed by syn (so a generator bug is an error, not bad code), and
+//! formatted by prettyplease for people to read.
+
+mod kernel;
+pub mod names;
+
+use std::fmt::Write;
+
+use crate::check::Program;
+use crate::ir::{self, DimIr};
+use crate::syntax::ast::Shape;
+use names::{camel, ident};
+
+/// Where the generated code finds the runtime (the facade re-exports it).
+pub const DEFAULT_RUNTIME: &str = "::signorini::runtime";
+
+pub struct Options {
+    /// Path of the runtime crate in the generated code.
+    pub runtime: String,
+    /// Name of the generated module.
+    pub module: String,
+    /// Shown in the module's documentation.
+    pub source_name: String,
+}
+
+/// Generated code of a unit, as a syn file (one `pub mod`).
+pub fn generate(prog: &Program, opts: &Options) -> Result<syn::File, String> {
+    let irs: Vec<DimIr> = ir::DIMS.iter().map(|&d| ir::build(prog, d)).collect();
+    let text = module_text(prog, &irs, opts);
+    syn::parse_file(&text)
+        .map_err(|e| format!("internal error: generated code does not parse: {e}\n{text}"))
+}
+
+/// Generated code formatted for reading, with its line count in a header comment.
+pub fn generate_pretty(prog: &Program, opts: &Options) -> Result<String, String> {
+    let file = generate(prog, opts)?;
+    let code = prettyplease::unparse(&file);
+    Ok(format!(
+        "// {} lines generated from {}\n{code}",
+        code.lines().count(),
+        opts.source_name
+    ))
+}
+
+fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
+    let rt = &opts.runtime;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "/// Kernels compiled from `{}` by signorini.",
+        opts.source_name
+    );
+    let _ = writeln!(s, "pub mod {} {{", ident(&opts.module));
+    s.push_str("#![allow(non_snake_case, non_camel_case_types, unused_variables, unused_mut, unused_parens, clippy::all)]\n");
+    let _ = writeln!(
+        s,
+        "use {rt}::kernel::{{CellCtx, Coef, FacetCtx, Form, FormKernel, FormMeta, LocalMatrix, LocalVector, ParamError, ParamRange, check_coef, check_param, heaviside}};"
+    );
+    let _ = writeln!(s, "use {rt}::geometry;");
+    s.push_str(&params_text(prog));
+    s.push_str(&coefs_text(prog));
+    let taken: Vec<String> = vec!["Params".into(), "Coefficients".into()];
+    let mut struct_names: Vec<String> = Vec::new();
+    for form in &prog.forms {
+        let mut name = camel(&form.name);
+        while taken.contains(&name) || struct_names.contains(&name) {
+            name.push_str("Form");
+        }
+        struct_names.push(name);
+    }
+    for (fi, form) in prog.forms.iter().enumerate() {
+        let sname = &struct_names[fi];
+        let ir2 = &irs[1].forms[fi];
+        let fields: Vec<String> = form
+            .fields
+            .iter()
+            .map(|f| format!("{:?}", f.name))
+            .collect();
+        let sig = format!(
+            "{}({}; {})",
+            form.name,
+            form.fields
+                .iter()
+                .map(|f| f.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            form.test.name
+        );
+        let _ = writeln!(
+            s,
+            "/// `form {sig}`{}",
+            if ir2.linear {
+                " (linear: its tangent does not depend on the fields)"
+            } else {
+                ""
+            }
+        );
+        let _ = writeln!(
+            s,
+            "#[derive(Clone, Debug)]\npub struct {sname} {{ params: Params, coefs: Coefficients }}"
+        );
+        let _ = writeln!(
+            s,
+            "impl {sname} {{ pub fn new(params: &Params, coefs: &Coefficients) -> Self {{ {sname} {{ params: *params, coefs: coefs.clone() }} }} }}"
+        );
+        let cell_degree = ir2
+            .integrals
+            .iter()
+            .find(|i| i.cell)
+            .map_or("None".to_string(), |i| {
+                format!("Some([{}, {}])", i.degree[0], i.degree[1])
+            });
+        let facets: Vec<String> = ir2
+            .integrals
+            .iter()
+            .filter(|i| !i.cell)
+            .map(|i| format!("({:?}, [{}, {}])", i.region, i.degree[0], i.degree[1]))
+            .collect();
+        let _ = writeln!(
+            s,
+            "impl Form for {sname} {{ const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, cell_degree: {cell_degree}, facets: &[{}] }}; }}",
+            form.name,
+            fields.join(", "),
+            form.test.name,
+            irs.iter().all(|ir| ir.forms[fi].linear),
+            facets.join(", ")
+        );
+        for ir in irs {
+            s.push_str(&kernel::form_impl(prog, ir, &ir.forms[fi], sname));
+        }
+    }
+    s.push_str("}\n");
+    s
+}
+
+fn params_text(prog: &Program) -> String {
+    let mut s = String::new();
+    let names: Vec<String> = prog
+        .params
+        .iter()
+        .map(|p| format!("{:?}", p.name))
+        .collect();
+    s.push_str("/// Parameters, with the defaults and ranges declared in the source. Values are range-checked\n/// when set.\n");
+    s.push_str("#[derive(Clone, Copy, Debug, PartialEq)]\npub struct Params {\n");
+    for p in &prog.params {
+        let _ = writeln!(s, "{}: f64,", ident(&p.name));
+    }
+    s.push_str("}\n");
+    s.push_str("impl Default for Params { fn default() -> Self { Params {\n");
+    for p in &prog.params {
+        let _ = writeln!(s, "{}: {:?},", ident(&p.name), p.default);
+    }
+    s.push_str("} } }\n");
+    s.push_str("impl Params {\n");
+    let _ = writeln!(
+        s,
+        "/// Parameter names, in declaration order.\npub const NAMES: &'static [&'static str] = &[{}];",
+        names.join(", ")
+    );
+    s.push_str("/// Declared ranges, in declaration order.\npub const RANGES: &'static [ParamRange] = &[\n");
+    for p in &prog.params {
+        let r = p.range.unwrap_or(crate::check::ParamRange {
+            lo: f64::NEG_INFINITY,
+            lo_closed: false,
+            hi: f64::INFINITY,
+            hi_closed: false,
+        });
+        let _ = writeln!(
+            s,
+            "ParamRange {{ name: {:?}, lo: {}, lo_closed: {}, hi: {}, hi_closed: {} }},",
+            p.name,
+            float(r.lo),
+            r.lo_closed,
+            float(r.hi),
+            r.hi_closed
+        );
+    }
+    s.push_str("];\n");
+    for p in &prog.params {
+        let range = p
+            .range
+            .map_or(String::new(), |r| format!(" in {}", r.describe()));
+        let _ = writeln!(
+            s,
+            "/// `{}` (default {:?}{range}).\npub fn {}(&self) -> f64 {{ self.{} }}",
+            p.name,
+            p.default,
+            ident(&p.name),
+            ident(&p.name)
+        );
+    }
+    s.push_str("/// The value of a parameter by name.\npub fn get(&self, name: &str) -> Option<f64> { match name {\n");
+    for p in &prog.params {
+        let _ = writeln!(s, "{:?} => Some(self.{}),", p.name, ident(&p.name));
+    }
+    s.push_str("_ => None } }\n");
+    s.push_str("/// Sets a parameter by name, refusing unknown names and values outside the declared range.\n");
+    s.push_str(
+        "pub fn set(&mut self, name: &str, value: f64) -> Result<(), ParamError> { match name {\n",
+    );
+    for (i, p) in prog.params.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "{:?} => self.{} = check_param(&Self::RANGES[{i}], value)?,",
+            p.name,
+            ident(&p.name)
+        );
+    }
+    s.push_str("_ => return Err(ParamError::Unknown { name: name.to_string(), known: Self::NAMES }),\n} Ok(()) }\n");
+    s.push_str("/// `set`, by value.\npub fn with(mut self, name: &str, value: f64) -> Result<Self, ParamError> { self.set(name, value)?; Ok(self) }\n");
+    s.push_str("}\n");
+    s
+}
+
+fn float(v: f64) -> String {
+    if v == f64::INFINITY {
+        "f64::INFINITY".into()
+    } else if v == f64::NEG_INFINITY {
+        "f64::NEG_INFINITY".into()
+    } else {
+        format!("{v:?}")
+    }
+}
+
+fn coefs_text(prog: &Program) -> String {
+    let mut s = String::new();
+    s.push_str(
+        "/// Case data (`coef` declarations): constants or functions of position and time.\n",
+    );
+    s.push_str("#[derive(Clone, Debug");
+    if prog.coefs.is_empty() {
+        s.push_str(", Default");
+    }
+    s.push_str(")]\npub struct Coefficients {\n");
+    for c in &prog.coefs {
+        let _ = writeln!(
+            s,
+            "/// `coef {}: {}`\npub {}: Coef,",
+            c.name,
+            c.shape.name(),
+            ident(&c.name)
+        );
+    }
+    s.push_str("}\n");
+    s.push_str("impl Coefficients {\n/// Checks that every coef has the number of components its shape needs in dimension `dim`.\n");
+    s.push_str("pub fn check(&self, dim: usize) -> Result<(), ::std::string::String> {\n");
+    for c in &prog.coefs {
+        let rank = match c.shape {
+            Shape::Scalar => 0,
+            Shape::Vector => 1,
+            Shape::Tensor => 2,
+        };
+        let _ = writeln!(
+            s,
+            "check_coef({:?}, &self.{}, {rank}, dim).map_err(|e| e.to_string())?;",
+            c.name,
+            ident(&c.name)
+        );
+    }
+    s.push_str("Ok(()) }\n}\n");
+    s
+}

@@ -1,0 +1,308 @@
+//! The element catalogue: reference cells, Lagrange P1/P2 basis functions and their
+//! gradients, local facets with their reference outward normals. Node order is Gmsh's.
+//!
+//! Reference cells: interval [0, 1]; triangle (0,0), (1,0), (0,1); tetrahedron (0,0,0),
+//! (1,0,0), (0,1,0), (0,0,1). P2 edge nodes: triangle 3:(0,1) 4:(1,2) 5:(2,0); tetrahedron
+//! 4:(0,1) 5:(1,2) 6:(0,2) 7:(0,3) 8:(2,3) 9:(1,3).
+
+/// The element types of the catalogue. Geometry is isoparametric: a P2 cell is curved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ElementKind {
+    IntervalP1,
+    TriangleP1,
+    TriangleP2,
+    TetrahedronP1,
+    TetrahedronP2,
+}
+
+/// Vertices of the reference triangle's edges, in facet order.
+const TRIANGLE_FACETS: [[usize; 2]; 3] = [[0, 1], [1, 2], [2, 0]];
+/// Vertices of the reference tetrahedron's faces, in facet order.
+const TET_FACETS: [[usize; 3]; 4] = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
+/// Vertex pairs of the P2 tetrahedron's edge nodes 4..10.
+const TET_EDGES: [[usize; 2]; 6] = [[0, 1], [1, 2], [0, 2], [0, 3], [2, 3], [1, 3]];
+/// Vertex pairs of the P2 triangle's edge nodes 3..6.
+const TRIANGLE_EDGES: [[usize; 2]; 3] = [[0, 1], [1, 2], [2, 0]];
+
+impl ElementKind {
+    pub const ALL: [ElementKind; 5] = [
+        ElementKind::IntervalP1,
+        ElementKind::TriangleP1,
+        ElementKind::TriangleP2,
+        ElementKind::TetrahedronP1,
+        ElementKind::TetrahedronP2,
+    ];
+
+    pub fn dim(self) -> usize {
+        match self {
+            ElementKind::IntervalP1 => 1,
+            ElementKind::TriangleP1 | ElementKind::TriangleP2 => 2,
+            ElementKind::TetrahedronP1 | ElementKind::TetrahedronP2 => 3,
+        }
+    }
+
+    pub fn degree(self) -> u32 {
+        match self {
+            ElementKind::IntervalP1 | ElementKind::TriangleP1 | ElementKind::TetrahedronP1 => 1,
+            ElementKind::TriangleP2 | ElementKind::TetrahedronP2 => 2,
+        }
+    }
+
+    /// Number of nodes (scalar basis functions).
+    pub fn nodes(self) -> usize {
+        match self {
+            ElementKind::IntervalP1 => 2,
+            ElementKind::TriangleP1 => 3,
+            ElementKind::TriangleP2 => 6,
+            ElementKind::TetrahedronP1 => 4,
+            ElementKind::TetrahedronP2 => 10,
+        }
+    }
+
+    pub fn vertices(self) -> usize {
+        self.dim() + 1
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ElementKind::IntervalP1 => "P1 interval",
+            ElementKind::TriangleP1 => "P1 triangle",
+            ElementKind::TriangleP2 => "P2 triangle",
+            ElementKind::TetrahedronP1 => "P1 tetrahedron",
+            ElementKind::TetrahedronP2 => "P2 tetrahedron",
+        }
+    }
+
+    /// Reference coordinates of the vertices.
+    pub fn reference_vertices(self) -> Vec<Vec<f64>> {
+        match self.dim() {
+            1 => vec![vec![0.0], vec![1.0]],
+            2 => vec![vec![0.0, 0.0], vec![1.0, 0.0], vec![0.0, 1.0]],
+            _ => vec![
+                vec![0.0, 0.0, 0.0],
+                vec![1.0, 0.0, 0.0],
+                vec![0.0, 1.0, 0.0],
+                vec![0.0, 0.0, 1.0],
+            ],
+        }
+    }
+
+    /// Reference coordinates of all nodes, in node order.
+    pub fn reference_nodes(self) -> Vec<Vec<f64>> {
+        let v = self.reference_vertices();
+        let mid = |a: usize, b: usize| {
+            v[a].iter()
+                .zip(&v[b])
+                .map(|(x, y)| 0.5 * (x + y))
+                .collect::<Vec<f64>>()
+        };
+        let mut nodes = v.clone();
+        match self {
+            ElementKind::TriangleP2 => nodes.extend(TRIANGLE_EDGES.iter().map(|e| mid(e[0], e[1]))),
+            ElementKind::TetrahedronP2 => nodes.extend(TET_EDGES.iter().map(|e| mid(e[0], e[1]))),
+            _ => {}
+        }
+        nodes
+    }
+
+    /// Local facets as lists of local vertex indices.
+    pub fn facets(self) -> Vec<Vec<usize>> {
+        match self.dim() {
+            1 => vec![vec![0], vec![1]],
+            2 => TRIANGLE_FACETS.iter().map(|f| f.to_vec()).collect(),
+            _ => TET_FACETS.iter().map(|f| f.to_vec()).collect(),
+        }
+    }
+
+    /// Local nodes lying on each facet (vertices, then edge nodes for P2).
+    pub fn facet_nodes(self, facet: usize) -> Vec<usize> {
+        let verts = &self.facets()[facet];
+        let mut nodes = verts.clone();
+        let edges: &[[usize; 2]] = match self {
+            ElementKind::TriangleP2 => &TRIANGLE_EDGES,
+            ElementKind::TetrahedronP2 => &TET_EDGES,
+            _ => &[],
+        };
+        let offset = self.vertices();
+        for (e, pair) in edges.iter().enumerate() {
+            if verts.contains(&pair[0]) && verts.contains(&pair[1]) {
+                nodes.push(offset + e);
+            }
+        }
+        nodes
+    }
+
+    /// Outward unit normal of a reference facet.
+    pub fn reference_normal(self, facet: usize) -> Vec<f64> {
+        let s2 = std::f64::consts::FRAC_1_SQRT_2;
+        let s3 = 1.0 / 3f64.sqrt();
+        match (self.dim(), facet) {
+            (1, 0) => vec![-1.0],
+            (1, _) => vec![1.0],
+            (2, 0) => vec![0.0, -1.0],
+            (2, 1) => vec![s2, s2],
+            (2, _) => vec![-1.0, 0.0],
+            (_, 0) => vec![0.0, 0.0, -1.0],
+            (_, 1) => vec![0.0, -1.0, 0.0],
+            (_, 2) => vec![-1.0, 0.0, 0.0],
+            _ => vec![s3, s3, s3],
+        }
+    }
+
+    /// Values of all basis functions at a reference point.
+    pub fn basis(self, xi: &[f64]) -> Vec<f64> {
+        let l = barycentric(xi);
+        match self {
+            ElementKind::IntervalP1 | ElementKind::TriangleP1 | ElementKind::TetrahedronP1 => l,
+            ElementKind::TriangleP2 => p2(&l, &TRIANGLE_EDGES),
+            ElementKind::TetrahedronP2 => p2(&l, &TET_EDGES),
+        }
+    }
+
+    /// Reference gradients of all basis functions at a reference point: `[node][direction]`.
+    pub fn basis_gradients(self, xi: &[f64]) -> Vec<Vec<f64>> {
+        let d = self.dim();
+        let l = barycentric(xi);
+        let dl = barycentric_gradients(d);
+        match self {
+            ElementKind::IntervalP1 | ElementKind::TriangleP1 | ElementKind::TetrahedronP1 => dl,
+            ElementKind::TriangleP2 | ElementKind::TetrahedronP2 => {
+                let edges: &[[usize; 2]] = if d == 2 { &TRIANGLE_EDGES } else { &TET_EDGES };
+                let mut g: Vec<Vec<f64>> = (0..=d)
+                    .map(|i| dl[i].iter().map(|x| (4.0 * l[i] - 1.0) * x).collect())
+                    .collect();
+                for &[a, b] in edges {
+                    g.push(
+                        (0..d)
+                            .map(|k| 4.0 * (dl[a][k] * l[b] + l[a] * dl[b][k]))
+                            .collect(),
+                    );
+                }
+                g
+            }
+        }
+    }
+
+    /// Maps a point of the reference facet (interval [0,1] or triangle) into the reference cell,
+    /// and returns it with the facet's measure scaling (reference facet → cell facet).
+    pub fn facet_point(self, facet: usize, s: &[f64]) -> (Vec<f64>, f64) {
+        let v = self.reference_vertices();
+        let f = &self.facets()[facet];
+        match self.dim() {
+            1 => (v[f[0]].clone(), 1.0),
+            2 => {
+                let (a, b) = (&v[f[0]], &v[f[1]]);
+                let p = (0..2).map(|k| a[k] + s[0] * (b[k] - a[k])).collect();
+                let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+                (p, len)
+            }
+            _ => {
+                let (a, b, c) = (&v[f[0]], &v[f[1]], &v[f[2]]);
+                let p = (0..3)
+                    .map(|k| a[k] + s[0] * (b[k] - a[k]) + s[1] * (c[k] - a[k]))
+                    .collect();
+                let e1: Vec<f64> = (0..3).map(|k| b[k] - a[k]).collect();
+                let e2: Vec<f64> = (0..3).map(|k| c[k] - a[k]).collect();
+                let cross = [
+                    e1[1] * e2[2] - e1[2] * e2[1],
+                    e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0],
+                ];
+                (p, cross.iter().map(|x| x * x).sum::<f64>().sqrt())
+            }
+        }
+    }
+}
+
+/// Barycentric coordinates (λ0 = 1 − Σ ξ, λk = ξk).
+fn barycentric(xi: &[f64]) -> Vec<f64> {
+    let mut l = vec![1.0 - xi.iter().sum::<f64>()];
+    l.extend_from_slice(xi);
+    l
+}
+
+fn barycentric_gradients(d: usize) -> Vec<Vec<f64>> {
+    let mut g = vec![vec![-1.0; d]];
+    for k in 0..d {
+        g.push((0..d).map(|j| if j == k { 1.0 } else { 0.0 }).collect());
+    }
+    g
+}
+
+fn p2(l: &[f64], edges: &[[usize; 2]]) -> Vec<f64> {
+    let mut v: Vec<f64> = l.iter().map(|x| x * (2.0 * x - 1.0)).collect();
+    v.extend(edges.iter().map(|&[a, b]| 4.0 * l[a] * l[b]));
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_is_nodal_and_a_partition_of_unity() {
+        for kind in ElementKind::ALL {
+            let nodes = kind.reference_nodes();
+            assert_eq!(nodes.len(), kind.nodes());
+            for (i, xi) in nodes.iter().enumerate() {
+                let phi = kind.basis(xi);
+                for (j, p) in phi.iter().enumerate() {
+                    assert!(
+                        (p - f64::from(i == j)).abs() < 1e-14,
+                        "{kind:?} node {i} basis {j}"
+                    );
+                }
+                let grads = kind.basis_gradients(xi);
+                for k in 0..kind.dim() {
+                    assert!(grads.iter().map(|g| g[k]).sum::<f64>().abs() < 1e-13);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn gradients_match_finite_differences() {
+        for kind in ElementKind::ALL {
+            let d = kind.dim();
+            let xi: Vec<f64> = (0..d).map(|k| 0.17 + 0.05 * k as f64).collect();
+            let g = kind.basis_gradients(&xi);
+            for k in 0..d {
+                let (mut p, mut m) = (xi.clone(), xi.clone());
+                p[k] += 1e-6;
+                m[k] -= 1e-6;
+                let (bp, bm) = (kind.basis(&p), kind.basis(&m));
+                for j in 0..kind.nodes() {
+                    assert!(((bp[j] - bm[j]) / 2e-6 - g[j][k]).abs() < 1e-8);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn facet_nodes_lie_on_their_facet() {
+        for kind in ElementKind::ALL {
+            let nodes = kind.reference_nodes();
+            for f in 0..kind.facets().len() {
+                let n = kind.reference_normal(f);
+                let v0 = &nodes[kind.facets()[f][0]];
+                for &i in &kind.facet_nodes(f) {
+                    let dist: f64 = nodes[i]
+                        .iter()
+                        .zip(v0)
+                        .zip(&n)
+                        .map(|((x, y), nn)| (x - y) * nn)
+                        .sum();
+                    assert!(dist.abs() < 1e-14);
+                }
+                assert_eq!(
+                    kind.facet_nodes(f).len(),
+                    if kind.degree() == 1 {
+                        kind.dim()
+                    } else {
+                        3 * kind.dim() - 3
+                    }
+                );
+            }
+        }
+    }
+}

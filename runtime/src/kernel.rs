@@ -1,0 +1,468 @@
+//! The interface between compiled forms and the runtime: tabulated basis functions at
+//! quadrature points, the per-cell context a kernel reads, case data (`coef`), parameter
+//! errors, and the traits every generated form implements.
+//!
+//! Kernels *add* into their output (the caller zeroes it), so cell and facet contributions
+//! of several forms can accumulate in one element array. Vector dofs are node-major:
+//! local dof `D*j + k` is component `k` of node `j`.
+
+use std::fmt;
+use std::sync::Arc;
+
+use crate::element::ElementKind;
+use crate::quadrature::{Rule, simplex_rule};
+
+/// Element vector: `[node][component]`.
+pub type LocalVector<const D: usize, const N: usize> = [[f64; D]; N];
+/// Element matrix: `[test node][test component][trial node][trial component]`, the same
+/// memory as a row-major (N·D)×(N·D) matrix.
+pub type LocalMatrix<const D: usize, const N: usize> = [[[[f64; D]; N]; D]; N];
+
+/// Basis functions and reference gradients at the points of a quadrature rule.
+#[derive(Clone, Debug)]
+pub struct Tabulation<const D: usize, const N: usize> {
+    /// Reference weights (for facets: including the reference facet's measure).
+    pub weights: Vec<f64>,
+    pub phi: Vec<[f64; N]>,
+    pub dphi: Vec<[[f64; D]; N]>,
+}
+
+/// A tabulation on each local facet of a cell, with the reference outward normals.
+#[derive(Clone, Debug)]
+pub struct FacetTabulation<const D: usize, const N: usize> {
+    pub facets: Vec<(Tabulation<D, N>, [f64; D])>,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ShapeError(pub String);
+
+impl fmt::Display for ShapeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for ShapeError {}
+
+fn check_kind<const D: usize, const N: usize>(kind: ElementKind) -> Result<(), ShapeError> {
+    if kind.dim() != D || kind.nodes() != N {
+        return Err(ShapeError(format!(
+            "{} has dimension {} and {} nodes, not {D} and {N}",
+            kind.name(),
+            kind.dim(),
+            kind.nodes()
+        )));
+    }
+    Ok(())
+}
+
+impl<const D: usize, const N: usize> Tabulation<D, N> {
+    /// Tabulates `kind` at the points of a rule on the reference cell.
+    pub fn new(kind: ElementKind, rule: &Rule) -> Result<Self, ShapeError> {
+        check_kind::<D, N>(kind)?;
+        let mut t = Tabulation {
+            weights: rule.weights.clone(),
+            phi: Vec::new(),
+            dphi: Vec::new(),
+        };
+        for p in &rule.points {
+            t.push(kind, p);
+        }
+        Ok(t)
+    }
+
+    /// Tabulates `kind` with the cell rule of at least `degree`.
+    pub fn cell(kind: ElementKind, degree: u32) -> Result<Self, ShapeError> {
+        Self::new(kind, &simplex_rule(D, degree))
+    }
+
+    fn push(&mut self, kind: ElementKind, xi: &[f64]) {
+        let phi = kind.basis(xi);
+        let grads = kind.basis_gradients(xi);
+        self.phi.push(std::array::from_fn(|j| phi[j]));
+        self.dphi.push(std::array::from_fn(|j| {
+            std::array::from_fn(|k| grads[j][k])
+        }));
+    }
+
+    pub fn len(&self) -> usize {
+        self.weights.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.weights.is_empty()
+    }
+}
+
+impl<const D: usize, const N: usize> FacetTabulation<D, N> {
+    /// Volume basis functions and gradients at the points of a facet rule of at least `degree`
+    /// (Gauss on edges, a triangle rule on faces, the point itself in 1D), on every local facet.
+    pub fn new(kind: ElementKind, degree: u32) -> Result<Self, ShapeError> {
+        Self::with_rule(kind, &simplex_rule(D - 1, degree))
+    }
+
+    /// As `new`, with an explicit rule on the reference facet.
+    pub fn with_rule(kind: ElementKind, rule: &Rule) -> Result<Self, ShapeError> {
+        check_kind::<D, N>(kind)?;
+        let facets = (0..kind.facets().len())
+            .map(|f| {
+                let mut t = Tabulation {
+                    weights: Vec::new(),
+                    phi: Vec::new(),
+                    dphi: Vec::new(),
+                };
+                for (s, w) in rule.points.iter().zip(&rule.weights) {
+                    let (xi, scale) = kind.facet_point(f, s);
+                    t.weights.push(w * scale);
+                    t.push(kind, &xi);
+                }
+                let n = kind.reference_normal(f);
+                (t, std::array::from_fn(|k| n[k]))
+            })
+            .collect();
+        Ok(FacetTabulation { facets })
+    }
+}
+
+/// What a cell kernel reads besides the fields.
+pub struct CellCtx<'a, const D: usize, const N: usize> {
+    pub tab: &'a Tabulation<D, N>,
+    pub coords: &'a [[f64; D]; N],
+    pub t: f64,
+}
+
+/// What a facet kernel reads besides the fields: the tabulation on this facet, its reference
+/// normal, and the diameter of the cell carrying it.
+pub struct FacetCtx<'a, const D: usize, const N: usize> {
+    pub tab: &'a Tabulation<D, N>,
+    pub ref_normal: &'a [f64; D],
+    pub coords: &'a [[f64; D]; N],
+    pub h: f64,
+    pub t: f64,
+}
+
+/// Case data (`coef` in a .wf file): a constant or a function of position and time.
+#[derive(Clone)]
+pub enum Coef {
+    Constant(Vec<f64>),
+    Function {
+        components: usize,
+        f: Arc<dyn Fn(&[f64], f64, &mut [f64]) + Send + Sync>,
+    },
+}
+
+impl Coef {
+    pub fn scalar(v: f64) -> Self {
+        Coef::Constant(vec![v])
+    }
+
+    /// A constant vector or (row-major) tensor.
+    pub fn constant(v: impl Into<Vec<f64>>) -> Self {
+        Coef::Constant(v.into())
+    }
+
+    /// `f(x, t, out)` writes the `components` values at position `x` and time `t`.
+    pub fn function(
+        components: usize,
+        f: impl Fn(&[f64], f64, &mut [f64]) + Send + Sync + 'static,
+    ) -> Self {
+        Coef::Function {
+            components,
+            f: Arc::new(f),
+        }
+    }
+
+    pub fn components(&self) -> usize {
+        match self {
+            Coef::Constant(v) => v.len(),
+            Coef::Function { components, .. } => *components,
+        }
+    }
+
+    #[inline]
+    pub fn eval(&self, x: &[f64], t: f64, out: &mut [f64]) {
+        match self {
+            Coef::Constant(v) => {
+                let n = v.len().min(out.len());
+                out[..n].copy_from_slice(&v[..n]);
+            }
+            Coef::Function { f, .. } => f(x, t, out),
+        }
+    }
+}
+
+impl fmt::Debug for Coef {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Coef::Constant(v) => write!(f, "Coef::Constant({v:?})"),
+            Coef::Function { components, .. } => {
+                write!(f, "Coef::Function({components} components)")
+            }
+        }
+    }
+}
+
+/// Checks that a coef has the number of components its declared shape needs in dimension `dim`.
+pub fn check_coef(name: &str, coef: &Coef, shape_rank: u32, dim: usize) -> Result<(), ShapeError> {
+    let want = dim.pow(shape_rank);
+    if coef.components() != want {
+        return Err(ShapeError(format!(
+            "coef `{name}` has {} components; it needs {want} in dimension {dim}",
+            coef.components()
+        )));
+    }
+    Ok(())
+}
+
+/// A parameter value refused by a generated `Params`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamError {
+    Unknown {
+        name: String,
+        known: &'static [&'static str],
+    },
+    OutOfRange {
+        name: &'static str,
+        value: f64,
+        range: String,
+    },
+}
+
+impl fmt::Display for ParamError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ParamError::Unknown { name, known } => write!(
+                f,
+                "unknown parameter `{name}` (known: {})",
+                known.join(", ")
+            ),
+            ParamError::OutOfRange { name, value, range } => write!(
+                f,
+                "parameter `{name}` = {value} is outside its range {range}"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for ParamError {}
+
+/// The declared range of a parameter (unbounded sides are infinite and open).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParamRange {
+    pub name: &'static str,
+    pub lo: f64,
+    pub lo_closed: bool,
+    pub hi: f64,
+    pub hi_closed: bool,
+}
+
+impl ParamRange {
+    pub fn contains(&self, v: f64) -> bool {
+        let above = if self.lo_closed {
+            v >= self.lo
+        } else {
+            v > self.lo
+        };
+        let below = if self.hi_closed {
+            v <= self.hi
+        } else {
+            v < self.hi
+        };
+        v.is_finite() && above && below
+    }
+}
+
+impl fmt::Display for ParamRange {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let b = |v: f64| {
+            if v.is_infinite() {
+                if v > 0.0 {
+                    "inf".to_string()
+                } else {
+                    "-inf".to_string()
+                }
+            } else {
+                format!("{v}")
+            }
+        };
+        write!(
+            f,
+            "{}{}, {}{}",
+            if self.lo_closed { "[" } else { "(" },
+            b(self.lo),
+            b(self.hi),
+            if self.hi_closed { "]" } else { ")" }
+        )
+    }
+}
+
+/// Range check used by generated `Params::set`: the value if it lies in the range.
+pub fn check_param(range: &ParamRange, value: f64) -> Result<f64, ParamError> {
+    if range.contains(value) {
+        Ok(value)
+    } else {
+        Err(ParamError::OutOfRange {
+            name: range.name,
+            value,
+            range: range.to_string(),
+        })
+    }
+}
+
+/// Static description of a compiled form.
+#[derive(Debug, Clone, Copy)]
+pub struct FormMeta {
+    pub name: &'static str,
+    pub fields: &'static [&'static str],
+    pub test: &'static str,
+    /// The tangent does not depend on the fields: assemble it once.
+    pub linear: bool,
+    /// Suggested cell quadrature degree for P1 and P2, if the form has a volume integral.
+    pub cell_degree: Option<[u32; 2]>,
+    /// Boundary regions with suggested facet quadrature degrees for P1 and P2.
+    pub facets: &'static [(&'static str, [u32; 2])],
+}
+
+/// Implemented by every generated form.
+pub trait Form {
+    const META: FormMeta;
+}
+
+/// Element kernels of a form for cells of dimension D with N nodes. Each method adds its
+/// contribution to `out`; forms without a volume (facet) integral add nothing there.
+pub trait FormKernel<const D: usize, const N: usize>: Form {
+    fn cell_residual(
+        &self,
+        ctx: &CellCtx<'_, D, N>,
+        fields: &[&LocalVector<D, N>],
+        out: &mut LocalVector<D, N>,
+    );
+    /// Derivative with respect to field argument `wrt`.
+    fn cell_tangent(
+        &self,
+        ctx: &CellCtx<'_, D, N>,
+        fields: &[&LocalVector<D, N>],
+        wrt: usize,
+        out: &mut LocalMatrix<D, N>,
+    );
+    /// `region` indexes `META.facets`.
+    fn facet_residual(
+        &self,
+        region: usize,
+        ctx: &FacetCtx<'_, D, N>,
+        fields: &[&LocalVector<D, N>],
+        out: &mut LocalVector<D, N>,
+    );
+    fn facet_tangent(
+        &self,
+        region: usize,
+        ctx: &FacetCtx<'_, D, N>,
+        fields: &[&LocalVector<D, N>],
+        wrt: usize,
+        out: &mut LocalMatrix<D, N>,
+    );
+}
+
+/// H(a) = 1 if a > 0, else 0 (so H(0) = 0).
+#[inline(always)]
+pub fn heaviside(a: f64) -> f64 {
+    if a > 0.0 { 1.0 } else { 0.0 }
+}
+
+/// Element residual of a form's volume integral on one cell (a fresh array, for tests and
+/// element-level checks; assembly reuses its buffers instead).
+pub fn cell_vector<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    k: &K,
+    tab: &Tabulation<D, N>,
+    coords: &[[f64; D]; N],
+    fields: &[&LocalVector<D, N>],
+    t: f64,
+) -> LocalVector<D, N> {
+    let mut out = [[0.0; D]; N];
+    k.cell_residual(&CellCtx { tab, coords, t }, fields, &mut out);
+    out
+}
+
+/// Element tangent of a form's volume integral on one cell, as a row-major (N·D)×(N·D) matrix.
+pub fn cell_matrix<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    k: &K,
+    tab: &Tabulation<D, N>,
+    coords: &[[f64; D]; N],
+    fields: &[&LocalVector<D, N>],
+    wrt: usize,
+    t: f64,
+) -> Vec<Vec<f64>> {
+    let mut out = Box::new([[[[0.0; D]; N]; D]; N]);
+    k.cell_tangent(&CellCtx { tab, coords, t }, fields, wrt, &mut out);
+    flatten(&out)
+}
+
+/// Facet residual of region `region` on local facet `facet`.
+#[allow(clippy::too_many_arguments)]
+pub fn facet_vector<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    k: &K,
+    region: usize,
+    tab: &FacetTabulation<D, N>,
+    facet: usize,
+    coords: &[[f64; D]; N],
+    h: f64,
+    fields: &[&LocalVector<D, N>],
+    t: f64,
+) -> LocalVector<D, N> {
+    let (ftab, normal) = &tab.facets[facet];
+    let mut out = [[0.0; D]; N];
+    k.facet_residual(
+        region,
+        &FacetCtx {
+            tab: ftab,
+            ref_normal: normal,
+            coords,
+            h,
+            t,
+        },
+        fields,
+        &mut out,
+    );
+    out
+}
+
+/// Facet tangent of region `region` on local facet `facet`, row-major.
+#[allow(clippy::too_many_arguments)]
+pub fn facet_matrix<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    k: &K,
+    region: usize,
+    tab: &FacetTabulation<D, N>,
+    facet: usize,
+    coords: &[[f64; D]; N],
+    h: f64,
+    fields: &[&LocalVector<D, N>],
+    wrt: usize,
+    t: f64,
+) -> Vec<Vec<f64>> {
+    let (ftab, normal) = &tab.facets[facet];
+    let mut out = Box::new([[[[0.0; D]; N]; D]; N]);
+    k.facet_tangent(
+        region,
+        &FacetCtx {
+            tab: ftab,
+            ref_normal: normal,
+            coords,
+            h,
+            t,
+        },
+        fields,
+        wrt,
+        &mut out,
+    );
+    flatten(&out)
+}
+
+fn flatten<const D: usize, const N: usize>(m: &LocalMatrix<D, N>) -> Vec<Vec<f64>> {
+    let mut rows = Vec::with_capacity(N * D);
+    for row_node in m.iter() {
+        for row in row_node.iter() {
+            rows.push(row.iter().flat_map(|col| col.iter().copied()).collect());
+        }
+    }
+    rows
+}
