@@ -15,7 +15,11 @@ fn gap(d: usize) -> Coef {
 }
 
 fn down(d: usize) -> Coef {
-    Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>())
+    Coef::constant(
+        (0..d)
+            .map(|k| if k == d - 1 { -1.0 } else { 0.0 })
+            .collect::<Vec<_>>(),
+    )
 }
 
 fn nitsche(theta: f64, gamma0: f64, e: f64, nu: f64, d: usize) -> contact_nitsche::Contact {
@@ -25,19 +29,34 @@ fn nitsche(theta: f64, gamma0: f64, e: f64, nu: f64, d: usize) -> contact_nitsch
         .and_then(|p| p.with("E", e))
         .and_then(|p| p.with("nu", nu))
         .unwrap();
-    let c = contact_nitsche::Coefficients { f: Coef::constant(vec![0.0; d]), g: gap(d), nc: down(d) };
+    let c = contact_nitsche::Coefficients {
+        f: Coef::constant(vec![0.0; d]),
+        g: gap(d),
+        nc: down(d),
+    };
     c.check(d).unwrap();
     contact_nitsche::Contact::new(&p, &c)
 }
 
 fn penalty(gamma0: f64, d: usize) -> contact_penalty::Contact {
-    let p = contact_penalty::Params::default().with("gamma0", gamma0).unwrap();
-    let c = contact_penalty::Coefficients { f: Coef::constant(vec![0.0; d]), g: gap(d), nc: down(d) };
+    let p = contact_penalty::Params::default()
+        .with("gamma0", gamma0)
+        .unwrap();
+    let c = contact_penalty::Coefficients {
+        f: Coef::constant(vec![0.0; d]),
+        g: gap(d),
+        nc: down(d),
+    };
     contact_penalty::Contact::new(&p, &c)
 }
 
 /// Max-norm relative difference between the tangent and central differences of the residual.
-fn fd_error<const D: usize, const N: usize, K: FormKernel<D, N>>(k: &K, tab: &FacetTabulation<D, N>, x: &[[f64; D]; N], u: &[[f64; D]; N]) -> f64 {
+fn fd_error<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    k: &K,
+    tab: &FacetTabulation<D, N>,
+    x: &[[f64; D]; N],
+    u: &[[f64; D]; N],
+) -> f64 {
     let h = signorini::runtime::geometry::diameter(x, D + 1);
     let jac = facet_matrix(k, 0, tab, 0, x, h, &[u], 0, 0.0);
     let scale = jac.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -57,7 +76,12 @@ fn fd_error<const D: usize, const N: usize, K: FormKernel<D, N>>(k: &K, tab: &Fa
     worst
 }
 
-fn tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(k: &K, tab: &FacetTabulation<D, N>, x: &[[f64; D]; N], u: &[[f64; D]; N]) -> Vec<Vec<f64>> {
+fn tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    k: &K,
+    tab: &FacetTabulation<D, N>,
+    x: &[[f64; D]; N],
+    u: &[[f64; D]; N],
+) -> Vec<Vec<f64>> {
     let h = signorini::runtime::geometry::diameter(x, D + 1);
     facet_matrix(k, 0, tab, 0, x, h, &[u], 0, 0.0)
 }
@@ -83,7 +107,12 @@ fn cell_2d() -> [[f64; 2]; 6] {
 /// A state whose normal displacement goes from penetrating to separated along the facet.
 fn state_2d(rng: &mut Rng, shift: f64) -> [[f64; 2]; 6] {
     let x = cell_2d();
-    std::array::from_fn(|j| [0.02 * rng.next(), 0.3 * (x[j][0] - 0.5) + 0.01 * rng.next() + shift])
+    std::array::from_fn(|j| {
+        [
+            0.02 * rng.next(),
+            0.3 * (x[j][0] - 0.5) + 0.01 * rng.next() + shift,
+        ]
+    })
 }
 
 fn check_2d<K: FormKernel<2, 6>>(k: &K, what: &str) {
@@ -93,21 +122,35 @@ fn check_2d<K: FormKernel<2, 6>>(k: &K, what: &str) {
     for trial in 0..5 {
         let u = state_2d(&mut rng, 0.0);
         let err = fd_error(k, &tab, &x, &u);
-        assert!(err < 1e-6, "{what}, trial {trial}: tangent differs from finite differences by {err:e}");
+        assert!(
+            err < 1e-6,
+            "{what}, trial {trial}: tangent differs from finite differences by {err:e}"
+        );
         // Mixed active set: the tangent differs from both the all-active state (pushed into
         // the obstacle) and the all-inactive one (lifted off it).
         let mixed = tangent(k, &tab, &x, &u);
         let all_in = tangent(k, &tab, &x, &u.map(|n| [n[0], n[1] - 10.0]));
         let all_out = tangent(k, &tab, &x, &u.map(|n| [n[0], n[1] + 10.0]));
-        let differ = |a: &[Vec<f64>], b: &[Vec<f64>]| a.iter().flatten().zip(b.iter().flatten()).any(|(p, q)| (p - q).abs() > 1e-8);
-        assert!(differ(&mixed, &all_in) && differ(&mixed, &all_out), "{what}, trial {trial}: the active set is not mixed");
+        let differ = |a: &[Vec<f64>], b: &[Vec<f64>]| {
+            a.iter()
+                .flatten()
+                .zip(b.iter().flatten())
+                .any(|(p, q)| (p - q).abs() > 1e-8)
+        };
+        assert!(
+            differ(&mixed, &all_in) && differ(&mixed, &all_out),
+            "{what}, trial {trial}: the active set is not mixed"
+        );
     }
 }
 
 #[test]
 fn nitsche_tangent_matches_finite_differences_in_2d() {
     for theta in [1.0, 0.0, -1.0] {
-        check_2d(&nitsche(theta, 5.0, 1.0, 0.3, 2), &format!("Nitsche θ = {theta}"));
+        check_2d(
+            &nitsche(theta, 5.0, 1.0, 0.3, 2),
+            &format!("Nitsche θ = {theta}"),
+        );
     }
 }
 
@@ -125,22 +168,35 @@ fn check_1d<K: FormKernel<1, 2>>(k: &K, what: &str) {
     for trial in 0..40 {
         let u = [[0.1 * rng.next()], [0.1 * rng.next()]];
         let err = fd_error(k, &tab, &x, &u);
-        assert!(err < 1e-6, "{what}, trial {trial}: tangent differs from finite differences by {err:e}");
+        assert!(
+            err < 1e-6,
+            "{what}, trial {trial}: tangent differs from finite differences by {err:e}"
+        );
         let j = tangent(k, &tab, &x, &u);
         let j_far = tangent(k, &tab, &x, &[[10.0], [10.0]]);
-        if j.iter().flatten().zip(j_far.iter().flatten()).any(|(p, q)| (p - q).abs() > 1e-8) {
+        if j.iter()
+            .flatten()
+            .zip(j_far.iter().flatten())
+            .any(|(p, q)| (p - q).abs() > 1e-8)
+        {
             active += 1;
         } else {
             inactive += 1;
         }
     }
-    assert!(active > 5 && inactive > 5, "{what}: {active} active and {inactive} inactive states");
+    assert!(
+        active > 5 && inactive > 5,
+        "{what}: {active} active and {inactive} inactive states"
+    );
 }
 
 #[test]
 fn contact_tangents_match_finite_differences_in_1d() {
     for theta in [1.0, 0.0, -1.0] {
-        check_1d(&nitsche(theta, 5.0, 1.0, 0.0, 1), &format!("Nitsche θ = {theta}"));
+        check_1d(
+            &nitsche(theta, 5.0, 1.0, 0.0, 1),
+            &format!("Nitsche θ = {theta}"),
+        );
     }
     check_1d(&penalty(5.0, 1), "penalty");
 }
@@ -162,10 +218,16 @@ fn one_dimensional_contact_residual_is_the_spec_kernel() {
             let su = s[0] * u[0][0] + s[1] * u[1][0];
             let p1 = su + gamma * u[0][0];
             let neg = p1.min(0.0);
-            let expect = [-theta / gamma * su * s[0] + neg / gamma * (theta * s[0] + gamma), -theta / gamma * su * s[1] + neg / gamma * theta * s[1]];
+            let expect = [
+                -theta / gamma * su * s[0] + neg / gamma * (theta * s[0] + gamma),
+                -theta / gamma * su * s[1] + neg / gamma * theta * s[1],
+            ];
             let got = facet_vector(&k, 0, &tab, 0, &x, h, &[&u], 0.0);
             for i in 0..2 {
-                assert!((got[i][0] - expect[i]).abs() < 1e-12 * (1.0 + expect[i].abs()), "θ = {theta}: {got:?} vs {expect:?}");
+                assert!(
+                    (got[i][0] - expect[i]).abs() < 1e-12 * (1.0 + expect[i].abs()),
+                    "θ = {theta}: {got:?} vs {expect:?}"
+                );
             }
         }
     }
@@ -174,6 +236,9 @@ fn one_dimensional_contact_residual_is_the_spec_kernel() {
         let u = [[0.05 * rng.next()], [0.05 * rng.next()]];
         let got = facet_vector(&k, 0, &tab, 0, &x, h, &[&u], 0.0);
         let expect = gamma * u[0][0].min(0.0);
-        assert!((got[0][0] - expect).abs() < 1e-12 && got[1][0] == 0.0, "penalty: {got:?} vs {expect}");
+        assert!(
+            (got[0][0] - expect).abs() < 1e-12 && got[1][0] == 0.0,
+            "penalty: {got:?} vs {expect}"
+        );
     }
 }

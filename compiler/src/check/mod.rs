@@ -42,6 +42,7 @@ pub struct Param {
     pub default: f64,
     pub range: Option<ParamRange>,
     pub span: Span,
+    pub name_span: Span,
     /// The default and range as written; `default` and `range` are their values.
     pub default_expr: Expr,
     pub range_expr: Option<ast::Range>,
@@ -199,13 +200,16 @@ fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
         }
         used
     };
+    // Unused-parameter warnings only for a unit without errors: a form that failed to check
+    // has not recorded what it uses.
+    let has_errors = diags.iter().any(Diagnostic::is_error);
     for (i, p) in prog.params.iter().enumerate() {
-        if p.span.file == prog.root && !used.contains(&i) {
+        if !has_errors && p.span.file == prog.root && !used.contains(&i) {
             diags.push(
                 Diagnostic::warning(
                     "W0001",
                     format!("unused param `{}`", p.name),
-                    p.span,
+                    p.name_span,
                     "no form uses this parameter",
                 )
                 .with_help("remove it, or use it in a form"),
@@ -269,6 +273,7 @@ fn declare(prog: &mut Program, files: &[(FileId, ast::File)], diags: &mut Vec<Di
                         default: f64::NAN,
                         range: None,
                         span: *span,
+                        name_span: name.span,
                         default_expr: default.clone(),
                         range_expr: range.clone(),
                     });
@@ -357,7 +362,7 @@ fn suggest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<
     candidates
         .filter(|c| *c != name)
         .map(|c| (strsim::damerau_levenshtein(name, c), c))
-        .filter(|(d, c)| *d <= 2.max(c.len() / 3) && *d < c.len().max(name.len()))
+        .filter(|(d, c)| *d <= 1.max(name.len() / 3) && *d < c.len())
         .min()
         .map(|(_, c)| c.to_string())
 }

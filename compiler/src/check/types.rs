@@ -642,6 +642,9 @@ impl<'p> Checker<'p> {
                 ty
             }
             Some(g) => {
+                if let Global::Param(i) = g {
+                    self.used_params.insert(*i);
+                }
                 let kind = g.kind();
                 let mut d = Diagnostic::error(
                     "E0204",

@@ -20,7 +20,7 @@ const ITEM_KEYWORDS: &[&str] = &["import", "param", "coef", "let", "fn", "form",
 /// neither the parser nor the recursive checks can exhaust the stack.
 pub const MAX_NESTING: usize = 64;
 /// Most operators accepted in one item, for the same reason (left-deep sums).
-pub const MAX_OPERATORS: usize = 4096;
+pub const MAX_OPERATORS: usize = 1000;
 
 static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
     PrattParser::new()
@@ -181,34 +181,77 @@ fn syntax_error(
     offset: usize,
     e: &pest::error::Error<Rule>,
 ) -> Diagnostic {
-    let pos = match e.location {
+    let mut pos = match e.location {
         pest::error::InputLocation::Pos(p) => p,
         pest::error::InputLocation::Span((s, _)) => s,
     };
-    let mut expected: Vec<String> = Vec::new();
+    let mut rules: Vec<Rule> = Vec::new();
+    let mut tokens: Vec<String> = Vec::new();
     if let pest::error::ErrorVariant::ParsingError { positives, .. } = &e.variant {
-        for r in positives {
-            if let Some(name) = rule_name(*r) {
-                expected.push(name.to_string());
+        rules.extend(positives);
+    }
+    // With error detail on, pest also records the furthest point any alternative reached,
+    // which is where the mistake is.
+    if let Some(attempts) = e.parse_attempts() {
+        if attempts.max_position >= pos {
+            if attempts.max_position > pos {
+                rules.clear();
             }
+            pos = attempts.max_position;
+            for stack in &attempts.call_stacks {
+                rules.extend(stack.deepest.get_rule().copied());
+                rules.extend(stack.parent);
+            }
+            tokens.extend(attempts.expected_tokens().iter().map(|t| t.to_string()));
         }
     }
-    if let Some(attempts) = e.parse_attempts() {
-        for t in attempts.expected_tokens() {
-            let token = t.to_string();
-            let punctuation = token.chars().all(|c| c.is_ascii_punctuation());
-            if punctuation && !matches!(token.as_str(), "//" | "/*" | "*/" | "\"" | "." | "..") {
-                expected.push(format!("`{token}`"));
-            }
+    let mut expected: Vec<String> = rules
+        .iter()
+        .filter_map(|r| rule_name(*r))
+        .map(str::to_string)
+        .collect();
+    let has = |what: &str, list: &[String]| list.iter().any(|e| e == what);
+    let expression = has("an expression", &expected);
+    let operator = has("an operator", &expected);
+    for t in tokens {
+        let punctuation = t.chars().all(|c| c.is_ascii_punctuation());
+        let part_of_expression = expression && matches!(t.as_str(), "(" | "-" | "_" | ".");
+        let part_of_operator = operator && matches!(t.as_str(), "+" | "-" | "*" | "/" | "^");
+        if punctuation
+            && !part_of_expression
+            && !part_of_operator
+            && !matches!(t.as_str(), "//" | "/*" | "*/" | "\"" | "." | "_")
+        {
+            expected.push(format!("`{t}`"));
         }
+    }
+    if expression {
+        expected.retain(|e| e != "a name" && e != "a number");
+    }
+    // Redundant alternatives: a new item may always follow a complete one; the sign and
+    // `int(` tokens are spelled out by the integral rule.
+    const ITEM: &str = "an item (`import`, `param`, `coef`, `let`, `fn`, `form`)";
+    if expected.len() > 1 {
+        expected.retain(|e| e != ITEM);
+    }
+    if has("an integral `int(REGION) ...`", &expected) {
+        expected.retain(|e| !matches!(e.as_str(), "`+`" | "`-`" | "`+` or `-`" | "`int(REGION)`"));
     }
     expected.sort();
     expected.dedup();
-    let found = found_token(&chunk[pos.min(chunk.len())..]);
-    let span_len = if found.is_empty() { 0 } else { found.len() };
-    let span = Span::new(file, offset + pos, offset + pos + span_len);
-    let found_text = if found.is_empty() {
-        "end of input".to_string()
+    // A failure at the end of the chunk is a missing continuation: point just after the last
+    // token of the item rather than at the next item.
+    let content_end = content_end(chunk);
+    let at_end = pos >= content_end;
+    let pos = pos.min(content_end);
+    let found = if at_end {
+        ""
+    } else {
+        found_token(&chunk[pos..])
+    };
+    let span = Span::new(file, offset + pos, offset + pos + found.len());
+    let found_text = if at_end {
+        "the end of the item".to_string()
     } else {
         format!("`{found}`")
     };
@@ -218,14 +261,51 @@ fn syntax_error(
         format!("expected {}, found {found_text}", join_or(&expected))
     };
     let mut d = Diagnostic::error("E0001", "syntax error", span, message);
+    let keyword = chunk.split_whitespace().next().unwrap_or("");
     if found == "=" && expected.iter().any(|e| e == "`(`") {
         d = d.with_help("a function needs its parameters: `fn name(arg) = ...`");
+    } else if keyword == "coef" && found == "=" {
+        d = d.with_help("a coef is case data supplied at run time (`coef g`, `coef nc: vector`); use `param` for a number");
     } else if found == ":" {
         d = d.with_help(
             "declare case data with `coef NAME: vector`; parameters are `param NAME = VALUE`",
         );
     }
     d
+}
+
+/// Offset just after the last character of the chunk that is not whitespace or a comment.
+fn content_end(chunk: &str) -> usize {
+    let mut end = 0;
+    let mut in_line_comment = false;
+    let mut in_block = false;
+    let bytes = chunk.as_bytes();
+    let mut i = 0;
+    while i < bytes.len() {
+        if in_line_comment {
+            if bytes[i] == b'\n' {
+                in_line_comment = false;
+            }
+        } else if in_block {
+            if bytes[i..].starts_with(b"*/") {
+                in_block = false;
+                i += 1;
+            }
+        } else if bytes[i..].starts_with(b"//") {
+            in_line_comment = true;
+        } else if bytes[i..].starts_with(b"/*") {
+            in_block = true;
+            i += 1;
+        } else if !bytes[i].is_ascii_whitespace() {
+            end = i + 1;
+        }
+        i += 1;
+    }
+    // Land on a character boundary.
+    while !chunk.is_char_boundary(end) {
+        end += 1;
+    }
+    end
 }
 
 fn join_or(items: &[String]) -> String {
@@ -274,7 +354,6 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::integral => "`int(REGION)`",
         Rule::integrals => "an integral `int(REGION) ...`",
         Rule::form_args | Rule::ident_list => "argument names",
-        Rule::EOI => return None,
         _ => return None,
     })
 }
@@ -285,9 +364,15 @@ struct Builder {
 }
 
 impl Builder {
+    /// The span of a pair without the whitespace pest may have consumed at its end.
     fn span(&self, p: &Pair<Rule>) -> Span {
         let s = p.as_span();
-        Span::new(self.file, self.offset + s.start(), self.offset + s.end())
+        let trimmed = s.as_str().trim_end().len();
+        Span::new(
+            self.file,
+            self.offset + s.start(),
+            self.offset + s.start() + trimmed,
+        )
     }
 
     fn ident(&self, p: Pair<Rule>) -> Ident {

@@ -1,0 +1,69 @@
+//! Snapshots of every stage for every file of the form library (`forms/`): the AST, the IR in
+//! 2D, and the generated Rust (whose first line records its length in lines).
+
+use std::path::{Path, PathBuf};
+
+use signorini_compiler::{FsLoader, check_path, codegen, ir, syntax};
+
+fn library() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for dir in ["../forms", "../forms/schemes"] {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            continue;
+        };
+        files.extend(
+            entries
+                .map(|e| e.expect("readable entry").path())
+                .filter(|p| p.extension().is_some_and(|e| e == "wf")),
+        );
+    }
+    files.sort();
+    files
+}
+
+fn stem(p: &Path) -> String {
+    p.file_stem().unwrap().to_string_lossy().into_owned()
+}
+
+#[test]
+fn library_compiles_without_warnings() {
+    let files = library();
+    assert!(files.len() >= 3);
+    for f in &files {
+        let (_, warnings) =
+            check_path(f, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", f.display()));
+        assert!(warnings.is_empty(), "{}:\n{warnings}", f.display());
+    }
+}
+
+#[test]
+fn generated_rust_snapshots() {
+    for f in library() {
+        let (prog, _) = check_path(&f, &FsLoader).unwrap();
+        let opts = codegen::Options {
+            runtime: codegen::DEFAULT_RUNTIME.into(),
+            module: stem(&f),
+            source_name: signorini_compiler::display_name(&f),
+        };
+        let code = codegen::generate_pretty(&prog, &opts).unwrap();
+        insta::with_settings!({ snapshot_path => "snapshots/rust", prepend_module_to_snapshot => false }, {
+            insta::assert_snapshot!(stem(&f), code);
+        });
+    }
+}
+
+#[test]
+fn ast_and_ir_snapshots() {
+    for f in library() {
+        let (prog, _) = check_path(&f, &FsLoader).unwrap();
+        let (ast, _) = syntax::parse(prog.root, prog.sources.text(prog.root));
+        let ast_text = syntax::print::print_file(&ast, &prog.sources);
+        let params: Vec<String> = prog.params.iter().map(|p| p.name.clone()).collect();
+        let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
+        let ir_text = ir::print::print(&ir::build(&prog, 2), &params, &coefs);
+        insta::with_settings!({ snapshot_path => "snapshots/stages", prepend_module_to_snapshot => false }, {
+            insta::assert_snapshot!(format!("{}.ast", stem(&f)), ast_text);
+            insta::assert_snapshot!(format!("{}.ir2d", stem(&f)), ir_text);
+        });
+    }
+}
