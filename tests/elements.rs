@@ -27,10 +27,7 @@ fn params(e: f64, nu: f64, rho: f64) -> Params {
 }
 
 fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
-    assert!(
-        (a - b).abs() <= tol * b.abs().max(1.0),
-        "{what}: {a} vs {b}"
-    );
+    assert!((a - b).abs() <= tol * b.abs().max(1.0), "{what}: {a} vs {b}");
 }
 
 #[test]
@@ -40,14 +37,7 @@ fn p1_interval_stiffness_and_mass_are_the_textbook_matrices() {
     let coords = [[1.0], [1.0 + h]];
     let zero = [[0.0; 1]; 2];
     let tab = Tabulation::<1, 2>::cell(ElementKind::IntervalP1, 2).unwrap();
-    let k = cell_matrix(
-        &Stiffness::new(&p, &coefs(1)),
-        &tab,
-        &coords,
-        &[&zero],
-        0,
-        0.0,
-    );
+    let k = cell_matrix(&Stiffness::new(&p, &coefs(1)), &tab, &coords, &[&zero], 0, 0.0);
     let m = cell_matrix(&Mass::new(&p, &coefs(1)), &tab, &coords, &[&zero], 0, 0.0);
     let k_exact = [[1.0, -1.0], [-1.0, 1.0]].map(|r| r.map(|x| e / h * x));
     let m_exact = [[2.0, 1.0], [1.0, 2.0]].map(|r| r.map(|x| rho * h / 6.0 * x));
@@ -78,19 +68,12 @@ fn straight_triangle() -> [[f64; 2]; 6] {
 /// Area of a P2 triangle by Green's theorem along its three quadratic edges.
 fn triangle_area(x: &[[f64; 2]; 6]) -> f64 {
     let edges = [(0, 3, 1), (1, 4, 2), (2, 5, 0)];
-    let gauss = [
-        (0.5 - 0.5 / 3f64.sqrt(), 0.5),
-        (0.5 + 0.5 / 3f64.sqrt(), 0.5),
-    ];
+    let gauss = [(0.5 - 0.5 / 3f64.sqrt(), 0.5), (0.5 + 0.5 / 3f64.sqrt(), 0.5)];
     let mut area = 0.0;
     for (a, m, b) in edges {
         for (s, w) in gauss {
             // Quadratic through a (s=0), m (s=1/2), b (s=1).
-            let l = [
-                (1.0 - s) * (1.0 - 2.0 * s),
-                4.0 * s * (1.0 - s),
-                s * (2.0 * s - 1.0),
-            ];
+            let l = [(1.0 - s) * (1.0 - 2.0 * s), 4.0 * s * (1.0 - s), s * (2.0 * s - 1.0)];
             let dl = [4.0 * s - 3.0, 4.0 - 8.0 * s, 4.0 * s - 1.0];
             let p = |k: usize| l[0] * x[a][k] + l[1] * x[m][k] + l[2] * x[b][k];
             let dp = |k: usize| dl[0] * x[a][k] + dl[1] * x[m][k] + dl[2] * x[b][k];
@@ -101,15 +84,10 @@ fn triangle_area(x: &[[f64; 2]; 6]) -> f64 {
 }
 
 fn matvec(m: &[Vec<f64>], v: &[f64]) -> Vec<f64> {
-    m.iter()
-        .map(|r| r.iter().zip(v).map(|(a, b)| a * b).sum())
-        .collect()
+    m.iter().map(|r| r.iter().zip(v).map(|(a, b)| a * b).sum()).collect()
 }
 
-fn check_symmetric_with_rigid_modes<const D: usize, const N: usize>(
-    k: &[Vec<f64>],
-    coords: &[[f64; D]; N],
-) {
+fn check_symmetric_with_rigid_modes<const D: usize, const N: usize>(k: &[Vec<f64>], coords: &[[f64; D]; N]) {
     let scale = k.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
     for i in 0..N * D {
         for j in 0..N * D {
@@ -122,11 +100,7 @@ fn check_symmetric_with_rigid_modes<const D: usize, const N: usize>(
     // Translations and infinitesimal rotations: e_a and x ↦ x_b e_a − x_a e_b.
     let mut modes: Vec<Vec<f64>> = Vec::new();
     for a in 0..D {
-        modes.push(
-            (0..N * D)
-                .map(|r| if r % D == a { 1.0 } else { 0.0 })
-                .collect(),
-        );
+        modes.push((0..N * D).map(|r| if r % D == a { 1.0 } else { 0.0 }).collect());
         for b in a + 1..D {
             modes.push(
                 (0..N * D)
@@ -157,11 +131,7 @@ fn check_symmetric_with_rigid_modes<const D: usize, const N: usize>(
     let stretch: Vec<f64> = (0..N * D)
         .map(|r| if r % D == 0 { coords[r / D][0] } else { 0.0 })
         .collect();
-    let energy: f64 = stretch
-        .iter()
-        .zip(matvec(k, &stretch))
-        .map(|(a, b)| a * b)
-        .sum();
+    let energy: f64 = stretch.iter().zip(matvec(k, &stretch)).map(|(a, b)| a * b).sum();
     assert!(energy > 1e-6 * scale);
 }
 
@@ -170,26 +140,14 @@ fn p2_triangle_stiffness_is_symmetric_with_three_rigid_modes() {
     let p = params(2.0, 0.3, 1.0);
     let tab = Tabulation::<2, 6>::cell(ElementKind::TriangleP2, 6).unwrap();
     for coords in [straight_triangle(), curved_triangle()] {
-        let k = cell_matrix(
-            &Stiffness::new(&p, &coefs(2)),
-            &tab,
-            &coords,
-            &[&[[0.0; 2]; 6]],
-            0,
-            0.0,
-        );
+        let k = cell_matrix(&Stiffness::new(&p, &coefs(2)), &tab, &coords, &[&[[0.0; 2]; 6]], 0, 0.0);
         check_symmetric_with_rigid_modes(&k, &coords);
     }
 }
 
 /// A P2 tetrahedron; `bulge` moves the midpoint of edge (0,1) off the straight line.
 fn tetrahedron(bulge: f64) -> [[f64; 3]; 10] {
-    let v = [
-        [0.0, 0.0, 0.0],
-        [1.2, 0.1, -0.1],
-        [0.2, 1.1, 0.1],
-        [0.1, 0.2, 0.9],
-    ];
+    let v = [[0.0, 0.0, 0.0], [1.2, 0.1, -0.1], [0.2, 1.1, 0.1], [0.1, 0.2, 0.9]];
     let edges = [[0, 1], [1, 2], [0, 2], [0, 3], [2, 3], [1, 3]];
     let mut x = [[0.0; 3]; 10];
     x[..4].copy_from_slice(&v);
@@ -217,9 +175,7 @@ fn tet_volume(x: &[[f64; 3]; 10]) -> f64 {
             let rv = kind.reference_vertices();
             let t1: Vec<f64> = (0..3).map(|k| rv[verts[1]][k] - rv[verts[0]][k]).collect();
             let t2: Vec<f64> = (0..3).map(|k| rv[verts[2]][k] - rv[verts[0]][k]).collect();
-            let pos: Vec<f64> = (0..3)
-                .map(|a| (0..10).map(|j| phi[j] * x[j][a]).sum())
-                .collect();
+            let pos: Vec<f64> = (0..3).map(|a| (0..10).map(|j| phi[j] * x[j][a]).sum()).collect();
             let dx = |t: &[f64]| -> Vec<f64> {
                 (0..3)
                     .map(|a| {
@@ -241,9 +197,7 @@ fn tet_volume(x: &[[f64; 3]; 10]) -> f64 {
                 let tn: Vec<f64> = (0..3)
                     .map(|a| {
                         (0..10)
-                            .map(|j| {
-                                x[j][a] * (0..3).map(|bb| dphi[j][bb] * n_ref[bb]).sum::<f64>()
-                            })
+                            .map(|j| x[j][a] * (0..3).map(|bb| dphi[j][bb] * n_ref[bb]).sum::<f64>())
                             .sum()
                     })
                     .collect();
@@ -280,46 +234,21 @@ fn mass_entries_sum_to_density_times_measure_times_dimension() {
     let p = params(1.0, 0.3, rho);
     let tab2 = Tabulation::<2, 6>::cell(ElementKind::TriangleP2, 6).unwrap();
     for coords in [straight_triangle(), curved_triangle()] {
-        let m = cell_matrix(
-            &Mass::new(&p, &coefs(2)),
-            &tab2,
-            &coords,
-            &[&[[0.0; 2]; 6]],
-            0,
-            0.0,
-        );
+        let m = cell_matrix(&Mass::new(&p, &coefs(2)), &tab2, &coords, &[&[[0.0; 2]; 6]], 0, 0.0);
         let sum: f64 = m.iter().flatten().sum();
-        assert_close(
-            sum,
-            rho * triangle_area(&coords) * 2.0,
-            1e-13,
-            "P2 triangle mass sum",
-        );
+        assert_close(sum, rho * triangle_area(&coords) * 2.0, 1e-13, "P2 triangle mass sum");
     }
     let tab3 = Tabulation::<3, 10>::cell(ElementKind::TetrahedronP2, 6).unwrap();
     for bulge in [0.0, 0.15] {
         let coords = tetrahedron(bulge);
-        let m = cell_matrix(
-            &Mass::new(&p, &coefs(3)),
-            &tab3,
-            &coords,
-            &[&[[0.0; 3]; 10]],
-            0,
-            0.0,
-        );
+        let m = cell_matrix(&Mass::new(&p, &coefs(3)), &tab3, &coords, &[&[[0.0; 3]; 10]], 0, 0.0);
         let sum: f64 = m.iter().flatten().sum();
-        assert_close(
-            sum,
-            rho * tet_volume(&coords) * 3.0,
-            1e-13,
-            "P2 tetrahedron mass sum",
-        );
+        assert_close(sum, rho * tet_volume(&coords) * 3.0, 1e-13, "P2 tetrahedron mass sum");
     }
     // The curved cells really are curved: their measure differs from the straight one.
     let straight_area = {
         let x = curved_triangle();
-        0.5 * ((x[1][0] - x[0][0]) * (x[2][1] - x[0][1])
-            - (x[2][0] - x[0][0]) * (x[1][1] - x[0][1]))
+        0.5 * ((x[1][0] - x[0][0]) * (x[2][1] - x[0][1]) - (x[2][0] - x[0][0]) * (x[1][1] - x[0][1]))
     };
     assert!((triangle_area(&curved_triangle()) - straight_area).abs() > 0.05);
     assert!((tet_volume(&tetrahedron(0.15)) - tet_volume(&tetrahedron(0.0))).abs() > 1e-3);

@@ -15,11 +15,7 @@ fn gap(d: usize) -> Coef {
 }
 
 fn down(d: usize) -> Coef {
-    Coef::constant(
-        (0..d)
-            .map(|k| if k == d - 1 { -1.0 } else { 0.0 })
-            .collect::<Vec<_>>(),
-    )
+    Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>())
 }
 
 fn nitsche(theta: f64, gamma0: f64, e: f64, nu: f64, d: usize) -> contact_nitsche::Contact {
@@ -39,9 +35,7 @@ fn nitsche(theta: f64, gamma0: f64, e: f64, nu: f64, d: usize) -> contact_nitsch
 }
 
 fn penalty(gamma0: f64, d: usize) -> contact_penalty::Contact {
-    let p = contact_penalty::Params::default()
-        .with("gamma0", gamma0)
-        .unwrap();
+    let p = contact_penalty::Params::default().with("gamma0", gamma0).unwrap();
     let c = contact_penalty::Coefficients {
         f: Coef::constant(vec![0.0; d]),
         g: gap(d),
@@ -107,12 +101,7 @@ fn cell_2d() -> [[f64; 2]; 6] {
 /// A state whose normal displacement goes from penetrating to separated along the facet.
 fn state_2d(rng: &mut Rng, shift: f64) -> [[f64; 2]; 6] {
     let x = cell_2d();
-    std::array::from_fn(|j| {
-        [
-            0.02 * rng.next(),
-            0.3 * (x[j][0] - 0.5) + 0.01 * rng.next() + shift,
-        ]
-    })
+    std::array::from_fn(|j| [0.02 * rng.next(), 0.3 * (x[j][0] - 0.5) + 0.01 * rng.next() + shift])
 }
 
 fn check_2d<K: FormKernel<2, 6>>(k: &K, what: &str) {
@@ -147,10 +136,7 @@ fn check_2d<K: FormKernel<2, 6>>(k: &K, what: &str) {
 #[test]
 fn nitsche_tangent_matches_finite_differences_in_2d() {
     for theta in [1.0, 0.0, -1.0] {
-        check_2d(
-            &nitsche(theta, 5.0, 1.0, 0.3, 2),
-            &format!("Nitsche θ = {theta}"),
-        );
+        check_2d(&nitsche(theta, 5.0, 1.0, 0.3, 2), &format!("Nitsche θ = {theta}"));
     }
 }
 
@@ -193,10 +179,7 @@ fn check_1d<K: FormKernel<1, 2>>(k: &K, what: &str) {
 #[test]
 fn contact_tangents_match_finite_differences_in_1d() {
     for theta in [1.0, 0.0, -1.0] {
-        check_1d(
-            &nitsche(theta, 5.0, 1.0, 0.0, 1),
-            &format!("Nitsche θ = {theta}"),
-        );
+        check_1d(&nitsche(theta, 5.0, 1.0, 0.0, 1), &format!("Nitsche θ = {theta}"));
     }
     check_1d(&penalty(5.0, 1), "penalty");
 }

@@ -30,12 +30,7 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
-    pub fn error(
-        code: &'static str,
-        message: impl Into<String>,
-        span: Span,
-        label: impl Into<String>,
-    ) -> Self {
+    pub fn error(code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
         Diagnostic {
             severity: Severity::Error,
             code,
@@ -50,12 +45,7 @@ impl Diagnostic {
         }
     }
 
-    pub fn warning(
-        code: &'static str,
-        message: impl Into<String>,
-        span: Span,
-        label: impl Into<String>,
-    ) -> Self {
+    pub fn warning(code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
         Diagnostic {
             severity: Severity::Warning,
             ..Diagnostic::error(code, message, span, label)
@@ -92,17 +82,11 @@ impl Diagnostic {
             Severity::Warning => cs::Severity::Warning,
         };
         let mut labels = vec![
-            cs::Label::primary(
-                self.primary.span.file,
-                self.primary.span.start..self.primary.span.end,
-            )
-            .with_message(&self.primary.message),
+            cs::Label::primary(self.primary.span.file, self.primary.span.start..self.primary.span.end)
+                .with_message(&self.primary.message),
         ];
         for l in &self.secondary {
-            labels.push(
-                cs::Label::secondary(l.span.file, l.span.start..l.span.end)
-                    .with_message(&l.message),
-            );
+            labels.push(cs::Label::secondary(l.span.file, l.span.start..l.span.end).with_message(&l.message));
         }
         let mut notes = self.notes.clone();
         if let Some(help) = &self.help {
@@ -150,20 +134,12 @@ pub fn render_all(diags: &[Diagnostic], sources: &SourceMap) -> String {
 /// reports its mistake once).
 pub fn normalize(diags: &mut Vec<Diagnostic>) {
     diags.sort_by(|a, b| {
-        (
-            a.primary.span.file,
-            a.primary.span.start,
-            a.severity,
-            a.code,
-        )
-            .cmp(&(
-                b.primary.span.file,
-                b.primary.span.start,
-                b.severity,
-                b.code,
-            ))
+        (a.primary.span.file, a.primary.span.start, a.severity, a.code).cmp(&(
+            b.primary.span.file,
+            b.primary.span.start,
+            b.severity,
+            b.code,
+        ))
     });
-    diags.dedup_by(|a, b| {
-        a.code == b.code && a.primary.span == b.primary.span && a.message == b.message
-    });
+    diags.dedup_by(|a, b| a.code == b.code && a.primary.span == b.primary.span && a.message == b.message);
 }

@@ -64,8 +64,6 @@ pub fn module_name(path: &Path) -> String {
 
 /// The file name shown in generated documentation (no machine-specific directories).
 pub fn display_name(path: &Path) -> String {
-    path.file_name().map_or_else(
-        || path.display().to_string(),
-        |s| s.to_string_lossy().into_owned(),
-    )
+    path.file_name()
+        .map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned())
 }

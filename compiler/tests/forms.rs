@@ -30,8 +30,7 @@ fn library_compiles_without_warnings() {
     let files = library();
     assert!(files.len() >= 3);
     for f in &files {
-        let (_, warnings) =
-            check_path(f, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", f.display()));
+        let (_, warnings) = check_path(f, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", f.display()));
         assert!(warnings.is_empty(), "{}:\n{warnings}", f.display());
     }
 }

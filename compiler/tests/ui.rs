@@ -23,22 +23,17 @@ fn bad_files_render_their_diagnostics() {
     assert!(files.len() >= 25, "the corpus has {} files", files.len());
     let mut codes = BTreeSet::new();
     for path in &files {
-        let (diags, rendered) =
-            match check_file(path, &FsLoader).expect("corpus files are readable") {
-                Err((diags, sources)) => {
-                    let r = render_all(&diags, &sources);
-                    (diags, r)
-                }
-                Ok(prog) => {
-                    let r = render_all(&prog.warnings, &prog.sources);
-                    (prog.warnings, r)
-                }
-            };
-        assert!(
-            !diags.is_empty(),
-            "{} produced no diagnostic",
-            path.display()
-        );
+        let (diags, rendered) = match check_file(path, &FsLoader).expect("corpus files are readable") {
+            Err((diags, sources)) => {
+                let r = render_all(&diags, &sources);
+                (diags, r)
+            }
+            Ok(prog) => {
+                let r = render_all(&prog.warnings, &prog.sources);
+                (prog.warnings, r)
+            }
+        };
+        assert!(!diags.is_empty(), "{} produced no diagnostic", path.display());
         codes.extend(diags.iter().map(|d| d.code));
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         insta::with_settings!({ snapshot_path => "snapshots/ui", prepend_module_to_snapshot => false, description => source_of(path) }, {
@@ -46,9 +41,9 @@ fn bad_files_render_their_diagnostics() {
         });
     }
     let expected = [
-        "E0001", "E0002", "E0101", "E0102", "E0103", "E0104", "E0105", "E0106", "E0201", "E0204",
-        "E0205", "E0206", "E0301", "E0303", "E0304", "E0401", "E0402", "E0403", "E0404", "E0405",
-        "E0501", "E0502", "E0601", "E0602", "E0603", "E0701", "E0702", "W0001",
+        "E0001", "E0002", "E0101", "E0102", "E0103", "E0104", "E0105", "E0106", "E0201", "E0204", "E0205", "E0206",
+        "E0301", "E0303", "E0304", "E0401", "E0402", "E0403", "E0404", "E0405", "E0501", "E0502", "E0601", "E0602",
+        "E0603", "E0701", "E0702", "W0001",
     ];
     for code in expected {
         assert!(codes.contains(code), "no corpus file exercises {code}");

@@ -90,12 +90,7 @@ impl ElementKind {
     /// Reference coordinates of all nodes, in node order.
     pub fn reference_nodes(self) -> Vec<Vec<f64>> {
         let v = self.reference_vertices();
-        let mid = |a: usize, b: usize| {
-            v[a].iter()
-                .zip(&v[b])
-                .map(|(x, y)| 0.5 * (x + y))
-                .collect::<Vec<f64>>()
-        };
+        let mid = |a: usize, b: usize| v[a].iter().zip(&v[b]).map(|(x, y)| 0.5 * (x + y)).collect::<Vec<f64>>();
         let mut nodes = v.clone();
         match self {
             ElementKind::TriangleP2 => nodes.extend(TRIANGLE_EDGES.iter().map(|e| mid(e[0], e[1]))),
@@ -172,11 +167,7 @@ impl ElementKind {
                     .map(|i| dl[i].iter().map(|x| (4.0 * l[i] - 1.0) * x).collect())
                     .collect();
                 for &[a, b] in edges {
-                    g.push(
-                        (0..d)
-                            .map(|k| 4.0 * (dl[a][k] * l[b] + l[a] * dl[b][k]))
-                            .collect(),
-                    );
+                    g.push((0..d).map(|k| 4.0 * (dl[a][k] * l[b] + l[a] * dl[b][k])).collect());
                 }
                 g
             }
@@ -247,10 +238,7 @@ mod tests {
             for (i, xi) in nodes.iter().enumerate() {
                 let phi = kind.basis(xi);
                 for (j, p) in phi.iter().enumerate() {
-                    assert!(
-                        (p - f64::from(i == j)).abs() < 1e-14,
-                        "{kind:?} node {i} basis {j}"
-                    );
+                    assert!((p - f64::from(i == j)).abs() < 1e-14, "{kind:?} node {i} basis {j}");
                 }
                 let grads = kind.basis_gradients(xi);
                 for k in 0..kind.dim() {
@@ -286,12 +274,7 @@ mod tests {
                 let n = kind.reference_normal(f);
                 let v0 = &nodes[kind.facets()[f][0]];
                 for &i in &kind.facet_nodes(f) {
-                    let dist: f64 = nodes[i]
-                        .iter()
-                        .zip(v0)
-                        .zip(&n)
-                        .map(|((x, y), nn)| (x - y) * nn)
-                        .sum();
+                    let dist: f64 = nodes[i].iter().zip(v0).zip(&n).map(|((x, y), nn)| (x - y) * nn).sum();
                     assert!(dist.abs() < 1e-14);
                 }
                 assert_eq!(

@@ -14,10 +14,7 @@ pub struct Jacobian<const D: usize> {
 
 /// Jacobian at a point from the cell's node coordinates and the reference gradients there.
 #[inline(always)]
-pub fn jacobian<const D: usize, const N: usize>(
-    coords: &[[f64; D]; N],
-    dref: &[[f64; D]; N],
-) -> Jacobian<D> {
+pub fn jacobian<const D: usize, const N: usize>(coords: &[[f64; D]; N], dref: &[[f64; D]; N]) -> Jacobian<D> {
     let mut j = [[0.0; D]; D];
     for (x, g) in coords.iter().zip(dref) {
         for a in 0..D {
@@ -73,10 +70,7 @@ pub fn invert<const D: usize>(m: &[[f64; D]; D]) -> (f64, [[f64; D]; D]) {
 
 /// Physical gradients of all basis functions: `[node][direction]`.
 #[inline(always)]
-pub fn physical_gradients<const D: usize, const N: usize>(
-    jac: &Jacobian<D>,
-    dref: &[[f64; D]; N],
-) -> [[f64; D]; N] {
+pub fn physical_gradients<const D: usize, const N: usize>(jac: &Jacobian<D>, dref: &[[f64; D]; N]) -> [[f64; D]; N] {
     let mut g = [[0.0; D]; N];
     for (gi, ri) in g.iter_mut().zip(dref) {
         for l in 0..D {
@@ -92,10 +86,7 @@ pub fn physical_gradients<const D: usize, const N: usize>(
 
 /// Value at a point of a vector field given at the nodes.
 #[inline(always)]
-pub fn interpolate<const D: usize, const N: usize>(
-    values: &[[f64; D]; N],
-    phi: &[f64; N],
-) -> [f64; D] {
+pub fn interpolate<const D: usize, const N: usize>(values: &[[f64; D]; N], phi: &[f64; N]) -> [f64; D] {
     let mut v = [0.0; D];
     for (u, p) in values.iter().zip(phi) {
         for k in 0..D {
@@ -107,10 +98,7 @@ pub fn interpolate<const D: usize, const N: usize>(
 
 /// Gradient at a point of a vector field given at the nodes: `[component][direction]`.
 #[inline(always)]
-pub fn gradient<const D: usize, const N: usize>(
-    values: &[[f64; D]; N],
-    dphi: &[[f64; D]; N],
-) -> [[f64; D]; D] {
+pub fn gradient<const D: usize, const N: usize>(values: &[[f64; D]; N], dphi: &[[f64; D]; N]) -> [[f64; D]; D] {
     let mut g = [[0.0; D]; D];
     for (u, dp) in values.iter().zip(dphi) {
         for k in 0..D {

@@ -80,9 +80,8 @@ impl<const D: usize, const N: usize> Tabulation<D, N> {
         let phi = kind.basis(xi);
         let grads = kind.basis_gradients(xi);
         self.phi.push(std::array::from_fn(|j| phi[j]));
-        self.dphi.push(std::array::from_fn(|j| {
-            std::array::from_fn(|k| grads[j][k])
-        }));
+        self.dphi
+            .push(std::array::from_fn(|j| std::array::from_fn(|k| grads[j][k])));
     }
 
     pub fn len(&self) -> usize {
@@ -141,13 +140,16 @@ pub struct FacetCtx<'a, const D: usize, const N: usize> {
     pub t: f64,
 }
 
+/// `f(x, t, out)`: a coef's values at position `x` and time `t`.
+pub type CoefFn = Arc<dyn Fn(&[f64], f64, &mut [f64]) + Send + Sync>;
+
 /// Case data (`coef` in a .wf file): a constant or a function of position and time.
 #[derive(Clone)]
 pub enum Coef {
     Constant(Vec<f64>),
     Function {
         components: usize,
-        f: Arc<dyn Fn(&[f64], f64, &mut [f64]) + Send + Sync>,
+        f: CoefFn,
     },
 }
 
@@ -162,10 +164,7 @@ impl Coef {
     }
 
     /// `f(x, t, out)` writes the `components` values at position `x` and time `t`.
-    pub fn function(
-        components: usize,
-        f: impl Fn(&[f64], f64, &mut [f64]) + Send + Sync + 'static,
-    ) -> Self {
+    pub fn function(components: usize, f: impl Fn(&[f64], f64, &mut [f64]) + Send + Sync + 'static) -> Self {
         Coef::Function {
             components,
             f: Arc::new(f),
@@ -231,15 +230,12 @@ pub enum ParamError {
 impl fmt::Display for ParamError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            ParamError::Unknown { name, known } => write!(
-                f,
-                "unknown parameter `{name}` (known: {})",
-                known.join(", ")
-            ),
-            ParamError::OutOfRange { name, value, range } => write!(
-                f,
-                "parameter `{name}` = {value} is outside its range {range}"
-            ),
+            ParamError::Unknown { name, known } => {
+                write!(f, "unknown parameter `{name}` (known: {})", known.join(", "))
+            }
+            ParamError::OutOfRange { name, value, range } => {
+                write!(f, "parameter `{name}` = {value} is outside its range {range}")
+            }
         }
     }
 }
@@ -258,16 +254,8 @@ pub struct ParamRange {
 
 impl ParamRange {
     pub fn contains(&self, v: f64) -> bool {
-        let above = if self.lo_closed {
-            v >= self.lo
-        } else {
-            v > self.lo
-        };
-        let below = if self.hi_closed {
-            v <= self.hi
-        } else {
-            v < self.hi
-        };
+        let above = if self.lo_closed { v >= self.lo } else { v > self.lo };
+        let below = if self.hi_closed { v <= self.hi } else { v < self.hi };
         v.is_finite() && above && below
     }
 }
@@ -276,11 +264,7 @@ impl fmt::Display for ParamRange {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let b = |v: f64| {
             if v.is_infinite() {
-                if v > 0.0 {
-                    "inf".to_string()
-                } else {
-                    "-inf".to_string()
-                }
+                if v > 0.0 { "inf".to_string() } else { "-inf".to_string() }
             } else {
                 format!("{v}")
             }
@@ -331,12 +315,7 @@ pub trait Form {
 /// Element kernels of a form for cells of dimension D with N nodes. Each method adds its
 /// contribution to `out`; forms without a volume (facet) integral add nothing there.
 pub trait FormKernel<const D: usize, const N: usize>: Form {
-    fn cell_residual(
-        &self,
-        ctx: &CellCtx<'_, D, N>,
-        fields: &[&LocalVector<D, N>],
-        out: &mut LocalVector<D, N>,
-    );
+    fn cell_residual(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>], out: &mut LocalVector<D, N>);
     /// Derivative with respect to field argument `wrt`.
     fn cell_tangent(
         &self,

@@ -182,8 +182,7 @@ fn tetrahedron(degree: u32) -> Rule {
                 for (pb, wb) in g.points.iter().zip(&g.weights) {
                     for (pc, wc) in g.points.iter().zip(&g.weights) {
                         let (a, b, c) = (pa[0], pb[0], pc[0]);
-                        r.points
-                            .push(vec![a, b * (1.0 - a), c * (1.0 - a) * (1.0 - b)]);
+                        r.points.push(vec![a, b * (1.0 - a), c * (1.0 - a) * (1.0 - b)]);
                         r.weights.push(wa * wb * wc * (1.0 - a).powi(2) * (1.0 - b));
                     }
                 }
@@ -203,8 +202,7 @@ mod tests {
 
     /// ∫ over the reference simplex of Π x_k^{e_k} = Π e_k! / (d + Σ e_k)!.
     fn exact(e: &[u32]) -> f64 {
-        e.iter().map(|&k| factorial(k)).product::<f64>()
-            / factorial(e.len() as u32 + e.iter().sum::<u32>())
+        e.iter().map(|&k| factorial(k)).product::<f64>() / factorial(e.len() as u32 + e.iter().sum::<u32>())
     }
 
     fn exponents(dim: usize, max: u32) -> Vec<Vec<u32>> {
@@ -215,9 +213,7 @@ mod tests {
                 .flat_map(|e| (0..=max).map(move |k| [e.clone(), vec![k]].concat()))
                 .collect();
         }
-        out.into_iter()
-            .filter(|e| e.iter().sum::<u32>() <= max)
-            .collect()
+        out.into_iter().filter(|e| e.iter().sum::<u32>() <= max).collect()
     }
 
     #[test]
@@ -232,13 +228,7 @@ mod tests {
                         .points
                         .iter()
                         .zip(&r.weights)
-                        .map(|(p, w)| {
-                            w * p
-                                .iter()
-                                .zip(&e)
-                                .map(|(x, k)| x.powi(*k as i32))
-                                .product::<f64>()
-                        })
+                        .map(|(p, w)| w * p.iter().zip(&e).map(|(x, k)| x.powi(*k as i32)).product::<f64>())
                         .sum();
                     let ex = exact(&e);
                     assert!(

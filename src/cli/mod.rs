@@ -1,6 +1,6 @@
 //! The `signorini` command line: `check` and `emit` for .wf files.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -61,14 +61,10 @@ fn check(files: &[PathBuf]) -> ExitCode {
             }
         }
     }
-    if failed {
-        ExitCode::FAILURE
-    } else {
-        ExitCode::SUCCESS
-    }
+    if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
 }
 
-fn emit(file: &PathBuf, stage: Stage, dim: usize) -> ExitCode {
+fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
     let (prog, warnings) = match compiler::check_path(file, &FsLoader) {
         Ok(p) => p,
         Err(e) => {

@@ -41,20 +41,13 @@ pub fn result_shape(name: &str, args: &[Shape]) -> Result<Shape, String> {
     match (name, args) {
         ("grad", [Scalar]) => Ok(Vector),
         ("grad", [Vector]) => Ok(Tensor),
-        ("grad", [Tensor]) => {
-            Err("grad of a tensor (a third-order tensor) is not supported".into())
-        }
+        ("grad", [Tensor]) => Err("grad of a tensor (a third-order tensor) is not supported".into()),
         ("div", [Vector]) => Ok(Scalar),
         ("div", [Tensor]) => Ok(Vector),
-        ("div", [s]) => Err(format!(
-            "div takes a vector or a tensor, not a {}",
-            s.name()
-        )),
+        ("div", [s]) => Err(format!("div takes a vector or a tensor, not a {}", s.name())),
         ("sym" | "transpose", [Tensor]) => Ok(Tensor),
         ("tr", [Tensor]) => Ok(Scalar),
-        ("sym" | "transpose" | "tr", [s]) => {
-            Err(format!("{name} takes a tensor, not a {}", s.name()))
-        }
+        ("sym" | "transpose" | "tr", [s]) => Err(format!("{name} takes a tensor, not a {}", s.name())),
         ("dot", [Vector, Vector]) => Ok(Scalar),
         ("dot", [Tensor, Vector] | [Vector, Tensor]) => Ok(Vector),
         ("dot", [Tensor, Tensor]) => Ok(Tensor),

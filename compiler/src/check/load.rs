@@ -15,11 +15,7 @@ pub struct Loaded {
 }
 
 /// Reads and parses `root` and everything it imports. Syntax errors do not stop loading.
-pub fn load(
-    root: &Path,
-    loader: &dyn Loader,
-    diags: &mut Vec<Diagnostic>,
-) -> Result<Loaded, String> {
+pub fn load(root: &Path, loader: &dyn Loader, diags: &mut Vec<Diagnostic>) -> Result<Loaded, String> {
     let root = normalize(root);
     let text = loader
         .load(&root)
@@ -40,12 +36,7 @@ pub fn load(
 }
 
 /// Parses a single in-memory text as a unit whose imports resolve through `loader`.
-pub fn load_text(
-    path: &Path,
-    text: &str,
-    loader: &dyn Loader,
-    diags: &mut Vec<Diagnostic>,
-) -> Loaded {
+pub fn load_text(path: &Path, text: &str, loader: &dyn Loader, diags: &mut Vec<Diagnostic>) -> Loaded {
     let mut l = Loader_ {
         loader,
         sources: SourceMap::default(),
@@ -122,8 +113,6 @@ fn cycle_note(stack: &[(PathBuf, Option<Span>)], back: &Path) -> String {
 }
 
 fn file_name(p: &Path) -> String {
-    p.file_name().map_or_else(
-        || p.display().to_string(),
-        |f| f.to_string_lossy().into_owned(),
-    )
+    p.file_name()
+        .map_or_else(|| p.display().to_string(), |f| f.to_string_lossy().into_owned())
 }

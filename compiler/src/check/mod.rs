@@ -58,16 +58,8 @@ pub struct ParamRange {
 
 impl ParamRange {
     pub fn contains(&self, v: f64) -> bool {
-        let above = if self.lo_closed {
-            v >= self.lo
-        } else {
-            v > self.lo
-        };
-        let below = if self.hi_closed {
-            v <= self.hi
-        } else {
-            v < self.hi
-        };
+        let above = if self.lo_closed { v >= self.lo } else { v > self.lo };
+        let below = if self.hi_closed { v <= self.hi } else { v < self.hi };
         above && below
     }
 
@@ -113,15 +105,8 @@ pub struct Form {
 pub enum Global {
     Param(usize),
     Coef(usize),
-    Let {
-        value: Expr,
-        span: Span,
-    },
-    Fn {
-        params: Vec<Ident>,
-        body: Expr,
-        span: Span,
-    },
+    Let { value: Expr, span: Span },
+    Fn { params: Vec<Ident>, body: Expr, span: Span },
     Form(usize),
 }
 
@@ -168,11 +153,7 @@ pub fn check_text(path: &Path, text: &str, loader: &dyn Loader) -> Checked {
 }
 
 fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
-    let load::Loaded {
-        sources,
-        files,
-        root,
-    } = loaded;
+    let load::Loaded { sources, files, root } = loaded;
     let mut prog = Program {
         sources,
         root,
@@ -182,10 +163,7 @@ fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
         globals: HashMap::new(),
         warnings: Vec::new(),
     };
-    let broken: HashSet<String> = files
-        .iter()
-        .flat_map(|(_, f)| f.broken_names.iter().cloned())
-        .collect();
+    let broken: HashSet<String> = files.iter().flat_map(|(_, f)| f.broken_names.iter().cloned()).collect();
     declare(&mut prog, &files, &mut diags);
     let used = {
         let mut c = types::Checker::new(&prog, &broken);
@@ -231,12 +209,7 @@ fn declare(prog: &mut Program, files: &[(FileId, ast::File)], diags: &mut Vec<Di
     for (_, file) in files {
         for item in &file.items {
             let Some(name) = item.name() else { continue };
-            if BUILTIN_VALUES
-                .iter()
-                .chain(BUILTIN_FUNCTIONS)
-                .any(|b| *b == name.name)
-                || name.name == CELL_REGION
-            {
+            if BUILTIN_VALUES.iter().chain(BUILTIN_FUNCTIONS).any(|b| *b == name.name) || name.name == CELL_REGION {
                 diags.push(
                     Diagnostic::error(
                         "E0106",
@@ -291,9 +264,7 @@ fn declare(prog: &mut Program, files: &[(FileId, ast::File)], diags: &mut Vec<Di
                     value: value.clone(),
                     span: *span,
                 },
-                ast::Item::Fn {
-                    params, body, span, ..
-                } => {
+                ast::Item::Fn { params, body, span, .. } => {
                     check_distinct(params, "parameter", diags);
                     Global::Fn {
                         params: params.clone(),

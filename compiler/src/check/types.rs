@@ -97,20 +97,18 @@ impl<'p> Checker<'p> {
         let mut values = Vec::with_capacity(n);
         for i in 0..n {
             let p = &self.prog.params[i];
-            let default = self
-                .constant(&p.default_expr, "a param default")
-                .filter(|v| {
-                    let finite = v.is_finite();
-                    if !finite {
-                        self.error(Diagnostic::error(
-                            "E0603",
-                            "a param default must be finite",
-                            p.default_expr.span,
-                            format!("evaluates to {v}"),
-                        ));
-                    }
-                    finite
-                });
+            let default = self.constant(&p.default_expr, "a param default").filter(|v| {
+                let finite = v.is_finite();
+                if !finite {
+                    self.error(Diagnostic::error(
+                        "E0603",
+                        "a param default must be finite",
+                        p.default_expr.span,
+                        format!("evaluates to {v}"),
+                    ));
+                }
+                finite
+            });
             let range = p.range_expr.as_ref().and_then(|r| {
                 let lo = self.constant(&r.lo, "a range bound")?;
                 let hi = self.constant(&r.hi, "a range bound")?;
@@ -131,22 +129,19 @@ impl<'p> Checker<'p> {
                 }
                 Some(range)
             });
-            if let (Some(v), Some(r)) = (default, range) {
-                if !r.contains(v) {
-                    let name = &self.prog.params[i].name;
-                    self.error(
-                        Diagnostic::error(
-                            "E0601",
-                            format!("default of `{name}` is outside its range"),
-                            p.default_expr.span,
-                            format!("{v} is not in {}", r.describe()),
-                        )
-                        .with_label(
-                            p.range_expr.as_ref().map_or(p.span, |r| r.span),
-                            "the declared range",
-                        ),
-                    );
-                }
+            if let (Some(v), Some(r)) = (default, range)
+                && !r.contains(v)
+            {
+                let name = &self.prog.params[i].name;
+                self.error(
+                    Diagnostic::error(
+                        "E0601",
+                        format!("default of `{name}` is outside its range"),
+                        p.default_expr.span,
+                        format!("{v} is not in {}", r.describe()),
+                    )
+                    .with_label(p.range_expr.as_ref().map_or(p.span, |r| r.span), "the declared range"),
+                );
             }
             values.push((default, range));
         }
@@ -159,13 +154,8 @@ impl<'p> Checker<'p> {
             Ok(v) => Some(v),
             Err(span) => {
                 self.error(
-                    Diagnostic::error(
-                        "E0603",
-                        format!("{what} must be a constant"),
-                        span,
-                        "not a constant",
-                    )
-                    .with_help("use numbers, arithmetic, sqrt, pi and inf"),
+                    Diagnostic::error("E0603", format!("{what} must be a constant"), span, "not a constant")
+                        .with_help("use numbers, arithmetic, sqrt, pi and inf"),
                 );
                 None
             }
@@ -214,9 +204,7 @@ impl<'p> Checker<'p> {
                 }
             }
             ExprKind::Call(f, args) => {
-                if !self.prog.globals.contains_key(&f.name)
-                    && !BUILTIN_FUNCTIONS.contains(&f.name.as_str())
-                {
+                if !self.prog.globals.contains_key(&f.name) && !BUILTIN_FUNCTIONS.contains(&f.name.as_str()) {
                     self.unknown(f);
                 }
                 for a in args {
@@ -259,25 +247,33 @@ impl<'p> Checker<'p> {
                             span,
                             format!("this is a {}", ty.shape.name()),
                         )
-                        .with_help(
-                            "take dot(..., v) or inner(..., grad(v)) with the test function",
-                        ),
+                        .with_help("take dot(..., v) or inner(..., grad(v)) with the test function"),
                     );
                 } else if !ty.test {
                     self.error(
-                        Diagnostic::error("E0401", format!("integrand does not depend on the test function `{}`", form.test.name), span, "no test function here")
-                            .with_note("a form is linear in its test function: every term must contain it exactly once"),
+                        Diagnostic::error(
+                            "E0401",
+                            format!("integrand does not depend on the test function `{}`", form.test.name),
+                            span,
+                            "no test function here",
+                        )
+                        .with_note("a form is linear in its test function: every term must contain it exactly once"),
                     );
                 }
-                if integral.region.name == CELL_REGION {
-                    if let Some(g) = ty.facet {
-                        let what = self.prog.sources.slice(g).to_string();
-                        self.error(
-                            Diagnostic::error("E0501", format!("`{what}` used in a volume integral"), g, "only defined on boundary facets")
-                                .with_label(integral.region.span, "this integral is over cells")
-                                .with_help("`n` and `h` belong in integrals over a boundary region, e.g. int(Gamma_C)"),
-                        );
-                    }
+                if integral.region.name == CELL_REGION
+                    && let Some(g) = ty.facet
+                {
+                    let what = self.prog.sources.slice(g).to_string();
+                    self.error(
+                        Diagnostic::error(
+                            "E0501",
+                            format!("`{what}` used in a volume integral"),
+                            g,
+                            "only defined on boundary facets",
+                        )
+                        .with_label(integral.region.span, "this integral is over cells")
+                        .with_help("`n` and `h` belong in integrals over a boundary region, e.g. int(Gamma_C)"),
+                    );
                 }
             }
             self.scope.clear();
@@ -297,12 +293,7 @@ impl<'p> Checker<'p> {
             .chain(BUILTIN_VALUES.iter().copied())
             .chain(BUILTIN_FUNCTIONS.iter().copied())
             .chain(scope_names.iter().map(String::as_str));
-        let mut d = Diagnostic::error(
-            "E0101",
-            format!("unknown name `{}`", id.name),
-            id.span,
-            "not defined",
-        );
+        let mut d = Diagnostic::error("E0101", format!("unknown name `{}`", id.name), id.span, "not defined");
         if let Some(s) = suggest(&id.name, candidates) {
             d = d.with_help(format!("did you mean `{s}`?"));
         }
@@ -466,9 +457,14 @@ impl<'p> Checker<'p> {
                 if ta.test != tb.test {
                     let (without, with) = if ta.test { (b, a) } else { (a, b) };
                     self.error(
-                        Diagnostic::error("E0405", "form is not linear in the test function", without.span, "this term does not contain the test function")
-                            .with_label(with.span, "this one does")
-                            .with_note("a form is linear in its test function: every term must contain it exactly once"),
+                        Diagnostic::error(
+                            "E0405",
+                            "form is not linear in the test function",
+                            without.span,
+                            "this term does not contain the test function",
+                        )
+                        .with_label(with.span, "this one does")
+                        .with_note("a form is linear in its test function: every term must contain it exactly once"),
                     );
                     return None;
                 }
@@ -506,11 +502,7 @@ impl<'p> Checker<'p> {
             }
             BinOp::Div => {
                 if tb.shape != Scalar {
-                    return mismatch(
-                        self,
-                        format!("cannot divide by a {}", tb.shape.name()),
-                        None,
-                    );
+                    return mismatch(self, format!("cannot divide by a {}", tb.shape.name()), None);
                 }
                 if tb.test {
                     self.error(
@@ -548,9 +540,7 @@ impl<'p> Checker<'p> {
                                 b.span,
                                 "not a constant integer",
                             )
-                            .with_help(
-                                "use sqrt(x) for x^(1/2); `^` takes integers from -64 to 64",
-                            ),
+                            .with_help("use sqrt(x) for x^(1/2); `^` takes integers from -64 to 64"),
                         );
                         return None;
                     }
@@ -610,13 +600,8 @@ impl<'p> Checker<'p> {
                 let arg_tys: Vec<Ty> = arg_tys.into_iter().collect::<Option<_>>()?;
                 if self.calls.iter().any(|(n, _)| *n == f.name) {
                     self.error(
-                        Diagnostic::error(
-                            "E0105",
-                            format!("`{}` calls itself", f.name),
-                            f.span,
-                            "recursive call",
-                        )
-                        .with_note("functions are inlined, so they cannot be recursive"),
+                        Diagnostic::error("E0105", format!("`{}` calls itself", f.name), f.span, "recursive call")
+                            .with_note("functions are inlined, so they cannot be recursive"),
                     );
                     return None;
                 }
@@ -629,11 +614,7 @@ impl<'p> Checker<'p> {
                     ));
                     return None;
                 }
-                let scope = params
-                    .iter()
-                    .zip(arg_tys)
-                    .map(|(p, t)| (p.name.clone(), t))
-                    .collect();
+                let scope = params.iter().zip(arg_tys).map(|(p, t)| (p.name.clone(), t)).collect();
                 let saved = std::mem::replace(&mut self.scope, scope);
                 self.calls.push((f.name.clone(), e.span));
                 let ty = self.ty(body);
@@ -716,30 +697,27 @@ impl<'p> Checker<'p> {
                 return None;
             }
         };
-        if NONLINEAR.contains(&name) {
-            if let Some((a, _)) = args.iter().zip(tys).find(|(_, t)| t.test) {
-                self.error(
-                    Diagnostic::error(
-                        "E0402",
-                        format!("test function inside `{name}`"),
-                        a.span,
-                        "depends on the test function",
-                    )
-                    .with_note(format!(
-                        "`{name}` is not linear, and a form must be linear in its test function"
-                    )),
-                );
-                return None;
-            }
+        if NONLINEAR.contains(&name)
+            && let Some((a, _)) = args.iter().zip(tys).find(|(_, t)| t.test)
+        {
+            self.error(
+                Diagnostic::error(
+                    "E0402",
+                    format!("test function inside `{name}`"),
+                    a.span,
+                    "depends on the test function",
+                )
+                .with_note(format!(
+                    "`{name}` is not linear, and a form must be linear in its test function"
+                )),
+            );
+            return None;
         }
         if matches!(name, "dot" | "inner" | "outer") && tys[0].test && tys[1].test {
             self.self_product(e.span, args[0].span, args[1].span);
             return None;
         }
-        let mut ty = tys
-            .iter()
-            .skip(1)
-            .fold(tys[0], |acc, t| Ty::join(&acc, t, shape));
+        let mut ty = tys.iter().skip(1).fold(tys[0], |acc, t| Ty::join(&acc, t, shape));
         ty.shape = shape;
         ty.konst = None;
         match name {

@@ -44,10 +44,7 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
     let cell = form.integrals.iter().find(|i| i.cell);
     let facets: Vec<&IntegralIr> = form.integrals.iter().filter(|i| !i.cell).collect();
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "impl<const N: usize> FormKernel<{d}, N> for {struct_name} {{"
-    );
+    let _ = writeln!(s, "impl<const N: usize> FormKernel<{d}, N> for {struct_name} {{");
 
     let _ = writeln!(
         s,
@@ -119,13 +116,7 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
     s
 }
 
-fn tangent_match(
-    prog: &Program,
-    g: &Graph,
-    d: usize,
-    form: &FormIr,
-    integral: &IntegralIr,
-) -> String {
+fn tangent_match(prog: &Program, g: &Graph, d: usize, form: &FormIr, integral: &IntegralIr) -> String {
     let mut s = String::from("match wrt {\n");
     for (a, field) in form.fields.iter().enumerate() {
         let _ = writeln!(s, "{a} => {{ // d/d{field}");
@@ -188,12 +179,7 @@ impl Body<'_> {
     fn emit(&self) -> String {
         let d = self.d;
         let g = self.g;
-        let idx = |v: &[usize]| {
-            v.iter()
-                .map(|x| x.to_string())
-                .collect::<Vec<_>>()
-                .join("_")
-        };
+        let idx = |v: &[usize]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join("_");
         // The pointwise coefficients this body needs, by the index conventions of ir::TangentIr.
         let mut outputs: Outputs = Vec::new();
         let mut add = |kind: &'static str, nodes: &[NodeId], dims: usize| {
@@ -243,13 +229,7 @@ impl Body<'_> {
         let nodes = g.reachable(roots.iter().copied());
         let syms: HashSet<Sym> = nodes
             .iter()
-            .filter_map(|&n| {
-                if let Node::Sym(s) = g.node(n) {
-                    Some(s)
-                } else {
-                    None
-                }
-            })
+            .filter_map(|&n| if let Node::Sym(s) = g.node(n) { Some(s) } else { None })
             .collect();
 
         // Names of leaves.
@@ -271,13 +251,7 @@ impl Body<'_> {
         let mut prologue = String::new();
         let mut params: Vec<u16> = syms
             .iter()
-            .filter_map(|s| {
-                if let Sym::Param(i) = s {
-                    Some(*i)
-                } else {
-                    None
-                }
-            })
+            .filter_map(|s| if let Sym::Param(i) = s { Some(*i) } else { None })
             .collect();
         params.sort_unstable();
         for i in params {
@@ -310,13 +284,7 @@ impl Body<'_> {
         }
         let mut coef_ids: Vec<u16> = syms
             .iter()
-            .filter_map(|s| {
-                if let Sym::Coef { id, .. } = s {
-                    Some(*id)
-                } else {
-                    None
-                }
-            })
+            .filter_map(|s| if let Sym::Coef { id, .. } = s { Some(*id) } else { None })
             .collect();
         coef_ids.sort_unstable();
         coef_ids.dedup();
@@ -327,10 +295,9 @@ impl Body<'_> {
         for s in &syms {
             let name = match *s {
                 Sym::Param(_) => continue,
-                Sym::Field { arg, comp } => format!(
-                    "{}[{comp}]",
-                    field_val[arg as usize].as_ref().expect("named above").1
-                ),
+                Sym::Field { arg, comp } => {
+                    format!("{}[{comp}]", field_val[arg as usize].as_ref().expect("named above").1)
+                }
                 Sym::FieldGrad { arg, comp, dir } => format!(
                     "{}[{comp}][{dir}]",
                     field_grad[arg as usize].as_ref().expect("named above").1
@@ -341,11 +308,7 @@ impl Body<'_> {
                 Sym::Time => "t".into(),
                 Sym::Coef { id, comp } => format!(
                     "{}[{comp}]",
-                    coef_locals
-                        .iter()
-                        .find(|(i, _)| *i == id)
-                        .expect("named above")
-                        .1
+                    coef_locals.iter().find(|(i, _)| *i == id).expect("named above").1
                 ),
                 Sym::Test { .. } | Sym::TestGrad { .. } => "0.0".into(), // linear forms: never reached
             };
@@ -409,11 +372,7 @@ impl Body<'_> {
         for (_, list) in &outputs {
             for o in list.iter().flatten() {
                 let (text, prec) = self.expr(o.node, &leaf, &bound);
-                let text = if prec < UNARY {
-                    format!("({text})")
-                } else {
-                    text
-                };
+                let text = if prec < UNARY { format!("({text})") } else { text };
                 let _ = writeln!(weighted, "let {} = w * {text};", o.name);
             }
         }
@@ -560,12 +519,7 @@ impl Body<'_> {
     }
 
     /// Rust text of a node and its precedence; let-bound nodes and leaves are names.
-    fn expr(
-        &self,
-        id: NodeId,
-        leaf: &HashMap<Sym, String>,
-        bound: &HashMap<NodeId, String>,
-    ) -> (String, u8) {
+    fn expr(&self, id: NodeId, leaf: &HashMap<Sym, String>, bound: &HashMap<NodeId, String>) -> (String, u8) {
         let g = self.g;
         let sub = |x: NodeId| -> (String, u8) {
             if let Some(b) = bound.get(&x) {
@@ -580,23 +534,15 @@ impl Body<'_> {
             Node::Add(a, b) => {
                 let l = wrap(sub(a), ADD);
                 match g.node(b) {
-                    Node::Neg(x) if !bound.contains_key(&b) => {
-                        (format!("{l} - {}", wrap(sub(x), MUL)), ADD)
-                    }
+                    Node::Neg(x) if !bound.contains_key(&b) => (format!("{l} - {}", wrap(sub(x), MUL)), ADD),
                     Node::Const(c) if f64::from_bits(c) < 0.0 => {
                         (format!("{l} - {}", literal(-f64::from_bits(c)).0), ADD)
                     }
                     _ => (format!("{l} + {}", wrap(sub(b), MUL)), ADD),
                 }
             }
-            Node::Mul(a, b) => (
-                format!("{} * {}", wrap(sub(a), MUL), wrap(sub(b), UNARY)),
-                MUL,
-            ),
-            Node::Div(a, b) => (
-                format!("{} / {}", wrap(sub(a), MUL), wrap(sub(b), UNARY)),
-                MUL,
-            ),
+            Node::Mul(a, b) => (format!("{} * {}", wrap(sub(a), MUL), wrap(sub(b), UNARY)), MUL),
+            Node::Div(a, b) => (format!("{} / {}", wrap(sub(a), MUL), wrap(sub(b), UNARY)), MUL),
             Node::Neg(a) => (format!("-{}", wrap(sub(a), UNARY)), UNARY),
             Node::Powi(a, k) => (format!("{}.powi({k})", wrap(sub(a), ATOM)), ATOM),
             Node::Sqrt(a) => (format!("{}.sqrt()", wrap(sub(a), ATOM)), ATOM),

@@ -31,8 +31,7 @@ pub struct Options {
 pub fn generate(prog: &Program, opts: &Options) -> Result<syn::File, String> {
     let irs: Vec<DimIr> = ir::DIMS.iter().map(|&d| ir::build(prog, d)).collect();
     let text = module_text(prog, &irs, opts);
-    syn::parse_file(&text)
-        .map_err(|e| format!("internal error: generated code does not parse: {e}\n{text}"))
+    syn::parse_file(&text).map_err(|e| format!("internal error: generated code does not parse: {e}\n{text}"))
 }
 
 /// Generated code formatted for reading, with its line count in a header comment.
@@ -49,13 +48,11 @@ pub fn generate_pretty(prog: &Program, opts: &Options) -> Result<String, String>
 fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
     let rt = &opts.runtime;
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "/// Kernels compiled from `{}` by signorini.",
-        opts.source_name
-    );
+    let _ = writeln!(s, "/// Kernels compiled from `{}` by signorini.", opts.source_name);
     let _ = writeln!(s, "pub mod {} {{", ident(&opts.module));
-    s.push_str("#![allow(non_snake_case, non_camel_case_types, unused_variables, unused_mut, unused_parens, clippy::all)]\n");
+    s.push_str(
+        "#![allow(non_snake_case, non_camel_case_types, unused_variables, unused_mut, unused_parens, clippy::all)]\n",
+    );
     let _ = writeln!(
         s,
         "use {rt}::kernel::{{CellCtx, Coef, FacetCtx, Form, FormKernel, FormMeta, LocalMatrix, LocalVector, ParamError, ParamRange, check_coef, check_param, heaviside}};"
@@ -75,11 +72,7 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
     for (fi, form) in prog.forms.iter().enumerate() {
         let sname = &struct_names[fi];
         let ir2 = &irs[1].forms[fi];
-        let fields: Vec<String> = form
-            .fields
-            .iter()
-            .map(|f| format!("{:?}", f.name))
-            .collect();
+        let fields: Vec<String> = form.fields.iter().map(|f| format!("{:?}", f.name)).collect();
         let sig = format!(
             "{}({}; {})",
             form.name,
@@ -107,13 +100,9 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
             s,
             "impl {sname} {{ pub fn new(params: &Params, coefs: &Coefficients) -> Self {{ {sname} {{ params: *params, coefs: coefs.clone() }} }} }}"
         );
-        let cell_degree = ir2
-            .integrals
-            .iter()
-            .find(|i| i.cell)
-            .map_or("None".to_string(), |i| {
-                format!("Some([{}, {}])", i.degree[0], i.degree[1])
-            });
+        let cell_degree = ir2.integrals.iter().find(|i| i.cell).map_or("None".to_string(), |i| {
+            format!("Some([{}, {}])", i.degree[0], i.degree[1])
+        });
         let facets: Vec<String> = ir2
             .integrals
             .iter()
@@ -139,11 +128,7 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
 
 fn params_text(prog: &Program) -> String {
     let mut s = String::new();
-    let names: Vec<String> = prog
-        .params
-        .iter()
-        .map(|p| format!("{:?}", p.name))
-        .collect();
+    let names: Vec<String> = prog.params.iter().map(|p| format!("{:?}", p.name)).collect();
     s.push_str("/// Parameters, with the defaults and ranges declared in the source. Values are range-checked\n/// when set.\n");
     s.push_str("#[derive(Clone, Copy, Debug, PartialEq)]\npub struct Params {\n");
     for p in &prog.params {
@@ -181,9 +166,7 @@ fn params_text(prog: &Program) -> String {
     }
     s.push_str("];\n");
     for p in &prog.params {
-        let range = p
-            .range
-            .map_or(String::new(), |r| format!(" in {}", r.describe()));
+        let range = p.range.map_or(String::new(), |r| format!(" in {}", r.describe()));
         let _ = writeln!(
             s,
             "/// `{}` (default {:?}{range}).\npub fn {}(&self) -> f64 {{ self.{} }}",
@@ -199,9 +182,7 @@ fn params_text(prog: &Program) -> String {
     }
     s.push_str("_ => None } }\n");
     s.push_str("/// Sets a parameter by name, refusing unknown names and values outside the declared range.\n");
-    s.push_str(
-        "pub fn set(&mut self, name: &str, value: f64) -> Result<(), ParamError> { match name {\n",
-    );
+    s.push_str("pub fn set(&mut self, name: &str, value: f64) -> Result<(), ParamError> { match name {\n");
     for (i, p) in prog.params.iter().enumerate() {
         let _ = writeln!(
             s,
@@ -228,9 +209,7 @@ fn float(v: f64) -> String {
 
 fn coefs_text(prog: &Program) -> String {
     let mut s = String::new();
-    s.push_str(
-        "/// Case data (`coef` declarations): constants or functions of position and time.\n",
-    );
+    s.push_str("/// Case data (`coef` declarations): constants or functions of position and time.\n");
     s.push_str("#[derive(Clone, Debug");
     if prog.coefs.is_empty() {
         s.push_str(", Default");

@@ -119,19 +119,19 @@ impl Graph {
     pub fn add(&mut self, a: NodeId, b: NodeId) -> NodeId {
         match (self.as_const(a), self.as_const(b)) {
             (Some(x), Some(y)) => return self.constant(x + y),
-            (Some(z), _) if z == 0.0 => return b,
-            (_, Some(z)) if z == 0.0 => return a,
+            (Some(0.0), _) => return b,
+            (_, Some(0.0)) => return a,
             _ => {}
         }
-        if let Node::Neg(nb) = self.node(b) {
-            if nb == a {
-                return self.zero();
-            }
+        if let Node::Neg(nb) = self.node(b)
+            && nb == a
+        {
+            return self.zero();
         }
-        if let Node::Neg(na) = self.node(a) {
-            if na == b {
-                return self.zero();
-            }
+        if let Node::Neg(na) = self.node(a)
+            && na == b
+        {
+            return self.zero();
         }
         if a == b {
             let two = self.constant(2.0);
@@ -157,21 +157,20 @@ impl Graph {
     pub fn mul(&mut self, a: NodeId, b: NodeId) -> NodeId {
         match (self.as_const(a), self.as_const(b)) {
             (Some(x), Some(y)) => return self.constant(x * y),
-            (Some(z), _) | (_, Some(z)) if z == 0.0 => return self.zero(),
-            (Some(o), _) if o == 1.0 => return b,
-            (_, Some(o)) if o == 1.0 => return a,
-            (Some(m), _) if m == -1.0 => return self.neg(b),
-            (_, Some(m)) if m == -1.0 => return self.neg(a),
+            (Some(0.0), _) | (_, Some(0.0)) => return self.zero(),
+            (Some(1.0), _) => return b,
+            (_, Some(1.0)) => return a,
+            (Some(-1.0), _) => return self.neg(b),
+            (_, Some(-1.0)) => return self.neg(a),
             _ => {}
         }
         // Fold constant factors: c1·(c2·x) = (c1·c2)·x.
-        if let Some(c1) = self.as_const(a) {
-            if let Node::Mul(x, y) = self.node(b) {
-                if let Some(c2) = self.as_const(x) {
-                    let c = self.constant(c1 * c2);
-                    return self.mul(c, y);
-                }
-            }
+        if let Some(c1) = self.as_const(a)
+            && let Node::Mul(x, y) = self.node(b)
+            && let Some(c2) = self.as_const(x)
+        {
+            let c = self.constant(c1 * c2);
+            return self.mul(c, y);
         }
         if self.as_const(b).is_some() && self.as_const(a).is_none() {
             return self.mul(b, a);
@@ -197,9 +196,9 @@ impl Graph {
     pub fn div(&mut self, a: NodeId, b: NodeId) -> NodeId {
         match (self.as_const(a), self.as_const(b)) {
             (Some(x), Some(y)) => return self.constant(x / y),
-            (Some(z), _) if z == 0.0 => return self.zero(),
-            (_, Some(o)) if o == 1.0 => return a,
-            (_, Some(m)) if m == -1.0 => return self.neg(a),
+            (Some(0.0), _) => return self.zero(),
+            (_, Some(1.0)) => return a,
+            (_, Some(-1.0)) => return self.neg(a),
             _ => {}
         }
         if a == b {

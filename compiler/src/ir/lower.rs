@@ -121,15 +121,8 @@ impl<'p> Lowerer<'p> {
         let mut integrands: Vec<Integrand> = Vec::new();
         for integral in &form.integrals {
             let v = self.expr(&integral.integrand).c[0].v;
-            let v = if integral.sign < 0.0 {
-                self.g.neg(v)
-            } else {
-                v
-            };
-            match integrands
-                .iter_mut()
-                .find(|i| i.region == integral.region.name)
-            {
+            let v = if integral.sign < 0.0 { self.g.neg(v) } else { v };
+            match integrands.iter_mut().find(|i| i.region == integral.region.name) {
                 Some(i) => i.value = self.g.add(i.value, v),
                 None => integrands.push(Integrand {
                     region: integral.region.name.clone(),
@@ -155,10 +148,7 @@ impl<'p> Lowerer<'p> {
 
     fn constant(&mut self, v: f64) -> Jet {
         let v = self.g.constant(v);
-        Jet {
-            v,
-            g: self.zero_grad(),
-        }
+        Jet { v, g: self.zero_grad() }
     }
 
     fn scalar(j: Jet) -> Val {
@@ -195,10 +185,7 @@ impl<'p> Lowerer<'p> {
         match self.prog.globals.get(name) {
             Some(Global::Param(i)) => {
                 let v = self.g.sym(Sym::Param(*i as u16));
-                Self::scalar(Jet {
-                    v,
-                    g: self.zero_grad(),
-                })
+                Self::scalar(Jet { v, g: self.zero_grad() })
             }
             Some(Global::Coef(i)) => {
                 let shape = self.prog.coefs[*i].shape;
@@ -252,17 +239,11 @@ impl<'p> Lowerer<'p> {
                 }
                 "t" => {
                     let v = self.g.sym(Sym::Time);
-                    Self::scalar(Jet {
-                        v,
-                        g: self.zero_grad(),
-                    })
+                    Self::scalar(Jet { v, g: self.zero_grad() })
                 }
                 "h" => {
                     let v = self.g.sym(Sym::CellDiameter);
-                    Self::scalar(Jet {
-                        v,
-                        g: self.zero_grad(),
-                    })
+                    Self::scalar(Jet { v, g: self.zero_grad() })
                 }
                 "n" => {
                     let c = (0..d)
@@ -343,11 +324,7 @@ impl<'p> Lowerer<'p> {
                     })
                     .collect();
                 Val {
-                    shape: if rows == 1 {
-                        Shape::Scalar
-                    } else {
-                        Shape::Vector
-                    },
+                    shape: if rows == 1 { Shape::Scalar } else { Shape::Vector },
                     c,
                 }
             }
@@ -368,9 +345,7 @@ impl<'p> Lowerer<'p> {
             }
             "transpose" => {
                 let a = next();
-                let c = (0..d * d)
-                    .map(|k| a.c[(k % d) * d + k / d].clone())
-                    .collect();
+                let c = (0..d * d).map(|k| a.c[(k % d) * d + k / d].clone()).collect();
                 Val {
                     shape: Shape::Tensor,
                     c,
@@ -399,9 +374,7 @@ impl<'p> Lowerer<'p> {
             }
             "outer" => {
                 let (a, b) = (next(), next());
-                let c = (0..d * d)
-                    .map(|k| self.jmul(&a.c[k / d], &b.c[k % d]))
-                    .collect();
+                let c = (0..d * d).map(|k| self.jmul(&a.c[k / d], &b.c[k % d])).collect();
                 Val {
                     shape: Shape::Tensor,
                     c,
@@ -437,11 +410,7 @@ impl<'p> Lowerer<'p> {
                 // max(a, b) = b + (a − b)·H(a − b); min(a, b) = b + (a − b)·H(b − a)
                 let (a, b) = (next().c.remove(0), next().c.remove(0));
                 let diff = self.jsub(&a, &b);
-                let arg = if f == "max" {
-                    diff.clone()
-                } else {
-                    self.jneg(&diff)
-                };
+                let arg = if f == "max" { diff.clone() } else { self.jneg(&diff) };
                 let h = self.jheaviside(&arg);
                 let p = self.jmul(&diff, &h);
                 Self::scalar(self.jadd(&b, &p))
@@ -504,11 +473,7 @@ impl<'p> Lowerer<'p> {
                 let c = (0..d * d)
                     .map(|k| {
                         let (i, j) = (k / d, k % d);
-                        self.sum_of_products(
-                            (0..d).map(|m| (i * d + m, m * d + j)).collect(),
-                            &a,
-                            &b,
-                        )
+                        self.sum_of_products((0..d).map(|m| (i * d + m, m * d + j)).collect(), &a, &b)
                     })
                     .collect();
                 Val { shape: Tensor, c }
@@ -537,19 +502,9 @@ impl<'p> Lowerer<'p> {
 
     // Scalar operations on jets (value and gradient together).
 
-    fn grads(
-        &mut self,
-        a: &Jet,
-        b: &Jet,
-        f: impl Fn(&mut Graph, NodeId, NodeId) -> NodeId,
-    ) -> Option<Vec<NodeId>> {
+    fn grads(&mut self, a: &Jet, b: &Jet, f: impl Fn(&mut Graph, NodeId, NodeId) -> NodeId) -> Option<Vec<NodeId>> {
         let (ga, gb) = (a.g.as_ref()?, b.g.as_ref()?);
-        Some(
-            ga.iter()
-                .zip(gb)
-                .map(|(&x, &y)| f(&mut self.g, x, y))
-                .collect(),
-        )
+        Some(ga.iter().zip(gb).map(|(&x, &y)| f(&mut self.g, x, y)).collect())
     }
 
     fn jadd(&mut self, a: &Jet, b: &Jet) -> Jet {
@@ -566,9 +521,7 @@ impl<'p> Lowerer<'p> {
 
     fn jneg(&mut self, a: &Jet) -> Jet {
         let v = self.g.neg(a.v);
-        let g =
-            a.g.as_ref()
-                .map(|ga| ga.iter().map(|&x| self.g.neg(x)).collect());
+        let g = a.g.as_ref().map(|ga| ga.iter().map(|&x| self.g.neg(x)).collect());
         Jet { v, g }
     }
 
@@ -618,10 +571,7 @@ impl<'p> Lowerer<'p> {
 
     fn jheaviside(&mut self, a: &Jet) -> Jet {
         let v = self.g.heaviside(a.v);
-        Jet {
-            v,
-            g: self.zero_grad(),
-        }
+        Jet { v, g: self.zero_grad() }
     }
 }
 

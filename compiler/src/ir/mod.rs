@@ -110,12 +110,10 @@ pub fn build(prog: &Program, d: usize) -> DimIr {
         let tangent_nodes = integrals
             .iter()
             .flat_map(|i| i.tangents.iter().flat_map(TangentIr::nodes));
-        let linear = !g.reachable(tangent_nodes).into_iter().any(|n| {
-            matches!(
-                g.node(n),
-                Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. })
-            )
-        });
+        let linear = !g
+            .reachable(tangent_nodes)
+            .into_iter()
+            .any(|n| matches!(g.node(n), Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. })));
         forms.push(FormIr {
             name: lf.name,
             fields: lf.fields,

@@ -22,11 +22,7 @@ pub fn print(ir: &DimIr, params: &[String], coefs: &[String]) -> String {
         if matches!(g.node(id), Node::Const(_) | Node::Sym(_)) {
             continue;
         }
-        let name = g
-            .names
-            .get(&id)
-            .map(|n| format!("  // {n}"))
-            .unwrap_or_default();
+        let name = g.names.get(&id).map(|n| format!("  // {n}")).unwrap_or_default();
         let _ = writeln!(out, "%{id} = {}{name}", node(g, id, params, coefs));
     }
     for f in &ir.forms {
@@ -39,11 +35,7 @@ pub fn print(ir: &DimIr, params: &[String], coefs: &[String]) -> String {
             if f.linear { "  [linear]" } else { "" }
         );
         for i in &f.integrals {
-            let _ = writeln!(
-                out,
-                "  int({})  degree P1 {} P2 {}",
-                i.region, i.degree[0], i.degree[1]
-            );
+            let _ = writeln!(out, "  int({})  degree P1 {} P2 {}", i.region, i.degree[0], i.degree[1]);
             list(&mut out, g, "f0", &i.f0, params, coefs);
             list(&mut out, g, "f1", &i.f1, params, coefs);
             for (a, t) in i.tangents.iter().enumerate() {
@@ -58,14 +50,7 @@ pub fn print(ir: &DimIr, params: &[String], coefs: &[String]) -> String {
     out
 }
 
-fn list(
-    out: &mut String,
-    g: &Graph,
-    label: &str,
-    ids: &[NodeId],
-    params: &[String],
-    coefs: &[String],
-) {
+fn list(out: &mut String, g: &Graph, label: &str, ids: &[NodeId], params: &[String], coefs: &[String]) {
     let nonzero: Vec<String> = ids
         .iter()
         .enumerate()
@@ -101,10 +86,7 @@ fn node(g: &Graph, id: NodeId, params: &[String], coefs: &[String]) -> String {
 
 pub fn sym(s: Sym, params: &[String], coefs: &[String]) -> String {
     match s {
-        Sym::Param(i) => params
-            .get(i as usize)
-            .cloned()
-            .unwrap_or_else(|| format!("param{i}")),
+        Sym::Param(i) => params.get(i as usize).cloned().unwrap_or_else(|| format!("param{i}")),
         Sym::Field { arg, comp } => format!("u{arg}[{comp}]"),
         Sym::FieldGrad { arg, comp, dir } => format!("grad_u{arg}[{comp}][{dir}]"),
         Sym::Test { comp } => format!("v[{comp}]"),
@@ -113,9 +95,6 @@ pub fn sym(s: Sym, params: &[String], coefs: &[String]) -> String {
         Sym::CellDiameter => "h".into(),
         Sym::Coord(k) => format!("x[{k}]"),
         Sym::Time => "t".into(),
-        Sym::Coef { id, comp } => format!(
-            "{}[{comp}]",
-            coefs.get(id as usize).map_or("coef", String::as_str)
-        ),
+        Sym::Coef { id, comp } => format!("{}[{comp}]", coefs.get(id as usize).map_or("coef", String::as_str)),
     }
 }

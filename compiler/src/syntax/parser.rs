@@ -44,16 +44,13 @@ pub fn parse(file: FileId, text: &str) -> (File, Vec<Diagnostic>) {
         }
         match WfParser::parse(Rule::chunk, chunk) {
             Ok(mut pairs) => {
-                let b = Builder {
-                    file,
-                    offset: start,
-                };
+                let b = Builder { file, offset: start };
                 let chunk_pair = pairs.next().expect("chunk rule always yields one pair");
                 for p in chunk_pair.into_inner() {
                     if p.as_rule() != Rule::EOI {
                         match b.item(p) {
                             Ok(item) => out.items.push(item),
-                            Err(d) => diags.push(d),
+                            Err(d) => diags.push(*d),
                         }
                     }
                 }
@@ -124,11 +121,7 @@ fn starts_item(rest: &str) -> bool {
 fn nesting_error(file: FileId, chunk: &str, offset: usize) -> Option<Diagnostic> {
     let operators = chunk.bytes().filter(|b| b"+-*/^,".contains(b)).count();
     if operators > MAX_OPERATORS {
-        let span = Span::new(
-            file,
-            offset,
-            offset + chunk.find('\n').unwrap_or(chunk.len()),
-        );
+        let span = Span::new(file, offset, offset + chunk.find('\n').unwrap_or(chunk.len()));
         return Some(
             Diagnostic::error(
                 "E0002",
@@ -175,12 +168,7 @@ fn note_broken_name(chunk: &str, names: &mut Vec<String>) {
     }
 }
 
-fn syntax_error(
-    file: FileId,
-    chunk: &str,
-    offset: usize,
-    e: &pest::error::Error<Rule>,
-) -> Diagnostic {
+fn syntax_error(file: FileId, chunk: &str, offset: usize, e: &pest::error::Error<Rule>) -> Diagnostic {
     let mut pos = match e.location {
         pest::error::InputLocation::Pos(p) => p,
         pest::error::InputLocation::Span((s, _)) => s,
@@ -192,24 +180,20 @@ fn syntax_error(
     }
     // With error detail on, pest also records the furthest point any alternative reached,
     // which is where the mistake is.
-    if let Some(attempts) = e.parse_attempts() {
-        if attempts.max_position >= pos {
-            if attempts.max_position > pos {
-                rules.clear();
-            }
-            pos = attempts.max_position;
-            for stack in &attempts.call_stacks {
-                rules.extend(stack.deepest.get_rule().copied());
-                rules.extend(stack.parent);
-            }
-            tokens.extend(attempts.expected_tokens().iter().map(|t| t.to_string()));
+    if let Some(attempts) = e.parse_attempts()
+        && attempts.max_position >= pos
+    {
+        if attempts.max_position > pos {
+            rules.clear();
         }
+        pos = attempts.max_position;
+        for stack in &attempts.call_stacks {
+            rules.extend(stack.deepest.get_rule().copied());
+            rules.extend(stack.parent);
+        }
+        tokens.extend(attempts.expected_tokens().iter().map(|t| t.to_string()));
     }
-    let mut expected: Vec<String> = rules
-        .iter()
-        .filter_map(|r| rule_name(*r))
-        .map(str::to_string)
-        .collect();
+    let mut expected: Vec<String> = rules.iter().filter_map(|r| rule_name(*r)).map(str::to_string).collect();
     let has = |what: &str, list: &[String]| list.iter().any(|e| e == what);
     let expression = has("an expression", &expected);
     let operator = has("an operator", &expected);
@@ -244,11 +228,7 @@ fn syntax_error(
     let content_end = content_end(chunk);
     let at_end = pos >= content_end;
     let pos = pos.min(content_end);
-    let found = if at_end {
-        ""
-    } else {
-        found_token(&chunk[pos..])
-    };
+    let found = if at_end { "" } else { found_token(&chunk[pos..]) };
     let span = Span::new(file, offset + pos, offset + pos + found.len());
     let found_text = if at_end {
         "the end of the item".to_string()
@@ -265,11 +245,11 @@ fn syntax_error(
     if found == "=" && expected.iter().any(|e| e == "`(`") {
         d = d.with_help("a function needs its parameters: `fn name(arg) = ...`");
     } else if keyword == "coef" && found == "=" {
-        d = d.with_help("a coef is case data supplied at run time (`coef g`, `coef nc: vector`); use `param` for a number");
-    } else if found == ":" {
         d = d.with_help(
-            "declare case data with `coef NAME: vector`; parameters are `param NAME = VALUE`",
+            "a coef is case data supplied at run time (`coef g`, `coef nc: vector`); use `param` for a number",
         );
+    } else if found == ":" {
+        d = d.with_help("declare case data with `coef NAME: vector`; parameters are `param NAME = VALUE`");
     }
     d
 }
@@ -339,12 +319,9 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::number => "a number",
         Rule::expr | Rule::call | Rule::neg => "an expression",
         Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::pow => "an operator",
-        Rule::import
-        | Rule::param
-        | Rule::coef
-        | Rule::let_decl
-        | Rule::fn_decl
-        | Rule::form_decl => "an item (`import`, `param`, `coef`, `let`, `fn`, `form`)",
+        Rule::import | Rule::param | Rule::coef | Rule::let_decl | Rule::fn_decl | Rule::form_decl => {
+            "an item (`import`, `param`, `coef`, `let`, `fn`, `form`)"
+        }
         Rule::range => "`in RANGE`",
         Rule::lbound => "`[` or `(`",
         Rule::rbound => "`]` or `)`",
@@ -368,11 +345,7 @@ impl Builder {
     fn span(&self, p: &Pair<Rule>) -> Span {
         let s = p.as_span();
         let trimmed = s.as_str().trim_end().len();
-        Span::new(
-            self.file,
-            self.offset + s.start(),
-            self.offset + s.start() + trimmed,
-        )
+        Span::new(self.file, self.offset + s.start(), self.offset + s.start() + trimmed)
     }
 
     fn ident(&self, p: Pair<Rule>) -> Ident {
@@ -382,7 +355,7 @@ impl Builder {
         }
     }
 
-    fn item(&self, p: Pair<Rule>) -> Result<Item, Diagnostic> {
+    fn item(&self, p: Pair<Rule>) -> Result<Item, Box<Diagnostic>> {
         let span = self.span(&p);
         let rule = p.as_rule();
         let mut it = p.into_inner();
@@ -434,9 +407,7 @@ impl Builder {
                 let mut body = None;
                 for q in it {
                     match q.as_rule() {
-                        Rule::ident_list => {
-                            params = q.into_inner().map(|i| self.ident(i)).collect()
-                        }
+                        Rule::ident_list => params = q.into_inner().map(|i| self.ident(i)).collect(),
                         _ => body = Some(self.expr(q)?),
                     }
                 }
@@ -454,9 +425,7 @@ impl Builder {
                 let mut test = None;
                 for a in args.into_inner() {
                     match a.as_rule() {
-                        Rule::ident_list => {
-                            fields = a.into_inner().map(|i| self.ident(i)).collect()
-                        }
+                        Rule::ident_list => fields = a.into_inner().map(|i| self.ident(i)).collect(),
                         _ => test = Some(self.ident(a)),
                     }
                 }
@@ -473,7 +442,7 @@ impl Builder {
         })
     }
 
-    fn range(&self, p: Pair<Rule>) -> Result<Range, Diagnostic> {
+    fn range(&self, p: Pair<Rule>) -> Result<Range, Box<Diagnostic>> {
         let span = self.span(&p);
         let mut it = p.into_inner();
         let lo_closed = it.next().map(|b| b.as_str() == "[").unwrap_or(true);
@@ -489,7 +458,7 @@ impl Builder {
         })
     }
 
-    fn integrals(&self, p: Pair<Rule>) -> Result<Vec<Integral>, Diagnostic> {
+    fn integrals(&self, p: Pair<Rule>) -> Result<Vec<Integral>, Box<Diagnostic>> {
         let mut out = Vec::new();
         let mut sign = 1.0;
         let mut sign_span: Option<Span> = None;
@@ -520,7 +489,7 @@ impl Builder {
         Ok(out)
     }
 
-    fn expr(&self, p: Pair<Rule>) -> Result<Expr, Diagnostic> {
+    fn expr(&self, p: Pair<Rule>) -> Result<Expr, Box<Diagnostic>> {
         PRATT
             .map_primary(|q| self.primary(q))
             .map_prefix(|op, rhs| {
@@ -549,7 +518,7 @@ impl Builder {
             .parse(p.into_inner())
     }
 
-    fn primary(&self, p: Pair<Rule>) -> Result<Expr, Diagnostic> {
+    fn primary(&self, p: Pair<Rule>) -> Result<Expr, Box<Diagnostic>> {
         let span = self.span(&p);
         Ok(match p.as_rule() {
             Rule::number => match p.as_str().parse::<f64>() {
@@ -558,12 +527,13 @@ impl Builder {
                     span,
                 },
                 _ => {
-                    return Err(Diagnostic::error(
+                    let d = Diagnostic::error(
                         "E0003",
                         "number out of range",
                         span,
                         "not a finite double-precision number",
-                    ));
+                    );
+                    return Err(Box::new(d));
                 }
             },
             Rule::ident => Expr {
@@ -604,9 +574,7 @@ mod tests {
     fn precedence_of_power_and_unary_minus() {
         let (f, d) = parse(0, "let a = -x^2 + 3*y/2");
         assert!(d.is_empty(), "{d:?}");
-        let Item::Let { value, .. } = &f.items[0] else {
-            panic!()
-        };
+        let Item::Let { value, .. } = &f.items[0] else { panic!() };
         let ExprKind::Binary(BinOp::Add, lhs, _) = &value.kind else {
             panic!("{value:?}")
         };
@@ -615,10 +583,7 @@ mod tests {
 
     #[test]
     fn integrand_stops_before_next_integral() {
-        let (f, d) = parse(
-            0,
-            "form a(u; v) = int(Omega) dot(u, v) + 1 - int(G) dot(u,v)",
-        );
+        let (f, d) = parse(0, "form a(u; v) = int(Omega) dot(u, v) + 1 - int(G) dot(u,v)");
         assert!(d.is_empty(), "{d:?}");
         let Item::Form { integrals, .. } = &f.items[0] else {
             panic!()

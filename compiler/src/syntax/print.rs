@@ -13,10 +13,7 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
         match item {
             Item::Import { path, .. } => out.push_str(&format!("{head}import {path:?}\n")),
             Item::Param {
-                name,
-                default,
-                range,
-                ..
+                name, default, range, ..
             } => {
                 out.push_str(&format!("{head}param {} = {}", name.name, expr(default)));
                 if let Some(r) = range {
@@ -30,22 +27,11 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 }
                 out.push('\n');
             }
-            Item::Coef { name, shape, .. } => {
-                out.push_str(&format!("{head}coef {}: {}\n", name.name, shape.name()))
-            }
-            Item::Let { name, value, .. } => {
-                out.push_str(&format!("{head}let {} = {}\n", name.name, expr(value)))
-            }
-            Item::Fn {
-                name, params, body, ..
-            } => {
+            Item::Coef { name, shape, .. } => out.push_str(&format!("{head}coef {}: {}\n", name.name, shape.name())),
+            Item::Let { name, value, .. } => out.push_str(&format!("{head}let {} = {}\n", name.name, expr(value))),
+            Item::Fn { name, params, body, .. } => {
                 let ps: Vec<_> = params.iter().map(|p| p.name.as_str()).collect();
-                out.push_str(&format!(
-                    "{head}fn {}({}) = {}\n",
-                    name.name,
-                    ps.join(", "),
-                    expr(body)
-                ));
+                out.push_str(&format!("{head}fn {}({}) = {}\n", name.name, ps.join(", "), expr(body)));
             }
             Item::Form {
                 name,
@@ -55,19 +41,10 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 ..
             } => {
                 let fs: Vec<_> = fields.iter().map(|p| p.name.as_str()).collect();
-                out.push_str(&format!(
-                    "{head}form {}({}; {})\n",
-                    name.name,
-                    fs.join(", "),
-                    test.name
-                ));
+                out.push_str(&format!("{head}form {}({}; {})\n", name.name, fs.join(", "), test.name));
                 for i in integrals {
                     let sign = if i.sign < 0.0 { "-" } else { "+" };
-                    out.push_str(&format!(
-                        "  {sign} int({}) {}\n",
-                        i.region.name,
-                        expr(&i.integrand)
-                    ));
+                    out.push_str(&format!("  {sign} int({}) {}\n", i.region.name, expr(&i.integrand)));
                 }
             }
         }
