@@ -327,6 +327,8 @@ impl Body<'_> {
         // Which nodes depend on the quadrature point, and how often each is used.
         let mut pointwise: HashMap<NodeId, bool> = HashMap::new();
         let mut uses: HashMap<NodeId, usize> = HashMap::new();
+        // Cell-constant nodes read inside the loop (by a pointwise node or as an output).
+        let mut read_in_loop: HashSet<NodeId> = roots.iter().copied().collect();
         for &n in &nodes {
             let pw = match g.node(n) {
                 // Constant over the cell: hoisted out of the quadrature loop.
@@ -337,6 +339,9 @@ impl Body<'_> {
             pointwise.insert(n, pw);
             for c in g.children(n) {
                 *uses.entry(c).or_default() += 1;
+                if pw {
+                    read_in_loop.insert(c);
+                }
             }
         }
         for r in &roots {
@@ -352,7 +357,7 @@ impl Body<'_> {
                 continue;
             }
             let named = g.names.get(&n);
-            let crosses = !pointwise[&n] && uses.get(&n).copied().unwrap_or(0) > 0;
+            let crosses = !pointwise[&n] && read_in_loop.contains(&n);
             if named.is_none() && uses.get(&n).copied().unwrap_or(0) <= 1 && !crosses {
                 continue;
             }
@@ -371,7 +376,10 @@ impl Body<'_> {
         let mut weighted = String::new();
         for (_, list) in &outputs {
             for o in list.iter().flatten() {
-                let (text, prec) = self.expr(o.node, &leaf, &bound);
+                let (text, prec) = match bound.get(&o.node) {
+                    Some(local) => (local.clone(), ATOM),
+                    None => self.expr(o.node, &leaf, &bound),
+                };
                 let text = if prec < UNARY { format!("({text})") } else { text };
                 let _ = writeln!(weighted, "let {} = w * {text};", o.name);
             }
