@@ -147,10 +147,7 @@ pub type CoefFn = Arc<dyn Fn(&[f64], f64, &mut [f64]) + Send + Sync>;
 #[derive(Clone)]
 pub enum Coef {
     Constant(Vec<f64>),
-    Function {
-        components: usize,
-        f: CoefFn,
-    },
+    Function { components: usize, f: CoefFn },
 }
 
 impl Coef {

@@ -44,14 +44,18 @@ impl Parse for Input {
 
 #[proc_macro]
 pub fn forms(input: TokenStream) -> TokenStream {
-    let input = match syn::parse::<Input>(input) {
+    forms_tokens(input.into()).into()
+}
+
+/// The macro on proc-macro2 tokens (testable outside the compiler).
+fn forms_tokens(input: proc_macro2::TokenStream) -> proc_macro2::TokenStream {
+    let input = match syn::parse2::<Input>(input) {
         Ok(i) => i,
-        Err(e) => return e.to_compile_error().into(),
+        Err(e) => return e.to_compile_error(),
     };
     let span = input.path.span();
-    let result = std::panic::catch_unwind(|| expand(&input));
-    match result {
-        Ok(Ok(tokens)) => tokens.into(),
+    match std::panic::catch_unwind(|| expand(&input)) {
+        Ok(Ok(tokens)) => tokens,
         Ok(Err(msg)) => error(span, &msg),
         Err(_) => error(
             span,
@@ -60,9 +64,9 @@ pub fn forms(input: TokenStream) -> TokenStream {
     }
 }
 
-fn error(span: Span, msg: &str) -> TokenStream {
+fn error(span: Span, msg: &str) -> proc_macro2::TokenStream {
     let msg = format!("signorini: the forms did not compile\n\n{msg}");
-    quote::quote_spanned!(span=> compile_error!(#msg);).into()
+    quote::quote_spanned!(span=> compile_error!(#msg);)
 }
 
 fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
@@ -98,4 +102,50 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
         }
     }
     Ok(quote!(#file))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp_file(name: &str, text: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("signorini-macro-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    #[test]
+    fn a_bad_file_becomes_compile_error_with_the_rendered_diagnostic() {
+        let path = temp_file(
+            "bad.wf",
+            "param E = 1.0\nform k(u; v) = int(Omega) inner(grd(u), grad(v)) * E\n",
+        );
+        let lit = path.display().to_string();
+        let out = forms_tokens(quote!(#lit)).to_string();
+        assert!(out.starts_with("compile_error !"), "{out}");
+        assert!(out.contains("unknown name `grd`"), "{out}");
+        assert!(out.contains("bad.wf:2:"), "{out}");
+        assert!(out.contains("did you mean `grad`?"), "{out}");
+    }
+
+    #[test]
+    fn a_good_file_becomes_a_module_that_tracks_its_sources() {
+        let path = temp_file(
+            "good.wf",
+            "param rho = 2.0\nform mass(a; v) = int(Omega) rho * dot(a, v)\n",
+        );
+        let lit = path.display().to_string();
+        let out = forms_tokens(quote!(pub mod named = #lit)).to_string();
+        assert!(out.contains("pub mod named {"), "{out}");
+        assert!(out.contains("include_bytes !"), "{out}");
+        assert!(out.contains("struct Mass"), "{out}");
+    }
+
+    #[test]
+    fn malformed_macro_input_is_a_syntax_error_not_a_panic() {
+        let out = forms_tokens(quote!(mod 42)).to_string();
+        assert!(out.contains("compile_error"), "{out}");
+    }
 }
