@@ -1,0 +1,69 @@
+//! The `signorini` binary: `check` and `emit` on the form library and on a bad file.
+
+use std::process::Command;
+
+fn signorini(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(args)
+        .output()
+        .expect("the binary runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn check_accepts_the_form_library() {
+    let (code, _, err) = signorini(&[
+        "check",
+        "forms/elasticity.wf",
+        "forms/contact_nitsche.wf",
+        "forms/contact_penalty.wf",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.is_empty(), "{err}");
+}
+
+#[test]
+fn check_reports_every_error_with_position_and_caret() {
+    let (code, _, err) = signorini(&[
+        "check",
+        "forms/elasticity.wf",
+        "compiler/tests/ui/syntax_two_broken_items.wf",
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("compiler/tests/ui/syntax_two_broken_items.wf:2:14"),
+        "{err}"
+    );
+    assert!(
+        err.contains("compiler/tests/ui/syntax_two_broken_items.wf:4:8"),
+        "{err}"
+    );
+    assert!(err.contains("^ expected"), "{err}");
+    assert!(err.contains("3 error(s)"), "{err}");
+}
+
+#[test]
+fn check_of_a_missing_file_fails_cleanly() {
+    let (code, _, err) = signorini(&["check", "forms/no_such_file.wf"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("cannot read forms/no_such_file.wf"), "{err}");
+}
+
+#[test]
+fn emit_prints_every_stage() {
+    let (code, ast, _) = signorini(&["emit", "forms/contact_nitsche.wf", "--stage", "ast"]);
+    assert_eq!(code, 0);
+    assert!(ast.contains("form contact(u; v)"), "{ast}");
+    let (code, ir, _) = signorini(&["emit", "forms/contact_nitsche.wf", "--stage", "ir", "--dim", "1"]);
+    assert_eq!(code, 0);
+    assert!(ir.contains("// dimension 1") && ir.contains("H "), "{ir}");
+    let (code, rust, _) = signorini(&["emit", "forms/contact_nitsche.wf"]);
+    assert_eq!(code, 0);
+    assert!(
+        rust.contains("pub mod contact_nitsche") && rust.contains("impl<const N: usize> FormKernel<2, N> for Contact")
+    );
+}
