@@ -8,6 +8,7 @@ use signorini::runtime::kernel::{Coef, FacetTabulation, FormKernel, facet_matrix
 
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
+signorini::forms!("tests/wf/hybrid_contact.wf");
 
 /// Gap to the plane {x_d = 0} with the obstacle below: g = x_d, n_c = −e_d.
 fn gap(d: usize) -> Coef {
@@ -223,5 +224,51 @@ fn one_dimensional_contact_residual_is_the_spec_kernel() {
             (got[0][0] - expect).abs() < 1e-12 && got[1][0] == 0.0,
             "penalty: {got:?} vs {expect}"
         );
+    }
+}
+
+/// A form of two time levels: the tangent with respect to either level matches finite
+/// differences with respect to that level only.
+#[test]
+fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
+    use signorini::runtime::kernel::Form;
+    let p = hybrid_contact::Params::default()
+        .with("gamma0", 5.0)
+        .and_then(|p| p.with("nu", 0.3))
+        .unwrap();
+    let c = hybrid_contact::Coefficients {
+        f: Coef::constant(vec![0.0; 2]),
+        g: gap(2),
+        nc: down(2),
+    };
+    let k = hybrid_contact::HybridContact::new(&p, &c);
+    assert_eq!(hybrid_contact::HybridContact::META.fields, &["u0", "u1"]);
+    assert!(!hybrid_contact::HybridContact::META.linear);
+    let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 7).unwrap();
+    let x = cell_2d();
+    let h = signorini::runtime::geometry::diameter(&x, 3);
+    let mut rng = Rng(4242);
+    for trial in 0..5 {
+        let u0 = state_2d(&mut rng, 0.0);
+        let u1 = state_2d(&mut rng, 0.02);
+        for wrt in 0..2 {
+            let jac = facet_matrix(&k, 0, &tab, 0, &x, h, &[&u0, &u1], wrt, 0.0);
+            let scale = jac.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(scale > 0.0);
+            for col in 0..12 {
+                let eps = 1e-7;
+                let mut plus = [u0, u1];
+                let mut minus = [u0, u1];
+                plus[wrt][col / 2][col % 2] += eps;
+                minus[wrt][col / 2][col % 2] -= eps;
+                let rp = facet_vector(&k, 0, &tab, 0, &x, h, &[&plus[0], &plus[1]], 0.0);
+                let rm = facet_vector(&k, 0, &tab, 0, &x, h, &[&minus[0], &minus[1]], 0.0);
+                for row in 0..12 {
+                    let fd = (rp[row / 2][row % 2] - rm[row / 2][row % 2]) / (2.0 * eps);
+                    let err = (fd - jac[row][col]).abs() / scale;
+                    assert!(err < 1e-6, "trial {trial}, d/du{wrt}, entry ({row}, {col}): {err:e}");
+                }
+            }
+        }
     }
 }
