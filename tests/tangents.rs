@@ -272,3 +272,54 @@ fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
         }
     }
 }
+
+/// Nitsche and penalty tangents depend on the state only through the active set: states with
+/// the same switches have the same tangent, and the switches of a mixed state are mixed.
+#[test]
+fn equal_switches_mean_equal_tangents() {
+    use signorini::runtime::kernel::{FacetCtx, Form};
+    assert!(contact_nitsche::Contact::META.piecewise && contact_penalty::Contact::META.piecewise);
+    let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 7).unwrap();
+    let x = cell_2d();
+    let h = signorini::runtime::geometry::diameter(&x, 3);
+    let k = nitsche(-1.0, 5.0, 1.0, 0.3, 2);
+    let switches = |u: &[[f64; 2]; 6]| {
+        let (ftab, normal) = &tab.facets[0];
+        let mut s = Vec::new();
+        k.facet_switches(
+            0,
+            &FacetCtx {
+                tab: ftab,
+                ref_normal: normal,
+                coords: &x,
+                h,
+                t: 0.0,
+            },
+            &[u],
+            0,
+            &mut s,
+        );
+        s
+    };
+    let mut rng = Rng(99);
+    let mut pairs = 0;
+    let states: Vec<[[f64; 2]; 6]> = (0..60)
+        .map(|_| {
+            let shift = 0.02 * rng.next();
+            state_2d(&mut rng, shift)
+        })
+        .collect();
+    for a in &states {
+        let sa = switches(a);
+        assert_eq!(sa.len(), tab.facets[0].0.len());
+        for b in &states {
+            if switches(b) == sa {
+                pairs += 1;
+                assert_eq!(tangent(&k, &tab, &x, a), tangent(&k, &tab, &x, b));
+            }
+        }
+    }
+    assert!(pairs > states.len(), "no two distinct states shared an active set");
+    let s = switches(&states[0]);
+    assert!(s.iter().any(|b| *b) && s.iter().any(|b| !*b), "{s:?}");
+}

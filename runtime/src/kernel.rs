@@ -298,6 +298,8 @@ pub struct FormMeta {
     pub test: &'static str,
     /// The tangent does not depend on the fields: assemble it once.
     pub linear: bool,
+    /// The tangent depends on the fields only through the switches (the active set).
+    pub piecewise: bool,
     /// Suggested cell quadrature degree for P1 and P2, if the form has a volume integral.
     pub cell_degree: Option<[u32; 2]>,
     /// Boundary regions with suggested facet quadrature degrees for P1 and P2.
@@ -321,6 +323,10 @@ pub trait FormKernel<const D: usize, const N: usize>: Form {
         wrt: usize,
         out: &mut LocalMatrix<D, N>,
     );
+    /// Pushes, at every quadrature point, the sign (`a > 0`) of each active-set switch H(a) of
+    /// the tangent with respect to field `wrt`. For a `piecewise` form, equal switches mean
+    /// an equal tangent.
+    fn cell_switches(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>], wrt: usize, out: &mut Vec<bool>);
     /// `region` indexes `META.facets`.
     fn facet_residual(
         &self,
@@ -336,6 +342,14 @@ pub trait FormKernel<const D: usize, const N: usize>: Form {
         fields: &[&LocalVector<D, N>],
         wrt: usize,
         out: &mut LocalMatrix<D, N>,
+    );
+    fn facet_switches(
+        &self,
+        region: usize,
+        ctx: &FacetCtx<'_, D, N>,
+        fields: &[&LocalVector<D, N>],
+        wrt: usize,
+        out: &mut Vec<bool>,
     );
 }
 

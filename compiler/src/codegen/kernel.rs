@@ -41,99 +41,82 @@ const RESERVED: &[&str] = &[
 pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -> String {
     let d = ir.dim;
     let g = &ir.graph;
+    let body = |integral: &IntegralIr, mode: Mode| {
+        Body {
+            prog,
+            g,
+            d,
+            form,
+            integral,
+            mode,
+        }
+        .emit()
+    };
+    // One `match wrt` arm per field argument.
+    let per_field = |integral: &IntegralIr, mode: fn(usize) -> Mode| {
+        let mut s = String::from("match wrt {\n");
+        for (a, field) in form.fields.iter().enumerate() {
+            let _ = writeln!(s, "{a} => {{ // d/d{field}\n{}}}", body(integral, mode(a)));
+        }
+        s.push_str("_ => {}\n}\n");
+        s
+    };
     let cell = form.integrals.iter().find(|i| i.cell);
     let facets: Vec<&IntegralIr> = form.integrals.iter().filter(|i| !i.cell).collect();
+    // One `match region` arm per boundary region.
+    let per_region = |f: &dyn Fn(&IntegralIr) -> String| {
+        if facets.is_empty() {
+            return String::new();
+        }
+        let mut s = String::from("match region {\n");
+        for (r, i) in facets.iter().enumerate() {
+            let _ = writeln!(s, "{r} => {{ // int({})\n{}}}", i.region, f(i));
+        }
+        s.push_str("_ => {}\n}\n");
+        s
+    };
+    let (vec, mat, fields) = (
+        format!("LocalVector<{d}, N>"),
+        format!("LocalMatrix<{d}, N>"),
+        format!("&[&LocalVector<{d}, N>]"),
+    );
+    let (cctx, fctx) = (format!("&CellCtx<'_, {d}, N>"), format!("&FacetCtx<'_, {d}, N>"));
     let mut s = String::new();
     let _ = writeln!(s, "impl<const N: usize> FormKernel<{d}, N> for {struct_name} {{");
-
-    let _ = writeln!(
-        s,
-        "fn cell_residual(&self, ctx: &CellCtx<'_, {d}, N>, fields: &[&LocalVector<{d}, N>], out: &mut LocalVector<{d}, N>) {{"
-    );
-    if let Some(i) = cell {
-        s.push_str(
-            &Body {
-                prog,
-                g,
-                d,
-                form,
-                integral: i,
-                mode: Mode::Residual,
-            }
-            .emit(),
-        );
+    let methods = [
+        (
+            format!("fn cell_residual(&self, ctx: {cctx}, fields: {fields}, out: &mut {vec})"),
+            cell.map(|i| body(i, Mode::Residual)),
+        ),
+        (
+            format!("fn cell_tangent(&self, ctx: {cctx}, fields: {fields}, wrt: usize, out: &mut {mat})"),
+            cell.map(|i| per_field(i, Mode::Tangent)),
+        ),
+        (
+            format!("fn cell_switches(&self, ctx: {cctx}, fields: {fields}, wrt: usize, out: &mut Vec<bool>)"),
+            cell.map(|i| per_field(i, Mode::Switches)),
+        ),
+        (
+            format!("fn facet_residual(&self, region: usize, ctx: {fctx}, fields: {fields}, out: &mut {vec})"),
+            Some(per_region(&|i| body(i, Mode::Residual))),
+        ),
+        (
+            format!(
+                "fn facet_tangent(&self, region: usize, ctx: {fctx}, fields: {fields}, wrt: usize, out: &mut {mat})"
+            ),
+            Some(per_region(&|i| per_field(i, Mode::Tangent))),
+        ),
+        (
+            format!(
+                "fn facet_switches(&self, region: usize, ctx: {fctx}, fields: {fields}, wrt: usize, out: &mut Vec<bool>)"
+            ),
+            Some(per_region(&|i| per_field(i, Mode::Switches))),
+        ),
+    ];
+    for (sig, text) in methods {
+        let _ = writeln!(s, "{sig} {{\n{}}}", text.unwrap_or_default());
     }
     s.push_str("}\n");
-
-    let _ = writeln!(
-        s,
-        "fn cell_tangent(&self, ctx: &CellCtx<'_, {d}, N>, fields: &[&LocalVector<{d}, N>], wrt: usize, out: &mut LocalMatrix<{d}, N>) {{"
-    );
-    if let Some(i) = cell {
-        s.push_str(&tangent_match(prog, g, d, form, i));
-    }
-    s.push_str("}\n");
-
-    let _ = writeln!(
-        s,
-        "fn facet_residual(&self, region: usize, ctx: &FacetCtx<'_, {d}, N>, fields: &[&LocalVector<{d}, N>], out: &mut LocalVector<{d}, N>) {{"
-    );
-    if !facets.is_empty() {
-        s.push_str("match region {\n");
-        for (r, i) in facets.iter().enumerate() {
-            let _ = writeln!(s, "{r} => {{ // int({})", i.region);
-            s.push_str(
-                &Body {
-                    prog,
-                    g,
-                    d,
-                    form,
-                    integral: i,
-                    mode: Mode::Residual,
-                }
-                .emit(),
-            );
-            s.push_str("}\n");
-        }
-        s.push_str("_ => {}\n}\n");
-    }
-    s.push_str("}\n");
-
-    let _ = writeln!(
-        s,
-        "fn facet_tangent(&self, region: usize, ctx: &FacetCtx<'_, {d}, N>, fields: &[&LocalVector<{d}, N>], wrt: usize, out: &mut LocalMatrix<{d}, N>) {{"
-    );
-    if !facets.is_empty() {
-        s.push_str("match region {\n");
-        for (r, i) in facets.iter().enumerate() {
-            let _ = writeln!(s, "{r} => {{ // int({})", i.region);
-            s.push_str(&tangent_match(prog, g, d, form, i));
-            s.push_str("}\n");
-        }
-        s.push_str("_ => {}\n}\n");
-    }
-    s.push_str("}\n}\n");
-    s
-}
-
-fn tangent_match(prog: &Program, g: &Graph, d: usize, form: &FormIr, integral: &IntegralIr) -> String {
-    let mut s = String::from("match wrt {\n");
-    for (a, field) in form.fields.iter().enumerate() {
-        let _ = writeln!(s, "{a} => {{ // d/d{field}");
-        s.push_str(
-            &Body {
-                prog,
-                g,
-                d,
-                form,
-                integral,
-                mode: Mode::Tangent(a),
-            }
-            .emit(),
-        );
-        s.push_str("}\n");
-    }
-    s.push_str("_ => {}\n}\n");
     s
 }
 
@@ -141,6 +124,8 @@ fn tangent_match(prog: &Program, g: &Graph, d: usize, form: &FormIr, integral: &
 enum Mode {
     Residual,
     Tangent(usize),
+    /// Signs of the active-set switches of the tangent with respect to a field.
+    Switches(usize),
 }
 
 struct Body<'a> {
@@ -216,6 +201,19 @@ impl Body<'_> {
                 add("c01", &t.c01, 3);
                 add("c10", &t.c10, 3);
                 add("c11", &t.c11, 4);
+            }
+            Mode::Switches(a) => {
+                let list = self.integral.tangents[a].switches.iter().enumerate();
+                outputs.push((
+                    "s",
+                    list.map(|(k, &node)| {
+                        Some(Output {
+                            name: format!("s_{k}"),
+                            node,
+                        })
+                    })
+                    .collect(),
+                ));
             }
         }
         let roots: Vec<NodeId> = outputs
@@ -372,16 +370,25 @@ impl Body<'_> {
             bound.insert(n, local);
         }
 
-        // Weighted outputs.
+        // Weighted outputs (switches are signs: no weight).
         let mut weighted = String::new();
+        let weight = if matches!(self.mode, Mode::Switches(_)) {
+            ""
+        } else {
+            "w * "
+        };
         for (_, list) in &outputs {
             for o in list.iter().flatten() {
                 let (text, prec) = match bound.get(&o.node) {
                     Some(local) => (local.clone(), ATOM),
                     None => self.expr(o.node, &leaf, &bound),
                 };
-                let text = if prec < UNARY { format!("({text})") } else { text };
-                let _ = writeln!(weighted, "let {} = w * {text};", o.name);
+                let text = if prec < UNARY && !weight.is_empty() {
+                    format!("({text})")
+                } else {
+                    text
+                };
+                let _ = writeln!(weighted, "let {} = {weight}{text};", o.name);
             }
         }
 
@@ -436,6 +443,11 @@ impl Body<'_> {
         match self.mode {
             Mode::Residual => s.push_str(&self.residual_loop(&outputs)),
             Mode::Tangent(_) => s.push_str(&self.tangent_loop(&outputs)),
+            Mode::Switches(_) => {
+                for o in outputs.iter().flat_map(|(_, l)| l.iter().flatten()) {
+                    let _ = writeln!(s, "out.push({} > 0.0);", o.name);
+                }
+            }
         }
         s.push_str("}\n");
         s

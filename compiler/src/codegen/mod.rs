@@ -111,11 +111,15 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "impl Form for {sname} {{ const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, cell_degree: {cell_degree}, facets: &[{}] }}; }}",
+            "impl Form for {sname} {{ const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: &[{}] }}; }}",
             form.name,
             fields.join(", "),
             form.test.name,
             irs.iter().all(|ir| ir.forms[fi].linear),
+            irs.iter().all(|ir| ir.forms[fi]
+                .integrals
+                .iter()
+                .all(|i| i.tangents.iter().all(|t| t.piecewise))),
             facets.join(", ")
         );
         for ir in irs {

@@ -60,6 +60,13 @@ pub struct TangentIr {
     pub c10: Vec<NodeId>,
     /// ∂f1[k,l]/∂(∂_n u_m) at `[((k*d + l)*d + m)*d + n]`.
     pub c11: Vec<NodeId>,
+    /// Arguments `a` of the Heaviside nodes H(a) in the tangent that depend on this field: the
+    /// active set. Their signs at the quadrature points decide the tangent when `piecewise`.
+    pub switches: Vec<NodeId>,
+    /// The tangent depends on this field only through the switches (true for Nitsche and
+    /// penalty contact, and for linear forms): an unchanged active set means an unchanged
+    /// matrix.
+    pub piecewise: bool,
 }
 
 impl TangentIr {
@@ -160,7 +167,37 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> Ta
             c11.push(dg.of(g, f));
         }
     }
-    TangentIr { c00, c01, c10, c11 }
+    let mut t = TangentIr {
+        c00,
+        c01,
+        c10,
+        c11,
+        switches: Vec::new(),
+        piecewise: true,
+    };
+    let is_field = |s: Sym| matches!(s, Sym::Field { arg: x, .. } | Sym::FieldGrad { arg: x, .. } if x == arg);
+    let roots: Vec<NodeId> = t.nodes().collect();
+    for n in g.reachable(roots.iter().copied()) {
+        if let Node::Heaviside(a) = g.node(n) {
+            if g.depends_on(a, is_field) {
+                t.switches.push(a);
+            }
+        }
+    }
+    // Field dependence outside the switches: walk the tangent without entering H nodes.
+    let mut seen = std::collections::HashSet::new();
+    let mut stack = roots;
+    while let Some(n) = stack.pop() {
+        if !seen.insert(n) {
+            continue;
+        }
+        match g.node(n) {
+            Node::Heaviside(_) => {}
+            Node::Sym(s) if is_field(s) => t.piecewise = false,
+            _ => stack.extend(g.children(n)),
+        }
+    }
+    t
 }
 
 /// Polynomial degree estimate of each node for Lagrange elements of degree p on affine cells
