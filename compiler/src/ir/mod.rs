@@ -178,10 +178,10 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> Ta
     let is_field = |s: Sym| matches!(s, Sym::Field { arg: x, .. } | Sym::FieldGrad { arg: x, .. } if x == arg);
     let roots: Vec<NodeId> = t.nodes().collect();
     for n in g.reachable(roots.iter().copied()) {
-        if let Node::Heaviside(a) = g.node(n) {
-            if g.depends_on(a, is_field) {
-                t.switches.push(a);
-            }
+        if let Node::Heaviside(a) = g.node(n)
+            && g.depends_on(a, is_field)
+        {
+            t.switches.push(a);
         }
     }
     // Field dependence outside the switches: walk the tangent without entering H nodes.
