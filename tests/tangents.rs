@@ -243,7 +243,7 @@ fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
     };
     let k = hybrid_contact::HybridContact::new(&p, &c);
     assert_eq!(hybrid_contact::HybridContact::META.fields, &["u0", "u1"]);
-    assert!(!hybrid_contact::HybridContact::META.linear);
+    const { assert!(!hybrid_contact::HybridContact::META.linear) };
     let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 7).unwrap();
     let x = cell_2d();
     let h = signorini::runtime::geometry::diameter(&x, 3);
@@ -278,7 +278,7 @@ fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
 #[test]
 fn equal_switches_mean_equal_tangents() {
     use signorini::runtime::kernel::{FacetCtx, Form};
-    assert!(contact_nitsche::Contact::META.piecewise && contact_penalty::Contact::META.piecewise);
+    const { assert!(contact_nitsche::Contact::META.piecewise && contact_penalty::Contact::META.piecewise) };
     let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 7).unwrap();
     let x = cell_2d();
     let h = signorini::runtime::geometry::diameter(&x, 3);
