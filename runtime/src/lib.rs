@@ -4,4 +4,5 @@
 pub mod element;
 pub mod geometry;
 pub mod kernel;
+pub mod mesh;
 pub mod quadrature;

@@ -1,0 +1,260 @@
+//! Meshes: node coordinates, cells of one element kind (isoparametric: a P2 cell's edge nodes
+//! may lie off the straight edges), named boundary regions as lists of (cell, local facet),
+//! and named cell groups. Built by the structured generators, the disc generator, or read from
+//! Gmsh files.
+
+mod boundary;
+pub mod disc;
+pub mod gmsh;
+pub mod structured;
+mod validate;
+
+use std::collections::HashMap;
+
+pub use boundary::facet_key;
+pub use validate::MeshError;
+
+use crate::element::ElementKind;
+use crate::geometry;
+
+/// A boundary facet: a local facet of a cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Facet {
+    pub cell: u32,
+    pub local: u8,
+}
+
+/// A named set of boundary facets (a contact zone, a Dirichlet side, ...).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Region {
+    pub name: String,
+    pub facets: Vec<Facet>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    pub kind: ElementKind,
+    /// `nodes × dim`, row-major.
+    pub coords: Vec<f64>,
+    /// `cells × kind.nodes()`, row-major, Gmsh node order.
+    pub cells: Vec<u32>,
+    /// Named boundary regions.
+    pub regions: Vec<Region>,
+    /// Named groups of cells (Gmsh physical groups of the cell dimension).
+    pub cell_groups: Vec<(String, Vec<u32>)>,
+}
+
+impl Mesh {
+    pub fn dim(&self) -> usize {
+        self.kind.dim()
+    }
+
+    pub fn num_nodes(&self) -> usize {
+        self.coords.len() / self.dim()
+    }
+
+    pub fn num_cells(&self) -> usize {
+        self.cells.len() / self.kind.nodes()
+    }
+
+    pub fn cell(&self, c: usize) -> &[u32] {
+        let n = self.kind.nodes();
+        &self.cells[c * n..(c + 1) * n]
+    }
+
+    pub fn node(&self, i: usize) -> &[f64] {
+        let d = self.dim();
+        &self.coords[i * d..(i + 1) * d]
+    }
+
+    /// The coordinates of a cell's nodes as a fixed-size array (D and N must match the kind).
+    pub fn cell_coords<const D: usize, const N: usize>(&self, c: usize) -> [[f64; D]; N] {
+        let nodes = self.cell(c);
+        std::array::from_fn(|j| std::array::from_fn(|k| self.coords[nodes[j] as usize * D + k]))
+    }
+
+    /// Diameter of a cell (largest distance between two vertices).
+    pub fn cell_diameter(&self, c: usize) -> f64 {
+        let d = self.dim();
+        let nodes = self.cell(c);
+        let nv = self.kind.vertices();
+        let mut h2: f64 = 0.0;
+        for a in 0..nv {
+            for b in a + 1..nv {
+                let (pa, pb) = (self.node(nodes[a] as usize), self.node(nodes[b] as usize));
+                h2 = h2.max((0..d).map(|k| (pa[k] - pb[k]).powi(2)).sum());
+            }
+        }
+        h2.sqrt()
+    }
+
+    /// Largest cell diameter.
+    pub fn max_diameter(&self) -> f64 {
+        (0..self.num_cells()).map(|c| self.cell_diameter(c)).fold(0.0, f64::max)
+    }
+
+    /// Every boundary facet (facets belonging to one cell only), sorted by (cell, local).
+    pub fn boundary_facets(&self) -> Vec<Facet> {
+        boundary::boundary_facets(self)
+    }
+
+    pub fn region(&self, name: &str) -> Result<&Region, MeshError> {
+        self.regions.iter().find(|r| r.name == name).ok_or_else(|| MeshError::NoSuchRegion {
+            name: name.to_string(),
+            known: self.regions.iter().map(|r| r.name.clone()).collect(),
+        })
+    }
+
+    /// Adds (or replaces) a region made of the boundary facets whose outward unit normal and
+    /// centroid satisfy `pred(normal, centroid)`.
+    pub fn add_region_where(&mut self, name: &str, pred: impl Fn(&[f64], &[f64]) -> bool) -> &Region {
+        let facets = self.boundary_facets().into_iter().filter(|f| {
+            let (n, x) = self.facet_normal_and_centroid(*f);
+            pred(&n, &x)
+        });
+        let region = Region { name: name.to_string(), facets: facets.collect() };
+        self.regions.retain(|r| r.name != name);
+        self.regions.push(region);
+        self.regions.last().expect("just pushed")
+    }
+
+    /// Outward unit normal and position at the centre of a facet (reference-facet centroid).
+    pub fn facet_normal_and_centroid(&self, f: Facet) -> (Vec<f64>, Vec<f64>) {
+        let d = self.dim();
+        let s = vec![1.0 / d as f64; d - 1];
+        let (xi, _) = self.kind.facet_point(f.local as usize, &s);
+        let grads = self.kind.basis_gradients(&xi);
+        let phi = self.kind.basis(&xi);
+        let nodes = self.cell(f.cell as usize);
+        let mut j = vec![vec![0.0; d]; d];
+        let mut x = vec![0.0; d];
+        for (a, &node) in nodes.iter().enumerate() {
+            let p = self.node(node as usize);
+            for r in 0..d {
+                x[r] += phi[a] * p[r];
+                for c in 0..d {
+                    j[r][c] += p[r] * grads[a][c];
+                }
+            }
+        }
+        let n_ref = self.kind.reference_normal(f.local as usize);
+        let n = match d {
+            1 => vec![n_ref[0] / j[0][0]],
+            2 => {
+                let m = [[j[0][0], j[0][1]], [j[1][0], j[1][1]]];
+                let (_, inv) = geometry::invert(&m);
+                (0..2).map(|l| (0..2).map(|b| inv[b][l] * n_ref[b]).sum()).collect()
+            }
+            _ => {
+                let m = [[j[0][0], j[0][1], j[0][2]], [j[1][0], j[1][1], j[1][2]], [j[2][0], j[2][1], j[2][2]]];
+                let (_, inv) = geometry::invert(&m);
+                (0..3).map(|l| (0..3).map(|b| inv[b][l] * n_ref[b]).sum()).collect()
+            }
+        };
+        let norm = n.iter().map(|v: &f64| v * v).sum::<f64>().sqrt();
+        (n.iter().map(|v| v / norm).collect(), x)
+    }
+
+    /// Nodes lying on the facets of a region (vertices and, for P2, edge nodes), sorted.
+    pub fn region_nodes(&self, region: &Region) -> Vec<u32> {
+        let mut nodes: Vec<u32> = region
+            .facets
+            .iter()
+            .flat_map(|f| {
+                let cell = self.cell(f.cell as usize);
+                self.kind.facet_nodes(f.local as usize).into_iter().map(move |i| cell[i])
+            })
+            .collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
+    }
+
+    /// Total measure (length, area, volume), integrated with the isoparametric map.
+    pub fn measure(&self) -> f64 {
+        let d = self.dim();
+        let rule = crate::quadrature::simplex_rule(d, 2 * d as u32);
+        let tab: Vec<Vec<Vec<f64>>> = rule.points.iter().map(|p| self.kind.basis_gradients(p)).collect();
+        let mut total = 0.0;
+        for c in 0..self.num_cells() {
+            let nodes = self.cell(c);
+            for (g, w) in tab.iter().zip(&rule.weights) {
+                let mut j = [[0.0; 3]; 3];
+                for (a, &node) in nodes.iter().enumerate() {
+                    let p = self.node(node as usize);
+                    for r in 0..d {
+                        for s in 0..d {
+                            j[r][s] += p[r] * g[a][s];
+                        }
+                    }
+                }
+                total += w * det(&j, d).abs();
+            }
+        }
+        total
+    }
+
+    /// Promotes a P1 mesh to P2 by adding edge midpoints (straight edges), keeping regions.
+    /// `project` may move each new boundary-edge midpoint (e.g. onto a circle).
+    pub fn to_p2(&self, project: Option<&dyn Fn(&mut [f64])>) -> Mesh {
+        let (kind, edges): (ElementKind, &[[usize; 2]]) = match self.kind {
+            ElementKind::TriangleP1 => (ElementKind::TriangleP2, &[[0, 1], [1, 2], [2, 0]]),
+            ElementKind::TetrahedronP1 => (ElementKind::TetrahedronP2, &[[0, 1], [1, 2], [0, 2], [0, 3], [2, 3], [1, 3]]),
+            _ => return self.clone(),
+        };
+        let d = self.dim();
+        let boundary_edges: std::collections::HashSet<(u32, u32)> = if project.is_some() {
+            self.boundary_facets()
+                .iter()
+                .flat_map(|f| {
+                    let cell = self.cell(f.cell as usize);
+                    let verts: Vec<u32> = self.kind.facets()[f.local as usize].iter().map(|&v| cell[v]).collect();
+                    let mut pairs = Vec::new();
+                    for a in 0..verts.len() {
+                        for b in a + 1..verts.len() {
+                            pairs.push((verts[a].min(verts[b]), verts[a].max(verts[b])));
+                        }
+                    }
+                    pairs
+                })
+                .collect()
+        } else {
+            Default::default()
+        };
+        let mut coords = self.coords.clone();
+        let mut midpoint: HashMap<(u32, u32), u32> = HashMap::new();
+        let nn = kind.nodes();
+        let mut cells = Vec::with_capacity(self.num_cells() * nn);
+        for c in 0..self.num_cells() {
+            let cell = self.cell(c).to_vec();
+            cells.extend_from_slice(&cell);
+            for &[a, b] in edges {
+                let key = (cell[a].min(cell[b]), cell[a].max(cell[b]));
+                let id = *midpoint.entry(key).or_insert_with(|| {
+                    let id = (coords.len() / d) as u32;
+                    let mut m: Vec<f64> = (0..d).map(|k| 0.5 * (self.node(cell[a] as usize)[k] + self.node(cell[b] as usize)[k])).collect();
+                    if let Some(p) = project {
+                        if boundary_edges.contains(&key) {
+                            p(&mut m);
+                        }
+                    }
+                    coords.extend_from_slice(&m);
+                    id
+                });
+                cells.push(id);
+            }
+        }
+        Mesh { kind, coords, cells, regions: self.regions.clone(), cell_groups: self.cell_groups.clone() }
+    }
+}
+
+fn det(j: &[[f64; 3]; 3], d: usize) -> f64 {
+    match d {
+        1 => j[0][0],
+        2 => j[0][0] * j[1][1] - j[0][1] * j[1][0],
+        _ => {
+            j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1]) - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
+                + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0])
+        }
+    }
+}
