@@ -1,0 +1,512 @@
+//! Assembly of compiled forms into global vectors and matrices.
+//!
+//! Dofs are node-major (`node * d + component`, one vector Lagrange node per mesh node). The
+//! sparsity pattern of a mesh is built once; for each cell it stores, for every pair of its
+//! nodes (i, j), the offset of node i's first row inside node j's columns, so element matrices
+//! are added in place without searching. Cells and facets are visited in a fixed order, so
+//! results are deterministic.
+
+use std::sync::Arc;
+
+use crate::element::ElementKind;
+use crate::kernel::{CellCtx, FacetCtx, FacetTabulation, Form, FormKernel, LocalMatrix, LocalVector, Tabulation};
+use crate::linalg::Matrix;
+use crate::mesh::{Facet, Mesh, MeshError};
+
+/// A kernel usable on every element kind of the catalogue (every generated form is).
+pub trait Kernel:
+    Form + FormKernel<1, 2> + FormKernel<2, 3> + FormKernel<2, 6> + FormKernel<3, 4> + FormKernel<3, 10> + Sync
+{
+}
+impl<K> Kernel for K where
+    K: Form + FormKernel<1, 2> + FormKernel<2, 3> + FormKernel<2, 6> + FormKernel<3, 4> + FormKernel<3, 10> + Sync
+{
+}
+
+/// Calls `$f::<D, N, ..>(args)` with the D and N of an element kind.
+macro_rules! dispatch {
+    ($kind:expr, $f:ident :: <$($g:ty),*> ($($arg:expr),* $(,)?)) => {
+        match $kind {
+            ElementKind::IntervalP1 => $f::<1, 2, $($g),*>($($arg),*),
+            ElementKind::TriangleP1 => $f::<2, 3, $($g),*>($($arg),*),
+            ElementKind::TriangleP2 => $f::<2, 6, $($g),*>($($arg),*),
+            ElementKind::TetrahedronP1 => $f::<3, 4, $($g),*>($($arg),*),
+            ElementKind::TetrahedronP2 => $f::<3, 10, $($g),*>($($arg),*),
+        }
+    };
+}
+
+/// The sparsity pattern of a vector field on a mesh (CSC, rows sorted in each column).
+#[derive(Debug)]
+pub struct Pattern {
+    dim: usize,
+    pub col_ptr: Vec<usize>,
+    pub row_idx: Vec<usize>,
+    /// Per cell, `[j][i]`: offset of node i's first row within the columns of node j.
+    cell_offsets: Vec<u32>,
+}
+
+impl Pattern {
+    /// Couples every pair of nodes sharing a cell.
+    pub fn new(mesh: &Mesh) -> Pattern {
+        let d = mesh.dim();
+        let npc = mesh.kind.nodes();
+        let nodes = mesh.num_nodes();
+        let cells = mesh.num_cells();
+        // Node → cells incidence.
+        let mut inc_ptr = vec![0usize; nodes + 1];
+        for &n in &mesh.cells {
+            inc_ptr[n as usize + 1] += 1;
+        }
+        for i in 0..nodes {
+            inc_ptr[i + 1] += inc_ptr[i];
+        }
+        let mut fill = inc_ptr.clone();
+        let mut inc = vec![0u32; mesh.cells.len()];
+        for c in 0..cells {
+            for &n in mesh.cell(c) {
+                inc[fill[n as usize]] = c as u32;
+                fill[n as usize] += 1;
+            }
+        }
+        // Node adjacency, sorted.
+        let mut adj_ptr = Vec::with_capacity(nodes + 1);
+        adj_ptr.push(0usize);
+        let mut adj: Vec<u32> = Vec::with_capacity(nodes * 2 * npc);
+        let mut scratch: Vec<u32> = Vec::new();
+        for n in 0..nodes {
+            scratch.clear();
+            for &c in &inc[inc_ptr[n]..inc_ptr[n + 1]] {
+                scratch.extend_from_slice(mesh.cell(c as usize));
+            }
+            scratch.sort_unstable();
+            scratch.dedup();
+            adj.extend_from_slice(&scratch);
+            adj_ptr.push(adj.len());
+        }
+        // Columns: node j's d columns each hold rows (i, k) for i adjacent to j.
+        let size = nodes * d;
+        let mut col_ptr = Vec::with_capacity(size + 1);
+        col_ptr.push(0usize);
+        let mut row_idx = Vec::with_capacity(adj.len() * d * d);
+        for j in 0..nodes {
+            let neighbours = &adj[adj_ptr[j]..adj_ptr[j + 1]];
+            for _m in 0..d {
+                for &i in neighbours {
+                    for k in 0..d {
+                        row_idx.push(i as usize * d + k);
+                    }
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        let mut cell_offsets = Vec::with_capacity(cells * npc * npc);
+        for c in 0..cells {
+            let cell = mesh.cell(c);
+            for &nj in cell {
+                let neighbours = &adj[adj_ptr[nj as usize]..adj_ptr[nj as usize + 1]];
+                for &ni in cell {
+                    let pos = neighbours.binary_search(&ni).expect("nodes of a cell are adjacent");
+                    cell_offsets.push((pos * d) as u32);
+                }
+            }
+        }
+        Pattern {
+            dim: d,
+            col_ptr,
+            row_idx,
+            cell_offsets,
+        }
+    }
+
+    /// Number of rows (= columns).
+    pub fn size(&self) -> usize {
+        self.col_ptr.len() - 1
+    }
+
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Adds an element matrix of cell `c` with nodes `cell` into `values`.
+    #[inline]
+    fn scatter<const D: usize, const N: usize>(
+        &self,
+        c: usize,
+        cell: &[u32],
+        ke: &LocalMatrix<D, N>,
+        values: &mut [f64],
+    ) {
+        let off = &self.cell_offsets[c * N * N..(c + 1) * N * N];
+        for j in 0..N {
+            let nj = cell[j] as usize;
+            for m in 0..D {
+                let base = self.col_ptr[nj * D + m];
+                for i in 0..N {
+                    let o = base + off[j * N + i] as usize;
+                    for k in 0..D {
+                        values[o + k] += ke[i][k][j][m];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Quadrature degrees chosen for a form: its suggestion for the element degree unless
+/// overridden.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Quadrature {
+    pub cell: Option<u32>,
+    pub facet: Option<u32>,
+}
+
+impl Quadrature {
+    pub fn degrees(cell: u32, facet: u32) -> Self {
+        Quadrature {
+            cell: Some(cell),
+            facet: Some(facet),
+        }
+    }
+
+    fn cell_degree<K: Form>(&self, kind: ElementKind) -> u32 {
+        self.cell
+            .unwrap_or_else(|| K::META.cell_degree.map_or(1, |d| d[kind.degree() as usize - 1]))
+    }
+
+    fn facet_degree<K: Form>(&self, kind: ElementKind, region: usize) -> u32 {
+        self.facet.unwrap_or_else(|| {
+            K::META
+                .facets
+                .get(region)
+                .map_or(1, |(_, d)| d[kind.degree() as usize - 1])
+        })
+    }
+}
+
+/// Assembles forms on one mesh into vectors and matrices sharing one pattern.
+pub struct Assembler<'m> {
+    pub mesh: &'m Mesh,
+    pub pattern: Arc<Pattern>,
+}
+
+impl<'m> Assembler<'m> {
+    pub fn new(mesh: &'m Mesh) -> Self {
+        Assembler {
+            mesh,
+            pattern: Arc::new(Pattern::new(mesh)),
+        }
+    }
+
+    /// Number of dofs.
+    pub fn size(&self) -> usize {
+        self.pattern.size()
+    }
+
+    pub fn zero_matrix(&self) -> Matrix {
+        Matrix::zeros(self.pattern.clone())
+    }
+
+    /// Adds the volume part of `k`'s residual at `fields` to `out`.
+    pub fn cell_residual<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64, out: &mut [f64]) {
+        let degree = q.cell_degree::<K>(self.mesh.kind);
+        dispatch!(self.mesh.kind, cell_residual::<K>(self.mesh, k, degree, fields, t, out))
+    }
+
+    /// Adds the volume part of `k`'s tangent with respect to field `wrt` to `m`.
+    pub fn cell_tangent<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
+        let degree = q.cell_degree::<K>(self.mesh.kind);
+        dispatch!(
+            self.mesh.kind,
+            cell_tangent::<K>(self.mesh, &self.pattern, k, degree, fields, wrt, t, &mut m.values)
+        )
+    }
+
+    /// Adds the residual of `k`'s integral over `region` (a name of `K::META.facets`) on the
+    /// mesh facets `facets`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn facet_residual<K: Kernel>(
+        &self,
+        k: &K,
+        region: &str,
+        facets: &[Facet],
+        q: Quadrature,
+        fields: &[&[f64]],
+        t: f64,
+        out: &mut [f64],
+    ) {
+        let Some(r) = region_index::<K>(region) else { return };
+        let degree = q.facet_degree::<K>(self.mesh.kind, r);
+        dispatch!(
+            self.mesh.kind,
+            facet_residual::<K>(self.mesh, k, r, facets, degree, fields, t, out)
+        )
+    }
+
+    /// Adds the tangent of `k`'s integral over `region` on `facets` to `m`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn facet_tangent<K: Kernel>(
+        &self,
+        k: &K,
+        region: &str,
+        facets: &[Facet],
+        q: Quadrature,
+        fields: &[&[f64]],
+        wrt: usize,
+        t: f64,
+        m: &mut Matrix,
+    ) {
+        let Some(r) = region_index::<K>(region) else { return };
+        let degree = q.facet_degree::<K>(self.mesh.kind, r);
+        dispatch!(
+            self.mesh.kind,
+            facet_tangent::<K>(
+                self.mesh,
+                &self.pattern,
+                k,
+                r,
+                facets,
+                degree,
+                fields,
+                wrt,
+                t,
+                &mut m.values
+            )
+        )
+    }
+
+    /// Appends the active-set switches of `k`'s integral over `region` on `facets`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn facet_switches<K: Kernel>(
+        &self,
+        k: &K,
+        region: &str,
+        facets: &[Facet],
+        q: Quadrature,
+        fields: &[&[f64]],
+        wrt: usize,
+        t: f64,
+        out: &mut Vec<bool>,
+    ) {
+        let Some(r) = region_index::<K>(region) else { return };
+        let degree = q.facet_degree::<K>(self.mesh.kind, r);
+        dispatch!(
+            self.mesh.kind,
+            facet_switches::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, out)
+        )
+    }
+
+    /// Facets of a named mesh region.
+    pub fn region(&self, name: &str) -> Result<&'m [Facet], MeshError> {
+        Ok(&self.mesh.region(name)?.facets)
+    }
+}
+
+fn region_index<K: Form>(region: &str) -> Option<usize> {
+    K::META.facets.iter().position(|(name, _)| *name == region)
+}
+
+/// Copies the values of global fields at a cell's nodes into local arrays.
+#[inline]
+fn gather<const D: usize, const N: usize>(cell: &[u32], fields: &[&[f64]], local: &mut [LocalVector<D, N>]) {
+    for (f, l) in fields.iter().zip(local.iter_mut()) {
+        for j in 0..N {
+            let n = cell[j] as usize;
+            l[j].copy_from_slice(&f[n * D..n * D + D]);
+        }
+    }
+}
+
+fn locals<const D: usize, const N: usize>(count: usize) -> Vec<LocalVector<D, N>> {
+    vec![[[0.0; D]; N]; count]
+}
+
+/// Calls `f` with references to the local fields, without allocating for up to three fields.
+#[inline]
+fn with_refs<const D: usize, const N: usize, R>(
+    local: &[LocalVector<D, N>],
+    f: impl FnOnce(&[&LocalVector<D, N>]) -> R,
+) -> R {
+    match local {
+        [] => f(&[]),
+        [a] => f(&[a]),
+        [a, b] => f(&[a, b]),
+        [a, b, c] => f(&[a, b, c]),
+        _ => f(&local.iter().collect::<Vec<_>>()),
+    }
+}
+
+fn cell_residual<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    mesh: &Mesh,
+    k: &K,
+    degree: u32,
+    fields: &[&[f64]],
+    t: f64,
+    out: &mut [f64],
+) {
+    let tab = Tabulation::<D, N>::cell(mesh.kind, degree).expect("kind matches D and N");
+    let mut local = locals::<D, N>(fields.len());
+    for c in 0..mesh.num_cells() {
+        let cell = mesh.cell(c);
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(cell, fields, &mut local);
+        let mut re = [[0.0; D]; N];
+        with_refs(&local, |refs| {
+            k.cell_residual(
+                &CellCtx {
+                    tab: &tab,
+                    coords: &coords,
+                    t,
+                },
+                refs,
+                &mut re,
+            )
+        });
+        add_local(cell, &re, out);
+    }
+}
+
+#[inline]
+fn add_local<const D: usize, const N: usize>(cell: &[u32], re: &LocalVector<D, N>, out: &mut [f64]) {
+    for j in 0..N {
+        let n = cell[j] as usize;
+        for k in 0..D {
+            out[n * D + k] += re[j][k];
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn cell_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    mesh: &Mesh,
+    pattern: &Pattern,
+    k: &K,
+    degree: u32,
+    fields: &[&[f64]],
+    wrt: usize,
+    t: f64,
+    values: &mut [f64],
+) {
+    let tab = Tabulation::<D, N>::cell(mesh.kind, degree).expect("kind matches D and N");
+    let mut local = locals::<D, N>(fields.len());
+    let mut ke: Box<LocalMatrix<D, N>> = Box::new([[[[0.0; D]; N]; D]; N]);
+    for c in 0..mesh.num_cells() {
+        let cell = mesh.cell(c);
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(cell, fields, &mut local);
+        *ke = [[[[0.0; D]; N]; D]; N];
+        with_refs(&local, |refs| {
+            k.cell_tangent(
+                &CellCtx {
+                    tab: &tab,
+                    coords: &coords,
+                    t,
+                },
+                refs,
+                wrt,
+                &mut ke,
+            )
+        });
+        pattern.scatter(c, cell, &ke, values);
+    }
+}
+
+fn facet_ctx<'a, const D: usize, const N: usize>(
+    mesh: &Mesh,
+    tabs: &'a FacetTabulation<D, N>,
+    f: Facet,
+    coords: &'a [[f64; D]; N],
+    t: f64,
+) -> FacetCtx<'a, D, N> {
+    let (tab, ref_normal) = &tabs.facets[f.local as usize];
+    FacetCtx {
+        tab,
+        ref_normal,
+        coords,
+        h: mesh.cell_diameter(f.cell as usize),
+        t,
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn facet_residual<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    mesh: &Mesh,
+    k: &K,
+    region: usize,
+    facets: &[Facet],
+    degree: u32,
+    fields: &[&[f64]],
+    t: f64,
+    out: &mut [f64],
+) {
+    let tabs = FacetTabulation::<D, N>::new(mesh.kind, degree).expect("kind matches D and N");
+    let mut local = locals::<D, N>(fields.len());
+    for &f in facets {
+        let c = f.cell as usize;
+        let cell = mesh.cell(c);
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(cell, fields, &mut local);
+        let mut re = [[0.0; D]; N];
+        with_refs(&local, |refs| {
+            k.facet_residual(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, &mut re)
+        });
+        add_local(cell, &re, out);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn facet_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    mesh: &Mesh,
+    pattern: &Pattern,
+    k: &K,
+    region: usize,
+    facets: &[Facet],
+    degree: u32,
+    fields: &[&[f64]],
+    wrt: usize,
+    t: f64,
+    values: &mut [f64],
+) {
+    let tabs = FacetTabulation::<D, N>::new(mesh.kind, degree).expect("kind matches D and N");
+    let mut local = locals::<D, N>(fields.len());
+    let mut ke: Box<LocalMatrix<D, N>> = Box::new([[[[0.0; D]; N]; D]; N]);
+    for &f in facets {
+        let c = f.cell as usize;
+        let cell = mesh.cell(c);
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(cell, fields, &mut local);
+        *ke = [[[[0.0; D]; N]; D]; N];
+        with_refs(&local, |refs| {
+            k.facet_tangent(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, &mut ke)
+        });
+        pattern.scatter(c, cell, &ke, values);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn facet_switches<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    mesh: &Mesh,
+    k: &K,
+    region: usize,
+    facets: &[Facet],
+    degree: u32,
+    fields: &[&[f64]],
+    wrt: usize,
+    t: f64,
+    out: &mut Vec<bool>,
+) {
+    let tabs = FacetTabulation::<D, N>::new(mesh.kind, degree).expect("kind matches D and N");
+    let mut local = locals::<D, N>(fields.len());
+    for &f in facets {
+        let c = f.cell as usize;
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(mesh.cell(c), fields, &mut local);
+        with_refs(&local, |refs| {
+            k.facet_switches(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, out)
+        });
+    }
+}

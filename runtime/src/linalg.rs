@@ -1,0 +1,277 @@
+//! Sparse linear algebra: the only module that touches faer (0.x; its API changes land here).
+//!
+//! A `Matrix` is a CSC matrix over a shared `Pattern`. A `Factorization` computes the
+//! symbolic analysis (fill-reducing ordering, elimination tree) once per pattern and reruns only
+//! the numeric factorization when asked; sparse Cholesky for symmetric positive definite
+//! matrices, LU with partial pivoting otherwise. Counters make the reuse testable.
+
+use std::sync::Arc;
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{self, LltRef, SymbolicCholesky};
+use faer::sparse::linalg::lu::{self, LuRef, NumericLu, SymbolicLu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par, Side};
+
+use crate::assembly::Pattern;
+
+/// A square sparse matrix in compressed-column form over a shared pattern.
+#[derive(Clone, Debug)]
+pub struct Matrix {
+    pub pattern: Arc<Pattern>,
+    pub values: Vec<f64>,
+}
+
+impl Matrix {
+    pub fn zeros(pattern: Arc<Pattern>) -> Self {
+        let values = vec![0.0; pattern.nnz()];
+        Matrix { pattern, values }
+    }
+
+    pub fn size(&self) -> usize {
+        self.pattern.size()
+    }
+
+    /// `y = A x`.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        y.iter_mut().for_each(|v| *v = 0.0);
+        let p = &self.pattern;
+        for (j, &xj) in x.iter().enumerate() {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                y[p.row_idx[k]] += self.values[k] * xj;
+            }
+        }
+    }
+
+    /// `self += alpha * other` (same pattern).
+    pub fn add_scaled(&mut self, alpha: f64, other: &Matrix) {
+        debug_assert!(Arc::ptr_eq(&self.pattern, &other.pattern) || self.pattern.nnz() == other.pattern.nnz());
+        for (a, b) in self.values.iter_mut().zip(&other.values) {
+            *a += alpha * b;
+        }
+    }
+
+    /// Entry (i, j), zero outside the pattern.
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        let p = &self.pattern;
+        let rows = &p.row_idx[p.col_ptr[j]..p.col_ptr[j + 1]];
+        rows.binary_search(&i).map_or(0.0, |k| self.values[p.col_ptr[j] + k])
+    }
+
+    /// Frobenius norm.
+    pub fn frobenius(&self) -> f64 {
+        self.values.iter().map(|v| v * v).sum::<f64>().sqrt()
+    }
+
+    /// Imposes `x_i = given` on the listed dofs: zeroes their rows and columns and puts `diag`
+    /// on the diagonal, keeping the matrix symmetric (the right-hand side is the caller's).
+    pub fn constrain(&mut self, dofs: &[usize], is_fixed: &[bool], diag: f64) {
+        let p = self.pattern.clone();
+        for j in 0..p.size() {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[k];
+                if is_fixed[i] || is_fixed[j] {
+                    self.values[k] = if i == j { diag } else { 0.0 };
+                }
+            }
+        }
+        debug_assert!(dofs.iter().all(|&d| is_fixed[d]));
+    }
+}
+
+/// Which factorization to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Structure {
+    /// Sparse Cholesky (only the lower triangle is read).
+    SymmetricPositiveDefinite,
+    /// Sparse LU with partial pivoting.
+    General,
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LinalgError {
+    #[error("the matrix is not positive definite (pivot {index} is not positive)")]
+    NotPositiveDefinite { index: usize },
+    #[error("the matrix is singular{}", index.map(|i| format!(" (no pivot at column {i})")).unwrap_or_default())]
+    Singular { index: Option<usize> },
+    #[error("the linear solver failed: {0}")]
+    Other(String),
+    #[error("solve requested before a successful factorization")]
+    NotFactored,
+}
+
+/// How many times each phase ran.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    pub symbolic: usize,
+    pub numeric: usize,
+    pub solves: usize,
+}
+
+enum Factors {
+    None,
+    Llt {
+        symbolic: SymbolicCholesky<usize>,
+        values: Vec<f64>,
+        factored: bool,
+    },
+    Lu {
+        symbolic: SymbolicLu<usize>,
+        numeric: NumericLu<usize, f64>,
+        factored: bool,
+    },
+}
+
+/// A reusable sparse factorization.
+pub struct Factorization {
+    structure: Structure,
+    factors: Factors,
+    /// The pattern the symbolic analysis belongs to.
+    pattern: Option<Arc<Pattern>>,
+    par: Par,
+    pub counters: Counters,
+}
+
+impl Factorization {
+    /// Sequential by default, so results do not depend on the number of threads.
+    pub fn new(structure: Structure) -> Self {
+        Factorization {
+            structure,
+            factors: Factors::None,
+            pattern: None,
+            par: Par::Seq,
+            counters: Counters::default(),
+        }
+    }
+
+    /// Uses `threads` threads (0: all) in factorizations and solves.
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.par = if threads == 1 { Par::Seq } else { Par::rayon(threads) };
+        self
+    }
+
+    pub fn structure(&self) -> Structure {
+        self.structure
+    }
+
+    /// Factors `a`: the symbolic analysis if `a`'s pattern is new, the numeric factorization
+    /// always.
+    pub fn factor(&mut self, a: &Matrix) -> Result<(), LinalgError> {
+        let n = a.size();
+        let same_pattern = self.pattern.as_ref().is_some_and(|p| Arc::ptr_eq(p, &a.pattern));
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &a.pattern.col_ptr, None, &a.pattern.row_idx);
+        if !same_pattern {
+            self.factors = match self.structure {
+                Structure::SymmetricPositiveDefinite => {
+                    let symbolic =
+                        cholesky::factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
+                            .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
+                    Factors::Llt {
+                        values: vec![0.0; symbolic.len_val()],
+                        symbolic,
+                        factored: false,
+                    }
+                }
+                Structure::General => {
+                    let symbolic = lu::factorize_symbolic_lu(sym, Default::default())
+                        .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
+                    Factors::Lu {
+                        symbolic,
+                        numeric: NumericLu::new(),
+                        factored: false,
+                    }
+                }
+            };
+            self.pattern = Some(a.pattern.clone());
+            self.counters.symbolic += 1;
+        }
+        let mat = SparseColMatRef::new(sym, &a.values);
+        let par = self.par;
+        self.counters.numeric += 1;
+        match &mut self.factors {
+            Factors::Llt {
+                symbolic,
+                values,
+                factored,
+            } => {
+                *factored = false;
+                let req = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+                let mut mem = MemBuffer::try_new(req).map_err(|_| LinalgError::Other("out of memory".into()))?;
+                symbolic
+                    .factorize_numeric_llt(
+                        values,
+                        mat,
+                        Side::Lower,
+                        Default::default(),
+                        par,
+                        MemStack::new(&mut mem),
+                        Default::default(),
+                    )
+                    .map_err(|e| match e {
+                        faer::linalg::solvers::LltError::NonPositivePivot { index } => {
+                            LinalgError::NotPositiveDefinite { index }
+                        }
+                    })?;
+                *factored = true;
+            }
+            Factors::Lu {
+                symbolic,
+                numeric,
+                factored,
+            } => {
+                *factored = false;
+                let req = symbolic.factorize_numeric_lu_scratch::<f64>(par, Default::default());
+                let mut mem = MemBuffer::try_new(req).map_err(|_| LinalgError::Other("out of memory".into()))?;
+                symbolic
+                    .factorize_numeric_lu(numeric, mat, par, MemStack::new(&mut mem), Default::default())
+                    .map_err(|e| match e {
+                        faer::sparse::linalg::LuError::SymbolicSingular { index } => {
+                            LinalgError::Singular { index: Some(index) }
+                        }
+                        other => LinalgError::Other(format!("{other:?}")),
+                    })?;
+                *factored = true;
+            }
+            Factors::None => unreachable!("symbolic analysis done above"),
+        }
+        Ok(())
+    }
+
+    /// Solves `A x = b` in place with the last factorization; a non-finite result (a
+    /// numerically singular matrix) is an error.
+    pub fn solve_in_place(&mut self, b: &mut [f64]) -> Result<(), LinalgError> {
+        let n = b.len();
+        let par = self.par;
+        let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
+        match &self.factors {
+            Factors::Llt {
+                symbolic,
+                values,
+                factored: true,
+            } => {
+                let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
+                LltRef::new(symbolic, values).solve_in_place_with_conj(Conj::No, rhs, par, MemStack::new(&mut mem));
+            }
+            Factors::Lu {
+                symbolic,
+                numeric,
+                factored: true,
+            } => {
+                let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
+                LuRef::new_unchecked(symbolic, numeric).solve_in_place_with_conj(
+                    Conj::No,
+                    rhs,
+                    par,
+                    MemStack::new(&mut mem),
+                );
+            }
+            _ => return Err(LinalgError::NotFactored),
+        }
+        self.counters.solves += 1;
+        if b.iter().all(|v| v.is_finite()) {
+            Ok(())
+        } else {
+            Err(LinalgError::Singular { index: None })
+        }
+    }
+}
