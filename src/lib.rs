@@ -10,4 +10,7 @@ pub use signorini_compiler as compiler;
 pub use signorini_macros::forms;
 pub use signorini_runtime as runtime;
 
+pub mod cases;
 pub mod cli;
+pub mod forms;
+pub mod output;

@@ -23,19 +23,6 @@ impl<K> Kernel for K where
 {
 }
 
-/// Calls `$f::<D, N, ..>(args)` with the D and N of an element kind.
-macro_rules! dispatch {
-    ($kind:expr, $f:ident :: <$($g:ty),*> ($($arg:expr),* $(,)?)) => {
-        match $kind {
-            ElementKind::IntervalP1 => $f::<1, 2, $($g),*>($($arg),*),
-            ElementKind::TriangleP1 => $f::<2, 3, $($g),*>($($arg),*),
-            ElementKind::TriangleP2 => $f::<2, 6, $($g),*>($($arg),*),
-            ElementKind::TetrahedronP1 => $f::<3, 4, $($g),*>($($arg),*),
-            ElementKind::TetrahedronP2 => $f::<3, 10, $($g),*>($($arg),*),
-        }
-    };
-}
-
 /// The sparsity pattern of a vector field on a mesh (CSC, rows sorted in each column).
 #[derive(Debug)]
 pub struct Pattern {

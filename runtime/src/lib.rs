@@ -1,10 +1,29 @@
 //! The signorini runtime: element catalogue, quadrature, the interface compiled kernels
 //! implement, and (later) meshes, assembly, solvers and time loops.
 
+/// Calls `$f::<D, N, ..>(args)` with the D and N of an element kind.
+macro_rules! dispatch {
+    ($kind:expr, $f:ident ($($arg:expr),* $(,)?)) => {
+        dispatch!($kind, $f::<>($($arg),*))
+    };
+    ($kind:expr, $f:ident :: <$($g:ty),*> ($($arg:expr),* $(,)?)) => {
+        match $kind {
+            $crate::element::ElementKind::IntervalP1 => $f::<1, 2, $($g),*>($($arg),*),
+            $crate::element::ElementKind::TriangleP1 => $f::<2, 3, $($g),*>($($arg),*),
+            $crate::element::ElementKind::TriangleP2 => $f::<2, 6, $($g),*>($($arg),*),
+            $crate::element::ElementKind::TetrahedronP1 => $f::<3, 4, $($g),*>($($arg),*),
+            $crate::element::ElementKind::TetrahedronP2 => $f::<3, 10, $($g),*>($($arg),*),
+        }
+    };
+}
+
 pub mod assembly;
 pub mod element;
+pub mod evaluate;
 pub mod geometry;
 pub mod kernel;
 pub mod linalg;
 pub mod mesh;
+pub mod newton;
+pub mod problem;
 pub mod quadrature;

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+use crate::cases::static_block::{self, ContactMethod};
 use crate::compiler::{self, FsLoader};
 
 #[derive(Parser)]
@@ -25,6 +26,11 @@ pub enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
+    /// Run a built-in case.
+    Run {
+        #[command(subcommand)]
+        case: Case,
+    },
     /// Print a compilation stage of a .wf file.
     Emit {
         file: PathBuf,
@@ -34,6 +40,42 @@ pub enum Command {
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=3))]
         dim: u8,
     },
+}
+
+/// Built-in cases.
+#[derive(Subcommand)]
+pub enum Case {
+    /// An elastic block resting on a rigid plane under its own weight (static contact).
+    StaticBlock(StaticBlockArgs),
+}
+
+#[derive(clap::Args)]
+pub struct StaticBlockArgs {
+    #[arg(long, value_enum, default_value_t = ContactMethod::Nitsche)]
+    contact: ContactMethod,
+    /// Nitsche variant: 1 symmetric, 0 incomplete, -1 skew-symmetric.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    theta: f64,
+    /// γ = γ0/h (Nitsche) or ε = γ0/h (penalty); E = 100 here, and θ = 1 needs γ0 ≳ 20 E.
+    #[arg(long, default_value_t = 5000.0)]
+    gamma0: f64,
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
+    dim: u8,
+    /// Polynomial degree (the 2D block is P2; 3D: 1 or 2).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
+    degree: u8,
+    /// Mesh size.
+    #[arg(long, default_value_t = 0.125)]
+    h: f64,
+    /// Curvature c of the obstacle x_d = -c|x'|² (0: the plane).
+    #[arg(long, default_value_t = 0.0)]
+    curvature: f64,
+    /// Backtracking line search in Newton.
+    #[arg(long)]
+    line_search: bool,
+    /// Directory for summary.json.
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -47,6 +89,9 @@ pub fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Check { files } => check(&files),
         Command::Emit { file, stage, dim } => emit(&file, stage, dim as usize),
+        Command::Run {
+            case: Case::StaticBlock(a),
+        } => static_block(a),
     }
 }
 
@@ -96,6 +141,37 @@ fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
     match out {
         Ok(text) => {
             print!("{text}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn static_block(a: StaticBlockArgs) -> ExitCode {
+    let opts = static_block::Options {
+        contact: a.contact,
+        theta: a.theta,
+        gamma0: a.gamma0,
+        dim: a.dim as usize,
+        degree: a.degree as u32,
+        h: a.h,
+        curvature: a.curvature,
+        newton: crate::runtime::newton::NewtonOptions {
+            line_search: a.line_search,
+            ..Default::default()
+        },
+        out: a.out,
+        ..Default::default()
+    };
+    match static_block::run(&opts) {
+        Ok(s) => {
+            println!(
+                "static-block: {} dofs, contact force {:.10e} (weight {:.10e}), max penetration {:.3e}, {} Newton iterations, {:.2} s",
+                s.dofs, s.contact_force, s.weight, s.max_penetration, s.newton_iterations, s.wall_seconds
+            );
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -31,6 +31,9 @@ pub struct Region {
     pub facets: Vec<Facet>,
 }
 
+/// Moves a point in place (a new boundary node onto the true boundary).
+pub type Projection<'a> = dyn Fn(&mut [f64]) + 'a;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     pub kind: ElementKind,
@@ -209,7 +212,7 @@ impl Mesh {
 
     /// Promotes a P1 mesh to P2 by adding edge midpoints (straight edges), keeping regions.
     /// `project` may move each new boundary-edge midpoint (e.g. onto a circle).
-    pub fn to_p2(&self, project: Option<&dyn Fn(&mut [f64])>) -> Mesh {
+    pub fn to_p2(&self, project: Option<&Projection<'_>>) -> Mesh {
         let (kind, edges): (ElementKind, &[[usize; 2]]) = match self.kind {
             ElementKind::TriangleP1 => (ElementKind::TriangleP2, &[[0, 1], [1, 2], [2, 0]]),
             ElementKind::TetrahedronP1 => (
@@ -251,10 +254,10 @@ impl Mesh {
                     let mut m: Vec<f64> = (0..d)
                         .map(|k| 0.5 * (self.node(cell[a] as usize)[k] + self.node(cell[b] as usize)[k]))
                         .collect();
-                    if let Some(p) = project {
-                        if boundary_edges.contains(&key) {
-                            p(&mut m);
-                        }
+                    if let Some(p) = project
+                        && boundary_edges.contains(&key)
+                    {
+                        p(&mut m);
                     }
                     coords.extend_from_slice(&m);
                     id

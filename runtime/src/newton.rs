@@ -1,0 +1,234 @@
+//! Semi-smooth Newton for R(w) = 0 with contact.
+//!
+//! Stops when ‖R(w)‖∞ ≤ tol · max(‖R(w⁰)‖∞, ‖b‖∞), b the loads. The contact tangent depends
+//! on the state only through the active set, so the problem reports its active set at each
+//! iterate; while it is the one the current factorization was computed for, the Jacobian is
+//! neither reassembled nor refactored. The factorization survives between solves (time steps)
+//! until `invalidate` is called.
+
+use tracing::debug;
+
+use crate::linalg::{Factorization, LinalgError, Matrix, Structure};
+
+/// A nonlinear system R(w) = 0 with a (semi-smooth) Jacobian.
+pub trait NonlinearProblem {
+    /// Writes R(w) (zero on constrained dofs).
+    fn residual(&mut self, w: &[f64], r: &mut [f64]);
+    /// ‖b‖∞ of the loads, for the stopping criterion.
+    fn load_scale(&self) -> f64;
+    /// Writes the active set at w. Returns false if the Jacobian depends on w otherwise (then
+    /// it is rebuilt at every iteration).
+    fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool;
+    /// Writes the Jacobian at w (constrained rows and columns replaced by the identity).
+    fn jacobian(&mut self, w: &[f64], j: &mut Matrix);
+    /// An empty matrix with the Jacobian's pattern.
+    fn jacobian_matrix(&self) -> Matrix;
+    /// Cholesky for symmetric positive definite Jacobians, LU otherwise.
+    fn structure(&self) -> Structure;
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonOptions {
+    pub tol: f64,
+    pub max_iterations: usize,
+    /// Backtracking on ‖R‖₂ (halving the step up to 10 times).
+    pub line_search: bool,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        NewtonOptions {
+            tol: 1e-10,
+            max_iterations: 25,
+            line_search: false,
+        }
+    }
+}
+
+/// One Newton iteration, as logged.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Iteration {
+    /// ‖R‖∞ after the step.
+    pub residual: f64,
+    /// Active contact points at the iterate the step was computed from.
+    pub active: usize,
+    /// The Jacobian was refactored for this step (the active set changed).
+    pub refactored: bool,
+    /// Step length (1 without line search).
+    pub step: f64,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct NewtonReport {
+    pub initial_residual: f64,
+    pub history: Vec<Iteration>,
+}
+
+impl NewtonReport {
+    pub fn iterations(&self) -> usize {
+        self.history.len()
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NewtonError {
+    #[error("Newton did not converge in {} iterations (residual {:.3e}, tolerance {:.3e})", .report.iterations(), .report.history.last().map_or(.report.initial_residual, |i| i.residual), .threshold)]
+    IterationLimit { report: NewtonReport, threshold: f64 },
+    #[error("Newton produced non-finite values at iteration {}", .report.iterations())]
+    NonFinite { report: NewtonReport },
+    #[error("Newton's linear solve failed at iteration {}: {source}", .report.iterations() + 1)]
+    Linear { source: LinalgError, report: NewtonReport },
+}
+
+/// Newton's method with a reusable factorization.
+pub struct Newton {
+    pub options: NewtonOptions,
+    factorization: Option<Factorization>,
+    jacobian: Option<Matrix>,
+    /// The active set the current factorization was computed for.
+    factored_for: Option<Vec<bool>>,
+}
+
+impl Newton {
+    pub fn new(options: NewtonOptions) -> Self {
+        Newton {
+            options,
+            factorization: None,
+            jacobian: None,
+            factored_for: None,
+        }
+    }
+
+    /// Forgets the factorization's validity (the linear part of the problem changed).
+    pub fn invalidate(&mut self) {
+        self.factored_for = None;
+    }
+
+    /// Symbolic and numeric factorizations and solves so far.
+    pub fn counters(&self) -> crate::linalg::Counters {
+        self.factorization.as_ref().map(|f| f.counters).unwrap_or_default()
+    }
+
+    /// Solves R(w) = 0 starting from `w`, which holds the solution on success.
+    pub fn solve(&mut self, p: &mut impl NonlinearProblem, w: &mut [f64]) -> Result<NewtonReport, NewtonError> {
+        let n = w.len();
+        let mut r = vec![0.0; n];
+        let mut delta = vec![0.0; n];
+        let mut set = Vec::new();
+        p.residual(w, &mut r);
+        let r0 = norm_inf(&r);
+        let mut report = NewtonReport {
+            initial_residual: r0,
+            history: Vec::new(),
+        };
+        if !r0.is_finite() {
+            return Err(NewtonError::NonFinite { report });
+        }
+        let threshold = self.options.tol * r0.max(p.load_scale());
+        let mut res = r0;
+        while res > threshold {
+            if report.history.len() >= self.options.max_iterations {
+                return Err(NewtonError::IterationLimit { report, threshold });
+            }
+            set.clear();
+            let piecewise = p.active_set(w, &mut set);
+            let active = set.iter().filter(|b| **b).count();
+            let refactor = !piecewise || self.factored_for.as_deref() != Some(&set);
+            if refactor {
+                if let Err(source) = self.refactor(p, w) {
+                    return Err(NewtonError::Linear { source, report });
+                }
+                self.factored_for = piecewise.then(|| set.clone());
+            }
+            delta.iter_mut().zip(&r).for_each(|(d, ri)| *d = -ri);
+            let f = self.factorization.as_mut().expect("factored above");
+            if let Err(source) = f.solve_in_place(&mut delta) {
+                return Err(NewtonError::Linear { source, report });
+            }
+            let step = self.step(p, w, &delta, &mut r);
+            res = norm_inf(&r);
+            debug!(
+                iteration = report.history.len() + 1,
+                residual = res,
+                active,
+                refactored = refactor,
+                step,
+                "newton"
+            );
+            report.history.push(Iteration {
+                residual: res,
+                active,
+                refactored: refactor,
+                step,
+            });
+            if !res.is_finite() || w.iter().any(|x| !x.is_finite()) {
+                return Err(NewtonError::NonFinite { report });
+            }
+        }
+        Ok(report)
+    }
+
+    /// Assembles and factors the Jacobian at w; a failed Cholesky falls back to LU.
+    fn refactor(&mut self, p: &mut impl NonlinearProblem, w: &[f64]) -> Result<(), LinalgError> {
+        let j = self.jacobian.get_or_insert_with(|| p.jacobian_matrix());
+        j.values.iter_mut().for_each(|v| *v = 0.0);
+        p.jacobian(w, j);
+        let f = self
+            .factorization
+            .get_or_insert_with(|| Factorization::new(p.structure()));
+        match f.factor(j) {
+            Err(LinalgError::NotPositiveDefinite { .. }) if f.structure() == Structure::SymmetricPositiveDefinite => {
+                debug!("Jacobian not positive definite: switching to LU");
+                let counters = f.counters;
+                let mut lu = Factorization::new(Structure::General);
+                lu.counters = counters;
+                lu.factor(j)?;
+                *f = lu;
+                Ok(())
+            }
+            other => other,
+        }
+    }
+
+    /// Takes the step (with backtracking if enabled); leaves R at the new iterate in `r`.
+    fn step(&self, p: &mut impl NonlinearProblem, w: &mut [f64], delta: &[f64], r: &mut [f64]) -> f64 {
+        let start: Vec<f64> = if self.options.line_search {
+            w.to_vec()
+        } else {
+            Vec::new()
+        };
+        let norm0 = if self.options.line_search { norm2(r) } else { 0.0 };
+        let mut alpha = 1.0;
+        loop {
+            if self.options.line_search {
+                w.iter_mut()
+                    .zip(&start)
+                    .zip(delta)
+                    .for_each(|((x, s), d)| *x = s + alpha * d);
+            } else {
+                w.iter_mut().zip(delta).for_each(|(x, d)| *x += d);
+            }
+            p.residual(w, r);
+            if !self.options.line_search || norm2(r) <= (1.0 - 1e-4 * alpha) * norm0 || alpha < 1e-3 {
+                return alpha;
+            }
+            alpha *= 0.5;
+        }
+    }
+}
+
+/// Max norm; NaN if any entry is NaN.
+pub fn norm_inf(v: &[f64]) -> f64 {
+    let mut m = 0.0f64;
+    for x in v {
+        if x.is_nan() {
+            return f64::NAN;
+        }
+        m = m.max(x.abs());
+    }
+    m
+}
+
+fn norm2(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}

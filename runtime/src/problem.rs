@@ -1,0 +1,152 @@
+//! Static problems assembled from compiled forms: K u + C(u) = L, where K is a linear form
+//! assembled once, C a contact form on a boundary region, and L the loads; homogeneous
+//! Dirichlet conditions on chosen dofs.
+
+use crate::assembly::{Assembler, Kernel, Quadrature};
+use crate::linalg::{Matrix, Structure};
+use crate::mesh::Facet;
+use crate::newton::NonlinearProblem;
+
+/// Dofs held at zero.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Constraints {
+    pub fixed: Vec<bool>,
+}
+
+impl Constraints {
+    pub fn none(size: usize) -> Self {
+        Constraints {
+            fixed: vec![false; size],
+        }
+    }
+
+    pub fn fix(&mut self, dof: usize) {
+        self.fixed[dof] = true;
+    }
+
+    pub fn dofs(&self) -> Vec<usize> {
+        self.fixed
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| **f)
+            .map(|(i, _)| i)
+            .collect()
+    }
+
+    /// Zeroes the constrained entries of a vector.
+    pub fn zero(&self, v: &mut [f64]) {
+        v.iter_mut()
+            .zip(&self.fixed)
+            .filter(|(_, f)| **f)
+            .for_each(|(x, _)| *x = 0.0);
+    }
+
+    /// Replaces constrained rows and columns by the identity.
+    pub fn apply(&self, m: &mut Matrix) {
+        m.constrain(&self.dofs(), &self.fixed, 1.0);
+    }
+}
+
+/// A contact term: a compiled form, the name of its boundary integral, and the mesh facets it
+/// is integrated over.
+pub struct ContactTerm<'m, C: Kernel> {
+    pub form: C,
+    pub region: String,
+    pub facets: &'m [Facet],
+    pub quadrature: Quadrature,
+}
+
+/// K u + C(u) − L = 0.
+pub struct StaticContact<'m, C: Kernel> {
+    asm: &'m Assembler<'m>,
+    stiffness: Matrix,
+    load: Vec<f64>,
+    load_scale: f64,
+    pub contact: ContactTerm<'m, C>,
+    pub constraints: Constraints,
+    structure: Structure,
+}
+
+impl<'m, C: Kernel> StaticContact<'m, C> {
+    /// Assembles the linear form `stiffness` once.
+    pub fn new<S: Kernel>(
+        asm: &'m Assembler<'m>,
+        stiffness: &S,
+        quadrature: Quadrature,
+        load: Vec<f64>,
+        contact: ContactTerm<'m, C>,
+        constraints: Constraints,
+        structure: Structure,
+    ) -> Self {
+        let n = asm.size();
+        let zero = vec![0.0; n];
+        let mut k = asm.zero_matrix();
+        asm.cell_tangent(stiffness, quadrature, &[&zero], 0, 0.0, &mut k);
+        let mut load = load;
+        constraints.zero(&mut load);
+        let load_scale = crate::newton::norm_inf(&load);
+        StaticContact {
+            asm,
+            stiffness: k,
+            load,
+            load_scale,
+            contact,
+            constraints,
+            structure,
+        }
+    }
+
+    /// Replaces the loads (the stiffness, and so a factorization, stay valid).
+    pub fn set_load(&mut self, mut load: Vec<f64>) {
+        self.constraints.zero(&mut load);
+        self.load_scale = crate::newton::norm_inf(&load);
+        self.load = load;
+    }
+
+    /// The contact term's residual C(u) (unconstrained).
+    pub fn contact_residual(&self, u: &[f64]) -> Vec<f64> {
+        let mut c = vec![0.0; u.len()];
+        let t = &self.contact;
+        self.asm
+            .facet_residual(&t.form, &t.region, t.facets, t.quadrature, &[u], 0.0, &mut c);
+        c
+    }
+}
+
+impl<C: Kernel> NonlinearProblem for StaticContact<'_, C> {
+    fn residual(&mut self, u: &[f64], r: &mut [f64]) {
+        self.stiffness.mul_vec(u, r);
+        let t = &self.contact;
+        self.asm
+            .facet_residual(&t.form, &t.region, t.facets, t.quadrature, &[u], 0.0, r);
+        r.iter_mut().zip(&self.load).for_each(|(ri, li)| *ri -= li);
+        self.constraints.zero(r);
+    }
+
+    fn load_scale(&self) -> f64 {
+        self.load_scale
+    }
+
+    fn active_set(&mut self, u: &[f64], out: &mut Vec<bool>) -> bool {
+        let t = &self.contact;
+        self.asm
+            .facet_switches(&t.form, &t.region, t.facets, t.quadrature, &[u], 0, 0.0, out);
+        C::META.piecewise
+    }
+
+    fn jacobian(&mut self, u: &[f64], j: &mut Matrix) {
+        j.values.copy_from_slice(&self.stiffness.values);
+        let t = &self.contact;
+        self.asm
+            .facet_tangent(&t.form, &t.region, t.facets, t.quadrature, &[u], 0, 0.0, j);
+        self.constraints.apply(j);
+    }
+
+    fn jacobian_matrix(&self) -> Matrix {
+        self.asm.zero_matrix()
+    }
+
+    fn structure(&self) -> Structure {
+        self.structure
+    }
+}

@@ -1,0 +1,16 @@
+//! Built-in cases (`signorini run NAME`).
+
+pub mod static_block;
+
+/// Why a case did not run.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    #[error("invalid option: {0}")]
+    Option(String),
+    #[error(transparent)]
+    Mesh(#[from] crate::runtime::mesh::MeshError),
+    #[error(transparent)]
+    Newton(#[from] crate::runtime::newton::NewtonError),
+    #[error("cannot write {path}: {source}")]
+    Write { path: String, source: std::io::Error },
+}

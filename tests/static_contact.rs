@@ -1,0 +1,161 @@
+//! Static Signorini problems end to end (the `static-block` case): equilibrium of the contact
+//! resultant with the weight, penetration under refinement, Newton iteration counts, and reuse
+//! of the factorization when the active set does not change.
+
+use signorini::cases::static_block::{self, ContactMethod, Options};
+use signorini::forms::nitsche;
+use signorini::runtime::assembly::{Assembler, Quadrature};
+use signorini::runtime::kernel::Coef;
+use signorini::runtime::linalg::Structure;
+use signorini::runtime::newton::{Newton, NewtonOptions};
+use signorini::runtime::problem::{Constraints, ContactTerm, StaticContact};
+
+fn methods() -> Vec<(ContactMethod, f64)> {
+    vec![
+        (ContactMethod::Nitsche, 1.0),
+        (ContactMethod::Nitsche, 0.0),
+        (ContactMethod::Nitsche, -1.0),
+        (ContactMethod::Penalty, 0.0),
+    ]
+}
+
+fn run(contact: ContactMethod, theta: f64, f: impl FnOnce(&mut Options)) -> static_block::Summary {
+    let mut o = Options {
+        contact,
+        theta,
+        ..Options::default()
+    };
+    f(&mut o);
+    static_block::run(&o).unwrap_or_else(|e| panic!("{contact:?} θ = {theta}: {e}"))
+}
+
+#[test]
+fn contact_resultant_equals_the_weight_in_2d_and_3d() {
+    for (contact, theta) in methods() {
+        for (dim, degree, h) in [(2, 2, 0.125), (3, 1, 0.125), (3, 2, 0.25)] {
+            let s = run(contact, theta, |o| {
+                o.dim = dim;
+                o.degree = degree;
+                o.h = h;
+            });
+            let rel = (s.contact_force - s.weight).abs() / s.weight;
+            assert!(
+                rel < 1e-8,
+                "{contact:?} θ = {theta}, {dim}D P{degree}: force {} vs weight {}",
+                s.contact_force,
+                s.weight
+            );
+            assert!(
+                s.newton_iterations <= 10,
+                "{contact:?} θ = {theta}, {dim}D: {} iterations",
+                s.newton_iterations
+            );
+            assert_eq!(
+                s.symbolic_factorizations, 1,
+                "{contact:?} θ = {theta}, {dim}D P{degree}"
+            );
+        }
+    }
+}
+
+#[test]
+fn penetration_decreases_under_refinement() {
+    for (contact, theta) in methods() {
+        let p: Vec<f64> = [0.25, 0.125, 0.0625]
+            .iter()
+            .map(|&h| run(contact, theta, |o| o.h = h).max_penetration)
+            .collect();
+        assert!(
+            p[0] > p[1] && p[1] > p[2] && p[2] > 0.0,
+            "{contact:?} θ = {theta}: {p:?}"
+        );
+    }
+}
+
+#[test]
+fn on_a_curved_obstacle_newton_finds_a_partial_contact_zone() {
+    for (contact, theta) in methods() {
+        let s = run(contact, theta, |o| o.curvature = 0.5);
+        let rel = (s.contact_force - s.weight).abs() / s.weight;
+        assert!(
+            rel < 1e-8,
+            "{contact:?} θ = {theta}: force {} vs weight {}",
+            s.contact_force,
+            s.weight
+        );
+        let points = 2 * 8 * 4; // bottom facets × Gauss points
+        assert!(
+            s.active_points > 0 && s.active_points < points / 2,
+            "{} of {points} points active",
+            s.active_points
+        );
+        // From the all-active start, semi-smooth Newton releases the edges a few points at a
+        // time: more iterations than on the plane, but a bounded number.
+        assert!(
+            s.newton_iterations <= 20,
+            "{contact:?} θ = {theta}: {} iterations",
+            s.newton_iterations
+        );
+    }
+}
+
+/// One symbolic analysis per pattern; a second solve with a 1% heavier load keeps the active
+/// set, so it reuses the numeric factorization and converges in one (linear) step.
+#[test]
+fn factorization_is_reused_while_the_active_set_is_unchanged() {
+    let mesh = static_block::mesh(&Options::default()).unwrap();
+    let p = nitsche::Params::default()
+        .with("E", 100.0)
+        .and_then(|p| p.with("gamma0", 5000.0))
+        .unwrap();
+    let c = nitsche::Coefficients {
+        f: Coef::constant(vec![0.0, -1.0]),
+        g: Coef::function(1, |x, _, o| o[0] = x[1] + 0.5 * x[0] * x[0]),
+        nc: Coef::constant(vec![0.0, -1.0]),
+    };
+    let asm = Assembler::new(&mesh);
+    let n = asm.size();
+    let mut load = vec![0.0; n];
+    asm.cell_residual(&nitsche::Load::new(&p, &c), Quadrature::default(), &[], 0.0, &mut load);
+    let term = ContactTerm {
+        form: nitsche::Contact::new(&p, &c),
+        region: "Gamma_C".into(),
+        facets: asm.region("bottom").unwrap(),
+        quadrature: Quadrature {
+            cell: None,
+            facet: Some(7),
+        },
+    };
+    let mut constraints = Constraints::none(n);
+    let centre = (0..mesh.num_nodes()).find(|&i| mesh.node(i) == [0.0, 0.0]).unwrap();
+    constraints.fix(2 * centre);
+    let mut problem = StaticContact::new(
+        &asm,
+        &nitsche::Stiffness::new(&p, &c),
+        Quadrature::default(),
+        load.clone(),
+        term,
+        constraints,
+        Structure::SymmetricPositiveDefinite,
+    );
+    let mut u = vec![0.0; n];
+    u.iter_mut().skip(1).step_by(2).for_each(|x| *x = -1e-7);
+    let mut newton = Newton::new(NewtonOptions::default());
+    let first = newton.solve(&mut problem, &mut u).unwrap();
+    let after_first = newton.counters();
+    assert_eq!(after_first.symbolic, 1);
+    assert_eq!(
+        after_first.numeric,
+        first.history.iter().filter(|i| i.refactored).count()
+    );
+    problem.set_load(load.iter().map(|l| 1.01 * l).collect());
+    let second = newton.solve(&mut problem, &mut u).unwrap();
+    let after_second = newton.counters();
+    assert_eq!(second.iterations(), 1, "{second:?}");
+    assert!(!second.history[0].refactored);
+    assert_eq!(
+        after_second.numeric, after_first.numeric,
+        "refactored although the active set did not change"
+    );
+    assert_eq!(after_second.symbolic, 1);
+}
