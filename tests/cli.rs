@@ -67,3 +67,51 @@ fn emit_prints_every_stage() {
         rust.contains("pub mod contact_nitsche") && rust.contains("impl<const N: usize> FormKernel<2, N> for Contact")
     );
 }
+
+#[test]
+fn mesh_info_prints_json_or_the_error() {
+    let (code, out, err) = signorini(&["mesh", "info", "runtime/tests/gmsh_good_41.msh"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["nodes"], 4);
+    assert_eq!(v["cells"]["P1 triangle"], 2);
+    assert_eq!(v["boundary_facets"], 4);
+    assert!((v["measure"].as_f64().unwrap() - 1.0).abs() < 1e-14);
+    let (code, _, err) = signorini(&["mesh", "info", "runtime/tests/gmsh_bad/node_out_of_range.msh"]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("node_out_of_range.msh:19: element 3 refers to node 9"),
+        "{err}"
+    );
+}
+
+#[test]
+fn static_block_writes_its_summary() {
+    let dir = std::env::temp_dir().join(format!("signorini-cli-{}", std::process::id()));
+    let (code, out, err) = signorini(&[
+        "run",
+        "static-block",
+        "--h",
+        "0.25",
+        "--theta",
+        "-1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("static-block:"), "{out}");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "contact_force",
+        "weight",
+        "max_penetration",
+        "newton_iterations",
+        "dofs",
+    ] {
+        assert!(s.get(key).is_some(), "summary.json lacks {key}");
+    }
+    let (code, _, err) = signorini(&["run", "static-block", "--h", "-1"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("--h must be in (0, 1]"), "{err}");
+}

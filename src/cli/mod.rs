@@ -26,6 +26,11 @@ pub enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
+    /// Mesh utilities.
+    Mesh {
+        #[command(subcommand)]
+        command: MeshCommand,
+    },
     /// Run a built-in case.
     Run {
         #[command(subcommand)]
@@ -40,6 +45,13 @@ pub enum Command {
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=3))]
         dim: u8,
     },
+}
+
+#[derive(Subcommand)]
+pub enum MeshCommand {
+    /// Print a JSON summary of a Gmsh file: nodes, cells by type, boundary facets, regions,
+    /// total measure.
+    Info { file: PathBuf },
 }
 
 /// Built-in cases.
@@ -57,7 +69,7 @@ pub struct StaticBlockArgs {
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     theta: f64,
     /// γ = γ0/h (Nitsche) or ε = γ0/h (penalty); E = 100 here, and θ = 1 needs γ0 ≳ 20 E.
-    #[arg(long, default_value_t = 5000.0)]
+    #[arg(long, default_value_t = 5000.0, allow_hyphen_values = true)]
     gamma0: f64,
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
     dim: u8,
@@ -65,10 +77,10 @@ pub struct StaticBlockArgs {
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
     degree: u8,
     /// Mesh size.
-    #[arg(long, default_value_t = 0.125)]
+    #[arg(long, default_value_t = 0.125, allow_hyphen_values = true)]
     h: f64,
     /// Curvature c of the obstacle x_d = -c|x'|² (0: the plane).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     curvature: f64,
     /// Backtracking line search in Newton.
     #[arg(long)]
@@ -92,6 +104,9 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Run {
             case: Case::StaticBlock(a),
         } => static_block(a),
+        Command::Mesh {
+            command: MeshCommand::Info { file },
+        } => mesh_info(&file),
     }
 }
 
@@ -172,6 +187,40 @@ fn static_block(a: StaticBlockArgs) -> ExitCode {
                 "static-block: {} dofs, contact force {:.10e} (weight {:.10e}), max penetration {:.3e}, {} Newton iterations, {:.2} s",
                 s.dofs, s.contact_force, s.weight, s.max_penetration, s.newton_iterations, s.wall_seconds
             );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn mesh_info(file: &Path) -> ExitCode {
+    match crate::runtime::mesh::gmsh::read(file) {
+        Ok(mesh) => {
+            let regions: serde_json::Map<String, serde_json::Value> = mesh
+                .regions
+                .iter()
+                .map(|r| (r.name.clone(), serde_json::json!({ "facets": r.facets.len() })))
+                .collect();
+            let groups: serde_json::Map<String, serde_json::Value> = mesh
+                .cell_groups
+                .iter()
+                .map(|(n, c)| (n.clone(), serde_json::json!({ "cells": c.len() })))
+                .collect();
+            let info = serde_json::json!({
+                "file": file.display().to_string(),
+                "dimension": mesh.dim(),
+                "nodes": mesh.num_nodes(),
+                "cells": { mesh.kind.name(): mesh.num_cells() },
+                "boundary_facets": mesh.boundary_facets().len(),
+                "regions": regions,
+                "cell_groups": groups,
+                "measure": mesh.measure(),
+                "max_cell_diameter": mesh.max_diameter(),
+            });
+            println!("{}", serde_json::to_string_pretty(&info).expect("JSON of plain values"));
             ExitCode::SUCCESS
         }
         Err(e) => {
