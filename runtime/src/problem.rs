@@ -1,27 +1,64 @@
 //! Static problems assembled from compiled forms: K u + C(u) = L, where K is a linear form
-//! assembled once, C a contact form on a boundary region, and L the loads; homogeneous
-//! Dirichlet conditions on chosen dofs.
+//! assembled once, C a contact form on a boundary region, and L the loads; Dirichlet
+//! conditions on chosen dofs.
 
 use crate::assembly::{Assembler, Kernel, Quadrature};
 use crate::linalg::{Matrix, Structure};
 use crate::mesh::Facet;
 use crate::newton::NonlinearProblem;
 
-/// Dofs held at zero.
+/// Dirichlet conditions: dofs held at given values (zero unless set).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Constraints {
     pub fixed: Vec<bool>,
+    pub values: Vec<f64>,
 }
 
 impl Constraints {
     pub fn none(size: usize) -> Self {
         Constraints {
             fixed: vec![false; size],
+            values: vec![0.0; size],
         }
     }
 
+    /// Holds `dof` at zero.
     pub fn fix(&mut self, dof: usize) {
         self.fixed[dof] = true;
+    }
+
+    /// Holds `dof` at `value`.
+    pub fn fix_value(&mut self, dof: usize, value: f64) {
+        self.fixed[dof] = true;
+        self.values[dof] = value;
+    }
+
+    /// Holds the listed components of every node of a boundary region at `value(x)`.
+    pub fn fix_region(
+        &mut self,
+        mesh: &crate::mesh::Mesh,
+        region: &str,
+        components: &[usize],
+        value: impl Fn(&[f64]) -> Vec<f64>,
+    ) -> Result<(), crate::mesh::MeshError> {
+        let d = mesh.dim();
+        let region = mesh.region(region)?;
+        for node in mesh.region_nodes(region) {
+            let v = value(mesh.node(node as usize));
+            for &k in components {
+                self.fix_value(node as usize * d + k, v[k]);
+            }
+        }
+        Ok(())
+    }
+
+    /// Sets the constrained entries of `u` to their values.
+    pub fn impose(&self, u: &mut [f64]) {
+        for ((x, f), v) in u.iter_mut().zip(&self.fixed).zip(&self.values) {
+            if *f {
+                *x = *v;
+            }
+        }
     }
 
     pub fn dofs(&self) -> Vec<usize> {
@@ -45,6 +82,29 @@ impl Constraints {
     pub fn apply(&self, m: &mut Matrix) {
         m.constrain(&self.dofs(), &self.fixed, 1.0);
     }
+}
+
+/// Solves the linear system K u = b with Dirichlet conditions (lifted: b − K u_D on the free
+/// dofs, the identity on the fixed ones), by Cholesky if `structure` says K is SPD.
+pub fn solve_linear(
+    k: &Matrix,
+    b: &[f64],
+    constraints: &Constraints,
+    structure: Structure,
+) -> Result<Vec<f64>, crate::linalg::LinalgError> {
+    let n = b.len();
+    let mut lift = vec![0.0; n];
+    constraints.impose(&mut lift);
+    let mut klift = vec![0.0; n];
+    k.mul_vec(&lift, &mut klift);
+    let mut rhs: Vec<f64> = b.iter().zip(&klift).map(|(bi, ki)| bi - ki).collect();
+    constraints.impose(&mut rhs);
+    let mut a = k.clone();
+    constraints.apply(&mut a);
+    let mut f = crate::linalg::Factorization::new(structure);
+    f.factor(&a)?;
+    f.solve_in_place(&mut rhs)?;
+    Ok(rhs)
 }
 
 /// A contact term: a compiled form, the name of its boundary integral, and the mesh facets it
