@@ -10,6 +10,7 @@ pub use signorini_compiler as compiler;
 pub use signorini_macros::forms;
 pub use signorini_runtime as runtime;
 
+pub mod bench;
 pub mod cases;
 pub mod cli;
 pub mod forms;

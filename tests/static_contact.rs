@@ -139,7 +139,8 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
         Structure::SymmetricPositiveDefinite,
     );
     let mut u = vec![0.0; n];
-    u.iter_mut().skip(1).step_by(2).for_each(|x| *x = -1e-7);
+    // Below the deepest gap (0.5 at the corners): every contact point active at the start.
+    u.iter_mut().skip(1).step_by(2).for_each(|x| *x = -0.5 - 1e-7);
     let mut newton = Newton::new(NewtonOptions::default());
     let first = newton.solve(&mut problem, &mut u).unwrap();
     let after_first = newton.counters();
@@ -158,4 +159,62 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
         "refactored although the active set did not change"
     );
     assert_eq!(after_second.symbolic, 1);
+}
+
+/// Newton's failures are typed and carry the history: an iteration limit, and a singular
+/// Jacobian (a block that never touches the obstacle floats: nothing fixes its vertical
+/// translation).
+#[test]
+fn newton_failures_are_typed_errors_with_history() {
+    use signorini::cases::CaseError;
+    use signorini::runtime::newton::NewtonError;
+    let mut o = Options {
+        curvature: 0.5,
+        ..Options::default()
+    };
+    o.newton.max_iterations = 2;
+    match static_block::run(&o) {
+        Err(CaseError::Newton(NewtonError::IterationLimit { report, threshold })) => {
+            assert_eq!(report.iterations(), 2);
+            assert!(report.history.last().unwrap().residual > threshold);
+            let text = CaseError::Newton(NewtonError::IterationLimit { report, threshold }).to_string();
+            assert!(text.contains("did not converge in 2 iterations"), "{text}");
+        }
+        other => panic!("expected an iteration limit, got {other:?}"),
+    }
+
+    let mesh = static_block::mesh(&Options::default()).unwrap();
+    let p = nitsche::Params::default().with("gamma0", 5000.0).unwrap();
+    let c = nitsche::Coefficients {
+        f: Coef::constant(vec![0.0, -1.0]),
+        g: Coef::function(1, |x, _, o| o[0] = x[1] + 10.0),
+        nc: Coef::constant(vec![0.0, -1.0]),
+    };
+    let asm = Assembler::new(&mesh);
+    let n = asm.size();
+    let mut load = vec![0.0; n];
+    asm.cell_residual(&nitsche::Load::new(&p, &c), Quadrature::default(), &[], 0.0, &mut load);
+    let term = ContactTerm {
+        form: nitsche::Contact::new(&p, &c),
+        region: "Gamma_C".into(),
+        facets: asm.region("bottom").unwrap(),
+        quadrature: Quadrature::default(),
+    };
+    let mut problem = StaticContact::new(
+        &asm,
+        &nitsche::Stiffness::new(&p, &c),
+        Quadrature::default(),
+        load,
+        term,
+        Constraints::none(n),
+        Structure::SymmetricPositiveDefinite,
+    );
+    let mut u = vec![0.0; n];
+    match Newton::new(NewtonOptions::default()).solve(&mut problem, &mut u) {
+        Err(NewtonError::Linear { report, source }) => {
+            assert_eq!(report.iterations(), 0);
+            assert!(source.to_string().contains("singular"), "{source}");
+        }
+        other => panic!("expected a singular Jacobian, got {other:?}"),
+    }
 }

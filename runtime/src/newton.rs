@@ -10,6 +10,10 @@ use tracing::debug;
 
 use crate::linalg::{Factorization, LinalgError, Matrix, Structure};
 
+/// Largest accepted ‖J δ + R‖∞ / ‖R‖∞ of a Newton step; above it the Jacobian is treated as
+/// singular (round-off in a sound solve stays orders of magnitude below).
+const LINEAR_TOLERANCE: f64 = 1e-6;
+
 /// A nonlinear system R(w) = 0 with a (semi-smooth) Jacobian.
 pub trait NonlinearProblem {
     /// Writes R(w) (zero on constrained dofs).
@@ -114,6 +118,7 @@ impl Newton {
         let n = w.len();
         let mut r = vec![0.0; n];
         let mut delta = vec![0.0; n];
+        let mut jd = vec![0.0; n];
         let mut set = Vec::new();
         p.residual(w, &mut r);
         let r0 = norm_inf(&r);
@@ -143,6 +148,19 @@ impl Newton {
             delta.iter_mut().zip(&r).for_each(|(d, ri)| *d = -ri);
             let f = self.factorization.as_mut().expect("factored above");
             if let Err(source) = f.solve_in_place(&mut delta) {
+                return Err(NewtonError::Linear { source, report });
+            }
+            // A (numerically) singular Jacobian still yields numbers: check that the step
+            // solves the linear system. J δ + R is small for any usable factorization.
+            let j = self.jacobian.as_ref().expect("assembled above");
+            j.mul_vec(&delta, &mut jd);
+            let linear = jd.iter().zip(&r).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(&r);
+            if !(linear <= LINEAR_TOLERANCE) {
+                let source = LinalgError::Singular { index: None };
+                debug!(
+                    linear_residual = linear,
+                    "the Jacobian is singular to working precision"
+                );
                 return Err(NewtonError::Linear { source, report });
             }
             let step = self.step(p, w, &delta, &mut r);

@@ -238,10 +238,20 @@ fn solve<S: Kernel, L: Kernel, C: Kernel>(
     };
     let constraints = sliding_constraints(mesh);
     let mut problem = StaticContact::new(&asm, stiffness, quad, l, term, constraints, structure);
-    // Start slightly inside the obstacle, so that every contact point is active and the first
-    // Jacobian is not singular (at u = 0 the block would float: H(0) = 0).
+    // Start with the block pushed into the obstacle below its largest gap, so that every contact
+    // point is active and the first Jacobian is not singular (at u = 0 the block would float,
+    // or pivot on one point of a curved obstacle: H(0) = 0). Newton then releases points.
+    let gap = |x: &[f64]| x[d - 1] + opts.curvature * x[..d - 1].iter().map(|v| v * v).sum::<f64>();
+    let deepest = mesh
+        .region_nodes(mesh.region("bottom")?)
+        .iter()
+        .map(|&i| gap(mesh.node(i as usize)))
+        .fold(0.0, f64::max);
     let mut u = vec![0.0; n];
-    u.iter_mut().skip(d - 1).step_by(d).for_each(|x| *x = -1e-6 * opts.h);
+    u.iter_mut()
+        .skip(d - 1)
+        .step_by(d)
+        .for_each(|x| *x = -(deepest + 1e-6 * opts.h));
     problem.constraints.zero(&mut u);
     let mut newton = Newton::new(opts.newton);
     let report = newton.solve(&mut problem, &mut u)?;
@@ -249,7 +259,6 @@ fn solve<S: Kernel, L: Kernel, C: Kernel>(
     let c = problem.contact_residual(&u);
     let contact_force = -c.iter().skip(d - 1).step_by(d).sum::<f64>();
     let samples = facet_samples(mesh, facets, contact_quad.facet.unwrap_or(4), &u);
-    let gap = |x: &[f64]| x[d - 1] + opts.curvature * x[..d - 1].iter().map(|v| v * v).sum::<f64>();
     let max_penetration = samples
         .iter()
         .map(|s| (-s.value[d - 1] - gap(&s.x)).max(0.0))

@@ -26,6 +26,11 @@ pub enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
+    /// Benchmarks (single thread; medians of repeated runs).
+    Bench {
+        #[command(subcommand)]
+        what: BenchCommand,
+    },
     /// Mesh utilities.
     Mesh {
         #[command(subcommand)]
@@ -44,6 +49,25 @@ pub enum Command {
         /// Space dimension of the IR to print.
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=3))]
         dim: u8,
+    },
+}
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// P2 plane-strain stiffness and mass assembly on N×N unit squares, and the factorization
+    /// of M/(β dt²) + K.
+    Assemble {
+        /// Mesh sizes N.
+        #[arg(long, value_delimiter = ',', default_values_t = vec![64, 256, 512])]
+        sizes: Vec<usize>,
+        /// N of the factorization benchmark (0: skip it).
+        #[arg(long, default_value_t = 256)]
+        factor: usize,
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Directory for bench_assemble.json.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
     },
 }
 
@@ -107,6 +131,15 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Mesh {
             command: MeshCommand::Info { file },
         } => mesh_info(&file),
+        Command::Bench {
+            what:
+                BenchCommand::Assemble {
+                    sizes,
+                    factor,
+                    repeats,
+                    out,
+                },
+        } => bench_assemble(&sizes, factor, repeats, &out),
     }
 }
 
@@ -225,6 +258,27 @@ fn mesh_info(file: &Path) -> ExitCode {
         }
         Err(e) => {
             eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn bench_assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) -> ExitCode {
+    if sizes.iter().any(|&n| n == 0 || n > 2048) {
+        eprintln!("error: --sizes must lie in 1..=2048");
+        return ExitCode::FAILURE;
+    }
+    let report = crate::bench::assemble(sizes, (factor > 0).then_some(factor), repeats, &mut |line| {
+        println!("{line}")
+    });
+    let path = out.join("bench_assemble.json");
+    match crate::output::write_json(&path, &report) {
+        Ok(()) => {
+            println!("wrote {}", path.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: cannot write {}: {e}", path.display());
             ExitCode::FAILURE
         }
     }
