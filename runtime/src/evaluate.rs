@@ -53,10 +53,13 @@ fn samples<const D: usize, const N: usize>(
     out
 }
 
+/// An exact solution: value and gradient (`[component][direction]`, row-major) at a point.
+pub type ExactSolution = dyn Fn(&[f64]) -> (Vec<f64>, Vec<f64>);
+
 /// ‖u_h − u‖_L2 and |u_h − u|_H1 of a vector field against an exact solution, whose value and
 /// gradient (`[component][direction]`, row-major) `exact(x)` returns; integrated with the cell
 /// rule of `degree` on the isoparametric cells.
-pub fn errors(mesh: &Mesh, field: &[f64], degree: u32, exact: &dyn Fn(&[f64]) -> (Vec<f64>, Vec<f64>)) -> (f64, f64) {
+pub fn errors(mesh: &Mesh, field: &[f64], degree: u32, exact: &ExactSolution) -> (f64, f64) {
     dispatch!(mesh.kind, cell_errors(mesh, field, degree, exact))
 }
 
@@ -64,7 +67,7 @@ fn cell_errors<const D: usize, const N: usize>(
     mesh: &Mesh,
     field: &[f64],
     degree: u32,
-    exact: &dyn Fn(&[f64]) -> (Vec<f64>, Vec<f64>),
+    exact: &ExactSolution,
 ) -> (f64, f64) {
     let tab = crate::kernel::Tabulation::<D, N>::cell(mesh.kind, degree).expect("kind matches D and N");
     let (mut l2, mut h1) = (0.0, 0.0);

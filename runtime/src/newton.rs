@@ -155,7 +155,7 @@ impl Newton {
             let j = self.jacobian.as_ref().expect("assembled above");
             j.mul_vec(&delta, &mut jd);
             let linear = jd.iter().zip(&r).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(&r);
-            if !(linear <= LINEAR_TOLERANCE) {
+            if linear.is_nan() || linear > LINEAR_TOLERANCE {
                 let source = LinalgError::Singular { index: None };
                 debug!(
                     linear_residual = linear,
