@@ -5,6 +5,7 @@ pub mod check;
 pub mod codegen;
 pub mod diagnostic;
 pub mod ir;
+pub mod scheme;
 pub mod source;
 pub mod syntax;
 

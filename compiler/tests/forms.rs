@@ -52,7 +52,7 @@ fn generated_rust_snapshots() {
 }
 
 #[test]
-fn ast_and_ir_snapshots() {
+fn ast_ir_and_scheme_snapshots() {
     for f in library() {
         let (prog, _) = check_path(&f, &FsLoader).unwrap();
         let (ast, _) = syntax::parse(prog.root, prog.sources.text(prog.root));
@@ -60,9 +60,17 @@ fn ast_and_ir_snapshots() {
         let params: Vec<String> = prog.params.iter().map(|p| p.name.clone()).collect();
         let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
         let ir_text = ir::print::print(&ir::build(&prog, 2), &params, &coefs);
+        let schemes: Vec<String> = prog
+            .schemes
+            .iter()
+            .map(signorini_compiler::scheme::print::print)
+            .collect();
         insta::with_settings!({ snapshot_path => "snapshots/stages", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(format!("{}.ast", stem(&f)), ast_text);
             insta::assert_snapshot!(format!("{}.ir2d", stem(&f)), ir_text);
+            if !schemes.is_empty() {
+                insta::assert_snapshot!(format!("{}.scheme", stem(&f)), schemes.join("\n"));
+            }
         });
     }
 }

@@ -118,6 +118,8 @@ pub struct StaticBlockArgs {
 pub enum Stage {
     Ast,
     Ir,
+    /// The schemes of the file, their relations solved.
+    Scheme,
     Rust,
 }
 
@@ -177,6 +179,12 @@ fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
             let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
             Ok(compiler::ir::print::print(&ir, &params, &coefs))
         }
+        Stage::Scheme => Ok(prog
+            .schemes
+            .iter()
+            .map(compiler::scheme::print::print)
+            .collect::<Vec<_>>()
+            .join("\n")),
         Stage::Rust => {
             let opts = compiler::codegen::Options {
                 runtime: compiler::codegen::DEFAULT_RUNTIME.to_string(),

@@ -31,6 +31,8 @@ pub struct Program {
     pub params: Vec<Param>,
     pub coefs: Vec<Coef>,
     pub forms: Vec<Form>,
+    /// Time schemes, compiled (their affine relations solved).
+    pub schemes: Vec<crate::scheme::SchemeIr>,
     pub globals: HashMap<String, Global>,
     /// Warnings (errors make `check` return `Err`).
     pub warnings: Vec<Diagnostic>,
@@ -108,6 +110,7 @@ pub enum Global {
     Let { value: Expr, span: Span },
     Fn { params: Vec<Ident>, body: Expr, span: Span },
     Form(usize),
+    Scheme(usize),
 }
 
 impl Global {
@@ -117,6 +120,7 @@ impl Global {
             Global::Coef(i) => coefs[*i].span,
             Global::Let { span, .. } | Global::Fn { span, .. } => *span,
             Global::Form(i) => forms[*i].span,
+            Global::Scheme(_) => Span::new(0, 0, 0),
         }
     }
 
@@ -127,6 +131,7 @@ impl Global {
             Global::Let { .. } => "let",
             Global::Fn { .. } => "fn",
             Global::Form(_) => "form",
+            Global::Scheme(_) => "scheme",
         }
     }
 }
@@ -160,11 +165,13 @@ fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
         params: Vec::new(),
         coefs: Vec::new(),
         forms: Vec::new(),
+        schemes: Vec::new(),
         globals: HashMap::new(),
         warnings: Vec::new(),
     };
     let broken: HashSet<String> = files.iter().flat_map(|(_, f)| f.broken_names.iter().cloned()).collect();
-    declare(&mut prog, &files, &mut diags);
+    let mut scheme_defs = Vec::new();
+    declare(&mut prog, &files, &mut scheme_defs, &mut diags);
     let used = {
         let mut c = types::Checker::new(&prog, &broken);
         let values = c.check_params();
@@ -194,6 +201,9 @@ fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
             );
         }
     }
+    if !diags.iter().any(Diagnostic::is_error) {
+        prog.schemes = crate::scheme::compile(&prog, &scheme_defs, &mut diags);
+    }
     diagnostic::normalize(&mut diags);
     if diags.iter().any(Diagnostic::is_error) {
         Err((diags, prog.sources))
@@ -204,7 +214,12 @@ fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
 }
 
 /// Builds the global name table; duplicate names and built-in names are errors.
-fn declare(prog: &mut Program, files: &[(FileId, ast::File)], diags: &mut Vec<Diagnostic>) {
+fn declare(
+    prog: &mut Program,
+    files: &[(FileId, ast::File)],
+    schemes: &mut Vec<crate::scheme::SchemeDef>,
+    diags: &mut Vec<Diagnostic>,
+) {
     let mut first: HashMap<String, Span> = HashMap::new();
     for (_, file) in files {
         for item in &file.items {
@@ -290,6 +305,26 @@ fn declare(prog: &mut Program, files: &[(FileId, ast::File)], diags: &mut Vec<Di
                         span: *span,
                     });
                     Global::Form(prog.forms.len() - 1)
+                }
+                ast::Item::Scheme {
+                    name,
+                    params,
+                    states,
+                    lets,
+                    initial,
+                    stages,
+                    span,
+                } => {
+                    schemes.push(crate::scheme::SchemeDef {
+                        name: name.clone(),
+                        params: params.clone(),
+                        states: states.clone(),
+                        lets: lets.clone(),
+                        initial: initial.clone(),
+                        stages: stages.clone(),
+                        span: *span,
+                    });
+                    Global::Scheme(schemes.len() - 1)
                 }
                 ast::Item::Import { .. } => continue,
             };

@@ -372,7 +372,7 @@ impl<'p> Checker<'p> {
                 ..Ty::plain(self.prog.coefs[*i].shape)
             }),
             Some(Global::Let { .. }) => self.let_ty(&id.name, id.span),
-            Some(g @ (Global::Fn { .. } | Global::Form(_))) => {
+            Some(g @ (Global::Fn { .. } | Global::Form(_) | Global::Scheme(_))) => {
                 let kind = g.kind();
                 self.error(
                     Diagnostic::error(

@@ -304,6 +304,7 @@ impl Body<'_> {
                 Sym::CellDiameter => "h".into(),
                 Sym::Coord(k) => format!("x[{k}]"),
                 Sym::Time => "t".into(),
+                Sym::Dt => "dt".into(), // never in a form
                 Sym::Coef { id, comp } => format!(
                     "{}[{comp}]",
                     coef_locals.iter().find(|(i, _)| *i == id).expect("named above").1

@@ -34,6 +34,8 @@ pub enum Sym {
     CellDiameter,
     Coord(u8),
     Time,
+    /// The time step (scheme coefficients only).
+    Dt,
     /// Component `comp` (row-major for tensors) of case datum `id`.
     Coef {
         id: u16,
@@ -56,7 +58,7 @@ pub enum Node {
     Heaviside(NodeId),
 }
 
-#[derive(Default, Clone)]
+#[derive(Default, Clone, Debug)]
 pub struct Graph {
     nodes: Vec<Node>,
     index: HashMap<Node, NodeId>,
@@ -194,6 +196,14 @@ impl Graph {
     }
 
     pub fn div(&mut self, a: NodeId, b: NodeId) -> NodeId {
+        if let Some(c) = self.as_const(a)
+            && c < 0.0
+            && self.as_const(b).is_none()
+        {
+            let p = self.constant(-c);
+            let q = self.div(p, b);
+            return self.neg(q);
+        }
         match (self.as_const(a), self.as_const(b)) {
             (Some(x), Some(y)) => return self.constant(x / y),
             (Some(0.0), _) => return self.zero(),
@@ -206,6 +216,10 @@ impl Graph {
         }
         if let Node::Neg(x) = self.node(a) {
             let q = self.div(x, b);
+            return self.neg(q);
+        }
+        if let Node::Neg(y) = self.node(b) {
+            let q = self.div(a, y);
             return self.neg(q);
         }
         self.intern(Node::Div(a, b))
@@ -243,7 +257,11 @@ impl Graph {
 
     /// Records a source name for a node (the first name given wins).
     pub fn name(&mut self, id: NodeId, name: &str) {
-        if matches!(self.node(id), Node::Const(_) | Node::Sym(_)) {
+        if matches!(
+            self.node(id),
+            Node::Const(_)
+                | Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. } | Sym::Test { .. } | Sym::TestGrad { .. })
+        ) {
             return;
         }
         self.names.entry(id).or_insert_with(|| name.to_string());

@@ -217,7 +217,7 @@ pub fn node_degrees(
                 Sym::Field { .. } | Sym::Test { .. } | Sym::Coef { .. } => p,
                 Sym::FieldGrad { .. } | Sym::TestGrad { .. } => p - 1,
                 Sym::Coord(_) => 1,
-                Sym::Param(_) | Sym::Normal(_) | Sym::CellDiameter | Sym::Time => 0,
+                Sym::Param(_) | Sym::Normal(_) | Sym::CellDiameter | Sym::Time | Sym::Dt => 0,
             },
             Node::Add(a, b) => dg(a).max(dg(b)),
             Node::Mul(a, b) | Node::Div(a, b) => dg(a) + dg(b),

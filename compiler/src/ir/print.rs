@@ -95,6 +95,7 @@ pub fn sym(s: Sym, params: &[String], coefs: &[String]) -> String {
         Sym::CellDiameter => "h".into(),
         Sym::Coord(k) => format!("x[{k}]"),
         Sym::Time => "t".into(),
+        Sym::Dt => "dt".into(),
         Sym::Coef { id, comp } => format!("{}[{comp}]", coefs.get(id as usize).map_or("coef", String::as_str)),
     }
 }

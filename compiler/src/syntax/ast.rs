@@ -79,6 +79,51 @@ pub struct Integral {
     pub span: Span,
 }
 
+/// A parameter of a scheme: `alpha = 0.05 in [0, 1/3]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SchemeParam {
+    pub name: Ident,
+    pub default: Expr,
+    pub range: Option<Range>,
+    pub span: Span,
+}
+
+/// One stage: an unknown, affine relations for the other new quantities, a residual.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Stage {
+    pub name: Option<Ident>,
+    /// Time of the stage (`at t + dt` when omitted).
+    pub at: Option<Expr>,
+    pub lets: Vec<(Ident, Expr)>,
+    pub unknown: Option<Ident>,
+    pub relates: Vec<Relate>,
+    pub residual: Option<Residual>,
+    pub span: Option<Span>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Relate {
+    pub name: Ident,
+    pub value: Expr,
+    pub span: Span,
+}
+
+/// `lhs == rhs`, both sums of scalar multiples of form applications.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Residual {
+    pub lhs: Expr,
+    pub rhs: Expr,
+    pub span: Span,
+}
+
+/// `initial a: mass(a) + ... == load(t)`: solves for a state at t = 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Initial {
+    pub unknown: Ident,
+    pub residual: Residual,
+    pub span: Span,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum Item {
     Import {
@@ -114,6 +159,16 @@ pub enum Item {
         integrals: Vec<Integral>,
         span: Span,
     },
+    Scheme {
+        name: Ident,
+        params: Vec<SchemeParam>,
+        states: Vec<Ident>,
+        /// Scalar lets shared by the stages.
+        lets: Vec<(Ident, Expr)>,
+        initial: Option<Initial>,
+        stages: Vec<Stage>,
+        span: Span,
+    },
 }
 
 impl Item {
@@ -125,7 +180,8 @@ impl Item {
             | Item::Coef { name, .. }
             | Item::Let { name, .. }
             | Item::Fn { name, .. }
-            | Item::Form { name, .. } => Some(name),
+            | Item::Form { name, .. }
+            | Item::Scheme { name, .. } => Some(name),
         }
     }
 
@@ -136,7 +192,8 @@ impl Item {
             | Item::Coef { span, .. }
             | Item::Let { span, .. }
             | Item::Fn { span, .. }
-            | Item::Form { span, .. } => *span,
+            | Item::Form { span, .. }
+            | Item::Scheme { span, .. } => *span,
         }
     }
 }

@@ -331,6 +331,13 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::integral => "`int(REGION)`",
         Rule::integrals => "an integral `int(REGION) ...`",
         Rule::form_args | Rule::ident_list => "argument names",
+        Rule::state_decl
+        | Rule::unknown_decl
+        | Rule::relate_decl
+        | Rule::residual_decl
+        | Rule::stage_block
+        | Rule::initial_decl => "a scheme item (`state`, `unknown`, `relate`, `residual`, `stage`, `initial`, `let`)",
+        Rule::scheme_params | Rule::scheme_param => "scheme parameters",
         _ => return None,
     })
 }
@@ -438,8 +445,146 @@ impl Builder {
                     span,
                 }
             }
+            Rule::scheme_decl => self.scheme(span, next(), it)?,
             r => unreachable!("not an item: {r:?}"),
         })
+    }
+
+    fn scheme(
+        &self,
+        span: Span,
+        name: Pair<Rule>,
+        rest: pest::iterators::Pairs<Rule>,
+    ) -> Result<Item, Box<Diagnostic>> {
+        let name = self.ident(name);
+        let (mut params, mut states, mut initial, mut lets) = (Vec::new(), Vec::new(), None, Vec::new());
+        let mut stages: Vec<Stage> = Vec::new();
+        // Items outside `stage` blocks form one implicit stage at t + dt.
+        let mut implicit = Stage::default();
+        for p in rest {
+            match p.as_rule() {
+                Rule::scheme_params => {
+                    for q in p.into_inner() {
+                        let span = self.span(&q);
+                        let mut it = q.into_inner();
+                        let name = self.ident(it.next().expect("param name"));
+                        let default = self.expr(it.next().expect("param default"))?;
+                        let range = it.next().map(|r| self.range(r)).transpose()?;
+                        params.push(SchemeParam {
+                            name,
+                            default,
+                            range,
+                            span,
+                        });
+                    }
+                }
+                Rule::state_decl => {
+                    let list = p.into_inner().next().expect("state names");
+                    states.extend(list.into_inner().map(|i| self.ident(i)));
+                }
+                Rule::initial_decl => {
+                    let span = self.span(&p);
+                    let mut it = p.into_inner();
+                    let unknown = self.ident(it.next().expect("initial unknown"));
+                    let lhs = self.expr(it.next().expect("lhs"))?;
+                    let rhs = self.expr(it.next().expect("rhs"))?;
+                    initial = Some(Initial {
+                        unknown,
+                        residual: Residual { lhs, rhs, span },
+                        span,
+                    });
+                }
+                Rule::stage_block => {
+                    let span = self.span(&p);
+                    let mut stage = Stage {
+                        span: Some(span),
+                        ..Stage::default()
+                    };
+                    for q in p.into_inner() {
+                        match q.as_rule() {
+                            Rule::ident => stage.name = Some(self.ident(q)),
+                            Rule::expr => stage.at = Some(self.expr(q)?),
+                            _ => self.stage_item(&mut stage, q)?,
+                        }
+                    }
+                    stages.push(stage);
+                }
+                Rule::let_decl => {
+                    let mut it = p.into_inner();
+                    let name = self.ident(it.next().expect("let name"));
+                    lets.push((name, self.expr(it.next().expect("let value"))?));
+                }
+                _ => self.stage_item(&mut implicit, p)?,
+            }
+        }
+        let implicit_used = implicit.unknown.is_some() || !implicit.relates.is_empty() || implicit.residual.is_some();
+        if implicit_used {
+            if stages.is_empty() {
+                stages.push(implicit);
+            } else {
+                let at = implicit
+                    .relates
+                    .first()
+                    .map(|r| r.span)
+                    .or(implicit.residual.as_ref().map(|r| r.span))
+                    .unwrap_or(span);
+                let d = Diagnostic::error(
+                    "E0803",
+                    "scheme items outside the `stage` blocks",
+                    at,
+                    "put this inside a stage",
+                )
+                .with_note("a scheme is either one implicit stage or a list of `stage NAME at TIME { ... }` blocks");
+                return Err(Box::new(d));
+            }
+        }
+        Ok(Item::Scheme {
+            name,
+            params,
+            states,
+            lets,
+            initial,
+            stages,
+            span,
+        })
+    }
+
+    fn stage_item(&self, stage: &mut Stage, p: Pair<Rule>) -> Result<(), Box<Diagnostic>> {
+        let span = self.span(&p);
+        let rule = p.as_rule();
+        let mut it = p.into_inner();
+        match rule {
+            Rule::let_decl => {
+                let name = self.ident(it.next().expect("let name"));
+                stage.lets.push((name, self.expr(it.next().expect("let value"))?));
+            }
+            Rule::unknown_decl => {
+                let name = self.ident(it.next().expect("unknown name"));
+                if let Some(prev) = &stage.unknown {
+                    let d = Diagnostic::error("E0804", "a stage has one unknown", name.span, "second unknown")
+                        .with_label(prev.span, "first unknown");
+                    return Err(Box::new(d));
+                }
+                stage.unknown = Some(name);
+            }
+            Rule::relate_decl => {
+                let name = self.ident(it.next().expect("relate name"));
+                let value = self.expr(it.next().expect("relate value"))?;
+                stage.relates.push(Relate { name, value, span });
+            }
+            Rule::residual_decl => {
+                let lhs = self.expr(it.next().expect("lhs"))?;
+                let rhs = self.expr(it.next().expect("rhs"))?;
+                if let Some(prev) = &stage.residual {
+                    let d = Diagnostic::error("E0804", "a stage has one residual", span, "second residual")
+                        .with_label(prev.span, "first residual");
+                    return Err(Box::new(d));
+                }
+                stage.residual = Some(Residual { lhs, rhs, span });
+            }
+            r => unreachable!("not a stage item: {r:?}"),
+        }
+        Ok(())
     }
 
     fn range(&self, p: Pair<Rule>) -> Result<Range, Box<Diagnostic>> {

@@ -33,6 +33,53 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 let ps: Vec<_> = params.iter().map(|p| p.name.as_str()).collect();
                 out.push_str(&format!("{head}fn {}({}) = {}\n", name.name, ps.join(", "), expr(body)));
             }
+            Item::Scheme {
+                name,
+                params,
+                states,
+                lets,
+                initial,
+                stages,
+                ..
+            } => {
+                let ps: Vec<String> = params
+                    .iter()
+                    .map(|p| format!("{} = {}", p.name.name, expr(&p.default)))
+                    .collect();
+                out.push_str(&format!("{head}scheme {}({})\n", name.name, ps.join(", ")));
+                let ss: Vec<&str> = states.iter().map(|s| s.name.as_str()).collect();
+                out.push_str(&format!("  state {}\n", ss.join(", ")));
+                for (n, v) in lets {
+                    out.push_str(&format!("  let {} = {}\n", n.name, expr(v)));
+                }
+                if let Some(i) = initial {
+                    out.push_str(&format!(
+                        "  initial {}: {} == {}\n",
+                        i.unknown.name,
+                        expr(&i.residual.lhs),
+                        expr(&i.residual.rhs)
+                    ));
+                }
+                for st in stages {
+                    let at = st.at.as_ref().map_or("(t + dt)".to_string(), expr);
+                    out.push_str(&format!(
+                        "  stage {} at {at}\n",
+                        st.name.as_ref().map_or("_", |n| n.name.as_str())
+                    ));
+                    for (n, v) in &st.lets {
+                        out.push_str(&format!("    let {} = {}\n", n.name, expr(v)));
+                    }
+                    if let Some(u) = &st.unknown {
+                        out.push_str(&format!("    unknown {}\n", u.name));
+                    }
+                    for r in &st.relates {
+                        out.push_str(&format!("    relate {} = {}\n", r.name.name, expr(&r.value)));
+                    }
+                    if let Some(r) = &st.residual {
+                        out.push_str(&format!("    residual {} == {}\n", expr(&r.lhs), expr(&r.rhs)));
+                    }
+                }
+            }
             Item::Form {
                 name,
                 fields,

@@ -1,0 +1,948 @@
+//! Time schemes: per stage, the affine relations between time levels are solved for the new
+//! quantities other than the unknown, and the residual becomes a sum of forms applied to affine
+//! combinations `α·unknown + Σ βₖ·knownₖ`, whose tangent is Σ coef·α·(form tangent).
+//!
+//! Scalars (parameters, lets, dt, t) live in one coefficient DAG; the generated stepper
+//! evaluates it for a given dt. A pivot of the elimination is checked not to vanish anywhere in
+//! the declared parameter ranges (by sampling them, with dt > 0).
+
+mod affine;
+pub mod print;
+
+use std::collections::HashMap;
+
+pub use affine::Affine;
+
+use crate::check::{Global, ParamRange, Program, const_eval};
+use crate::diagnostic::Diagnostic;
+use crate::ir::graph::{Graph, NodeId, Sym};
+use crate::source::Span;
+use crate::syntax::ast::{self, BinOp, Expr, ExprKind, Ident};
+
+/// A scheme as written.
+#[derive(Clone, Debug)]
+pub struct SchemeDef {
+    pub name: Ident,
+    pub params: Vec<ast::SchemeParam>,
+    pub states: Vec<Ident>,
+    pub lets: Vec<(Ident, Expr)>,
+    pub initial: Option<ast::Initial>,
+    pub stages: Vec<ast::Stage>,
+    pub span: Span,
+}
+
+/// A vector known when a stage starts, or one of its new quantities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Quantity {
+    /// A state at the start of the step.
+    State(usize),
+    /// New quantity `index` of stage `stage`.
+    Stage { stage: usize, index: usize },
+}
+
+#[derive(Clone, Debug)]
+pub struct SchemeParamInfo {
+    pub name: String,
+    pub default: f64,
+    pub range: Option<ParamRange>,
+}
+
+/// One form application in a residual: `coef · form(args)` at time `time`.
+#[derive(Clone, Debug)]
+pub struct Term {
+    pub coef: NodeId,
+    pub form: String,
+    /// Field arguments (empty for loads).
+    pub args: Vec<Affine>,
+    /// When the form is evaluated.
+    pub time: NodeId,
+}
+
+#[derive(Clone, Debug)]
+pub struct StageIr {
+    pub name: String,
+    pub time: NodeId,
+    /// Names of the stage's new quantities; the unknown is first.
+    pub quantities: Vec<String>,
+    /// Each new quantity in terms of the unknown and the known quantities.
+    pub values: Vec<Affine>,
+    /// Residual = Σ terms (the right-hand side moved over with a minus sign).
+    pub terms: Vec<Term>,
+}
+
+#[derive(Clone, Debug)]
+pub struct InitialIr {
+    /// The state solved for at the start.
+    pub state: usize,
+    pub terms: Vec<Term>,
+}
+
+#[derive(Clone, Debug)]
+pub struct SchemeIr {
+    pub name: String,
+    pub params: Vec<SchemeParamInfo>,
+    pub states: Vec<String>,
+    pub graph: Graph,
+    pub initial: Option<InitialIr>,
+    pub stages: Vec<StageIr>,
+    /// For each state, the quantity holding its value at the end of the step.
+    pub updates: Vec<Quantity>,
+}
+
+/// Compiles every scheme; errors go to `diags`.
+pub fn compile(prog: &Program, defs: &[SchemeDef], diags: &mut Vec<Diagnostic>) -> Vec<SchemeIr> {
+    defs.iter()
+        .filter_map(|d| Compiler::new(prog, d).run().map_err(|mut e| diags.append(&mut e)).ok())
+        .collect()
+}
+
+/// What a name means inside a scheme.
+#[derive(Clone, Debug)]
+enum Value {
+    Scalar(NodeId),
+    Vector(Affine),
+}
+
+struct Compiler<'a> {
+    prog: &'a Program,
+    def: &'a SchemeDef,
+    g: Graph,
+    params: Vec<SchemeParamInfo>,
+    diags: Vec<Diagnostic>,
+    /// Names visible in the current stage: scalars and known or new vectors.
+    scope: HashMap<String, Value>,
+    /// Quantities of the stage being compiled: name → index.
+    new: Vec<String>,
+    stage_index: usize,
+}
+
+const SCHEME_BUILTINS: &[&str] = &["dt", "t", "pi"];
+
+impl<'a> Compiler<'a> {
+    fn new(prog: &'a Program, def: &'a SchemeDef) -> Self {
+        Compiler {
+            prog,
+            def,
+            g: Graph::default(),
+            params: Vec::new(),
+            diags: Vec::new(),
+            scope: HashMap::new(),
+            new: Vec::new(),
+            stage_index: 0,
+        }
+    }
+
+    fn error(&mut self, d: Diagnostic) {
+        self.diags.push(d);
+    }
+
+    fn run(mut self) -> Result<SchemeIr, Vec<Diagnostic>> {
+        let def = self.def;
+        // Parameters.
+        for (i, p) in def.params.iter().enumerate() {
+            let default = match const_eval(&p.default) {
+                Ok(v) if v.is_finite() => v,
+                _ => {
+                    self.error(Diagnostic::error(
+                        "E0603",
+                        "a scheme parameter default must be a finite constant",
+                        p.default.span,
+                        "not a constant",
+                    ));
+                    f64::NAN
+                }
+            };
+            let range = p.range.as_ref().and_then(|r| {
+                let (lo, hi) = (const_eval(&r.lo).ok()?, const_eval(&r.hi).ok()?);
+                Some(ParamRange {
+                    lo,
+                    lo_closed: r.lo_closed,
+                    hi,
+                    hi_closed: r.hi_closed,
+                })
+            });
+            if let Some(r) = range
+                && default.is_finite()
+                && !r.contains(default)
+            {
+                self.error(Diagnostic::error(
+                    "E0601",
+                    format!("default of `{}` is outside its range", p.name.name),
+                    p.default.span,
+                    format!("{default} is not in {}", r.describe()),
+                ));
+            }
+            self.params.push(SchemeParamInfo {
+                name: p.name.name.clone(),
+                default,
+                range,
+            });
+            let node = self.g.sym(Sym::Param(i as u16));
+            self.g.name(node, &p.name.name);
+            self.scope.insert(p.name.name.clone(), Value::Scalar(node));
+        }
+        let dt = self.g.sym(Sym::Dt);
+        let t = self.g.sym(Sym::Time);
+        self.scope.insert("dt".into(), Value::Scalar(dt));
+        self.scope.insert("t".into(), Value::Scalar(t));
+        let pi = self.g.constant(std::f64::consts::PI);
+        self.scope.insert("pi".into(), Value::Scalar(pi));
+        if def.states.is_empty() {
+            self.error(
+                Diagnostic::error(
+                    "E0805",
+                    format!("scheme `{}` declares no state", def.name.name),
+                    def.name.span,
+                    "no `state` line",
+                )
+                .with_help("declare the states: `state u, v, a`"),
+            );
+            return Err(self.diags);
+        }
+        for (i, s) in def.states.iter().enumerate() {
+            if self.scope.contains_key(&s.name) {
+                self.error(Diagnostic::error(
+                    "E0102",
+                    format!("`{}` is defined twice", s.name),
+                    s.span,
+                    "already a name of this scheme",
+                ));
+            }
+            self.scope.insert(
+                s.name.clone(),
+                Value::Vector(Affine::known(&mut self.g, Quantity::State(i))),
+            );
+        }
+        for (name, value) in &def.lets {
+            self.bind_let(name, value);
+        }
+        if !self.diags.is_empty() {
+            return Err(self.diags);
+        }
+        let initial = def.initial.as_ref().and_then(|i| self.initial(i));
+        let mut stages = Vec::new();
+        for (s, stage) in def.stages.iter().enumerate() {
+            self.stage_index = s;
+            if let Some(ir) = self.stage(stage, s == def.stages.len() - 1) {
+                stages.push(ir);
+            }
+        }
+        if stages.is_empty() && self.diags.is_empty() {
+            self.error(Diagnostic::error(
+                "E0805",
+                format!("scheme `{}` has no stage", def.name.name),
+                def.name.span,
+                "no unknown, relations or residual",
+            ));
+        }
+        // Each state's value at the end of the step: its primed quantity in the last stage.
+        let mut updates = Vec::new();
+        if let Some(last) = stages.last() {
+            for s in &def.states {
+                let primed = format!("{}'", s.name);
+                match last.quantities.iter().position(|q| *q == primed) {
+                    Some(index) => updates.push(Quantity::Stage {
+                        stage: stages.len() - 1,
+                        index,
+                    }),
+                    None => {
+                        let at = def
+                            .stages
+                            .last()
+                            .and_then(|s| s.name.as_ref().map(|n| n.span))
+                            .unwrap_or(def.name.span);
+                        self.error(
+                            Diagnostic::error(
+                                "E0806",
+                                format!("state `{}` gets no new value", s.name),
+                                at,
+                                format!("no `{primed}` in the last stage"),
+                            )
+                            .with_help(format!(
+                                "relate `{primed}` to the other quantities, or make it the unknown"
+                            )),
+                        );
+                    }
+                }
+            }
+        }
+        if !self.diags.is_empty() {
+            return Err(self.diags);
+        }
+        Ok(SchemeIr {
+            name: def.name.name.clone(),
+            params: self.params,
+            states: def.states.iter().map(|s| s.name.clone()).collect(),
+            graph: self.g,
+            initial,
+            stages,
+            updates,
+        })
+    }
+
+    fn bind_let(&mut self, name: &Ident, value: &Expr) {
+        if let Some(v) = self.value(value) {
+            match v {
+                Value::Scalar(n) => {
+                    self.g.name(n, &name.name);
+                    self.scope.insert(name.name.clone(), Value::Scalar(n));
+                }
+                Value::Vector(_) => self.error(
+                    Diagnostic::error(
+                        "E0807",
+                        "a scheme `let` must be a scalar",
+                        value.span,
+                        "this is a combination of time levels",
+                    )
+                    .with_help("introduce a new quantity with `relate NAME = ...` instead"),
+                ),
+            }
+        }
+    }
+
+    fn initial(&mut self, init: &ast::Initial) -> Option<InitialIr> {
+        let Some(state) = self.def.states.iter().position(|s| s.name == init.unknown.name) else {
+            self.error(Diagnostic::error(
+                "E0808",
+                format!("`{}` is not a state", init.unknown.name),
+                init.unknown.span,
+                "the initial problem solves for a state",
+            ));
+            return None;
+        };
+        let saved = self.scope.clone();
+        // Within the initial problem the state is the unknown.
+        self.new = vec![init.unknown.name.clone()];
+        let unknown = Affine::unknown(&mut self.g);
+        self.scope.insert(init.unknown.name.clone(), Value::Vector(unknown));
+        let time = self.g.sym(Sym::Time);
+        let terms = self.residual(&init.residual, time, &[]);
+        self.scope = saved;
+        let terms = terms?;
+        if !terms.iter().any(|t| t.args.iter().any(|a| !self.g.is_zero(a.unknown))) {
+            self.error(Diagnostic::error(
+                "E0809",
+                "the initial residual does not depend on its unknown",
+                init.residual.span,
+                format!("no form is applied to `{}`", init.unknown.name),
+            ));
+            return None;
+        }
+        Some(InitialIr { state, terms })
+    }
+
+    fn stage(&mut self, st: &ast::Stage, last: bool) -> Option<StageIr> {
+        let name = st
+            .name
+            .as_ref()
+            .map_or_else(|| format!("stage{}", self.stage_index + 1), |n| n.name.clone());
+        let at_span = st.span.unwrap_or(self.def.span);
+        let Some(unknown) = &st.unknown else {
+            self.error(
+                Diagnostic::error(
+                    "E0805",
+                    format!("stage `{name}` has no unknown"),
+                    at_span,
+                    "no `unknown` line",
+                )
+                .with_help("`unknown u'` names the quantity Newton solves for"),
+            );
+            return None;
+        };
+        let Some(residual) = &st.residual else {
+            self.error(Diagnostic::error(
+                "E0805",
+                format!("stage `{name}` has no residual"),
+                at_span,
+                "no `residual ... == ...` line",
+            ));
+            return None;
+        };
+        let saved = self.scope.clone();
+        for (n, v) in &st.lets {
+            self.bind_let(n, v);
+        }
+        let time = match &st.at {
+            Some(e) => match self.value(e) {
+                Some(Value::Scalar(n)) => n,
+                Some(Value::Vector(_)) => {
+                    self.error(Diagnostic::error(
+                        "E0301",
+                        "a stage time must be a scalar",
+                        e.span,
+                        "a combination of time levels",
+                    ));
+                    return None;
+                }
+                None => return None,
+            },
+            None => {
+                let (t, dt) = (self.g.sym(Sym::Time), self.g.sym(Sym::Dt));
+                self.g.add(t, dt)
+            }
+        };
+        // New quantities: the unknown, the relations' left-hand sides, and the names their
+        // right-hand sides introduce.
+        self.new = vec![unknown.name.clone()];
+        let mut lhs_spans = Vec::new();
+        for r in &st.relates {
+            if r.name.name == unknown.name {
+                // A relation for the unknown determines one of the other new quantities.
+                continue;
+            }
+            if self.new.contains(&r.name.name) {
+                self.error(
+                    Diagnostic::error(
+                        "E0810",
+                        format!("`{}` is related twice", r.name.name),
+                        r.name.span,
+                        "second relation",
+                    )
+                    .with_help("one relation per new quantity"),
+                );
+            } else if self.scope.contains_key(&r.name.name) {
+                self.error(Diagnostic::error(
+                    "E0810",
+                    format!("`{}` is already known", r.name.name),
+                    r.name.span,
+                    "cannot be related here",
+                ));
+            } else {
+                self.new.push(r.name.name.clone());
+                lhs_spans.push(r.name.span);
+            }
+        }
+        for r in &st.relates {
+            self.collect_new_names(&r.value, last);
+        }
+        if !last {
+            // Intermediate stages: primes belong to the last stage.
+        }
+        let n_new = self.new.len();
+        for (i, q) in self.new.clone().iter().enumerate() {
+            let v = if i == 0 {
+                Affine::unknown(&mut self.g)
+            } else {
+                Affine::new_quantity(&mut self.g, i)
+            };
+            self.scope.insert(q.clone(), Value::Vector(v));
+        }
+        // Equations: lhs − rhs = 0, affine in the new quantities.
+        let mut equations: Vec<(Affine, Span, Option<usize>)> = Vec::new();
+        for (k, r) in st.relates.iter().enumerate() {
+            let Some(Value::Vector(lhs)) = self.scope.get(&r.name.name).cloned() else {
+                continue;
+            };
+            match self.value(&r.value) {
+                Some(Value::Vector(rhs)) => {
+                    let eq = lhs.sub(&mut self.g, &rhs);
+                    let own = self.new.iter().position(|q| *q == r.name.name);
+                    equations.push((eq, r.span, own));
+                    let _ = k;
+                }
+                Some(Value::Scalar(_)) => self.error(
+                    Diagnostic::error(
+                        "E0301",
+                        "a relation must give a combination of time levels",
+                        r.value.span,
+                        "this is a scalar",
+                    )
+                    .with_label(r.name.span, "a vector quantity"),
+                ),
+                None => {}
+            }
+        }
+        if !self.diags.is_empty() {
+            self.scope = saved;
+            return None;
+        }
+        if equations.len() + 1 != n_new {
+            let missing: Vec<String> = self.new[1..]
+                .iter()
+                .filter(|q| !st.relates.iter().any(|r| r.name.name == **q))
+                .cloned()
+                .collect();
+            self.error(
+                Diagnostic::error(
+                    "E0811",
+                    format!(
+                        "stage `{name}` has {} new quantities besides its unknown but {} relations",
+                        n_new - 1,
+                        equations.len()
+                    ),
+                    st.name.as_ref().map_or(unknown.span, |n| n.span),
+                    "the relations do not determine the new quantities",
+                )
+                .with_note(format!("quantities without a relation: {}", missing.join(", "))),
+            );
+            self.scope = saved;
+            return None;
+        }
+        // Gaussian elimination of the new quantities other than the unknown.
+        let mut solved: Vec<Option<Affine>> = vec![None; n_new];
+        solved[0] = Some(Affine::unknown(&mut self.g));
+        let mut pending: Vec<(Affine, Span, Option<usize>)> = equations;
+        while let Some((eq, span, own)) = pending.first().cloned() {
+            pending.remove(0);
+            let candidates: Vec<usize> = (1..n_new).filter(|&q| solved[q].is_none() && eq.has_new(q)).collect();
+            let pivot = own
+                .filter(|o| candidates.contains(o))
+                .or_else(|| candidates.first().copied());
+            let Some(q) = pivot else {
+                self.error(Diagnostic::error(
+                    "E0812",
+                    "this relation determines no new quantity",
+                    span,
+                    "it repeats or contradicts the others",
+                ));
+                self.scope = saved;
+                return None;
+            };
+            let c = eq.new_coef(&mut self.g, q);
+            if let Err(why) = self.check_pivot(c) {
+                self.error(
+                    Diagnostic::error(
+                        "E0802",
+                        format!(
+                            "solving this relation for `{}` divides by a coefficient that can vanish",
+                            self.new[q]
+                        ),
+                        span,
+                        why,
+                    )
+                    .with_help("restrict the parameter range, or relate the quantities differently"),
+                );
+                self.scope = saved;
+                return None;
+            }
+            // q = −(eq − c·q)/c
+            let value = eq.solve_for(&mut self.g, q);
+            for other in pending.iter_mut() {
+                other.0 = other.0.substitute(&mut self.g, q, &value);
+            }
+            for s in solved.iter_mut().flatten() {
+                *s = s.substitute(&mut self.g, q, &value);
+            }
+            solved[q] = Some(value);
+        }
+        let values: Vec<Affine> = solved.into_iter().map(|v| v.expect("every quantity solved")).collect();
+        for (i, q) in self.new.clone().iter().enumerate() {
+            self.scope.insert(q.clone(), Value::Vector(values[i].clone()));
+        }
+        let terms = self.residual(residual, time, &values);
+        let quantities = self.new.clone();
+        self.scope = saved;
+        let terms = terms?;
+        if !terms.iter().any(|t| t.args.iter().any(|a| !self.g.is_zero(a.unknown))) {
+            self.error(Diagnostic::error(
+                "E0809",
+                "the residual does not depend on the unknown",
+                residual.span,
+                format!("no form is applied to a level containing `{}`", unknown.name),
+            ));
+            return None;
+        }
+        // Later stages see this stage's quantities as known values.
+        for (i, q) in quantities.iter().enumerate() {
+            let v = Affine::known(
+                &mut self.g,
+                Quantity::Stage {
+                    stage: self.stage_index,
+                    index: i,
+                },
+            );
+            self.scope.insert(q.clone(), Value::Vector(v));
+        }
+        Some(StageIr {
+            name,
+            time,
+            quantities,
+            values,
+            terms,
+        })
+    }
+
+    /// Names on right-hand sides that are neither known nor new yet become new quantities
+    /// (auxiliary unknowns such as a mean acceleration).
+    fn collect_new_names(&mut self, e: &Expr, last: bool) {
+        match &e.kind {
+            ExprKind::Name(id) => {
+                if !self.scope.contains_key(&id.name)
+                    && !self.new.contains(&id.name)
+                    && self.is_vector_name(&id.name, last)
+                {
+                    self.new.push(id.name.clone());
+                }
+            }
+            ExprKind::Call(_, args) => args.iter().for_each(|a| self.collect_new_names(a, last)),
+            ExprKind::Neg(a) => self.collect_new_names(a, last),
+            ExprKind::Binary(_, a, b) => {
+                self.collect_new_names(a, last);
+                self.collect_new_names(b, last);
+            }
+            ExprKind::Number(_) => {}
+        }
+    }
+
+    /// Whether an unknown name may be a new quantity: not a global or built-in name.
+    fn is_vector_name(&self, name: &str, _last: bool) -> bool {
+        !self.prog.globals.contains_key(name)
+            && !SCHEME_BUILTINS.contains(&name)
+            && !crate::check::BUILTIN_VALUES.contains(&name)
+    }
+
+    /// Checks that a pivot coefficient keeps one sign, away from zero, over the parameter
+    /// ranges and dt > 0.
+    fn check_pivot(&self, c: NodeId) -> Result<(), String> {
+        let samples: Vec<Vec<f64>> = self.params.iter().map(|p| p.samples()).collect();
+        let mut index = vec![0usize; samples.len()];
+        let mut sign = 0.0;
+        loop {
+            let values: Vec<f64> = index.iter().zip(&samples).map(|(&i, s)| s[i]).collect();
+            for dt in [1e-4, 1e-2, 1.0, 100.0] {
+                let v = affine::eval(&self.g, c, &values, dt, 0.0);
+                let described = || {
+                    let ps: Vec<String> = self
+                        .params
+                        .iter()
+                        .zip(&values)
+                        .map(|(p, v)| format!("{} = {v}", p.name))
+                        .collect();
+                    let shown = if v == 0.0 { "0".to_string() } else { format!("{v:e}") };
+                    format!(
+                        "it is {shown} at {}dt = {dt}",
+                        if ps.is_empty() {
+                            String::new()
+                        } else {
+                            format!("{}, ", ps.join(", "))
+                        }
+                    )
+                };
+                if !v.is_finite() || v == 0.0 {
+                    return Err(described());
+                }
+                if sign == 0.0 {
+                    sign = v.signum();
+                } else if v.signum() != sign {
+                    return Err(format!("it changes sign: {}", described()));
+                }
+            }
+            // Next combination of samples.
+            let mut k = 0;
+            loop {
+                if k == index.len() {
+                    return Ok(());
+                }
+                index[k] += 1;
+                if index[k] < samples[k].len() {
+                    break;
+                }
+                index[k] = 0;
+                k += 1;
+            }
+        }
+    }
+
+    /// A residual `lhs == rhs` as a list of terms (rhs with flipped signs).
+    fn residual(&mut self, r: &ast::Residual, time: NodeId, _values: &[Affine]) -> Option<Vec<Term>> {
+        let mut lhs = self.form_sum(&r.lhs, time)?;
+        let rhs = self.form_sum(&r.rhs, time)?;
+        let minus = self.g.constant(-1.0);
+        for mut t in rhs {
+            t.coef = self.g.mul(minus, t.coef);
+            lhs.push(t);
+        }
+        Some(lhs)
+    }
+
+    /// A sum of scalar multiples of form applications.
+    fn form_sum(&mut self, e: &Expr, time: NodeId) -> Option<Vec<Term>> {
+        match &e.kind {
+            ExprKind::Call(f, args) if matches!(self.prog.globals.get(&f.name), Some(Global::Form(_))) => {
+                let Some(Global::Form(fi)) = self.prog.globals.get(&f.name) else {
+                    unreachable!()
+                };
+                let form = &self.prog.forms[*fi];
+                let one = self.g.one();
+                if form.fields.is_empty() {
+                    // A load: its argument is the time.
+                    let at = match args.as_slice() {
+                        [] => time,
+                        [a] => match self.value(a)? {
+                            Value::Scalar(n) => n,
+                            Value::Vector(_) => {
+                                self.error(Diagnostic::error(
+                                    "E0301",
+                                    format!("`{}` takes the time, not a time level", f.name),
+                                    a.span,
+                                    "a combination of time levels",
+                                ));
+                                return None;
+                            }
+                        },
+                        _ => {
+                            self.error(Diagnostic::error(
+                                "E0201",
+                                format!("`{}` takes at most one argument (the time)", f.name),
+                                e.span,
+                                format!("{} arguments", args.len()),
+                            ));
+                            return None;
+                        }
+                    };
+                    return Some(vec![Term {
+                        coef: one,
+                        form: f.name.clone(),
+                        args: Vec::new(),
+                        time: at,
+                    }]);
+                }
+                if args.len() != form.fields.len() {
+                    self.error(Diagnostic::error(
+                        "E0201",
+                        format!(
+                            "form `{}` takes {} time level(s), but {} were given",
+                            f.name,
+                            form.fields.len(),
+                            args.len()
+                        ),
+                        e.span,
+                        format!("{} arguments", args.len()),
+                    ));
+                    return None;
+                }
+                let mut affine_args = Vec::new();
+                for a in args {
+                    match self.value(a)? {
+                        Value::Vector(v) => affine_args.push(v),
+                        Value::Scalar(_) => {
+                            self.error(Diagnostic::error(
+                                "E0301",
+                                format!("`{}` is applied to time levels", f.name),
+                                a.span,
+                                "this is a scalar",
+                            ));
+                            return None;
+                        }
+                    }
+                }
+                Some(vec![Term {
+                    coef: one,
+                    form: f.name.clone(),
+                    args: affine_args,
+                    time,
+                }])
+            }
+            ExprKind::Binary(op @ (BinOp::Add | BinOp::Sub), a, b) => {
+                let mut x = self.form_sum(a, time)?;
+                let y = self.form_sum(b, time)?;
+                let sign = self.g.constant(if *op == BinOp::Add { 1.0 } else { -1.0 });
+                for mut t in y {
+                    t.coef = self.g.mul(sign, t.coef);
+                    x.push(t);
+                }
+                Some(x)
+            }
+            ExprKind::Neg(a) => {
+                let mut x = self.form_sum(a, time)?;
+                let m = self.g.constant(-1.0);
+                x.iter_mut().for_each(|t| t.coef = self.g.mul(m, t.coef));
+                Some(x)
+            }
+            ExprKind::Binary(BinOp::Mul, a, b) => {
+                let (scalar, sum) = if self.is_form_sum(a) { (b, a) } else { (a, b) };
+                let s = self.scalar(scalar)?;
+                let mut x = self.form_sum(sum, time)?;
+                x.iter_mut().for_each(|t| t.coef = self.g.mul(s, t.coef));
+                Some(x)
+            }
+            ExprKind::Binary(BinOp::Div, a, b) => {
+                let s = self.scalar(b)?;
+                let mut x = self.form_sum(a, time)?;
+                x.iter_mut().for_each(|t| t.coef = self.g.div(t.coef, s));
+                Some(x)
+            }
+            _ => {
+                self.error(
+                    Diagnostic::error(
+                        "E0813",
+                        "a residual side is a sum of forms applied to time levels",
+                        e.span,
+                        "not a form application",
+                    )
+                    .with_help("write e.g. `mass(a') + stiffness(u') == load(t + dt)`"),
+                );
+                None
+            }
+        }
+    }
+
+    fn is_form_sum(&self, e: &Expr) -> bool {
+        match &e.kind {
+            ExprKind::Call(f, _) => matches!(self.prog.globals.get(&f.name), Some(Global::Form(_))),
+            ExprKind::Neg(a) => self.is_form_sum(a),
+            ExprKind::Binary(BinOp::Add | BinOp::Sub, a, b) => self.is_form_sum(a) || self.is_form_sum(b),
+            ExprKind::Binary(BinOp::Mul, a, b) => self.is_form_sum(a) || self.is_form_sum(b),
+            ExprKind::Binary(BinOp::Div, a, _) => self.is_form_sum(a),
+            _ => false,
+        }
+    }
+
+    fn scalar(&mut self, e: &Expr) -> Option<NodeId> {
+        match self.value(e)? {
+            Value::Scalar(n) => Some(n),
+            Value::Vector(_) => {
+                self.error(Diagnostic::error(
+                    "E0301",
+                    "expected a scalar",
+                    e.span,
+                    "a combination of time levels",
+                ));
+                None
+            }
+        }
+    }
+
+    /// A scalar, or an affine combination of time levels.
+    fn value(&mut self, e: &Expr) -> Option<Value> {
+        match &e.kind {
+            ExprKind::Number(v) => Some(Value::Scalar(self.g.constant(*v))),
+            ExprKind::Name(id) => match self.scope.get(&id.name) {
+                Some(v) => Some(v.clone()),
+                None => {
+                    let what = match self.prog.globals.get(&id.name) {
+                        Some(Global::Form(_)) => "a form: apply it to time levels in a residual",
+                        Some(Global::Param(_)) => "a form parameter: schemes see their own parameters only",
+                        Some(_) => "not usable in a scheme",
+                        None => "not defined in this scheme",
+                    };
+                    let mut d =
+                        Diagnostic::error("E0101", format!("unknown name `{}` in scheme", id.name), id.span, what);
+                    if id.name.ends_with('\'') {
+                        d = d.with_help(
+                            "primed quantities exist in the last stage: relate them, or make one the unknown",
+                        );
+                    }
+                    self.error(d);
+                    None
+                }
+            },
+            ExprKind::Neg(a) => Some(match self.value(a)? {
+                Value::Scalar(n) => Value::Scalar(self.g.neg(n)),
+                Value::Vector(v) => {
+                    let m = self.g.constant(-1.0);
+                    Value::Vector(v.scale(&mut self.g, m))
+                }
+            }),
+            ExprKind::Binary(op, a, b) => {
+                let (x, y) = (self.value(a)?, self.value(b)?);
+                match (op, x, y) {
+                    (BinOp::Add, Value::Scalar(p), Value::Scalar(q)) => Some(Value::Scalar(self.g.add(p, q))),
+                    (BinOp::Sub, Value::Scalar(p), Value::Scalar(q)) => Some(Value::Scalar(self.g.sub(p, q))),
+                    (BinOp::Mul, Value::Scalar(p), Value::Scalar(q)) => Some(Value::Scalar(self.g.mul(p, q))),
+                    (BinOp::Div, Value::Scalar(p), Value::Scalar(q)) => Some(Value::Scalar(self.g.div(p, q))),
+                    (BinOp::Pow, Value::Scalar(p), Value::Scalar(_)) => match crate::check::const_value(b) {
+                        Some(k) if k.fract() == 0.0 && k.abs() <= 64.0 => Some(Value::Scalar(self.g.powi(p, k as i32))),
+                        _ => {
+                            self.error(Diagnostic::error(
+                                "E0303",
+                                "exponent must be a constant integer",
+                                b.span,
+                                "not a constant integer",
+                            ));
+                            None
+                        }
+                    },
+                    (BinOp::Add, Value::Vector(p), Value::Vector(q)) => Some(Value::Vector(p.add(&mut self.g, &q))),
+                    (BinOp::Sub, Value::Vector(p), Value::Vector(q)) => Some(Value::Vector(p.sub(&mut self.g, &q))),
+                    (BinOp::Mul, Value::Scalar(s), Value::Vector(v))
+                    | (BinOp::Mul, Value::Vector(v), Value::Scalar(s)) => Some(Value::Vector(v.scale(&mut self.g, s))),
+                    (BinOp::Div, Value::Vector(v), Value::Scalar(s)) => {
+                        let one = self.g.one();
+                        let inv = self.g.div(one, s);
+                        Some(Value::Vector(v.scale(&mut self.g, inv)))
+                    }
+                    (op, _, _) => {
+                        let why = match op {
+                            BinOp::Add | BinOp::Sub => "adds a scalar to a time level",
+                            BinOp::Mul => "multiplies two time levels",
+                            BinOp::Div => "divides by a time level",
+                            BinOp::Pow => "raises a time level to a power",
+                        };
+                        self.error(
+                            Diagnostic::error(
+                                "E0814",
+                                "not an affine relation between time levels",
+                                e.span,
+                                format!("this {why}"),
+                            )
+                            .with_note(
+                                "relations and form arguments are combinations Σ cₖ·levelₖ with scalar coefficients",
+                            ),
+                        );
+                        None
+                    }
+                }
+            }
+            ExprKind::Call(f, args) => {
+                if matches!(self.prog.globals.get(&f.name), Some(Global::Form(_))) {
+                    self.error(Diagnostic::error(
+                        "E0813",
+                        format!("form `{}` applied outside a residual", f.name),
+                        e.span,
+                        "forms belong in `residual` lines",
+                    ));
+                    return None;
+                }
+                let vals: Vec<NodeId> = args.iter().map(|a| self.scalar(a)).collect::<Option<_>>()?;
+                let node = match (f.name.as_str(), vals.as_slice()) {
+                    ("sqrt", [x]) => self.g.sqrt(*x),
+                    ("abs", [x]) => {
+                        let h = self.g.heaviside(*x);
+                        let m = self.g.neg(*x);
+                        let hm = self.g.heaviside(m);
+                        let s = self.g.sub(h, hm);
+                        self.g.mul(*x, s)
+                    }
+                    _ => {
+                        self.error(Diagnostic::error(
+                            "E0101",
+                            format!("`{}` is not available in schemes", f.name),
+                            f.span,
+                            "schemes use arithmetic, sqrt and abs",
+                        ));
+                        return None;
+                    }
+                };
+                Some(Value::Scalar(node))
+            }
+        }
+    }
+}
+
+impl SchemeParamInfo {
+    /// Values at which a pivot is checked: the default, and the ends of the range (just inside
+    /// open ends; a large value for infinite ones).
+    fn samples(&self) -> Vec<f64> {
+        let mut s = vec![self.default];
+        if let Some(r) = self.range {
+            let span = if r.lo.is_finite() && r.hi.is_finite() {
+                r.hi - r.lo
+            } else {
+                1.0
+            };
+            let lo = if r.lo.is_finite() {
+                if r.lo_closed { r.lo } else { r.lo + 1e-6 * span }
+            } else {
+                -1e6
+            };
+            let hi = if r.hi.is_finite() {
+                if r.hi_closed { r.hi } else { r.hi - 1e-6 * span }
+            } else {
+                1e6
+            };
+            s.extend([lo, hi, 0.5 * (lo + hi)]);
+        }
+        s
+    }
+}
