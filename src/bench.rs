@@ -48,11 +48,7 @@ pub struct Report {
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
+    if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
 }
 
 fn forms() -> (Stiffness, Mass) {
@@ -61,11 +57,8 @@ fn forms() -> (Stiffness, Mass) {
         .and_then(|p| p.with("nu", 0.3))
         .and_then(|p| p.with("rho", 1.0))
         .expect("valid parameters");
-    let c = Coefficients {
-        f: Coef::constant(vec![0.0, 0.0]),
-        g: Coef::scalar(0.0),
-        nc: Coef::constant(vec![0.0, -1.0]),
-    };
+    let c =
+        Coefficients { f: Coef::constant(vec![0.0, 0.0]), g: Coef::scalar(0.0), nc: Coef::constant(vec![0.0, -1.0]) };
     (Stiffness::new(&p, &c), Mass::new(&p, &c))
 }
 
@@ -92,31 +85,11 @@ pub fn assemble(sizes: &[usize], factor_n: Option<usize>, repeats: usize, progre
         for _ in 0..repeats {
             kmat.values.iter_mut().for_each(|v| *v = 0.0);
             let t = Instant::now();
-            asm.cell_tangent(
-                &k,
-                Quadrature {
-                    cell: Some(2),
-                    facet: None,
-                },
-                &[&zero],
-                0,
-                0.0,
-                &mut kmat,
-            );
+            asm.cell_tangent(&k, Quadrature { cell: Some(2), facet: None }, &[&zero], 0, 0.0, &mut kmat);
             tk.push(t.elapsed().as_secs_f64());
             mmat.values.iter_mut().for_each(|v| *v = 0.0);
             let t = Instant::now();
-            asm.cell_tangent(
-                &m,
-                Quadrature {
-                    cell: Some(4),
-                    facet: None,
-                },
-                &[&zero],
-                0,
-                0.0,
-                &mut mmat,
-            );
+            asm.cell_tangent(&m, Quadrature { cell: Some(4), facet: None }, &[&zero], 0, 0.0, &mut mmat);
             tm.push(t.elapsed().as_secs_f64());
         }
         let timing = AssemblyTiming {
@@ -141,28 +114,8 @@ pub fn assemble(sizes: &[usize], factor_n: Option<usize>, repeats: usize, progre
         let zero = vec![0.0; asm.size()];
         let mut a = asm.zero_matrix();
         let mut mmat = asm.zero_matrix();
-        asm.cell_tangent(
-            &k,
-            Quadrature {
-                cell: Some(2),
-                facet: None,
-            },
-            &[&zero],
-            0,
-            0.0,
-            &mut a,
-        );
-        asm.cell_tangent(
-            &m,
-            Quadrature {
-                cell: Some(4),
-                facet: None,
-            },
-            &[&zero],
-            0,
-            0.0,
-            &mut mmat,
-        );
+        asm.cell_tangent(&k, Quadrature { cell: Some(2), facet: None }, &[&zero], 0, 0.0, &mut a);
+        asm.cell_tangent(&m, Quadrature { cell: Some(4), facet: None }, &[&zero], 0, 0.0, &mut mmat);
         let (beta, dt) = (0.25, 1e-3);
         a.add_scaled(1.0 / (beta * dt * dt), &mmat);
         let (mut ts, mut tn, mut tsol) = (Vec::new(), Vec::new(), Vec::new());
@@ -202,9 +155,5 @@ pub fn assemble(sizes: &[usize], factor_n: Option<usize>, repeats: usize, progre
         ));
         t
     });
-    Report {
-        assembly,
-        factor,
-        repeats,
-    }
+    Report { assembly, factor, repeats }
 }

@@ -10,11 +10,7 @@ signorini::forms!("forms/elasticity.wf");
 fn forms(nu: f64, f: Vec<f64>) -> (elasticity::Stiffness, elasticity::Mass, elasticity::Load) {
     let p = elasticity::Params::default().with("nu", nu).unwrap();
     let c = elasticity::Coefficients { f: Coef::constant(f) };
-    (
-        elasticity::Stiffness::new(&p, &c),
-        elasticity::Mass::new(&p, &c),
-        elasticity::Load::new(&p, &c),
-    )
+    (elasticity::Stiffness::new(&p, &c), elasticity::Mass::new(&p, &c), elasticity::Load::new(&p, &c))
 }
 
 #[test]
@@ -24,17 +20,7 @@ fn p2_stiffness_frobenius_norm_matches_the_reference_value() {
     let (k, _, _) = forms(0.3, vec![0.0, 0.0]);
     let zero = vec![0.0; asm.size()];
     let mut kmat = asm.zero_matrix();
-    asm.cell_tangent(
-        &k,
-        Quadrature {
-            cell: Some(2),
-            facet: None,
-        },
-        &[&zero],
-        0,
-        0.0,
-        &mut kmat,
-    );
+    asm.cell_tangent(&k, Quadrature { cell: Some(2), facet: None }, &[&zero], 0, 0.0, &mut kmat);
     // DOLFINx, GetFEM and FEniCS agree to ten digits on 988.894321.
     assert!((kmat.frobenius() - 988.894321).abs() < 1e-6, "{}", kmat.frobenius());
 }

@@ -3,10 +3,7 @@
 use std::process::Command;
 
 fn signorini(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_signorini"))
-        .args(args)
-        .output()
-        .expect("the binary runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).output().expect("the binary runs");
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -16,32 +13,18 @@ fn signorini(args: &[&str]) -> (i32, String, String) {
 
 #[test]
 fn check_accepts_the_form_library() {
-    let (code, _, err) = signorini(&[
-        "check",
-        "forms/elasticity.wf",
-        "forms/contact_nitsche.wf",
-        "forms/contact_penalty.wf",
-    ]);
+    let (code, _, err) =
+        signorini(&["check", "forms/elasticity.wf", "forms/contact_nitsche.wf", "forms/contact_penalty.wf"]);
     assert_eq!(code, 0, "{err}");
     assert!(err.is_empty(), "{err}");
 }
 
 #[test]
 fn check_reports_every_error_with_position_and_caret() {
-    let (code, _, err) = signorini(&[
-        "check",
-        "forms/elasticity.wf",
-        "compiler/tests/ui/syntax_two_broken_items.wf",
-    ]);
+    let (code, _, err) = signorini(&["check", "forms/elasticity.wf", "compiler/tests/ui/syntax_two_broken_items.wf"]);
     assert_eq!(code, 1);
-    assert!(
-        err.contains("compiler/tests/ui/syntax_two_broken_items.wf:2:14"),
-        "{err}"
-    );
-    assert!(
-        err.contains("compiler/tests/ui/syntax_two_broken_items.wf:4:8"),
-        "{err}"
-    );
+    assert!(err.contains("compiler/tests/ui/syntax_two_broken_items.wf:2:14"), "{err}");
+    assert!(err.contains("compiler/tests/ui/syntax_two_broken_items.wf:4:8"), "{err}");
     assert!(err.contains("^ expected"), "{err}");
     assert!(err.contains("3 error(s)"), "{err}");
 }
@@ -79,36 +62,19 @@ fn mesh_info_prints_json_or_the_error() {
     assert!((v["measure"].as_f64().unwrap() - 1.0).abs() < 1e-14);
     let (code, _, err) = signorini(&["mesh", "info", "runtime/tests/gmsh_bad/node_out_of_range.msh"]);
     assert_eq!(code, 1);
-    assert!(
-        err.contains("node_out_of_range.msh:19: element 3 refers to node 9"),
-        "{err}"
-    );
+    assert!(err.contains("node_out_of_range.msh:19: element 3 refers to node 9"), "{err}");
 }
 
 #[test]
 fn static_block_writes_its_summary() {
     let dir = std::env::temp_dir().join(format!("signorini-cli-{}", std::process::id()));
-    let (code, out, err) = signorini(&[
-        "run",
-        "static-block",
-        "--h",
-        "0.25",
-        "--theta",
-        "-1",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    let (code, out, err) =
+        signorini(&["run", "static-block", "--h", "0.25", "--theta", "-1", "--out", dir.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("static-block:"), "{out}");
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    for key in [
-        "contact_force",
-        "weight",
-        "max_penetration",
-        "newton_iterations",
-        "dofs",
-    ] {
+    for key in ["contact_force", "weight", "max_penetration", "newton_iterations", "dofs"] {
         assert!(s.get(key).is_some(), "summary.json lacks {key}");
     }
     let (code, _, err) = signorini(&["run", "static-block", "--h", "-1"]);

@@ -47,25 +47,13 @@ fn solve(mesh: &Mesh, boundary: &[&str], nu: f64) -> (f64, f64) {
     let e = 1.0;
     let (lambda, mu) = (e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), e / (2.0 * (1.0 + nu)));
     let p = elasticity::Params::default().with("nu", nu).unwrap();
-    let c = elasticity::Coefficients {
-        f: Coef::function(d, move |x, _, out| body_force(x, lambda, mu, out)),
-    };
+    let c = elasticity::Coefficients { f: Coef::function(d, move |x, _, out| body_force(x, lambda, mu, out)) };
     let asm = Assembler::new(mesh);
     let n = asm.size();
     let degree = mesh.kind.degree();
-    let quad = Quadrature {
-        cell: Some(2 * degree + 2),
-        facet: None,
-    };
+    let quad = Quadrature { cell: Some(2 * degree + 2), facet: None };
     let mut k = asm.zero_matrix();
-    asm.cell_tangent(
-        &elasticity::Stiffness::new(&p, &c),
-        quad,
-        &[&vec![0.0; n]],
-        0,
-        0.0,
-        &mut k,
-    );
+    asm.cell_tangent(&elasticity::Stiffness::new(&p, &c), quad, &[&vec![0.0; n]], 0, 0.0, &mut k);
     let mut b = vec![0.0; n];
     asm.cell_residual(&elasticity::Load::new(&p, &c), quad, &[], 0.0, &mut b);
     let mut dirichlet = Constraints::none(n);
@@ -86,20 +74,14 @@ fn rates(errs: &[(f64, f64)]) -> (f64, f64) {
 fn check(what: &str, p: u32, errs: &[(f64, f64)]) {
     let (l2, h1) = rates(errs);
     eprintln!("{what}: errors {errs:?}, rates L2 {l2:.3} H1 {h1:.3}");
-    assert!(
-        l2 >= p as f64 + 1.0 - 0.1,
-        "{what}: L2 rate {l2:.3} < {}",
-        p as f64 + 0.9
-    );
+    assert!(l2 >= p as f64 + 1.0 - 0.1, "{what}: L2 rate {l2:.3} < {}", p as f64 + 0.9);
     assert!(h1 >= p as f64 - 0.1, "{what}: H1 rate {h1:.3} < {}", p as f64 - 0.1);
 }
 
 #[test]
 fn one_dimensional_p1() {
-    let errs: Vec<_> = [8, 16, 32]
-        .iter()
-        .map(|&n| solve(&structured::interval(n, 0.0, 1.0), &["left", "right"], 0.0))
-        .collect();
+    let errs: Vec<_> =
+        [8, 16, 32].iter().map(|&n| solve(&structured::interval(n, 0.0, 1.0), &["left", "right"], 0.0)).collect();
     check("1D P1", 1, &errs);
 }
 
@@ -110,13 +92,7 @@ fn two_dimensional_p1_and_p2_on_straight_meshes() {
         for diagonal in [Diagonal::Right, Diagonal::Left] {
             let errs: Vec<_> = [4, 8, 16]
                 .iter()
-                .map(|&n| {
-                    solve(
-                        &structured::rectangle(n, n, [0.0, 1.0], [0.0, 1.0], diagonal, degree),
-                        &sides,
-                        0.3,
-                    )
-                })
+                .map(|&n| solve(&structured::rectangle(n, n, [0.0, 1.0], [0.0, 1.0], diagonal, degree), &sides, 0.3))
                 .collect();
             check(&format!("2D P{degree} {diagonal:?}"), degree, &errs);
         }
@@ -126,10 +102,8 @@ fn two_dimensional_p1_and_p2_on_straight_meshes() {
 #[test]
 fn two_dimensional_p2_on_the_curved_disc() {
     // Off-centre, so the solution has no symmetry the mesh could exploit.
-    let errs: Vec<_> = [0.5, 0.25, 0.125]
-        .iter()
-        .map(|&h| solve(&disc(1.0, [0.3, 0.2], h), &["boundary"], 0.3))
-        .collect();
+    let errs: Vec<_> =
+        [0.5, 0.25, 0.125].iter().map(|&h| solve(&disc(1.0, [0.3, 0.2], h), &["boundary"], 0.3)).collect();
     check("2D P2 curved disc", 2, &errs);
 }
 
@@ -137,14 +111,10 @@ fn two_dimensional_p2_on_the_curved_disc() {
 fn three_dimensional_p1_and_p2() {
     let sides = ["left", "right", "front", "back", "bottom", "top"];
     let unit = [0.0, 1.0];
-    let p1: Vec<_> = [4, 8, 16]
-        .iter()
-        .map(|&n| solve(&structured::cuboid([n; 3], unit, unit, unit, 1), &sides, 0.3))
-        .collect();
+    let p1: Vec<_> =
+        [4, 8, 16].iter().map(|&n| solve(&structured::cuboid([n; 3], unit, unit, unit, 1), &sides, 0.3)).collect();
     check("3D P1", 1, &p1);
-    let p2: Vec<_> = [2, 4, 8]
-        .iter()
-        .map(|&n| solve(&structured::cuboid([n; 3], unit, unit, unit, 2), &sides, 0.3))
-        .collect();
+    let p2: Vec<_> =
+        [2, 4, 8].iter().map(|&n| solve(&structured::cuboid([n; 3], unit, unit, unit, 2), &sides, 0.3)).collect();
     check("3D P2", 2, &p2);
 }

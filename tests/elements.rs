@@ -11,19 +11,11 @@ signorini::forms!("forms/elasticity.wf");
 use elasticity::{Coefficients, Mass, Params, Stiffness};
 
 fn coefs(d: usize) -> Coefficients {
-    Coefficients {
-        f: Coef::constant(vec![0.0; d]),
-    }
+    Coefficients { f: Coef::constant(vec![0.0; d]) }
 }
 
 fn params(e: f64, nu: f64, rho: f64) -> Params {
-    Params::default()
-        .with("E", e)
-        .unwrap()
-        .with("nu", nu)
-        .unwrap()
-        .with("rho", rho)
-        .unwrap()
+    Params::default().with("E", e).unwrap().with("nu", nu).unwrap().with("rho", rho).unwrap()
 }
 
 fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
@@ -91,10 +83,7 @@ fn check_symmetric_with_rigid_modes<const D: usize, const N: usize>(k: &[Vec<f64
     let scale = k.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
     for i in 0..N * D {
         for j in 0..N * D {
-            assert!(
-                (k[i][j] - k[j][i]).abs() <= 1e-13 * scale,
-                "not symmetric at ({i}, {j})"
-            );
+            assert!((k[i][j] - k[j][i]).abs() <= 1e-13 * scale, "not symmetric at ({i}, {j})");
         }
     }
     // Translations and infinitesimal rotations: e_a and x ↦ x_b e_a − x_a e_b.
@@ -122,15 +111,10 @@ fn check_symmetric_with_rigid_modes<const D: usize, const N: usize>(k: &[Vec<f64
     for (i, m) in modes.iter().enumerate() {
         let r = matvec(k, m);
         let norm = r.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        assert!(
-            norm <= 1e-12 * scale,
-            "rigid mode {i} not in the kernel: |K r| = {norm}"
-        );
+        assert!(norm <= 1e-12 * scale, "rigid mode {i} not in the kernel: |K r| = {norm}");
     }
     // And nothing else: a non-rigid field has positive energy.
-    let stretch: Vec<f64> = (0..N * D)
-        .map(|r| if r % D == 0 { coords[r / D][0] } else { 0.0 })
-        .collect();
+    let stretch: Vec<f64> = (0..N * D).map(|r| if r % D == 0 { coords[r / D][0] } else { 0.0 }).collect();
     let energy: f64 = stretch.iter().zip(matvec(k, &stretch)).map(|(a, b)| a * b).sum();
     assert!(energy > 1e-6 * scale);
 }
@@ -178,28 +162,16 @@ fn tet_volume(x: &[[f64; 3]; 10]) -> f64 {
             let pos: Vec<f64> = (0..3).map(|a| (0..10).map(|j| phi[j] * x[j][a]).sum()).collect();
             let dx = |t: &[f64]| -> Vec<f64> {
                 (0..3)
-                    .map(|a| {
-                        (0..10)
-                            .map(|j| x[j][a] * (0..3).map(|b| dphi[j][b] * t[b]).sum::<f64>())
-                            .sum()
-                    })
+                    .map(|a| (0..10).map(|j| x[j][a] * (0..3).map(|b| dphi[j][b] * t[b]).sum::<f64>()).sum())
                     .collect()
             };
             let (a, b) = (dx(&t1), dx(&t2));
-            let cross = [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ];
+            let cross = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
             // Orient outwards with the reference normal.
             let n_ref = kind.reference_normal(f);
             let jn: f64 = {
                 let tn: Vec<f64> = (0..3)
-                    .map(|a| {
-                        (0..10)
-                            .map(|j| x[j][a] * (0..3).map(|bb| dphi[j][bb] * n_ref[bb]).sum::<f64>())
-                            .sum()
-                    })
+                    .map(|a| (0..10).map(|j| x[j][a] * (0..3).map(|bb| dphi[j][bb] * n_ref[bb]).sum::<f64>()).sum())
                     .collect();
                 tn.iter().zip(&cross).map(|(p, q)| p * q).sum()
             };
@@ -216,14 +188,7 @@ fn p2_tetrahedron_stiffness_is_symmetric_with_six_rigid_modes() {
     let tab = Tabulation::<3, 10>::cell(ElementKind::TetrahedronP2, 4).unwrap();
     for bulge in [0.0, 0.15] {
         let coords = tetrahedron(bulge);
-        let k = cell_matrix(
-            &Stiffness::new(&p, &coefs(3)),
-            &tab,
-            &coords,
-            &[&[[0.0; 3]; 10]],
-            0,
-            0.0,
-        );
+        let k = cell_matrix(&Stiffness::new(&p, &coefs(3)), &tab, &coords, &[&[[0.0; 3]; 10]], 0, 0.0);
         check_symmetric_with_rigid_modes(&k, &coords);
     }
 }

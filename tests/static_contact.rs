@@ -20,11 +20,7 @@ fn methods() -> Vec<(ContactMethod, f64)> {
 }
 
 fn run(contact: ContactMethod, theta: f64, f: impl FnOnce(&mut Options)) -> static_block::Summary {
-    let mut o = Options {
-        contact,
-        theta,
-        ..Options::default()
-    };
+    let mut o = Options { contact, theta, ..Options::default() };
     f(&mut o);
     static_block::run(&o).unwrap_or_else(|e| panic!("{contact:?} θ = {theta}: {e}"))
 }
@@ -45,15 +41,8 @@ fn contact_resultant_equals_the_weight_in_2d_and_3d() {
                 s.contact_force,
                 s.weight
             );
-            assert!(
-                s.newton_iterations <= 10,
-                "{contact:?} θ = {theta}, {dim}D: {} iterations",
-                s.newton_iterations
-            );
-            assert_eq!(
-                s.symbolic_factorizations, 1,
-                "{contact:?} θ = {theta}, {dim}D P{degree}"
-            );
+            assert!(s.newton_iterations <= 10, "{contact:?} θ = {theta}, {dim}D: {} iterations", s.newton_iterations);
+            assert_eq!(s.symbolic_factorizations, 1, "{contact:?} θ = {theta}, {dim}D P{degree}");
         }
     }
 }
@@ -61,14 +50,9 @@ fn contact_resultant_equals_the_weight_in_2d_and_3d() {
 #[test]
 fn penetration_decreases_under_refinement() {
     for (contact, theta) in methods() {
-        let p: Vec<f64> = [0.25, 0.125, 0.0625]
-            .iter()
-            .map(|&h| run(contact, theta, |o| o.h = h).max_penetration)
-            .collect();
-        assert!(
-            p[0] > p[1] && p[1] > p[2] && p[2] > 0.0,
-            "{contact:?} θ = {theta}: {p:?}"
-        );
+        let p: Vec<f64> =
+            [0.25, 0.125, 0.0625].iter().map(|&h| run(contact, theta, |o| o.h = h).max_penetration).collect();
+        assert!(p[0] > p[1] && p[1] > p[2] && p[2] > 0.0, "{contact:?} θ = {theta}: {p:?}");
     }
 }
 
@@ -77,25 +61,12 @@ fn on_a_curved_obstacle_newton_finds_a_partial_contact_zone() {
     for (contact, theta) in methods() {
         let s = run(contact, theta, |o| o.curvature = 0.5);
         let rel = (s.contact_force - s.weight).abs() / s.weight;
-        assert!(
-            rel < 1e-8,
-            "{contact:?} θ = {theta}: force {} vs weight {}",
-            s.contact_force,
-            s.weight
-        );
+        assert!(rel < 1e-8, "{contact:?} θ = {theta}: force {} vs weight {}", s.contact_force, s.weight);
         let points = 2 * 8 * 4; // bottom facets × Gauss points
-        assert!(
-            s.active_points > 0 && s.active_points < points / 2,
-            "{} of {points} points active",
-            s.active_points
-        );
+        assert!(s.active_points > 0 && s.active_points < points / 2, "{} of {points} points active", s.active_points);
         // From the all-active start, semi-smooth Newton releases the edges a few points at a
         // time: more iterations than on the plane, but a bounded number.
-        assert!(
-            s.newton_iterations <= 20,
-            "{contact:?} θ = {theta}: {} iterations",
-            s.newton_iterations
-        );
+        assert!(s.newton_iterations <= 20, "{contact:?} θ = {theta}: {} iterations", s.newton_iterations);
     }
 }
 
@@ -104,10 +75,7 @@ fn on_a_curved_obstacle_newton_finds_a_partial_contact_zone() {
 #[test]
 fn factorization_is_reused_while_the_active_set_is_unchanged() {
     let mesh = static_block::mesh(&Options::default()).unwrap();
-    let p = nitsche::Params::default()
-        .with("E", 100.0)
-        .and_then(|p| p.with("gamma0", 5000.0))
-        .unwrap();
+    let p = nitsche::Params::default().with("E", 100.0).and_then(|p| p.with("gamma0", 5000.0)).unwrap();
     let c = nitsche::Coefficients {
         f: Coef::constant(vec![0.0, -1.0]),
         g: Coef::function(1, |x, _, o| o[0] = x[1] + 0.5 * x[0] * x[0]),
@@ -121,10 +89,7 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
         form: nitsche::Contact::new(&p, &c),
         region: "Gamma_C".into(),
         facets: asm.region("bottom").unwrap(),
-        quadrature: Quadrature {
-            cell: None,
-            facet: Some(7),
-        },
+        quadrature: Quadrature { cell: None, facet: Some(7) },
     };
     let mut constraints = Constraints::none(n);
     let centre = (0..mesh.num_nodes()).find(|&i| mesh.node(i) == [0.0, 0.0]).unwrap();
@@ -145,19 +110,13 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
     let first = newton.solve(&mut problem, &mut u).unwrap();
     let after_first = newton.counters();
     assert_eq!(after_first.symbolic, 1);
-    assert_eq!(
-        after_first.numeric,
-        first.history.iter().filter(|i| i.refactored).count()
-    );
+    assert_eq!(after_first.numeric, first.history.iter().filter(|i| i.refactored).count());
     problem.set_load(load.iter().map(|l| 1.01 * l).collect());
     let second = newton.solve(&mut problem, &mut u).unwrap();
     let after_second = newton.counters();
     assert_eq!(second.iterations(), 1, "{second:?}");
     assert!(!second.history[0].refactored);
-    assert_eq!(
-        after_second.numeric, after_first.numeric,
-        "refactored although the active set did not change"
-    );
+    assert_eq!(after_second.numeric, after_first.numeric, "refactored although the active set did not change");
     assert_eq!(after_second.symbolic, 1);
 }
 
@@ -168,10 +127,7 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
 fn newton_failures_are_typed_errors_with_history() {
     use signorini::cases::CaseError;
     use signorini::runtime::newton::NewtonError;
-    let mut o = Options {
-        curvature: 0.5,
-        ..Options::default()
-    };
+    let mut o = Options { curvature: 0.5, ..Options::default() };
     o.newton.max_iterations = 2;
     match static_block::run(&o) {
         Err(CaseError::Newton(NewtonError::IterationLimit { report, threshold })) => {

@@ -26,22 +26,14 @@ fn nitsche(theta: f64, gamma0: f64, e: f64, nu: f64, d: usize) -> contact_nitsch
         .and_then(|p| p.with("E", e))
         .and_then(|p| p.with("nu", nu))
         .unwrap();
-    let c = contact_nitsche::Coefficients {
-        f: Coef::constant(vec![0.0; d]),
-        g: gap(d),
-        nc: down(d),
-    };
+    let c = contact_nitsche::Coefficients { f: Coef::constant(vec![0.0; d]), g: gap(d), nc: down(d) };
     c.check(d).unwrap();
     contact_nitsche::Contact::new(&p, &c)
 }
 
 fn penalty(gamma0: f64, d: usize) -> contact_penalty::Contact {
     let p = contact_penalty::Params::default().with("gamma0", gamma0).unwrap();
-    let c = contact_penalty::Coefficients {
-        f: Coef::constant(vec![0.0; d]),
-        g: gap(d),
-        nc: down(d),
-    };
+    let c = contact_penalty::Coefficients { f: Coef::constant(vec![0.0; d]), g: gap(d), nc: down(d) };
     contact_penalty::Contact::new(&p, &c)
 }
 
@@ -112,20 +104,14 @@ fn check_2d<K: FormKernel<2, 6>>(k: &K, what: &str) {
     for trial in 0..5 {
         let u = state_2d(&mut rng, 0.0);
         let err = fd_error(k, &tab, &x, &u);
-        assert!(
-            err < 1e-6,
-            "{what}, trial {trial}: tangent differs from finite differences by {err:e}"
-        );
+        assert!(err < 1e-6, "{what}, trial {trial}: tangent differs from finite differences by {err:e}");
         // Mixed active set: the tangent differs from both the all-active state (pushed into
         // the obstacle) and the all-inactive one (lifted off it).
         let mixed = tangent(k, &tab, &x, &u);
         let all_in = tangent(k, &tab, &x, &u.map(|n| [n[0], n[1] - 10.0]));
         let all_out = tangent(k, &tab, &x, &u.map(|n| [n[0], n[1] + 10.0]));
         let differ = |a: &[Vec<f64>], b: &[Vec<f64>]| {
-            a.iter()
-                .flatten()
-                .zip(b.iter().flatten())
-                .any(|(p, q)| (p - q).abs() > 1e-8)
+            a.iter().flatten().zip(b.iter().flatten()).any(|(p, q)| (p - q).abs() > 1e-8)
         };
         assert!(
             differ(&mixed, &all_in) && differ(&mixed, &all_out),
@@ -155,26 +141,16 @@ fn check_1d<K: FormKernel<1, 2>>(k: &K, what: &str) {
     for trial in 0..40 {
         let u = [[0.1 * rng.next()], [0.1 * rng.next()]];
         let err = fd_error(k, &tab, &x, &u);
-        assert!(
-            err < 1e-6,
-            "{what}, trial {trial}: tangent differs from finite differences by {err:e}"
-        );
+        assert!(err < 1e-6, "{what}, trial {trial}: tangent differs from finite differences by {err:e}");
         let j = tangent(k, &tab, &x, &u);
         let j_far = tangent(k, &tab, &x, &[[10.0], [10.0]]);
-        if j.iter()
-            .flatten()
-            .zip(j_far.iter().flatten())
-            .any(|(p, q)| (p - q).abs() > 1e-8)
-        {
+        if j.iter().flatten().zip(j_far.iter().flatten()).any(|(p, q)| (p - q).abs() > 1e-8) {
             active += 1;
         } else {
             inactive += 1;
         }
     }
-    assert!(
-        active > 5 && inactive > 5,
-        "{what}: {active} active and {inactive} inactive states"
-    );
+    assert!(active > 5 && inactive > 5, "{what}: {active} active and {inactive} inactive states");
 }
 
 #[test]
@@ -220,10 +196,7 @@ fn one_dimensional_contact_residual_is_the_spec_kernel() {
         let u = [[0.05 * rng.next()], [0.05 * rng.next()]];
         let got = facet_vector(&k, 0, &tab, 0, &x, h, &[&u], 0.0);
         let expect = gamma * u[0][0].min(0.0);
-        assert!(
-            (got[0][0] - expect).abs() < 1e-12 && got[1][0] == 0.0,
-            "penalty: {got:?} vs {expect}"
-        );
+        assert!((got[0][0] - expect).abs() < 1e-12 && got[1][0] == 0.0, "penalty: {got:?} vs {expect}");
     }
 }
 
@@ -232,15 +205,8 @@ fn one_dimensional_contact_residual_is_the_spec_kernel() {
 #[test]
 fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
     use signorini::runtime::kernel::Form;
-    let p = hybrid_contact::Params::default()
-        .with("gamma0", 5.0)
-        .and_then(|p| p.with("nu", 0.3))
-        .unwrap();
-    let c = hybrid_contact::Coefficients {
-        f: Coef::constant(vec![0.0; 2]),
-        g: gap(2),
-        nc: down(2),
-    };
+    let p = hybrid_contact::Params::default().with("gamma0", 5.0).and_then(|p| p.with("nu", 0.3)).unwrap();
+    let c = hybrid_contact::Coefficients { f: Coef::constant(vec![0.0; 2]), g: gap(2), nc: down(2) };
     let k = hybrid_contact::HybridContact::new(&p, &c);
     assert_eq!(hybrid_contact::HybridContact::META.fields, &["u0", "u1"]);
     const { assert!(!hybrid_contact::HybridContact::META.linear) };
@@ -286,19 +252,7 @@ fn equal_switches_mean_equal_tangents() {
     let switches = |u: &[[f64; 2]; 6]| {
         let (ftab, normal) = &tab.facets[0];
         let mut s = Vec::new();
-        k.facet_switches(
-            0,
-            &FacetCtx {
-                tab: ftab,
-                ref_normal: normal,
-                coords: &x,
-                h,
-                t: 0.0,
-            },
-            &[u],
-            0,
-            &mut s,
-        );
+        k.facet_switches(0, &FacetCtx { tab: ftab, ref_normal: normal, coords: &x, h, t: 0.0 }, &[u], 0, &mut s);
         s
     };
     let mut rng = Rng(99);

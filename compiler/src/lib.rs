@@ -31,12 +31,8 @@ impl std::fmt::Display for Failure {
 /// Checks a unit; on success returns the program and its rendered warnings.
 pub fn check_path(path: &Path, loader: &dyn Loader) -> Result<(Program, String), Failure> {
     match check_file(path, loader) {
-        Err(io) => Err(Failure {
-            rendered: format!("error: {io}\n"),
-        }),
-        Ok(Err((diags, sources))) => Err(Failure {
-            rendered: render_all(&diags, &sources),
-        }),
+        Err(io) => Err(Failure { rendered: format!("error: {io}\n") }),
+        Ok(Err((diags, sources))) => Err(Failure { rendered: render_all(&diags, &sources) }),
         Ok(Ok(prog)) => {
             let warnings = render_all(&prog.warnings, &prog.sources);
             Ok((prog, warnings))
@@ -47,24 +43,17 @@ pub fn check_path(path: &Path, loader: &dyn Loader) -> Result<(Program, String),
 /// Compiles a unit to formatted Rust (the module named after the file stem).
 pub fn compile_to_rust(path: &Path, loader: &dyn Loader, runtime: &str) -> Result<String, Failure> {
     let (prog, _) = check_path(path, loader)?;
-    let opts = codegen::Options {
-        runtime: runtime.to_string(),
-        module: module_name(path),
-        source_name: display_name(path),
-    };
-    codegen::generate_pretty(&prog, &opts).map_err(|e| Failure {
-        rendered: format!("error: {e}\n"),
-    })
+    let opts =
+        codegen::Options { runtime: runtime.to_string(), module: module_name(path), source_name: display_name(path) };
+    codegen::generate_pretty(&prog, &opts).map_err(|e| Failure { rendered: format!("error: {e}\n") })
 }
 
 /// The default module name of a .wf file: its stem.
 pub fn module_name(path: &Path) -> String {
-    path.file_stem()
-        .map_or_else(|| "forms".to_string(), |s| s.to_string_lossy().into_owned())
+    path.file_stem().map_or_else(|| "forms".to_string(), |s| s.to_string_lossy().into_owned())
 }
 
 /// The file name shown in generated documentation (no machine-specific directories).
 pub fn display_name(path: &Path) -> String {
-    path.file_name()
-        .map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned())
+    path.file_name().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned())
 }

@@ -12,9 +12,7 @@ fn library() -> Vec<PathBuf> {
             continue;
         };
         files.extend(
-            entries
-                .map(|e| e.expect("readable entry").path())
-                .filter(|p| p.extension().is_some_and(|e| e == "wf")),
+            entries.map(|e| e.expect("readable entry").path()).filter(|p| p.extension().is_some_and(|e| e == "wf")),
         );
     }
     files.sort();
@@ -60,11 +58,7 @@ fn ast_ir_and_scheme_snapshots() {
         let params: Vec<String> = prog.params.iter().map(|p| p.name.clone()).collect();
         let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
         let ir_text = ir::print::print(&ir::build(&prog, 2), &params, &coefs);
-        let schemes: Vec<String> = prog
-            .schemes
-            .iter()
-            .map(signorini_compiler::scheme::print::print)
-            .collect();
+        let schemes: Vec<String> = prog.schemes.iter().map(signorini_compiler::scheme::print::print).collect();
         insta::with_settings!({ snapshot_path => "snapshots/stages", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(format!("{}.ast", stem(&f)), ast_text);
             insta::assert_snapshot!(format!("{}.ir2d", stem(&f)), ir_text);

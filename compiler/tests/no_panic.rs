@@ -27,11 +27,8 @@ fn run(text: &str, loader: &MemLoader) {
             assert!(rendered.contains("error["));
         }
         Ok(prog) => {
-            let opts = codegen::Options {
-                runtime: "::rt".into(),
-                module: "fuzz".into(),
-                source_name: "fuzz.wf".into(),
-            };
+            let opts =
+                codegen::Options { runtime: "::rt".into(), module: "fuzz".into(), source_name: "fuzz.wf".into() };
             if let Err(e) = codegen::generate(&prog, &opts) {
                 panic!("valid input generated bad code: {e}\ninput:\n{text}");
             }
@@ -189,8 +186,5 @@ fn pathological_inputs_are_refused_cleanly() {
     run(&format!("let a = {}", vec!["x"; 3000].join(" + ")), &loader);
     run(&format!("let a = {}1{}", "(".repeat(10000), ")".repeat(10000)), &loader);
     run("form f(u; v) = int(Omega) dot(u, v) * 1e308 * 1e308 / 0", &loader);
-    run(
-        "fn f(a) = g(a)\nfn g(a) = f(a)\nform k(u; v) = int(Omega) f(1) * dot(u, v)",
-        &loader,
-    );
+    run("fn f(a) = g(a)\nfn g(a) = f(a)\nform k(u; v) = int(Omega) f(1) * dot(u, v)", &loader);
 }

@@ -98,12 +98,7 @@ impl Pattern {
                 }
             }
         }
-        Pattern {
-            dim: d,
-            col_ptr,
-            row_idx,
-            cell_offsets,
-        }
+        Pattern { dim: d, col_ptr, row_idx, cell_offsets }
     }
 
     /// Number of rows (= columns).
@@ -154,24 +149,15 @@ pub struct Quadrature {
 
 impl Quadrature {
     pub fn degrees(cell: u32, facet: u32) -> Self {
-        Quadrature {
-            cell: Some(cell),
-            facet: Some(facet),
-        }
+        Quadrature { cell: Some(cell), facet: Some(facet) }
     }
 
     fn cell_degree<K: Form>(&self, kind: ElementKind) -> u32 {
-        self.cell
-            .unwrap_or_else(|| K::META.cell_degree.map_or(1, |d| d[kind.degree() as usize - 1]))
+        self.cell.unwrap_or_else(|| K::META.cell_degree.map_or(1, |d| d[kind.degree() as usize - 1]))
     }
 
     fn facet_degree<K: Form>(&self, kind: ElementKind, region: usize) -> u32 {
-        self.facet.unwrap_or_else(|| {
-            K::META
-                .facets
-                .get(region)
-                .map_or(1, |(_, d)| d[kind.degree() as usize - 1])
-        })
+        self.facet.unwrap_or_else(|| K::META.facets.get(region).map_or(1, |(_, d)| d[kind.degree() as usize - 1]))
     }
 }
 
@@ -183,10 +169,7 @@ pub struct Assembler<'m> {
 
 impl<'m> Assembler<'m> {
     pub fn new(mesh: &'m Mesh) -> Self {
-        Assembler {
-            mesh,
-            pattern: Arc::new(Pattern::new(mesh)),
-        }
+        Assembler { mesh, pattern: Arc::new(Pattern::new(mesh)) }
     }
 
     /// Number of dofs.
@@ -207,10 +190,7 @@ impl<'m> Assembler<'m> {
     /// Adds the volume part of `k`'s tangent with respect to field `wrt` to `m`.
     pub fn cell_tangent<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
         let degree = q.cell_degree::<K>(self.mesh.kind);
-        dispatch!(
-            self.mesh.kind,
-            cell_tangent::<K>(self.mesh, &self.pattern, k, degree, fields, wrt, t, &mut m.values)
-        )
+        dispatch!(self.mesh.kind, cell_tangent::<K>(self.mesh, &self.pattern, k, degree, fields, wrt, t, &mut m.values))
     }
 
     /// Adds the residual of `k`'s integral over `region` (a name of `K::META.facets`) on the
@@ -228,10 +208,7 @@ impl<'m> Assembler<'m> {
     ) {
         let Some(r) = region_index::<K>(region) else { return };
         let degree = q.facet_degree::<K>(self.mesh.kind, r);
-        dispatch!(
-            self.mesh.kind,
-            facet_residual::<K>(self.mesh, k, r, facets, degree, fields, t, out)
-        )
+        dispatch!(self.mesh.kind, facet_residual::<K>(self.mesh, k, r, facets, degree, fields, t, out))
     }
 
     /// Adds the tangent of `k`'s integral over `region` on `facets` to `m`.
@@ -251,18 +228,7 @@ impl<'m> Assembler<'m> {
         let degree = q.facet_degree::<K>(self.mesh.kind, r);
         dispatch!(
             self.mesh.kind,
-            facet_tangent::<K>(
-                self.mesh,
-                &self.pattern,
-                k,
-                r,
-                facets,
-                degree,
-                fields,
-                wrt,
-                t,
-                &mut m.values
-            )
+            facet_tangent::<K>(self.mesh, &self.pattern, k, r, facets, degree, fields, wrt, t, &mut m.values)
         )
     }
 
@@ -281,10 +247,7 @@ impl<'m> Assembler<'m> {
     ) {
         let Some(r) = region_index::<K>(region) else { return };
         let degree = q.facet_degree::<K>(self.mesh.kind, r);
-        dispatch!(
-            self.mesh.kind,
-            facet_switches::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, out)
-        )
+        dispatch!(self.mesh.kind, facet_switches::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, out))
     }
 
     /// Facets of a named mesh region.
@@ -342,17 +305,7 @@ fn cell_residual<const D: usize, const N: usize, K: FormKernel<D, N>>(
         let coords = mesh.cell_coords::<D, N>(c);
         gather(cell, fields, &mut local);
         let mut re = [[0.0; D]; N];
-        with_refs(&local, |refs| {
-            k.cell_residual(
-                &CellCtx {
-                    tab: &tab,
-                    coords: &coords,
-                    t,
-                },
-                refs,
-                &mut re,
-            )
-        });
+        with_refs(&local, |refs| k.cell_residual(&CellCtx { tab: &tab, coords: &coords, t }, refs, &mut re));
         add_local(cell, &re, out);
     }
 }
@@ -386,18 +339,7 @@ fn cell_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
         let coords = mesh.cell_coords::<D, N>(c);
         gather(cell, fields, &mut local);
         *ke = [[[[0.0; D]; N]; D]; N];
-        with_refs(&local, |refs| {
-            k.cell_tangent(
-                &CellCtx {
-                    tab: &tab,
-                    coords: &coords,
-                    t,
-                },
-                refs,
-                wrt,
-                &mut ke,
-            )
-        });
+        with_refs(&local, |refs| k.cell_tangent(&CellCtx { tab: &tab, coords: &coords, t }, refs, wrt, &mut ke));
         pattern.scatter(c, cell, &ke, values);
     }
 }
@@ -410,13 +352,7 @@ fn facet_ctx<'a, const D: usize, const N: usize>(
     t: f64,
 ) -> FacetCtx<'a, D, N> {
     let (tab, ref_normal) = &tabs.facets[f.local as usize];
-    FacetCtx {
-        tab,
-        ref_normal,
-        coords,
-        h: mesh.cell_diameter(f.cell as usize),
-        t,
-    }
+    FacetCtx { tab, ref_normal, coords, h: mesh.cell_diameter(f.cell as usize), t }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -438,9 +374,7 @@ fn facet_residual<const D: usize, const N: usize, K: FormKernel<D, N>>(
         let coords = mesh.cell_coords::<D, N>(c);
         gather(cell, fields, &mut local);
         let mut re = [[0.0; D]; N];
-        with_refs(&local, |refs| {
-            k.facet_residual(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, &mut re)
-        });
+        with_refs(&local, |refs| k.facet_residual(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, &mut re));
         add_local(cell, &re, out);
     }
 }
@@ -467,9 +401,7 @@ fn facet_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
         let coords = mesh.cell_coords::<D, N>(c);
         gather(cell, fields, &mut local);
         *ke = [[[[0.0; D]; N]; D]; N];
-        with_refs(&local, |refs| {
-            k.facet_tangent(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, &mut ke)
-        });
+        with_refs(&local, |refs| k.facet_tangent(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, &mut ke));
         pattern.scatter(c, cell, &ke, values);
     }
 }
@@ -492,8 +424,6 @@ fn facet_switches<const D: usize, const N: usize, K: FormKernel<D, N>>(
         let c = f.cell as usize;
         let coords = mesh.cell_coords::<D, N>(c);
         gather(mesh.cell(c), fields, &mut local);
-        with_refs(&local, |refs| {
-            k.facet_switches(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, out)
-        });
+        with_refs(&local, |refs| k.facet_switches(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, out));
     }
 }

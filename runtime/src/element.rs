@@ -78,12 +78,7 @@ impl ElementKind {
         match self.dim() {
             1 => vec![vec![0.0], vec![1.0]],
             2 => vec![vec![0.0, 0.0], vec![1.0, 0.0], vec![0.0, 1.0]],
-            _ => vec![
-                vec![0.0, 0.0, 0.0],
-                vec![1.0, 0.0, 0.0],
-                vec![0.0, 1.0, 0.0],
-                vec![0.0, 0.0, 1.0],
-            ],
+            _ => vec![vec![0.0, 0.0, 0.0], vec![1.0, 0.0, 0.0], vec![0.0, 1.0, 0.0], vec![0.0, 0.0, 1.0]],
         }
     }
 
@@ -163,9 +158,8 @@ impl ElementKind {
             ElementKind::IntervalP1 | ElementKind::TriangleP1 | ElementKind::TetrahedronP1 => dl,
             ElementKind::TriangleP2 | ElementKind::TetrahedronP2 => {
                 let edges: &[[usize; 2]] = if d == 2 { &TRIANGLE_EDGES } else { &TET_EDGES };
-                let mut g: Vec<Vec<f64>> = (0..=d)
-                    .map(|i| dl[i].iter().map(|x| (4.0 * l[i] - 1.0) * x).collect())
-                    .collect();
+                let mut g: Vec<Vec<f64>> =
+                    (0..=d).map(|i| dl[i].iter().map(|x| (4.0 * l[i] - 1.0) * x).collect()).collect();
                 for &[a, b] in edges {
                     g.push((0..d).map(|k| 4.0 * (dl[a][k] * l[b] + l[a] * dl[b][k])).collect());
                 }
@@ -189,16 +183,11 @@ impl ElementKind {
             }
             _ => {
                 let (a, b, c) = (&v[f[0]], &v[f[1]], &v[f[2]]);
-                let p = (0..3)
-                    .map(|k| a[k] + s[0] * (b[k] - a[k]) + s[1] * (c[k] - a[k]))
-                    .collect();
+                let p = (0..3).map(|k| a[k] + s[0] * (b[k] - a[k]) + s[1] * (c[k] - a[k])).collect();
                 let e1: Vec<f64> = (0..3).map(|k| b[k] - a[k]).collect();
                 let e2: Vec<f64> = (0..3).map(|k| c[k] - a[k]).collect();
-                let cross = [
-                    e1[1] * e2[2] - e1[2] * e2[1],
-                    e1[2] * e2[0] - e1[0] * e2[2],
-                    e1[0] * e2[1] - e1[1] * e2[0],
-                ];
+                let cross =
+                    [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
                 (p, cross.iter().map(|x| x * x).sum::<f64>().sqrt())
             }
         }
@@ -277,14 +266,7 @@ mod tests {
                     let dist: f64 = nodes[i].iter().zip(v0).zip(&n).map(|((x, y), nn)| (x - y) * nn).sum();
                     assert!(dist.abs() < 1e-14);
                 }
-                assert_eq!(
-                    kind.facet_nodes(f).len(),
-                    if kind.degree() == 1 {
-                        kind.dim()
-                    } else {
-                        3 * kind.dim() - 3
-                    }
-                );
+                assert_eq!(kind.facet_nodes(f).len(), if kind.degree() == 1 { kind.dim() } else { 3 * kind.dim() - 3 });
             }
         }
     }

@@ -43,11 +43,7 @@ fn samples<const D: usize, const N: usize>(
                     value[k] += phi[j] * field[cell[j] as usize * D + k];
                 }
             }
-            out.push(FacetSample {
-                x: x.to_vec(),
-                value,
-                weight: tab.weights[q] * scale,
-            });
+            out.push(FacetSample { x: x.to_vec(), value, weight: tab.weights[q] * scale });
         }
     }
     out

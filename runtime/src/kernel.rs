@@ -60,11 +60,7 @@ impl<const D: usize, const N: usize> Tabulation<D, N> {
     /// Tabulates `kind` at the points of a rule on the reference cell.
     pub fn new(kind: ElementKind, rule: &Rule) -> Result<Self, ShapeError> {
         check_kind::<D, N>(kind)?;
-        let mut t = Tabulation {
-            weights: rule.weights.clone(),
-            phi: Vec::new(),
-            dphi: Vec::new(),
-        };
+        let mut t = Tabulation { weights: rule.weights.clone(), phi: Vec::new(), dphi: Vec::new() };
         for p in &rule.points {
             t.push(kind, p);
         }
@@ -80,8 +76,7 @@ impl<const D: usize, const N: usize> Tabulation<D, N> {
         let phi = kind.basis(xi);
         let grads = kind.basis_gradients(xi);
         self.phi.push(std::array::from_fn(|j| phi[j]));
-        self.dphi
-            .push(std::array::from_fn(|j| std::array::from_fn(|k| grads[j][k])));
+        self.dphi.push(std::array::from_fn(|j| std::array::from_fn(|k| grads[j][k])));
     }
 
     pub fn len(&self) -> usize {
@@ -105,11 +100,7 @@ impl<const D: usize, const N: usize> FacetTabulation<D, N> {
         check_kind::<D, N>(kind)?;
         let facets = (0..kind.facets().len())
             .map(|f| {
-                let mut t = Tabulation {
-                    weights: Vec::new(),
-                    phi: Vec::new(),
-                    dphi: Vec::new(),
-                };
+                let mut t = Tabulation { weights: Vec::new(), phi: Vec::new(), dphi: Vec::new() };
                 for (s, w) in rule.points.iter().zip(&rule.weights) {
                     let (xi, scale) = kind.facet_point(f, s);
                     t.weights.push(w * scale);
@@ -162,10 +153,7 @@ impl Coef {
 
     /// `f(x, t, out)` writes the `components` values at position `x` and time `t`.
     pub fn function(components: usize, f: impl Fn(&[f64], f64, &mut [f64]) + Send + Sync + 'static) -> Self {
-        Coef::Function {
-            components,
-            f: Arc::new(f),
-        }
+        Coef::Function { components, f: Arc::new(f) }
     }
 
     pub fn components(&self) -> usize {
@@ -213,15 +201,8 @@ pub fn check_coef(name: &str, coef: &Coef, shape_rank: u32, dim: usize) -> Resul
 /// A parameter value refused by a generated `Params`.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ParamError {
-    Unknown {
-        name: String,
-        known: &'static [&'static str],
-    },
-    OutOfRange {
-        name: &'static str,
-        value: f64,
-        range: String,
-    },
+    Unknown { name: String, known: &'static [&'static str] },
+    OutOfRange { name: &'static str, value: f64, range: String },
 }
 
 impl fmt::Display for ParamError {
@@ -260,11 +241,7 @@ impl ParamRange {
 impl fmt::Display for ParamRange {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let b = |v: f64| {
-            if v.is_infinite() {
-                if v > 0.0 { "inf".to_string() } else { "-inf".to_string() }
-            } else {
-                format!("{v}")
-            }
+            if v.is_infinite() { if v > 0.0 { "inf".to_string() } else { "-inf".to_string() } } else { format!("{v}") }
         };
         write!(
             f,
@@ -282,11 +259,7 @@ pub fn check_param(range: &ParamRange, value: f64) -> Result<f64, ParamError> {
     if range.contains(value) {
         Ok(value)
     } else {
-        Err(ParamError::OutOfRange {
-            name: range.name,
-            value,
-            range: range.to_string(),
-        })
+        Err(ParamError::OutOfRange { name: range.name, value, range: range.to_string() })
     }
 }
 
@@ -401,18 +374,7 @@ pub fn facet_vector<const D: usize, const N: usize, K: FormKernel<D, N>>(
 ) -> LocalVector<D, N> {
     let (ftab, normal) = &tab.facets[facet];
     let mut out = [[0.0; D]; N];
-    k.facet_residual(
-        region,
-        &FacetCtx {
-            tab: ftab,
-            ref_normal: normal,
-            coords,
-            h,
-            t,
-        },
-        fields,
-        &mut out,
-    );
+    k.facet_residual(region, &FacetCtx { tab: ftab, ref_normal: normal, coords, h, t }, fields, &mut out);
     out
 }
 
@@ -431,19 +393,7 @@ pub fn facet_matrix<const D: usize, const N: usize, K: FormKernel<D, N>>(
 ) -> Vec<Vec<f64>> {
     let (ftab, normal) = &tab.facets[facet];
     let mut out = Box::new([[[[0.0; D]; N]; D]; N]);
-    k.facet_tangent(
-        region,
-        &FacetCtx {
-            tab: ftab,
-            ref_normal: normal,
-            coords,
-            h,
-            t,
-        },
-        fields,
-        wrt,
-        &mut out,
-    );
+    k.facet_tangent(region, &FacetCtx { tab: ftab, ref_normal: normal, coords, h, t }, fields, wrt, &mut out);
     flatten(&out)
 }
 

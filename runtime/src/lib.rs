@@ -27,3 +27,4 @@ pub mod mesh;
 pub mod newton;
 pub mod problem;
 pub mod quadrature;
+pub mod scheme;

@@ -110,16 +110,8 @@ pub struct Counters {
 
 enum Factors {
     None,
-    Llt {
-        symbolic: SymbolicCholesky<usize>,
-        values: Vec<f64>,
-        factored: bool,
-    },
-    Lu {
-        symbolic: SymbolicLu<usize>,
-        numeric: NumericLu<usize, f64>,
-        factored: bool,
-    },
+    Llt { symbolic: SymbolicCholesky<usize>, values: Vec<f64>, factored: bool },
+    Lu { symbolic: SymbolicLu<usize>, numeric: NumericLu<usize, f64>, factored: bool },
 }
 
 /// A reusable sparse factorization.
@@ -135,13 +127,7 @@ pub struct Factorization {
 impl Factorization {
     /// Sequential by default, so results do not depend on the number of threads.
     pub fn new(structure: Structure) -> Self {
-        Factorization {
-            structure,
-            factors: Factors::None,
-            pattern: None,
-            par: Par::Seq,
-            counters: Counters::default(),
-        }
+        Factorization { structure, factors: Factors::None, pattern: None, par: Par::Seq, counters: Counters::default() }
     }
 
     /// Uses `threads` threads (0: all) in factorizations and solves.
@@ -166,20 +152,12 @@ impl Factorization {
                     let symbolic =
                         cholesky::factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
                             .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
-                    Factors::Llt {
-                        values: vec![0.0; symbolic.len_val()],
-                        symbolic,
-                        factored: false,
-                    }
+                    Factors::Llt { values: vec![0.0; symbolic.len_val()], symbolic, factored: false }
                 }
                 Structure::General => {
                     let symbolic = lu::factorize_symbolic_lu(sym, Default::default())
                         .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
-                    Factors::Lu {
-                        symbolic,
-                        numeric: NumericLu::new(),
-                        factored: false,
-                    }
+                    Factors::Lu { symbolic, numeric: NumericLu::new(), factored: false }
                 }
             };
             self.pattern = Some(a.pattern.clone());
@@ -189,11 +167,7 @@ impl Factorization {
         let par = self.par;
         self.counters.numeric += 1;
         match &mut self.factors {
-            Factors::Llt {
-                symbolic,
-                values,
-                factored,
-            } => {
+            Factors::Llt { symbolic, values, factored } => {
                 *factored = false;
                 let req = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
                 let mut mem = MemBuffer::try_new(req).map_err(|_| LinalgError::Other("out of memory".into()))?;
@@ -214,22 +188,18 @@ impl Factorization {
                     })?;
                 *factored = true;
             }
-            Factors::Lu {
-                symbolic,
-                numeric,
-                factored,
-            } => {
+            Factors::Lu { symbolic, numeric, factored } => {
                 *factored = false;
                 let req = symbolic.factorize_numeric_lu_scratch::<f64>(par, Default::default());
                 let mut mem = MemBuffer::try_new(req).map_err(|_| LinalgError::Other("out of memory".into()))?;
-                symbolic
-                    .factorize_numeric_lu(numeric, mat, par, MemStack::new(&mut mem), Default::default())
-                    .map_err(|e| match e {
+                symbolic.factorize_numeric_lu(numeric, mat, par, MemStack::new(&mut mem), Default::default()).map_err(
+                    |e| match e {
                         faer::sparse::linalg::LuError::SymbolicSingular { index } => {
                             LinalgError::Singular { index: Some(index) }
                         }
                         other => LinalgError::Other(format!("{other:?}")),
-                    })?;
+                    },
+                )?;
                 *factored = true;
             }
             Factors::None => unreachable!("symbolic analysis done above"),
@@ -244,19 +214,11 @@ impl Factorization {
         let par = self.par;
         let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
         match &self.factors {
-            Factors::Llt {
-                symbolic,
-                values,
-                factored: true,
-            } => {
+            Factors::Llt { symbolic, values, factored: true } => {
                 let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
                 LltRef::new(symbolic, values).solve_in_place_with_conj(Conj::No, rhs, par, MemStack::new(&mut mem));
             }
-            Factors::Lu {
-                symbolic,
-                numeric,
-                factored: true,
-            } => {
+            Factors::Lu { symbolic, numeric, factored: true } => {
                 let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
                 LuRef::new_unchecked(symbolic, numeric).solve_in_place_with_conj(
                     Conj::No,
@@ -268,10 +230,6 @@ impl Factorization {
             _ => return Err(LinalgError::NotFactored),
         }
         self.counters.solves += 1;
-        if b.iter().all(|v| v.is_finite()) {
-            Ok(())
-        } else {
-            Err(LinalgError::Singular { index: None })
-        }
+        if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(LinalgError::Singular { index: None }) }
     }
 }

@@ -41,11 +41,7 @@ pub struct NewtonOptions {
 
 impl Default for NewtonOptions {
     fn default() -> Self {
-        NewtonOptions {
-            tol: 1e-10,
-            max_iterations: 25,
-            line_search: false,
-        }
+        NewtonOptions { tol: 1e-10, max_iterations: 25, line_search: false }
     }
 }
 
@@ -95,12 +91,7 @@ pub struct Newton {
 
 impl Newton {
     pub fn new(options: NewtonOptions) -> Self {
-        Newton {
-            options,
-            factorization: None,
-            jacobian: None,
-            factored_for: None,
-        }
+        Newton { options, factorization: None, jacobian: None, factored_for: None }
     }
 
     /// Forgets the factorization's validity (the linear part of the problem changed).
@@ -122,10 +113,7 @@ impl Newton {
         let mut set = Vec::new();
         p.residual(w, &mut r);
         let r0 = norm_inf(&r);
-        let mut report = NewtonReport {
-            initial_residual: r0,
-            history: Vec::new(),
-        };
+        let mut report = NewtonReport { initial_residual: r0, history: Vec::new() };
         if !r0.is_finite() {
             return Err(NewtonError::NonFinite { report });
         }
@@ -157,28 +145,13 @@ impl Newton {
             let linear = jd.iter().zip(&r).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(&r);
             if linear.is_nan() || linear > LINEAR_TOLERANCE {
                 let source = LinalgError::Singular { index: None };
-                debug!(
-                    linear_residual = linear,
-                    "the Jacobian is singular to working precision"
-                );
+                debug!(linear_residual = linear, "the Jacobian is singular to working precision");
                 return Err(NewtonError::Linear { source, report });
             }
             let step = self.step(p, w, &delta, &mut r);
             res = norm_inf(&r);
-            debug!(
-                iteration = report.history.len() + 1,
-                residual = res,
-                active,
-                refactored = refactor,
-                step,
-                "newton"
-            );
-            report.history.push(Iteration {
-                residual: res,
-                active,
-                refactored: refactor,
-                step,
-            });
+            debug!(iteration = report.history.len() + 1, residual = res, active, refactored = refactor, step, "newton");
+            report.history.push(Iteration { residual: res, active, refactored: refactor, step });
             if !res.is_finite() || w.iter().any(|x| !x.is_finite()) {
                 return Err(NewtonError::NonFinite { report });
             }
@@ -191,9 +164,7 @@ impl Newton {
         let j = self.jacobian.get_or_insert_with(|| p.jacobian_matrix());
         j.values.iter_mut().for_each(|v| *v = 0.0);
         p.jacobian(w, j);
-        let f = self
-            .factorization
-            .get_or_insert_with(|| Factorization::new(p.structure()));
+        let f = self.factorization.get_or_insert_with(|| Factorization::new(p.structure()));
         match f.factor(j) {
             Err(LinalgError::NotPositiveDefinite { .. }) if f.structure() == Structure::SymmetricPositiveDefinite => {
                 debug!("Jacobian not positive definite: switching to LU");
@@ -210,19 +181,12 @@ impl Newton {
 
     /// Takes the step (with backtracking if enabled); leaves R at the new iterate in `r`.
     fn step(&self, p: &mut impl NonlinearProblem, w: &mut [f64], delta: &[f64], r: &mut [f64]) -> f64 {
-        let start: Vec<f64> = if self.options.line_search {
-            w.to_vec()
-        } else {
-            Vec::new()
-        };
+        let start: Vec<f64> = if self.options.line_search { w.to_vec() } else { Vec::new() };
         let norm0 = if self.options.line_search { norm2(r) } else { 0.0 };
         let mut alpha = 1.0;
         loop {
             if self.options.line_search {
-                w.iter_mut()
-                    .zip(&start)
-                    .zip(delta)
-                    .for_each(|((x, s), d)| *x = s + alpha * d);
+                w.iter_mut().zip(&start).zip(delta).for_each(|((x, s), d)| *x = s + alpha * d);
             } else {
                 w.iter_mut().zip(delta).for_each(|(x, d)| *x += d);
             }

@@ -16,10 +16,7 @@ pub struct Constraints {
 
 impl Constraints {
     pub fn none(size: usize) -> Self {
-        Constraints {
-            fixed: vec![false; size],
-            values: vec![0.0; size],
-        }
+        Constraints { fixed: vec![false; size], values: vec![0.0; size] }
     }
 
     /// Holds `dof` at zero.
@@ -62,20 +59,12 @@ impl Constraints {
     }
 
     pub fn dofs(&self) -> Vec<usize> {
-        self.fixed
-            .iter()
-            .enumerate()
-            .filter(|(_, f)| **f)
-            .map(|(i, _)| i)
-            .collect()
+        self.fixed.iter().enumerate().filter(|(_, f)| **f).map(|(i, _)| i).collect()
     }
 
     /// Zeroes the constrained entries of a vector.
     pub fn zero(&self, v: &mut [f64]) {
-        v.iter_mut()
-            .zip(&self.fixed)
-            .filter(|(_, f)| **f)
-            .for_each(|(x, _)| *x = 0.0);
+        v.iter_mut().zip(&self.fixed).filter(|(_, f)| **f).for_each(|(x, _)| *x = 0.0);
     }
 
     /// Replaces constrained rows and columns by the identity.
@@ -145,15 +134,7 @@ impl<'m, C: Kernel> StaticContact<'m, C> {
         let mut load = load;
         constraints.zero(&mut load);
         let load_scale = crate::newton::norm_inf(&load);
-        StaticContact {
-            asm,
-            stiffness: k,
-            load,
-            load_scale,
-            contact,
-            constraints,
-            structure,
-        }
+        StaticContact { asm, stiffness: k, load, load_scale, contact, constraints, structure }
     }
 
     /// Replaces the loads (the stiffness, and so a factorization, stay valid).
@@ -167,8 +148,7 @@ impl<'m, C: Kernel> StaticContact<'m, C> {
     pub fn contact_residual(&self, u: &[f64]) -> Vec<f64> {
         let mut c = vec![0.0; u.len()];
         let t = &self.contact;
-        self.asm
-            .facet_residual(&t.form, &t.region, t.facets, t.quadrature, &[u], 0.0, &mut c);
+        self.asm.facet_residual(&t.form, &t.region, t.facets, t.quadrature, &[u], 0.0, &mut c);
         c
     }
 }
@@ -177,8 +157,7 @@ impl<C: Kernel> NonlinearProblem for StaticContact<'_, C> {
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
         self.stiffness.mul_vec(u, r);
         let t = &self.contact;
-        self.asm
-            .facet_residual(&t.form, &t.region, t.facets, t.quadrature, &[u], 0.0, r);
+        self.asm.facet_residual(&t.form, &t.region, t.facets, t.quadrature, &[u], 0.0, r);
         r.iter_mut().zip(&self.load).for_each(|(ri, li)| *ri -= li);
         self.constraints.zero(r);
     }
@@ -189,16 +168,14 @@ impl<C: Kernel> NonlinearProblem for StaticContact<'_, C> {
 
     fn active_set(&mut self, u: &[f64], out: &mut Vec<bool>) -> bool {
         let t = &self.contact;
-        self.asm
-            .facet_switches(&t.form, &t.region, t.facets, t.quadrature, &[u], 0, 0.0, out);
+        self.asm.facet_switches(&t.form, &t.region, t.facets, t.quadrature, &[u], 0, 0.0, out);
         C::META.piecewise
     }
 
     fn jacobian(&mut self, u: &[f64], j: &mut Matrix) {
         j.values.copy_from_slice(&self.stiffness.values);
         let t = &self.contact;
-        self.asm
-            .facet_tangent(&t.form, &t.region, t.facets, t.quadrature, &[u], 0, 0.0, j);
+        self.asm.facet_tangent(&t.form, &t.region, t.facets, t.quadrature, &[u], 0, 0.0, j);
         self.constraints.apply(j);
     }
 

@@ -25,11 +25,7 @@ impl Rule {
 /// The rule of at least `degree` on the reference simplex of dimension `dim` (0: a point).
 pub fn simplex_rule(dim: usize, degree: u32) -> Rule {
     match dim {
-        0 => Rule {
-            points: vec![vec![]],
-            weights: vec![1.0],
-            degree: u32::MAX,
-        },
+        0 => Rule { points: vec![vec![]], weights: vec![1.0], degree: u32::MAX },
         1 => gauss_legendre(degree as usize / 2 + 1),
         2 => triangle(degree),
         _ => tetrahedron(degree),
@@ -62,11 +58,7 @@ pub fn gauss_legendre(n: usize) -> Rule {
     // Increasing order of the points.
     points.reverse();
     weights.reverse();
-    Rule {
-        points,
-        weights,
-        degree: (2 * n - 1) as u32,
-    }
+    Rule { points, weights, degree: (2 * n - 1) as u32 }
 }
 
 /// P_n(x) and P_n'(x).
@@ -86,11 +78,7 @@ fn legendre(n: usize, x: f64) -> (f64, f64) {
 }
 
 fn triangle(degree: u32) -> Rule {
-    let mut r = Rule {
-        points: Vec::new(),
-        weights: Vec::new(),
-        degree,
-    };
+    let mut r = Rule { points: Vec::new(), weights: Vec::new(), degree };
     // Orbits of barycentric coordinates with weights normalised to area 1/2.
     let mut s3 = |a: f64, w: f64| {
         let b = 1.0 - 2.0 * a;
@@ -101,11 +89,7 @@ fn triangle(degree: u32) -> Rule {
     };
     match degree {
         0 | 1 => {
-            return Rule {
-                points: vec![vec![1.0 / 3.0, 1.0 / 3.0]],
-                weights: vec![0.5],
-                degree: 1,
-            };
+            return Rule { points: vec![vec![1.0 / 3.0, 1.0 / 3.0]], weights: vec![0.5], degree: 1 };
         }
         2 => s3(1.0 / 6.0, 1.0 / 3.0),
         3 | 4 => {
@@ -116,11 +100,7 @@ fn triangle(degree: u32) -> Rule {
         5 | 6 => {
             s3(0.249_286_745_170_910_4, 0.116_786_275_726_379_4);
             s3(0.063_089_014_491_502_23, 0.050_844_906_370_206_82);
-            let (a, b, w) = (
-                0.053_145_049_844_816_95,
-                0.310_352_451_033_784_4,
-                0.082_851_075_618_373_58,
-            );
+            let (a, b, w) = (0.053_145_049_844_816_95, 0.310_352_451_033_784_4, 0.082_851_075_618_373_58);
             let c = 1.0 - a - b;
             for p in [[a, b], [b, a], [a, c], [c, a], [b, c], [c, b]] {
                 r.points.push(p.to_vec());
@@ -137,11 +117,7 @@ fn triangle(degree: u32) -> Rule {
 fn collapsed_triangle(degree: u32) -> Rule {
     let n = (degree as usize + 2).div_ceil(2);
     let g = gauss_legendre(n);
-    let mut r = Rule {
-        points: Vec::new(),
-        weights: Vec::new(),
-        degree,
-    };
+    let mut r = Rule { points: Vec::new(), weights: Vec::new(), degree };
     for (pa, wa) in g.points.iter().zip(&g.weights) {
         for (pb, wb) in g.points.iter().zip(&g.weights) {
             let (a, b) = (pa[0], pb[0]);
@@ -154,30 +130,18 @@ fn collapsed_triangle(degree: u32) -> Rule {
 
 fn tetrahedron(degree: u32) -> Rule {
     match degree {
-        0 | 1 => Rule {
-            points: vec![vec![0.25; 3]],
-            weights: vec![1.0 / 6.0],
-            degree: 1,
-        },
+        0 | 1 => Rule { points: vec![vec![0.25; 3]], weights: vec![1.0 / 6.0], degree: 1 },
         2 => {
             let a = (5.0 - 5f64.sqrt()) / 20.0;
             let b = (5.0 + 3.0 * 5f64.sqrt()) / 20.0;
             let points = vec![vec![a, a, a], vec![b, a, a], vec![a, b, a], vec![a, a, b]];
-            Rule {
-                points,
-                weights: vec![1.0 / 24.0; 4],
-                degree: 2,
-            }
+            Rule { points, weights: vec![1.0 / 24.0; 4], degree: 2 }
         }
         _ => {
             // x = a, y = b(1 − a), z = c(1 − a)(1 − b); Jacobian (1 − a)²(1 − b).
             let n = (degree as usize + 3).div_ceil(2);
             let g = gauss_legendre(n);
-            let mut r = Rule {
-                points: Vec::new(),
-                weights: Vec::new(),
-                degree,
-            };
+            let mut r = Rule { points: Vec::new(), weights: Vec::new(), degree };
             for (pa, wa) in g.points.iter().zip(&g.weights) {
                 for (pb, wb) in g.points.iter().zip(&g.weights) {
                     for (pc, wc) in g.points.iter().zip(&g.weights) {
@@ -208,10 +172,7 @@ mod tests {
     fn exponents(dim: usize, max: u32) -> Vec<Vec<u32>> {
         let mut out = vec![vec![]];
         for _ in 0..dim {
-            out = out
-                .into_iter()
-                .flat_map(|e| (0..=max).map(move |k| [e.clone(), vec![k]].concat()))
-                .collect();
+            out = out.into_iter().flat_map(|e| (0..=max).map(move |k| [e.clone(), vec![k]].concat())).collect();
         }
         out.into_iter().filter(|e| e.iter().sum::<u32>() <= max).collect()
     }

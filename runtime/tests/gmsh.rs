@@ -8,9 +8,7 @@ use signorini_runtime::mesh::{Mesh, MeshError, gmsh};
 
 /// A reference mesh of `../shared/meshes` (beside the clone, in CI too).
 fn shared(name: &str) -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/meshes")
-        .join(name);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes").join(name);
     assert!(
         p.exists(),
         "{} is missing: the reference meshes live in ../shared/meshes beside the repository",
@@ -85,54 +83,31 @@ fn malformed_files_fail_with_position_and_reason() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gmsh_bad");
     let expected: &[(&str, &str)] = &[
         ("binary_22.msh", ":2: MSH 2.2 binary files are not supported"),
-        (
-            "boundary_element_not_a_facet.msh",
-            ":17: element 1 is not a boundary facet of any cell",
-        ),
+        ("boundary_element_not_a_facet.msh", ":17: element 1 is not a boundary facet of any cell"),
         ("degenerate_cell.msh", ":19: element 3: cell 1 is degenerate"),
         ("empty.msh", ":1: not a Gmsh mesh"),
         ("huge_count.msh", ":14: expected a node tag, found `$EndNodes`"),
         ("inverted_p2_cell.msh", ":15: element 1: cell 0 is inverted"),
         ("missing_end_nodes.msh", ":14: expected `$EndNodes`, found `$Elements`"),
         ("mixed_cell_types.msh", ":20: mixed cell types (2 and 9)"),
-        (
-            "node_count_too_large.msh",
-            ":14: expected a node tag, found `$EndNodes` (a count does not match the data)",
-        ),
+        ("node_count_too_large.msh", ":14: expected a node tag, found `$EndNodes` (a count does not match the data)"),
         ("node_count_too_small.msh", ":13: expected `$EndNodes`, found `4 0 1 0`"),
-        (
-            "node_out_of_range.msh",
-            ":19: element 3 refers to node 9, which is not in `$Nodes`",
-        ),
+        ("node_out_of_range.msh", ":19: element 3 refers to node 9, which is not in `$Nodes`"),
         ("non_finite_coordinate.msh", ":12: y is not finite"),
         ("not_a_number.msh", ":12: expected y (a number), found `one`"),
         ("not_gmsh.msh", ":1: expected a section such as `$Nodes`"),
         ("not_planar.msh", ":13: a 2D mesh must lie in the plane"),
         ("repeated_node_tag.msh", ":13: node tag 3 is repeated"),
-        (
-            "truncated_nodes.msh",
-            ":12: unexpected end of file: expected a node tag",
-        ),
+        ("truncated_nodes.msh", ":12: unexpected end of file: expected a node tag"),
         ("unknown_element_type.msh", ":19: unknown element type 99"),
         ("unknown_version.msh", ":2: unsupported MSH version 3.0"),
-        (
-            "v41_binary_bad_endianness.msh",
-            "at byte 20: the endianness check is not the integer 1",
-        ),
+        ("v41_binary_bad_endianness.msh", "at byte 20: the endianness check is not the integer 1"),
         ("v41_binary_truncated.msh", "at byte 195: unexpected end of file"),
-        (
-            "v41_block_count_mismatch.msh",
-            ":9: the header announces 5 nodes, the blocks hold 4",
-        ),
-        (
-            "v41_element_dimension_mismatch.msh",
-            ":22: element type 2 has dimension 2, but its block says 3",
-        ),
+        ("v41_block_count_mismatch.msh", ":9: the header announces 5 nodes, the blocks hold 4"),
+        ("v41_element_dimension_mismatch.msh", ":22: element type 2 has dimension 2, but its block says 3"),
     ];
-    let mut files: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
+    let mut files: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     files.sort();
     assert!(files.len() >= 15);
     assert_eq!(

@@ -68,10 +68,6 @@ fn disc_is_curved_p2_with_its_boundary_on_the_circle() {
     }
     let contact = m.region("contact").unwrap();
     assert_eq!(contact.facets.len(), 30);
-    let lowest = m
-        .region_nodes(contact)
-        .iter()
-        .map(|&n| m.node(n as usize)[1])
-        .fold(f64::INFINITY, f64::min);
+    let lowest = m.region_nodes(contact).iter().map(|&n| m.node(n as usize)[1]).fold(f64::INFINITY, f64::min);
     assert!(close(lowest, 2.0, 1e-12));
 }

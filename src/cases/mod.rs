@@ -1,5 +1,7 @@
 //! Built-in cases (`signorini run NAME`).
 
+pub mod bar;
+pub mod exact;
 pub mod static_block;
 
 /// Why a case did not run.

@@ -111,10 +111,7 @@ pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
         }
         3 => {
             if !(1..=2).contains(&opts.degree) {
-                return Err(CaseError::Option(format!(
-                    "--degree must be 1 or 2, not {}",
-                    opts.degree
-                )));
+                return Err(CaseError::Option(format!("--degree must be 1 or 2, not {}", opts.degree)));
             }
             let m = 2 * n(0.5);
             structured::cuboid([m, m, n(1.0)], [-0.5, 0.5], [-0.5, 0.5], [0.0, 1.0], opts.degree)
@@ -132,19 +129,12 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
     let d = opts.dim;
     let c = opts.curvature;
     if !(c >= 0.0 && c.is_finite()) {
-        return Err(CaseError::Option(format!(
-            "--curvature must be a finite number ≥ 0, not {c}"
-        )));
+        return Err(CaseError::Option(format!("--curvature must be a finite number ≥ 0, not {c}")));
     }
-    let gap = Coef::function(1, move |x, _, out| {
-        out[0] = x[d - 1] + c * x[..d - 1].iter().map(|v| v * v).sum::<f64>()
-    });
+    let gap = Coef::function(1, move |x, _, out| out[0] = x[d - 1] + c * x[..d - 1].iter().map(|v| v * v).sum::<f64>());
     let down = Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>());
-    let force = Coef::constant(
-        (0..d)
-            .map(|k| if k == d - 1 { -opts.density * opts.gravity } else { 0.0 })
-            .collect::<Vec<_>>(),
-    );
+    let force =
+        Coef::constant((0..d).map(|k| if k == d - 1 { -opts.density * opts.gravity } else { 0.0 }).collect::<Vec<_>>());
     let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
     let mut summary = match opts.contact {
         ContactMethod::Nitsche => {
@@ -155,17 +145,9 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
                 .and_then(|p| p.with("gamma0", opts.gamma0))
                 .and_then(|p| p.with("theta", opts.theta))
                 .map_err(bad)?;
-            let c = nitsche::Coefficients {
-                f: force,
-                g: gap,
-                nc: down,
-            };
+            let c = nitsche::Coefficients { f: force, g: gap, nc: down };
             // θ = 1 gives a symmetric tangent (Cholesky; LU if γ0 is too small for coercivity).
-            let structure = if opts.theta == 1.0 {
-                Structure::SymmetricPositiveDefinite
-            } else {
-                Structure::General
-            };
+            let structure = if opts.theta == 1.0 { Structure::SymmetricPositiveDefinite } else { Structure::General };
             solve(
                 opts,
                 &mesh,
@@ -182,11 +164,7 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
                 .and_then(|p| p.with("rho", opts.density))
                 .and_then(|p| p.with("gamma0", opts.gamma0))
                 .map_err(bad)?;
-            let c = penalty::Coefficients {
-                f: force,
-                g: gap,
-                nc: down,
-            };
+            let c = penalty::Coefficients { f: force, g: gap, nc: down };
             let structure = Structure::SymmetricPositiveDefinite;
             solve(
                 opts,
@@ -201,10 +179,8 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
     summary.wall_seconds = start.elapsed().as_secs_f64();
     if let Some(dir) = &opts.out {
         let path = dir.join("summary.json");
-        crate::output::write_json(&path, &summary).map_err(|source| CaseError::Write {
-            path: path.display().to_string(),
-            source,
-        })?;
+        crate::output::write_json(&path, &summary)
+            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
     }
     Ok(summary)
 }
@@ -226,32 +202,18 @@ fn solve<S: Kernel, L: Kernel, C: Kernel>(
     let facets = asm.region("bottom")?;
     // Four Gauss points per edge in 2D, a degree-4 rule on faces in 3D: exact for the smooth
     // parts, and resolves the edge of the contact zone.
-    let contact_quad = Quadrature {
-        cell: None,
-        facet: Some(if d == 2 { 7 } else { 4 }),
-    };
-    let term = ContactTerm {
-        form: contact,
-        region: "Gamma_C".into(),
-        facets,
-        quadrature: contact_quad,
-    };
+    let contact_quad = Quadrature { cell: None, facet: Some(if d == 2 { 7 } else { 4 }) };
+    let term = ContactTerm { form: contact, region: "Gamma_C".into(), facets, quadrature: contact_quad };
     let constraints = sliding_constraints(mesh);
     let mut problem = StaticContact::new(&asm, stiffness, quad, l, term, constraints, structure);
     // Start with the block pushed into the obstacle below its largest gap, so that every contact
     // point is active and the first Jacobian is not singular (at u = 0 the block would float,
     // or pivot on one point of a curved obstacle: H(0) = 0). Newton then releases points.
     let gap = |x: &[f64]| x[d - 1] + opts.curvature * x[..d - 1].iter().map(|v| v * v).sum::<f64>();
-    let deepest = mesh
-        .region_nodes(mesh.region("bottom")?)
-        .iter()
-        .map(|&i| gap(mesh.node(i as usize)))
-        .fold(0.0, f64::max);
+    let deepest =
+        mesh.region_nodes(mesh.region("bottom")?).iter().map(|&i| gap(mesh.node(i as usize))).fold(0.0, f64::max);
     let mut u = vec![0.0; n];
-    u.iter_mut()
-        .skip(d - 1)
-        .step_by(d)
-        .for_each(|x| *x = -(deepest + 1e-6 * opts.h));
+    u.iter_mut().skip(d - 1).step_by(d).for_each(|x| *x = -(deepest + 1e-6 * opts.h));
     problem.constraints.zero(&mut u);
     let mut newton = Newton::new(opts.newton);
     let report = newton.solve(&mut problem, &mut u)?;
@@ -259,10 +221,7 @@ fn solve<S: Kernel, L: Kernel, C: Kernel>(
     let c = problem.contact_residual(&u);
     let contact_force = -c.iter().skip(d - 1).step_by(d).sum::<f64>();
     let samples = facet_samples(mesh, facets, contact_quad.facet.unwrap_or(4), &u);
-    let max_penetration = samples
-        .iter()
-        .map(|s| (-s.value[d - 1] - gap(&s.x)).max(0.0))
-        .fold(0.0, f64::max);
+    let max_penetration = samples.iter().map(|s| (-s.value[d - 1] - gap(&s.x)).max(0.0)).fold(0.0, f64::max);
     let mut set = Vec::new();
     use crate::runtime::newton::NonlinearProblem;
     problem.active_set(&u, &mut set);

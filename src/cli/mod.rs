@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+use crate::cases::bar::{self, SchemeChoice};
 use crate::cases::static_block::{self, ContactMethod};
 use crate::compiler::{self, FsLoader};
 
@@ -83,6 +84,33 @@ pub enum MeshCommand {
 pub enum Case {
     /// An elastic block resting on a rigid plane under its own weight (static contact).
     StaticBlock(StaticBlockArgs),
+    /// The compressed 1D bar against its exact solution (spec §6.1).
+    Bar(BarArgs),
+}
+
+#[derive(clap::Args)]
+pub struct BarArgs {
+    #[arg(long, value_enum, default_value_t = SchemeChoice::Newmark)]
+    scheme: SchemeChoice,
+    /// HHT's α (talk's convention, in [0, 1/3]); default 0.05.
+    #[arg(long)]
+    alpha: Option<f64>,
+    #[arg(long, value_enum, default_value_t = ContactMethod::Nitsche)]
+    contact: ContactMethod,
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    theta: f64,
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
+    gamma0: f64,
+    /// Number of elements.
+    #[arg(long, default_value_t = 20)]
+    ne: usize,
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
+    dt: f64,
+    #[arg(long, default_value_t = 12.0, allow_hyphen_values = true)]
+    t_end: f64,
+    /// Directory for series.csv and summary.json.
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -127,21 +155,12 @@ pub fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Check { files } => check(&files),
         Command::Emit { file, stage, dim } => emit(&file, stage, dim as usize),
-        Command::Run {
-            case: Case::StaticBlock(a),
-        } => static_block(a),
-        Command::Mesh {
-            command: MeshCommand::Info { file },
-        } => mesh_info(&file),
-        Command::Bench {
-            what:
-                BenchCommand::Assemble {
-                    sizes,
-                    factor,
-                    repeats,
-                    out,
-                },
-        } => bench_assemble(&sizes, factor, repeats, &out),
+        Command::Run { case: Case::StaticBlock(a) } => static_block(a),
+        Command::Run { case: Case::Bar(a) } => run_bar(a),
+        Command::Mesh { command: MeshCommand::Info { file } } => mesh_info(&file),
+        Command::Bench { what: BenchCommand::Assemble { sizes, factor, repeats, out } } => {
+            bench_assemble(&sizes, factor, repeats, &out)
+        }
     }
 }
 
@@ -179,12 +198,7 @@ fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
             let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
             Ok(compiler::ir::print::print(&ir, &params, &coefs))
         }
-        Stage::Scheme => Ok(prog
-            .schemes
-            .iter()
-            .map(compiler::scheme::print::print)
-            .collect::<Vec<_>>()
-            .join("\n")),
+        Stage::Scheme => Ok(prog.schemes.iter().map(compiler::scheme::print::print).collect::<Vec<_>>().join("\n")),
         Stage::Rust => {
             let opts = compiler::codegen::Options {
                 runtime: compiler::codegen::DEFAULT_RUNTIME.to_string(),
@@ -215,10 +229,7 @@ fn static_block(a: StaticBlockArgs) -> ExitCode {
         degree: a.degree as u32,
         h: a.h,
         curvature: a.curvature,
-        newton: crate::runtime::newton::NewtonOptions {
-            line_search: a.line_search,
-            ..Default::default()
-        },
+        newton: crate::runtime::newton::NewtonOptions { line_search: a.line_search, ..Default::default() },
         out: a.out,
         ..Default::default()
     };
@@ -245,11 +256,8 @@ fn mesh_info(file: &Path) -> ExitCode {
                 .iter()
                 .map(|r| (r.name.clone(), serde_json::json!({ "facets": r.facets.len() })))
                 .collect();
-            let groups: serde_json::Map<String, serde_json::Value> = mesh
-                .cell_groups
-                .iter()
-                .map(|(n, c)| (n.clone(), serde_json::json!({ "cells": c.len() })))
-                .collect();
+            let groups: serde_json::Map<String, serde_json::Value> =
+                mesh.cell_groups.iter().map(|(n, c)| (n.clone(), serde_json::json!({ "cells": c.len() }))).collect();
             let info = serde_json::json!({
                 "file": file.display().to_string(),
                 "dimension": mesh.dim(),
@@ -276,9 +284,7 @@ fn bench_assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) ->
         eprintln!("error: --sizes must lie in 1..=2048");
         return ExitCode::FAILURE;
     }
-    let report = crate::bench::assemble(sizes, (factor > 0).then_some(factor), repeats, &mut |line| {
-        println!("{line}")
-    });
+    let report = crate::bench::assemble(sizes, (factor > 0).then_some(factor), repeats, &mut |line| println!("{line}"));
     let path = out.join("bench_assemble.json");
     match crate::output::write_json(&path, &report) {
         Ok(()) => {
@@ -287,6 +293,46 @@ fn bench_assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) ->
         }
         Err(e) => {
             eprintln!("error: cannot write {}: {e}", path.display());
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run_bar(a: BarArgs) -> ExitCode {
+    let opts = bar::Options {
+        scheme: a.scheme,
+        alpha: a.alpha,
+        contact: a.contact,
+        theta: a.theta,
+        gamma0: a.gamma0,
+        elements: a.ne,
+        dt: a.dt,
+        t_end: a.t_end,
+        out: a.out,
+        ..Default::default()
+    };
+    match bar::run(&opts) {
+        Ok(r) => {
+            let s = &r.summary;
+            println!(
+                "bar: {} {:?} θ = {}, {} steps: err_u {:.4}, err_λ {:.4}, E_Θ {:.6} → {:.6}, penetration {:.3e}, Newton {} (max {}), {:.2} s",
+                s.scheme.name(),
+                s.contact,
+                s.theta,
+                s.steps,
+                s.err_linf_l2_u,
+                s.err_l2_lambda,
+                s.energy_aug_initial,
+                s.energy_aug_final,
+                s.max_penetration,
+                s.newton_total,
+                s.newton_max,
+                s.wall_seconds
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
             ExitCode::FAILURE
         }
     }

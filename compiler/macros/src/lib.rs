@@ -23,22 +23,14 @@ struct Input {
 impl Parse for Input {
     fn parse(input: ParseStream) -> syn::Result<Self> {
         if input.peek(LitStr) {
-            return Ok(Input {
-                vis: Visibility::Inherited,
-                name: None,
-                path: input.parse()?,
-            });
+            return Ok(Input { vis: Visibility::Inherited, name: None, path: input.parse()? });
         }
         let vis: Visibility = input.parse()?;
         input.parse::<Token![mod]>()?;
         let name: Ident = input.parse()?;
         input.parse::<Token![=]>()?;
         let path = input.parse()?;
-        Ok(Input {
-            vis,
-            name: Some(name),
-            path,
-        })
+        Ok(Input { vis, name: Some(name), path })
     }
 }
 
@@ -57,10 +49,7 @@ fn forms_tokens(input: proc_macro2::TokenStream) -> proc_macro2::TokenStream {
     match std::panic::catch_unwind(|| expand(&input)) {
         Ok(Ok(tokens)) => tokens,
         Ok(Err(msg)) => error(span, &msg),
-        Err(_) => error(
-            span,
-            "internal error in the signorini compiler (please report it with the .wf file)",
-        ),
+        Err(_) => error(span, "internal error in the signorini compiler (please report it with the .wf file)"),
     }
 }
 
@@ -70,9 +59,7 @@ fn error(span: Span, msg: &str) -> proc_macro2::TokenStream {
 }
 
 fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
-    let manifest = std::env::var("CARGO_MANIFEST_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_default();
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").map(PathBuf::from).unwrap_or_default();
     let rel = input.path.value();
     let path = manifest.join(&rel);
     let (prog, _warnings) = check_path(&path, &FsLoader).map_err(|f| f.rendered)?;
@@ -80,20 +67,14 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
         Some(n) => n.to_string(),
         None => signorini_compiler::module_name(Path::new(&rel)),
     };
-    let opts = codegen::Options {
-        runtime: codegen::DEFAULT_RUNTIME.to_string(),
-        module,
-        source_name: rel.clone(),
-    };
+    let opts = codegen::Options { runtime: codegen::DEFAULT_RUNTIME.to_string(), module, source_name: rel.clone() };
     let mut file = codegen::generate(&prog, &opts)?;
     if let Some(syn::Item::Mod(m)) = file.items.first_mut() {
         if input.name.is_some() {
             m.vis = input.vis.clone();
         }
         // Rebuild when any file of the unit changes.
-        let deps: Vec<String> = (0..prog.sources.len())
-            .map(|f| prog.sources.path(f).display().to_string())
-            .collect();
+        let deps: Vec<String> = (0..prog.sources.len()).map(|f| prog.sources.path(f).display().to_string()).collect();
         let track: syn::Item = syn::parse_quote! {
             const _: &[&[u8]] = &[#(include_bytes!(#deps)),*];
         };
@@ -118,10 +99,7 @@ mod tests {
 
     #[test]
     fn a_bad_file_becomes_compile_error_with_the_rendered_diagnostic() {
-        let path = temp_file(
-            "bad.wf",
-            "param E = 1.0\nform k(u; v) = int(Omega) inner(grd(u), grad(v)) * E\n",
-        );
+        let path = temp_file("bad.wf", "param E = 1.0\nform k(u; v) = int(Omega) inner(grd(u), grad(v)) * E\n");
         let lit = path.display().to_string();
         let out = forms_tokens(quote!(#lit)).to_string();
         assert!(out.starts_with("compile_error !"), "{out}");
@@ -132,10 +110,7 @@ mod tests {
 
     #[test]
     fn a_good_file_becomes_a_module_that_tracks_its_sources() {
-        let path = temp_file(
-            "good.wf",
-            "param rho = 2.0\nform mass(a; v) = int(Omega) rho * dot(a, v)\n",
-        );
+        let path = temp_file("good.wf", "param rho = 2.0\nform mass(a; v) = int(Omega) rho * dot(a, v)\n");
         let lit = path.display().to_string();
         let out = forms_tokens(quote!(pub mod named = #lit)).to_string();
         assert!(out.contains("pub mod named {"), "{out}");

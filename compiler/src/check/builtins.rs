@@ -6,23 +6,8 @@ use crate::syntax::ast::Shape;
 pub const BUILTIN_VALUES: &[&str] = &["I", "n", "h", "x", "t", "pi", "inf"];
 
 /// Built-in functions.
-pub const BUILTIN_FUNCTIONS: &[&str] = &[
-    "grad",
-    "div",
-    "sym",
-    "tr",
-    "transpose",
-    "dot",
-    "inner",
-    "outer",
-    "pos",
-    "neg",
-    "H",
-    "min",
-    "max",
-    "abs",
-    "sqrt",
-];
+pub const BUILTIN_FUNCTIONS: &[&str] =
+    &["grad", "div", "sym", "tr", "transpose", "dot", "inner", "outer", "pos", "neg", "H", "min", "max", "abs", "sqrt"];
 
 /// Functions of one scalar that are not linear, so a test function must not appear inside.
 pub const NONLINEAR: &[&str] = &["pos", "neg", "H", "min", "max", "abs", "sqrt"];
@@ -51,23 +36,13 @@ pub fn result_shape(name: &str, args: &[Shape]) -> Result<Shape, String> {
         ("dot", [Vector, Vector]) => Ok(Scalar),
         ("dot", [Tensor, Vector] | [Vector, Tensor]) => Ok(Vector),
         ("dot", [Tensor, Tensor]) => Ok(Tensor),
-        ("dot", [a, b]) => Err(format!(
-            "dot takes vectors or tensors, not a {} and a {}",
-            a.name(),
-            b.name()
-        )),
+        ("dot", [a, b]) => Err(format!("dot takes vectors or tensors, not a {} and a {}", a.name(), b.name())),
         ("inner", [a, b]) if a == b => Ok(Scalar),
-        ("inner", [a, b]) => Err(format!(
-            "inner takes two arguments of the same shape, not a {} and a {}",
-            a.name(),
-            b.name()
-        )),
+        ("inner", [a, b]) => {
+            Err(format!("inner takes two arguments of the same shape, not a {} and a {}", a.name(), b.name()))
+        }
         ("outer", [Vector, Vector]) => Ok(Tensor),
-        ("outer", [a, b]) => Err(format!(
-            "outer takes two vectors, not a {} and a {}",
-            a.name(),
-            b.name()
-        )),
+        ("outer", [a, b]) => Err(format!("outer takes two vectors, not a {} and a {}", a.name(), b.name())),
         ("pos" | "neg" | "H" | "abs" | "sqrt", [Scalar]) => Ok(Scalar),
         ("min" | "max", [Scalar, Scalar]) => Ok(Scalar),
         (_, shapes) => {

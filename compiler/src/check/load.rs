@@ -17,39 +17,19 @@ pub struct Loaded {
 /// Reads and parses `root` and everything it imports. Syntax errors do not stop loading.
 pub fn load(root: &Path, loader: &dyn Loader, diags: &mut Vec<Diagnostic>) -> Result<Loaded, String> {
     let root = normalize(root);
-    let text = loader
-        .load(&root)
-        .map_err(|e| format!("cannot read {}: {e}", root.display()))?;
-    let mut l = Loader_ {
-        loader,
-        sources: SourceMap::default(),
-        files: Vec::new(),
-        stack: Vec::new(),
-    };
+    let text = loader.load(&root).map_err(|e| format!("cannot read {}: {e}", root.display()))?;
+    let mut l = Loader_ { loader, sources: SourceMap::default(), files: Vec::new(), stack: Vec::new() };
     let root_id = l.sources.add(root.clone(), text);
     l.visit(root_id, diags);
-    Ok(Loaded {
-        sources: l.sources,
-        files: l.files,
-        root: root_id,
-    })
+    Ok(Loaded { sources: l.sources, files: l.files, root: root_id })
 }
 
 /// Parses a single in-memory text as a unit whose imports resolve through `loader`.
 pub fn load_text(path: &Path, text: &str, loader: &dyn Loader, diags: &mut Vec<Diagnostic>) -> Loaded {
-    let mut l = Loader_ {
-        loader,
-        sources: SourceMap::default(),
-        files: Vec::new(),
-        stack: Vec::new(),
-    };
+    let mut l = Loader_ { loader, sources: SourceMap::default(), files: Vec::new(), stack: Vec::new() };
     let root_id = l.sources.add(normalize(path), text.to_string());
     l.visit(root_id, diags);
-    Loaded {
-        sources: l.sources,
-        files: l.files,
-        root: root_id,
-    }
+    Loaded { sources: l.sources, files: l.files, root: root_id }
 }
 
 struct Loader_<'a> {
@@ -73,13 +53,9 @@ impl Loader_<'_> {
             };
             let target = normalize(&dir.join(rel));
             if let Some(pos) = self.stack.iter().position(|(p, _)| *p == target) {
-                let mut d = Diagnostic::error(
-                    "E0702",
-                    "cyclic import",
-                    *span,
-                    format!("`{}` is already being imported", rel),
-                )
-                .with_note(cycle_note(&self.stack[pos..], &target));
+                let mut d =
+                    Diagnostic::error("E0702", "cyclic import", *span, format!("`{}` is already being imported", rel))
+                        .with_note(cycle_note(&self.stack[pos..], &target));
                 if let Some(first) = self.stack[pos + 1..].iter().find_map(|(_, s)| *s) {
                     d = d.with_label(first, "the cycle starts here");
                 }
@@ -113,6 +89,5 @@ fn cycle_note(stack: &[(PathBuf, Option<Span>)], back: &Path) -> String {
 }
 
 fn file_name(p: &Path) -> String {
-    p.file_name()
-        .map_or_else(|| p.display().to_string(), |f| f.to_string_lossy().into_owned())
+    p.file_name().map_or_else(|| p.display().to_string(), |f| f.to_string_lossy().into_owned())
 }

@@ -250,12 +250,7 @@ fn declare(
             }
             first.insert(name.name.clone(), name.span);
             let global = match item {
-                ast::Item::Param {
-                    name,
-                    default,
-                    range,
-                    span,
-                } => {
+                ast::Item::Param { name, default, range, span } => {
                     prog.params.push(Param {
                         name: name.name.clone(),
                         default: f64::NAN,
@@ -268,32 +263,15 @@ fn declare(
                     Global::Param(prog.params.len() - 1)
                 }
                 ast::Item::Coef { name, shape, span } => {
-                    prog.coefs.push(Coef {
-                        name: name.name.clone(),
-                        shape: *shape,
-                        span: *span,
-                    });
+                    prog.coefs.push(Coef { name: name.name.clone(), shape: *shape, span: *span });
                     Global::Coef(prog.coefs.len() - 1)
                 }
-                ast::Item::Let { value, span, .. } => Global::Let {
-                    value: value.clone(),
-                    span: *span,
-                },
+                ast::Item::Let { value, span, .. } => Global::Let { value: value.clone(), span: *span },
                 ast::Item::Fn { params, body, span, .. } => {
                     check_distinct(params, "parameter", diags);
-                    Global::Fn {
-                        params: params.clone(),
-                        body: body.clone(),
-                        span: *span,
-                    }
+                    Global::Fn { params: params.clone(), body: body.clone(), span: *span }
                 }
-                ast::Item::Form {
-                    name,
-                    fields,
-                    test,
-                    integrals,
-                    span,
-                } => {
+                ast::Item::Form { name, fields, test, integrals, span } => {
                     let mut args = fields.clone();
                     args.push(test.clone());
                     check_distinct(&args, "argument", diags);
@@ -306,15 +284,7 @@ fn declare(
                     });
                     Global::Form(prog.forms.len() - 1)
                 }
-                ast::Item::Scheme {
-                    name,
-                    params,
-                    states,
-                    lets,
-                    initial,
-                    stages,
-                    span,
-                } => {
+                ast::Item::Scheme { name, params, states, lets, initial, stages, span } => {
                     schemes.push(crate::scheme::SchemeDef {
                         name: name.clone(),
                         params: params.clone(),
@@ -338,13 +308,8 @@ fn check_distinct(names: &[Ident], what: &str, diags: &mut Vec<Diagnostic>) {
     for n in names {
         if let Some(prev) = seen.get(n.name.as_str()) {
             diags.push(
-                Diagnostic::error(
-                    "E0103",
-                    format!("duplicate {what} `{}`", n.name),
-                    n.span,
-                    "repeated here",
-                )
-                .with_label(*prev, "first here"),
+                Diagnostic::error("E0103", format!("duplicate {what} `{}`", n.name), n.span, "repeated here")
+                    .with_label(*prev, "first here"),
             );
         } else {
             seen.insert(&n.name, n.span);

@@ -25,30 +25,15 @@ pub struct Ty {
 
 impl Ty {
     fn plain(shape: Shape) -> Ty {
-        Ty {
-            shape,
-            test: false,
-            facet: None,
-            smooth: true,
-            konst: None,
-        }
+        Ty { shape, test: false, facet: None, smooth: true, konst: None }
     }
 
     fn constant(v: f64) -> Ty {
-        Ty {
-            konst: Some(v),
-            ..Ty::plain(Shape::Scalar)
-        }
+        Ty { konst: Some(v), ..Ty::plain(Shape::Scalar) }
     }
 
     fn join(a: &Ty, b: &Ty, shape: Shape) -> Ty {
-        Ty {
-            shape,
-            test: a.test || b.test,
-            facet: a.facet.or(b.facet),
-            smooth: a.smooth && b.smooth,
-            konst: None,
-        }
+        Ty { shape, test: a.test || b.test, facet: a.facet.or(b.facet), smooth: a.smooth && b.smooth, konst: None }
     }
 }
 
@@ -112,12 +97,7 @@ impl<'p> Checker<'p> {
             let range = p.range_expr.as_ref().and_then(|r| {
                 let lo = self.constant(&r.lo, "a range bound")?;
                 let hi = self.constant(&r.hi, "a range bound")?;
-                let range = ParamRange {
-                    lo,
-                    lo_closed: r.lo_closed,
-                    hi,
-                    hi_closed: r.hi_closed,
-                };
+                let range = ParamRange { lo, lo_closed: r.lo_closed, hi, hi_closed: r.hi_closed };
                 if lo > hi || (lo == hi && !(r.lo_closed && r.hi_closed)) {
                     self.error(Diagnostic::error(
                         "E0602",
@@ -176,10 +156,7 @@ impl<'p> Checker<'p> {
                 }
                 Global::Fn { params, body, .. } => {
                     let saved = std::mem::take(&mut self.used_params);
-                    let scope = params
-                        .iter()
-                        .map(|p| (p.name.clone(), Ty::plain(Shape::Vector)))
-                        .collect();
+                    let scope = params.iter().map(|p| (p.name.clone(), Ty::plain(Shape::Vector))).collect();
                     let old = std::mem::replace(&mut self.scope, scope);
                     // Shapes of parameters are unknown here: check names only.
                     self.names_only(body, params);
@@ -221,18 +198,9 @@ impl<'p> Checker<'p> {
 
     pub fn check_forms(&mut self) {
         for form in &self.prog.forms {
-            let mut scope: Vec<(String, Ty)> = form
-                .fields
-                .iter()
-                .map(|f| (f.name.clone(), Ty::plain(Shape::Vector)))
-                .collect();
-            scope.push((
-                form.test.name.clone(),
-                Ty {
-                    test: true,
-                    ..Ty::plain(Shape::Vector)
-                },
-            ));
+            let mut scope: Vec<(String, Ty)> =
+                form.fields.iter().map(|f| (f.name.clone(), Ty::plain(Shape::Vector))).collect();
+            scope.push((form.test.name.clone(), Ty { test: true, ..Ty::plain(Shape::Vector) }));
             self.scope = scope;
             for integral in &form.integrals {
                 let Some(ty) = self.ty(&integral.integrand) else {
@@ -345,10 +313,7 @@ impl<'p> Checker<'p> {
             ExprKind::Name(id) => self.name_ty(id),
             ExprKind::Neg(a) => {
                 let a = self.ty(a)?;
-                Some(Ty {
-                    konst: a.konst.map(|v| -v),
-                    ..a
-                })
+                Some(Ty { konst: a.konst.map(|v| -v), ..a })
             }
             ExprKind::Binary(op, a, b) => {
                 let (ta, tb) = (self.ty(a), self.ty(b));
@@ -367,10 +332,7 @@ impl<'p> Checker<'p> {
                 self.used_params.insert(*i);
                 Some(Ty::plain(Shape::Scalar))
             }
-            Some(Global::Coef(i)) => Some(Ty {
-                smooth: false,
-                ..Ty::plain(self.prog.coefs[*i].shape)
-            }),
+            Some(Global::Coef(i)) => Some(Ty { smooth: false, ..Ty::plain(self.prog.coefs[*i].shape) }),
             Some(Global::Let { .. }) => self.let_ty(&id.name, id.span),
             Some(g @ (Global::Fn { .. } | Global::Form(_) | Global::Scheme(_))) => {
                 let kind = g.kind();
@@ -390,15 +352,8 @@ impl<'p> Checker<'p> {
                 "x" => Some(Ty::plain(Shape::Vector)),
                 "t" => Some(Ty::plain(Shape::Scalar)),
                 "pi" => Some(Ty::constant(std::f64::consts::PI)),
-                "n" => Some(Ty {
-                    facet: Some(id.span),
-                    smooth: false,
-                    ..Ty::plain(Shape::Vector)
-                }),
-                "h" => Some(Ty {
-                    facet: Some(id.span),
-                    ..Ty::plain(Shape::Scalar)
-                }),
+                "n" => Some(Ty { facet: Some(id.span), smooth: false, ..Ty::plain(Shape::Vector) }),
+                "h" => Some(Ty { facet: Some(id.span), ..Ty::plain(Shape::Scalar) }),
                 "inf" => {
                     self.error(Diagnostic::error(
                         "E0206",
@@ -472,10 +427,7 @@ impl<'p> Checker<'p> {
                     (Some(x), Some(y)) => Some(if op == BinOp::Add { x + y } else { x - y }),
                     _ => None,
                 };
-                Some(Ty {
-                    konst,
-                    ..Ty::join(&ta, &tb, ta.shape)
-                })
+                Some(Ty { konst, ..Ty::join(&ta, &tb, ta.shape) })
             }
             BinOp::Mul => {
                 let shape = match (ta.shape, tb.shape) {
@@ -495,10 +447,7 @@ impl<'p> Checker<'p> {
                     return None;
                 }
                 let konst = ta.konst.zip(tb.konst).map(|(x, y)| x * y);
-                Some(Ty {
-                    konst,
-                    ..Ty::join(&ta, &tb, shape)
-                })
+                Some(Ty { konst, ..Ty::join(&ta, &tb, shape) })
             }
             BinOp::Div => {
                 if tb.shape != Scalar {
@@ -517,10 +466,7 @@ impl<'p> Checker<'p> {
                     return None;
                 }
                 let konst = ta.konst.zip(tb.konst).map(|(x, y)| x / y);
-                Some(Ty {
-                    konst,
-                    ..Ty::join(&ta, &tb, ta.shape)
-                })
+                Some(Ty { konst, ..Ty::join(&ta, &tb, ta.shape) })
             }
             BinOp::Pow => {
                 if ta.shape != Scalar {
@@ -558,25 +504,17 @@ impl<'p> Checker<'p> {
                     }
                     return None;
                 }
-                Some(Ty {
-                    konst: ta.konst.map(|x| x.powi(k as i32)),
-                    ..ta
-                })
+                Some(Ty { konst: ta.konst.map(|x| x.powi(k as i32)), ..ta })
             }
         }
     }
 
     fn self_product(&mut self, span: Span, a: Span, b: Span) {
         self.error(
-            Diagnostic::error(
-                "E0404",
-                "test function multiplied by itself",
-                span,
-                "quadratic in the test function",
-            )
-            .with_label(a, "contains the test function")
-            .with_label(b, "contains it too")
-            .with_note("a form must be linear in its test function"),
+            Diagnostic::error("E0404", "test function multiplied by itself", span, "quadratic in the test function")
+                .with_label(a, "contains the test function")
+                .with_label(b, "contains it too")
+                .with_note("a form must be linear in its test function"),
         );
     }
 
@@ -707,9 +645,7 @@ impl<'p> Checker<'p> {
                     a.span,
                     "depends on the test function",
                 )
-                .with_note(format!(
-                    "`{name}` is not linear, and a form must be linear in its test function"
-                )),
+                .with_note(format!("`{name}` is not linear, and a form must be linear in its test function")),
             );
             return None;
         }
@@ -723,11 +659,7 @@ impl<'p> Checker<'p> {
         match name {
             "grad" | "div" => {
                 if !tys[0].smooth {
-                    let reason = if tys[0].facet.is_some() {
-                        "the normal"
-                    } else {
-                        "case data or a derivative"
-                    };
+                    let reason = if tys[0].facet.is_some() { "the normal" } else { "case data or a derivative" };
                     self.error(
                         Diagnostic::error("E0502", format!("cannot take `{name}` of this expression"), args[0].span, format!("depends on {reason}"))
                             .with_note("derivatives are available for fields, test functions, x, and smooth functions of them, once"),

@@ -41,17 +41,7 @@ const RESERVED: &[&str] = &[
 pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -> String {
     let d = ir.dim;
     let g = &ir.graph;
-    let body = |integral: &IntegralIr, mode: Mode| {
-        Body {
-            prog,
-            g,
-            d,
-            form,
-            integral,
-            mode,
-        }
-        .emit()
-    };
+    let body = |integral: &IntegralIr, mode: Mode| Body { prog, g, d, form, integral, mode }.emit();
     // One `match wrt` arm per field argument.
     let per_field = |integral: &IntegralIr, mode: fn(usize) -> Mode| {
         let mut s = String::from("match wrt {\n");
@@ -75,11 +65,8 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
         s.push_str("_ => {}\n}\n");
         s
     };
-    let (vec, mat, fields) = (
-        format!("LocalVector<{d}, N>"),
-        format!("LocalMatrix<{d}, N>"),
-        format!("&[&LocalVector<{d}, N>]"),
-    );
+    let (vec, mat, fields) =
+        (format!("LocalVector<{d}, N>"), format!("LocalMatrix<{d}, N>"), format!("&[&LocalVector<{d}, N>]"));
     let (cctx, fctx) = (format!("&CellCtx<'_, {d}, N>"), format!("&FacetCtx<'_, {d}, N>"));
     let mut s = String::new();
     let _ = writeln!(s, "impl<const N: usize> FormKernel<{d}, N> for {struct_name} {{");
@@ -146,13 +133,7 @@ struct Output {
 type Outputs = Vec<(&'static str, Vec<Option<Output>>)>;
 
 fn output(outputs: &Outputs, kind: &str, flat: usize) -> Option<String> {
-    outputs
-        .iter()
-        .find(|(k, _)| *k == kind)?
-        .1
-        .get(flat)?
-        .as_ref()
-        .map(|o| o.name.clone())
+    outputs.iter().find(|(k, _)| *k == kind)?.1.get(flat)?.as_ref().map(|o| o.name.clone())
 }
 
 const ATOM: u8 = 4;
@@ -182,10 +163,7 @@ impl Body<'_> {
                         rest /= d;
                     }
                     ix.reverse();
-                    Some(Output {
-                        name: format!("{kind}_{}", idx(&ix)),
-                        node: n,
-                    })
+                    Some(Output { name: format!("{kind}_{}", idx(&ix)), node: n })
                 })
                 .collect();
             outputs.push((kind, list));
@@ -204,31 +182,16 @@ impl Body<'_> {
             }
             Mode::Switches(a) => {
                 let list = self.integral.tangents[a].switches.iter().enumerate();
-                outputs.push((
-                    "s",
-                    list.map(|(k, &node)| {
-                        Some(Output {
-                            name: format!("s_{k}"),
-                            node,
-                        })
-                    })
-                    .collect(),
-                ));
+                outputs.push(("s", list.map(|(k, &node)| Some(Output { name: format!("s_{k}"), node })).collect()));
             }
         }
-        let roots: Vec<NodeId> = outputs
-            .iter()
-            .flat_map(|(_, l)| l.iter().flatten())
-            .map(|o| o.node)
-            .collect();
+        let roots: Vec<NodeId> = outputs.iter().flat_map(|(_, l)| l.iter().flatten()).map(|o| o.node).collect();
         if roots.is_empty() {
             return String::new();
         }
         let nodes = g.reachable(roots.iter().copied());
-        let syms: HashSet<Sym> = nodes
-            .iter()
-            .filter_map(|&n| if let Node::Sym(s) = g.node(n) { Some(s) } else { None })
-            .collect();
+        let syms: HashSet<Sym> =
+            nodes.iter().filter_map(|&n| if let Node::Sym(s) = g.node(n) { Some(s) } else { None }).collect();
 
         // Names of leaves.
         let mut namer = Namer::new(RESERVED);
@@ -247,10 +210,8 @@ impl Body<'_> {
         }
         let mut leaf: HashMap<Sym, String> = HashMap::new();
         let mut prologue = String::new();
-        let mut params: Vec<u16> = syms
-            .iter()
-            .filter_map(|s| if let Sym::Param(i) = s { Some(*i) } else { None })
-            .collect();
+        let mut params: Vec<u16> =
+            syms.iter().filter_map(|s| if let Sym::Param(i) = s { Some(*i) } else { None }).collect();
         params.sort_unstable();
         for i in params {
             let pname = &self.prog.params[i as usize].name;
@@ -262,12 +223,8 @@ impl Body<'_> {
         let mut field_val = vec![None; nfields];
         let mut field_grad = vec![None; nfields];
         for a in 0..nfields {
-            let uses_val = syms
-                .iter()
-                .any(|s| matches!(s, Sym::Field { arg, .. } if *arg as usize == a));
-            let uses_grad = syms
-                .iter()
-                .any(|s| matches!(s, Sym::FieldGrad { arg, .. } if *arg as usize == a));
+            let uses_val = syms.iter().any(|s| matches!(s, Sym::Field { arg, .. } if *arg as usize == a));
+            let uses_grad = syms.iter().any(|s| matches!(s, Sym::FieldGrad { arg, .. } if *arg as usize == a));
             if uses_val || uses_grad {
                 let fname = &self.form.fields[a];
                 let dofs = namer.fresh(fname);
@@ -280,35 +237,29 @@ impl Body<'_> {
                 }
             }
         }
-        let mut coef_ids: Vec<u16> = syms
-            .iter()
-            .filter_map(|s| if let Sym::Coef { id, .. } = s { Some(*id) } else { None })
-            .collect();
+        let mut coef_ids: Vec<u16> =
+            syms.iter().filter_map(|s| if let Sym::Coef { id, .. } = s { Some(*id) } else { None }).collect();
         coef_ids.sort_unstable();
         coef_ids.dedup();
-        let coef_locals: Vec<(u16, String)> = coef_ids
-            .iter()
-            .map(|&id| (id, namer.fresh(&self.prog.coefs[id as usize].name)))
-            .collect();
+        let coef_locals: Vec<(u16, String)> =
+            coef_ids.iter().map(|&id| (id, namer.fresh(&self.prog.coefs[id as usize].name))).collect();
         for s in &syms {
             let name = match *s {
                 Sym::Param(_) => continue,
                 Sym::Field { arg, comp } => {
                     format!("{}[{comp}]", field_val[arg as usize].as_ref().expect("named above").1)
                 }
-                Sym::FieldGrad { arg, comp, dir } => format!(
-                    "{}[{comp}][{dir}]",
-                    field_grad[arg as usize].as_ref().expect("named above").1
-                ),
+                Sym::FieldGrad { arg, comp, dir } => {
+                    format!("{}[{comp}][{dir}]", field_grad[arg as usize].as_ref().expect("named above").1)
+                }
                 Sym::Normal(k) => format!("n[{k}]"),
                 Sym::CellDiameter => "h".into(),
                 Sym::Coord(k) => format!("x[{k}]"),
                 Sym::Time => "t".into(),
                 Sym::Dt => "dt".into(), // never in a form
-                Sym::Coef { id, comp } => format!(
-                    "{}[{comp}]",
-                    coef_locals.iter().find(|(i, _)| *i == id).expect("named above").1
-                ),
+                Sym::Coef { id, comp } => {
+                    format!("{}[{comp}]", coef_locals.iter().find(|(i, _)| *i == id).expect("named above").1)
+                }
                 Sym::Test { .. } | Sym::TestGrad { .. } => "0.0".into(), // linear forms: never reached
             };
             leaf.insert(*s, name);
@@ -373,32 +324,20 @@ impl Body<'_> {
 
         // Weighted outputs (switches are signs: no weight).
         let mut weighted = String::new();
-        let weight = if matches!(self.mode, Mode::Switches(_)) {
-            ""
-        } else {
-            "w * "
-        };
+        let weight = if matches!(self.mode, Mode::Switches(_)) { "" } else { "w * " };
         for (_, list) in &outputs {
             for o in list.iter().flatten() {
                 let (text, prec) = match bound.get(&o.node) {
                     Some(local) => (local.clone(), ATOM),
                     None => self.expr(o.node, &leaf, &bound),
                 };
-                let text = if prec < UNARY && !weight.is_empty() {
-                    format!("({text})")
-                } else {
-                    text
-                };
+                let text = if prec < UNARY && !weight.is_empty() { format!("({text})") } else { text };
                 let _ = writeln!(weighted, "let {} = {weight}{text};", o.name);
             }
         }
 
         // Geometry needed at the point.
-        let needs = |kinds: &[&str]| {
-            outputs
-                .iter()
-                .any(|(k, l)| kinds.contains(k) && l.iter().any(Option::is_some))
-        };
+        let needs = |kinds: &[&str]| outputs.iter().any(|(k, l)| kinds.contains(k) && l.iter().any(Option::is_some));
         let field_vals = field_val.iter().any(Option::is_some);
         let field_grads = field_grad.iter().any(Option::is_some);
         let need_phi = field_vals || uses_x || needs(&["f0", "c00", "c01", "c10"]);
@@ -577,21 +516,10 @@ fn literal(v: f64) -> (String, u8) {
     if v.is_nan() {
         ("f64::NAN".into(), ATOM)
     } else if v.is_infinite() {
-        (
-            if v > 0.0 {
-                "f64::INFINITY".into()
-            } else {
-                "-f64::INFINITY".into()
-            },
-            if v > 0.0 { ATOM } else { UNARY },
-        )
+        (if v > 0.0 { "f64::INFINITY".into() } else { "-f64::INFINITY".into() }, if v > 0.0 { ATOM } else { UNARY })
     } else {
         let s = format!("{v:?}");
-        let s = if s.contains(['.', 'e', 'E']) {
-            s
-        } else {
-            format!("{s}.0")
-        };
+        let s = if s.contains(['.', 'e', 'E']) { s } else { format!("{s}.0") };
         if v < 0.0 { (s, UNARY) } else { (s, ATOM) }
     }
 }

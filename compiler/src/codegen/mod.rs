@@ -7,6 +7,7 @@
 
 mod kernel;
 pub mod names;
+mod scheme;
 
 use std::fmt::Write;
 
@@ -38,11 +39,7 @@ pub fn generate(prog: &Program, opts: &Options) -> Result<syn::File, String> {
 pub fn generate_pretty(prog: &Program, opts: &Options) -> Result<String, String> {
     let file = generate(prog, opts)?;
     let code = prettyplease::unparse(&file);
-    Ok(format!(
-        "// {} lines generated from {}\n{code}",
-        code.lines().count(),
-        opts.source_name
-    ))
+    Ok(format!("// {} lines generated from {}\n{code}", code.lines().count(), opts.source_name))
 }
 
 fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
@@ -58,6 +55,12 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
         "use {rt}::kernel::{{CellCtx, Coef, FacetCtx, Form, FormKernel, FormMeta, LocalMatrix, LocalVector, ParamError, ParamRange, check_coef, check_param, heaviside}};"
     );
     let _ = writeln!(s, "use {rt}::geometry;");
+    if !prog.schemes.is_empty() {
+        let _ = writeln!(
+            s,
+            "use {rt}::scheme::{{Combination, InitialDesc, Level, SchemeDesc, StageDesc, TermDesc, TimeScheme}};"
+        );
+    }
     s.push_str(&params_text(prog));
     s.push_str(&coefs_text(prog));
     let taken: Vec<String> = vec!["Params".into(), "Coefficients".into()];
@@ -76,33 +79,24 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
         let sig = format!(
             "{}({}; {})",
             form.name,
-            form.fields
-                .iter()
-                .map(|f| f.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", "),
+            form.fields.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", "),
             form.test.name
         );
         let _ = writeln!(
             s,
             "/// `form {sig}`{}",
-            if ir2.linear {
-                " (linear: its tangent does not depend on the fields)"
-            } else {
-                ""
-            }
+            if ir2.linear { " (linear: its tangent does not depend on the fields)" } else { "" }
         );
-        let _ = writeln!(
-            s,
-            "#[derive(Clone, Debug)]\npub struct {sname} {{ params: Params, coefs: Coefficients }}"
-        );
+        let _ = writeln!(s, "#[derive(Clone, Debug)]\npub struct {sname} {{ params: Params, coefs: Coefficients }}");
         let _ = writeln!(
             s,
             "impl {sname} {{ pub fn new(params: &Params, coefs: &Coefficients) -> Self {{ {sname} {{ params: *params, coefs: coefs.clone() }} }} }}"
         );
-        let cell_degree = ir2.integrals.iter().find(|i| i.cell).map_or("None".to_string(), |i| {
-            format!("Some([{}, {}])", i.degree[0], i.degree[1])
-        });
+        let cell_degree = ir2
+            .integrals
+            .iter()
+            .find(|i| i.cell)
+            .map_or("None".to_string(), |i| format!("Some([{}, {}])", i.degree[0], i.degree[1]));
         let facets: Vec<String> = ir2
             .integrals
             .iter()
@@ -116,43 +110,56 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
             fields.join(", "),
             form.test.name,
             irs.iter().all(|ir| ir.forms[fi].linear),
-            irs.iter().all(|ir| ir.forms[fi]
-                .integrals
-                .iter()
-                .all(|i| i.tangents.iter().all(|t| t.piecewise))),
+            irs.iter().all(|ir| ir.forms[fi].integrals.iter().all(|i| i.tangents.iter().all(|t| t.piecewise))),
             facets.join(", ")
         );
         for ir in irs {
             s.push_str(&kernel::form_impl(prog, ir, &ir.forms[fi], sname));
         }
     }
+    for sch in &prog.schemes {
+        let mut name = camel(&sch.name);
+        while taken.contains(&name) || struct_names.contains(&name) {
+            name.push_str("Scheme");
+        }
+        struct_names.push(name.clone());
+        s.push_str(&scheme::scheme_text(sch, &name));
+    }
     s.push_str("}\n");
     s
 }
 
 fn params_text(prog: &Program) -> String {
+    let list: Vec<(String, f64, Option<crate::check::ParamRange>)> =
+        prog.params.iter().map(|p| (p.name.clone(), p.default, p.range)).collect();
+    let doc = "/// Parameters, with the defaults and ranges declared in the source. Values are range-checked\n/// when set.\n";
+    params_struct("Params", doc, &list)
+}
+
+/// A struct of named f64 parameters with defaults, ranges, getters and checked setters.
+fn params_struct(name: &str, doc: &str, params: &[(String, f64, Option<crate::check::ParamRange>)]) -> String {
     let mut s = String::new();
-    let names: Vec<String> = prog.params.iter().map(|p| format!("{:?}", p.name)).collect();
-    s.push_str("/// Parameters, with the defaults and ranges declared in the source. Values are range-checked\n/// when set.\n");
-    s.push_str("#[derive(Clone, Copy, Debug, PartialEq)]\npub struct Params {\n");
-    for p in &prog.params {
-        let _ = writeln!(s, "{}: f64,", ident(&p.name));
+    let names: Vec<String> = params.iter().map(|p| format!("{:?}", p.0)).collect();
+    s.push_str(doc);
+    let _ = writeln!(s, "#[derive(Clone, Copy, Debug, PartialEq)]\npub struct {name} {{");
+    for (p, _, _) in params {
+        let _ = writeln!(s, "{}: f64,", ident(p));
     }
     s.push_str("}\n");
-    s.push_str("impl Default for Params { fn default() -> Self { Params {\n");
-    for p in &prog.params {
-        let _ = writeln!(s, "{}: {:?},", ident(&p.name), p.default);
+    let _ = writeln!(s, "impl Default for {name} {{ fn default() -> Self {{ {name} {{");
+    for (p, default, _) in params {
+        let _ = writeln!(s, "{}: {:?},", ident(p), default);
     }
     s.push_str("} } }\n");
-    s.push_str("impl Params {\n");
+    let _ = writeln!(s, "impl {name} {{");
     let _ = writeln!(
         s,
         "/// Parameter names, in declaration order.\npub const NAMES: &'static [&'static str] = &[{}];",
         names.join(", ")
     );
     s.push_str("/// Declared ranges, in declaration order.\npub const RANGES: &'static [ParamRange] = &[\n");
-    for p in &prog.params {
-        let r = p.range.unwrap_or(crate::check::ParamRange {
+    for (p, _, range) in params {
+        let r = range.unwrap_or(crate::check::ParamRange {
             lo: f64::NEG_INFINITY,
             lo_closed: false,
             hi: f64::INFINITY,
@@ -160,8 +167,7 @@ fn params_text(prog: &Program) -> String {
         });
         let _ = writeln!(
             s,
-            "ParamRange {{ name: {:?}, lo: {}, lo_closed: {}, hi: {}, hi_closed: {} }},",
-            p.name,
+            "ParamRange {{ name: {p:?}, lo: {}, lo_closed: {}, hi: {}, hi_closed: {} }},",
             float(r.lo),
             r.lo_closed,
             float(r.hi),
@@ -169,33 +175,32 @@ fn params_text(prog: &Program) -> String {
         );
     }
     s.push_str("];\n");
-    for p in &prog.params {
-        let range = p.range.map_or(String::new(), |r| format!(" in {}", r.describe()));
+    for (p, default, range) in params {
+        let range = range.map_or(String::new(), |r| format!(" in {}", r.describe()));
         let _ = writeln!(
             s,
-            "/// `{}` (default {:?}{range}).\npub fn {}(&self) -> f64 {{ self.{} }}",
-            p.name,
-            p.default,
-            ident(&p.name),
-            ident(&p.name)
+            "/// `{p}` (default {default:?}{range}).\npub fn {}(&self) -> f64 {{ self.{} }}",
+            ident(p),
+            ident(p)
         );
     }
     s.push_str("/// The value of a parameter by name.\npub fn get(&self, name: &str) -> Option<f64> { match name {\n");
-    for p in &prog.params {
-        let _ = writeln!(s, "{:?} => Some(self.{}),", p.name, ident(&p.name));
+    for (p, _, _) in params {
+        let _ = writeln!(s, "{p:?} => Some(self.{}),", ident(p));
     }
     s.push_str("_ => None } }\n");
     s.push_str("/// Sets a parameter by name, refusing unknown names and values outside the declared range.\n");
-    s.push_str("pub fn set(&mut self, name: &str, value: f64) -> Result<(), ParamError> { match name {\n");
-    for (i, p) in prog.params.iter().enumerate() {
-        let _ = writeln!(
-            s,
-            "{:?} => self.{} = check_param(&Self::RANGES[{i}], value)?,",
-            p.name,
-            ident(&p.name)
+    if params.is_empty() {
+        s.push_str("pub fn set(&mut self, name: &str, value: f64) -> Result<(), ParamError> { Err(ParamError::Unknown { name: name.to_string(), known: Self::NAMES }) }\n");
+    } else {
+        s.push_str("pub fn set(&mut self, name: &str, value: f64) -> Result<(), ParamError> { match name {\n");
+        for (i, (p, _, _)) in params.iter().enumerate() {
+            let _ = writeln!(s, "{p:?} => self.{} = check_param(&Self::RANGES[{i}], value)?,", ident(p));
+        }
+        s.push_str(
+            "_ => return Err(ParamError::Unknown { name: name.to_string(), known: Self::NAMES }),\n} Ok(()) }\n",
         );
     }
-    s.push_str("_ => return Err(ParamError::Unknown { name: name.to_string(), known: Self::NAMES }),\n} Ok(()) }\n");
     s.push_str("/// `set`, by value.\npub fn with(mut self, name: &str, value: f64) -> Result<Self, ParamError> { self.set(name, value)?; Ok(self) }\n");
     s.push_str("}\n");
     s
@@ -220,13 +225,7 @@ fn coefs_text(prog: &Program) -> String {
     }
     s.push_str(")]\npub struct Coefficients {\n");
     for c in &prog.coefs {
-        let _ = writeln!(
-            s,
-            "/// `coef {}: {}`\npub {}: Coef,",
-            c.name,
-            c.shape.name(),
-            ident(&c.name)
-        );
+        let _ = writeln!(s, "/// `coef {}: {}`\npub {}: Coef,", c.name, c.shape.name(), ident(&c.name));
     }
     s.push_str("}\n");
     s.push_str("impl Coefficients {\n/// Checks that every coef has the number of components its shape needs in dimension `dim`.\n");
@@ -237,12 +236,8 @@ fn coefs_text(prog: &Program) -> String {
             Shape::Vector => 1,
             Shape::Tensor => 2,
         };
-        let _ = writeln!(
-            s,
-            "check_coef({:?}, &self.{}, {rank}, dim).map_err(|e| e.to_string())?;",
-            c.name,
-            ident(&c.name)
-        );
+        let _ =
+            writeln!(s, "check_coef({:?}, &self.{}, {rank}, dim).map_err(|e| e.to_string())?;", c.name, ident(&c.name));
     }
     s.push_str("Ok(()) }\n}\n");
     s

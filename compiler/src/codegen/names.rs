@@ -42,9 +42,7 @@ pub struct Namer {
 
 impl Namer {
     pub fn new(reserved: &[&str]) -> Self {
-        Namer {
-            taken: reserved.iter().map(|s| s.to_string()).collect(),
-        }
+        Namer { taken: reserved.iter().map(|s| s.to_string()).collect() }
     }
 
     /// `want` if free, else `want_`, `want_2`, `want_3`, ...
@@ -57,9 +55,6 @@ impl Namer {
         if self.taken.insert(under.clone()) {
             return under;
         }
-        (2..)
-            .map(|k| format!("{base}_{k}"))
-            .find(|c| self.taken.insert(c.clone()))
-            .expect("an unused name exists")
+        (2..).map(|k| format!("{base}_{k}")).find(|c| self.taken.insert(c.clone())).expect("an unused name exists")
     }
 }

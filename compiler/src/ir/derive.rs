@@ -14,10 +14,7 @@ pub struct Derivative {
 
 impl Derivative {
     pub fn new(target: Sym) -> Self {
-        Derivative {
-            target,
-            memo: HashMap::new(),
-        }
+        Derivative { target, memo: HashMap::new() }
     }
 
     /// ∂root/∂target. Iterative over the reachable nodes (children have smaller ids), so deep

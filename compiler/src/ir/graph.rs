@@ -187,11 +187,7 @@ impl Graph {
             return self.neg(p);
         }
         // Constants first, then by id: a canonical order for commutative products.
-        let (a, b) = if self.as_const(b).is_some() || (self.as_const(a).is_none() && b < a) {
-            (b, a)
-        } else {
-            (a, b)
-        };
+        let (a, b) = if self.as_const(b).is_some() || (self.as_const(a).is_none() && b < a) { (b, a) } else { (a, b) };
         self.intern(Node::Mul(a, b))
     }
 
@@ -296,8 +292,6 @@ impl Graph {
 
     /// Whether `id` depends on any symbol accepted by `pred`.
     pub fn depends_on(&self, id: NodeId, pred: impl Fn(Sym) -> bool) -> bool {
-        self.reachable([id])
-            .into_iter()
-            .any(|n| matches!(self.node(n), Node::Sym(s) if pred(s)))
+        self.reachable([id]).into_iter().any(|n| matches!(self.node(n), Node::Sym(s) if pred(s)))
     }
 }

@@ -50,13 +50,7 @@ pub struct Lowerer<'p> {
 
 impl<'p> Lowerer<'p> {
     pub fn new(prog: &'p Program, d: usize) -> Self {
-        Lowerer {
-            g: Graph::default(),
-            prog,
-            d,
-            scope: Vec::new(),
-            lets: HashMap::new(),
-        }
+        Lowerer { g: Graph::default(), prog, d, scope: Vec::new(), lets: HashMap::new() }
     }
 
     pub fn dim(&self) -> usize {
@@ -70,53 +64,23 @@ impl<'p> Lowerer<'p> {
         for (a, f) in form.fields.iter().enumerate() {
             let c = (0..d)
                 .map(|k| Jet {
-                    v: self.g.sym(Sym::Field {
-                        arg: a as u8,
-                        comp: k as u8,
-                    }),
+                    v: self.g.sym(Sym::Field { arg: a as u8, comp: k as u8 }),
                     g: Some(
                         (0..d)
-                            .map(|l| {
-                                self.g.sym(Sym::FieldGrad {
-                                    arg: a as u8,
-                                    comp: k as u8,
-                                    dir: l as u8,
-                                })
-                            })
+                            .map(|l| self.g.sym(Sym::FieldGrad { arg: a as u8, comp: k as u8, dir: l as u8 }))
                             .collect(),
                     ),
                 })
                 .collect();
-            scope.push((
-                f.name.clone(),
-                Val {
-                    shape: Shape::Vector,
-                    c,
-                },
-            ));
+            scope.push((f.name.clone(), Val { shape: Shape::Vector, c }));
         }
         let c = (0..d)
             .map(|k| Jet {
                 v: self.g.sym(Sym::Test { comp: k as u8 }),
-                g: Some(
-                    (0..d)
-                        .map(|l| {
-                            self.g.sym(Sym::TestGrad {
-                                comp: k as u8,
-                                dir: l as u8,
-                            })
-                        })
-                        .collect(),
-                ),
+                g: Some((0..d).map(|l| self.g.sym(Sym::TestGrad { comp: k as u8, dir: l as u8 })).collect()),
             })
             .collect();
-        scope.push((
-            form.test.name.clone(),
-            Val {
-                shape: Shape::Vector,
-                c,
-            },
-        ));
+        scope.push((form.test.name.clone(), Val { shape: Shape::Vector, c }));
         self.scope = scope;
         let mut integrands: Vec<Integrand> = Vec::new();
         for integral in &form.integrals {
@@ -124,10 +88,7 @@ impl<'p> Lowerer<'p> {
             let v = if integral.sign < 0.0 { self.g.neg(v) } else { v };
             match integrands.iter_mut().find(|i| i.region == integral.region.name) {
                 Some(i) => i.value = self.g.add(i.value, v),
-                None => integrands.push(Integrand {
-                    region: integral.region.name.clone(),
-                    value: v,
-                }),
+                None => integrands.push(Integrand { region: integral.region.name.clone(), value: v }),
             }
         }
         // Volume integral first: kernels are emitted in this order.
@@ -152,10 +113,7 @@ impl<'p> Lowerer<'p> {
     }
 
     fn scalar(j: Jet) -> Val {
-        Val {
-            shape: Shape::Scalar,
-            c: vec![j],
-        }
+        Val { shape: Shape::Scalar, c: vec![j] }
     }
 
     fn expr(&mut self, e: &Expr) -> Val {
@@ -191,13 +149,7 @@ impl<'p> Lowerer<'p> {
                 let shape = self.prog.coefs[*i].shape;
                 let n = components(shape, d);
                 let c = (0..n)
-                    .map(|k| Jet {
-                        v: self.g.sym(Sym::Coef {
-                            id: *i as u16,
-                            comp: k as u8,
-                        }),
-                        g: None,
-                    })
+                    .map(|k| Jet { v: self.g.sym(Sym::Coef { id: *i as u16, comp: k as u8 }), g: None })
                     .collect();
                 Val { shape, c }
             }
@@ -214,28 +166,18 @@ impl<'p> Lowerer<'p> {
             }
             _ => match name {
                 "I" => {
-                    let c = (0..d * d)
-                        .map(|k| self.constant(if k / d == k % d { 1.0 } else { 0.0 }))
-                        .collect();
-                    Val {
-                        shape: Shape::Tensor,
-                        c,
-                    }
+                    let c = (0..d * d).map(|k| self.constant(if k / d == k % d { 1.0 } else { 0.0 })).collect();
+                    Val { shape: Shape::Tensor, c }
                 }
                 "x" => {
                     let c = (0..d)
                         .map(|k| {
                             let v = self.g.sym(Sym::Coord(k as u8));
-                            let g = (0..d)
-                                .map(|l| self.g.constant(if k == l { 1.0 } else { 0.0 }))
-                                .collect();
+                            let g = (0..d).map(|l| self.g.constant(if k == l { 1.0 } else { 0.0 })).collect();
                             Jet { v, g: Some(g) }
                         })
                         .collect();
-                    Val {
-                        shape: Shape::Vector,
-                        c,
-                    }
+                    Val { shape: Shape::Vector, c }
                 }
                 "t" => {
                     let v = self.g.sym(Sym::Time);
@@ -246,16 +188,8 @@ impl<'p> Lowerer<'p> {
                     Self::scalar(Jet { v, g: self.zero_grad() })
                 }
                 "n" => {
-                    let c = (0..d)
-                        .map(|k| Jet {
-                            v: self.g.sym(Sym::Normal(k as u8)),
-                            g: None,
-                        })
-                        .collect();
-                    Val {
-                        shape: Shape::Vector,
-                        c,
-                    }
+                    let c = (0..d).map(|k| Jet { v: self.g.sym(Sym::Normal(k as u8)), g: None }).collect();
+                    Val { shape: Shape::Vector, c }
                 }
                 "pi" => Self::scalar(self.constant(std::f64::consts::PI)),
                 _ => unreachable!("checked name `{name}`"),
@@ -295,18 +229,9 @@ impl<'p> Lowerer<'p> {
                 let a = next();
                 let c: Vec<Jet> =
                     a.c.iter()
-                        .flat_map(|j| {
-                            j.g.clone()
-                                .expect("checked smooth")
-                                .into_iter()
-                                .map(|v| Jet { v, g: None })
-                        })
+                        .flat_map(|j| j.g.clone().expect("checked smooth").into_iter().map(|v| Jet { v, g: None }))
                         .collect();
-                let shape = if a.shape == Shape::Scalar {
-                    Shape::Vector
-                } else {
-                    Shape::Tensor
-                };
+                let shape = if a.shape == Shape::Scalar { Shape::Vector } else { Shape::Tensor };
                 Val { shape, c }
             }
             "div" => {
@@ -323,10 +248,7 @@ impl<'p> Lowerer<'p> {
                         Jet { v: acc, g: None }
                     })
                     .collect();
-                Val {
-                    shape: if rows == 1 { Shape::Scalar } else { Shape::Vector },
-                    c,
-                }
+                Val { shape: if rows == 1 { Shape::Scalar } else { Shape::Vector }, c }
             }
             "sym" => {
                 let a = next();
@@ -338,18 +260,12 @@ impl<'p> Lowerer<'p> {
                         self.jmul(&half, &s)
                     })
                     .collect();
-                Val {
-                    shape: Shape::Tensor,
-                    c,
-                }
+                Val { shape: Shape::Tensor, c }
             }
             "transpose" => {
                 let a = next();
                 let c = (0..d * d).map(|k| a.c[(k % d) * d + k / d].clone()).collect();
-                Val {
-                    shape: Shape::Tensor,
-                    c,
-                }
+                Val { shape: Shape::Tensor, c }
             }
             "tr" => {
                 let a = next();
@@ -375,10 +291,7 @@ impl<'p> Lowerer<'p> {
             "outer" => {
                 let (a, b) = (next(), next());
                 let c = (0..d * d).map(|k| self.jmul(&a.c[k / d], &b.c[k % d])).collect();
-                Val {
-                    shape: Shape::Tensor,
-                    c,
-                }
+                Val { shape: Shape::Tensor, c }
             }
             "H" => {
                 let a = next();
@@ -458,15 +371,13 @@ impl<'p> Lowerer<'p> {
                 Self::scalar(c)
             }
             (Tensor, Vector) => {
-                let c = (0..d)
-                    .map(|i| self.sum_of_products((0..d).map(|j| (i * d + j, j)).collect(), &a, &b))
-                    .collect();
+                let c =
+                    (0..d).map(|i| self.sum_of_products((0..d).map(|j| (i * d + j, j)).collect(), &a, &b)).collect();
                 Val { shape: Vector, c }
             }
             (Vector, Tensor) => {
-                let c = (0..d)
-                    .map(|j| self.sum_of_products((0..d).map(|i| (i, i * d + j)).collect(), &a, &b))
-                    .collect();
+                let c =
+                    (0..d).map(|j| self.sum_of_products((0..d).map(|i| (i, i * d + j)).collect(), &a, &b)).collect();
                 Val { shape: Vector, c }
             }
             (Tensor, Tensor) => {

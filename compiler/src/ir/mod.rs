@@ -71,12 +71,7 @@ pub struct TangentIr {
 
 impl TangentIr {
     pub fn nodes(&self) -> impl Iterator<Item = NodeId> + '_ {
-        self.c00
-            .iter()
-            .chain(&self.c01)
-            .chain(&self.c10)
-            .chain(&self.c11)
-            .copied()
+        self.c00.iter().chain(&self.c01).chain(&self.c10).chain(&self.c11).copied()
     }
 }
 
@@ -89,21 +84,15 @@ pub fn build(prog: &Program, d: usize) -> DimIr {
     for lf in lowered {
         let mut integrals = Vec::new();
         for integrand in &lf.integrands {
-            let f0: Vec<NodeId> = (0..d)
-                .map(|k| Derivative::new(Sym::Test { comp: k as u8 }).of(&mut g, integrand.value))
-                .collect();
+            let f0: Vec<NodeId> =
+                (0..d).map(|k| Derivative::new(Sym::Test { comp: k as u8 }).of(&mut g, integrand.value)).collect();
             let f1: Vec<NodeId> = (0..d * d)
                 .map(|kl| {
-                    Derivative::new(Sym::TestGrad {
-                        comp: (kl / d) as u8,
-                        dir: (kl % d) as u8,
-                    })
-                    .of(&mut g, integrand.value)
+                    Derivative::new(Sym::TestGrad { comp: (kl / d) as u8, dir: (kl % d) as u8 })
+                        .of(&mut g, integrand.value)
                 })
                 .collect();
-            let tangents = (0..lf.fields.len())
-                .map(|a| tangent(&mut g, d, a as u8, &f0, &f1))
-                .collect::<Vec<_>>();
+            let tangents = (0..lf.fields.len()).map(|a| tangent(&mut g, d, a as u8, &f0, &f1)).collect::<Vec<_>>();
             let degree = [1, 2].map(|p| integral_degree(&g, p, &f0, &f1, &tangents));
             integrals.push(IntegralIr {
                 region: integrand.region.clone(),
@@ -114,37 +103,20 @@ pub fn build(prog: &Program, d: usize) -> DimIr {
                 degree,
             });
         }
-        let tangent_nodes = integrals
-            .iter()
-            .flat_map(|i| i.tangents.iter().flat_map(TangentIr::nodes));
+        let tangent_nodes = integrals.iter().flat_map(|i| i.tangents.iter().flat_map(TangentIr::nodes));
         let linear = !g
             .reachable(tangent_nodes)
             .into_iter()
             .any(|n| matches!(g.node(n), Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. })));
-        forms.push(FormIr {
-            name: lf.name,
-            fields: lf.fields,
-            test: lf.test,
-            integrals,
-            linear,
-        });
+        forms.push(FormIr { name: lf.name, fields: lf.fields, test: lf.test, integrals, linear });
     }
-    DimIr {
-        dim: d,
-        graph: g,
-        forms,
-    }
+    DimIr { dim: d, graph: g, forms }
 }
 
 fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> TangentIr {
     let val: Vec<Sym> = (0..d).map(|m| Sym::Field { arg, comp: m as u8 }).collect();
-    let grad: Vec<Sym> = (0..d * d)
-        .map(|mn| Sym::FieldGrad {
-            arg,
-            comp: (mn / d) as u8,
-            dir: (mn % d) as u8,
-        })
-        .collect();
+    let grad: Vec<Sym> =
+        (0..d * d).map(|mn| Sym::FieldGrad { arg, comp: (mn / d) as u8, dir: (mn % d) as u8 }).collect();
     let mut dval: Vec<Derivative> = val.iter().map(|s| Derivative::new(*s)).collect();
     let mut dgrad: Vec<Derivative> = grad.iter().map(|s| Derivative::new(*s)).collect();
     let mut c00 = Vec::new();
@@ -167,14 +139,7 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> Ta
             c11.push(dg.of(g, f));
         }
     }
-    let mut t = TangentIr {
-        c00,
-        c01,
-        c10,
-        c11,
-        switches: Vec::new(),
-        piecewise: true,
-    };
+    let mut t = TangentIr { c00, c01, c10, c11, switches: Vec::new(), piecewise: true };
     let is_field = |s: Sym| matches!(s, Sym::Field { arg: x, .. } | Sym::FieldGrad { arg: x, .. } if x == arg);
     let roots: Vec<NodeId> = t.nodes().collect();
     for n in g.reachable(roots.iter().copied()) {
@@ -232,12 +197,7 @@ pub fn node_degrees(
 }
 
 fn integral_degree(g: &Graph, p: u32, f0: &[NodeId], f1: &[NodeId], tangents: &[TangentIr]) -> u32 {
-    let roots: Vec<NodeId> = f0
-        .iter()
-        .chain(f1)
-        .copied()
-        .chain(tangents.iter().flat_map(TangentIr::nodes))
-        .collect();
+    let roots: Vec<NodeId> = f0.iter().chain(f1).copied().chain(tangents.iter().flat_map(TangentIr::nodes)).collect();
     let deg = node_degrees(g, p, roots);
     let d = |n: &NodeId| if g.is_zero(*n) { None } else { Some(deg[n]) };
     let mut best = 0;

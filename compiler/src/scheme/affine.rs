@@ -25,11 +25,7 @@ pub struct Affine {
 impl Affine {
     fn from_map(g: &mut Graph, map: BTreeMap<Key, NodeId>) -> Affine {
         let zero = g.zero();
-        let mut a = Affine {
-            unknown: zero,
-            known: Vec::new(),
-            new: Vec::new(),
-        };
+        let mut a = Affine { unknown: zero, known: Vec::new(), new: Vec::new() };
         for (k, c) in map {
             if g.is_zero(c) {
                 continue;
@@ -98,10 +94,7 @@ impl Affine {
 
     /// Coefficient of new quantity `index`.
     pub fn new_coef(&self, g: &mut Graph, index: usize) -> NodeId {
-        self.new
-            .iter()
-            .find(|(i, _)| *i == index)
-            .map_or_else(|| g.zero(), |(_, c)| *c)
+        self.new.iter().find(|(i, _)| *i == index).map_or_else(|| g.zero(), |(_, c)| *c)
     }
 
     /// Solves `self = 0` for new quantity `index`: −(self − c·q)/c.

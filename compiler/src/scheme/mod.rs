@@ -91,9 +91,7 @@ pub struct SchemeIr {
 
 /// Compiles every scheme; errors go to `diags`.
 pub fn compile(prog: &Program, defs: &[SchemeDef], diags: &mut Vec<Diagnostic>) -> Vec<SchemeIr> {
-    defs.iter()
-        .filter_map(|d| Compiler::new(prog, d).run().map_err(|mut e| diags.append(&mut e)).ok())
-        .collect()
+    defs.iter().filter_map(|d| Compiler::new(prog, d).run().map_err(|mut e| diags.append(&mut e)).ok()).collect()
 }
 
 /// What a name means inside a scheme.
@@ -154,12 +152,7 @@ impl<'a> Compiler<'a> {
             };
             let range = p.range.as_ref().and_then(|r| {
                 let (lo, hi) = (const_eval(&r.lo).ok()?, const_eval(&r.hi).ok()?);
-                Some(ParamRange {
-                    lo,
-                    lo_closed: r.lo_closed,
-                    hi,
-                    hi_closed: r.hi_closed,
-                })
+                Some(ParamRange { lo, lo_closed: r.lo_closed, hi, hi_closed: r.hi_closed })
             });
             if let Some(r) = range
                 && default.is_finite()
@@ -172,11 +165,7 @@ impl<'a> Compiler<'a> {
                     format!("{default} is not in {}", r.describe()),
                 ));
             }
-            self.params.push(SchemeParamInfo {
-                name: p.name.name.clone(),
-                default,
-                range,
-            });
+            self.params.push(SchemeParamInfo { name: p.name.name.clone(), default, range });
             let node = self.g.sym(Sym::Param(i as u16));
             self.g.name(node, &p.name.name);
             self.scope.insert(p.name.name.clone(), Value::Scalar(node));
@@ -208,10 +197,7 @@ impl<'a> Compiler<'a> {
                     "already a name of this scheme",
                 ));
             }
-            self.scope.insert(
-                s.name.clone(),
-                Value::Vector(Affine::known(&mut self.g, Quantity::State(i))),
-            );
+            self.scope.insert(s.name.clone(), Value::Vector(Affine::known(&mut self.g, Quantity::State(i))));
         }
         for (name, value) in &def.lets {
             self.bind_let(name, value);
@@ -241,16 +227,10 @@ impl<'a> Compiler<'a> {
             for s in &def.states {
                 let primed = format!("{}'", s.name);
                 match last.quantities.iter().position(|q| *q == primed) {
-                    Some(index) => updates.push(Quantity::Stage {
-                        stage: stages.len() - 1,
-                        index,
-                    }),
+                    Some(index) => updates.push(Quantity::Stage { stage: stages.len() - 1, index }),
                     None => {
-                        let at = def
-                            .stages
-                            .last()
-                            .and_then(|s| s.name.as_ref().map(|n| n.span))
-                            .unwrap_or(def.name.span);
+                        let at =
+                            def.stages.last().and_then(|s| s.name.as_ref().map(|n| n.span)).unwrap_or(def.name.span);
                         self.error(
                             Diagnostic::error(
                                 "E0806",
@@ -258,9 +238,7 @@ impl<'a> Compiler<'a> {
                                 at,
                                 format!("no `{primed}` in the last stage"),
                             )
-                            .with_help(format!(
-                                "relate `{primed}` to the other quantities, or make it the unknown"
-                            )),
+                            .with_help(format!("relate `{primed}` to the other quantities, or make it the unknown")),
                         );
                     }
                 }
@@ -332,20 +310,12 @@ impl<'a> Compiler<'a> {
     }
 
     fn stage(&mut self, st: &ast::Stage, last: bool) -> Option<StageIr> {
-        let name = st
-            .name
-            .as_ref()
-            .map_or_else(|| format!("stage{}", self.stage_index + 1), |n| n.name.clone());
+        let name = st.name.as_ref().map_or_else(|| format!("stage{}", self.stage_index + 1), |n| n.name.clone());
         let at_span = st.span.unwrap_or(self.def.span);
         let Some(unknown) = &st.unknown else {
             self.error(
-                Diagnostic::error(
-                    "E0805",
-                    format!("stage `{name}` has no unknown"),
-                    at_span,
-                    "no `unknown` line",
-                )
-                .with_help("`unknown u'` names the quantity Newton solves for"),
+                Diagnostic::error("E0805", format!("stage `{name}` has no unknown"), at_span, "no `unknown` line")
+                    .with_help("`unknown u'` names the quantity Newton solves for"),
             );
             return None;
         };
@@ -420,11 +390,7 @@ impl<'a> Compiler<'a> {
         }
         let n_new = self.new.len();
         for (i, q) in self.new.clone().iter().enumerate() {
-            let v = if i == 0 {
-                Affine::unknown(&mut self.g)
-            } else {
-                Affine::new_quantity(&mut self.g, i)
-            };
+            let v = if i == 0 { Affine::unknown(&mut self.g) } else { Affine::new_quantity(&mut self.g, i) };
             self.scope.insert(q.clone(), Value::Vector(v));
         }
         // Equations: lhs − rhs = 0, affine in the new quantities.
@@ -457,11 +423,8 @@ impl<'a> Compiler<'a> {
             return None;
         }
         if equations.len() + 1 != n_new {
-            let missing: Vec<String> = self.new[1..]
-                .iter()
-                .filter(|q| !st.relates.iter().any(|r| r.name.name == **q))
-                .cloned()
-                .collect();
+            let missing: Vec<String> =
+                self.new[1..].iter().filter(|q| !st.relates.iter().any(|r| r.name.name == **q)).cloned().collect();
             self.error(
                 Diagnostic::error(
                     "E0811",
@@ -485,9 +448,7 @@ impl<'a> Compiler<'a> {
         while let Some((eq, span, own)) = pending.first().cloned() {
             pending.remove(0);
             let candidates: Vec<usize> = (1..n_new).filter(|&q| solved[q].is_none() && eq.has_new(q)).collect();
-            let pivot = own
-                .filter(|o| candidates.contains(o))
-                .or_else(|| candidates.first().copied());
+            let pivot = own.filter(|o| candidates.contains(o)).or_else(|| candidates.first().copied());
             let Some(q) = pivot else {
                 self.error(Diagnostic::error(
                     "E0812",
@@ -503,10 +464,7 @@ impl<'a> Compiler<'a> {
                 self.error(
                     Diagnostic::error(
                         "E0802",
-                        format!(
-                            "solving this relation for `{}` divides by a coefficient that can vanish",
-                            self.new[q]
-                        ),
+                        format!("solving this relation for `{}` divides by a coefficient that can vanish", self.new[q]),
                         span,
                         why,
                     )
@@ -544,22 +502,10 @@ impl<'a> Compiler<'a> {
         }
         // Later stages see this stage's quantities as known values.
         for (i, q) in quantities.iter().enumerate() {
-            let v = Affine::known(
-                &mut self.g,
-                Quantity::Stage {
-                    stage: self.stage_index,
-                    index: i,
-                },
-            );
+            let v = Affine::known(&mut self.g, Quantity::Stage { stage: self.stage_index, index: i });
             self.scope.insert(q.clone(), Value::Vector(v));
         }
-        Some(StageIr {
-            name,
-            time,
-            quantities,
-            values,
-            terms,
-        })
+        Some(StageIr { name, time, quantities, values, terms })
     }
 
     /// Names on right-hand sides that are neither known nor new yet become new quantities
@@ -602,20 +548,12 @@ impl<'a> Compiler<'a> {
             for dt in [1e-4, 1e-2, 1.0, 100.0] {
                 let v = affine::eval(&self.g, c, &values, dt, 0.0);
                 let described = || {
-                    let ps: Vec<String> = self
-                        .params
-                        .iter()
-                        .zip(&values)
-                        .map(|(p, v)| format!("{} = {v}", p.name))
-                        .collect();
+                    let ps: Vec<String> =
+                        self.params.iter().zip(&values).map(|(p, v)| format!("{} = {v}", p.name)).collect();
                     let shown = if v == 0.0 { "0".to_string() } else { format!("{v:e}") };
                     format!(
                         "it is {shown} at {}dt = {dt}",
-                        if ps.is_empty() {
-                            String::new()
-                        } else {
-                            format!("{}, ", ps.join(", "))
-                        }
+                        if ps.is_empty() { String::new() } else { format!("{}, ", ps.join(", ")) }
                     )
                 };
                 if !v.is_finite() || v == 0.0 {
@@ -659,9 +597,7 @@ impl<'a> Compiler<'a> {
     fn form_sum(&mut self, e: &Expr, time: NodeId) -> Option<Vec<Term>> {
         match &e.kind {
             ExprKind::Call(f, args) if matches!(self.prog.globals.get(&f.name), Some(Global::Form(_))) => {
-                let Some(Global::Form(fi)) = self.prog.globals.get(&f.name) else {
-                    unreachable!()
-                };
+                let Some(Global::Form(fi)) = self.prog.globals.get(&f.name) else { unreachable!() };
                 let form = &self.prog.forms[*fi];
                 let one = self.g.one();
                 if form.fields.is_empty() {
@@ -690,12 +626,7 @@ impl<'a> Compiler<'a> {
                             return None;
                         }
                     };
-                    return Some(vec![Term {
-                        coef: one,
-                        form: f.name.clone(),
-                        args: Vec::new(),
-                        time: at,
-                    }]);
+                    return Some(vec![Term { coef: one, form: f.name.clone(), args: Vec::new(), time: at }]);
                 }
                 if args.len() != form.fields.len() {
                     self.error(Diagnostic::error(
@@ -726,12 +657,7 @@ impl<'a> Compiler<'a> {
                         }
                     }
                 }
-                Some(vec![Term {
-                    coef: one,
-                    form: f.name.clone(),
-                    args: affine_args,
-                    time,
-                }])
+                Some(vec![Term { coef: one, form: f.name.clone(), args: affine_args, time }])
             }
             ExprKind::Binary(op @ (BinOp::Add | BinOp::Sub), a, b) => {
                 let mut x = self.form_sum(a, time)?;
@@ -792,12 +718,7 @@ impl<'a> Compiler<'a> {
         match self.value(e)? {
             Value::Scalar(n) => Some(n),
             Value::Vector(_) => {
-                self.error(Diagnostic::error(
-                    "E0301",
-                    "expected a scalar",
-                    e.span,
-                    "a combination of time levels",
-                ));
+                self.error(Diagnostic::error("E0301", "expected a scalar", e.span, "a combination of time levels"));
                 None
             }
         }
@@ -926,21 +847,9 @@ impl SchemeParamInfo {
     fn samples(&self) -> Vec<f64> {
         let mut s = vec![self.default];
         if let Some(r) = self.range {
-            let span = if r.lo.is_finite() && r.hi.is_finite() {
-                r.hi - r.lo
-            } else {
-                1.0
-            };
-            let lo = if r.lo.is_finite() {
-                if r.lo_closed { r.lo } else { r.lo + 1e-6 * span }
-            } else {
-                -1e6
-            };
-            let hi = if r.hi.is_finite() {
-                if r.hi_closed { r.hi } else { r.hi - 1e-6 * span }
-            } else {
-                1e6
-            };
+            let span = if r.lo.is_finite() && r.hi.is_finite() { r.hi - r.lo } else { 1.0 };
+            let lo = if r.lo.is_finite() { if r.lo_closed { r.lo } else { r.lo + 1e-6 * span } } else { -1e6 };
+            let hi = if r.hi.is_finite() { if r.hi_closed { r.hi } else { r.hi - 1e-6 * span } } else { 1e6 };
             s.extend([lo, hi, 0.5 * (lo + hi)]);
         }
         s

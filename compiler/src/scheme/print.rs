@@ -13,10 +13,7 @@ pub fn print(s: &SchemeIr) -> String {
     let _ = writeln!(out, "  states {}", s.states.join(", "));
     let names = |q: Quantity| match q {
         Quantity::State(i) => s.states[i].clone(),
-        Quantity::Stage { stage, index } => s
-            .stages
-            .get(stage)
-            .map_or("?".into(), |st| st.quantities[index].clone()),
+        Quantity::Stage { stage, index } => s.stages.get(stage).map_or("?".into(), |st| st.quantities[index].clone()),
     };
     if let Some(init) = &s.initial {
         let _ = writeln!(out, "  initial: solve for {}", s.states[init.state]);
@@ -25,13 +22,7 @@ pub fn print(s: &SchemeIr) -> String {
         }
     }
     for st in &s.stages {
-        let _ = writeln!(
-            out,
-            "  stage {} at {}  (unknown {})",
-            st.name,
-            scalar(&s.graph, st.time),
-            st.quantities[0]
-        );
+        let _ = writeln!(out, "  stage {} at {}  (unknown {})", st.name, scalar(&s.graph, st.time), st.quantities[0]);
         for (q, v) in st.quantities.iter().zip(&st.values).skip(1) {
             let _ = writeln!(out, "    {q} = {}", affine(&s.graph, v, &st.quantities[0], &names));
         }
@@ -40,12 +31,8 @@ pub fn print(s: &SchemeIr) -> String {
             let _ = writeln!(out, "      {}", term(&s.graph, t, &st.quantities[0], &names));
         }
     }
-    let updates: Vec<String> = s
-        .updates
-        .iter()
-        .enumerate()
-        .map(|(i, q)| format!("{} ← {}", s.states[i], names(*q)))
-        .collect();
+    let updates: Vec<String> =
+        s.updates.iter().enumerate().map(|(i, q)| format!("{} ← {}", s.states[i], names(*q))).collect();
     let _ = writeln!(out, "  update {}", updates.join(", "));
     out
 }
@@ -69,11 +56,7 @@ fn affine(g: &Graph, a: &Affine, unknown: &str, names: &dyn Fn(Quantity) -> Stri
     for (q, c) in &a.known {
         parts.push(format!("{}·{}", factor(g, *c), names(*q)));
     }
-    if parts.is_empty() {
-        "0".into()
-    } else {
-        parts.join(" + ")
-    }
+    if parts.is_empty() { "0".into() } else { parts.join(" + ") }
 }
 
 /// A coefficient in front of a level: parenthesised unless a product or an atom.

@@ -110,11 +110,7 @@ fn chunks(text: &str) -> Vec<(usize, usize)> {
 
 fn starts_item(rest: &str) -> bool {
     ITEM_KEYWORDS.iter().any(|k| {
-        rest.starts_with(k)
-            && rest[k.len()..]
-                .chars()
-                .next()
-                .is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_'))
+        rest.starts_with(k) && rest[k.len()..].chars().next().is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_'))
     })
 }
 
@@ -230,11 +226,7 @@ fn syntax_error(file: FileId, chunk: &str, offset: usize, e: &pest::error::Error
     let pos = pos.min(content_end);
     let found = if at_end { "" } else { found_token(&chunk[pos..]) };
     let span = Span::new(file, offset + pos, offset + pos + found.len());
-    let found_text = if at_end {
-        "the end of the item".to_string()
-    } else {
-        format!("`{found}`")
-    };
+    let found_text = if at_end { "the end of the item".to_string() } else { format!("`{found}`") };
     let message = if expected.is_empty() {
         format!("unexpected {found_text}")
     } else {
@@ -356,10 +348,7 @@ impl Builder {
     }
 
     fn ident(&self, p: Pair<Rule>) -> Ident {
-        Ident {
-            name: p.as_str().to_string(),
-            span: self.span(&p),
-        }
+        Ident { name: p.as_str().to_string(), span: self.span(&p) }
     }
 
     fn item(&self, p: Pair<Rule>) -> Result<Item, Box<Diagnostic>> {
@@ -386,12 +375,7 @@ impl Builder {
                 for r in it {
                     range = Some(self.range(r)?);
                 }
-                Item::Param {
-                    name,
-                    default,
-                    range,
-                    span,
-                }
+                Item::Param { name, default, range, span }
             }
             Rule::coef => {
                 let name = self.ident(next());
@@ -418,12 +402,7 @@ impl Builder {
                         _ => body = Some(self.expr(q)?),
                     }
                 }
-                Item::Fn {
-                    name,
-                    params,
-                    body: body.expect("fn has a body"),
-                    span,
-                }
+                Item::Fn { name, params, body: body.expect("fn has a body"), span }
             }
             Rule::form_decl => {
                 let name = self.ident(next());
@@ -437,13 +416,7 @@ impl Builder {
                     }
                 }
                 let integrals = self.integrals(next())?;
-                Item::Form {
-                    name,
-                    fields,
-                    test: test.expect("form has a test function"),
-                    integrals,
-                    span,
-                }
+                Item::Form { name, fields, test: test.expect("form has a test function"), integrals, span }
             }
             Rule::scheme_decl => self.scheme(span, next(), it)?,
             r => unreachable!("not an item: {r:?}"),
@@ -470,12 +443,7 @@ impl Builder {
                         let name = self.ident(it.next().expect("param name"));
                         let default = self.expr(it.next().expect("param default"))?;
                         let range = it.next().map(|r| self.range(r)).transpose()?;
-                        params.push(SchemeParam {
-                            name,
-                            default,
-                            range,
-                            span,
-                        });
+                        params.push(SchemeParam { name, default, range, span });
                     }
                 }
                 Rule::state_decl => {
@@ -488,18 +456,11 @@ impl Builder {
                     let unknown = self.ident(it.next().expect("initial unknown"));
                     let lhs = self.expr(it.next().expect("lhs"))?;
                     let rhs = self.expr(it.next().expect("rhs"))?;
-                    initial = Some(Initial {
-                        unknown,
-                        residual: Residual { lhs, rhs, span },
-                        span,
-                    });
+                    initial = Some(Initial { unknown, residual: Residual { lhs, rhs, span }, span });
                 }
                 Rule::stage_block => {
                     let span = self.span(&p);
-                    let mut stage = Stage {
-                        span: Some(span),
-                        ..Stage::default()
-                    };
+                    let mut stage = Stage { span: Some(span), ..Stage::default() };
                     for q in p.into_inner() {
                         match q.as_rule() {
                             Rule::ident => stage.name = Some(self.ident(q)),
@@ -538,15 +499,7 @@ impl Builder {
                 return Err(Box::new(d));
             }
         }
-        Ok(Item::Scheme {
-            name,
-            params,
-            states,
-            lets,
-            initial,
-            stages,
-            span,
-        })
+        Ok(Item::Scheme { name, params, states, lets, initial, stages, span })
     }
 
     fn stage_item(&self, stage: &mut Stage, p: Pair<Rule>) -> Result<(), Box<Diagnostic>> {
@@ -594,13 +547,7 @@ impl Builder {
         let lo = self.expr(it.next().expect("range lower bound"))?;
         let hi = self.expr(it.next().expect("range upper bound"))?;
         let hi_closed = it.next().map(|b| b.as_str() == "]").unwrap_or(true);
-        Ok(Range {
-            lo,
-            lo_closed,
-            hi,
-            hi_closed,
-            span,
-        })
+        Ok(Range { lo, lo_closed, hi, hi_closed, span })
     }
 
     fn integrals(&self, p: Pair<Rule>) -> Result<Vec<Integral>, Box<Diagnostic>> {
@@ -621,12 +568,7 @@ impl Builder {
                     let mut it = q.into_inner();
                     let region = self.ident(it.next().expect("integral region"));
                     let integrand = self.expr(it.next().expect("integrand"))?;
-                    out.push(Integral {
-                        sign,
-                        region,
-                        integrand,
-                        span,
-                    });
+                    out.push(Integral { sign, region, integrand, span });
                     sign = 1.0;
                 }
             }
@@ -640,10 +582,7 @@ impl Builder {
             .map_prefix(|op, rhs| {
                 let rhs = rhs?;
                 let span = self.span(&op).to(rhs.span);
-                Ok(Expr {
-                    kind: ExprKind::Neg(Box::new(rhs)),
-                    span,
-                })
+                Ok(Expr { kind: ExprKind::Neg(Box::new(rhs)), span })
             })
             .map_infix(|lhs, op, rhs| {
                 let (lhs, rhs) = (lhs?, rhs?);
@@ -655,10 +594,7 @@ impl Builder {
                     _ => BinOp::Pow,
                 };
                 let span = lhs.span.to(rhs.span);
-                Ok(Expr {
-                    kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
-                    span,
-                })
+                Ok(Expr { kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)), span })
             })
             .parse(p.into_inner())
     }
@@ -667,32 +603,19 @@ impl Builder {
         let span = self.span(&p);
         Ok(match p.as_rule() {
             Rule::number => match p.as_str().parse::<f64>() {
-                Ok(v) if v.is_finite() => Expr {
-                    kind: ExprKind::Number(v),
-                    span,
-                },
+                Ok(v) if v.is_finite() => Expr { kind: ExprKind::Number(v), span },
                 _ => {
-                    let d = Diagnostic::error(
-                        "E0003",
-                        "number out of range",
-                        span,
-                        "not a finite double-precision number",
-                    );
+                    let d =
+                        Diagnostic::error("E0003", "number out of range", span, "not a finite double-precision number");
                     return Err(Box::new(d));
                 }
             },
-            Rule::ident => Expr {
-                kind: ExprKind::Name(self.ident(p)),
-                span,
-            },
+            Rule::ident => Expr { kind: ExprKind::Name(self.ident(p)), span },
             Rule::call => {
                 let mut it = p.into_inner();
                 let name = self.ident(it.next().expect("callee"));
                 let args = it.map(|a| self.expr(a)).collect::<Result<Vec<_>, _>>()?;
-                Expr {
-                    kind: ExprKind::Call(name, args),
-                    span,
-                }
+                Expr { kind: ExprKind::Call(name, args), span }
             }
             Rule::expr => {
                 // Parenthesised: keep the span of the parentheses' content.
@@ -720,9 +643,7 @@ mod tests {
         let (f, d) = parse(0, "let a = -x^2 + 3*y/2");
         assert!(d.is_empty(), "{d:?}");
         let Item::Let { value, .. } = &f.items[0] else { panic!() };
-        let ExprKind::Binary(BinOp::Add, lhs, _) = &value.kind else {
-            panic!("{value:?}")
-        };
+        let ExprKind::Binary(BinOp::Add, lhs, _) = &value.kind else { panic!("{value:?}") };
         assert!(matches!(lhs.kind, ExprKind::Neg(_)));
     }
 
@@ -730,9 +651,7 @@ mod tests {
     fn integrand_stops_before_next_integral() {
         let (f, d) = parse(0, "form a(u; v) = int(Omega) dot(u, v) + 1 - int(G) dot(u,v)");
         assert!(d.is_empty(), "{d:?}");
-        let Item::Form { integrals, .. } = &f.items[0] else {
-            panic!()
-        };
+        let Item::Form { integrals, .. } = &f.items[0] else { panic!() };
         assert_eq!(integrals.len(), 2);
         assert_eq!(integrals[1].sign, -1.0);
     }

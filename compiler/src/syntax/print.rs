@@ -12,9 +12,7 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
         let head = format!("{line}:{col} ");
         match item {
             Item::Import { path, .. } => out.push_str(&format!("{head}import {path:?}\n")),
-            Item::Param {
-                name, default, range, ..
-            } => {
+            Item::Param { name, default, range, .. } => {
                 out.push_str(&format!("{head}param {} = {}", name.name, expr(default)));
                 if let Some(r) = range {
                     out.push_str(&format!(
@@ -33,19 +31,9 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 let ps: Vec<_> = params.iter().map(|p| p.name.as_str()).collect();
                 out.push_str(&format!("{head}fn {}({}) = {}\n", name.name, ps.join(", "), expr(body)));
             }
-            Item::Scheme {
-                name,
-                params,
-                states,
-                lets,
-                initial,
-                stages,
-                ..
-            } => {
-                let ps: Vec<String> = params
-                    .iter()
-                    .map(|p| format!("{} = {}", p.name.name, expr(&p.default)))
-                    .collect();
+            Item::Scheme { name, params, states, lets, initial, stages, .. } => {
+                let ps: Vec<String> =
+                    params.iter().map(|p| format!("{} = {}", p.name.name, expr(&p.default))).collect();
                 out.push_str(&format!("{head}scheme {}({})\n", name.name, ps.join(", ")));
                 let ss: Vec<&str> = states.iter().map(|s| s.name.as_str()).collect();
                 out.push_str(&format!("  state {}\n", ss.join(", ")));
@@ -62,10 +50,7 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 }
                 for st in stages {
                     let at = st.at.as_ref().map_or("(t + dt)".to_string(), expr);
-                    out.push_str(&format!(
-                        "  stage {} at {at}\n",
-                        st.name.as_ref().map_or("_", |n| n.name.as_str())
-                    ));
+                    out.push_str(&format!("  stage {} at {at}\n", st.name.as_ref().map_or("_", |n| n.name.as_str())));
                     for (n, v) in &st.lets {
                         out.push_str(&format!("    let {} = {}\n", n.name, expr(v)));
                     }
@@ -80,13 +65,7 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                     }
                 }
             }
-            Item::Form {
-                name,
-                fields,
-                test,
-                integrals,
-                ..
-            } => {
+            Item::Form { name, fields, test, integrals, .. } => {
                 let fs: Vec<_> = fields.iter().map(|p| p.name.as_str()).collect();
                 out.push_str(&format!("{head}form {}({}; {})\n", name.name, fs.join(", "), test.name));
                 for i in integrals {

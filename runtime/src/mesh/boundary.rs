@@ -20,13 +20,7 @@ pub(super) fn boundary_facets(mesh: &Mesh) -> Vec<Facet> {
         let cell = mesh.cell(c);
         for (f, verts) in local.iter().enumerate() {
             let vs: Vec<u32> = verts.iter().map(|&v| cell[v]).collect();
-            let entry = count.entry(facet_key(&vs)).or_insert((
-                0,
-                Facet {
-                    cell: c as u32,
-                    local: f as u8,
-                },
-            ));
+            let entry = count.entry(facet_key(&vs)).or_insert((0, Facet { cell: c as u32, local: f as u8 }));
             entry.0 += 1;
         }
     }

@@ -17,10 +17,7 @@ use crate::element::ElementKind;
 /// Reads a mesh file and validates its geometry.
 pub fn read(path: &Path) -> Result<Mesh, MeshError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| MeshError::File {
-        file: file.clone(),
-        reason: e.to_string(),
-    })?;
+    let bytes = std::fs::read(path).map_err(|e| MeshError::File { file: file.clone(), reason: e.to_string() })?;
     parse(&bytes, &file)
 }
 
@@ -39,16 +36,8 @@ enum At {
 
 fn err(file: &str, at: At, reason: impl Into<String>) -> MeshError {
     match at {
-        At::Line(line) => MeshError::Line {
-            file: file.to_string(),
-            line,
-            reason: reason.into(),
-        },
-        At::Byte(offset) => MeshError::Byte {
-            file: file.to_string(),
-            offset,
-            reason: reason.into(),
-        },
+        At::Line(line) => MeshError::Line { file: file.to_string(), line, reason: reason.into() },
+        At::Byte(offset) => MeshError::Byte { file: file.to_string(), offset, reason: reason.into() },
     }
 }
 
@@ -107,23 +96,11 @@ struct Parser<'a> {
 
 impl<'a> Parser<'a> {
     fn new(bytes: &'a [u8], file: &'a str) -> Self {
-        Parser {
-            bytes,
-            file,
-            pos: 0,
-            line: 1,
-            binary: false,
-            little_endian: true,
-            version: 0,
-        }
+        Parser { bytes, file, pos: 0, line: 1, binary: false, little_endian: true, version: 0 }
     }
 
     fn at(&self) -> At {
-        if self.binary {
-            At::Byte(self.pos)
-        } else {
-            At::Line(self.line)
-        }
+        if self.binary { At::Byte(self.pos) } else { At::Line(self.line) }
     }
 
     /// The position of the next token (ASCII: after skipping whitespace, so on its line).
@@ -180,9 +157,7 @@ impl<'a> Parser<'a> {
         let tok = std::str::from_utf8(&bytes[start..self.pos])
             .map_err(|_| self.line_error(format!("expected {what}, found non-UTF-8 bytes")))?;
         if tok.starts_with('$') {
-            return Err(self.line_error(format!(
-                "expected {what}, found `{tok}` (a count does not match the data)"
-            )));
+            return Err(self.line_error(format!("expected {what}, found `{tok}` (a count does not match the data)")));
         }
         Ok(tok)
     }
@@ -192,8 +167,7 @@ impl<'a> Parser<'a> {
             return self.bin_u64(what);
         }
         let t = self.token(what)?;
-        t.parse::<u64>()
-            .map_err(|_| self.line_error(format!("expected {what} (a non-negative integer), found `{t}`")))
+        t.parse::<u64>().map_err(|_| self.line_error(format!("expected {what} (a non-negative integer), found `{t}`")))
     }
 
     fn int(&mut self, what: &str) -> Result<i64, MeshError> {
@@ -201,8 +175,7 @@ impl<'a> Parser<'a> {
             return self.bin_i32(what).map(i64::from);
         }
         let t = self.token(what)?;
-        t.parse::<i64>()
-            .map_err(|_| self.line_error(format!("expected {what} (an integer), found `{t}`")))
+        t.parse::<i64>().map_err(|_| self.line_error(format!("expected {what} (an integer), found `{t}`")))
     }
 
     /// An int in binary files (4 bytes), an integer token in ASCII.
@@ -219,15 +192,10 @@ impl<'a> Parser<'a> {
         let v = if self.binary {
             let b = self.take(8, what)?;
             let a: [u8; 8] = b.try_into().expect("8 bytes");
-            if self.little_endian {
-                f64::from_le_bytes(a)
-            } else {
-                f64::from_be_bytes(a)
-            }
+            if self.little_endian { f64::from_le_bytes(a) } else { f64::from_be_bytes(a) }
         } else {
             let t = self.token(what)?;
-            t.parse::<f64>()
-                .map_err(|_| self.line_error(format!("expected {what} (a number), found `{t}`")))?
+            t.parse::<f64>().map_err(|_| self.line_error(format!("expected {what} (a number), found `{t}`")))?
         };
         if !v.is_finite() {
             return Err(err(self.file, at, format!("{what} is not finite ({v})")));
@@ -246,20 +214,12 @@ impl<'a> Parser<'a> {
 
     fn bin_i32(&mut self, what: &str) -> Result<i32, MeshError> {
         let a: [u8; 4] = self.take(4, what)?.try_into().expect("4 bytes");
-        Ok(if self.little_endian {
-            i32::from_le_bytes(a)
-        } else {
-            i32::from_be_bytes(a)
-        })
+        Ok(if self.little_endian { i32::from_le_bytes(a) } else { i32::from_be_bytes(a) })
     }
 
     fn bin_u64(&mut self, what: &str) -> Result<u64, MeshError> {
         let a: [u8; 8] = self.take(8, what)?.try_into().expect("8 bytes");
-        Ok(if self.little_endian {
-            u64::from_le_bytes(a)
-        } else {
-            u64::from_be_bytes(a)
-        })
+        Ok(if self.little_endian { u64::from_le_bytes(a) } else { u64::from_be_bytes(a) })
     }
 
     /// Expects the `$EndName` line that closes a section.
@@ -271,9 +231,9 @@ impl<'a> Parser<'a> {
             }
             let want = format!("$End{name}");
             if !self.bytes[self.pos..].starts_with(want.as_bytes()) {
-                return Err(self.error(format!(
-                    "expected `{want}` (the data of ${name} is longer than its counts say)"
-                )));
+                return Err(
+                    self.error(format!("expected `{want}` (the data of ${name} is longer than its counts say)"))
+                );
             }
             self.pos += want.len();
             if self.pos < self.bytes.len() && self.bytes[self.pos] == b'\r' {
@@ -338,9 +298,7 @@ impl<'a> Parser<'a> {
                 "PhysicalNames" => {
                     // ASCII even in binary files.
                     let binary = std::mem::replace(&mut self.binary, false);
-                    let result = self
-                        .physical_names(&mut raw)
-                        .and_then(|()| self.end_section("PhysicalNames"));
+                    let result = self.physical_names(&mut raw).and_then(|()| self.end_section("PhysicalNames"));
                     self.binary = binary;
                     result?;
                 }
@@ -366,29 +324,17 @@ impl<'a> Parser<'a> {
                 }
                 other => {
                     if other.starts_with("End") {
-                        return Err(err(
-                            self.file,
-                            At::Line(line_no),
-                            format!("`${other}` without its section"),
-                        ));
+                        return Err(err(self.file, At::Line(line_no), format!("`${other}` without its section")));
                     }
                     self.skip_section(other, line_no)?;
                 }
             }
         }
         if !seen_format {
-            return Err(err(
-                self.file,
-                At::Line(1),
-                "not a Gmsh mesh: the file is empty or has no `$MeshFormat`",
-            ));
+            return Err(err(self.file, At::Line(1), "not a Gmsh mesh: the file is empty or has no `$MeshFormat`"));
         }
         if raw.nodes.is_empty() {
-            return Err(err(
-                self.file,
-                At::Line(self.line),
-                "the file has no `$Nodes` section (or it is empty)",
-            ));
+            return Err(err(self.file, At::Line(self.line), "the file has no `$Nodes` section (or it is empty)"));
         }
         Ok(raw)
     }
@@ -405,19 +351,13 @@ impl<'a> Parser<'a> {
                 self.next_line();
                 Ok(())
             }
-            None => Err(err(
-                self.file,
-                At::Line(start),
-                format!("section `${name}` has no `{end}`"),
-            )),
+            None => Err(err(self.file, At::Line(start), format!("section `${name}` has no `{end}`"))),
         }
     }
 
     fn mesh_format(&mut self) -> Result<(), MeshError> {
         let line_no = self.line;
-        let line = self
-            .next_line()
-            .ok_or_else(|| self.line_error("unexpected end of file in `$MeshFormat`"))?;
+        let line = self.next_line().ok_or_else(|| self.line_error("unexpected end of file in `$MeshFormat`"))?;
         let parts: Vec<&str> = line.split_whitespace().collect();
         let [version, file_type, data_size] = parts[..] else {
             return Err(err(
@@ -456,11 +396,7 @@ impl<'a> Parser<'a> {
             ));
         }
         if data_size != "8" {
-            return Err(err(
-                self.file,
-                At::Line(line_no),
-                format!("data-size must be 8, not `{data_size}`"),
-            ));
+            return Err(err(self.file, At::Line(line_no), format!("data-size must be 8, not `{data_size}`")));
         }
         if self.binary {
             let at = self.at();
@@ -483,16 +419,9 @@ impl<'a> Parser<'a> {
             // The name is the rest of the line, in quotes.
             let line_no = self.line;
             let rest = self.next_line().unwrap_or("").trim();
-            let name = rest
-                .strip_prefix('"')
-                .and_then(|r| r.strip_suffix('"'))
-                .ok_or_else(|| {
-                    err(
-                        self.file,
-                        At::Line(line_no),
-                        format!("expected a quoted name, found `{}`", truncate(rest)),
-                    )
-                })?;
+            let name = rest.strip_prefix('"').and_then(|r| r.strip_suffix('"')).ok_or_else(|| {
+                err(self.file, At::Line(line_no), format!("expected a quoted name, found `{}`", truncate(rest)))
+            })?;
             raw.names.insert((dim.min(3) as u32, tag), name.to_string());
         }
         Ok(())
@@ -570,10 +499,7 @@ impl<'a> Parser<'a> {
             return Err(err(
                 self.file,
                 at,
-                format!(
-                    "the header announces {total} nodes, the blocks hold {}",
-                    raw.nodes.len() - before
-                ),
+                format!("the header announces {total} nodes, the blocks hold {}", raw.nodes.len() - before),
             ));
         }
         Ok(())
@@ -601,13 +527,7 @@ impl<'a> Parser<'a> {
             // The first tag is the physical group (0: none).
             let physicals = tags.first().filter(|&&p| p != 0).map(|&p| vec![p]).unwrap_or_default();
             if element_info(kind).is_some() {
-                raw.elements.push(RawElement {
-                    tag,
-                    kind,
-                    nodes,
-                    physicals,
-                    at,
-                });
+                raw.elements.push(RawElement { tag, kind, nodes, physicals, at });
             }
         }
         Ok(())
@@ -649,13 +569,7 @@ impl<'a> Parser<'a> {
                     nodes.push(self.uint("a node tag")?);
                 }
                 if element_info(kind).is_some() {
-                    raw.elements.push(RawElement {
-                        tag,
-                        kind,
-                        nodes,
-                        physicals: physicals.clone(),
-                        at,
-                    });
+                    raw.elements.push(RawElement { tag, kind, nodes, physicals: physicals.clone(), at });
                 }
                 read += 1;
             }
@@ -672,11 +586,7 @@ impl<'a> Parser<'a> {
 }
 
 fn truncate(s: &str) -> String {
-    if s.chars().count() > 40 {
-        format!("{}…", s.chars().take(40).collect::<String>())
-    } else {
-        s.to_string()
-    }
+    if s.chars().count() > 40 { format!("{}…", s.chars().take(40).collect::<String>()) } else { s.to_string() }
 }
 
 fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
@@ -688,24 +598,15 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         }
     }
     let index_of = |tag: u64| raw.nodes.binary_search_by_key(&tag, |(t, _, _)| *t).ok();
-    let dim = raw
-        .elements
-        .iter()
-        .filter_map(|e| element_info(e.kind))
-        .map(|(d, _)| d)
-        .max()
-        .unwrap_or(0);
+    let dim = raw.elements.iter().filter_map(|e| element_info(e.kind)).map(|(d, _)| d).max().unwrap_or(0);
     if dim == 0 {
         return Err(MeshError::File {
             file: file.to_string(),
             reason: "no lines, triangles or tetrahedra in `$Elements`".into(),
         });
     }
-    let mut cells: Vec<&RawElement> = raw
-        .elements
-        .iter()
-        .filter(|e| element_info(e.kind).is_some_and(|(d, _)| d == dim))
-        .collect();
+    let mut cells: Vec<&RawElement> =
+        raw.elements.iter().filter(|e| element_info(e.kind).is_some_and(|(d, _)| d == dim)).collect();
     cells.sort_by_key(|e| e.tag);
     let kind = match cells[0].kind {
         1 => ElementKind::IntervalP1,
@@ -727,10 +628,7 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         return Err(err(
             file,
             other.at,
-            format!(
-                "mixed cell types ({} and {}): one element kind per mesh",
-                cells[0].kind, other.kind
-            ),
+            format!("mixed cell types ({} and {}): one element kind per mesh", cells[0].kind, other.kind),
         ));
     }
     for w in cells.windows(2) {
@@ -744,11 +642,7 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
     for e in &cells {
         for &t in &e.nodes {
             let i = index_of(t).ok_or_else(|| {
-                err(
-                    file,
-                    e.at,
-                    format!("element {} refers to node {t}, which is not in `$Nodes`", e.tag),
-                )
+                err(file, e.at, format!("element {} refers to node {t}, which is not in `$Nodes`", e.tag))
             })?;
             used[i] = true;
             cell_nodes.push(i);
@@ -770,19 +664,8 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         }
     }
     let cells_flat: Vec<u32> = cell_nodes.iter().map(|&i| new_index[i]).collect();
-    let mut mesh = Mesh {
-        kind,
-        coords,
-        cells: cells_flat,
-        regions: Vec::new(),
-        cell_groups: Vec::new(),
-    };
-    let name_of = |d: u32, tag: i64| {
-        raw.names
-            .get(&(d, tag))
-            .cloned()
-            .unwrap_or_else(|| format!("physical_{tag}"))
-    };
+    let mut mesh = Mesh { kind, coords, cells: cells_flat, regions: Vec::new(), cell_groups: Vec::new() };
+    let name_of = |d: u32, tag: i64| raw.names.get(&(d, tag)).cloned().unwrap_or_else(|| format!("physical_{tag}"));
     // Cell groups.
     let mut groups: BTreeMap<String, Vec<u32>> = BTreeMap::new();
     for (c, e) in cells.iter().enumerate() {
@@ -810,11 +693,7 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
             let mut vs = Vec::with_capacity(vertices);
             for &t in e.nodes.iter().take(vertices) {
                 let i = index_of(t).ok_or_else(|| {
-                    err(
-                        file,
-                        e.at,
-                        format!("element {} refers to node {t}, which is not in `$Nodes`", e.tag),
-                    )
+                    err(file, e.at, format!("element {} refers to node {t}, which is not in `$Nodes`", e.tag))
                 })?;
                 if new_index[i] == u32::MAX {
                     return Err(err(
@@ -825,13 +704,9 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
                 }
                 vs.push(new_index[i]);
             }
-            let f = *facet_of.get(&facet_key(&vs)).ok_or_else(|| {
-                err(
-                    file,
-                    e.at,
-                    format!("element {} is not a boundary facet of any cell", e.tag),
-                )
-            })?;
+            let f = *facet_of
+                .get(&facet_key(&vs))
+                .ok_or_else(|| err(file, e.at, format!("element {} is not a boundary facet of any cell", e.tag)))?;
             for &p in &e.physicals {
                 regions.entry(name_of(dim - 1, p)).or_default().push(f);
             }
@@ -846,10 +721,7 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         MeshError::Degenerate { cell, .. } | MeshError::Inverted { cell } => {
             err(file, cells[cell].at, format!("element {}: {e}", cells[cell].tag))
         }
-        other => MeshError::File {
-            file: file.to_string(),
-            reason: other.to_string(),
-        },
+        other => MeshError::File { file: file.to_string(), reason: other.to_string() },
     })?;
     Ok(mesh)
 }

@@ -102,13 +102,10 @@ impl Mesh {
     }
 
     pub fn region(&self, name: &str) -> Result<&Region, MeshError> {
-        self.regions
-            .iter()
-            .find(|r| r.name == name)
-            .ok_or_else(|| MeshError::NoSuchRegion {
-                name: name.to_string(),
-                known: self.regions.iter().map(|r| r.name.clone()).collect(),
-            })
+        self.regions.iter().find(|r| r.name == name).ok_or_else(|| MeshError::NoSuchRegion {
+            name: name.to_string(),
+            known: self.regions.iter().map(|r| r.name.clone()).collect(),
+        })
     }
 
     /// Adds (or replaces) a region made of the boundary facets whose outward unit normal and
@@ -118,10 +115,7 @@ impl Mesh {
             let (n, x) = self.facet_normal_and_centroid(*f);
             pred(&n, &x)
         });
-        let region = Region {
-            name: name.to_string(),
-            facets: facets.collect(),
-        };
+        let region = Region { name: name.to_string(), facets: facets.collect() };
         self.regions.retain(|r| r.name != name);
         self.regions.push(region);
         self.regions.last().expect("just pushed")
@@ -155,11 +149,7 @@ impl Mesh {
                 (0..2).map(|l| (0..2).map(|b| inv[b][l] * n_ref[b]).sum()).collect()
             }
             _ => {
-                let m = [
-                    [j[0][0], j[0][1], j[0][2]],
-                    [j[1][0], j[1][1], j[1][2]],
-                    [j[2][0], j[2][1], j[2][2]],
-                ];
+                let m = [[j[0][0], j[0][1], j[0][2]], [j[1][0], j[1][1], j[1][2]], [j[2][0], j[2][1], j[2][2]]];
                 let (_, inv) = geometry::invert(&m);
                 (0..3).map(|l| (0..3).map(|b| inv[b][l] * n_ref[b]).sum()).collect()
             }
@@ -175,10 +165,7 @@ impl Mesh {
             .iter()
             .flat_map(|f| {
                 let cell = self.cell(f.cell as usize);
-                self.kind
-                    .facet_nodes(f.local as usize)
-                    .into_iter()
-                    .map(move |i| cell[i])
+                self.kind.facet_nodes(f.local as usize).into_iter().map(move |i| cell[i])
             })
             .collect();
         nodes.sort_unstable();
@@ -215,10 +202,9 @@ impl Mesh {
     pub fn to_p2(&self, project: Option<&Projection<'_>>) -> Mesh {
         let (kind, edges): (ElementKind, &[[usize; 2]]) = match self.kind {
             ElementKind::TriangleP1 => (ElementKind::TriangleP2, &[[0, 1], [1, 2], [2, 0]]),
-            ElementKind::TetrahedronP1 => (
-                ElementKind::TetrahedronP2,
-                &[[0, 1], [1, 2], [0, 2], [0, 3], [2, 3], [1, 3]],
-            ),
+            ElementKind::TetrahedronP1 => {
+                (ElementKind::TetrahedronP2, &[[0, 1], [1, 2], [0, 2], [0, 3], [2, 3], [1, 3]])
+            }
             _ => return self.clone(),
         };
         let d = self.dim();
@@ -265,13 +251,7 @@ impl Mesh {
                 cells.push(id);
             }
         }
-        Mesh {
-            kind,
-            coords,
-            cells,
-            regions: self.regions.clone(),
-            cell_groups: self.cell_groups.clone(),
-        }
+        Mesh { kind, coords, cells, regions: self.regions.clone(), cell_groups: self.cell_groups.clone() }
     }
 }
 

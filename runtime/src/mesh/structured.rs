@@ -20,25 +20,10 @@ pub fn interval(n: usize, a: f64, b: f64) -> Mesh {
     let coords = (0..=n).map(|i| a + (b - a) * i as f64 / n as f64).collect();
     let cells = (0..n as u32).flat_map(|i| [i, i + 1]).collect();
     let regions = vec![
-        Region {
-            name: "left".into(),
-            facets: vec![Facet { cell: 0, local: 0 }],
-        },
-        Region {
-            name: "right".into(),
-            facets: vec![Facet {
-                cell: n as u32 - 1,
-                local: 1,
-            }],
-        },
+        Region { name: "left".into(), facets: vec![Facet { cell: 0, local: 0 }] },
+        Region { name: "right".into(), facets: vec![Facet { cell: n as u32 - 1, local: 1 }] },
     ];
-    Mesh {
-        kind: ElementKind::IntervalP1,
-        coords,
-        cells,
-        regions,
-        cell_groups: Vec::new(),
-    }
+    Mesh { kind: ElementKind::IntervalP1, coords, cells, regions, cell_groups: Vec::new() }
 }
 
 /// `nx × ny` squares of [x0, x1] × [y0, y1], two triangles each, P1 or P2 (`degree`).
@@ -62,23 +47,9 @@ pub fn rectangle(nx: usize, ny: usize, x: [f64; 2], y: [f64; 2], diagonal: Diago
             }
         }
     }
-    let mesh = Mesh {
-        kind: ElementKind::TriangleP1,
-        coords,
-        cells,
-        regions: Vec::new(),
-        cell_groups: Vec::new(),
-    };
+    let mesh = Mesh { kind: ElementKind::TriangleP1, coords, cells, regions: Vec::new(), cell_groups: Vec::new() };
     let mut mesh = if degree >= 2 { mesh.to_p2(None) } else { mesh };
-    name_sides(
-        &mut mesh,
-        &[
-            ("left", 0, -1.0),
-            ("right", 0, 1.0),
-            ("bottom", 1, -1.0),
-            ("top", 1, 1.0),
-        ],
-    );
+    name_sides(&mut mesh, &[("left", 0, -1.0), ("right", 0, 1.0), ("bottom", 1, -1.0), ("top", 1, 1.0)]);
     mesh
 }
 
@@ -114,13 +85,8 @@ pub fn cuboid(n: [usize; 3], x: [f64; 2], y: [f64; 2], z: [f64; 2], degree: u32)
             }
         }
     }
-    let mut mesh = Mesh {
-        kind: ElementKind::TetrahedronP1,
-        coords,
-        cells,
-        regions: Vec::new(),
-        cell_groups: Vec::new(),
-    };
+    let mut mesh =
+        Mesh { kind: ElementKind::TetrahedronP1, coords, cells, regions: Vec::new(), cell_groups: Vec::new() };
     orient_positively(&mut mesh);
     let mut mesh = if degree >= 2 { mesh.to_p2(None) } else { mesh };
     name_sides(
@@ -143,10 +109,7 @@ fn orient_positively(mesh: &mut Mesh) {
     let nn = mesh.kind.nodes();
     for c in 0..mesh.num_cells() {
         let cell = &mesh.cells[c * nn..(c + 1) * nn];
-        let p: Vec<&[f64]> = cell
-            .iter()
-            .map(|&i| &mesh.coords[i as usize * d..(i as usize + 1) * d])
-            .collect();
+        let p: Vec<&[f64]> = cell.iter().map(|&i| &mesh.coords[i as usize * d..(i as usize + 1) * d]).collect();
         let e: Vec<Vec<f64>> = (1..=d).map(|a| (0..d).map(|k| p[a][k] - p[0][k]).collect()).collect();
         let det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0])
             + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);

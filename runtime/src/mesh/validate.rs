@@ -11,11 +11,7 @@ pub enum MeshError {
     Line { file: String, line: usize, reason: String },
     /// A problem at a byte offset of a binary file.
     #[error("{file}: at byte {offset}: {reason}")]
-    Byte {
-        file: String,
-        offset: usize,
-        reason: String,
-    },
+    Byte { file: String, offset: usize, reason: String },
     /// A problem with a file as a whole.
     #[error("{file}: {reason}")]
     File { file: String, reason: String },
@@ -49,11 +45,7 @@ impl Mesh {
         for c in 0..self.num_cells() {
             let cell = self.cell(c);
             if let Some(&bad) = cell.iter().find(|&&n| n as usize >= nodes) {
-                return Err(MeshError::NodeOutOfRange {
-                    cell: c,
-                    node: bad as usize,
-                    nodes,
-                });
+                return Err(MeshError::NodeOutOfRange { cell: c, node: bad as usize, nodes });
             }
             let h = self.cell_diameter(c);
             let tol = 1e-10 * h.powi(d as i32);

@@ -1,0 +1,498 @@
+//! Time schemes compiled from `.wf` files: the static description a generated scheme provides,
+//! and the engine that steps with it.
+//!
+//! Per stage, the compiler has written every term's arguments as `α·w + Σ βₖ·knownₖ` (w the
+//! stage's unknown). The engine precomputes the known parts once per stage, assembles the
+//! constant operator Σ coef·α·K of the linear forms once per time step size, and runs Newton on
+//! the rest (the contact terms), reusing the factorization while the active set is unchanged.
+
+use std::collections::HashMap;
+
+use crate::assembly::{Assembler, Kernel, Quadrature};
+use crate::linalg::{Matrix, Structure};
+use crate::mesh::Facet;
+use crate::newton::{Newton, NewtonError, NewtonOptions, NewtonReport, NonlinearProblem};
+use crate::problem::Constraints;
+
+/// A vector known when a stage starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Level {
+    /// A state at the start of the step.
+    State(usize),
+    /// Quantity `.1` of an earlier stage `.0`.
+    Stage(usize, usize),
+}
+
+/// `c[unknown]·w + Σ c[k]·level` (indices into the coefficient array; `None`: no unknown).
+#[derive(Clone, Copy, Debug)]
+pub struct Combination {
+    pub unknown: Option<usize>,
+    pub known: &'static [(Level, usize)],
+}
+
+/// `c[coef] · form(args)` at time `c[time]`.
+#[derive(Clone, Copy, Debug)]
+pub struct TermDesc {
+    pub coef: usize,
+    pub form: &'static str,
+    pub args: &'static [Combination],
+    pub time: usize,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct StageDesc {
+    pub name: &'static str,
+    pub time: usize,
+    /// New quantities, the unknown first.
+    pub quantities: &'static [&'static str],
+    pub values: &'static [Combination],
+    pub terms: &'static [TermDesc],
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct InitialDesc {
+    pub state: usize,
+    pub terms: &'static [TermDesc],
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct SchemeDesc {
+    pub name: &'static str,
+    pub states: &'static [&'static str],
+    pub initial: Option<InitialDesc>,
+    pub stages: &'static [StageDesc],
+    /// The level each state takes at the end of a step.
+    pub updates: &'static [Level],
+    /// Length of the coefficient array.
+    pub coefficients: usize,
+}
+
+/// Implemented by every generated scheme.
+pub trait TimeScheme {
+    const DESC: SchemeDesc;
+    /// Evaluates every coefficient for step size `dt` from time `t`.
+    fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]);
+}
+
+/// A compiled form bound to a mesh: its kernel, the mesh facets of each boundary region it
+/// integrates over, and quadrature degrees. Object-safe, so a scheme's forms may differ in type.
+pub trait BoundForm {
+    fn name(&self) -> &str;
+    fn fields(&self) -> usize;
+    fn linear(&self) -> bool;
+    fn piecewise(&self) -> bool;
+    fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]);
+    fn tangent(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix);
+    fn switches(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, out: &mut Vec<bool>);
+}
+
+/// A kernel with its integration data.
+pub struct Bound<'m, K: Kernel> {
+    pub kernel: K,
+    pub quadrature: Quadrature,
+    /// For each boundary region of the form (by its name in the .wf file), the mesh facets.
+    pub regions: Vec<(String, &'m [Facet])>,
+}
+
+impl<K: Kernel> BoundForm for Bound<'_, K> {
+    fn name(&self) -> &str {
+        K::META.name
+    }
+    fn fields(&self) -> usize {
+        K::META.fields.len()
+    }
+    fn linear(&self) -> bool {
+        K::META.linear
+    }
+    fn piecewise(&self) -> bool {
+        K::META.piecewise
+    }
+    fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {
+        if K::META.cell_degree.is_some() {
+            asm.cell_residual(&self.kernel, self.quadrature, fields, t, out);
+        }
+        for (region, facets) in &self.regions {
+            asm.facet_residual(&self.kernel, region, facets, self.quadrature, fields, t, out);
+        }
+    }
+    fn tangent(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
+        if K::META.cell_degree.is_some() {
+            asm.cell_tangent(&self.kernel, self.quadrature, fields, wrt, t, m);
+        }
+        for (region, facets) in &self.regions {
+            asm.facet_tangent(&self.kernel, region, facets, self.quadrature, fields, wrt, t, m);
+        }
+    }
+    fn switches(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, out: &mut Vec<bool>) {
+        for (region, facets) in &self.regions {
+            asm.facet_switches(&self.kernel, region, facets, self.quadrature, fields, wrt, t, out);
+        }
+    }
+}
+
+/// A linear form given by its matrix (e.g. a redistributed mass matrix).
+pub struct MatrixForm {
+    pub name: String,
+    pub matrix: Matrix,
+}
+
+impl BoundForm for MatrixForm {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn fields(&self) -> usize {
+        1
+    }
+    fn linear(&self) -> bool {
+        true
+    }
+    fn piecewise(&self) -> bool {
+        true
+    }
+    fn residual(&self, _asm: &Assembler, fields: &[&[f64]], _t: f64, out: &mut [f64]) {
+        let mut y = vec![0.0; out.len()];
+        self.matrix.mul_vec(fields[0], &mut y);
+        out.iter_mut().zip(&y).for_each(|(o, v)| *o += v);
+    }
+    fn tangent(&self, _asm: &Assembler, _fields: &[&[f64]], _wrt: usize, _t: f64, m: &mut Matrix) {
+        m.add_scaled(1.0, &self.matrix);
+    }
+    fn switches(&self, _asm: &Assembler, _fields: &[&[f64]], _wrt: usize, _t: f64, _out: &mut Vec<bool>) {}
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum StepError {
+    #[error("scheme `{scheme}` uses form `{form}`, which the case does not provide")]
+    MissingForm { scheme: &'static str, form: String },
+    #[error("form `{form}` takes {expected} field(s), but the scheme applies it to {given}")]
+    Arity { form: String, expected: usize, given: usize },
+    #[error("stage `{stage}` at t = {t}: {source}")]
+    Newton { stage: &'static str, t: f64, source: NewtonError },
+}
+
+/// Statistics of one step.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct StepReport {
+    /// Newton report per stage.
+    pub stages: Vec<NewtonReport>,
+}
+
+impl StepReport {
+    pub fn iterations(&self) -> usize {
+        self.stages.iter().map(NewtonReport::iterations).sum()
+    }
+}
+
+/// Steps a scheme on a mesh with bound forms.
+pub struct Stepper<'a, S: TimeScheme> {
+    pub scheme: S,
+    asm: &'a Assembler<'a>,
+    forms: HashMap<String, Box<dyn BoundForm + 'a>>,
+    pub constraints: Constraints,
+    structure: Structure,
+    pub newton_options: NewtonOptions,
+    /// Per stage: its Newton (keeps its factorization) and the constant operator for `dt`.
+    stages: Vec<StageCache>,
+    /// Linear forms' matrices (assembled once).
+    matrices: HashMap<String, Matrix>,
+    coefs: Vec<f64>,
+}
+
+struct StageCache {
+    newton: Newton,
+    dt: f64,
+    constant: Option<Matrix>,
+}
+
+impl<'a, S: TimeScheme> Stepper<'a, S> {
+    /// `forms` binds the form names the scheme uses to bound kernels (a slot may hold any form
+    /// of the right arity: `contact` is Nitsche's or the penalty's). `structure`: Cholesky for
+    /// symmetric positive definite stage Jacobians, LU otherwise.
+    pub fn new(
+        scheme: S,
+        asm: &'a Assembler<'a>,
+        forms: Vec<(&str, Box<dyn BoundForm + 'a>)>,
+        constraints: Constraints,
+        structure: Structure,
+        newton_options: NewtonOptions,
+    ) -> Result<Self, StepError> {
+        let forms: HashMap<String, Box<dyn BoundForm + 'a>> =
+            forms.into_iter().map(|(slot, f)| (slot.to_string(), f)).collect();
+        let desc = S::DESC;
+        let all_terms =
+            desc.stages.iter().flat_map(|s| s.terms.iter()).chain(desc.initial.iter().flat_map(|i| i.terms.iter()));
+        for term in all_terms {
+            let form = forms
+                .get(term.form)
+                .ok_or_else(|| StepError::MissingForm { scheme: desc.name, form: term.form.to_string() })?;
+            if form.fields() != term.args.len() {
+                return Err(StepError::Arity {
+                    form: term.form.to_string(),
+                    expected: form.fields(),
+                    given: term.args.len(),
+                });
+            }
+        }
+        let mut matrices = HashMap::new();
+        let zero = vec![0.0; asm.size()];
+        for (name, f) in &forms {
+            if f.linear() && f.fields() == 1 {
+                let mut m = asm.zero_matrix();
+                f.tangent(asm, &[&zero], 0, 0.0, &mut m);
+                matrices.insert(name.clone(), m);
+            }
+        }
+        let stages = (0..desc.stages.len() + 1)
+            .map(|_| StageCache { newton: Newton::new(newton_options), dt: f64::NAN, constant: None })
+            .collect();
+        Ok(Stepper {
+            scheme,
+            asm,
+            forms,
+            constraints,
+            structure,
+            newton_options,
+            stages,
+            matrices,
+            coefs: vec![0.0; desc.coefficients],
+        })
+    }
+
+    /// The matrix of a linear one-field form (e.g. `mass`, for energies).
+    pub fn matrix(&self, form: &str) -> Option<&Matrix> {
+        self.matrices.get(form)
+    }
+
+    /// Solves the initial problem (e.g. M a⁰ = L⁰ − B(u⁰)) for its state, if the scheme has one.
+    pub fn initialize(&mut self, states: &mut [Vec<f64>], t: f64) -> Result<Option<NewtonReport>, StepError> {
+        let Some(init) = S::DESC.initial else { return Ok(None) };
+        self.scheme.coefficients(1.0, t, &mut self.coefs);
+        let guess = states[init.state].clone();
+        let stage = StageDesc { name: "initial", time: 0, quantities: &[], values: &[], terms: init.terms };
+        let cache = self.stages.len() - 1;
+        let (w, report) = self.solve_stage(&stage, cache, states, &[], guess, 1.0, t)?;
+        states[init.state] = w;
+        Ok(Some(report))
+    }
+
+    /// Advances `states` from t to t + dt.
+    pub fn step(&mut self, states: &mut [Vec<f64>], t: f64, dt: f64) -> Result<StepReport, StepError> {
+        let desc = S::DESC;
+        self.scheme.coefficients(dt, t, &mut self.coefs);
+        let mut quantities: Vec<Vec<Vec<f64>>> = Vec::with_capacity(desc.stages.len());
+        let mut report = StepReport::default();
+        for (s, stage) in desc.stages.iter().enumerate() {
+            let name = stage.quantities[0];
+            let guess = desc
+                .states
+                .iter()
+                .position(|st| name.trim_end_matches('\'') == *st)
+                .map_or_else(|| states[0].clone(), |i| states[i].clone());
+            let (w, r) = self.solve_stage(stage, s, states, &quantities, guess, dt, t)?;
+            report.stages.push(r);
+            let values: Vec<Vec<f64>> =
+                stage.values.iter().map(|c| self.combine(c, Some(&w), states, &quantities)).collect();
+            quantities.push(values);
+        }
+        let new_states: Vec<Vec<f64>> = desc
+            .updates
+            .iter()
+            .map(|l| match *l {
+                Level::State(i) => states[i].clone(),
+                Level::Stage(s, q) => quantities[s][q].clone(),
+            })
+            .collect();
+        for (st, v) in states.iter_mut().zip(new_states) {
+            *st = v;
+        }
+        Ok(report)
+    }
+
+    /// Σ c·level (+ c_w·w).
+    fn combine(
+        &self,
+        c: &Combination,
+        w: Option<&[f64]>,
+        states: &[Vec<f64>],
+        quantities: &[Vec<Vec<f64>>],
+    ) -> Vec<f64> {
+        let n = self.asm.size();
+        let mut out = vec![0.0; n];
+        if let (Some(k), Some(w)) = (c.unknown, w) {
+            let a = self.coefs[k];
+            out.iter_mut().zip(w).for_each(|(o, x)| *o += a * x);
+        }
+        for &(level, k) in c.known {
+            let v = match level {
+                Level::State(i) => &states[i],
+                Level::Stage(s, q) => &quantities[s][q],
+            };
+            let a = self.coefs[k];
+            out.iter_mut().zip(v).for_each(|(o, x)| *o += a * x);
+        }
+        out
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn solve_stage(
+        &mut self,
+        stage: &StageDesc,
+        cache: usize,
+        states: &[Vec<f64>],
+        quantities: &[Vec<Vec<f64>>],
+        guess: Vec<f64>,
+        dt: f64,
+        t: f64,
+    ) -> Result<(Vec<f64>, NewtonReport), StepError> {
+        let n = self.asm.size();
+        let stage_t = self.coefs.get(stage.time).copied().filter(|_| !stage.quantities.is_empty()).unwrap_or(t);
+        // Known parts of every argument, and the constant part of the residual.
+        let mut constant_rhs = vec![0.0; n];
+        let mut nonlinear: Vec<ActiveTerm> = Vec::new();
+        let rebuild = self.stages[cache].dt != dt || self.stages[cache].constant.is_none();
+        let mut constant = if rebuild { Some(self.asm.zero_matrix()) } else { None };
+        for term in stage.terms {
+            let coef = self.coefs[term.coef];
+            let form = &self.forms[term.form];
+            let term_t = self.coefs[term.time];
+            if term.args.is_empty() {
+                let mut b = vec![0.0; n];
+                form.residual(self.asm, &[], term_t, &mut b);
+                constant_rhs.iter_mut().zip(&b).for_each(|(r, x)| *r += coef * x);
+                continue;
+            }
+            let bases: Vec<Vec<f64>> = term.args.iter().map(|c| self.combine(c, None, states, quantities)).collect();
+            let alphas: Vec<f64> = term.args.iter().map(|c| c.unknown.map_or(0.0, |k| self.coefs[k])).collect();
+            match self.matrices.get(term.form) {
+                Some(k) if alphas.len() == 1 => {
+                    // Linear: coef·K·(α w + base).
+                    let mut kb = vec![0.0; n];
+                    k.mul_vec(&bases[0], &mut kb);
+                    constant_rhs.iter_mut().zip(&kb).for_each(|(r, x)| *r += coef * x);
+                    if let Some(c) = constant.as_mut() {
+                        c.add_scaled(coef * alphas[0], k);
+                    }
+                }
+                _ if alphas.iter().all(|a| *a == 0.0) => {
+                    let refs: Vec<&[f64]> = bases.iter().map(Vec::as_slice).collect();
+                    let mut b = vec![0.0; n];
+                    form.residual(self.asm, &refs, term_t, &mut b);
+                    constant_rhs.iter_mut().zip(&b).for_each(|(r, x)| *r += coef * x);
+                }
+                _ => nonlinear.push(ActiveTerm { form: term.form, coef, alphas, bases, t: term_t }),
+            }
+        }
+        if let Some(c) = constant {
+            let entry = &mut self.stages[cache];
+            entry.constant = Some(c);
+            entry.dt = dt;
+            entry.newton.invalidate();
+        }
+        let piecewise = nonlinear.iter().all(|a| self.forms[a.form].piecewise());
+        let stage_cache = &mut self.stages[cache];
+        let mut problem = StageProblem {
+            asm: self.asm,
+            forms: &self.forms,
+            constant: stage_cache.constant.as_ref().expect("built above"),
+            rhs: constant_rhs,
+            terms: nonlinear,
+            constraints: &self.constraints,
+            structure: self.structure,
+            piecewise,
+        };
+        let mut w = guess;
+        self.constraints.impose(&mut w);
+        let report = stage_cache.newton.solve(&mut problem, &mut w).map_err(|source| StepError::Newton {
+            stage: stage.name,
+            t: stage_t,
+            source,
+        })?;
+        Ok((w, report))
+    }
+}
+
+/// A nonlinear term of a stage: coef·form(α₁w + b₁, ...).
+struct ActiveTerm {
+    form: &'static str,
+    coef: f64,
+    alphas: Vec<f64>,
+    bases: Vec<Vec<f64>>,
+    t: f64,
+}
+
+impl ActiveTerm {
+    fn args(&self, w: &[f64]) -> Vec<Vec<f64>> {
+        self.alphas
+            .iter()
+            .zip(&self.bases)
+            .map(|(a, b)| b.iter().zip(w).map(|(bi, wi)| bi + a * wi).collect())
+            .collect()
+    }
+}
+
+struct StageProblem<'p, 'a> {
+    asm: &'p Assembler<'a>,
+    forms: &'p HashMap<String, Box<dyn BoundForm + 'a>>,
+    constant: &'p Matrix,
+    rhs: Vec<f64>,
+    terms: Vec<ActiveTerm>,
+    constraints: &'p Constraints,
+    structure: Structure,
+    piecewise: bool,
+}
+
+impl NonlinearProblem for StageProblem<'_, '_> {
+    fn residual(&mut self, w: &[f64], r: &mut [f64]) {
+        self.constant.mul_vec(w, r);
+        r.iter_mut().zip(&self.rhs).for_each(|(ri, c)| *ri += c);
+        for term in &self.terms {
+            let args = term.args(w);
+            let refs: Vec<&[f64]> = args.iter().map(Vec::as_slice).collect();
+            let mut b = vec![0.0; r.len()];
+            self.forms[term.form].residual(self.asm, &refs, term.t, &mut b);
+            r.iter_mut().zip(&b).for_each(|(ri, x)| *ri += term.coef * x);
+        }
+        self.constraints.zero(r);
+    }
+
+    fn load_scale(&self) -> f64 {
+        crate::newton::norm_inf(&self.rhs)
+    }
+
+    fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool {
+        for term in &self.terms {
+            let args = term.args(w);
+            let refs: Vec<&[f64]> = args.iter().map(Vec::as_slice).collect();
+            for (k, a) in term.alphas.iter().enumerate() {
+                if *a != 0.0 {
+                    self.forms[term.form].switches(self.asm, &refs, k, term.t, out);
+                }
+            }
+        }
+        self.piecewise
+    }
+
+    fn jacobian(&mut self, w: &[f64], j: &mut Matrix) {
+        j.values.copy_from_slice(&self.constant.values);
+        for term in &self.terms {
+            let args = term.args(w);
+            let refs: Vec<&[f64]> = args.iter().map(Vec::as_slice).collect();
+            for (k, a) in term.alphas.iter().enumerate() {
+                if *a != 0.0 {
+                    let mut m = self.asm.zero_matrix();
+                    self.forms[term.form].tangent(self.asm, &refs, k, term.t, &mut m);
+                    j.add_scaled(term.coef * a, &m);
+                }
+            }
+        }
+        self.constraints.apply(j);
+    }
+
+    fn jacobian_matrix(&self) -> Matrix {
+        self.asm.zero_matrix()
+    }
+
+    fn structure(&self) -> Structure {
+        self.structure
+    }
+}

@@ -1,0 +1,364 @@
+//! `signorini run bar`: the compressed bar of spec §6.1 with any compiled scheme, Nitsche or
+//! penalty contact, against its exact solution.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::CaseError;
+use super::exact;
+use super::static_block::ContactMethod;
+use crate::forms::schemes;
+use crate::forms::{nitsche, penalty};
+use crate::runtime::assembly::{Assembler, Kernel, Quadrature};
+use crate::runtime::kernel::Coef;
+use crate::runtime::linalg::{Matrix, Structure};
+use crate::runtime::mesh::structured;
+use crate::runtime::newton::NewtonOptions;
+use crate::runtime::problem::Constraints;
+use crate::runtime::scheme::{Bound, BoundForm, Stepper, TimeScheme};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum SchemeChoice {
+    Newmark,
+    Hht,
+    HhtImex,
+    HhtUnweighted,
+    Midpoint,
+    Trbdf2,
+    Hybrid,
+}
+
+impl SchemeChoice {
+    pub const ALL: [SchemeChoice; 7] = [
+        SchemeChoice::Newmark,
+        SchemeChoice::Hht,
+        SchemeChoice::HhtImex,
+        SchemeChoice::HhtUnweighted,
+        SchemeChoice::Midpoint,
+        SchemeChoice::Trbdf2,
+        SchemeChoice::Hybrid,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SchemeChoice::Newmark => "newmark",
+            SchemeChoice::Hht => "hht",
+            SchemeChoice::HhtImex => "hht-imex",
+            SchemeChoice::HhtUnweighted => "hht-unweighted",
+            SchemeChoice::Midpoint => "midpoint",
+            SchemeChoice::Trbdf2 => "trbdf2",
+            SchemeChoice::Hybrid => "hybrid",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    pub scheme: SchemeChoice,
+    /// HHT's α (HHT variants only).
+    pub alpha: Option<f64>,
+    pub contact: ContactMethod,
+    pub theta: f64,
+    pub gamma0: f64,
+    pub elements: usize,
+    pub dt: f64,
+    pub t_end: f64,
+    pub newton: NewtonOptions,
+    pub out: Option<PathBuf>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            scheme: SchemeChoice::Newmark,
+            alpha: None,
+            contact: ContactMethod::Nitsche,
+            theta: 1.0,
+            gamma0: 5.0,
+            elements: 20,
+            dt: 0.01,
+            t_end: 12.0,
+            newton: NewtonOptions::default(),
+            out: None,
+        }
+    }
+}
+
+/// One row of `series.csv`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    pub t: f64,
+    pub u_c: f64,
+    pub v_c: f64,
+    pub lambda: f64,
+    pub energy: f64,
+    pub energy_aug: f64,
+    pub penetration: f64,
+    pub newton: usize,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub case: &'static str,
+    pub scheme: SchemeChoice,
+    pub alpha: Option<f64>,
+    pub contact: ContactMethod,
+    pub theta: f64,
+    pub gamma0: f64,
+    pub elements: usize,
+    pub dt: f64,
+    pub t_end: f64,
+    pub dofs: usize,
+    pub steps: usize,
+    /// max_n ‖u_h − I_h u‖_M / max_n ‖I_h u‖_M.
+    pub err_linf_l2_u: f64,
+    /// (Σ (λⁿ − σ_ex(0, tⁿ))²)^½ / (Σ σ_ex(0, tⁿ)²)^½.
+    pub err_l2_lambda: f64,
+    pub energy_initial: f64,
+    pub energy_final: f64,
+    pub energy_aug_initial: f64,
+    pub energy_aug_final: f64,
+    /// (E_Θ(T) − E_Θ(0)) / E_Θ(0).
+    pub energy_aug_drift_final: f64,
+    /// max_n |E_Θⁿ − E_Θ(0)| / E_Θ(0).
+    pub energy_aug_drift_max: f64,
+    pub max_penetration: f64,
+    pub newton_total: usize,
+    pub newton_max: usize,
+    pub wall_seconds: f64,
+}
+
+pub struct Run {
+    pub summary: Summary,
+    pub series: Vec<Row>,
+}
+
+/// Runs the bar; writes series.csv and summary.json into `opts.out` if set.
+pub fn run(opts: &Options) -> Result<Run, CaseError> {
+    if opts.elements == 0 || opts.elements > 100_000 {
+        return Err(CaseError::Option(format!("--ne must be in 1..=100000, not {}", opts.elements)));
+    }
+    if !(opts.dt > 0.0 && opts.dt.is_finite()) || !(opts.t_end > 0.0 && opts.t_end.is_finite()) {
+        return Err(CaseError::Option("--dt and --t-end must be positive".into()));
+    }
+    if opts.t_end / opts.dt > 1e7 {
+        return Err(CaseError::Option("more than 10⁷ steps".into()));
+    }
+    let hht = matches!(opts.scheme, SchemeChoice::Hht | SchemeChoice::HhtImex | SchemeChoice::HhtUnweighted);
+    if opts.alpha.is_some() && !hht {
+        return Err(CaseError::Option(format!("--alpha applies to the HHT schemes, not {}", opts.scheme.name())));
+    }
+    let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
+    let alpha = opts.alpha.unwrap_or(0.05);
+    match opts.scheme {
+        SchemeChoice::Newmark => simulate(opts, schemes::newmark::Newmark::default()),
+        SchemeChoice::Hht => simulate(opts, schemes::hht::Hht::default().with("alpha", alpha).map_err(bad)?),
+        SchemeChoice::HhtImex => {
+            simulate(opts, schemes::hht_imex::HhtImex::default().with("alpha", alpha).map_err(bad)?)
+        }
+        SchemeChoice::HhtUnweighted => {
+            simulate(opts, schemes::hht_unweighted::HhtUnweighted::default().with("alpha", alpha).map_err(bad)?)
+        }
+        SchemeChoice::Midpoint => simulate(opts, schemes::midpoint::Midpoint::default()),
+        SchemeChoice::Trbdf2 => simulate(opts, schemes::trbdf2::Trbdf2::default()),
+        SchemeChoice::Hybrid => simulate(opts, schemes::hybrid::Hybrid::default()),
+    }
+}
+
+fn bound<'m, K: Kernel + 'm>(
+    kernel: K,
+    quadrature: Quadrature,
+    contact: Option<&'m [crate::runtime::mesh::Facet]>,
+) -> Box<dyn BoundForm + 'm> {
+    let regions = contact.map(|f| vec![("Gamma_C".to_string(), f)]).unwrap_or_default();
+    Box::new(Bound { kernel, quadrature, regions })
+}
+
+fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> {
+    let start = Instant::now();
+    let ne = opts.elements;
+    let h = 1.0 / ne as f64;
+    let mesh = structured::interval(ne, 0.0, 1.0);
+    let asm = Assembler::new(&mesh);
+    let n = asm.size();
+    let contact_facets = asm.region("left")?;
+    let gap = || Coef::function(1, |x, _, out| out[0] = x[0]);
+    let normal = || Coef::constant(vec![-1.0]);
+    let zero_force = || Coef::constant(vec![0.0]);
+    let gamma = opts.gamma0 / h;
+    let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
+    let q = Quadrature::default();
+    let hybrid = opts.scheme == SchemeChoice::Hybrid;
+    let (forms, structure): (Vec<(&str, Box<dyn BoundForm + '_>)>, Structure) = match opts.contact {
+        ContactMethod::Nitsche => {
+            let p = nitsche::Params::default()
+                .with("gamma0", opts.gamma0)
+                .and_then(|p| p.with("theta", opts.theta))
+                .map_err(bad)?;
+            let c = nitsche::Coefficients { f: zero_force(), g: gap(), nc: normal() };
+            let mut forms: Vec<(&str, Box<dyn BoundForm>)> = vec![
+                ("mass", bound(nitsche::Mass::new(&p, &c), q, None)),
+                ("stiffness", bound(nitsche::Stiffness::new(&p, &c), q, None)),
+                ("load", bound(nitsche::Load::new(&p, &c), q, None)),
+                ("contact", bound(nitsche::Contact::new(&p, &c), q, Some(contact_facets))),
+            ];
+            if hybrid {
+                let hp = schemes::hybrid::Params::default()
+                    .with("gamma0", opts.gamma0)
+                    .and_then(|p| p.with("theta", opts.theta))
+                    .map_err(bad)?;
+                let hc = schemes::hybrid::Coefficients { f: zero_force(), g: gap(), nc: normal() };
+                forms.push((
+                    "hybrid_contact",
+                    bound(schemes::hybrid::HybridContact::new(&hp, &hc), q, Some(contact_facets)),
+                ));
+            }
+            (forms, if opts.theta == 1.0 { Structure::SymmetricPositiveDefinite } else { Structure::General })
+        }
+        ContactMethod::Penalty => {
+            let p = penalty::Params::default().with("gamma0", opts.gamma0).map_err(bad)?;
+            let c = penalty::Coefficients { f: zero_force(), g: gap(), nc: normal() };
+            let mut forms: Vec<(&str, Box<dyn BoundForm>)> = vec![
+                ("mass", bound(penalty::Mass::new(&p, &c), q, None)),
+                ("stiffness", bound(penalty::Stiffness::new(&p, &c), q, None)),
+                ("load", bound(penalty::Load::new(&p, &c), q, None)),
+                ("contact", bound(penalty::Contact::new(&p, &c), q, Some(contact_facets))),
+            ];
+            if hybrid {
+                let hp = schemes::hybrid::Params::default().with("gamma0", opts.gamma0).map_err(bad)?;
+                let hc = schemes::hybrid::Coefficients { f: zero_force(), g: gap(), nc: normal() };
+                forms.push((
+                    "hybrid_contact",
+                    bound(schemes::hybrid::HybridPenalty::new(&hp, &hc), q, Some(contact_facets)),
+                ));
+            }
+            (forms, Structure::SymmetricPositiveDefinite)
+        }
+    };
+    let mut constraints = Constraints::none(n);
+    constraints.fix(ne); // u(1) = 0
+    let mut stepper = Stepper::new(scheme, &asm, forms, constraints, structure, opts.newton)
+        .map_err(|e| CaseError::Option(e.to_string()))?;
+    let mass = stepper.matrix("mass").expect("mass is linear").clone();
+    let stiffness = stepper.matrix("stiffness").expect("stiffness is linear").clone();
+    // Initial state: u₀ = (1 − x)/2, v₀ = 0, a₀ from the scheme's initial problem.
+    let states_names = S::DESC.states;
+    let mut states: Vec<Vec<f64>> = states_names.iter().map(|_| vec![0.0; n]).collect();
+    states[0] = (0..n).map(|i| 0.5 * (1.0 - mesh.node(i)[0])).collect();
+    stepper.initialize(&mut states, 0.0).map_err(|e| CaseError::Option(e.to_string()))?;
+    let steps = (opts.t_end / opts.dt).round() as usize;
+    let mut series = Vec::with_capacity(steps + 1);
+    let measure = |u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
+        let u0 = u[0];
+        let ux = (u[1] - u[0]) / h;
+        let (lambda, aug) = match opts.contact {
+            ContactMethod::Nitsche => {
+                let p1 = ux + gamma * u0;
+                let neg = p1.min(0.0);
+                (neg, -opts.theta / (2.0 * gamma) * ux * ux + neg * neg / (2.0 * gamma))
+            }
+            ContactMethod::Penalty => {
+                let pen = gamma * u0.min(0.0);
+                (pen, 0.5 * gamma * u0.min(0.0).powi(2))
+            }
+        };
+        let energy = 0.5 * quad(&stiffness, u) + v.map_or(0.0, |v| 0.5 * quad(&mass, v));
+        Row {
+            t,
+            u_c: u0,
+            v_c: v.map_or(f64::NAN, |v| v[0]),
+            lambda,
+            energy,
+            energy_aug: energy + aug,
+            penetration: (-u0).max(0.0),
+            newton,
+        }
+    };
+    let v_index = states_names.iter().position(|s| *s == "v");
+    series.push(measure(&states[0], v_index.map(|i| states[i].as_slice()), 0, 0.0));
+    let (mut err_max, mut exact_max) = (0.0f64, 0.0f64);
+    let (mut lam_err, mut lam_norm) = (0.0, 0.0);
+    let mut track = |u: &[f64], row: &Row| {
+        let interp: Vec<f64> = (0..n).map(|i| exact::displacement(mesh.node(i)[0], row.t)).collect();
+        let diff: Vec<f64> = u.iter().zip(&interp).map(|(a, b)| a - b).collect();
+        err_max = err_max.max(quad(&mass, &diff).sqrt());
+        exact_max = exact_max.max(quad(&mass, &interp).sqrt());
+        let s = exact::contact_stress(row.t);
+        lam_err += (row.lambda - s).powi(2);
+        lam_norm += s * s;
+    };
+    track(&states[0], &series[0]);
+    let mut t = 0.0;
+    for k in 0..steps {
+        let report = stepper.step(&mut states, t, opts.dt).map_err(|e| CaseError::Option(e.to_string()))?;
+        t = (k + 1) as f64 * opts.dt;
+        let row = measure(&states[0], v_index.map(|i| states[i].as_slice()), report.iterations(), t);
+        track(&states[0], &row);
+        series.push(row);
+    }
+    let first = &series[0];
+    let last = series.last().expect("at least the initial row");
+    let e0 = first.energy_aug;
+    let summary = Summary {
+        case: "bar",
+        scheme: opts.scheme,
+        alpha: opts.alpha.or(matches!(
+            opts.scheme,
+            SchemeChoice::Hht | SchemeChoice::HhtImex | SchemeChoice::HhtUnweighted
+        )
+        .then_some(0.05)),
+        contact: opts.contact,
+        theta: opts.theta,
+        gamma0: opts.gamma0,
+        elements: ne,
+        dt: opts.dt,
+        t_end: t,
+        dofs: n,
+        steps,
+        err_linf_l2_u: err_max / exact_max,
+        err_l2_lambda: (lam_err / lam_norm).sqrt(),
+        energy_initial: first.energy,
+        energy_final: last.energy,
+        energy_aug_initial: e0,
+        energy_aug_final: last.energy_aug,
+        energy_aug_drift_final: (last.energy_aug - e0) / e0,
+        energy_aug_drift_max: series.iter().map(|r| (r.energy_aug - e0).abs()).fold(0.0, f64::max) / e0,
+        max_penetration: series.iter().map(|r| r.penetration).fold(0.0, f64::max),
+        newton_total: series.iter().map(|r| r.newton).sum(),
+        newton_max: series.iter().map(|r| r.newton).max().unwrap_or(0),
+        wall_seconds: start.elapsed().as_secs_f64(),
+    };
+    if let Some(dir) = &opts.out {
+        write_outputs(dir, &summary, &series)?;
+    }
+    Ok(Run { summary, series })
+}
+
+/// xᵀ A x.
+fn quad(a: &Matrix, x: &[f64]) -> f64 {
+    let mut y = vec![0.0; x.len()];
+    a.mul_vec(x, &mut y);
+    x.iter().zip(&y).map(|(p, q)| p * q).sum()
+}
+
+fn write_outputs(dir: &std::path::Path, summary: &Summary, series: &[Row]) -> Result<(), CaseError> {
+    let mut csv = String::from("t,u_c,v_c,lambda,energy,energy_aug,penetration,newton\n");
+    for r in series {
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{},{}\n",
+            r.t, r.u_c, r.v_c, r.lambda, r.energy, r.energy_aug, r.penetration, r.newton
+        ));
+    }
+    let write = |name: &str, bytes: &[u8]| {
+        let path = dir.join(name);
+        crate::output::write_atomic(&path, bytes)
+            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })
+    };
+    write("series.csv", csv.as_bytes())?;
+    let path = dir.join("summary.json");
+    crate::output::write_json(&path, summary)
+        .map_err(|source| CaseError::Write { path: path.display().to_string(), source })
+}

@@ -1,0 +1,69 @@
+//! The exact solution of the compressed bar (spec §6.1): Ω = (0, 1), E = ρ = 1, u(1, t) = 0,
+//! contact at x = 0, u₀(x) = (1 − x)/2, v₀ = 0. Period 3; zones by s = τ − ⌊τ⌋, τ = t mod 3.
+
+/// u(x, t).
+pub fn displacement(x: f64, t: f64) -> f64 {
+    let tau = t.rem_euclid(3.0);
+    let phase = tau.floor().min(2.0);
+    let s = tau - phase;
+    let left = s >= x; // zones II and IV
+    let upper = s > 1.0 - x; // zones III and IV
+    match (phase as u8, left, upper) {
+        (0, false, _) => (1.0 - x) / 2.0,
+        (0, true, _) => (1.0 - s) / 2.0,
+        (1, false, false) => -s / 2.0,
+        (1, true, false) => -x / 2.0,
+        (1, false, true) => (x - 1.0) / 2.0,
+        (1, true, true) => (s - 1.0) / 2.0,
+        (_, _, false) => s / 2.0,
+        (_, _, true) => (1.0 - x) / 2.0,
+    }
+}
+
+/// Contact stress E u_x(0, t): −½ while in contact (τ ∈ (1, 2)), else 0.
+pub fn contact_stress(t: f64) -> f64 {
+    let tau = t.rem_euclid(3.0);
+    if tau > 1.0 && tau < 2.0 { -0.5 } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matches_the_contact_point_table_and_the_initial_data() {
+        for k in 0..=100 {
+            let x = k as f64 / 100.0;
+            assert!((displacement(x, 0.0) - (1.0 - x) / 2.0).abs() < 1e-15);
+            assert_eq!(displacement(1.0, 0.37 * k as f64), 0.0);
+        }
+        for k in 0..300 {
+            let t = k as f64 * 0.01;
+            let tau = t % 3.0;
+            let u0 = if tau <= 1.0 {
+                (1.0 - tau) / 2.0
+            } else if tau <= 2.0 {
+                0.0
+            } else {
+                (tau - 2.0) / 2.0
+            };
+            assert!((displacement(0.0, t) - u0).abs() < 1e-14, "t = {t}");
+        }
+    }
+
+    /// The solution is continuous in x and t and satisfies d'Alembert's identity
+    /// u(x−h, t) + u(x+h, t) = u(x, t−h) + u(x, t+h) (wave speed 1) inside the bar.
+    #[test]
+    fn is_continuous_and_solves_the_wave_equation() {
+        let h = 1.0 / 64.0;
+        for i in 1..64 {
+            for n in 1..400 {
+                let (x, t) = (i as f64 * h, n as f64 * h);
+                let lhs = displacement(x - h, t) + displacement(x + h, t);
+                let rhs = displacement(x, t - h) + displacement(x, t + h);
+                assert!((lhs - rhs).abs() < 1e-13, "x = {x}, t = {t}: {lhs} vs {rhs}");
+                assert!((displacement(x + 1e-9, t) - displacement(x, t)).abs() < 1e-8);
+            }
+        }
+    }
+}
