@@ -211,7 +211,7 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
     pub fn new(
         scheme: S,
         asm: &'a Assembler<'a>,
-        forms: Vec<(&str, Box<dyn BoundForm + 'a>)>,
+        forms: Vec<(&'static str, Box<dyn BoundForm + 'a>)>,
         constraints: Constraints,
         structure: Structure,
         newton_options: NewtonOptions,

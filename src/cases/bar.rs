@@ -141,7 +141,8 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     if opts.elements == 0 || opts.elements > 100_000 {
         return Err(CaseError::Option(format!("--ne must be in 1..=100000, not {}", opts.elements)));
     }
-    if !(opts.dt > 0.0 && opts.dt.is_finite()) || !(opts.t_end > 0.0 && opts.t_end.is_finite()) {
+    let positive = |x: f64| x > 0.0 && x.is_finite();
+    if !positive(opts.dt) || !positive(opts.t_end) {
         return Err(CaseError::Option("--dt and --t-end must be positive".into()));
     }
     if opts.t_end / opts.dt > 1e7 {
@@ -168,6 +169,9 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     }
 }
 
+/// A form bound to the name a scheme uses for it.
+type Slot<'m> = (&'static str, Box<dyn BoundForm + 'm>);
+
 fn bound<'m, K: Kernel + 'm>(
     kernel: K,
     quadrature: Quadrature,
@@ -192,14 +196,14 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
     let q = Quadrature::default();
     let hybrid = opts.scheme == SchemeChoice::Hybrid;
-    let (forms, structure): (Vec<(&str, Box<dyn BoundForm + '_>)>, Structure) = match opts.contact {
+    let (forms, structure): (Vec<Slot<'_>>, Structure) = match opts.contact {
         ContactMethod::Nitsche => {
             let p = nitsche::Params::default()
                 .with("gamma0", opts.gamma0)
                 .and_then(|p| p.with("theta", opts.theta))
                 .map_err(bad)?;
             let c = nitsche::Coefficients { f: zero_force(), g: gap(), nc: normal() };
-            let mut forms: Vec<(&str, Box<dyn BoundForm>)> = vec![
+            let mut forms: Vec<Slot> = vec![
                 ("mass", bound(nitsche::Mass::new(&p, &c), q, None)),
                 ("stiffness", bound(nitsche::Stiffness::new(&p, &c), q, None)),
                 ("load", bound(nitsche::Load::new(&p, &c), q, None)),
@@ -221,7 +225,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
         ContactMethod::Penalty => {
             let p = penalty::Params::default().with("gamma0", opts.gamma0).map_err(bad)?;
             let c = penalty::Coefficients { f: zero_force(), g: gap(), nc: normal() };
-            let mut forms: Vec<(&str, Box<dyn BoundForm>)> = vec![
+            let mut forms: Vec<Slot> = vec![
                 ("mass", bound(penalty::Mass::new(&p, &c), q, None)),
                 ("stiffness", bound(penalty::Stiffness::new(&p, &c), q, None)),
                 ("load", bound(penalty::Load::new(&p, &c), q, None)),
