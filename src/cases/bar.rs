@@ -98,6 +98,9 @@ pub struct Row {
     pub energy_aug: f64,
     pub penetration: f64,
     pub newton: usize,
+    /// P_{1,γ}(u) at the contact point, unclamped (Nitsche), or −ε u(0) (penalty).
+    #[serde(skip)]
+    pub p1: f64,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -258,15 +261,15 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let measure = |u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
         let u0 = u[0];
         let ux = (u[1] - u[0]) / h;
-        let (lambda, aug) = match opts.contact {
+        let (lambda, aug, p1) = match opts.contact {
             ContactMethod::Nitsche => {
                 let p1 = ux + gamma * u0;
                 let neg = p1.min(0.0);
-                (neg, -opts.theta / (2.0 * gamma) * ux * ux + neg * neg / (2.0 * gamma))
+                (neg, -opts.theta / (2.0 * gamma) * ux * ux + neg * neg / (2.0 * gamma), p1)
             }
             ContactMethod::Penalty => {
                 let pen = gamma * u0.min(0.0);
-                (pen, 0.5 * gamma * u0.min(0.0).powi(2))
+                (pen, 0.5 * gamma * u0.min(0.0).powi(2), gamma * u0)
             }
         };
         let energy = 0.5 * quad(&stiffness, u) + v.map_or(0.0, |v| 0.5 * quad(&mass, v));
@@ -279,6 +282,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
             energy_aug: energy + aug,
             penetration: (-u0).max(0.0),
             newton,
+            p1,
         }
     };
     let v_index = states_names.iter().position(|s| *s == "v");

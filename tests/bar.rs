@@ -1,0 +1,102 @@
+//! The compressed bar (spec §6.1, §7): initial energy, Nitsche against penalty, convergence,
+//! HHT dissipation, the hybrid scheme's energy decay, and the exact energy identities of
+//! Crank–Nicolson and midpoint with contact.
+
+use signorini::cases::bar::{self, Options, SchemeChoice};
+use signorini::cases::static_block::ContactMethod;
+
+fn run(f: impl FnOnce(&mut Options)) -> bar::Run {
+    let mut o = Options::default();
+    f(&mut o);
+    bar::run(&o).unwrap()
+}
+
+#[test]
+fn initial_energy_is_one_eighth() {
+    let r = run(|o| o.t_end = 0.1);
+    assert!((r.summary.energy_initial - 0.125).abs() < 1e-14, "{}", r.summary.energy_initial);
+}
+
+#[test]
+fn nitsche_penetrates_less_than_penalty() {
+    let nitsche = run(|_| {}).summary.max_penetration;
+    let penalty = run(|o| o.contact = ContactMethod::Penalty).summary.max_penetration;
+    assert!(nitsche < 0.9 * penalty, "Nitsche {nitsche} vs penalty {penalty}");
+}
+
+#[test]
+fn displacement_error_decreases_under_refinement() {
+    let coarse = run(|_| {}).summary.err_linf_l2_u;
+    let fine = run(|o| {
+        o.elements = 100;
+        o.dt = 0.002;
+    })
+    .summary
+    .err_linf_l2_u;
+    assert!(fine < coarse, "{coarse} → {fine}");
+}
+
+#[test]
+fn hht_dissipation_grows_with_alpha() {
+    let e: Vec<f64> = [0.0, 0.05, 1.0 / 3.0]
+        .iter()
+        .map(|&a| {
+            run(|o| {
+                o.scheme = SchemeChoice::Hht;
+                o.alpha = Some(a);
+            })
+            .summary
+            .energy_aug_final
+        })
+        .collect();
+    assert!(e[0] > e[1] && e[1] > e[2], "{e:?}");
+}
+
+#[test]
+fn hybrid_never_increases_the_augmented_energy() {
+    for dt in [0.01, 0.05, 0.1] {
+        let r = run(|o| {
+            o.scheme = SchemeChoice::Hybrid;
+            o.dt = dt;
+        });
+        let e0 = r.summary.energy_aug_initial;
+        for w in r.series.windows(2) {
+            assert!(
+                w[1].energy_aug <= w[0].energy_aug + 1e-11 * e0,
+                "dt = {dt}, t = {}: {} → {}",
+                w[1].t,
+                w[0].energy_aug,
+                w[1].energy_aug
+            );
+        }
+    }
+}
+
+/// Spec §4.2–4.3 with θ = 1 and one contact point: E_Θ increments equal D (weight 1).
+#[test]
+fn crank_nicolson_and_midpoint_energy_increments_match_the_formulas() {
+    let gamma = 5.0 * 20.0;
+    let neg = |p: f64| p.min(0.0);
+    let cn = |p0: f64, p1: f64| (neg(p1).powi(2) - neg(p0).powi(2) - (neg(p0) + neg(p1)) * (p1 - p0)) / (2.0 * gamma);
+    let mid = |p0: f64, p1: f64| {
+        (neg(p1).powi(2) - neg(p0).powi(2)) / (2.0 * gamma) - neg(0.5 * (p0 + p1)) * (p1 - p0) / gamma
+    };
+    for (scheme, formula) in [(SchemeChoice::Newmark, &cn as &dyn Fn(f64, f64) -> f64), (SchemeChoice::Midpoint, &mid)]
+    {
+        let r = run(|o| o.scheme = scheme);
+        let e0 = r.summary.energy_aug_initial;
+        let (mut gains, mut losses) = (0, 0);
+        for w in r.series.windows(2) {
+            let d = formula(w[0].p1, w[1].p1);
+            let de = w[1].energy_aug - w[0].energy_aug;
+            assert!((de - d).abs() < 1e-11 * e0, "{scheme:?} t = {}: ΔE_Θ {de:e} vs D {d:e}", w[1].t);
+            if d > 1e-14 * e0 {
+                gains += 1;
+            }
+            if d < -1e-14 * e0 {
+                losses += 1;
+            }
+        }
+        assert!(gains > 0 && losses > 0, "{scheme:?}: {gains} gains, {losses} losses");
+    }
+}
