@@ -27,4 +27,5 @@ pub mod mesh;
 pub mod newton;
 pub mod problem;
 pub mod quadrature;
+pub mod redistribute;
 pub mod scheme;

@@ -189,6 +189,9 @@ pub struct Stepper<'a, S: TimeScheme> {
     asm: &'a Assembler<'a>,
     forms: HashMap<String, Box<dyn BoundForm + 'a>>,
     pub constraints: Constraints,
+    /// Extra Dirichlet conditions for the initial problem only (e.g. a⁰ = 0 on massless
+    /// contact dofs after mass redistribution).
+    pub initial_constraints: Option<Constraints>,
     structure: Structure,
     pub newton_options: NewtonOptions,
     /// Per stage: its Newton (keeps its factorization) and the constant operator for `dt`.
@@ -250,6 +253,7 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
             asm,
             forms,
             constraints,
+            initial_constraints: None,
             structure,
             newton_options,
             stages,
@@ -270,7 +274,12 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
         let guess = states[init.state].clone();
         let stage = StageDesc { name: "initial", time: 0, quantities: &[], values: &[], terms: init.terms };
         let cache = self.stages.len() - 1;
-        let (w, report) = self.solve_stage(&stage, cache, states, &[], guess, 1.0, t)?;
+        let saved = self.initial_constraints.as_ref().map(|c| std::mem::replace(&mut self.constraints, c.clone()));
+        let result = self.solve_stage(&stage, cache, states, &[], guess, 1.0, t);
+        if let Some(c) = saved {
+            self.constraints = c;
+        }
+        let (w, report) = result?;
         states[init.state] = w;
         Ok(Some(report))
     }

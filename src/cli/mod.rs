@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use crate::cases::bar::{self, SchemeChoice};
+use crate::cases::bar::{self, MassChoice, SchemeChoice};
 use crate::cases::static_block::{self, ContactMethod};
 use crate::compiler::{self, FsLoader};
 
@@ -108,6 +108,8 @@ pub struct BarArgs {
     dt: f64,
     #[arg(long, default_value_t = 12.0, allow_hyphen_values = true)]
     t_end: f64,
+    #[arg(long, value_enum, default_value_t = MassChoice::Consistent)]
+    mass: MassChoice,
     /// Directory for series.csv and summary.json.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -308,6 +310,7 @@ fn run_bar(a: BarArgs) -> ExitCode {
         elements: a.ne,
         dt: a.dt,
         t_end: a.t_end,
+        mass: a.mass,
         out: a.out,
         ..Default::default()
     };
