@@ -42,7 +42,7 @@ pub fn redistribute(mesh: &Mesh, mass: &Matrix, contact_nodes: &[u32]) -> Result
         let col = j * d;
         for k in p.col_ptr[col]..p.col_ptr[col + 1] {
             let row = p.row_idx[k];
-            if row % d == 0 && row / d <= j {
+            if row.is_multiple_of(d) && row / d <= j {
                 entries.push((row / d, j, mass.values[k]));
             }
         }
@@ -111,7 +111,7 @@ pub fn redistribute(mesh: &Mesh, mass: &Matrix, contact_nodes: &[u32]) -> Result
             let col = j * d;
             for k in p.col_ptr[col]..p.col_ptr[col + 1] {
                 let row = p.row_idx[k];
-                if row % d == 0 {
+                if row.is_multiple_of(d) {
                     total += q[r][row / d] * mat.values[k] * q[s][j];
                 }
             }
