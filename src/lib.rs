@@ -15,3 +15,4 @@ pub mod cases;
 pub mod cli;
 pub mod forms;
 pub mod output;
+pub mod plot;

@@ -100,3 +100,29 @@ fn crank_nicolson_and_midpoint_energy_increments_match_the_formulas() {
         assert!(gains > 0 && losses > 0, "{scheme:?}: {gains} gains, {losses} losses");
     }
 }
+
+/// Spec §7 check 10: with HHT or TR-BDF2, mass redistribution calms the contact stress: its
+/// standard deviation over τ ∈ (1.2, 1.8) drops by at least 2×.
+#[test]
+fn mass_redistribution_calms_the_contact_stress() {
+    use signorini::cases::bar::MassChoice;
+    let std = |r: &bar::Run| {
+        let lam: Vec<f64> = r.series.iter().filter(|row| row.t > 1.2 && row.t < 1.8).map(|row| row.lambda).collect();
+        let mean = lam.iter().sum::<f64>() / lam.len() as f64;
+        (lam.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lam.len() as f64).sqrt()
+    };
+    for scheme in [SchemeChoice::Hht, SchemeChoice::Trbdf2] {
+        let consistent = run(|o| o.scheme = scheme);
+        let redistributed = run(|o| {
+            o.scheme = scheme;
+            o.mass = MassChoice::Redistributed;
+        });
+        let (a, b) = (std(&consistent), std(&redistributed));
+        assert!(b <= a / 2.0, "{scheme:?}: std of λ {a} → {b}");
+        assert!(
+            redistributed.summary.max_penetration < 1e-12,
+            "{scheme:?}: penetration {}",
+            redistributed.summary.max_penetration
+        );
+    }
+}

@@ -81,3 +81,35 @@ fn static_block_writes_its_summary() {
     assert_eq!(code, 1);
     assert!(err.contains("--h must be in (0, 1]"), "{err}");
 }
+
+#[test]
+fn bar_writes_series_summary_and_plots() {
+    let dir = std::env::temp_dir().join(format!("signorini-bar-{}", std::process::id()));
+    let (code, out, err) = signorini(&["run", "bar", "--t-end", "1", "--out", dir.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("bar: newmark"), "{out}");
+    let csv = std::fs::read_to_string(dir.join("series.csv")).unwrap();
+    assert!(csv.starts_with("t,u_c,v_c,lambda,energy,energy_aug,penetration,newton\n"));
+    assert_eq!(csv.lines().count(), 1 + 101);
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "err_linf_l2_u",
+        "err_l2_lambda",
+        "energy_aug_drift_final",
+        "energy_aug_drift_max",
+        "newton_total",
+        "newton_max",
+        "dofs",
+        "steps",
+    ] {
+        assert!(s.get(key).is_some(), "summary.json lacks {key}");
+    }
+    for png in ["contact.png", "energy.png"] {
+        let bytes = std::fs::read(dir.join(png)).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG"), "{png} is not a PNG");
+    }
+    let (code, _, err) = signorini(&["run", "bar", "--scheme", "midpoint", "--alpha", "0.1"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("--alpha applies to the HHT schemes"), "{err}");
+}

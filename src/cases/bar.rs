@@ -399,6 +399,52 @@ fn write_outputs(dir: &std::path::Path, summary: &Summary, series: &[Row]) -> Re
             .map_err(|source| CaseError::Write { path: path.display().to_string(), source })
     };
     write("series.csv", csv.as_bytes())?;
+    let pts = |f: &dyn Fn(&Row) -> f64| series.iter().map(|r| (r.t, f(r))).collect::<Vec<_>>();
+    let dense: Vec<f64> = (0..=2400).map(|k| k as f64 * summary.t_end / 2400.0).collect();
+    let exact_u: Vec<(f64, f64)> = dense.iter().map(|&t| (t, exact::displacement(0.0, t))).collect();
+    let exact_s: Vec<(f64, f64)> = dense.iter().map(|&t| (t, exact::contact_stress(t))).collect();
+    use crate::plot::Curve;
+    let plot_err = |e: String| CaseError::Write { path: dir.display().to_string(), source: std::io::Error::other(e) };
+    crate::plot::panels(
+        &dir.join("contact.png"),
+        "t",
+        &[
+            (
+                "displacement of the contact point",
+                "u(0, t)",
+                vec![
+                    Curve { label: "computed", points: pts(&|r| r.u_c), dashed: false },
+                    Curve { label: "exact", points: exact_u, dashed: true },
+                ],
+            ),
+            (
+                "contact stress",
+                "λ",
+                vec![
+                    Curve { label: "computed", points: pts(&|r| r.lambda), dashed: false },
+                    Curve { label: "exact", points: exact_s, dashed: true },
+                ],
+            ),
+        ],
+    )
+    .map_err(plot_err)?;
+    crate::plot::panels(
+        &dir.join("energy.png"),
+        "t",
+        &[(
+            "energies",
+            "energy",
+            vec![
+                Curve { label: "E", points: pts(&|r| r.energy), dashed: false },
+                Curve {
+                    label: if summary.contact == ContactMethod::Nitsche { "E_Θ" } else { "E_pen" },
+                    points: pts(&|r| r.energy_aug),
+                    dashed: false,
+                },
+            ],
+        )],
+    )
+    .map_err(plot_err)?;
     let path = dir.join("summary.json");
     crate::output::write_json(&path, summary)
         .map_err(|source| CaseError::Write { path: path.display().to_string(), source })

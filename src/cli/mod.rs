@@ -110,9 +110,13 @@ pub struct BarArgs {
     t_end: f64,
     #[arg(long, value_enum, default_value_t = MassChoice::Consistent)]
     mass: MassChoice,
-    /// Directory for series.csv and summary.json.
+    /// Directory for series.csv and summary.json (with --all: one subdirectory per run).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Run every scheme × {Nitsche θ = 1, 0, −1, penalty} × {consistent, redistributed} and
+    /// print one table.
+    #[arg(long)]
+    all: bool,
 }
 
 #[derive(clap::Args)]
@@ -301,6 +305,9 @@ fn bench_assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) ->
 }
 
 fn run_bar(a: BarArgs) -> ExitCode {
+    if a.all {
+        return run_bar_all(a);
+    }
     let opts = bar::Options {
         scheme: a.scheme,
         alpha: a.alpha,
@@ -339,4 +346,79 @@ fn run_bar(a: BarArgs) -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn run_bar_all(a: BarArgs) -> ExitCode {
+    let contacts = [
+        (ContactMethod::Nitsche, 1.0),
+        (ContactMethod::Nitsche, 0.0),
+        (ContactMethod::Nitsche, -1.0),
+        (ContactMethod::Penalty, 0.0),
+    ];
+    println!(
+        "{:<15} {:<8} {:>3} {:<13} {:>8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>7} {:>4}",
+        "scheme", "contact", "θ", "mass", "err_u", "err_λ", "E_Θ(0)", "E_Θ(T)", "max|ΔE_Θ|", "penetr.", "Newton", "max"
+    );
+    let mut failed = false;
+    for scheme in SchemeChoice::ALL {
+        for (contact, theta) in contacts {
+            for mass in [MassChoice::Consistent, MassChoice::Redistributed] {
+                let label = format!(
+                    "{}-{}{}-{}",
+                    scheme.name(),
+                    if contact == ContactMethod::Nitsche { "nitsche" } else { "penalty" },
+                    if contact == ContactMethod::Nitsche { format!("{theta}") } else { String::new() },
+                    if mass == MassChoice::Consistent { "consistent" } else { "redistributed" }
+                );
+                let opts = bar::Options {
+                    scheme,
+                    alpha: a.alpha.filter(|_| {
+                        matches!(scheme, SchemeChoice::Hht | SchemeChoice::HhtImex | SchemeChoice::HhtUnweighted)
+                    }),
+                    contact,
+                    theta,
+                    gamma0: a.gamma0,
+                    elements: a.ne,
+                    dt: a.dt,
+                    t_end: a.t_end,
+                    mass,
+                    out: a.out.as_ref().map(|d| d.join(&label)),
+                    ..Default::default()
+                };
+                let contact_name = if contact == ContactMethod::Nitsche { "Nitsche" } else { "penalty" };
+                let mass_name = if mass == MassChoice::Consistent { "consistent" } else { "redistributed" };
+                match bar::run(&opts) {
+                    Ok(r) => {
+                        let s = r.summary;
+                        println!(
+                            "{:<15} {:<8} {:>3} {:<13} {:>8.4} {:>8.4} {:>9.6} {:>9.6} {:>10.2e} {:>10.2e} {:>7} {:>4}",
+                            scheme.name(),
+                            contact_name,
+                            if contact == ContactMethod::Nitsche { format!("{theta}") } else { "-".into() },
+                            mass_name,
+                            s.err_linf_l2_u,
+                            s.err_l2_lambda,
+                            s.energy_aug_initial,
+                            s.energy_aug_final,
+                            s.energy_aug_drift_max * s.energy_aug_initial,
+                            s.max_penetration,
+                            s.newton_total,
+                            s.newton_max
+                        );
+                    }
+                    Err(e) => {
+                        println!(
+                            "{:<15} {:<8} {:>3} {:<13} failed: {e}",
+                            scheme.name(),
+                            contact_name,
+                            theta,
+                            mass_name
+                        );
+                        failed = true;
+                    }
+                }
+            }
+        }
+    }
+    if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
 }
