@@ -408,6 +408,7 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
             constraints: &self.constraints,
             structure: self.structure,
             piecewise,
+            scratch: None,
         };
         let mut w = guess;
         self.constraints.impose(&mut w);
@@ -448,6 +449,8 @@ struct StageProblem<'p, 'a> {
     constraints: &'p Constraints,
     structure: Structure,
     piecewise: bool,
+    /// Reused for the nonlinear terms' tangents.
+    scratch: Option<Matrix>,
 }
 
 impl NonlinearProblem for StageProblem<'_, '_> {
@@ -488,9 +491,11 @@ impl NonlinearProblem for StageProblem<'_, '_> {
             let refs: Vec<&[f64]> = args.iter().map(Vec::as_slice).collect();
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
-                    let mut m = self.asm.zero_matrix();
-                    self.forms[term.form].tangent(self.asm, &refs, k, term.t, &mut m);
-                    j.add_scaled(term.coef * a, &m);
+                    // Kernels add unscaled: assemble into the scratch matrix, then scale in.
+                    let m = self.scratch.get_or_insert_with(|| self.asm.zero_matrix());
+                    m.values.iter_mut().for_each(|v| *v = 0.0);
+                    self.forms[term.form].tangent(self.asm, &refs, k, term.t, m);
+                    j.add_scaled(term.coef * a, m);
                 }
             }
         }

@@ -42,6 +42,11 @@ impl SchemeChoice {
         SchemeChoice::Hybrid,
     ];
 
+    /// The HHT variants (which take α).
+    pub fn is_hht(self) -> bool {
+        matches!(self, SchemeChoice::Hht | SchemeChoice::HhtImex | SchemeChoice::HhtUnweighted)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             SchemeChoice::Newmark => "newmark",
@@ -162,7 +167,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     if opts.t_end / opts.dt > 1e7 {
         return Err(CaseError::Option("more than 10⁷ steps".into()));
     }
-    let hht = matches!(opts.scheme, SchemeChoice::Hht | SchemeChoice::HhtImex | SchemeChoice::HhtUnweighted);
+    let hht = opts.scheme.is_hht();
     if opts.alpha.is_some() && !hht {
         return Err(CaseError::Option(format!("--alpha applies to the HHT schemes, not {}", opts.scheme.name())));
     }
@@ -345,11 +350,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let summary = Summary {
         case: "bar",
         scheme: opts.scheme,
-        alpha: opts.alpha.or(matches!(
-            opts.scheme,
-            SchemeChoice::Hht | SchemeChoice::HhtImex | SchemeChoice::HhtUnweighted
-        )
-        .then_some(0.05)),
+        alpha: opts.alpha.or(opts.scheme.is_hht().then_some(0.05)),
         contact: opts.contact,
         theta: opts.theta,
         gamma0: opts.gamma0,
