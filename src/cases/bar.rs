@@ -7,17 +7,17 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::CaseError;
+use super::binding::{Contact, Material, bind};
 use super::exact;
 use super::static_block::ContactMethod;
 use crate::forms::schemes;
-use crate::forms::{nitsche, penalty};
-use crate::runtime::assembly::{Assembler, Kernel, Quadrature};
+use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
-use crate::runtime::linalg::{Matrix, Structure};
+use crate::runtime::linalg::Matrix;
 use crate::runtime::mesh::structured;
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
-use crate::runtime::scheme::{Bound, BoundForm, MatrixForm, Stepper, TimeScheme};
+use crate::runtime::scheme::{MatrixForm, Stepper, TimeScheme};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
@@ -188,18 +188,6 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     }
 }
 
-/// A form bound to the name a scheme uses for it.
-type Slot<'m> = (&'static str, Box<dyn BoundForm + 'm>);
-
-fn bound<'m, K: Kernel + 'm>(
-    kernel: K,
-    quadrature: Quadrature,
-    contact: Option<&'m [crate::runtime::mesh::Facet]>,
-) -> Box<dyn BoundForm + 'm> {
-    let regions = contact.map(|f| vec![("Gamma_C".to_string(), f)]).unwrap_or_default();
-    Box::new(Bound { kernel, quadrature, regions })
-}
-
 fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> {
     let start = Instant::now();
     let ne = opts.elements;
@@ -208,60 +196,12 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let asm = Assembler::new(&mesh);
     let n = asm.size();
     let contact_facets = asm.region("left")?;
-    let gap = || Coef::function(1, |x, _, out| out[0] = x[0]);
-    let normal = || Coef::constant(vec![-1.0]);
-    let zero_force = || Coef::constant(vec![0.0]);
     let gamma = opts.gamma0 / h;
-    let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
-    let q = Quadrature::default();
-    let hybrid = opts.scheme == SchemeChoice::Hybrid;
-    let (forms, structure): (Vec<Slot<'_>>, Structure) = match opts.contact {
-        ContactMethod::Nitsche => {
-            let p = nitsche::Params::default()
-                .with("gamma0", opts.gamma0)
-                .and_then(|p| p.with("theta", opts.theta))
-                .map_err(bad)?;
-            let c = nitsche::Coefficients { f: zero_force(), g: gap(), nc: normal() };
-            let mut forms: Vec<Slot> = vec![
-                ("mass", bound(nitsche::Mass::new(&p, &c), q, None)),
-                ("stiffness", bound(nitsche::Stiffness::new(&p, &c), q, None)),
-                ("load", bound(nitsche::Load::new(&p, &c), q, None)),
-                ("contact", bound(nitsche::Contact::new(&p, &c), q, Some(contact_facets))),
-            ];
-            if hybrid {
-                let hp = schemes::hybrid::Params::default()
-                    .with("gamma0", opts.gamma0)
-                    .and_then(|p| p.with("theta", opts.theta))
-                    .map_err(bad)?;
-                let hc = schemes::hybrid::Coefficients { f: zero_force(), g: gap(), nc: normal() };
-                forms.push((
-                    "hybrid_contact",
-                    bound(schemes::hybrid::HybridContact::new(&hp, &hc), q, Some(contact_facets)),
-                ));
-            }
-            (forms, if opts.theta == 1.0 { Structure::SymmetricPositiveDefinite } else { Structure::General })
-        }
-        ContactMethod::Penalty => {
-            let p = penalty::Params::default().with("gamma0", opts.gamma0).map_err(bad)?;
-            let c = penalty::Coefficients { f: zero_force(), g: gap(), nc: normal() };
-            let mut forms: Vec<Slot> = vec![
-                ("mass", bound(penalty::Mass::new(&p, &c), q, None)),
-                ("stiffness", bound(penalty::Stiffness::new(&p, &c), q, None)),
-                ("load", bound(penalty::Load::new(&p, &c), q, None)),
-                ("contact", bound(penalty::Contact::new(&p, &c), q, Some(contact_facets))),
-            ];
-            if hybrid {
-                let hp = schemes::hybrid::Params::default().with("gamma0", opts.gamma0).map_err(bad)?;
-                let hc = schemes::hybrid::Coefficients { f: zero_force(), g: gap(), nc: normal() };
-                forms.push((
-                    "hybrid_contact",
-                    bound(schemes::hybrid::HybridPenalty::new(&hp, &hc), q, Some(contact_facets)),
-                ));
-            }
-            (forms, Structure::SymmetricPositiveDefinite)
-        }
-    };
-    let mut forms = forms;
+    // E = ρ = 1 (ν = 0: σ = E u'); no body force; gap g = x, obstacle normal −1 at x = 0.
+    let material = Material { young: 1.0, poisson: 0.0, density: 1.0 };
+    let contact = Contact { method: opts.contact, theta: opts.theta, gamma0: opts.gamma0, facets: contact_facets };
+    let data = || (Coef::constant(vec![0.0]), Coef::function(1, |x, _, out| out[0] = x[0]), Coef::constant(vec![-1.0]));
+    let (mut forms, structure) = bind(material, contact, &data, Quadrature::default())?;
     let redistributed = opts.mass == MassChoice::Redistributed;
     if redistributed {
         let slot = forms.iter().position(|(name, _)| *name == "mass").expect("mass slot");

@@ -1,6 +1,7 @@
 //! Built-in cases (`signorini run NAME`).
 
 pub mod bar;
+pub mod binding;
 pub mod exact;
 pub mod static_block;
 
