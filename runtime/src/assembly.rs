@@ -9,7 +9,9 @@
 use std::sync::Arc;
 
 use crate::element::ElementKind;
-use crate::kernel::{CellCtx, FacetCtx, FacetTabulation, Form, FormKernel, LocalMatrix, LocalVector, Tabulation};
+use crate::kernel::{
+    CellCtx, FacetCtx, FacetTabulation, Form, FormKernel, FunctionalKernel, LocalMatrix, LocalVector, Tabulation,
+};
 use crate::linalg::Matrix;
 use crate::mesh::{Facet, Mesh, MeshError};
 
@@ -20,6 +22,28 @@ pub trait Kernel:
 }
 impl<K> Kernel for K where
     K: Form + FormKernel<1, 2> + FormKernel<2, 3> + FormKernel<2, 6> + FormKernel<3, 4> + FormKernel<3, 10> + Sync
+{
+}
+
+/// A functional usable on every element kind of the catalogue.
+pub trait Functional:
+    Form
+    + FunctionalKernel<1, 2>
+    + FunctionalKernel<2, 3>
+    + FunctionalKernel<2, 6>
+    + FunctionalKernel<3, 4>
+    + FunctionalKernel<3, 10>
+    + Sync
+{
+}
+impl<K> Functional for K where
+    K: Form
+        + FunctionalKernel<1, 2>
+        + FunctionalKernel<2, 3>
+        + FunctionalKernel<2, 6>
+        + FunctionalKernel<3, 4>
+        + FunctionalKernel<3, 10>
+        + Sync
 {
 }
 
@@ -250,6 +274,28 @@ impl<'m> Assembler<'m> {
         dispatch!(self.mesh.kind, facet_switches::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, out))
     }
 
+    /// The volume integral of a functional at `fields`.
+    pub fn cell_value<K: Functional>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64) -> f64 {
+        let degree = q.cell_degree::<K>(self.mesh.kind);
+        dispatch!(self.mesh.kind, cell_value::<K>(self.mesh, k, degree, fields, t))
+    }
+
+    /// The integral of a functional over its boundary region `region` on the mesh `facets`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn facet_value<K: Functional>(
+        &self,
+        k: &K,
+        region: &str,
+        facets: &[Facet],
+        q: Quadrature,
+        fields: &[&[f64]],
+        t: f64,
+    ) -> f64 {
+        let Some(r) = region_index::<K>(region) else { return 0.0 };
+        let degree = q.facet_degree::<K>(self.mesh.kind, r);
+        dispatch!(self.mesh.kind, facet_value::<K>(self.mesh, k, r, facets, degree, fields, t))
+    }
+
     /// Facets of a named mesh region.
     pub fn region(&self, name: &str) -> Result<&'m [Facet], MeshError> {
         Ok(&self.mesh.region(name)?.facets)
@@ -426,4 +472,44 @@ fn facet_switches<const D: usize, const N: usize, K: FormKernel<D, N>>(
         gather(mesh.cell(c), fields, &mut local);
         with_refs(&local, |refs| k.facet_switches(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, out));
     }
+}
+
+fn cell_value<const D: usize, const N: usize, K: FunctionalKernel<D, N>>(
+    mesh: &Mesh,
+    k: &K,
+    degree: u32,
+    fields: &[&[f64]],
+    t: f64,
+) -> f64 {
+    let tab = Tabulation::<D, N>::cell(mesh.kind, degree).expect("kind matches D and N");
+    let mut local = locals::<D, N>(fields.len());
+    let mut total = 0.0;
+    for c in 0..mesh.num_cells() {
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(mesh.cell(c), fields, &mut local);
+        total += with_refs(&local, |refs| k.cell_value(&CellCtx { tab: &tab, coords: &coords, t }, refs));
+    }
+    total
+}
+
+#[allow(clippy::too_many_arguments)]
+fn facet_value<const D: usize, const N: usize, K: FunctionalKernel<D, N>>(
+    mesh: &Mesh,
+    k: &K,
+    region: usize,
+    facets: &[Facet],
+    degree: u32,
+    fields: &[&[f64]],
+    t: f64,
+) -> f64 {
+    let tabs = FacetTabulation::<D, N>::new(mesh.kind, degree).expect("kind matches D and N");
+    let mut local = locals::<D, N>(fields.len());
+    let mut total = 0.0;
+    for &f in facets {
+        let c = f.cell as usize;
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(mesh.cell(c), fields, &mut local);
+        total += with_refs(&local, |refs| k.facet_value(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs));
+    }
+    total
 }

@@ -326,6 +326,13 @@ pub trait FormKernel<const D: usize, const N: usize>: Form {
     );
 }
 
+/// Kernels of a functional (a form without a test function): the integral over one cell or
+/// one facet of region `region`.
+pub trait FunctionalKernel<const D: usize, const N: usize>: Form {
+    fn cell_value(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>]) -> f64;
+    fn facet_value(&self, region: usize, ctx: &FacetCtx<'_, D, N>, fields: &[&LocalVector<D, N>]) -> f64;
+}
+
 /// H(a) = 1 if a > 0, else 0 (so H(0) = 0).
 #[inline(always)]
 pub fn heaviside(a: f64) -> f64 {

@@ -201,7 +201,8 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let material = Material { young: 1.0, poisson: 0.0, density: 1.0 };
     let contact = Contact { method: opts.contact, theta: opts.theta, gamma0: opts.gamma0, facets: contact_facets };
     let data = || (Coef::constant(vec![0.0]), Coef::function(1, |x, _, out| out[0] = x[0]), Coef::constant(vec![-1.0]));
-    let (mut forms, structure) = bind(material, contact, &data, Quadrature::default())?;
+    let bound = bind(material, contact, &data, Quadrature::default())?;
+    let (mut forms, structure, contact_energy) = (bound.forms, bound.structure, bound.contact_energy);
     let redistributed = opts.mass == MassChoice::Redistributed;
     if redistributed {
         let slot = forms.iter().position(|(name, _)| *name == "mass").expect("mass slot");
@@ -233,17 +234,13 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let measure = |u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
         let u0 = u[0];
         let ux = (u[1] - u[0]) / h;
-        let (lambda, aug, p1) = match opts.contact {
-            ContactMethod::Nitsche => {
-                let p1 = ux + gamma * u0;
-                let neg = p1.min(0.0);
-                (neg, -opts.theta / (2.0 * gamma) * ux * ux + neg * neg / (2.0 * gamma), p1)
-            }
-            ContactMethod::Penalty => {
-                let pen = gamma * u0.min(0.0);
-                (pen, 0.5 * gamma * u0.min(0.0).powi(2), gamma * u0)
-            }
+        // λ and P from spec §3.4 (u_x(0) from the first element); the energy from the compiled
+        // functional.
+        let (lambda, p1) = match opts.contact {
+            ContactMethod::Nitsche => ((ux + gamma * u0).min(0.0), ux + gamma * u0),
+            ContactMethod::Penalty => (gamma * u0.min(0.0), gamma * u0),
         };
+        let aug = contact_energy(&asm, u);
         let energy = 0.5 * quad(&stiffness, u) + v.map_or(0.0, |v| 0.5 * quad(&mass, v));
         Row {
             t,

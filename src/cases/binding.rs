@@ -5,11 +5,11 @@ use super::CaseError;
 use super::static_block::ContactMethod;
 use crate::forms::schemes::hybrid;
 use crate::forms::{nitsche, penalty};
-use crate::runtime::assembly::{Kernel, Quadrature};
+use crate::runtime::assembly::{Assembler, Functional, Kernel, Quadrature};
 use crate::runtime::kernel::{Coef, ParamError};
 use crate::runtime::linalg::Structure;
 use crate::runtime::mesh::Facet;
-use crate::runtime::scheme::{Bound, BoundForm};
+use crate::runtime::scheme::{self, BoundForm};
 
 /// A form bound to the name a scheme uses for it.
 pub type Slot<'m> = (&'static str, Box<dyn BoundForm + 'm>);
@@ -39,20 +39,36 @@ fn bound<'m, K: Kernel + 'm>(
     facets: Option<&'m [Facet]>,
 ) -> Box<dyn BoundForm + 'm> {
     let regions = facets.map(|f| vec![("Gamma_C".to_string(), f)]).unwrap_or_default();
-    Box::new(Bound { kernel, quadrature, regions })
+    Box::new(scheme::Bound { kernel, quadrature, regions })
 }
 
 fn bad(e: ParamError) -> CaseError {
     CaseError::Option(e.to_string())
 }
 
-/// The forms and the structure of the stage Jacobians (symmetric for θ = 1 and penalty).
+/// The contact term of the augmented energy (E_Θ − E for Nitsche, E_pen − E for penalty) at a
+/// displacement.
+pub type ContactEnergy<'m> = Box<dyn Fn(&Assembler, &[f64]) -> f64 + 'm>;
+
+fn energy<'m, K: Functional + 'm>(kernel: K, quadrature: Quadrature, facets: &'m [Facet]) -> ContactEnergy<'m> {
+    Box::new(move |asm: &Assembler, u: &[f64]| asm.facet_value(&kernel, "Gamma_C", facets, quadrature, &[u], 0.0))
+}
+
+/// What a case needs from the form library.
+pub struct Bound<'m> {
+    pub forms: Vec<Slot<'m>>,
+    /// Cholesky (θ = 1 and penalty: symmetric) or LU for the stage Jacobians.
+    pub structure: Structure,
+    pub contact_energy: ContactEnergy<'m>,
+}
+
+/// Binds the library for a material and a contact law.
 pub fn bind<'m>(
     material: Material,
     contact: Contact<'m>,
     data: CaseData<'_>,
     quadrature: Quadrature,
-) -> Result<(Vec<Slot<'m>>, Structure), CaseError> {
+) -> Result<Bound<'m>, CaseError> {
     let q = quadrature;
     let facets = Some(contact.facets);
     let set = |p: f64, name: &str| (name.to_string(), p);
@@ -83,7 +99,11 @@ pub fn bind<'m>(
                 ("contact", bound(nitsche::Contact::new(&p, &c), q, facets)),
                 ("hybrid_contact", bound(hybrid::HybridContact::new(&hp, &hc), q, facets)),
             ];
-            Ok((forms, if contact.theta == 1.0 { Structure::SymmetricPositiveDefinite } else { Structure::General }))
+            Ok(Bound {
+                forms,
+                structure: if contact.theta == 1.0 { Structure::SymmetricPositiveDefinite } else { Structure::General },
+                contact_energy: energy(nitsche::ContactEnergy::new(&p, &c), q, contact.facets),
+            })
         }
         ContactMethod::Penalty => {
             let mut p = penalty::Params::default();
@@ -105,7 +125,11 @@ pub fn bind<'m>(
                 ("contact", bound(penalty::Contact::new(&p, &c), q, facets)),
                 ("hybrid_contact", bound(hybrid::HybridPenalty::new(&hp, &hc), q, facets)),
             ];
-            Ok((forms, Structure::SymmetricPositiveDefinite))
+            Ok(Bound {
+                forms,
+                structure: Structure::SymmetricPositiveDefinite,
+                contact_energy: energy(penalty::ContactEnergy::new(&p, &c), q, contact.facets),
+            })
         }
     }
 }

@@ -97,7 +97,8 @@ pub struct Coef {
 pub struct Form {
     pub name: String,
     pub fields: Vec<Ident>,
-    pub test: Ident,
+    /// The test function; `None` for a functional.
+    pub test: Option<Ident>,
     pub integrals: Vec<ast::Integral>,
     pub span: Span,
 }
@@ -273,7 +274,7 @@ fn declare(
                 }
                 ast::Item::Form { name, fields, test, integrals, span } => {
                     let mut args = fields.clone();
-                    args.push(test.clone());
+                    args.extend(test.clone());
                     check_distinct(&args, "argument", diags);
                     prog.forms.push(Form {
                         name: name.name.clone(),

@@ -200,7 +200,9 @@ impl<'p> Checker<'p> {
         for form in &self.prog.forms {
             let mut scope: Vec<(String, Ty)> =
                 form.fields.iter().map(|f| (f.name.clone(), Ty::plain(Shape::Vector))).collect();
-            scope.push((form.test.name.clone(), Ty { test: true, ..Ty::plain(Shape::Vector) }));
+            if let Some(test) = &form.test {
+                scope.push((test.name.clone(), Ty { test: true, ..Ty::plain(Shape::Vector) }));
+            }
             self.scope = scope;
             for integral in &form.integrals {
                 let Some(ty) = self.ty(&integral.integrand) else {
@@ -217,11 +219,11 @@ impl<'p> Checker<'p> {
                         )
                         .with_help("take dot(..., v) or inner(..., grad(v)) with the test function"),
                     );
-                } else if !ty.test {
+                } else if let Some(test) = form.test.as_ref().filter(|_| !ty.test) {
                     self.error(
                         Diagnostic::error(
                             "E0401",
-                            format!("integrand does not depend on the test function `{}`", form.test.name),
+                            format!("integrand does not depend on the test function `{}`", test.name),
                             span,
                             "no test function here",
                         )

@@ -35,6 +35,8 @@ const RESERVED: &[&str] = &[
     "heaviside",
     "Params",
     "Coefficients",
+    "total",
+    "value",
 ];
 
 /// `impl<const N: usize> FormKernel<D, N> for Struct { ... }`.
@@ -107,12 +109,40 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
     s
 }
 
+/// `impl<const N: usize> FunctionalKernel<D, N> for Struct { ... }`: the value of each
+/// integral of a functional.
+pub fn functional_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -> String {
+    let d = ir.dim;
+    let g = &ir.graph;
+    let body = |integral: &IntegralIr| {
+        let b = Body { prog, g, d, form, integral, mode: Mode::Value }.emit();
+        format!("let mut total = 0.0;\n{b}total\n")
+    };
+    let fields = format!("&[&LocalVector<{d}, N>]");
+    let mut s = String::new();
+    let _ = writeln!(s, "impl<const N: usize> FunctionalKernel<{d}, N> for {struct_name} {{");
+    let cell = form.integrals.iter().find(|i| i.cell).map_or_else(|| "0.0\n".to_string(), body);
+    let _ = writeln!(s, "fn cell_value(&self, ctx: &CellCtx<'_, {d}, N>, fields: {fields}) -> f64 {{\n{cell}}}");
+    let mut arms = String::new();
+    for (r, i) in form.integrals.iter().filter(|i| !i.cell).enumerate() {
+        let _ = writeln!(arms, "{r} => {{ // int({})\n{}}}", i.region, body(i));
+    }
+    let _ = writeln!(
+        s,
+        "fn facet_value(&self, region: usize, ctx: &FacetCtx<'_, {d}, N>, fields: {fields}) -> f64 {{\nmatch region {{\n{arms}_ => 0.0,\n}}\n}}"
+    );
+    s.push_str("}\n");
+    s
+}
+
 #[derive(Clone, Copy, PartialEq)]
 enum Mode {
     Residual,
     Tangent(usize),
     /// Signs of the active-set switches of the tangent with respect to a field.
     Switches(usize),
+    /// The integral of a functional.
+    Value,
 }
 
 struct Body<'a> {
@@ -179,6 +209,10 @@ impl Body<'_> {
                 add("c01", &t.c01, 3);
                 add("c10", &t.c10, 3);
                 add("c11", &t.c11, 4);
+            }
+            Mode::Value => {
+                let node = self.integral.value.expect("functionals have a value");
+                outputs.push(("value", vec![(!g.is_zero(node)).then(|| Output { name: "value".into(), node })]));
             }
             Mode::Switches(a) => {
                 let list = self.integral.tangents[a].switches.iter().enumerate();
@@ -388,6 +422,7 @@ impl Body<'_> {
                     let _ = writeln!(s, "out.push({} > 0.0);", o.name);
                 }
             }
+            Mode::Value => s.push_str("total += value;\n"),
         }
         s.push_str("}\n");
         s

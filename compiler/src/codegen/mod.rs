@@ -48,11 +48,11 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
     let _ = writeln!(s, "/// Kernels compiled from `{}` by signorini.", opts.source_name);
     let _ = writeln!(s, "pub mod {} {{", ident(&opts.module));
     s.push_str(
-        "#![allow(non_snake_case, non_camel_case_types, unused_variables, unused_mut, unused_parens, clippy::all)]\n",
+        "#![allow(non_snake_case, non_camel_case_types, unused_variables, unused_mut, unused_parens, unused_imports, clippy::all)]\n",
     );
     let _ = writeln!(
         s,
-        "use {rt}::kernel::{{CellCtx, Coef, FacetCtx, Form, FormKernel, FormMeta, LocalMatrix, LocalVector, ParamError, ParamRange, check_coef, check_param, heaviside}};"
+        "use {rt}::kernel::{{CellCtx, Coef, FacetCtx, Form, FormKernel, FormMeta, FunctionalKernel, LocalMatrix, LocalVector, ParamError, ParamRange, check_coef, check_param, heaviside}};"
     );
     let _ = writeln!(s, "use {rt}::geometry;");
     if !prog.schemes.is_empty() {
@@ -77,14 +77,15 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
         let ir2 = &irs[1].forms[fi];
         let fields: Vec<String> = form.fields.iter().map(|f| format!("{:?}", f.name)).collect();
         let sig = format!(
-            "{}({}; {})",
+            "{} {}({}{})",
+            if form.test.is_some() { "form" } else { "functional" },
             form.name,
             form.fields.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", "),
-            form.test.name
+            form.test.as_ref().map_or(String::new(), |t| format!("; {}", t.name))
         );
         let _ = writeln!(
             s,
-            "/// `form {sig}`{}",
+            "/// `{sig}`{}",
             if ir2.linear { " (linear: its tangent does not depend on the fields)" } else { "" }
         );
         let _ = writeln!(s, "#[derive(Clone, Debug)]\npub struct {sname} {{ params: Params, coefs: Coefficients }}");
@@ -108,13 +109,17 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
             "impl Form for {sname} {{ const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: &[{}] }}; }}",
             form.name,
             fields.join(", "),
-            form.test.name,
+            form.test.as_ref().map_or("", |t| t.name.as_str()),
             irs.iter().all(|ir| ir.forms[fi].linear),
             irs.iter().all(|ir| ir.forms[fi].integrals.iter().all(|i| i.tangents.iter().all(|t| t.piecewise))),
             facets.join(", ")
         );
         for ir in irs {
-            s.push_str(&kernel::form_impl(prog, ir, &ir.forms[fi], sname));
+            if form.test.is_some() {
+                s.push_str(&kernel::form_impl(prog, ir, &ir.forms[fi], sname));
+            } else {
+                s.push_str(&kernel::functional_impl(prog, ir, &ir.forms[fi], sname));
+            }
         }
     }
     for sch in &prog.schemes {

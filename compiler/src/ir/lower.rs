@@ -35,7 +35,8 @@ pub struct Integrand {
 pub struct LoweredForm {
     pub name: String,
     pub fields: Vec<String>,
-    pub test: String,
+    /// `None` for a functional.
+    pub test: Option<String>,
     /// One per region, in order of first appearance; integrals over one region are summed.
     pub integrands: Vec<Integrand>,
 }
@@ -80,7 +81,9 @@ impl<'p> Lowerer<'p> {
                 g: Some((0..d).map(|l| self.g.sym(Sym::TestGrad { comp: k as u8, dir: l as u8 })).collect()),
             })
             .collect();
-        scope.push((form.test.name.clone(), Val { shape: Shape::Vector, c }));
+        if let Some(test) = &form.test {
+            scope.push((test.name.clone(), Val { shape: Shape::Vector, c }));
+        }
         self.scope = scope;
         let mut integrands: Vec<Integrand> = Vec::new();
         for integral in &form.integrals {
@@ -97,7 +100,7 @@ impl<'p> Lowerer<'p> {
         LoweredForm {
             name: form.name.clone(),
             fields: form.fields.iter().map(|f| f.name.clone()).collect(),
-            test: form.test.name.clone(),
+            test: form.test.as_ref().map(|t| t.name.clone()),
             integrands,
         }
     }

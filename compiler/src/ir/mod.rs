@@ -28,7 +28,8 @@ pub struct DimIr {
 pub struct FormIr {
     pub name: String,
     pub fields: Vec<String>,
-    pub test: String,
+    /// `None` for a functional (no test function: one value per integral).
+    pub test: Option<String>,
     pub integrals: Vec<IntegralIr>,
     /// The tangent does not depend on the fields: assemble once.
     pub linear: bool,
@@ -44,6 +45,8 @@ pub struct IntegralIr {
     pub f1: Vec<NodeId>,
     /// Derivatives with respect to each field argument.
     pub tangents: Vec<TangentIr>,
+    /// The integrand of a functional.
+    pub value: Option<NodeId>,
     /// Suggested quadrature degree for P1 and P2 elements (exact on affine cells when the
     /// integrand is polynomial).
     pub degree: [u32; 2],
@@ -84,6 +87,20 @@ pub fn build(prog: &Program, d: usize) -> DimIr {
     for lf in lowered {
         let mut integrals = Vec::new();
         for integrand in &lf.integrands {
+            if lf.test.is_none() {
+                let roots = [integrand.value];
+                let degree = [1, 2].map(|p| node_degrees(&g, p, roots)[&integrand.value]);
+                integrals.push(IntegralIr {
+                    region: integrand.region.clone(),
+                    cell: integrand.region == CELL_REGION,
+                    f0: Vec::new(),
+                    f1: Vec::new(),
+                    tangents: Vec::new(),
+                    value: Some(integrand.value),
+                    degree,
+                });
+                continue;
+            }
             let f0: Vec<NodeId> =
                 (0..d).map(|k| Derivative::new(Sym::Test { comp: k as u8 }).of(&mut g, integrand.value)).collect();
             let f1: Vec<NodeId> = (0..d * d)
@@ -100,6 +117,7 @@ pub fn build(prog: &Program, d: usize) -> DimIr {
                 f0,
                 f1,
                 tangents,
+                value: None,
                 degree,
             });
         }

@@ -28,14 +28,18 @@ pub fn print(ir: &DimIr, params: &[String], coefs: &[String]) -> String {
     for f in &ir.forms {
         let _ = writeln!(
             out,
-            "\nform {}({}; {}){}",
+            "\n{} {}({}{}){}",
+            if f.test.is_some() { "form" } else { "functional" },
             f.name,
             f.fields.join(", "),
-            f.test,
+            f.test.as_ref().map_or(String::new(), |t| format!("; {t}")),
             if f.linear { "  [linear]" } else { "" }
         );
         for i in &f.integrals {
             let _ = writeln!(out, "  int({})  degree P1 {} P2 {}", i.region, i.degree[0], i.degree[1]);
+            if let Some(v) = i.value {
+                list(&mut out, g, "value", &[v], params, coefs);
+            }
             list(&mut out, g, "f0", &i.f0, params, coefs);
             list(&mut out, g, "f1", &i.f1, params, coefs);
             for (a, t) in i.tangents.iter().enumerate() {

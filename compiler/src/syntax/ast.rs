@@ -155,7 +155,7 @@ pub enum Item {
     Form {
         name: Ident,
         fields: Vec<Ident>,
-        test: Ident,
+        test: Option<Ident>,
         integrals: Vec<Integral>,
         span: Span,
     },

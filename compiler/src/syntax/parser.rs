@@ -14,7 +14,7 @@ use crate::source::{FileId, Span};
 #[grammar = "syntax/grammar.pest"]
 struct WfParser;
 
-const ITEM_KEYWORDS: &[&str] = &["import", "param", "coef", "let", "fn", "form", "scheme"];
+const ITEM_KEYWORDS: &[&str] = &["import", "param", "coef", "let", "fn", "form", "functional", "scheme"];
 
 /// Deepest nesting of parentheses accepted; deeper input is refused before parsing, so that
 /// neither the parser nor the recursive checks can exhaust the stack.
@@ -311,9 +311,13 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::number => "a number",
         Rule::expr | Rule::call | Rule::neg => "an expression",
         Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::pow => "an operator",
-        Rule::import | Rule::param | Rule::coef | Rule::let_decl | Rule::fn_decl | Rule::form_decl => {
-            "an item (`import`, `param`, `coef`, `let`, `fn`, `form`)"
-        }
+        Rule::import
+        | Rule::param
+        | Rule::coef
+        | Rule::let_decl
+        | Rule::fn_decl
+        | Rule::form_decl
+        | Rule::functional_decl => "an item (`import`, `param`, `coef`, `let`, `fn`, `form`)",
         Rule::range => "`in RANGE`",
         Rule::lbound => "`[` or `(`",
         Rule::rbound => "`]` or `)`",
@@ -416,9 +420,21 @@ impl Builder {
                     }
                 }
                 let integrals = self.integrals(next())?;
-                Item::Form { name, fields, test: test.expect("form has a test function"), integrals, span }
+                Item::Form { name, fields, test: Some(test.expect("form has a test function")), integrals, span }
             }
             Rule::scheme_decl => self.scheme(span, next(), it)?,
+            Rule::functional_decl => {
+                let name = self.ident(next());
+                let mut fields = Vec::new();
+                let mut integrals = Vec::new();
+                for q in it {
+                    match q.as_rule() {
+                        Rule::ident_list => fields = q.into_inner().map(|i| self.ident(i)).collect(),
+                        _ => integrals = self.integrals(q)?,
+                    }
+                }
+                Item::Form { name, fields, test: None, integrals, span }
+            }
             r => unreachable!("not an item: {r:?}"),
         })
     }

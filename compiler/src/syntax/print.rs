@@ -67,7 +67,12 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
             }
             Item::Form { name, fields, test, integrals, .. } => {
                 let fs: Vec<_> = fields.iter().map(|p| p.name.as_str()).collect();
-                out.push_str(&format!("{head}form {}({}; {})\n", name.name, fs.join(", "), test.name));
+                match test {
+                    Some(test) => {
+                        out.push_str(&format!("{head}form {}({}; {})\n", name.name, fs.join(", "), test.name))
+                    }
+                    None => out.push_str(&format!("{head}functional {}({})\n", name.name, fs.join(", "))),
+                }
                 for i in integrals {
                     let sign = if i.sign < 0.0 { "-" } else { "+" };
                     out.push_str(&format!("  {sign} int({}) {}\n", i.region.name, expr(&i.integrand)));
