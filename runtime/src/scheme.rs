@@ -170,6 +170,9 @@ pub enum StepError {
     Newton { stage: &'static str, t: f64, source: NewtonError },
 }
 
+/// How many load vectors the stepper remembers (a step evaluates loads at two or three times).
+const LOAD_CACHE: usize = 4;
+
 /// Statistics of one step.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct StepReport {
@@ -198,6 +201,8 @@ pub struct Stepper<'a, S: TimeScheme> {
     stages: Vec<StageCache>,
     /// Linear forms' matrices (assembled once).
     matrices: HashMap<String, Matrix>,
+    /// Recently assembled loads, by (form, time).
+    loads: Vec<((&'static str, u64), Vec<f64>)>,
     coefs: Vec<f64>,
 }
 
@@ -258,6 +263,7 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
             newton_options,
             stages,
             matrices,
+            loads: Vec::new(),
             coefs: vec![0.0; desc.coefficients],
         })
     }
@@ -365,9 +371,21 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
             let form = &self.forms[term.form];
             let term_t = self.coefs[term.time];
             if term.args.is_empty() {
-                let mut b = vec![0.0; n];
-                form.residual(self.asm, &[], term_t, &mut b);
-                constant_rhs.iter_mut().zip(&b).for_each(|(r, x)| *r += coef * x);
+                // Loads depend on time only: the one at t + dt this step is the one at t next step.
+                let key = (term.form, term_t.to_bits());
+                let b = match self.loads.iter().position(|(k, _)| *k == key) {
+                    Some(i) => &self.loads[i].1,
+                    None => {
+                        let mut b = vec![0.0; n];
+                        form.residual(self.asm, &[], term_t, &mut b);
+                        if self.loads.len() == LOAD_CACHE {
+                            self.loads.remove(0);
+                        }
+                        self.loads.push((key, b));
+                        &self.loads.last().expect("just pushed").1
+                    }
+                };
+                constant_rhs.iter_mut().zip(b).for_each(|(r, x)| *r += coef * x);
                 continue;
             }
             let bases: Vec<Vec<f64>> = term.args.iter().map(|c| self.combine(c, None, states, quantities)).collect();

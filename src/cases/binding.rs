@@ -60,6 +60,8 @@ pub struct Bound<'m> {
     /// Cholesky (θ = 1 and penalty: symmetric) or LU for the stage Jacobians.
     pub structure: Structure,
     pub contact_energy: ContactEnergy<'m>,
+    /// Another instance of the `contact` form, for measurements (resultant, active points).
+    pub contact_probe: Box<dyn BoundForm + 'm>,
 }
 
 /// Binds the library for a material and a contact law.
@@ -103,6 +105,7 @@ pub fn bind<'m>(
                 forms,
                 structure: if contact.theta == 1.0 { Structure::SymmetricPositiveDefinite } else { Structure::General },
                 contact_energy: energy(nitsche::ContactEnergy::new(&p, &c), q, contact.facets),
+                contact_probe: bound(nitsche::Contact::new(&p, &c), q, facets),
             })
         }
         ContactMethod::Penalty => {
@@ -129,6 +132,7 @@ pub fn bind<'m>(
                 forms,
                 structure: Structure::SymmetricPositiveDefinite,
                 contact_energy: energy(penalty::ContactEnergy::new(&p, &c), q, contact.facets),
+                contact_probe: bound(penalty::Contact::new(&p, &c), q, facets),
             })
         }
     }

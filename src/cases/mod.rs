@@ -2,6 +2,7 @@
 
 pub mod bar;
 pub mod binding;
+pub mod disc;
 pub mod exact;
 pub mod static_block;
 

@@ -86,6 +86,37 @@ pub enum Case {
     StaticBlock(StaticBlockArgs),
     /// The compressed 1D bar against its exact solution (spec §6.1).
     Bar(BarArgs),
+    /// The elastic disc bouncing on a rigid plane (spec §6.2).
+    Disc(DiscArgs),
+}
+
+#[derive(clap::Args)]
+pub struct DiscArgs {
+    #[arg(long, value_enum, default_value_t = SchemeChoice::Newmark)]
+    scheme: SchemeChoice,
+    #[arg(long)]
+    alpha: Option<f64>,
+    #[arg(long, value_enum, default_value_t = ContactMethod::Nitsche)]
+    contact: ContactMethod,
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    theta: f64,
+    #[arg(long, default_value_t = 1000.0, allow_hyphen_values = true)]
+    gamma0: f64,
+    #[arg(long, value_enum, default_value_t = MassChoice::Consistent)]
+    mass: MassChoice,
+    /// A Gmsh mesh (MSH 2.2 or 4.1); default: the built-in curved P2 disc.
+    #[arg(long)]
+    mesh: Option<PathBuf>,
+    /// Mesh size of the built-in disc.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    h: f64,
+    #[arg(long, default_value_t = 0.02, allow_hyphen_values = true)]
+    dt: f64,
+    #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
+    t_end: f64,
+    /// Directory for series.csv, summary.json and disc.png.
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -163,6 +194,7 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Emit { file, stage, dim } => emit(&file, stage, dim as usize),
         Command::Run { case: Case::StaticBlock(a) } => static_block(a),
         Command::Run { case: Case::Bar(a) } => run_bar(a),
+        Command::Run { case: Case::Disc(a) } => run_disc(a),
         Command::Mesh { command: MeshCommand::Info { file } } => mesh_info(&file),
         Command::Bench { what: BenchCommand::Assemble { sizes, factor, repeats, out } } => {
             bench_assemble(&sizes, factor, repeats, &out)
@@ -406,4 +438,46 @@ fn run_bar_all(a: BarArgs) -> ExitCode {
         }
     }
     if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
+}
+
+fn run_disc(a: DiscArgs) -> ExitCode {
+    let opts = crate::cases::disc::Options {
+        scheme: a.scheme,
+        alpha: a.alpha,
+        contact: a.contact,
+        theta: a.theta,
+        gamma0: a.gamma0,
+        mass: a.mass,
+        mesh: a.mesh,
+        h: a.h,
+        dt: a.dt,
+        t_end: a.t_end,
+        out: a.out,
+        ..Default::default()
+    };
+    match crate::cases::disc::run(&opts) {
+        Ok(r) => {
+            let s = &r.summary;
+            println!(
+                "disc: {} {:?}, {} dofs, {} steps, first contact at t = {}, max penetration {:.3e}, E_aug {:.6} → {:.6}, Newton {} (max {}), {:.2} s ({:.3} ms/step)",
+                s.scheme.name(),
+                s.contact,
+                s.dofs,
+                s.steps,
+                s.first_contact.map_or("never".to_string(), |t| format!("{t:.2}")),
+                s.max_penetration,
+                s.energy_aug_initial,
+                s.energy_aug_final,
+                s.newton_total,
+                s.newton_max,
+                s.wall_seconds,
+                1e3 * s.seconds_per_step
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }

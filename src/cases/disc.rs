@@ -1,0 +1,327 @@
+//! `signorini run disc`: the elastic disc bouncing on a rigid plane (spec §6.2). A disc of
+//! radius 10 centred at (0, 12) falls from rest under f = (0, −0.1) onto {y = 0}; plane strain
+//! with λ = μ = 20 (E = 50, ν = 1/4), ρ = 1; curved P2 triangles; no Dirichlet condition.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::CaseError;
+use super::bar::{MassChoice, SchemeChoice};
+use super::binding::{Contact, Material, bind};
+use super::static_block::ContactMethod;
+use crate::forms::schemes;
+use crate::runtime::assembly::{Assembler, Quadrature};
+use crate::runtime::evaluate::facet_samples;
+use crate::runtime::kernel::Coef;
+use crate::runtime::linalg::Matrix;
+use crate::runtime::mesh::{Mesh, disc::disc, gmsh};
+use crate::runtime::newton::NewtonOptions;
+use crate::runtime::problem::Constraints;
+use crate::runtime::scheme::{MatrixForm, Stepper, TimeScheme};
+
+/// Gravity of the benchmark.
+pub const GRAVITY: f64 = 0.1;
+/// Cell and contact-facet quadrature degrees (12-point triangle rule; 4 Gauss points per edge).
+const QUADRATURE: Quadrature = Quadrature { cell: Some(6), facet: Some(7) };
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    pub scheme: SchemeChoice,
+    pub alpha: Option<f64>,
+    pub contact: ContactMethod,
+    pub theta: f64,
+    pub gamma0: f64,
+    pub mass: MassChoice,
+    /// A Gmsh file; the built-in curved disc generator otherwise.
+    pub mesh: Option<PathBuf>,
+    /// Mesh size of the built-in generator.
+    pub h: f64,
+    pub dt: f64,
+    pub t_end: f64,
+    pub newton: NewtonOptions,
+    pub out: Option<PathBuf>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            scheme: SchemeChoice::Newmark,
+            alpha: None,
+            contact: ContactMethod::Nitsche,
+            theta: 1.0,
+            gamma0: 1000.0,
+            mass: MassChoice::Consistent,
+            mesh: None,
+            h: 1.0,
+            dt: 0.02,
+            t_end: 20.0,
+            newton: NewtonOptions::default(),
+            out: None,
+        }
+    }
+}
+
+/// One row of `series.csv`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    pub t: f64,
+    pub energy: f64,
+    pub energy_aug: f64,
+    pub uy_mean: f64,
+    pub uy_lowest: f64,
+    pub fy_contact: f64,
+    pub active_points: usize,
+    pub penetration: f64,
+    pub newton: usize,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub case: &'static str,
+    pub scheme: SchemeChoice,
+    pub contact: ContactMethod,
+    pub theta: f64,
+    pub gamma0: f64,
+    pub mass: MassChoice,
+    pub mesh: String,
+    pub cells: usize,
+    pub dofs: usize,
+    pub dt: f64,
+    pub steps: usize,
+    /// Time of the first step that ends with an active contact point.
+    pub first_contact: Option<f64>,
+    pub max_penetration: f64,
+    pub min_uy_mean: f64,
+    pub energy_aug_initial: f64,
+    pub energy_aug_final: f64,
+    pub newton_total: usize,
+    pub newton_max: usize,
+    pub wall_seconds: f64,
+    pub seconds_per_step: f64,
+}
+
+pub struct Run {
+    pub summary: Summary,
+    pub series: Vec<Row>,
+}
+
+/// The mesh: read or generated, validated, with its `contact` region (the Gmsh group of that
+/// name, else the facets whose outward normal has n_y < 0).
+pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
+    let mut mesh = match &opts.mesh {
+        Some(path) => gmsh::read(path)?,
+        None => {
+            if !(opts.h > 0.05 && opts.h <= 10.0) {
+                return Err(CaseError::Option(format!("--h must be in (0.05, 10], not {}", opts.h)));
+            }
+            disc(10.0, [0.0, 12.0], opts.h)
+        }
+    };
+    if mesh.dim() != 2 {
+        return Err(CaseError::Option(format!("the disc case needs a 2D mesh, not {}D", mesh.dim())));
+    }
+    if mesh.region("contact").is_err() {
+        mesh.add_region_where("contact", |n, _| n[1] < 0.0);
+    }
+    mesh.validate()?;
+    Ok(mesh)
+}
+
+pub fn run(opts: &Options) -> Result<Run, CaseError> {
+    let positive = |x: f64| x > 0.0 && x.is_finite();
+    if !positive(opts.dt) || !positive(opts.t_end) || opts.t_end / opts.dt > 1e7 {
+        return Err(CaseError::Option("--dt and --t-end must be positive, with at most 10⁷ steps".into()));
+    }
+    if opts.alpha.is_some() && !opts.scheme.is_hht() {
+        return Err(CaseError::Option(format!("--alpha applies to the HHT schemes, not {}", opts.scheme.name())));
+    }
+    let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
+    let alpha = opts.alpha.unwrap_or(0.05);
+    match opts.scheme {
+        SchemeChoice::Newmark => simulate(opts, schemes::newmark::Newmark::default()),
+        SchemeChoice::Hht => simulate(opts, schemes::hht::Hht::default().with("alpha", alpha).map_err(bad)?),
+        SchemeChoice::HhtImex => {
+            simulate(opts, schemes::hht_imex::HhtImex::default().with("alpha", alpha).map_err(bad)?)
+        }
+        SchemeChoice::HhtUnweighted => {
+            simulate(opts, schemes::hht_unweighted::HhtUnweighted::default().with("alpha", alpha).map_err(bad)?)
+        }
+        SchemeChoice::Midpoint => simulate(opts, schemes::midpoint::Midpoint::default()),
+        SchemeChoice::Trbdf2 => simulate(opts, schemes::trbdf2::Trbdf2::default()),
+        SchemeChoice::Hybrid => simulate(opts, schemes::hybrid::Hybrid::default()),
+    }
+}
+
+fn quad(a: &Matrix, x: &[f64], y: &[f64]) -> f64 {
+    let mut ay = vec![0.0; y.len()];
+    a.mul_vec(y, &mut ay);
+    x.iter().zip(&ay).map(|(p, q)| p * q).sum()
+}
+
+fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> {
+    let start = Instant::now();
+    let mesh = mesh(opts)?;
+    let asm = Assembler::new(&mesh);
+    let n = asm.size();
+    let contact_facets = asm.region("contact")?;
+    let material = Material { young: 50.0, poisson: 0.25, density: 1.0 };
+    let contact = Contact { method: opts.contact, theta: opts.theta, gamma0: opts.gamma0, facets: contact_facets };
+    let data = || {
+        (
+            Coef::constant(vec![0.0, -GRAVITY]),
+            Coef::function(1, |x, _, out| out[0] = x[1]),
+            Coef::constant(vec![0.0, -1.0]),
+        )
+    };
+    let bound = bind(material, contact, &data, QUADRATURE)?;
+    let (mut forms, structure, contact_energy, probe) =
+        (bound.forms, bound.structure, bound.contact_energy, bound.contact_probe);
+    // Consistent mass and stiffness, the load: for the measurements.
+    let zero = vec![0.0; n];
+    let slot = |forms: &[(&str, Box<dyn crate::runtime::scheme::BoundForm + '_>)], name: &str| {
+        forms.iter().position(|(s, _)| *s == name).expect("bound by `bind`")
+    };
+    let mut mass = asm.zero_matrix();
+    forms[slot(&forms, "mass")].1.tangent(&asm, &[&zero], 0, 0.0, &mut mass);
+    let mut stiffness = asm.zero_matrix();
+    forms[slot(&forms, "stiffness")].1.tangent(&asm, &[&zero], 0, 0.0, &mut stiffness);
+    let mut load = vec![0.0; n];
+    forms[slot(&forms, "load")].1.residual(&asm, &[], 0.0, &mut load);
+    let redistributed = opts.mass == MassChoice::Redistributed;
+    let constraints = Constraints::none(n);
+    let contact_nodes = mesh.region_nodes(mesh.region("contact")?);
+    let energy_mass = if redistributed {
+        let r = crate::runtime::redistribute::redistribute(&mesh, &mass, &contact_nodes)
+            .map_err(|e| CaseError::Option(e.to_string()))?;
+        let i = slot(&forms, "mass");
+        forms[i] = ("mass", Box::new(MatrixForm { name: "mass".into(), matrix: r.matrix.clone() }));
+        r.matrix
+    } else {
+        mass.clone()
+    };
+    let mut stepper = Stepper::new(scheme, &asm, forms, constraints.clone(), structure, opts.newton)
+        .map_err(|e| CaseError::Option(e.to_string()))?;
+    if redistributed {
+        let mut initial = constraints;
+        for &c in &contact_nodes {
+            initial.fix(2 * c as usize);
+            initial.fix(2 * c as usize + 1);
+        }
+        stepper.initial_constraints = Some(initial);
+    }
+    let names = S::DESC.states;
+    let mut states: Vec<Vec<f64>> = names.iter().map(|_| vec![0.0; n]).collect();
+    stepper.initialize(&mut states, 0.0).map_err(|e| CaseError::Option(e.to_string()))?;
+    let v_index = names.iter().position(|s| *s == "v");
+    let ey: Vec<f64> = (0..n).map(|i| if i % 2 == 1 { 1.0 } else { 0.0 }).collect();
+    let mut mass_ey = vec![0.0; n];
+    mass.mul_vec(&ey, &mut mass_ey);
+    let total_mass: f64 = mass_ey.iter().zip(&ey).map(|(a, b)| a * b).sum();
+    let lowest = (0..mesh.num_nodes()).min_by(|&a, &b| mesh.node(a)[1].total_cmp(&mesh.node(b)[1])).expect("nodes");
+    let measure = |u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
+        let energy = 0.5 * quad(&stiffness, u, u) + v.map_or(0.0, |v| 0.5 * quad(&energy_mass, v, v))
+            - load.iter().zip(u).map(|(l, x)| l * x).sum::<f64>();
+        let mut c = vec![0.0; n];
+        probe.residual(&asm, &[u], t, &mut c);
+        let mut switches = Vec::new();
+        probe.switches(&asm, &[u], 0, t, &mut switches);
+        let samples = facet_samples(&mesh, contact_facets, QUADRATURE.facet.unwrap_or(7), u);
+        let penetration = samples.iter().map(|s| (-s.value[1] - s.x[1]).max(0.0)).fold(0.0, f64::max);
+        Row {
+            t,
+            energy,
+            energy_aug: energy + contact_energy(&asm, u),
+            // Area-weighted mean of u_y: e_yᵀ M u / e_yᵀ M e_y.
+            uy_mean: mass_ey.iter().zip(u).map(|(a, b)| a * b).sum::<f64>() / total_mass,
+            uy_lowest: u[2 * lowest + 1],
+            // C(u) tested with e_y is minus the upward force on the disc.
+            fy_contact: -c.iter().skip(1).step_by(2).sum::<f64>(),
+            active_points: switches.iter().filter(|b| **b).count(),
+            penetration,
+            newton,
+        }
+    };
+    let mut series = vec![measure(&states[0], v_index.map(|i| states[i].as_slice()), 0, 0.0)];
+    let steps = (opts.t_end / opts.dt).round() as usize;
+    for k in 0..steps {
+        let t = k as f64 * opts.dt;
+        let report = stepper.step(&mut states, t, opts.dt).map_err(|e| CaseError::Option(e.to_string()))?;
+        series.push(measure(&states[0], v_index.map(|i| states[i].as_slice()), report.iterations(), t + opts.dt));
+    }
+    let wall = start.elapsed().as_secs_f64();
+    let last = series.last().expect("initial row");
+    let summary = Summary {
+        case: "disc",
+        scheme: opts.scheme,
+        contact: opts.contact,
+        theta: opts.theta,
+        gamma0: opts.gamma0,
+        mass: opts.mass,
+        mesh: opts.mesh.as_ref().map_or_else(|| format!("built-in disc, h = {}", opts.h), |p| p.display().to_string()),
+        cells: mesh.num_cells(),
+        dofs: n,
+        dt: opts.dt,
+        steps,
+        first_contact: series.iter().find(|r| r.active_points > 0).map(|r| r.t),
+        max_penetration: series.iter().map(|r| r.penetration).fold(0.0, f64::max),
+        min_uy_mean: series.iter().map(|r| r.uy_mean).fold(f64::INFINITY, f64::min),
+        energy_aug_initial: series[0].energy_aug,
+        energy_aug_final: last.energy_aug,
+        newton_total: series.iter().map(|r| r.newton).sum(),
+        newton_max: series.iter().map(|r| r.newton).max().unwrap_or(0),
+        wall_seconds: wall,
+        seconds_per_step: wall / steps.max(1) as f64,
+    };
+    if let Some(dir) = &opts.out {
+        write_outputs(dir, &summary, &series)?;
+    }
+    Ok(Run { summary, series })
+}
+
+fn write_outputs(dir: &std::path::Path, summary: &Summary, series: &[Row]) -> Result<(), CaseError> {
+    let mut csv = String::from("t,energy,energy_aug,uy_mean,uy_lowest,fy_contact,active_points,penetration,newton\n");
+    for r in series {
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{}\n",
+            r.t, r.energy, r.energy_aug, r.uy_mean, r.uy_lowest, r.fy_contact, r.active_points, r.penetration, r.newton
+        ));
+    }
+    let err = |path: std::path::PathBuf| move |source| CaseError::Write { path: path.display().to_string(), source };
+    crate::output::write_atomic(&dir.join("series.csv"), csv.as_bytes()).map_err(err(dir.join("series.csv")))?;
+    crate::output::write_json(&dir.join("summary.json"), summary).map_err(err(dir.join("summary.json")))?;
+    use crate::plot::Curve;
+    let pts = |f: &dyn Fn(&Row) -> f64| series.iter().map(|r| (r.t, f(r))).collect::<Vec<_>>();
+    let plot_err = |e: String| CaseError::Write { path: dir.display().to_string(), source: std::io::Error::other(e) };
+    let aug = if summary.contact == ContactMethod::Nitsche { "E_Θ" } else { "E_pen" };
+    crate::plot::panels(
+        &dir.join("disc.png"),
+        "t",
+        &[
+            (
+                "energies",
+                "energy",
+                vec![
+                    Curve { label: "E", points: pts(&|r| r.energy), dashed: false },
+                    Curve { label: aug, points: pts(&|r| r.energy_aug), dashed: false },
+                ],
+            ),
+            (
+                "vertical displacement",
+                "u_y",
+                vec![
+                    Curve { label: "mean", points: pts(&|r| r.uy_mean), dashed: false },
+                    Curve { label: "lowest point", points: pts(&|r| r.uy_lowest), dashed: false },
+                ],
+            ),
+            ("contact force", "F_y", vec![Curve { label: "F_y", points: pts(&|r| r.fy_contact), dashed: false }]),
+            (
+                "Newton iterations",
+                "iterations",
+                vec![Curve { label: "per step", points: pts(&|r| r.newton as f64), dashed: false }],
+            ),
+        ],
+    )
+    .map_err(plot_err)
+}
