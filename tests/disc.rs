@@ -6,7 +6,7 @@ use signorini::cases::disc::{self, GRAVITY, Options};
 
 #[test]
 fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
-    let t_star = (2.0 * 2.0 / GRAVITY as f64).sqrt();
+    let t_star = (2.0 * 2.0 / GRAVITY).sqrt();
     for scheme in SchemeChoice::ALL {
         let opts = Options { scheme, h: 2.0, t_end: 6.5, ..Options::default() };
         let r = disc::run(&opts).unwrap_or_else(|e| panic!("{scheme:?}: {e}"));
