@@ -25,3 +25,72 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
         assert!(first - opts.dt < t_star && t_star <= first, "{scheme:?}: first contact at {first}, t* = {t_star}");
     }
 }
+
+/// Spec §4.5: the hybrid scheme with θ = 1 never increases E_Θ (to 1e-9 of the energy scale).
+#[test]
+fn hybrid_never_increases_the_augmented_energy() {
+    let r = disc::run(&Options { scheme: SchemeChoice::Hybrid, h: 2.0, t_end: 20.0, ..Options::default() }).unwrap();
+    let scale = r.series.iter().map(|row| row.energy_aug.abs()).fold(0.0, f64::max);
+    assert!(scale > 1e-3);
+    for w in r.series.windows(2) {
+        assert!(
+            w[1].energy_aug <= w[0].energy_aug + 1e-9 * scale,
+            "t = {}: {} → {}",
+            w[1].t,
+            w[0].energy_aug,
+            w[1].energy_aug
+        );
+    }
+}
+
+/// Penetration decreases when γ0 grows (Nitsche) and when ε = γ0/h grows (penalty).
+#[test]
+fn penetration_decreases_with_the_contact_parameter() {
+    use signorini::cases::static_block::ContactMethod;
+    for contact in [ContactMethod::Nitsche, ContactMethod::Penalty] {
+        // θ = 1 needs γ0 ≳ 20E (E = 50) for coercivity: start there.
+        let p: Vec<f64> = [1000.0, 3000.0, 10000.0]
+            .iter()
+            .map(|&gamma0| {
+                let o = Options {
+                    scheme: SchemeChoice::Hybrid,
+                    contact,
+                    gamma0,
+                    h: 2.0,
+                    t_end: 12.0,
+                    ..Options::default()
+                };
+                disc::run(&o).unwrap().summary.max_penetration
+            })
+            .collect();
+        assert!(p[0] > p[1] && p[1] > p[2], "{contact:?}: {p:?}");
+    }
+}
+
+/// The reference Gmsh mesh and the built-in generator at the same h give the same physics:
+/// impact, deepest descent and rebound of the centre of mass, release time.
+#[test]
+fn gmsh_mesh_and_built_in_generator_agree() {
+    let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/disc_r10_h1_v22.msh");
+    assert!(shared.exists(), "{} is missing: the reference meshes live in ../shared/meshes", shared.display());
+    let summary = |mesh: Option<std::path::PathBuf>| {
+        let r = disc::run(&Options { scheme: SchemeChoice::Hybrid, mesh, t_end: 26.0, ..Options::default() }).unwrap();
+        let release = r.series.iter().filter(|row| row.active_points > 0).map(|row| row.t).fold(0.0, f64::max);
+        let rebound =
+            r.series.iter().filter(|row| row.t > release).map(|row| row.uy_mean).fold(f64::NEG_INFINITY, f64::max);
+        (r.summary.first_contact.unwrap(), r.summary.min_uy_mean, release, rebound)
+    };
+    let (a, b) = (summary(None), summary(Some(shared)));
+    assert_eq!(a.0, b.0, "impact");
+    assert!((a.1 - b.1).abs() < 0.01, "deepest mean displacement {} vs {}", a.1, b.1);
+    assert!((a.2 - b.2).abs() < 0.2, "release {} vs {}", a.2, b.2);
+    assert!((a.3 - b.3).abs() < 0.02, "rebound {} vs {}", a.3, b.3);
+}
+
+#[test]
+fn an_unstable_setting_fails_with_a_clear_error() {
+    // Nitsche θ = 1 with γ0 = 2E is not coercive: the free fall already diverges.
+    let o = Options { h: 2.0, gamma0: 100.0, t_end: 20.0, ..Options::default() };
+    let e = disc::run(&o).err().expect("diverges").to_string();
+    assert!(e.contains("time stepping failed") && e.contains("finite"), "{e}");
+}

@@ -166,6 +166,10 @@ pub enum StepError {
     MissingForm { scheme: &'static str, form: String },
     #[error("form `{form}` takes {expected} field(s), but the scheme applies it to {given}")]
     Arity { form: String, expected: usize, given: usize },
+    #[error(
+        "the solution is no longer finite at t = {t}: the scheme is unstable with these parameters (Nitsche with θ = 1 needs γ0 large enough for coercivity)"
+    )]
+    NonFinite { t: f64 },
     #[error("stage `{stage}` at t = {t}: {source}")]
     Newton { stage: &'static str, t: f64, source: NewtonError },
 }
@@ -317,6 +321,9 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
                 Level::Stage(s, q) => quantities[s][q].clone(),
             })
             .collect();
+        if new_states.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(StepError::NonFinite { t: t + dt });
+        }
         for (st, v) in states.iter_mut().zip(new_states) {
             *st = v;
         }

@@ -214,8 +214,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     }
     let mut constraints = Constraints::none(n);
     constraints.fix(ne); // u(1) = 0
-    let mut stepper = Stepper::new(scheme, &asm, forms, constraints.clone(), structure, opts.newton)
-        .map_err(|e| CaseError::Option(e.to_string()))?;
+    let mut stepper = Stepper::new(scheme, &asm, forms, constraints.clone(), structure, opts.newton)?;
     if redistributed {
         // The contact node carries no inertia: a⁰ = 0 there (spec §4, initial acceleration).
         let mut initial = constraints;
@@ -228,7 +227,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let states_names = S::DESC.states;
     let mut states: Vec<Vec<f64>> = states_names.iter().map(|_| vec![0.0; n]).collect();
     states[0] = (0..n).map(|i| 0.5 * (1.0 - mesh.node(i)[0])).collect();
-    stepper.initialize(&mut states, 0.0).map_err(|e| CaseError::Option(e.to_string()))?;
+    stepper.initialize(&mut states, 0.0)?;
     let steps = (opts.t_end / opts.dt).round() as usize;
     let mut series = Vec::with_capacity(steps + 1);
     let measure = |u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
@@ -271,7 +270,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let mut t = 0.0;
     for k in 0..steps {
         let u_before = states[0][0];
-        let report = stepper.step(&mut states, t, opts.dt).map_err(|e| CaseError::Option(e.to_string()))?;
+        let report = stepper.step(&mut states, t, opts.dt)?;
         t = (k + 1) as f64 * opts.dt;
         let mut row = measure(&states[0], v_index.map(|i| states[i].as_slice()), report.iterations(), t);
         if redistributed {

@@ -201,8 +201,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     } else {
         mass.clone()
     };
-    let mut stepper = Stepper::new(scheme, &asm, forms, constraints.clone(), structure, opts.newton)
-        .map_err(|e| CaseError::Option(e.to_string()))?;
+    let mut stepper = Stepper::new(scheme, &asm, forms, constraints.clone(), structure, opts.newton)?;
     if redistributed {
         let mut initial = constraints;
         for &c in &contact_nodes {
@@ -213,7 +212,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     }
     let names = S::DESC.states;
     let mut states: Vec<Vec<f64>> = names.iter().map(|_| vec![0.0; n]).collect();
-    stepper.initialize(&mut states, 0.0).map_err(|e| CaseError::Option(e.to_string()))?;
+    stepper.initialize(&mut states, 0.0)?;
     let v_index = names.iter().position(|s| *s == "v");
     let ey: Vec<f64> = (0..n).map(|i| if i % 2 == 1 { 1.0 } else { 0.0 }).collect();
     let mut mass_ey = vec![0.0; n];
@@ -247,7 +246,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let steps = (opts.t_end / opts.dt).round() as usize;
     for k in 0..steps {
         let t = k as f64 * opts.dt;
-        let report = stepper.step(&mut states, t, opts.dt).map_err(|e| CaseError::Option(e.to_string()))?;
+        let report = stepper.step(&mut states, t, opts.dt)?;
         series.push(measure(&states[0], v_index.map(|i| states[i].as_slice()), report.iterations(), t + opts.dt));
     }
     let wall = start.elapsed().as_secs_f64();

@@ -15,6 +15,8 @@ pub enum CaseError {
     Mesh(#[from] crate::runtime::mesh::MeshError),
     #[error(transparent)]
     Newton(#[from] crate::runtime::newton::NewtonError),
+    #[error("time stepping failed: {0}")]
+    Step(#[from] crate::runtime::scheme::StepError),
     #[error("cannot write {path}: {source}")]
     Write { path: String, source: std::io::Error },
 }
