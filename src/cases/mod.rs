@@ -4,6 +4,7 @@ pub mod bar;
 pub mod binding;
 pub mod disc;
 pub mod exact;
+pub mod file;
 pub mod static_block;
 
 /// Why a case did not run.
@@ -11,6 +12,9 @@ pub mod static_block;
 pub enum CaseError {
     #[error("invalid option: {0}")]
     Option(String),
+    /// A case file problem, with file and line.
+    #[error("{0}")]
+    CaseFile(String),
     #[error(transparent)]
     Mesh(#[from] crate::runtime::mesh::MeshError),
     #[error(transparent)]

@@ -37,10 +37,13 @@ pub enum Command {
         #[command(subcommand)]
         command: MeshCommand,
     },
-    /// Run a built-in case.
+    /// Run a built-in case, or a case file (`signorini run case.toml`).
+    #[command(args_conflicts_with_subcommands = true)]
     Run {
         #[command(subcommand)]
-        case: Case,
+        case: Option<Case>,
+        /// A TOML case file (`case = "bar"` or `"disc"`, and the options as keys).
+        file: Option<PathBuf>,
     },
     /// Print a compilation stage of a .wf file.
     Emit {
@@ -192,9 +195,14 @@ pub fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Check { files } => check(&files),
         Command::Emit { file, stage, dim } => emit(&file, stage, dim as usize),
-        Command::Run { case: Case::StaticBlock(a) } => static_block(a),
-        Command::Run { case: Case::Bar(a) } => run_bar(a),
-        Command::Run { case: Case::Disc(a) } => run_disc(a),
+        Command::Run { case: Some(Case::StaticBlock(a)), .. } => static_block(a),
+        Command::Run { case: Some(Case::Bar(a)), .. } => run_bar(a),
+        Command::Run { case: Some(Case::Disc(a)), .. } => run_disc(a),
+        Command::Run { case: None, file: Some(file) } => run_file(&file),
+        Command::Run { case: None, file: None } => {
+            eprintln!("error: name a case (static-block, bar, disc) or a case file");
+            ExitCode::FAILURE
+        }
         Command::Mesh { command: MeshCommand::Info { file } } => mesh_info(&file),
         Command::Bench { what: BenchCommand::Assemble { sizes, factor, repeats, out } } => {
             bench_assemble(&sizes, factor, repeats, &out)
@@ -353,31 +361,7 @@ fn run_bar(a: BarArgs) -> ExitCode {
         out: a.out,
         ..Default::default()
     };
-    match bar::run(&opts) {
-        Ok(r) => {
-            let s = &r.summary;
-            println!(
-                "bar: {} {:?} θ = {}, {} steps: err_u {:.4}, err_λ {:.4}, E_Θ {:.6} → {:.6}, penetration {:.3e}, Newton {} (max {}), {:.2} s",
-                s.scheme.name(),
-                s.contact,
-                s.theta,
-                s.steps,
-                s.err_linf_l2_u,
-                s.err_l2_lambda,
-                s.energy_aug_initial,
-                s.energy_aug_final,
-                s.max_penetration,
-                s.newton_total,
-                s.newton_max,
-                s.wall_seconds
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    finish_bar(bar::run(&opts))
 }
 
 fn run_bar_all(a: BarArgs) -> ExitCode {
@@ -455,7 +439,57 @@ fn run_disc(a: DiscArgs) -> ExitCode {
         out: a.out,
         ..Default::default()
     };
-    match crate::cases::disc::run(&opts) {
+    finish_disc(crate::cases::disc::run(&opts))
+}
+
+fn run_file(file: &Path) -> ExitCode {
+    use crate::cases::file::{self, Case};
+    match file::read(file) {
+        Ok(Case::Bar(mut opts)) => {
+            opts.out.get_or_insert_with(|| file::default_out(file));
+            finish_bar(bar::run(&opts))
+        }
+        Ok(Case::Disc(mut opts)) => {
+            opts.out.get_or_insert_with(|| file::default_out(file));
+            finish_disc(crate::cases::disc::run(&opts))
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn finish_bar(result: Result<bar::Run, crate::cases::CaseError>) -> ExitCode {
+    match result {
+        Ok(r) => {
+            let s = &r.summary;
+            println!(
+                "bar: {} {:?} θ = {}, {} steps: err_u {:.4}, err_λ {:.4}, E_Θ {:.6} → {:.6}, penetration {:.3e}, Newton {} (max {}), {:.2} s",
+                s.scheme.name(),
+                s.contact,
+                s.theta,
+                s.steps,
+                s.err_linf_l2_u,
+                s.err_l2_lambda,
+                s.energy_aug_initial,
+                s.energy_aug_final,
+                s.max_penetration,
+                s.newton_total,
+                s.newton_max,
+                s.wall_seconds
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn finish_disc(result: Result<crate::cases::disc::Run, crate::cases::CaseError>) -> ExitCode {
+    match result {
         Ok(r) => {
             let s = &r.summary;
             println!(
