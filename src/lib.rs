@@ -16,3 +16,4 @@ pub mod cli;
 pub mod forms;
 pub mod output;
 pub mod plot;
+pub mod progress;

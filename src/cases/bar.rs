@@ -82,6 +82,8 @@ pub struct Options {
     pub mass: MassChoice,
     pub newton: NewtonOptions,
     pub out: Option<PathBuf>,
+    /// Show a progress bar on long runs (when stdout is a terminal).
+    pub progress: bool,
 }
 
 impl Default for Options {
@@ -98,6 +100,7 @@ impl Default for Options {
             mass: MassChoice::Consistent,
             newton: NewtonOptions::default(),
             out: None,
+            progress: false,
         }
     }
 }
@@ -268,7 +271,9 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     };
     track(&states[0], &series[0]);
     let mut t = 0.0;
+    let mut progress = crate::progress::Progress::new(steps, opts.progress);
     for k in 0..steps {
+        progress.tick(k);
         let u_before = states[0][0];
         let report = stepper.step(&mut states, t, opts.dt)?;
         t = (k + 1) as f64 * opts.dt;
@@ -280,6 +285,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
         track(&states[0], &row);
         series.push(row);
     }
+    progress.finish();
     let first = &series[0];
     let last = series.last().expect("at least the initial row");
     let e0 = first.energy_aug;

@@ -42,6 +42,8 @@ pub struct Options {
     pub t_end: f64,
     pub newton: NewtonOptions,
     pub out: Option<PathBuf>,
+    /// Show a progress bar on long runs (when stdout is a terminal).
+    pub progress: bool,
 }
 
 impl Default for Options {
@@ -59,6 +61,7 @@ impl Default for Options {
             t_end: 20.0,
             newton: NewtonOptions::default(),
             out: None,
+            progress: false,
         }
     }
 }
@@ -244,11 +247,14 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     };
     let mut series = vec![measure(&states[0], v_index.map(|i| states[i].as_slice()), 0, 0.0)];
     let steps = (opts.t_end / opts.dt).round() as usize;
+    let mut progress = crate::progress::Progress::new(steps, opts.progress);
     for k in 0..steps {
+        progress.tick(k);
         let t = k as f64 * opts.dt;
         let report = stepper.step(&mut states, t, opts.dt)?;
         series.push(measure(&states[0], v_index.map(|i| states[i].as_slice()), report.iterations(), t + opts.dt));
     }
+    progress.finish();
     let wall = start.elapsed().as_secs_f64();
     let last = series.last().expect("initial row");
     let summary = Summary {

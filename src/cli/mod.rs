@@ -359,6 +359,7 @@ fn run_bar(a: BarArgs) -> ExitCode {
         t_end: a.t_end,
         mass: a.mass,
         out: a.out,
+        progress: true,
         ..Default::default()
     };
     finish_bar(bar::run(&opts))
@@ -437,6 +438,7 @@ fn run_disc(a: DiscArgs) -> ExitCode {
         dt: a.dt,
         t_end: a.t_end,
         out: a.out,
+        progress: true,
         ..Default::default()
     };
     finish_disc(crate::cases::disc::run(&opts))
@@ -447,10 +449,12 @@ fn run_file(file: &Path) -> ExitCode {
     match file::read(file) {
         Ok(Case::Bar(mut opts)) => {
             opts.out.get_or_insert_with(|| file::default_out(file));
+            opts.progress = true;
             finish_bar(bar::run(&opts))
         }
         Ok(Case::Disc(mut opts)) => {
             opts.out.get_or_insert_with(|| file::default_out(file));
+            opts.progress = true;
             finish_disc(crate::cases::disc::run(&opts))
         }
         Err(e) => {
