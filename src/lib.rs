@@ -17,3 +17,4 @@ pub mod forms;
 pub mod output;
 pub mod plot;
 pub mod progress;
+pub mod vtu;

@@ -280,6 +280,12 @@ impl<'m> Assembler<'m> {
         dispatch!(self.mesh.kind, cell_value::<K>(self.mesh, k, degree, fields, t))
     }
 
+    /// The volume integral of a functional on each cell.
+    pub fn cell_values<K: Functional>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64) -> Vec<f64> {
+        let degree = q.cell_degree::<K>(self.mesh.kind);
+        dispatch!(self.mesh.kind, cell_values::<K>(self.mesh, k, degree, fields, t))
+    }
+
     /// The integral of a functional over its boundary region `region` on the mesh `facets`.
     #[allow(clippy::too_many_arguments)]
     pub fn facet_value<K: Functional>(
@@ -481,15 +487,25 @@ fn cell_value<const D: usize, const N: usize, K: FunctionalKernel<D, N>>(
     fields: &[&[f64]],
     t: f64,
 ) -> f64 {
+    cell_values::<D, N, K>(mesh, k, degree, fields, t).iter().sum()
+}
+
+fn cell_values<const D: usize, const N: usize, K: FunctionalKernel<D, N>>(
+    mesh: &Mesh,
+    k: &K,
+    degree: u32,
+    fields: &[&[f64]],
+    t: f64,
+) -> Vec<f64> {
     let tab = Tabulation::<D, N>::cell(mesh.kind, degree).expect("kind matches D and N");
     let mut local = locals::<D, N>(fields.len());
-    let mut total = 0.0;
-    for c in 0..mesh.num_cells() {
-        let coords = mesh.cell_coords::<D, N>(c);
-        gather(mesh.cell(c), fields, &mut local);
-        total += with_refs(&local, |refs| k.cell_value(&CellCtx { tab: &tab, coords: &coords, t }, refs));
-    }
-    total
+    (0..mesh.num_cells())
+        .map(|c| {
+            let coords = mesh.cell_coords::<D, N>(c);
+            gather(mesh.cell(c), fields, &mut local);
+            with_refs(&local, |refs| k.cell_value(&CellCtx { tab: &tab, coords: &coords, t }, refs))
+        })
+        .collect()
 }
 
 #[allow(clippy::too_many_arguments)]

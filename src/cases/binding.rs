@@ -62,6 +62,26 @@ pub struct Bound<'m> {
     pub contact_energy: ContactEnergy<'m>,
     /// Another instance of the `contact` form, for measurements (resultant, active points).
     pub contact_probe: Box<dyn BoundForm + 'm>,
+    /// Cell averages of the von Mises stress (plane strain) at a displacement.
+    pub von_mises: CellField<'m>,
+}
+
+/// Per-cell values of a displacement.
+pub type CellField<'m> = Box<dyn Fn(&Assembler, &[f64]) -> Vec<f64> + 'm>;
+
+/// Cell averages of the library's plane-strain von Mises stress for a material.
+fn von_mises<'m>(material: Material, data: CaseData<'_>, quadrature: Quadrature) -> Result<CellField<'m>, CaseError> {
+    let mut p = nitsche::Params::default();
+    for (name, v) in [("E", material.young), ("nu", material.poisson), ("rho", material.density)] {
+        p.set(name, v).map_err(bad)?;
+    }
+    let (f, g, nc) = data();
+    let c = nitsche::Coefficients { f, g, nc };
+    let (vm, measure) = (nitsche::VonMises::new(&p, &c), nitsche::Measure::new(&p, &c));
+    Ok(Box::new(move |asm: &Assembler, u: &[f64]| {
+        let area = asm.cell_values(&measure, quadrature, &[], 0.0);
+        asm.cell_values(&vm, quadrature, &[u], 0.0).iter().zip(&area).map(|(v, a)| v / a).collect()
+    }))
 }
 
 /// Binds the library for a material and a contact law.
@@ -106,6 +126,7 @@ pub fn bind<'m>(
                 structure: if contact.theta == 1.0 { Structure::SymmetricPositiveDefinite } else { Structure::General },
                 contact_energy: energy(nitsche::ContactEnergy::new(&p, &c), q, contact.facets),
                 contact_probe: bound(nitsche::Contact::new(&p, &c), q, facets),
+                von_mises: von_mises(material, data, q)?,
             })
         }
         ContactMethod::Penalty => {
@@ -133,6 +154,7 @@ pub fn bind<'m>(
                 structure: Structure::SymmetricPositiveDefinite,
                 contact_energy: energy(penalty::ContactEnergy::new(&p, &c), q, contact.facets),
                 contact_probe: bound(penalty::Contact::new(&p, &c), q, facets),
+                von_mises: von_mises(material, data, q)?,
             })
         }
     }

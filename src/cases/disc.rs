@@ -42,6 +42,8 @@ pub struct Options {
     pub t_end: f64,
     pub newton: NewtonOptions,
     pub out: Option<PathBuf>,
+    /// Write a VTU snapshot every this many steps (0: none) into `out`/vtu, with disc.pvd.
+    pub vtu_every: usize,
     /// Show a progress bar on long runs (when stdout is a terminal).
     pub progress: bool,
 }
@@ -61,6 +63,7 @@ impl Default for Options {
             t_end: 20.0,
             newton: NewtonOptions::default(),
             out: None,
+            vtu_every: 0,
             progress: false,
         }
     }
@@ -179,8 +182,8 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
         )
     };
     let bound = bind(material, contact, &data, QUADRATURE)?;
-    let (mut forms, structure, contact_energy, probe) =
-        (bound.forms, bound.structure, bound.contact_energy, bound.contact_probe);
+    let (mut forms, structure, contact_energy, probe, von_mises) =
+        (bound.forms, bound.structure, bound.contact_energy, bound.contact_probe, bound.von_mises);
     // Consistent mass and stiffness, the load: for the measurements.
     let zero = vec![0.0; n];
     let slot = |forms: &[(&str, Box<dyn crate::runtime::scheme::BoundForm + '_>)], name: &str| {
@@ -248,11 +251,45 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let mut series = vec![measure(&states[0], v_index.map(|i| states[i].as_slice()), 0, 0.0)];
     let steps = (opts.t_end / opts.dt).round() as usize;
     let mut progress = crate::progress::Progress::new(steps, opts.progress);
+    let vtu_dir = opts.out.as_ref().filter(|_| opts.vtu_every > 0).map(|d| d.join("vtu"));
+    let mut snapshots: Vec<(f64, String)> = Vec::new();
+    let mut snapshot = |k: usize, t: f64, u: &[f64], v: &[f64]| -> Result<(), CaseError> {
+        let Some(dir) = &vtu_dir else { return Ok(()) };
+        if k % opts.vtu_every != 0 {
+            return Ok(());
+        }
+        let name = format!("disc_{k:06}.vtu");
+        let vm = von_mises(&asm, u);
+        let point = [
+            crate::vtu::Field { name: "displacement", components: 2, values: u },
+            crate::vtu::Field { name: "velocity", components: 2, values: v },
+        ];
+        let cell = [crate::vtu::Field { name: "von_mises", components: 1, values: &vm }];
+        let path = dir.join(&name);
+        crate::vtu::write(&path, &mesh, &point, &cell)
+            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
+        snapshots.push((t, format!("vtu/{name}")));
+        Ok(())
+    };
+    let velocity = |states: &[Vec<f64>], before: &[f64]| -> Vec<f64> {
+        match v_index {
+            Some(i) => states[i].clone(),
+            None => states[0].iter().zip(before).map(|(a, b)| (a - b) / opts.dt).collect(),
+        }
+    };
+    snapshot(0, 0.0, &states[0], &velocity(&states, &states[0]))?;
     for k in 0..steps {
         progress.tick(k);
         let t = k as f64 * opts.dt;
+        let before = states[0].clone();
         let report = stepper.step(&mut states, t, opts.dt)?;
         series.push(measure(&states[0], v_index.map(|i| states[i].as_slice()), report.iterations(), t + opts.dt));
+        snapshot(k + 1, t + opts.dt, &states[0], &velocity(&states, &before))?;
+    }
+    if let (Some(out), false) = (&opts.out, snapshots.is_empty()) {
+        let path = out.join("disc.pvd");
+        crate::vtu::write_collection(&path, &snapshots)
+            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
     }
     progress.finish();
     let wall = start.elapsed().as_secs_f64();

@@ -120,6 +120,9 @@ pub struct DiscArgs {
     /// Directory for series.csv, summary.json and disc.png.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Write a VTU snapshot every K steps into DIR/vtu, and DIR/disc.pvd for ParaView.
+    #[arg(long, default_value_t = 0)]
+    vtu_every: usize,
 }
 
 #[derive(clap::Args)]
@@ -438,6 +441,7 @@ fn run_disc(a: DiscArgs) -> ExitCode {
         dt: a.dt,
         t_end: a.t_end,
         out: a.out,
+        vtu_every: a.vtu_every,
         progress: true,
         ..Default::default()
     };
