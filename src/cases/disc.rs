@@ -255,7 +255,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let mut snapshots: Vec<(f64, String)> = Vec::new();
     let mut snapshot = |k: usize, t: f64, u: &[f64], v: &[f64]| -> Result<(), CaseError> {
         let Some(dir) = &vtu_dir else { return Ok(()) };
-        if k % opts.vtu_every != 0 {
+        if !k.is_multiple_of(opts.vtu_every) {
             return Ok(());
         }
         let name = format!("disc_{k:06}.vtu");
