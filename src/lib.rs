@@ -17,4 +17,5 @@ pub mod forms;
 pub mod output;
 pub mod plot;
 pub mod progress;
+pub mod report;
 pub mod vtu;

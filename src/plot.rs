@@ -25,12 +25,16 @@ pub struct Curve<'a> {
     pub dashed: bool,
 }
 
-const COLOURS: [RGBColor; 5] = [
+/// Eight distinguishable colours: the bar figures overlay up to seven schemes.
+const COLOURS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
     RGBColor(255, 127, 14),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
 ];
 
 /// Draws `panels` stacked vertically (title, y label, curves) over a shared x label.

@@ -113,3 +113,19 @@ fn bar_writes_series_summary_and_plots() {
     assert_eq!(code, 1);
     assert!(err.contains("--alpha applies to the HHT schemes"), "{err}");
 }
+
+#[test]
+fn report_writes_markdown_with_its_figures() {
+    let dir = std::env::temp_dir().join(format!("signorini-report-{}", std::process::id()));
+    let (code, out, err) = signorini(&["report", "--out", dir.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("report.md"), "{out}");
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(md.contains("## 1. Compressed bar") && md.contains("## 2. Bouncing disc"));
+    for png in
+        ["bar_energies.png", "disc_energies.png", "bar/newmark-nitsche-consistent/contact.png", "disc/hybrid/disc.png"]
+    {
+        assert!(md.contains(png.split('/').next().unwrap()), "{png} not referenced");
+        assert!(std::fs::read(dir.join(png)).unwrap().starts_with(b"\x89PNG"), "{png}");
+    }
+}

@@ -32,6 +32,11 @@ pub enum Command {
         #[command(subcommand)]
         what: BenchCommand,
     },
+    /// Run the talk's comparisons and write DIR/report.md with tables and figures.
+    Report {
+        #[arg(long, default_value = "results/report")]
+        out: PathBuf,
+    },
     /// Mesh utilities.
     Mesh {
         #[command(subcommand)]
@@ -198,6 +203,16 @@ pub fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Check { files } => check(&files),
         Command::Emit { file, stage, dim } => emit(&file, stage, dim as usize),
+        Command::Report { out } => match crate::report::write(&out, &mut |what| eprintln!("running {what}")) {
+            Ok(()) => {
+                println!("wrote {}", out.join("report.md").display());
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::FAILURE
+            }
+        },
         Command::Run { case: Some(Case::StaticBlock(a)), .. } => static_block(a),
         Command::Run { case: Some(Case::Bar(a)), .. } => run_bar(a),
         Command::Run { case: Some(Case::Disc(a)), .. } => run_disc(a),
