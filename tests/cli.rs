@@ -129,3 +129,19 @@ fn report_writes_markdown_with_its_figures() {
         assert!(std::fs::read(dir.join(png)).unwrap().starts_with(b"\x89PNG"), "{png}");
     }
 }
+
+#[test]
+fn bench_disc_times_the_stepper_and_reports_missing_meshes() {
+    let (code, _, err) = signorini(&["bench", "disc", "--mesh", "/nonexistent/disc.msh", "--repeats", "1"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("/nonexistent/disc.msh"), "{err}");
+    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/disc_r10_h1_v22.msh");
+    let dir = std::env::temp_dir().join(format!("signorini-bench-disc-{}", std::process::id()));
+    let (code, _, err) =
+        signorini(&["bench", "disc", "--mesh", mesh, "--repeats", "1", "--out", dir.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let json = std::fs::read_to_string(dir.join("bench_disc.json")).unwrap();
+    for key in ["\"dofs\": 3250", "\"steps\": 1000", "\"ms_per_step\"", "\"median_step_ms\""] {
+        assert!(json.contains(key), "{key} missing from {json}");
+    }
+}

@@ -106,6 +106,10 @@ pub struct Summary {
     pub newton_max: usize,
     pub wall_seconds: f64,
     pub seconds_per_step: f64,
+    /// Time inside the time stepper alone (no setup, measurements or output), in total and
+    /// the median over steps.
+    pub stepping_seconds: f64,
+    pub step_median_seconds: f64,
 }
 
 pub struct Run {
@@ -278,11 +282,14 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
         }
     };
     snapshot(0, 0.0, &states[0], &velocity(&states, &states[0]))?;
+    let mut step_times = Vec::with_capacity(steps);
     for k in 0..steps {
         progress.tick(k);
         let t = k as f64 * opts.dt;
         let before = states[0].clone();
+        let clock = Instant::now();
         let report = stepper.step(&mut states, t, opts.dt)?;
+        step_times.push(clock.elapsed().as_secs_f64());
         series.push(measure(&states[0], v_index.map(|i| states[i].as_slice()), report.iterations(), t + opts.dt));
         snapshot(k + 1, t + opts.dt, &states[0], &velocity(&states, &before))?;
     }
@@ -315,6 +322,8 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
         newton_max: series.iter().map(|r| r.newton).max().unwrap_or(0),
         wall_seconds: wall,
         seconds_per_step: wall / steps.max(1) as f64,
+        stepping_seconds: step_times.iter().sum(),
+        step_median_seconds: crate::bench::median(step_times),
     };
     if let Some(dir) = &opts.out {
         write_outputs(dir, &summary, &series)?;

@@ -78,6 +78,17 @@ pub enum BenchCommand {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
+    /// Time per step of the bouncing disc (Newmark, Nitsche θ = 1, Δt = 0.02, 1000 steps),
+    /// stepper alone, on each Gmsh mesh.
+    Disc {
+        #[arg(long = "mesh", required = true, num_args = 1..)]
+        meshes: Vec<PathBuf>,
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Directory for bench_disc.json.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
 }
 
 #[derive(Subcommand)]
@@ -225,6 +236,7 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Bench { what: BenchCommand::Assemble { sizes, factor, repeats, out } } => {
             bench_assemble(&sizes, factor, repeats, &out)
         }
+        Command::Bench { what: BenchCommand::Disc { meshes, repeats, out } } => bench_disc(&meshes, repeats, &out),
     }
 }
 
@@ -350,6 +362,27 @@ fn bench_assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) ->
     }
     let report = crate::bench::assemble(sizes, (factor > 0).then_some(factor), repeats, &mut |line| println!("{line}"));
     let path = out.join("bench_assemble.json");
+    match crate::output::write_json(&path, &report) {
+        Ok(()) => {
+            println!("wrote {}", path.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: cannot write {}: {e}", path.display());
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn bench_disc(meshes: &[PathBuf], repeats: usize, out: &Path) -> ExitCode {
+    let report = match crate::bench::disc::disc(meshes, repeats, &mut |line| println!("{line}")) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let path = out.join("bench_disc.json");
     match crate::output::write_json(&path, &report) {
         Ok(()) => {
             println!("wrote {}", path.display());

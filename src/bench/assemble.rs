@@ -9,6 +9,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::median;
 use crate::forms::nitsche::{Coefficients, Mass, Params, Stiffness};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
@@ -43,12 +44,6 @@ pub struct Report {
     pub assembly: Vec<AssemblyTiming>,
     pub factor: Option<FactorTiming>,
     pub repeats: usize,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
 }
 
 fn forms() -> (Stiffness, Mass) {
