@@ -1,7 +1,7 @@
 //! `signorini report`: the talk's comparisons, run and written up as DIR/report.md with tables
 //! and figures (bar: Nitsche against penalty with Crank–Nicolson and HHT, midpoint with and
 //! without mass redistribution, TR-BDF2, hybrid, every scheme's energy; disc: energies and
-//! Newton iterations per scheme).
+//! Newton iterations per scheme, and the disc at Δt ∈ {0.01, 0.05, 0.2}).
 
 use std::fmt::Write;
 use std::path::Path;
@@ -118,9 +118,6 @@ pub fn write(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<(), CaseError
             r.series.iter().map(|row| (row.t, row.newton as f64)).collect::<Vec<_>>(),
         ));
     }
-    let curves = |data: &[(String, Vec<(f64, f64)>)]| -> Vec<(String, Vec<(f64, f64)>)> { data.to_vec() };
-    let e = curves(&disc_energies);
-    let n = curves(&disc_newton);
     crate::plot::panels(
         &out.join("disc_energies.png"),
         "t",
@@ -128,18 +125,66 @@ pub fn write(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<(), CaseError
             (
                 "E_Θ per scheme",
                 "E_Θ",
-                e.iter().map(|(l, p)| Curve { label: l, points: p.clone(), dashed: false }).collect(),
+                disc_energies.iter().map(|(l, p)| Curve { label: l, points: p.clone(), dashed: false }).collect(),
             ),
             (
                 "Newton iterations per step",
                 "iterations",
-                n.iter().map(|(l, p)| Curve { label: l, points: p.clone(), dashed: false }).collect(),
+                disc_newton.iter().map(|(l, p)| Curve { label: l, points: p.clone(), dashed: false }).collect(),
             ),
         ],
     )
     .map_err(|e| CaseError::Write { path: out.display().to_string(), source: std::io::Error::other(e) })?;
     md.push_str("\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `disc/<scheme>/disc.png` (energies, displacements, contact force, Newton).\n\n");
+    disc_robustness(&mut md, progress);
     let _ = writeln!(md, "_Run time: {:.1} s._", start.elapsed().as_secs_f64());
     crate::output::write_atomic(&out.join("report.md"), md.as_bytes())
         .map_err(|source| CaseError::Write { path: out.join("report.md").display().to_string(), source })
+}
+
+/// The disc at Δt ∈ {0.01, 0.05, 0.2} for every implicit scheme (spec §6.2): a failure (Newton
+/// not converging, blow-up) is a result here, reported in the table, not an error.
+fn disc_robustness(md: &mut String, progress: &mut dyn FnMut(&str)) {
+    md.push_str(
+        "### Robustness in Δt
+
+Same disc, T = 20. `Newton/step in contact`: mean iterations over the steps that end with an active contact point.\n\n",
+    );
+    md.push_str("| Δt | scheme | min mean u_y | E_Θ(0) → E_Θ(20) | max penetration | Newton/step in contact | max/step |\n|---|---|---|---|---|---|---|\n");
+    for dt in [0.01, 0.05, 0.2] {
+        for scheme in SchemeChoice::ALL {
+            if scheme == SchemeChoice::HhtImex {
+                continue;
+            }
+            progress(&format!("disc {} Δt = {dt}", scheme.name()));
+            match disc::run(&disc::Options { scheme, dt, ..Default::default() }) {
+                Ok(r) => {
+                    let s = &r.summary;
+                    let contact: Vec<usize> =
+                        r.series.iter().filter(|row| row.active_points > 0).map(|row| row.newton).collect();
+                    let mean = contact.iter().sum::<usize>() as f64 / contact.len().max(1) as f64;
+                    let _ = writeln!(
+                        md,
+                        "| {dt} | {} | {:.4} | {:.4} → {:.4} | {:.2e} | {:.2} | {} |",
+                        scheme.name(),
+                        s.min_uy_mean,
+                        s.energy_aug_initial,
+                        s.energy_aug_final,
+                        s.max_penetration,
+                        mean,
+                        s.newton_max
+                    );
+                }
+                Err(e) => {
+                    let _ = writeln!(
+                        md,
+                        "| {dt} | {} | failed: {} | | | | |",
+                        scheme.name(),
+                        e.to_string().replace('|', "/")
+                    );
+                }
+            }
+        }
+    }
+    md.push('\n');
 }

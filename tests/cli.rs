@@ -122,6 +122,10 @@ fn report_writes_markdown_with_its_figures() {
     assert!(out.contains("report.md"), "{out}");
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(md.contains("## 1. Compressed bar") && md.contains("## 2. Bouncing disc"));
+    // Every implicit scheme survives Δt up to 0.2 on the disc (spec §6.2).
+    let robust = md.split("### Robustness in Δt").nth(1).expect("robustness section");
+    assert_eq!(robust.lines().filter(|l| l.starts_with("| 0.")).count(), 18, "{robust}");
+    assert!(!robust.contains("failed:"), "{robust}");
     for png in
         ["bar_energies.png", "disc_energies.png", "bar/newmark-nitsche-consistent/contact.png", "disc/hybrid/disc.png"]
     {
