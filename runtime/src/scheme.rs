@@ -273,6 +273,15 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
     }
 
     /// The matrix of a linear one-field form (e.g. `mass`, for energies).
+    /// Factorizations and solves of all stages so far.
+    pub fn counters(&self) -> crate::linalg::Counters {
+        self.stages.iter().map(|s| s.newton.counters()).fold(Default::default(), |a, c| crate::linalg::Counters {
+            symbolic: a.symbolic + c.symbolic,
+            numeric: a.numeric + c.numeric,
+            solves: a.solves + c.solves,
+        })
+    }
+
     pub fn matrix(&self, form: &str) -> Option<&Matrix> {
         self.matrices.get(form)
     }

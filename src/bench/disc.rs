@@ -18,6 +18,7 @@ pub struct DiscTiming {
     pub dofs: usize,
     pub steps: usize,
     pub newton_total: usize,
+    pub factorizations: usize,
     /// Median over runs of (stepping time / steps).
     pub ms_per_step: f64,
     /// Median over runs of the median step time.
@@ -55,13 +56,21 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             dofs: s.dofs,
             steps: s.steps,
             newton_total: s.newton_total,
+            factorizations: s.factorizations,
             ms_per_step: median(mean),
             median_step_ms: median(med),
             ms_per_step_with_setup: median(whole),
         };
         progress(&format!(
-            "{}: {} dofs, {} steps, {} Newton iterations; {:.3} ms/step stepping (median step {:.3} ms), {:.3} ms/step whole run",
-            t.mesh, t.dofs, t.steps, t.newton_total, t.ms_per_step, t.median_step_ms, t.ms_per_step_with_setup
+            "{}: {} dofs, {} steps, {} Newton iterations, {} factorizations; {:.3} ms/step stepping (median step {:.3} ms), {:.3} ms/step whole run",
+            t.mesh,
+            t.dofs,
+            t.steps,
+            t.newton_total,
+            t.factorizations,
+            t.ms_per_step,
+            t.median_step_ms,
+            t.ms_per_step_with_setup
         ));
         out.push(t);
     }

@@ -110,6 +110,8 @@ pub struct Summary {
     /// the median over steps.
     pub stepping_seconds: f64,
     pub step_median_seconds: f64,
+    /// Numeric factorizations of the stage Jacobians (the rest of the Newton iterations reuse one).
+    pub factorizations: usize,
 }
 
 pub struct Run {
@@ -324,6 +326,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
         seconds_per_step: wall / steps.max(1) as f64,
         stepping_seconds: step_times.iter().sum(),
         step_median_seconds: crate::bench::median(step_times),
+        factorizations: stepper.counters().numeric,
     };
     if let Some(dir) = &opts.out {
         write_outputs(dir, &summary, &series)?;
