@@ -174,24 +174,41 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     if opts.t_end / opts.dt > 1e7 {
         return Err(CaseError::Option("more than 10⁷ steps".into()));
     }
-    let hht = opts.scheme.is_hht();
-    if opts.alpha.is_some() && !hht {
-        return Err(CaseError::Option(format!("--alpha applies to the HHT schemes, not {}", opts.scheme.name())));
+    dispatch(opts.scheme, opts.alpha, Simulate(opts))
+}
+
+/// A run generic in the time scheme: what [`dispatch`] calls with the chosen scheme.
+pub trait WithScheme {
+    type Output;
+    fn run<S: TimeScheme>(self, scheme: S) -> Result<Self::Output, CaseError>;
+}
+
+/// Builds the chosen scheme (HHT variants with `alpha`, default 0.05) and runs `w` with it.
+pub fn dispatch<W: WithScheme>(choice: SchemeChoice, alpha: Option<f64>, w: W) -> Result<W::Output, CaseError> {
+    if alpha.is_some() && !choice.is_hht() {
+        return Err(CaseError::Option(format!("--alpha applies to the HHT schemes, not {}", choice.name())));
     }
     let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
-    let alpha = opts.alpha.unwrap_or(0.05);
-    match opts.scheme {
-        SchemeChoice::Newmark => simulate(opts, schemes::newmark::Newmark::default()),
-        SchemeChoice::Hht => simulate(opts, schemes::hht::Hht::default().with("alpha", alpha).map_err(bad)?),
-        SchemeChoice::HhtImex => {
-            simulate(opts, schemes::hht_imex::HhtImex::default().with("alpha", alpha).map_err(bad)?)
-        }
+    let alpha = alpha.unwrap_or(0.05);
+    match choice {
+        SchemeChoice::Newmark => w.run(schemes::newmark::Newmark::default()),
+        SchemeChoice::Hht => w.run(schemes::hht::Hht::default().with("alpha", alpha).map_err(bad)?),
+        SchemeChoice::HhtImex => w.run(schemes::hht_imex::HhtImex::default().with("alpha", alpha).map_err(bad)?),
         SchemeChoice::HhtUnweighted => {
-            simulate(opts, schemes::hht_unweighted::HhtUnweighted::default().with("alpha", alpha).map_err(bad)?)
+            w.run(schemes::hht_unweighted::HhtUnweighted::default().with("alpha", alpha).map_err(bad)?)
         }
-        SchemeChoice::Midpoint => simulate(opts, schemes::midpoint::Midpoint::default()),
-        SchemeChoice::Trbdf2 => simulate(opts, schemes::trbdf2::Trbdf2::default()),
-        SchemeChoice::Hybrid => simulate(opts, schemes::hybrid::Hybrid::default()),
+        SchemeChoice::Midpoint => w.run(schemes::midpoint::Midpoint::default()),
+        SchemeChoice::Trbdf2 => w.run(schemes::trbdf2::Trbdf2::default()),
+        SchemeChoice::Hybrid => w.run(schemes::hybrid::Hybrid::default()),
+    }
+}
+
+struct Simulate<'a>(&'a Options);
+
+impl WithScheme for Simulate<'_> {
+    type Output = Run;
+    fn run<S: TimeScheme>(self, scheme: S) -> Result<Run, CaseError> {
+        simulate(self.0, scheme)
     }
 }
 

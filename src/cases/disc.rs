@@ -8,10 +8,9 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::CaseError;
-use super::bar::{MassChoice, SchemeChoice};
+use super::bar::{MassChoice, SchemeChoice, WithScheme};
 use super::binding::{Contact, Material, bind};
 use super::static_block::ContactMethod;
-use crate::forms::schemes;
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::evaluate::facet_samples;
 use crate::runtime::kernel::Coef;
@@ -146,23 +145,15 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     if !positive(opts.dt) || !positive(opts.t_end) || opts.t_end / opts.dt > 1e7 {
         return Err(CaseError::Option("--dt and --t-end must be positive, with at most 10⁷ steps".into()));
     }
-    if opts.alpha.is_some() && !opts.scheme.is_hht() {
-        return Err(CaseError::Option(format!("--alpha applies to the HHT schemes, not {}", opts.scheme.name())));
-    }
-    let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
-    let alpha = opts.alpha.unwrap_or(0.05);
-    match opts.scheme {
-        SchemeChoice::Newmark => simulate(opts, schemes::newmark::Newmark::default()),
-        SchemeChoice::Hht => simulate(opts, schemes::hht::Hht::default().with("alpha", alpha).map_err(bad)?),
-        SchemeChoice::HhtImex => {
-            simulate(opts, schemes::hht_imex::HhtImex::default().with("alpha", alpha).map_err(bad)?)
-        }
-        SchemeChoice::HhtUnweighted => {
-            simulate(opts, schemes::hht_unweighted::HhtUnweighted::default().with("alpha", alpha).map_err(bad)?)
-        }
-        SchemeChoice::Midpoint => simulate(opts, schemes::midpoint::Midpoint::default()),
-        SchemeChoice::Trbdf2 => simulate(opts, schemes::trbdf2::Trbdf2::default()),
-        SchemeChoice::Hybrid => simulate(opts, schemes::hybrid::Hybrid::default()),
+    super::bar::dispatch(opts.scheme, opts.alpha, Simulate(opts))
+}
+
+struct Simulate<'a>(&'a Options);
+
+impl WithScheme for Simulate<'_> {
+    type Output = Run;
+    fn run<S: TimeScheme>(self, scheme: S) -> Result<Run, CaseError> {
+        simulate(self.0, scheme)
     }
 }
 

@@ -361,17 +361,7 @@ fn bench_assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) ->
         return ExitCode::FAILURE;
     }
     let report = crate::bench::assemble(sizes, (factor > 0).then_some(factor), repeats, &mut |line| println!("{line}"));
-    let path = out.join("bench_assemble.json");
-    match crate::output::write_json(&path, &report) {
-        Ok(()) => {
-            println!("wrote {}", path.display());
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: cannot write {}: {e}", path.display());
-            ExitCode::FAILURE
-        }
-    }
+    write_bench(&out.join("bench_assemble.json"), &report)
 }
 
 fn bench_disc(meshes: &[PathBuf], repeats: usize, out: &Path) -> ExitCode {
@@ -382,8 +372,12 @@ fn bench_disc(meshes: &[PathBuf], repeats: usize, out: &Path) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    let path = out.join("bench_disc.json");
-    match crate::output::write_json(&path, &report) {
+    write_bench(&out.join("bench_disc.json"), &report)
+}
+
+/// Writes a benchmark's JSON and says where.
+fn write_bench(path: &Path, report: &impl serde::Serialize) -> ExitCode {
+    match crate::output::write_json(path, report) {
         Ok(()) => {
             println!("wrote {}", path.display());
             ExitCode::SUCCESS
