@@ -10,7 +10,8 @@ use std::sync::Arc;
 
 use crate::element::ElementKind;
 use crate::kernel::{
-    CellCtx, FacetCtx, FacetTabulation, Form, FormKernel, FunctionalKernel, LocalMatrix, LocalVector, Tabulation,
+    CellCtx, FacetCtx, FacetTabulation, Form, FormKernel, FormMeta, FunctionalKernel, LocalMatrix, LocalVector,
+    Tabulation,
 };
 use crate::linalg::Matrix;
 use crate::mesh::{Facet, Mesh, MeshError};
@@ -176,12 +177,12 @@ impl Quadrature {
         Quadrature { cell: Some(cell), facet: Some(facet) }
     }
 
-    fn cell_degree<K: Form>(&self, kind: ElementKind) -> u32 {
-        self.cell.unwrap_or_else(|| K::META.cell_degree.map_or(1, |d| d[kind.degree() as usize - 1]))
+    fn cell_degree(&self, meta: &FormMeta, kind: ElementKind) -> u32 {
+        self.cell.unwrap_or_else(|| meta.cell_degree.map_or(1, |d| d[kind.degree() as usize - 1]))
     }
 
-    fn facet_degree<K: Form>(&self, kind: ElementKind, region: usize) -> u32 {
-        self.facet.unwrap_or_else(|| K::META.facets.get(region).map_or(1, |(_, d)| d[kind.degree() as usize - 1]))
+    fn facet_degree(&self, meta: &FormMeta, kind: ElementKind, region: usize) -> u32 {
+        self.facet.unwrap_or_else(|| meta.facets.get(region).map_or(1, |(_, d)| d[kind.degree() as usize - 1]))
     }
 }
 
@@ -207,13 +208,13 @@ impl<'m> Assembler<'m> {
 
     /// Adds the volume part of `k`'s residual at `fields` to `out`.
     pub fn cell_residual<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64, out: &mut [f64]) {
-        let degree = q.cell_degree::<K>(self.mesh.kind);
+        let degree = q.cell_degree(k.meta(), self.mesh.kind);
         dispatch!(self.mesh.kind, cell_residual::<K>(self.mesh, k, degree, fields, t, out))
     }
 
     /// Adds the volume part of `k`'s tangent with respect to field `wrt` to `m`.
     pub fn cell_tangent<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
-        let degree = q.cell_degree::<K>(self.mesh.kind);
+        let degree = q.cell_degree(k.meta(), self.mesh.kind);
         dispatch!(self.mesh.kind, cell_tangent::<K>(self.mesh, &self.pattern, k, degree, fields, wrt, t, &mut m.values))
     }
 
@@ -230,8 +231,8 @@ impl<'m> Assembler<'m> {
         t: f64,
         out: &mut [f64],
     ) {
-        let Some(r) = region_index::<K>(region) else { return };
-        let degree = q.facet_degree::<K>(self.mesh.kind, r);
+        let Some(r) = region_index(k.meta(), region) else { return };
+        let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
         dispatch!(self.mesh.kind, facet_residual::<K>(self.mesh, k, r, facets, degree, fields, t, out))
     }
 
@@ -248,8 +249,8 @@ impl<'m> Assembler<'m> {
         t: f64,
         m: &mut Matrix,
     ) {
-        let Some(r) = region_index::<K>(region) else { return };
-        let degree = q.facet_degree::<K>(self.mesh.kind, r);
+        let Some(r) = region_index(k.meta(), region) else { return };
+        let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
         dispatch!(
             self.mesh.kind,
             facet_tangent::<K>(self.mesh, &self.pattern, k, r, facets, degree, fields, wrt, t, &mut m.values)
@@ -269,20 +270,20 @@ impl<'m> Assembler<'m> {
         t: f64,
         out: &mut Vec<bool>,
     ) {
-        let Some(r) = region_index::<K>(region) else { return };
-        let degree = q.facet_degree::<K>(self.mesh.kind, r);
+        let Some(r) = region_index(k.meta(), region) else { return };
+        let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
         dispatch!(self.mesh.kind, facet_switches::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, out))
     }
 
     /// The volume integral of a functional at `fields`.
     pub fn cell_value<K: Functional>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64) -> f64 {
-        let degree = q.cell_degree::<K>(self.mesh.kind);
+        let degree = q.cell_degree(k.meta(), self.mesh.kind);
         dispatch!(self.mesh.kind, cell_value::<K>(self.mesh, k, degree, fields, t))
     }
 
     /// The volume integral of a functional on each cell.
     pub fn cell_values<K: Functional>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64) -> Vec<f64> {
-        let degree = q.cell_degree::<K>(self.mesh.kind);
+        let degree = q.cell_degree(k.meta(), self.mesh.kind);
         dispatch!(self.mesh.kind, cell_values::<K>(self.mesh, k, degree, fields, t))
     }
 
@@ -297,8 +298,8 @@ impl<'m> Assembler<'m> {
         fields: &[&[f64]],
         t: f64,
     ) -> f64 {
-        let Some(r) = region_index::<K>(region) else { return 0.0 };
-        let degree = q.facet_degree::<K>(self.mesh.kind, r);
+        let Some(r) = region_index(k.meta(), region) else { return 0.0 };
+        let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
         dispatch!(self.mesh.kind, facet_value::<K>(self.mesh, k, r, facets, degree, fields, t))
     }
 
@@ -308,8 +309,8 @@ impl<'m> Assembler<'m> {
     }
 }
 
-fn region_index<K: Form>(region: &str) -> Option<usize> {
-    K::META.facets.iter().position(|(name, _)| *name == region)
+fn region_index(meta: &FormMeta, region: &str) -> Option<usize> {
+    meta.facets.iter().position(|(name, _)| *name == region)
 }
 
 /// Copies the values of global fields at a cell's nodes into local arrays.

@@ -281,7 +281,8 @@ pub struct FormMeta {
 
 /// Implemented by every generated form.
 pub trait Form {
-    const META: FormMeta;
+    /// Generated forms return their `META` constant; interpreted forms, what they were built with.
+    fn meta(&self) -> &FormMeta;
 }
 
 /// Element kernels of a form for cells of dimension D with N nodes. Each method adds its

@@ -169,7 +169,7 @@ impl<C: Kernel> NonlinearProblem for StaticContact<'_, C> {
     fn active_set(&mut self, u: &[f64], out: &mut Vec<bool>) -> bool {
         let t = &self.contact;
         self.asm.facet_switches(&t.form, &t.region, t.facets, t.quadrature, &[u], 0, 0.0, out);
-        C::META.piecewise
+        t.form.meta().piecewise
     }
 
     fn jacobian(&mut self, u: &[f64], j: &mut Matrix) {

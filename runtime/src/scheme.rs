@@ -96,19 +96,19 @@ pub struct Bound<'m, K: Kernel> {
 
 impl<K: Kernel> BoundForm for Bound<'_, K> {
     fn name(&self) -> &str {
-        K::META.name
+        self.kernel.meta().name
     }
     fn fields(&self) -> usize {
-        K::META.fields.len()
+        self.kernel.meta().fields.len()
     }
     fn linear(&self) -> bool {
-        K::META.linear
+        self.kernel.meta().linear
     }
     fn piecewise(&self) -> bool {
-        K::META.piecewise
+        self.kernel.meta().piecewise
     }
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {
-        if K::META.cell_degree.is_some() {
+        if self.kernel.meta().cell_degree.is_some() {
             asm.cell_residual(&self.kernel, self.quadrature, fields, t, out);
         }
         for (region, facets) in &self.regions {
@@ -116,7 +116,7 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
         }
     }
     fn tangent(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
-        if K::META.cell_degree.is_some() {
+        if self.kernel.meta().cell_degree.is_some() {
             asm.cell_tangent(&self.kernel, self.quadrature, fields, wrt, t, m);
         }
         for (region, facets) in &self.regions {

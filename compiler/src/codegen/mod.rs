@@ -106,7 +106,7 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "impl Form for {sname} {{ const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: &[{}] }}; }}",
+            "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: &[{}] }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }} }}",
             form.name,
             fields.join(", "),
             form.test.as_ref().map_or("", |t| t.name.as_str()),
