@@ -13,6 +13,7 @@ pub use signorini_runtime as runtime;
 pub mod bench;
 pub mod cases;
 pub mod cli;
+pub mod driver;
 pub mod forms;
 pub mod output;
 pub mod plot;

@@ -4,6 +4,7 @@
 pub mod check;
 pub mod codegen;
 pub mod diagnostic;
+pub mod docs;
 pub mod ir;
 pub mod scheme;
 pub mod source;

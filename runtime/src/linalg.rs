@@ -59,6 +59,18 @@ impl Matrix {
     }
 
     /// Frobenius norm.
+    /// Whether |a_ij − a_ji| ≤ tol·max|a| for every stored entry.
+    pub fn is_symmetric(&self, tol: f64) -> bool {
+        let scale = self.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let p = &self.pattern;
+        (0..p.col_ptr.len() - 1).all(|j| {
+            (p.col_ptr[j]..p.col_ptr[j + 1]).all(|k| {
+                let i = p.row_idx[k];
+                i <= j || (self.values[k] - self.get(j, i)).abs() <= tol * scale
+            })
+        })
+    }
+
     pub fn frobenius(&self) -> f64 {
         self.values.iter().map(|v| v * v).sum::<f64>().sqrt()
     }
@@ -86,6 +98,9 @@ pub enum Structure {
     SymmetricPositiveDefinite,
     /// Sparse LU with partial pivoting.
     General,
+    /// Decided at each factorization: Cholesky when the matrix is symmetric (to round-off),
+    /// LU otherwise or once Cholesky has met a non-positive pivot.
+    Auto,
 }
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -154,7 +169,7 @@ impl Factorization {
                             .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
                     Factors::Llt { values: vec![0.0; symbolic.len_val()], symbolic, factored: false }
                 }
-                Structure::General => {
+                Structure::General | Structure::Auto => {
                     let symbolic = lu::factorize_symbolic_lu(sym, Default::default())
                         .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
                     Factors::Lu { symbolic, numeric: NumericLu::new(), factored: false }

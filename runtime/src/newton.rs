@@ -84,6 +84,10 @@ pub enum NewtonError {
 pub struct Newton {
     pub options: NewtonOptions,
     factorization: Option<Factorization>,
+    /// With `Structure::Auto`: the factorization of the other structure, kept for its symbolic
+    /// analysis, and whether Cholesky has failed (then LU from there on).
+    spare: Option<Factorization>,
+    spd_failed: bool,
     jacobian: Option<Matrix>,
     /// The active set the current factorization was computed for.
     factored_for: Option<Vec<bool>>,
@@ -91,7 +95,7 @@ pub struct Newton {
 
 impl Newton {
     pub fn new(options: NewtonOptions) -> Self {
-        Newton { options, factorization: None, jacobian: None, factored_for: None }
+        Newton { options, factorization: None, spare: None, spd_failed: false, jacobian: None, factored_for: None }
     }
 
     /// Forgets the factorization's validity (the linear part of the problem changed).
@@ -101,7 +105,13 @@ impl Newton {
 
     /// Symbolic and numeric factorizations and solves so far.
     pub fn counters(&self) -> crate::linalg::Counters {
-        self.factorization.as_ref().map(|f| f.counters).unwrap_or_default()
+        let c = |f: &Option<Factorization>| f.as_ref().map(|f| f.counters).unwrap_or_default();
+        let (a, b) = (c(&self.factorization), c(&self.spare));
+        crate::linalg::Counters {
+            symbolic: a.symbolic + b.symbolic,
+            numeric: a.numeric + b.numeric,
+            solves: a.solves + b.solves,
+        }
     }
 
     /// Solves R(w) = 0 starting from `w`, which holds the solution on success.
@@ -164,10 +174,28 @@ impl Newton {
         let j = self.jacobian.get_or_insert_with(|| p.jacobian_matrix());
         j.values.iter_mut().for_each(|v| *v = 0.0);
         p.jacobian(w, j);
-        let f = self.factorization.get_or_insert_with(|| Factorization::new(p.structure()));
+        let want = match p.structure() {
+            Structure::Auto if self.spd_failed || !j.is_symmetric(1e-12) => Structure::General,
+            Structure::Auto => Structure::SymmetricPositiveDefinite,
+            s => s,
+        };
+        if self.factorization.as_ref().is_some_and(|f| f.structure() != want) {
+            std::mem::swap(&mut self.factorization, &mut self.spare);
+        }
+        let f = match &mut self.factorization {
+            Some(f) if f.structure() == want => f,
+            slot => {
+                let old = slot.replace(Factorization::new(want));
+                if old.is_some() {
+                    self.spare = old;
+                }
+                slot.as_mut().expect("just set")
+            }
+        };
         match f.factor(j) {
             Err(LinalgError::NotPositiveDefinite { .. }) if f.structure() == Structure::SymmetricPositiveDefinite => {
                 debug!("Jacobian not positive definite: switching to LU");
+                self.spd_failed = true;
                 let counters = f.counters;
                 let mut lu = Factorization::new(Structure::General);
                 lu.counters = counters;

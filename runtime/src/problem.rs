@@ -2,10 +2,10 @@
 //! assembled once, C a contact form on a boundary region, and L the loads; Dirichlet
 //! conditions on chosen dofs.
 
-use crate::assembly::{Assembler, Kernel, Quadrature};
+use crate::assembly::Assembler;
 use crate::linalg::{Matrix, Structure};
-use crate::mesh::Facet;
 use crate::newton::NonlinearProblem;
+use crate::scheme::BoundForm;
 
 /// Dirichlet conditions: dofs held at given values (zero unless set).
 #[derive(Clone, Debug, PartialEq)]
@@ -96,41 +96,32 @@ pub fn solve_linear(
     Ok(rhs)
 }
 
-/// A contact term: a compiled form, the name of its boundary integral, and the mesh facets it
-/// is integrated over.
-pub struct ContactTerm<'m, C: Kernel> {
-    pub form: C,
-    pub region: String,
-    pub facets: &'m [Facet],
-    pub quadrature: Quadrature,
-}
-
 /// K u + C(u) − L = 0.
-pub struct StaticContact<'m, C: Kernel> {
+pub struct StaticContact<'m> {
     asm: &'m Assembler<'m>,
     stiffness: Matrix,
     load: Vec<f64>,
     load_scale: f64,
-    pub contact: ContactTerm<'m, C>,
+    /// The contact form, bound to its boundary region.
+    pub contact: Box<dyn BoundForm + 'm>,
     pub constraints: Constraints,
     structure: Structure,
 }
 
-impl<'m, C: Kernel> StaticContact<'m, C> {
+impl<'m> StaticContact<'m> {
     /// Assembles the linear form `stiffness` once.
-    pub fn new<S: Kernel>(
+    pub fn new(
         asm: &'m Assembler<'m>,
-        stiffness: &S,
-        quadrature: Quadrature,
+        stiffness: &dyn BoundForm,
         load: Vec<f64>,
-        contact: ContactTerm<'m, C>,
+        contact: Box<dyn BoundForm + 'm>,
         constraints: Constraints,
         structure: Structure,
     ) -> Self {
         let n = asm.size();
         let zero = vec![0.0; n];
         let mut k = asm.zero_matrix();
-        asm.cell_tangent(stiffness, quadrature, &[&zero], 0, 0.0, &mut k);
+        stiffness.tangent(asm, &[&zero], 0, 0.0, &mut k);
         let mut load = load;
         constraints.zero(&mut load);
         let load_scale = crate::newton::norm_inf(&load);
@@ -147,17 +138,15 @@ impl<'m, C: Kernel> StaticContact<'m, C> {
     /// The contact term's residual C(u) (unconstrained).
     pub fn contact_residual(&self, u: &[f64]) -> Vec<f64> {
         let mut c = vec![0.0; u.len()];
-        let t = &self.contact;
-        self.asm.facet_residual(&t.form, &t.region, t.facets, t.quadrature, &[u], 0.0, &mut c);
+        self.contact.residual(self.asm, &[u], 0.0, &mut c);
         c
     }
 }
 
-impl<C: Kernel> NonlinearProblem for StaticContact<'_, C> {
+impl NonlinearProblem for StaticContact<'_> {
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
         self.stiffness.mul_vec(u, r);
-        let t = &self.contact;
-        self.asm.facet_residual(&t.form, &t.region, t.facets, t.quadrature, &[u], 0.0, r);
+        self.contact.residual(self.asm, &[u], 0.0, r);
         r.iter_mut().zip(&self.load).for_each(|(ri, li)| *ri -= li);
         self.constraints.zero(r);
     }
@@ -167,15 +156,13 @@ impl<C: Kernel> NonlinearProblem for StaticContact<'_, C> {
     }
 
     fn active_set(&mut self, u: &[f64], out: &mut Vec<bool>) -> bool {
-        let t = &self.contact;
-        self.asm.facet_switches(&t.form, &t.region, t.facets, t.quadrature, &[u], 0, 0.0, out);
-        t.form.meta().piecewise
+        self.contact.switches(self.asm, &[u], 0, 0.0, out);
+        self.contact.piecewise()
     }
 
     fn jacobian(&mut self, u: &[f64], j: &mut Matrix) {
         j.values.copy_from_slice(&self.stiffness.values);
-        let t = &self.contact;
-        self.asm.facet_tangent(&t.form, &t.region, t.facets, t.quadrature, &[u], 0, 0.0, j);
+        self.contact.tangent(self.asm, &[u], 0, 0.0, j);
         self.constraints.apply(j);
     }
 

@@ -58,6 +58,8 @@ pub struct InitialDesc {
 #[derive(Clone, Copy, Debug)]
 pub struct SchemeDesc {
     pub name: &'static str,
+    /// The slots it applies (`uses`), with where they are declared.
+    pub uses: &'static [crate::library::SlotUse],
     pub states: &'static [&'static str],
     pub initial: Option<InitialDesc>,
     pub stages: &'static [StageDesc],
@@ -67,9 +69,9 @@ pub struct SchemeDesc {
     pub coefficients: usize,
 }
 
-/// Implemented by every generated scheme.
+/// Implemented by every generated scheme, and by schemes interpreted at run time.
 pub trait TimeScheme {
-    const DESC: SchemeDesc;
+    fn desc(&self) -> &SchemeDesc;
     /// Evaluates every coefficient for step size `dt` from time `t`.
     fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]);
 }
@@ -162,8 +164,8 @@ impl BoundForm for MatrixForm {
 
 #[derive(Debug, thiserror::Error)]
 pub enum StepError {
-    #[error("scheme `{scheme}` uses form `{form}`, which the case does not provide")]
-    MissingForm { scheme: &'static str, form: String },
+    #[error("scheme `{scheme}` applies slot `{form}` ({declared}), which no form file in use provides")]
+    MissingForm { scheme: &'static str, form: String, declared: &'static str },
     #[error("form `{form}` takes {expected} field(s), but the scheme applies it to {given}")]
     Arity { form: String, expected: usize, given: usize },
     #[error(
@@ -191,8 +193,9 @@ impl StepReport {
 }
 
 /// Steps a scheme on a mesh with bound forms.
-pub struct Stepper<'a, S: TimeScheme> {
-    pub scheme: S,
+pub struct Stepper<'a> {
+    pub scheme: Box<dyn TimeScheme + 'a>,
+    desc: SchemeDesc,
     asm: &'a Assembler<'a>,
     forms: HashMap<String, Box<dyn BoundForm + 'a>>,
     pub constraints: Constraints,
@@ -216,12 +219,12 @@ struct StageCache {
     constant: Option<Matrix>,
 }
 
-impl<'a, S: TimeScheme> Stepper<'a, S> {
+impl<'a> Stepper<'a> {
     /// `forms` binds the form names the scheme uses to bound kernels (a slot may hold any form
     /// of the right arity: `contact` is Nitsche's or the penalty's). `structure`: Cholesky for
     /// symmetric positive definite stage Jacobians, LU otherwise.
     pub fn new(
-        scheme: S,
+        scheme: Box<dyn TimeScheme + 'a>,
         asm: &'a Assembler<'a>,
         forms: Vec<(&'static str, Box<dyn BoundForm + 'a>)>,
         constraints: Constraints,
@@ -230,13 +233,15 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
     ) -> Result<Self, StepError> {
         let forms: HashMap<String, Box<dyn BoundForm + 'a>> =
             forms.into_iter().map(|(slot, f)| (slot.to_string(), f)).collect();
-        let desc = S::DESC;
+        let desc = *scheme.desc();
         let all_terms =
             desc.stages.iter().flat_map(|s| s.terms.iter()).chain(desc.initial.iter().flat_map(|i| i.terms.iter()));
         for term in all_terms {
-            let form = forms
-                .get(term.form)
-                .ok_or_else(|| StepError::MissingForm { scheme: desc.name, form: term.form.to_string() })?;
+            let form = forms.get(term.form).ok_or_else(|| StepError::MissingForm {
+                scheme: desc.name,
+                form: term.form.to_string(),
+                declared: desc.uses.iter().find(|u| u.name == term.form).map_or("", |u| u.declared),
+            })?;
             if form.fields() != term.args.len() {
                 return Err(StepError::Arity {
                     form: term.form.to_string(),
@@ -254,11 +259,16 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
                 matrices.insert(name.clone(), m);
             }
         }
+        let structure = match structure {
+            Structure::Auto => probe_structure(asm, &forms, &matrices),
+            s => s,
+        };
         let stages = (0..desc.stages.len() + 1)
             .map(|_| StageCache { newton: Newton::new(newton_options), dt: f64::NAN, constant: None })
             .collect();
         Ok(Stepper {
             scheme,
+            desc,
             asm,
             forms,
             constraints,
@@ -272,7 +282,11 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
         })
     }
 
-    /// The matrix of a linear one-field form (e.g. `mass`, for energies).
+    /// The scheme's description (states, stages, slots).
+    pub fn desc(&self) -> &SchemeDesc {
+        &self.desc
+    }
+
     /// Factorizations and solves of all stages so far.
     pub fn counters(&self) -> crate::linalg::Counters {
         self.stages.iter().map(|s| s.newton.counters()).fold(Default::default(), |a, c| crate::linalg::Counters {
@@ -282,13 +296,14 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
         })
     }
 
+    /// The matrix of a linear one-field form (e.g. `mass`, for energies).
     pub fn matrix(&self, form: &str) -> Option<&Matrix> {
         self.matrices.get(form)
     }
 
     /// Solves the initial problem (e.g. M a⁰ = L⁰ − B(u⁰)) for its state, if the scheme has one.
     pub fn initialize(&mut self, states: &mut [Vec<f64>], t: f64) -> Result<Option<NewtonReport>, StepError> {
-        let Some(init) = S::DESC.initial else { return Ok(None) };
+        let Some(init) = self.desc.initial else { return Ok(None) };
         self.scheme.coefficients(1.0, t, &mut self.coefs);
         let guess = states[init.state].clone();
         let stage = StageDesc { name: "initial", time: 0, quantities: &[], values: &[], terms: init.terms };
@@ -305,7 +320,7 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
 
     /// Advances `states` from t to t + dt.
     pub fn step(&mut self, states: &mut [Vec<f64>], t: f64, dt: f64) -> Result<StepReport, StepError> {
-        let desc = S::DESC;
+        let desc = self.desc;
         self.scheme.coefficients(dt, t, &mut self.coefs);
         let mut quantities: Vec<Vec<Vec<f64>>> = Vec::with_capacity(desc.stages.len());
         let mut report = StepReport::default();
@@ -453,6 +468,51 @@ impl<'a, S: TimeScheme> Stepper<'a, S> {
         })?;
         Ok((w, report))
     }
+}
+
+/// Cholesky if every form's tangent is symmetric, LU otherwise. Nonlinear tangents are probed at
+/// pseudo-random states ±s, larger than the mesh, so that a switched term (a contact law's
+/// active set) is active at each point in one of them.
+fn probe_structure(
+    asm: &Assembler,
+    forms: &HashMap<String, Box<dyn BoundForm + '_>>,
+    matrices: &HashMap<String, Matrix>,
+) -> Structure {
+    if matrices.values().any(|m| !m.is_symmetric(1e-12)) {
+        return Structure::General;
+    }
+    let n = asm.size();
+    let scale = 10.0 * asm.mesh.max_diameter() * asm.mesh.num_cells().max(1) as f64;
+    let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+    let mut random = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        scale * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+    };
+    let mut names: Vec<&String> = forms.keys().filter(|k| !matrices.contains_key(*k)).collect();
+    names.sort();
+    for name in names {
+        let form = &forms[name];
+        if form.fields() == 0 {
+            continue;
+        }
+        for _ in 0..2 {
+            let state: Vec<Vec<f64>> = (0..form.fields()).map(|_| (0..n).map(|_| random()).collect()).collect();
+            for sign in [1.0, -1.0] {
+                let fields: Vec<Vec<f64>> = state.iter().map(|f| f.iter().map(|x| sign * x).collect()).collect();
+                let refs: Vec<&[f64]> = fields.iter().map(Vec::as_slice).collect();
+                for wrt in 0..form.fields() {
+                    let mut m = asm.zero_matrix();
+                    form.tangent(asm, &refs, wrt, 0.0, &mut m);
+                    if !m.is_symmetric(1e-12) {
+                        return Structure::General;
+                    }
+                }
+            }
+        }
+    }
+    Structure::SymmetricPositiveDefinite
 }
 
 /// A nonlinear term of a stage: coef·form(α₁w + b₁, ...).

@@ -10,7 +10,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::median;
-use crate::forms::nitsche::{Coefficients, Mass, Params, Stiffness};
+use crate::forms::elasticity::{Coefficients, Mass, Params, Stiffness};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
 use crate::runtime::linalg::{Factorization, Structure};
@@ -52,8 +52,7 @@ fn forms() -> (Stiffness, Mass) {
         .and_then(|p| p.with("nu", 0.3))
         .and_then(|p| p.with("rho", 1.0))
         .expect("valid parameters");
-    let c =
-        Coefficients { f: Coef::constant(vec![0.0, 0.0]), g: Coef::scalar(0.0), nc: Coef::constant(vec![0.0, -1.0]) };
+    let c = Coefficients { f: Coef::constant(vec![0.0, 0.0]) };
     (Stiffness::new(&p, &c), Mass::new(&p, &c))
 }
 

@@ -7,58 +7,19 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::CaseError;
-use super::binding::{Contact, Material, bind};
 use super::exact;
-use super::static_block::ContactMethod;
-use crate::forms::schemes;
+use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
-use crate::runtime::linalg::Matrix;
+use crate::runtime::library::Binding;
+use crate::runtime::linalg::{Matrix, Structure};
 use crate::runtime::mesh::structured;
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
-use crate::runtime::scheme::{MatrixForm, Stepper, TimeScheme};
+use crate::runtime::scheme::{MatrixForm, Stepper};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum SchemeChoice {
-    Newmark,
-    Hht,
-    HhtImex,
-    HhtUnweighted,
-    Midpoint,
-    Trbdf2,
-    Hybrid,
-}
-
-impl SchemeChoice {
-    pub const ALL: [SchemeChoice; 7] = [
-        SchemeChoice::Newmark,
-        SchemeChoice::Hht,
-        SchemeChoice::HhtImex,
-        SchemeChoice::HhtUnweighted,
-        SchemeChoice::Midpoint,
-        SchemeChoice::Trbdf2,
-        SchemeChoice::Hybrid,
-    ];
-
-    /// The HHT variants (which take α).
-    pub fn is_hht(self) -> bool {
-        matches!(self, SchemeChoice::Hht | SchemeChoice::HhtImex | SchemeChoice::HhtUnweighted)
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            SchemeChoice::Newmark => "newmark",
-            SchemeChoice::Hht => "hht",
-            SchemeChoice::HhtImex => "hht-imex",
-            SchemeChoice::HhtUnweighted => "hht-unweighted",
-            SchemeChoice::Midpoint => "midpoint",
-            SchemeChoice::Trbdf2 => "trbdf2",
-            SchemeChoice::Hybrid => "hybrid",
-        }
-    }
-}
+/// The bar's material is the form files' default (E = ρ = 1, ν = 0): no overrides.
+pub const OVERRIDES: &[(&str, f64)] = &[];
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
@@ -70,12 +31,8 @@ pub enum MassChoice {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
-    pub scheme: SchemeChoice,
-    /// HHT's α (HHT variants only).
-    pub alpha: Option<f64>,
-    pub contact: ContactMethod,
-    pub theta: f64,
-    pub gamma0: f64,
+    /// Scheme, contact law, extra forms and params.
+    pub setup: Setup,
     pub elements: usize,
     pub dt: f64,
     pub t_end: f64,
@@ -89,11 +46,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
-            scheme: SchemeChoice::Newmark,
-            alpha: None,
-            contact: ContactMethod::Nitsche,
-            theta: 1.0,
-            gamma0: 5.0,
+            setup: Setup::default(),
             elements: 20,
             dt: 0.01,
             t_end: 12.0,
@@ -116,7 +69,8 @@ pub struct Row {
     pub energy_aug: f64,
     pub penetration: f64,
     pub newton: usize,
-    /// P_{1,γ}(u) at the contact point, unclamped (Nitsche), or −ε u(0) (penalty).
+    /// The contact law's `contact_trial` at the contact point: P_{1,γ}(u) before the projection
+    /// (Nitsche), −ε (u_N − g) (penalty).
     #[serde(skip)]
     pub p1: f64,
 }
@@ -124,11 +78,13 @@ pub struct Row {
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
     pub case: &'static str,
-    pub scheme: SchemeChoice,
-    pub alpha: Option<f64>,
-    pub contact: ContactMethod,
-    pub theta: f64,
-    pub gamma0: f64,
+    pub scheme: String,
+    /// The contact law (its file stem).
+    pub contact: String,
+    /// The scheme was compiled at run time from a file.
+    pub interpreted: bool,
+    /// Every param of the scheme and form files, with its value and where it comes from.
+    pub params: std::collections::BTreeMap<String, ParamValue>,
     pub mass: MassChoice,
     pub elements: usize,
     pub dt: f64,
@@ -174,62 +130,40 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     if opts.t_end / opts.dt > 1e7 {
         return Err(CaseError::Option("more than 10⁷ steps".into()));
     }
-    dispatch(opts.scheme, opts.alpha, Simulate(opts))
+    let active = Active::resolve(&opts.setup, OVERRIDES)?;
+    simulate(opts, &active)
 }
 
-/// A run generic in the time scheme: what [`dispatch`] calls with the chosen scheme.
-pub trait WithScheme {
-    type Output;
-    fn run<S: TimeScheme>(self, scheme: S) -> Result<Self::Output, CaseError>;
-}
-
-/// Builds the chosen scheme (HHT variants with `alpha`, default 0.05) and runs `w` with it.
-pub fn dispatch<W: WithScheme>(choice: SchemeChoice, alpha: Option<f64>, w: W) -> Result<W::Output, CaseError> {
-    if alpha.is_some() && !choice.is_hht() {
-        return Err(CaseError::Option(format!("--alpha applies to the HHT schemes, not {}", choice.name())));
-    }
-    let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
-    let alpha = alpha.unwrap_or(0.05);
-    match choice {
-        SchemeChoice::Newmark => w.run(schemes::newmark::Newmark::default()),
-        SchemeChoice::Hht => w.run(schemes::hht::Hht::default().with("alpha", alpha).map_err(bad)?),
-        SchemeChoice::HhtImex => w.run(schemes::hht_imex::HhtImex::default().with("alpha", alpha).map_err(bad)?),
-        SchemeChoice::HhtUnweighted => {
-            w.run(schemes::hht_unweighted::HhtUnweighted::default().with("alpha", alpha).map_err(bad)?)
-        }
-        SchemeChoice::Midpoint => w.run(schemes::midpoint::Midpoint::default()),
-        SchemeChoice::Trbdf2 => w.run(schemes::trbdf2::Trbdf2::default()),
-        SchemeChoice::Hybrid => w.run(schemes::hybrid::Hybrid::default()),
+/// Case data: no body force; gap g = x; obstacle normal −1 at x = 0.
+fn coefs(name: &str) -> Option<Coef> {
+    match name {
+        "f" => Some(Coef::constant(vec![0.0])),
+        "g" => Some(Coef::function(1, |x, _, out| out[0] = x[0])),
+        "nc" => Some(Coef::constant(vec![-1.0])),
+        _ => None,
     }
 }
 
-struct Simulate<'a>(&'a Options);
-
-impl WithScheme for Simulate<'_> {
-    type Output = Run;
-    fn run<S: TimeScheme>(self, scheme: S) -> Result<Run, CaseError> {
-        simulate(self.0, scheme)
-    }
-}
-
-fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> {
+fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let start = Instant::now();
     let ne = opts.elements;
-    let h = 1.0 / ne as f64;
     let mesh = structured::interval(ne, 0.0, 1.0);
     let asm = Assembler::new(&mesh);
     let n = asm.size();
     let contact_facets = asm.region("left")?;
-    let gamma = opts.gamma0 / h;
-    // E = ρ = 1 (ν = 0: σ = E u'); no body force; gap g = x, obstacle normal −1 at x = 0.
-    let material = Material { young: 1.0, poisson: 0.0, density: 1.0 };
-    let contact = Contact { method: opts.contact, theta: opts.theta, gamma0: opts.gamma0, facets: contact_facets };
-    let data = || (Coef::constant(vec![0.0]), Coef::function(1, |x, _, out| out[0] = x[0]), Coef::constant(vec![-1.0]));
-    let bound = bind(material, contact, &data, Quadrature::default())?;
-    let (mut forms, structure, contact_energy) = (bound.forms, bound.structure, bound.contact_energy);
+    let binding =
+        Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), contact_facets)], dim: 1 };
+    let mut inst = active.instantiate(&coefs, &binding)?;
+    let mut forms = active.scheme_forms(&mut inst)?;
+    let contact_energy = inst.take_functional("contact_energy");
+    let pressure = inst.take_functional("contact_pressure");
+    let trial = inst.take_functional("contact_trial");
     let redistributed = opts.mass == MassChoice::Redistributed;
     if redistributed {
-        let slot = forms.iter().position(|(name, _)| *name == "mass").expect("mass slot");
+        let slot = forms
+            .iter()
+            .position(|(name, _)| *name == "mass")
+            .ok_or_else(|| CaseError::Option("mass redistribution needs a `mass` slot in the scheme".into()))?;
         let mut m = asm.zero_matrix();
         forms[slot].1.tangent(&asm, &[&vec![0.0; n]], 0, 0.0, &mut m);
         let r = crate::runtime::redistribute::redistribute(&mesh, &m, &[0])
@@ -238,35 +172,41 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     }
     let mut constraints = Constraints::none(n);
     constraints.fix(ne); // u(1) = 0
-    let mut stepper = Stepper::new(scheme, &asm, forms, constraints.clone(), structure, opts.newton)?;
+    let mut stepper =
+        Stepper::new(active.time_scheme()?, &asm, forms, constraints.clone(), Structure::Auto, opts.newton)?;
     if redistributed {
         // The contact node carries no inertia: a⁰ = 0 there (spec §4, initial acceleration).
         let mut initial = constraints;
         initial.fix(0);
         stepper.initial_constraints = Some(initial);
     }
-    let mass = stepper.matrix("mass").expect("mass is linear").clone();
-    let stiffness = stepper.matrix("stiffness").expect("stiffness is linear").clone();
+    let linear = |name: &str| {
+        stepper.matrix(name).cloned().ok_or_else(|| {
+            CaseError::Option(format!(
+                "the bar measures energies with a linear `{name}` slot, which the scheme does not apply"
+            ))
+        })
+    };
+    let mass = linear("mass")?;
+    let stiffness = linear("stiffness")?;
     // Initial state: u₀ = (1 − x)/2, v₀ = 0, a₀ from the scheme's initial problem.
-    let states_names = S::DESC.states;
+    let states_names = stepper.desc().states;
     let mut states: Vec<Vec<f64>> = states_names.iter().map(|_| vec![0.0; n]).collect();
     states[0] = (0..n).map(|i| 0.5 * (1.0 - mesh.node(i)[0])).collect();
     stepper.initialize(&mut states, 0.0)?;
     let steps = (opts.t_end / opts.dt).round() as usize;
     let mut series = Vec::with_capacity(steps + 1);
-    // λ and P from spec §3.4 (u_x(0) from the first element).
-    let contact_stress = |u: &[f64]| -> (f64, f64) {
-        let (u0, ux) = (u[0], (u[1] - u[0]) / h);
-        match opts.contact {
-            ContactMethod::Nitsche => ((ux + gamma * u0).min(0.0), ux + gamma * u0),
-            ContactMethod::Penalty => (gamma * u0.min(0.0), gamma * u0),
-        }
+    // λ and P at the contact point (spec §3.4), from the contact law's functionals: in 1D the
+    // integral over Γ_C is the value at x = 0. NaN when the law does not provide them.
+    let value = |f: &Option<Box<dyn crate::runtime::library::BoundFunctional + '_>>, u: &[f64]| {
+        f.as_ref().map_or(f64::NAN, |f| f.value(&asm, &[u], 0.0))
     };
+    let contact_stress = |u: &[f64]| -> (f64, f64) { (value(&pressure, u), value(&trial, u)) };
     let measure = |u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
         let u0 = u[0];
         let (lambda, p1) = contact_stress(u);
-        // The energy from the compiled functional.
-        let aug = contact_energy(&asm, u);
+        // The energy from the contact law's functional.
+        let aug = value(&contact_energy, u);
         let energy = 0.5 * quad(&stiffness, u) + v.map_or(0.0, |v| 0.5 * quad(&mass, v));
         Row {
             t,
@@ -320,11 +260,10 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let e0 = first.energy_aug;
     let summary = Summary {
         case: "bar",
-        scheme: opts.scheme,
-        alpha: opts.alpha.or(opts.scheme.is_hht().then_some(0.05)),
-        contact: opts.contact,
-        theta: opts.theta,
-        gamma0: opts.gamma0,
+        scheme: active.scheme_name().to_string(),
+        contact: active.contact_name().to_string(),
+        interpreted: active.scheme.interpreted(),
+        params: active.params.values(),
         mass: opts.mass,
         elements: ne,
         dt: opts.dt,
@@ -409,11 +348,7 @@ fn write_outputs(dir: &std::path::Path, summary: &Summary, series: &[Row]) -> Re
             "energy",
             vec![
                 Curve { label: "E", points: pts(&|r| r.energy), dashed: false },
-                Curve {
-                    label: if summary.contact == ContactMethod::Nitsche { "E_Θ" } else { "E_pen" },
-                    points: pts(&|r| r.energy_aug),
-                    dashed: false,
-                },
+                Curve { label: "E + contact energy", points: pts(&|r| r.energy_aug), dashed: false },
             ],
         )],
     )

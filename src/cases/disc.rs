@@ -8,30 +8,29 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::CaseError;
-use super::bar::{MassChoice, SchemeChoice, WithScheme};
-use super::binding::{Contact, Material, bind};
-use super::static_block::ContactMethod;
+use super::bar::MassChoice;
+use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::evaluate::facet_samples;
 use crate::runtime::kernel::Coef;
-use crate::runtime::linalg::Matrix;
+use crate::runtime::library::Binding;
+use crate::runtime::linalg::{Matrix, Structure};
 use crate::runtime::mesh::{Mesh, disc::disc, gmsh};
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
-use crate::runtime::scheme::{MatrixForm, Stepper, TimeScheme};
+use crate::runtime::scheme::{MatrixForm, Stepper};
 
 /// Gravity of the benchmark.
 pub const GRAVITY: f64 = 0.1;
 /// Cell and contact-facet quadrature degrees (12-point triangle rule; 4 Gauss points per edge).
 const QUADRATURE: Quadrature = Quadrature { cell: Some(6), facet: Some(7) };
+/// The disc's material (λ = μ = 20) and its Nitsche/penalty parameter, over the files' defaults.
+pub const OVERRIDES: &[(&str, f64)] = &[("E", 50.0), ("nu", 0.25), ("rho", 1.0), ("gamma0", 1000.0)];
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
-    pub scheme: SchemeChoice,
-    pub alpha: Option<f64>,
-    pub contact: ContactMethod,
-    pub theta: f64,
-    pub gamma0: f64,
+    /// Scheme, contact law, extra forms and params.
+    pub setup: Setup,
     pub mass: MassChoice,
     /// A Gmsh file; the built-in curved disc generator otherwise.
     pub mesh: Option<PathBuf>,
@@ -50,11 +49,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
-            scheme: SchemeChoice::Newmark,
-            alpha: None,
-            contact: ContactMethod::Nitsche,
-            theta: 1.0,
-            gamma0: 1000.0,
+            setup: Setup::default(),
             mass: MassChoice::Consistent,
             mesh: None,
             h: 1.0,
@@ -85,10 +80,13 @@ pub struct Row {
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
     pub case: &'static str,
-    pub scheme: SchemeChoice,
-    pub contact: ContactMethod,
-    pub theta: f64,
-    pub gamma0: f64,
+    pub scheme: String,
+    /// The contact law (its file stem).
+    pub contact: String,
+    /// The scheme was compiled at run time from a file.
+    pub interpreted: bool,
+    /// Every param of the scheme and form files, with its value and where it comes from.
+    pub params: std::collections::BTreeMap<String, ParamValue>,
     pub mass: MassChoice,
     pub mesh: String,
     pub cells: usize,
@@ -145,15 +143,17 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     if !positive(opts.dt) || !positive(opts.t_end) || opts.t_end / opts.dt > 1e7 {
         return Err(CaseError::Option("--dt and --t-end must be positive, with at most 10⁷ steps".into()));
     }
-    super::bar::dispatch(opts.scheme, opts.alpha, Simulate(opts))
+    let active = Active::resolve(&opts.setup, OVERRIDES)?;
+    simulate(opts, &active)
 }
 
-struct Simulate<'a>(&'a Options);
-
-impl WithScheme for Simulate<'_> {
-    type Output = Run;
-    fn run<S: TimeScheme>(self, scheme: S) -> Result<Run, CaseError> {
-        simulate(self.0, scheme)
+/// Case data: gravity, the gap to {y = 0} and the obstacle normal −e_y.
+fn coefs(name: &str) -> Option<Coef> {
+    match name {
+        "f" => Some(Coef::constant(vec![0.0, -GRAVITY])),
+        "g" => Some(Coef::function(1, |x, _, out| out[0] = x[1])),
+        "nc" => Some(Coef::constant(vec![0.0, -1.0])),
+        _ => None,
     }
 }
 
@@ -163,48 +163,47 @@ fn quad(a: &Matrix, x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(&ay).map(|(p, q)| p * q).sum()
 }
 
-fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> {
+fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let start = Instant::now();
     let mesh = mesh(opts)?;
     let asm = Assembler::new(&mesh);
     let n = asm.size();
     let contact_facets = asm.region("contact")?;
-    let material = Material { young: 50.0, poisson: 0.25, density: 1.0 };
-    let contact = Contact { method: opts.contact, theta: opts.theta, gamma0: opts.gamma0, facets: contact_facets };
-    let data = || {
-        (
-            Coef::constant(vec![0.0, -GRAVITY]),
-            Coef::function(1, |x, _, out| out[0] = x[1]),
-            Coef::constant(vec![0.0, -1.0]),
-        )
+    let binding = Binding { quadrature: QUADRATURE, regions: vec![("Gamma_C".into(), contact_facets)], dim: 2 };
+    let mut inst = active.instantiate(&coefs, &binding)?;
+    let mut forms = active.scheme_forms(&mut inst)?;
+    let missing = |what: &str| {
+        CaseError::Option(format!("the disc measures `{what}`, which the form files in use do not provide"))
     };
-    let bound = bind(material, contact, &data, QUADRATURE)?;
-    let (mut forms, structure, contact_energy, probe, von_mises) =
-        (bound.forms, bound.structure, bound.contact_energy, bound.contact_probe, bound.von_mises);
+    let contact_energy = inst.take_functional("contact_energy");
+    let probe = active.instantiate(&coefs, &binding)?.take_form("contact").ok_or_else(|| missing("contact"))?;
+    let von_mises = inst.take_functional("von_mises");
+    let cell_measure = inst.take_functional("measure");
     // Consistent mass and stiffness, the load: for the measurements.
     let zero = vec![0.0; n];
     let slot = |forms: &[(&str, Box<dyn crate::runtime::scheme::BoundForm + '_>)], name: &str| {
-        forms.iter().position(|(s, _)| *s == name).expect("bound by `bind`")
+        forms.iter().position(|(s, _)| *s == name).ok_or_else(|| missing(name))
     };
     let mut mass = asm.zero_matrix();
-    forms[slot(&forms, "mass")].1.tangent(&asm, &[&zero], 0, 0.0, &mut mass);
+    forms[slot(&forms, "mass")?].1.tangent(&asm, &[&zero], 0, 0.0, &mut mass);
     let mut stiffness = asm.zero_matrix();
-    forms[slot(&forms, "stiffness")].1.tangent(&asm, &[&zero], 0, 0.0, &mut stiffness);
+    forms[slot(&forms, "stiffness")?].1.tangent(&asm, &[&zero], 0, 0.0, &mut stiffness);
     let mut load = vec![0.0; n];
-    forms[slot(&forms, "load")].1.residual(&asm, &[], 0.0, &mut load);
+    forms[slot(&forms, "load")?].1.residual(&asm, &[], 0.0, &mut load);
     let redistributed = opts.mass == MassChoice::Redistributed;
     let constraints = Constraints::none(n);
     let contact_nodes = mesh.region_nodes(mesh.region("contact")?);
     let energy_mass = if redistributed {
         let r = crate::runtime::redistribute::redistribute(&mesh, &mass, &contact_nodes)
             .map_err(|e| CaseError::Option(e.to_string()))?;
-        let i = slot(&forms, "mass");
+        let i = slot(&forms, "mass")?;
         forms[i] = ("mass", Box::new(MatrixForm { name: "mass".into(), matrix: r.matrix.clone() }));
         r.matrix
     } else {
         mass.clone()
     };
-    let mut stepper = Stepper::new(scheme, &asm, forms, constraints.clone(), structure, opts.newton)?;
+    let mut stepper =
+        Stepper::new(active.time_scheme()?, &asm, forms, constraints.clone(), Structure::Auto, opts.newton)?;
     if redistributed {
         let mut initial = constraints;
         for &c in &contact_nodes {
@@ -213,7 +212,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
         }
         stepper.initial_constraints = Some(initial);
     }
-    let names = S::DESC.states;
+    let names = stepper.desc().states;
     let mut states: Vec<Vec<f64>> = names.iter().map(|_| vec![0.0; n]).collect();
     stepper.initialize(&mut states, 0.0)?;
     let v_index = names.iter().position(|s| *s == "v");
@@ -234,7 +233,7 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
         Row {
             t,
             energy,
-            energy_aug: energy + contact_energy(&asm, u),
+            energy_aug: energy + contact_energy.as_ref().map_or(f64::NAN, |e| e.value(&asm, &[u], 0.0)),
             // Area-weighted mean of u_y: e_yᵀ M u / e_yᵀ M e_y.
             uy_mean: mass_ey.iter().zip(u).map(|(a, b)| a * b).sum::<f64>() / total_mass,
             uy_lowest: u[2 * lowest + 1],
@@ -256,7 +255,13 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
             return Ok(());
         }
         let name = format!("disc_{k:06}.vtu");
-        let vm = von_mises(&asm, u);
+        let vm = match (&von_mises, &cell_measure) {
+            (Some(vm), Some(measure)) => {
+                let area = measure.cell_values(&asm, &[], 0.0);
+                vm.cell_values(&asm, &[u], 0.0).iter().zip(&area).map(|(v, a)| v / a).collect()
+            }
+            _ => vec![f64::NAN; mesh.num_cells()],
+        };
         let point = [
             crate::vtu::Field { name: "displacement", components: 2, values: u },
             crate::vtu::Field { name: "velocity", components: 2, values: v },
@@ -296,10 +301,10 @@ fn simulate<S: TimeScheme>(opts: &Options, scheme: S) -> Result<Run, CaseError> 
     let last = series.last().expect("initial row");
     let summary = Summary {
         case: "disc",
-        scheme: opts.scheme,
-        contact: opts.contact,
-        theta: opts.theta,
-        gamma0: opts.gamma0,
+        scheme: active.scheme_name().to_string(),
+        contact: active.contact_name().to_string(),
+        interpreted: active.scheme.interpreted(),
+        params: active.params.values(),
         mass: opts.mass,
         mesh: opts.mesh.as_ref().map_or_else(|| format!("built-in disc, h = {}", opts.h), |p| p.display().to_string()),
         cells: mesh.num_cells(),
@@ -339,7 +344,7 @@ fn write_outputs(dir: &std::path::Path, summary: &Summary, series: &[Row]) -> Re
     use crate::plot::Curve;
     let pts = |f: &dyn Fn(&Row) -> f64| series.iter().map(|r| (r.t, f(r))).collect::<Vec<_>>();
     let plot_err = |e: String| CaseError::Write { path: dir.display().to_string(), source: std::io::Error::other(e) };
-    let aug = if summary.contact == ContactMethod::Nitsche { "E_Θ" } else { "E_pen" };
+    let aug = "E + contact energy";
     crate::plot::panels(
         &dir.join("disc.png"),
         "t",

@@ -1,6 +1,7 @@
-//! Case files: `signorini run case.toml` with every option of `run bar` / `run disc` as keys.
-//! Unknown keys, keys of the other case and out-of-range values are refused with the line of
-//! the key.
+//! Case files: `signorini run case.toml` with every option of `run bar` / `run disc` as keys,
+//! and the params of the scheme and form files in `[params]` (`alpha = 0.1`, or per file:
+//! `[params.elasticity] rho = 2`). Unknown keys, unknown params, keys of the other case and
+//! out-of-range values are refused with the line of the key.
 
 use std::path::{Path, PathBuf};
 
@@ -9,17 +10,29 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::CaseError;
-use super::bar::{self, MassChoice, SchemeChoice};
+use super::bar::{self, MassChoice};
 use super::disc;
-use super::static_block::ContactMethod;
+use crate::driver::{self, Setting, Setup};
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ParamEntry {
+    Value(Spanned<f64>),
+    /// `[params.OWNER]`: the params of one file or scheme.
+    Owner(std::collections::BTreeMap<String, Spanned<f64>>),
+}
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CaseFile {
     case: Spanned<String>,
     scheme: Option<Spanned<String>>,
-    alpha: Option<Spanned<f64>>,
     contact: Option<Spanned<String>>,
+    material: Option<Spanned<String>>,
+    forms: Option<Spanned<Vec<String>>>,
+    params: Option<std::collections::BTreeMap<String, ParamEntry>>,
+    /// Shorthands for `[params]` entries.
+    alpha: Option<Spanned<f64>>,
     theta: Option<Spanned<f64>>,
     gamma0: Option<Spanned<f64>>,
     mass: Option<Spanned<String>>,
@@ -100,19 +113,8 @@ pub fn read(path: &Path) -> Result<Case, CaseError> {
     })?;
     let r = Reader { file: &file, text: &text };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let scheme: SchemeChoice = r.choice(&parsed.scheme, "scheme", SchemeChoice::Newmark)?;
-    let contact: ContactMethod = r.choice(&parsed.contact, "contact", ContactMethod::Nitsche)?;
     let mass: MassChoice = r.choice(&parsed.mass, "mass", MassChoice::Consistent)?;
-    let theta = r.number(&parsed.theta, "theta", |x| (-1.0..=1.0).contains(&x), "in [-1, 1]", 1.0)?;
-    let alpha = match &parsed.alpha {
-        Some(a) if !scheme.is_hht() => {
-            return Err(r.error(a, "alpha", format!("applies to the HHT schemes, not {}", scheme.name())));
-        }
-        a => a
-            .as_ref()
-            .map(|_| r.number(a, "alpha", |x| (0.0..=1.0 / 3.0).contains(&x), "in [0, 1/3]", 0.05))
-            .transpose()?,
-    };
+    let setup = setup(&r, &parsed, &base)?;
     let out = parsed.out.as_ref().map(|o| base.join(o.get_ref()));
     match parsed.case.get_ref().as_str() {
         "bar" => {
@@ -125,11 +127,7 @@ pub fn read(path: &Path) -> Result<Case, CaseError> {
                 Some(s) => return Err(r.error(s, "ne", format!("{} is not in 1..=100000", s.get_ref()))),
             };
             Ok(Case::Bar(bar::Options {
-                scheme,
-                alpha,
-                contact,
-                theta,
-                gamma0: r.number(&parsed.gamma0, "gamma0", |x| x > 0.0, "positive", d.gamma0)?,
+                setup,
                 elements,
                 dt: r.number(&parsed.dt, "dt", |x| x > 0.0, "positive", d.dt)?,
                 t_end: r.number(&parsed.t_end, "t_end", |x| x > 0.0, "positive", d.t_end)?,
@@ -142,11 +140,7 @@ pub fn read(path: &Path) -> Result<Case, CaseError> {
             r.absent(&parsed.ne, "ne", "disc")?;
             let d = disc::Options::default();
             Ok(Case::Disc(disc::Options {
-                scheme,
-                alpha,
-                contact,
-                theta,
-                gamma0: r.number(&parsed.gamma0, "gamma0", |x| x > 0.0, "positive", d.gamma0)?,
+                setup,
                 mass,
                 mesh: parsed.mesh.as_ref().map(|m| base.join(m.get_ref())),
                 h: r.number(&parsed.h, "h", |x| x > 0.05 && x <= 10.0, "in (0.05, 10]", d.h)?,
@@ -158,6 +152,64 @@ pub fn read(path: &Path) -> Result<Case, CaseError> {
         }
         other => Err(r.error(&parsed.case, "case", format!("`{other}` is not a case with a file form (bar, disc)"))),
     }
+}
+
+/// A name of the library, or a path relative to the case file.
+fn name_or_path(value: &str, base: &Path) -> String {
+    if value.ends_with(".wf") || value.contains('/') {
+        base.join(value).display().to_string()
+    } else {
+        value.to_string()
+    }
+}
+
+/// The scheme, forms and params of a case file, checked against the library (errors at the
+/// key's line).
+fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError> {
+    let d = Setup::default();
+    let mut setup = Setup {
+        scheme: parsed.scheme.as_ref().map_or(d.scheme, |s| name_or_path(s.get_ref(), base)),
+        contact: parsed.contact.as_ref().map_or(d.contact, |s| name_or_path(s.get_ref(), base)),
+        material: parsed.material.as_ref().map_or(d.material, |s| name_or_path(s.get_ref(), base)),
+        forms: parsed.forms.as_ref().map_or_else(Vec::new, |f| f.get_ref().iter().map(|p| base.join(p)).collect()),
+        params: Vec::new(),
+    };
+    let at = |span: std::ops::Range<usize>| format!("{}:{}", r.file, r.line(span.start));
+    for (key, v) in [("alpha", &parsed.alpha), ("theta", &parsed.theta), ("gamma0", &parsed.gamma0)] {
+        if let Some(v) = v {
+            setup.params.push(Setting { name: key.into(), value: *v.get_ref(), origin: at(v.span()) });
+        }
+    }
+    for (name, entry) in parsed.params.iter().flatten() {
+        match entry {
+            ParamEntry::Value(v) => {
+                setup.params.push(Setting { name: name.clone(), value: *v.get_ref(), origin: at(v.span()) })
+            }
+            ParamEntry::Owner(values) => {
+                for (p, v) in values {
+                    setup.params.push(Setting {
+                        name: format!("{name}.{p}"),
+                        value: *v.get_ref(),
+                        origin: at(v.span()),
+                    });
+                }
+            }
+        }
+    }
+    // Resolve now, so that a bad name is reported at its key.
+    let scheme = driver::scheme(&setup).map_err(|e| match &parsed.scheme {
+        Some(s) => r.error(s, "scheme", e),
+        None => e,
+    })?;
+    driver::form_units(&setup).map_err(|e| match (&parsed.contact, &parsed.forms, &parsed.material) {
+        (Some(s), _, _) if e.to_string().contains(s.get_ref().as_str()) => r.error(s, "contact", e),
+        (_, Some(f), _) => r.error(f, "forms", e),
+        (_, _, Some(m)) => r.error(m, "material", e),
+        (Some(s), _, _) => r.error(s, "contact", e),
+        _ => e,
+    })?;
+    let _ = scheme;
+    Ok(setup)
 }
 
 /// Where a case file's outputs go when it names none.

@@ -1,7 +1,6 @@
 //! Built-in cases (`signorini run NAME`).
 
 pub mod bar;
-pub mod binding;
 pub mod disc;
 pub mod exact;
 pub mod file;

@@ -15,34 +15,28 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::CaseError;
-use crate::forms::{nitsche, penalty};
-use crate::runtime::assembly::{Assembler, Kernel, Quadrature};
+use crate::driver::{Active, ParamValue, Setup};
+use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::evaluate::facet_samples;
 use crate::runtime::kernel::Coef;
+use crate::runtime::library::Binding;
 use crate::runtime::linalg::Structure;
 use crate::runtime::mesh::Mesh;
 use crate::runtime::mesh::structured::{self, Diagonal};
 use crate::runtime::newton::{Newton, NewtonOptions, NewtonReport};
-use crate::runtime::problem::{Constraints, ContactTerm, StaticContact};
+use crate::runtime::problem::{Constraints, StaticContact};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum ContactMethod {
-    Nitsche,
-    Penalty,
-}
+/// The block's material (E = 100, ν = 0.3, ρ = 1) and γ0 (θ = 1 needs γ0 ≳ 20 E), over the
+/// files' defaults.
+pub const OVERRIDES: &[(&str, f64)] = &[("E", 100.0), ("nu", 0.3), ("rho", 1.0), ("gamma0", 5000.0)];
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
-    pub contact: ContactMethod,
-    pub theta: f64,
-    pub gamma0: f64,
+    /// The contact law, material and params (the scheme is not used).
+    pub setup: Setup,
     pub dim: usize,
     pub degree: u32,
     pub h: f64,
-    pub young: f64,
-    pub poisson: f64,
-    pub density: f64,
     pub gravity: f64,
     /// Curvature of the obstacle (0: the plane).
     pub curvature: f64,
@@ -53,15 +47,10 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
-            contact: ContactMethod::Nitsche,
-            theta: 1.0,
-            gamma0: 5000.0,
+            setup: Setup::default(),
             dim: 2,
             degree: 2,
             h: 0.125,
-            young: 100.0,
-            poisson: 0.3,
-            density: 1.0,
             gravity: 1.0,
             curvature: 0.0,
             newton: NewtonOptions::default(),
@@ -73,9 +62,10 @@ impl Default for Options {
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
     pub case: &'static str,
-    pub contact: ContactMethod,
-    pub theta: f64,
-    pub gamma0: f64,
+    /// The contact law (its file stem).
+    pub contact: String,
+    /// Every param of the form files, with its value and where it comes from.
+    pub params: std::collections::BTreeMap<String, ParamValue>,
     pub curvature: f64,
     pub dim: usize,
     pub degree: u32,
@@ -131,81 +121,39 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
     if !(c >= 0.0 && c.is_finite()) {
         return Err(CaseError::Option(format!("--curvature must be a finite number ≥ 0, not {c}")));
     }
-    let gap = Coef::function(1, move |x, _, out| out[0] = x[d - 1] + c * x[..d - 1].iter().map(|v| v * v).sum::<f64>());
-    let down = Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>());
-    let force =
-        Coef::constant((0..d).map(|k| if k == d - 1 { -opts.density * opts.gravity } else { 0.0 }).collect::<Vec<_>>());
-    let bad = |e: crate::runtime::kernel::ParamError| CaseError::Option(e.to_string());
-    let mut summary = match opts.contact {
-        ContactMethod::Nitsche => {
-            let p = nitsche::Params::default()
-                .with("E", opts.young)
-                .and_then(|p| p.with("nu", opts.poisson))
-                .and_then(|p| p.with("rho", opts.density))
-                .and_then(|p| p.with("gamma0", opts.gamma0))
-                .and_then(|p| p.with("theta", opts.theta))
-                .map_err(bad)?;
-            let c = nitsche::Coefficients { f: force, g: gap, nc: down };
-            // θ = 1 gives a symmetric tangent (Cholesky; LU if γ0 is too small for coercivity).
-            let structure = if opts.theta == 1.0 { Structure::SymmetricPositiveDefinite } else { Structure::General };
-            solve(
-                opts,
-                &mesh,
-                &nitsche::Stiffness::new(&p, &c),
-                &nitsche::Load::new(&p, &c),
-                nitsche::Contact::new(&p, &c),
-                structure,
-            )?
+    let active = Active::resolve_forms(&opts.setup, OVERRIDES)?;
+    let density = active.params.get("rho").unwrap_or(1.0);
+    let gravity = opts.gravity;
+    let coefs = move |name: &str| match name {
+        "g" => Some(Coef::function(1, move |x, _, out| {
+            out[0] = x[d - 1] + c * x[..d - 1].iter().map(|v| v * v).sum::<f64>()
+        })),
+        "nc" => Some(Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>())),
+        "f" => {
+            Some(Coef::constant((0..d).map(|k| if k == d - 1 { -density * gravity } else { 0.0 }).collect::<Vec<_>>()))
         }
-        ContactMethod::Penalty => {
-            let p = penalty::Params::default()
-                .with("E", opts.young)
-                .and_then(|p| p.with("nu", opts.poisson))
-                .and_then(|p| p.with("rho", opts.density))
-                .and_then(|p| p.with("gamma0", opts.gamma0))
-                .map_err(bad)?;
-            let c = penalty::Coefficients { f: force, g: gap, nc: down };
-            let structure = Structure::SymmetricPositiveDefinite;
-            solve(
-                opts,
-                &mesh,
-                &penalty::Stiffness::new(&p, &c),
-                &penalty::Load::new(&p, &c),
-                penalty::Contact::new(&p, &c),
-                structure,
-            )?
-        }
+        _ => None,
     };
-    summary.wall_seconds = start.elapsed().as_secs_f64();
-    if let Some(dir) = &opts.out {
-        let path = dir.join("summary.json");
-        crate::output::write_json(&path, &summary)
-            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
-    }
-    Ok(summary)
-}
-
-fn solve<S: Kernel, L: Kernel, C: Kernel>(
-    opts: &Options,
-    mesh: &Mesh,
-    stiffness: &S,
-    load: &L,
-    contact: C,
-    structure: Structure,
-) -> Result<Summary, CaseError> {
-    let d = opts.dim;
-    let asm = Assembler::new(mesh);
+    let asm = Assembler::new(&mesh);
     let n = asm.size();
-    let quad = Quadrature::default();
-    let mut l = vec![0.0; n];
-    asm.cell_residual(load, quad, &[], 0.0, &mut l);
     let facets = asm.region("bottom")?;
     // Four Gauss points per edge in 2D, a degree-4 rule on faces in 3D: exact for the smooth
     // parts, and resolves the edge of the contact zone.
     let contact_quad = Quadrature { cell: None, facet: Some(if d == 2 { 7 } else { 4 }) };
-    let term = ContactTerm { form: contact, region: "Gamma_C".into(), facets, quadrature: contact_quad };
-    let constraints = sliding_constraints(mesh);
-    let mut problem = StaticContact::new(&asm, stiffness, quad, l, term, constraints, structure);
+    let regions = vec![("Gamma_C".to_string(), facets)];
+    let volume = Binding { quadrature: Quadrature::default(), regions: regions.clone(), dim: d };
+    let boundary = Binding { quadrature: contact_quad, regions, dim: d };
+    let missing = |what: &str| {
+        CaseError::Option(format!("the static block needs a `{what}` form, which the files in use do not provide"))
+    };
+    let mut inst = active.instantiate(&coefs, &volume)?;
+    let stiffness = inst.take_form("stiffness").ok_or_else(|| missing("stiffness"))?;
+    let load_form = inst.take_form("load").ok_or_else(|| missing("load"))?;
+    let contact = active.instantiate(&coefs, &boundary)?.take_form("contact").ok_or_else(|| missing("contact"))?;
+    let mut l = vec![0.0; n];
+    load_form.residual(&asm, &[], 0.0, &mut l);
+    let constraints = sliding_constraints(&mesh);
+    let mut problem = StaticContact::new(&asm, stiffness.as_ref(), l, contact, constraints, Structure::Auto);
     // Start with the block pushed into the obstacle below its largest gap, so that every contact
     // point is active and the first Jacobian is not singular (at u = 0 the block would float,
     // or pivot on one point of a curved obstacle: H(0) = 0). Newton then releases points.
@@ -218,26 +166,25 @@ fn solve<S: Kernel, L: Kernel, C: Kernel>(
     let mut newton = Newton::new(opts.newton);
     let report = newton.solve(&mut problem, &mut u)?;
     // Vertical resultant: C(u) tested with e_d is minus the upward force on the block.
-    let c = problem.contact_residual(&u);
-    let contact_force = -c.iter().skip(d - 1).step_by(d).sum::<f64>();
-    let samples = facet_samples(mesh, facets, contact_quad.facet.unwrap_or(4), &u);
+    let cres = problem.contact_residual(&u);
+    let contact_force = -cres.iter().skip(d - 1).step_by(d).sum::<f64>();
+    let samples = facet_samples(&mesh, facets, contact_quad.facet.unwrap_or(4), &u);
     let max_penetration = samples.iter().map(|s| (-s.value[d - 1] - gap(&s.x)).max(0.0)).fold(0.0, f64::max);
     let mut set = Vec::new();
     use crate::runtime::newton::NonlinearProblem;
     problem.active_set(&u, &mut set);
     let counters = newton.counters();
-    Ok(Summary {
+    let summary = Summary {
         case: "static-block",
-        contact: opts.contact,
-        theta: opts.theta,
-        gamma0: opts.gamma0,
+        contact: active.contact_name().to_string(),
+        params: active.params.values(),
         curvature: opts.curvature,
         dim: d,
         degree: mesh.kind.degree(),
         h: opts.h,
         cells: mesh.num_cells(),
         dofs: n,
-        weight: opts.density * opts.gravity * mesh.measure(),
+        weight: density * opts.gravity * mesh.measure(),
         contact_force,
         max_penetration,
         active_points: set.iter().filter(|b| **b).count(),
@@ -245,8 +192,14 @@ fn solve<S: Kernel, L: Kernel, C: Kernel>(
         newton: report,
         symbolic_factorizations: counters.symbolic,
         numeric_factorizations: counters.numeric,
-        wall_seconds: 0.0,
-    })
+        wall_seconds: start.elapsed().as_secs_f64(),
+    };
+    if let Some(dir) = &opts.out {
+        let path = dir.join("summary.json");
+        crate::output::write_json(&path, &summary)
+            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
+    }
+    Ok(summary)
 }
 
 /// Dirichlet conditions that remove the rigid sliding modes and nothing more.

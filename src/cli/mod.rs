@@ -5,9 +5,12 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use crate::cases::bar::{self, MassChoice, SchemeChoice};
-use crate::cases::static_block::{self, ContactMethod};
+mod list;
+
+use crate::cases::bar::{self, MassChoice};
+use crate::cases::static_block;
 use crate::compiler::{self, FsLoader};
+use crate::driver::{Setting, Setup};
 
 #[derive(Parser)]
 #[command(
@@ -50,6 +53,9 @@ pub enum Command {
         /// A TOML case file (`case = "bar"` or `"disc"`, and the options as keys).
         file: Option<PathBuf>,
     },
+    /// Print every scheme and contact law of the library with its params (defaults, ranges,
+    /// docs), and the other form files with their slots.
+    List,
     /// Print a compilation stage of a .wf file.
     Emit {
         file: PathBuf,
@@ -109,18 +115,63 @@ pub enum Case {
     Disc(DiscArgs),
 }
 
+/// The scheme, the form files and their params (`signorini list` shows what there is).
+#[derive(clap::Args, Clone)]
+pub struct MethodArgs {
+    /// A scheme of the library by name, or a .wf file (run interpreted).
+    #[arg(long, default_value = "newmark")]
+    scheme: String,
+    /// A contact law of the library by name (nitsche, penalty), or a .wf file.
+    #[arg(long, default_value = "nitsche")]
+    contact: String,
+    /// The material's form file (by name or path).
+    #[arg(long, default_value = "elasticity")]
+    material: String,
+    /// Extra form files whose slots the scheme applies (repeatable).
+    #[arg(long = "forms", value_name = "FILE.wf")]
+    forms: Vec<PathBuf>,
+    /// A param of the scheme or form files: NAME=VALUE, or OWNER.NAME=VALUE (repeatable).
+    #[arg(long = "param", value_name = "NAME=VALUE", allow_hyphen_values = true)]
+    params: Vec<String>,
+    /// Shorthand for --param alpha=VALUE.
+    #[arg(long, allow_hyphen_values = true)]
+    alpha: Option<f64>,
+    /// Shorthand for --param theta=VALUE.
+    #[arg(long, allow_hyphen_values = true)]
+    theta: Option<f64>,
+    /// Shorthand for --param gamma0=VALUE.
+    #[arg(long, allow_hyphen_values = true)]
+    gamma0: Option<f64>,
+}
+
+impl MethodArgs {
+    fn setup(&self) -> Result<Setup, String> {
+        let mut params = Vec::new();
+        for (name, v) in [("alpha", self.alpha), ("theta", self.theta), ("gamma0", self.gamma0)] {
+            if let Some(value) = v {
+                params.push(Setting { name: name.into(), value, origin: format!("--{name}") });
+            }
+        }
+        for p in &self.params {
+            let (name, value) = p.split_once('=').ok_or_else(|| format!("--param {p}: expected NAME=VALUE"))?;
+            let value: f64 =
+                value.trim().parse().map_err(|_| format!("--param {p}: `{}` is not a number", value.trim()))?;
+            params.push(Setting { name: name.trim().into(), value, origin: format!("--param {p}") });
+        }
+        Ok(Setup {
+            scheme: self.scheme.clone(),
+            contact: self.contact.clone(),
+            material: self.material.clone(),
+            forms: self.forms.clone(),
+            params,
+        })
+    }
+}
+
 #[derive(clap::Args)]
 pub struct DiscArgs {
-    #[arg(long, value_enum, default_value_t = SchemeChoice::Newmark)]
-    scheme: SchemeChoice,
-    #[arg(long)]
-    alpha: Option<f64>,
-    #[arg(long, value_enum, default_value_t = ContactMethod::Nitsche)]
-    contact: ContactMethod,
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
-    theta: f64,
-    #[arg(long, default_value_t = 1000.0, allow_hyphen_values = true)]
-    gamma0: f64,
+    #[command(flatten)]
+    methods: MethodArgs,
     #[arg(long, value_enum, default_value_t = MassChoice::Consistent)]
     mass: MassChoice,
     /// A Gmsh mesh (MSH 2.2 or 4.1); default: the built-in curved P2 disc.
@@ -143,17 +194,8 @@ pub struct DiscArgs {
 
 #[derive(clap::Args)]
 pub struct BarArgs {
-    #[arg(long, value_enum, default_value_t = SchemeChoice::Newmark)]
-    scheme: SchemeChoice,
-    /// HHT's α (talk's convention, in [0, 1/3]); default 0.05.
-    #[arg(long)]
-    alpha: Option<f64>,
-    #[arg(long, value_enum, default_value_t = ContactMethod::Nitsche)]
-    contact: ContactMethod,
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
-    theta: f64,
-    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
-    gamma0: f64,
+    #[command(flatten)]
+    methods: MethodArgs,
     /// Number of elements.
     #[arg(long, default_value_t = 20)]
     ne: usize,
@@ -166,22 +208,18 @@ pub struct BarArgs {
     /// Directory for series.csv and summary.json (with --all: one subdirectory per run).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Run every scheme × {Nitsche θ = 1, 0, −1, penalty} × {consistent, redistributed} and
-    /// print one table.
+    /// Run every scheme × every contact law × {consistent, redistributed} (with the --param
+    /// settings that apply) and print one table.
     #[arg(long)]
     all: bool,
 }
 
 #[derive(clap::Args)]
 pub struct StaticBlockArgs {
-    #[arg(long, value_enum, default_value_t = ContactMethod::Nitsche)]
-    contact: ContactMethod,
-    /// Nitsche variant: 1 symmetric, 0 incomplete, -1 skew-symmetric.
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
-    theta: f64,
-    /// γ = γ0/h (Nitsche) or ε = γ0/h (penalty); E = 100 here, and θ = 1 needs γ0 ≳ 20 E.
-    #[arg(long, default_value_t = 5000.0, allow_hyphen_values = true)]
-    gamma0: f64,
+    /// The contact law and params (E = 100, γ0 = 5000 here; θ = 1 needs γ0 ≳ 20 E); the scheme
+    /// is not used.
+    #[command(flatten)]
+    methods: MethodArgs,
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
     dim: u8,
     /// Polynomial degree (the 2D block is P2; 3D: 1 or 2).
@@ -214,6 +252,10 @@ pub fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Check { files } => check(&files),
         Command::Emit { file, stage, dim } => emit(&file, stage, dim as usize),
+        Command::List => {
+            print!("{}", list::text());
+            ExitCode::SUCCESS
+        }
         Command::Report { out } => match crate::report::write(&out, &mut |what| eprintln!("running {what}")) {
             Ok(()) => {
                 println!("wrote {}", out.join("report.md").display());
@@ -296,11 +338,19 @@ fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
     }
 }
 
+/// Prints an error and fails.
+fn fail(e: impl std::fmt::Display) -> ExitCode {
+    eprintln!("error: {e}");
+    ExitCode::FAILURE
+}
+
 fn static_block(a: StaticBlockArgs) -> ExitCode {
+    let setup = match a.methods.setup() {
+        Ok(s) => s,
+        Err(e) => return fail(e),
+    };
     let opts = static_block::Options {
-        contact: a.contact,
-        theta: a.theta,
-        gamma0: a.gamma0,
+        setup,
         dim: a.dim as usize,
         degree: a.degree as u32,
         h: a.h,
@@ -390,15 +440,15 @@ fn write_bench(path: &Path, report: &impl serde::Serialize) -> ExitCode {
 }
 
 fn run_bar(a: BarArgs) -> ExitCode {
+    let setup = match a.methods.setup() {
+        Ok(s) => s,
+        Err(e) => return fail(e),
+    };
     if a.all {
-        return run_bar_all(a);
+        return run_bar_all(a, setup);
     }
     let opts = bar::Options {
-        scheme: a.scheme,
-        alpha: a.alpha,
-        contact: a.contact,
-        theta: a.theta,
-        gamma0: a.gamma0,
+        setup,
         elements: a.ne,
         dt: a.dt,
         t_end: a.t_end,
@@ -410,30 +460,35 @@ fn run_bar(a: BarArgs) -> ExitCode {
     finish_bar(bar::run(&opts))
 }
 
-fn run_bar_all(a: BarArgs) -> ExitCode {
-    // (contact law, θ, its label)
-    let contacts = [
-        (ContactMethod::Nitsche, 1.0, "Nitsche θ=1"),
-        (ContactMethod::Nitsche, 0.0, "Nitsche θ=0"),
-        (ContactMethod::Nitsche, -1.0, "Nitsche θ=-1"),
-        (ContactMethod::Penalty, 0.0, "penalty"),
-    ];
+fn run_bar_all(a: BarArgs, base: Setup) -> ExitCode {
     let masses = [(MassChoice::Consistent, "consistent"), (MassChoice::Redistributed, "redistributed")];
     println!(
-        "{:<15} {:<13} {:<13} {:>8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>7} {:>4}",
-        "scheme", "contact", "mass", "err_u", "err_λ", "E_Θ(0)", "E_Θ(T)", "max|ΔE_Θ|", "penetr.", "Newton", "max"
+        "{:<15} {:<16} {:<13} {:>8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>7} {:>4}",
+        "scheme", "contact", "mass", "err_u", "err_λ", "E_aug(0)", "E_aug(T)", "max|ΔE|", "penetr.", "Newton", "max"
     );
     let mut failed = false;
-    for scheme in SchemeChoice::ALL {
-        for (contact, theta, contact_name) in contacts {
+    for scheme in crate::driver::all_schemes() {
+        for contact in crate::driver::contact_names() {
             for (mass, mass_name) in masses {
-                let label = format!("{}_{}_{}", scheme.name(), contact_name.replace([' ', '='], ""), mass_name);
+                // A setting that names a param the scheme lacks (alpha for newmark) is left out.
+                let params: Vec<Setting> = base
+                    .params
+                    .iter()
+                    .filter(|p| {
+                        let probe = Setup {
+                            scheme: scheme.into(),
+                            contact: contact.into(),
+                            params: vec![(*p).clone()],
+                            ..base.clone()
+                        };
+                        crate::driver::Active::resolve(&probe, bar::OVERRIDES).is_ok()
+                    })
+                    .cloned()
+                    .collect();
+                let setup = Setup { scheme: scheme.into(), contact: contact.into(), params, ..base.clone() };
+                let label = format!("{scheme}_{contact}_{mass_name}");
                 let opts = bar::Options {
-                    scheme,
-                    alpha: a.alpha.filter(|_| scheme.is_hht()),
-                    contact,
-                    theta,
-                    gamma0: a.gamma0,
+                    setup,
                     elements: a.ne,
                     dt: a.dt,
                     t_end: a.t_end,
@@ -445,9 +500,9 @@ fn run_bar_all(a: BarArgs) -> ExitCode {
                     Ok(r) => {
                         let s = r.summary;
                         println!(
-                            "{:<15} {:<13} {:<13} {:>8.4} {:>8.4} {:>9.6} {:>9.6} {:>10.2e} {:>10.2e} {:>7} {:>4}",
-                            scheme.name(),
-                            contact_name,
+                            "{:<15} {:<16} {:<13} {:>8.4} {:>8.4} {:>9.6} {:>9.6} {:>10.2e} {:>10.2e} {:>7} {:>4}",
+                            scheme,
+                            contact,
                             mass_name,
                             s.err_linf_l2_u,
                             s.err_l2_lambda,
@@ -460,7 +515,7 @@ fn run_bar_all(a: BarArgs) -> ExitCode {
                         );
                     }
                     Err(e) => {
-                        println!("{:<15} {:<13} {:<13} failed: {e}", scheme.name(), contact_name, mass_name);
+                        println!("{scheme:<15} {contact:<16} {mass_name:<13} failed: {e}");
                         failed = true;
                     }
                 }
@@ -471,12 +526,12 @@ fn run_bar_all(a: BarArgs) -> ExitCode {
 }
 
 fn run_disc(a: DiscArgs) -> ExitCode {
+    let setup = match a.methods.setup() {
+        Ok(s) => s,
+        Err(e) => return fail(e),
+    };
     let opts = crate::cases::disc::Options {
-        scheme: a.scheme,
-        alpha: a.alpha,
-        contact: a.contact,
-        theta: a.theta,
-        gamma0: a.gamma0,
+        setup,
         mass: a.mass,
         mesh: a.mesh,
         h: a.h,
@@ -515,10 +570,10 @@ fn finish_bar(result: Result<bar::Run, crate::cases::CaseError>) -> ExitCode {
         Ok(r) => {
             let s = &r.summary;
             println!(
-                "bar: {} {:?} θ = {}, {} steps: err_u {:.4}, err_λ {:.4}, E_Θ {:.6} → {:.6}, penetration {:.3e}, Newton {} (max {}), {:.2} s",
-                s.scheme.name(),
+                "bar: {} {}{}, {} steps: err_u {:.4}, err_λ {:.4}, E_aug {:.6} → {:.6}, penetration {:.3e}, Newton {} (max {}), {:.2} s",
+                s.scheme,
                 s.contact,
-                s.theta,
+                params_text(&s.params),
                 s.steps,
                 s.err_linf_l2_u,
                 s.err_l2_lambda,
@@ -543,9 +598,10 @@ fn finish_disc(result: Result<crate::cases::disc::Run, crate::cases::CaseError>)
         Ok(r) => {
             let s = &r.summary;
             println!(
-                "disc: {} {:?}, {} dofs, {} steps, first contact at t = {}, max penetration {:.3e}, E_aug {:.6} → {:.6}, Newton {} (max {}), {:.2} s ({:.3} ms/step)",
-                s.scheme.name(),
+                "disc: {} {}{}, {} dofs, {} steps, first contact at t = {}, max penetration {:.3e}, E_aug {:.6} → {:.6}, Newton {} (max {}), {:.2} s ({:.3} ms/step)",
+                s.scheme,
                 s.contact,
+                params_text(&s.params),
                 s.dofs,
                 s.steps,
                 s.first_contact.map_or("never".to_string(), |t| format!("{t:.2}")),
@@ -564,4 +620,14 @@ fn finish_disc(result: Result<crate::cases::disc::Run, crate::cases::CaseError>)
             ExitCode::FAILURE
         }
     }
+}
+
+/// The params the user or the case set (not the files' defaults), for one-line summaries.
+fn params_text(params: &std::collections::BTreeMap<String, crate::driver::ParamValue>) -> String {
+    let set: Vec<String> = params
+        .iter()
+        .filter(|(_, p)| p.source != crate::driver::params::Source::File)
+        .map(|(n, p)| format!("{n} = {}", p.value))
+        .collect();
+    if set.is_empty() { String::new() } else { format!(" ({})", set.join(", ")) }
 }

@@ -285,10 +285,11 @@ fn declare(
                     });
                     Global::Form(prog.forms.len() - 1)
                 }
-                ast::Item::Scheme { name, params, states, lets, initial, stages, span } => {
+                ast::Item::Scheme { name, params, uses, states, lets, initial, stages, span } => {
                     schemes.push(crate::scheme::SchemeDef {
                         name: name.clone(),
                         params: params.clone(),
+                        uses: uses.clone(),
                         states: states.clone(),
                         lets: lets.clone(),
                         initial: initial.clone(),
@@ -330,7 +331,7 @@ fn check_distinct(names: &[Ident], what: &str, diags: &mut Vec<Diagnostic>) {
 }
 
 /// Names visible everywhere, for "did you mean" suggestions.
-fn suggest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<String> {
+pub fn suggest_name<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<String> {
     candidates
         .filter(|c| *c != name)
         .map(|c| (strsim::damerau_levenshtein(name, c), c))

@@ -4,7 +4,7 @@
 use std::collections::{HashMap, HashSet};
 
 use super::builtins::{self, BUILTIN_FUNCTIONS, BUILTIN_VALUES, NONLINEAR};
-use super::{CELL_REGION, Global, ParamRange, ParamSet, Program, suggest};
+use super::{CELL_REGION, Global, ParamRange, ParamSet, Program};
 use crate::diagnostic::Diagnostic;
 use crate::source::Span;
 use crate::syntax::ast::{BinOp, Expr, ExprKind, Ident, Shape};
@@ -264,7 +264,7 @@ impl<'p> Checker<'p> {
             .chain(BUILTIN_FUNCTIONS.iter().copied())
             .chain(scope_names.iter().map(String::as_str));
         let mut d = Diagnostic::error("E0101", format!("unknown name `{}`", id.name), id.span, "not defined");
-        if let Some(s) = suggest(&id.name, candidates) {
+        if let Some(s) = super::suggest_name(&id.name, candidates) {
             d = d.with_help(format!("did you mean `{s}`?"));
         }
         self.error(d);

@@ -6,6 +6,7 @@
 //! formatted by prettyplease for people to read.
 
 mod kernel;
+mod library;
 pub mod names;
 mod scheme;
 
@@ -54,6 +55,10 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
         s,
         "use {rt}::kernel::{{CellCtx, Coef, FacetCtx, Form, FormKernel, FormMeta, FunctionalKernel, LocalMatrix, LocalVector, ParamError, ParamRange, check_coef, check_param, heaviside}};"
     );
+    let _ = writeln!(
+        s,
+        "use {rt}::library::{{Binding, CoefInfo, FormUnit, LibraryError, Made, ParamInfo, SchemeUnit, SlotInfo, SlotUse, Unit, need_coef}};"
+    );
     let _ = writeln!(s, "use {rt}::geometry;");
     if !prog.schemes.is_empty() {
         let _ = writeln!(
@@ -61,8 +66,12 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
             "use {rt}::scheme::{{Combination, InitialDesc, Level, SchemeDesc, StageDesc, TermDesc, TimeScheme}};"
         );
     }
-    s.push_str(&params_text(prog));
-    s.push_str(&coefs_text(prog));
+    // Kernels for the forms declared in this file; imported files have modules of their own.
+    let own: Vec<usize> = (0..prog.forms.len()).filter(|&i| prog.forms[i].span.file == prog.root).collect();
+    if !own.is_empty() {
+        s.push_str(&params_text(prog));
+        s.push_str(&coefs_text(prog));
+    }
     let taken: Vec<String> = vec!["Params".into(), "Coefficients".into()];
     let mut struct_names: Vec<String> = Vec::new();
     for form in &prog.forms {
@@ -72,7 +81,8 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
         }
         struct_names.push(name);
     }
-    for (fi, form) in prog.forms.iter().enumerate() {
+    for &fi in &own {
+        let form = &prog.forms[fi];
         let sname = &struct_names[fi];
         let ir2 = &irs[1].forms[fi];
         let fields: Vec<String> = form.fields.iter().map(|f| format!("{:?}", f.name)).collect();
@@ -122,14 +132,34 @@ fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
             }
         }
     }
+    let mut scheme_units = Vec::new();
     for sch in &prog.schemes {
         let mut name = camel(&sch.name);
         while taken.contains(&name) || struct_names.contains(&name) {
             name.push_str("Scheme");
         }
         struct_names.push(name.clone());
-        s.push_str(&scheme::scheme_text(sch, &name));
+        s.push_str(&scheme::scheme_text(prog, sch, &name));
+        let (items, unit) = library::scheme_unit(prog, sch, &name);
+        s.push_str(&items);
+        scheme_units.push(unit);
     }
+    let forms_unit = if own.is_empty() {
+        "None".to_string()
+    } else {
+        let own_names: Vec<(usize, &str)> = own.iter().map(|&fi| (fi, struct_names[fi].as_str())).collect();
+        s.push_str(&library::forms_items(prog, &own_names));
+        "Some(FormUnit { params: PARAMS, coefs: COEFS, slots: SLOTS, make })".to_string()
+    };
+    let _ = writeln!(
+        s,
+        "/// What `{}` tells the runtime about itself: params, coefs, slots, schemes.\npub const UNIT: Unit = Unit {{ name: {:?}, file: {:?}, doc: {:?}, forms: {forms_unit}, schemes: &[{}] }};",
+        opts.source_name,
+        opts.module,
+        opts.source_name,
+        crate::docs::file(prog.sources.text(prog.root)),
+        scheme_units.join(", ")
+    );
     s.push_str("}\n");
     s
 }

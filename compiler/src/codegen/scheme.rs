@@ -2,82 +2,67 @@
 //! `TimeScheme` implementation: the static description of stages, terms and updates, and the
 //! evaluation of every coefficient for a step size.
 
-use std::collections::HashMap;
 use std::fmt::Write;
 
 use super::names::ident;
+use crate::check::Program;
 use crate::ir::graph::{Graph, Node, NodeId, Sym};
-use crate::scheme::{Affine, Quantity, SchemeIr, Term};
+use crate::scheme::layout::{self, Combination, Layout, TermLayout};
+use crate::scheme::{Quantity, SchemeIr};
 
-pub fn scheme_text(s: &SchemeIr, struct_name: &str) -> String {
+pub fn scheme_text(prog: &Program, s: &SchemeIr, struct_name: &str) -> String {
     let params: Vec<(String, f64, Option<crate::check::ParamRange>)> =
         s.params.iter().map(|p| (p.name.clone(), p.default, p.range)).collect();
     let sig: Vec<String> = s.params.iter().map(|p| format!("{} = {}", p.name, p.default)).collect();
     let doc = format!("/// `scheme {}({})`: its parameters; it implements `TimeScheme`.\n", s.name, sig.join(", "));
     let mut out = super::params_struct(struct_name, &doc, &params);
-    let mut coefs = Coefficients::default();
-    let desc = describe(s, &mut coefs);
+    let layout = layout::layout(s);
+    let desc = describe(prog, s, &layout);
+    let _ = writeln!(out, "impl {struct_name} {{ pub const DESC: SchemeDesc = {desc}; }}");
     let _ = writeln!(out, "impl TimeScheme for {struct_name} {{");
-    let _ = writeln!(out, "const DESC: SchemeDesc = {desc};");
+    out.push_str("fn desc(&self) -> &SchemeDesc { &Self::DESC }\n");
     out.push_str("fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]) {\n");
-    out.push_str(&coefs.code(&s.graph, s));
+    out.push_str(&coefficient_code(&layout.coefficients, &s.graph, s));
     out.push_str("}\n}\n");
     out
 }
 
-/// The coefficient nodes a description refers to, numbered in first-use order.
-#[derive(Default)]
-struct Coefficients {
-    index: HashMap<NodeId, usize>,
-    order: Vec<NodeId>,
-}
-
-impl Coefficients {
-    fn of(&mut self, n: NodeId) -> usize {
-        *self.index.entry(n).or_insert_with(|| {
-            self.order.push(n);
-            self.order.len() - 1
-        })
+/// Straight-line evaluation of the needed nodes, then the stores.
+fn coefficient_code(order: &[NodeId], g: &Graph, s: &SchemeIr) -> String {
+    let mut out = String::new();
+    let nodes = g.reachable(order.iter().copied());
+    let used_params: Vec<usize> =
+        (0..s.params.len()).filter(|&i| nodes.iter().any(|&n| g.node(n) == Node::Sym(Sym::Param(i as u16)))).collect();
+    for i in used_params {
+        let _ = writeln!(out, "let {} = self.{};", ident(&s.params[i].name), ident(&s.params[i].name));
     }
-
-    /// Straight-line evaluation of the needed nodes, then the stores.
-    fn code(&self, g: &Graph, s: &SchemeIr) -> String {
-        let mut out = String::new();
-        let nodes = g.reachable(self.order.iter().copied());
-        let used_params: Vec<usize> = (0..s.params.len())
-            .filter(|&i| nodes.iter().any(|&n| g.node(n) == Node::Sym(Sym::Param(i as u16))))
-            .collect();
-        for i in used_params {
-            let _ = writeln!(out, "let {} = self.{};", ident(&s.params[i].name), ident(&s.params[i].name));
+    let name = |n: NodeId| -> String {
+        match g.node(n) {
+            Node::Const(b) => literal(f64::from_bits(b)),
+            Node::Sym(Sym::Param(i)) => ident(&s.params[i as usize].name),
+            Node::Sym(Sym::Dt) => "dt".into(),
+            Node::Sym(Sym::Time) => "t".into(),
+            Node::Sym(_) => "f64::NAN".into(),
+            _ => format!("c{n}"),
         }
-        let name = |n: NodeId| -> String {
-            match g.node(n) {
-                Node::Const(b) => literal(f64::from_bits(b)),
-                Node::Sym(Sym::Param(i)) => ident(&s.params[i as usize].name),
-                Node::Sym(Sym::Dt) => "dt".into(),
-                Node::Sym(Sym::Time) => "t".into(),
-                Node::Sym(_) => "f64::NAN".into(),
-                _ => format!("c{n}"),
-            }
+    };
+    for &n in &nodes {
+        let text = match g.node(n) {
+            Node::Const(_) | Node::Sym(_) => continue,
+            Node::Add(a, b) => format!("{} + {}", name(a), name(b)),
+            Node::Mul(a, b) => format!("{} * {}", name(a), name(b)),
+            Node::Div(a, b) => format!("{} / {}", name(a), name(b)),
+            Node::Neg(a) => format!("-{}", name(a)),
+            Node::Powi(a, k) => format!("{}.powi({k})", name(a)),
+            Node::Sqrt(a) => format!("{}.sqrt()", name(a)),
+            Node::Heaviside(a) => format!("heaviside({})", name(a)),
         };
-        for &n in &nodes {
-            let text = match g.node(n) {
-                Node::Const(_) | Node::Sym(_) => continue,
-                Node::Add(a, b) => format!("{} + {}", name(a), name(b)),
-                Node::Mul(a, b) => format!("{} * {}", name(a), name(b)),
-                Node::Div(a, b) => format!("{} / {}", name(a), name(b)),
-                Node::Neg(a) => format!("-{}", name(a)),
-                Node::Powi(a, k) => format!("{}.powi({k})", name(a)),
-                Node::Sqrt(a) => format!("{}.sqrt()", name(a)),
-                Node::Heaviside(a) => format!("heaviside({})", name(a)),
-            };
-            let _ = writeln!(out, "let c{n} = {text};");
-        }
-        for (k, &n) in self.order.iter().enumerate() {
-            let _ = writeln!(out, "out[{k}] = {};", name(n));
-        }
-        out
+        let _ = writeln!(out, "let c{n} = {text};");
     }
+    for (k, &n) in order.iter().enumerate() {
+        let _ = writeln!(out, "out[{k}] = {};", name(n));
+    }
+    out
 }
 
 fn literal(v: f64) -> String {
@@ -99,55 +84,71 @@ fn level(q: Quantity) -> String {
     }
 }
 
-fn combination(g: &Graph, a: &Affine, c: &mut Coefficients) -> String {
-    let unknown = if g.is_zero(a.unknown) { "None".to_string() } else { format!("Some({})", c.of(a.unknown)) };
-    let known: Vec<String> = a.known.iter().map(|(q, k)| format!("({}, {})", level(*q), c.of(*k))).collect();
+fn combination(c: &Combination) -> String {
+    let unknown = c.unknown.map_or("None".to_string(), |k| format!("Some({k})"));
+    let known: Vec<String> = c.known.iter().map(|(q, k)| format!("({}, {k})", level(*q))).collect();
     format!("Combination {{ unknown: {unknown}, known: &[{}] }}", known.join(", "))
 }
 
-fn terms(g: &Graph, ts: &[Term], c: &mut Coefficients) -> String {
+fn terms(ts: &[TermLayout]) -> String {
     let list: Vec<String> = ts
         .iter()
         .map(|t| {
-            let coef = c.of(t.coef);
-            let args: Vec<String> = t.args.iter().map(|a| combination(g, a, c)).collect();
-            let time = c.of(t.time);
-            format!("TermDesc {{ coef: {coef}, form: {:?}, args: &[{}], time: {time} }}", t.form, args.join(", "))
+            let args: Vec<String> = t.args.iter().map(combination).collect();
+            format!(
+                "TermDesc {{ coef: {}, form: {:?}, args: &[{}], time: {} }}",
+                t.coef,
+                t.slot,
+                args.join(", "),
+                t.time
+            )
         })
         .collect();
     format!("&[{}]", list.join(", "))
 }
 
-fn describe(s: &SchemeIr, c: &mut Coefficients) -> String {
-    let g = &s.graph;
+fn describe(prog: &Program, s: &SchemeIr, layout: &Layout) -> String {
+    let uses: Vec<String> = s
+        .slots
+        .iter()
+        .map(|u| {
+            format!(
+                "SlotUse {{ name: {:?}, fields: {}, declared: {:?} }}",
+                u.name,
+                u.fields,
+                crate::docs::location_col(&prog.sources, u.span)
+            )
+        })
+        .collect();
     let states: Vec<String> = s.states.iter().map(|x| format!("{x:?}")).collect();
-    let initial = match &s.initial {
-        Some(i) => format!("Some(InitialDesc {{ state: {}, terms: {} }})", i.state, terms(g, &i.terms, c)),
+    let initial = match &layout.initial {
+        Some((state, ts)) => format!("Some(InitialDesc {{ state: {state}, terms: {} }})", terms(ts)),
         None => "None".into(),
     };
-    let stages: Vec<String> = s
+    let stages: Vec<String> = layout
         .stages
         .iter()
         .map(|st| {
-            let time = c.of(st.time);
             let quantities: Vec<String> = st.quantities.iter().map(|q| format!("{q:?}")).collect();
-            let values: Vec<String> = st.values.iter().map(|v| combination(g, v, c)).collect();
+            let values: Vec<String> = st.values.iter().map(combination).collect();
             format!(
-                "StageDesc {{ name: {:?}, time: {time}, quantities: &[{}], values: &[{}], terms: {} }}",
+                "StageDesc {{ name: {:?}, time: {}, quantities: &[{}], values: &[{}], terms: {} }}",
                 st.name,
+                st.time,
                 quantities.join(", "),
                 values.join(", "),
-                terms(g, &st.terms, c)
+                terms(&st.terms)
             )
         })
         .collect();
     let updates: Vec<String> = s.updates.iter().map(|q| level(*q)).collect();
     format!(
-        "SchemeDesc {{ name: {:?}, states: &[{}], initial: {initial}, stages: &[{}], updates: &[{}], coefficients: {} }}",
+        "SchemeDesc {{ name: {:?}, uses: &[{}], states: &[{}], initial: {initial}, stages: &[{}], updates: &[{}], coefficients: {} }}",
         s.name,
+        uses.join(", "),
         states.join(", "),
         stages.join(", "),
         updates.join(", "),
-        c.order.len()
+        layout.coefficients.len()
     )
 }

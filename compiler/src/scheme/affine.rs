@@ -126,10 +126,16 @@ impl Affine {
 
 /// Numeric value of a coefficient node for given scheme parameters, dt and t.
 pub fn eval(g: &Graph, id: NodeId, params: &[f64], dt: f64, t: f64) -> f64 {
-    let mut memo: std::collections::HashMap<NodeId, f64> = std::collections::HashMap::new();
-    for n in g.reachable([id]) {
-        let v = |x: NodeId| memo[&x];
-        let value = match g.node(n) {
+    eval_all(g, &[id], params, dt, t)[0]
+}
+
+/// The values of scheme scalars (params, dt and t are the only leaves), in one pass.
+pub fn eval_all(g: &Graph, roots: &[NodeId], params: &[f64], dt: f64, t: f64) -> Vec<f64> {
+    let mut value = vec![f64::NAN; g.len()];
+    // `reachable` is sorted by id, and children have smaller ids than their parents.
+    for n in g.reachable(roots.iter().copied()) {
+        let v = |x: NodeId| value[x as usize];
+        value[n as usize] = match g.node(n) {
             Node::Const(b) => f64::from_bits(b),
             Node::Sym(Sym::Param(i)) => params.get(i as usize).copied().unwrap_or(f64::NAN),
             Node::Sym(Sym::Dt) => dt,
@@ -143,7 +149,6 @@ pub fn eval(g: &Graph, id: NodeId, params: &[f64], dt: f64, t: f64) -> f64 {
             Node::Sqrt(a) => v(a).sqrt(),
             Node::Heaviside(a) => f64::from(v(a) > 0.0),
         };
-        memo.insert(n, value);
     }
-    memo[&id]
+    roots.iter().map(|&r| value[r as usize]).collect()
 }

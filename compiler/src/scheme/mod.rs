@@ -7,11 +7,12 @@
 //! the declared parameter ranges (by sampling them, with dt > 0).
 
 mod affine;
+pub mod layout;
 pub mod print;
 
 use std::collections::HashMap;
 
-pub use affine::Affine;
+pub use affine::{Affine, eval_all};
 
 use crate::check::{Global, ParamRange, Program, const_eval};
 use crate::diagnostic::Diagnostic;
@@ -24,6 +25,7 @@ use crate::syntax::ast::{self, BinOp, Expr, ExprKind, Ident};
 pub struct SchemeDef {
     pub name: Ident,
     pub params: Vec<ast::SchemeParam>,
+    pub uses: Vec<Ident>,
     pub states: Vec<Ident>,
     pub lets: Vec<(Ident, Expr)>,
     pub initial: Option<ast::Initial>,
@@ -45,6 +47,18 @@ pub struct SchemeParamInfo {
     pub name: String,
     pub default: f64,
     pub range: Option<ParamRange>,
+    /// The declaration (`alpha = 0.05 in [0, 1/3]`).
+    pub span: Span,
+}
+
+/// A slot the scheme applies: a form of a case's files, bound by name.
+#[derive(Clone, Debug)]
+pub struct SlotUse {
+    pub name: String,
+    /// Time levels it is applied to; 0 for a load (applied to a time).
+    pub fields: usize,
+    /// Its name in the `uses` line.
+    pub span: Span,
 }
 
 /// One form application in a residual: `coef · form(args)` at time `time`.
@@ -80,7 +94,11 @@ pub struct InitialIr {
 #[derive(Clone, Debug)]
 pub struct SchemeIr {
     pub name: String,
+    /// The declaration (for its doc comment and location).
+    pub span: Span,
     pub params: Vec<SchemeParamInfo>,
+    /// The slots it applies, in `uses` order.
+    pub slots: Vec<SlotUse>,
     pub states: Vec<String>,
     pub graph: Graph,
     pub initial: Option<InitialIr>,
@@ -112,9 +130,13 @@ struct Compiler<'a> {
     /// Quantities of the stage being compiled: name → index.
     new: Vec<String>,
     stage_index: usize,
+    /// Per `uses` entry: the first application (fields, span), once seen.
+    applied: Vec<Option<(usize, Span)>>,
 }
 
 const SCHEME_BUILTINS: &[&str] = &["dt", "t", "pi"];
+/// Scalar functions available in schemes (every other call is a slot application).
+const SCHEME_FUNCTIONS: &[&str] = &["sqrt", "abs"];
 
 impl<'a> Compiler<'a> {
     fn new(prog: &'a Program, def: &'a SchemeDef) -> Self {
@@ -127,6 +149,7 @@ impl<'a> Compiler<'a> {
             scope: HashMap::new(),
             new: Vec::new(),
             stage_index: 0,
+            applied: vec![None; def.uses.len()],
         }
     }
 
@@ -165,11 +188,12 @@ impl<'a> Compiler<'a> {
                     format!("{default} is not in {}", r.describe()),
                 ));
             }
-            self.params.push(SchemeParamInfo { name: p.name.name.clone(), default, range });
+            self.params.push(SchemeParamInfo { name: p.name.name.clone(), default, range, span: p.span });
             let node = self.g.sym(Sym::Param(i as u16));
             self.g.name(node, &p.name.name);
             self.scope.insert(p.name.name.clone(), Value::Scalar(node));
         }
+        self.check_uses();
         let dt = self.g.sym(Sym::Dt);
         let t = self.g.sym(Sym::Time);
         self.scope.insert("dt".into(), Value::Scalar(dt));
@@ -244,18 +268,138 @@ impl<'a> Compiler<'a> {
                 }
             }
         }
+        let mut slots = Vec::new();
+        for (u, applied) in def.uses.iter().zip(self.applied.clone()) {
+            match applied {
+                Some((fields, _)) => slots.push(SlotUse { name: u.name.clone(), fields, span: u.span }),
+                None => self.error(
+                    Diagnostic::error("E0817", format!("slot `{}` is never applied", u.name), u.span, "unused slot")
+                        .with_help("apply it in a residual, or remove it from the `uses` line"),
+                ),
+            }
+        }
         if !self.diags.is_empty() {
             return Err(self.diags);
         }
         Ok(SchemeIr {
             name: def.name.name.clone(),
+            span: def.span,
             params: self.params,
+            slots,
             states: def.states.iter().map(|s| s.name.clone()).collect(),
             graph: self.g,
             initial,
             stages,
             updates,
         })
+    }
+
+    fn is_slot(&self, name: &str) -> bool {
+        self.def.uses.iter().any(|u| u.name == name)
+    }
+
+    /// Duplicate and reserved names in the `uses` line.
+    fn check_uses(&mut self) {
+        for (i, u) in self.def.uses.iter().enumerate() {
+            if let Some(prev) = self.def.uses[..i].iter().find(|p| p.name == u.name) {
+                self.error(
+                    Diagnostic::error("E0103", format!("duplicate slot `{}`", u.name), u.span, "repeated here")
+                        .with_label(prev.span, "first here"),
+                );
+            } else if SCHEME_FUNCTIONS.contains(&u.name.as_str()) || SCHEME_BUILTINS.contains(&u.name.as_str()) {
+                self.error(Diagnostic::error(
+                    "E0106",
+                    format!("`{}` is a built-in name", u.name),
+                    u.span,
+                    "cannot be a slot",
+                ));
+            }
+        }
+    }
+
+    /// Records that a slot is applied to `fields` levels (0: a load); every application of a
+    /// slot must agree.
+    fn record_application(&mut self, f: &Ident, fields: usize, span: Span) -> bool {
+        let i = self.def.uses.iter().position(|u| u.name == f.name).expect("a slot");
+        match self.applied[i] {
+            None => {
+                self.applied[i] = Some((fields, span));
+                true
+            }
+            Some((n, _)) if n == fields => true,
+            Some((n, first)) => {
+                let what = |k: usize| if k == 0 { "a time (a load)".to_string() } else { format!("{k} time level(s)") };
+                self.error(
+                    Diagnostic::error(
+                        "E0201",
+                        format!("slot `{}` is applied to {} here but to {} before", f.name, what(fields), what(n)),
+                        span,
+                        format!("{} argument(s)", fields),
+                    )
+                    .with_label(first, "first application"),
+                );
+                false
+            }
+        }
+    }
+
+    /// A call that is neither a slot nor a scalar function.
+    fn unknown_slot(&mut self, f: &Ident) {
+        let uses = &self.def.uses;
+        let mut d = Diagnostic::error(
+            "E0816",
+            format!("`{}` is not a slot of scheme `{}`", f.name, self.def.name.name),
+            f.span,
+            "not in the `uses` line",
+        );
+        if let Some(s) = crate::check::suggest_name(&f.name, uses.iter().map(|u| u.name.as_str())) {
+            d = d.with_help(format!("did you mean `{s}`?"));
+        } else if uses.is_empty() {
+            d = d.with_help(format!(
+                "a scheme names the forms it applies: add `uses {}` inside scheme `{}`",
+                self.called_names().join(", "),
+                self.def.name.name
+            ));
+        } else {
+            let names: Vec<&str> = uses.iter().map(|u| u.name.as_str()).collect();
+            d = d.with_help(format!("add it to the `uses` line: `uses {}, {}`", names.join(", "), f.name));
+        }
+        if let Some(Global::Form(_)) = self.prog.globals.get(&f.name) {
+            d = d.with_note("schemes apply slots, not the forms of imported files: a case binds each slot to a form");
+        }
+        self.error(d);
+    }
+
+    /// Every name applied in the scheme's residuals, in order of appearance.
+    fn called_names(&self) -> Vec<String> {
+        fn walk(e: &Expr, out: &mut Vec<String>) {
+            match &e.kind {
+                ExprKind::Call(f, args) => {
+                    if !SCHEME_FUNCTIONS.contains(&f.name.as_str()) && !out.contains(&f.name) {
+                        out.push(f.name.clone());
+                    }
+                    args.iter().for_each(|a| walk(a, out));
+                }
+                ExprKind::Neg(a) => walk(a, out),
+                ExprKind::Binary(_, a, b) => {
+                    walk(a, out);
+                    walk(b, out);
+                }
+                _ => {}
+            }
+        }
+        let mut out = Vec::new();
+        let residuals = self
+            .def
+            .initial
+            .iter()
+            .map(|i| &i.residual)
+            .chain(self.def.stages.iter().filter_map(|s| s.residual.as_ref()));
+        for r in residuals {
+            walk(&r.lhs, &mut out);
+            walk(&r.rhs, &mut out);
+        }
+        out
     }
 
     fn bind_let(&mut self, name: &Ident, value: &Expr) {
@@ -596,11 +740,22 @@ impl<'a> Compiler<'a> {
     /// A sum of scalar multiples of form applications.
     fn form_sum(&mut self, e: &Expr, time: NodeId) -> Option<Vec<Term>> {
         match &e.kind {
-            ExprKind::Call(f, args) if matches!(self.prog.globals.get(&f.name), Some(Global::Form(_))) => {
-                let Some(Global::Form(fi)) = self.prog.globals.get(&f.name) else { unreachable!() };
-                let form = &self.prog.forms[*fi];
+            ExprKind::Call(f, _) if !self.is_slot(&f.name) && !SCHEME_FUNCTIONS.contains(&f.name.as_str()) => {
+                self.unknown_slot(f);
+                None
+            }
+            ExprKind::Call(f, args) if self.is_slot(&f.name) => {
                 let one = self.g.one();
-                if form.fields.is_empty() {
+                // A slot applied to nothing or to one scalar is a load (a function of time).
+                let first = match args.first() {
+                    Some(a) => Some(self.value(a)?),
+                    None => None,
+                };
+                let is_load = args.len() <= 1 && !matches!(first, Some(Value::Vector(_)));
+                if !self.record_application(f, if is_load { 0 } else { args.len() }, e.span) {
+                    return None;
+                }
+                if is_load {
                     // A load: its argument is the time.
                     let at = match args.as_slice() {
                         [] => time,
@@ -627,20 +782,6 @@ impl<'a> Compiler<'a> {
                         }
                     };
                     return Some(vec![Term { coef: one, form: f.name.clone(), args: Vec::new(), time: at }]);
-                }
-                if args.len() != form.fields.len() {
-                    self.error(Diagnostic::error(
-                        "E0201",
-                        format!(
-                            "form `{}` takes {} time level(s), but {} were given",
-                            f.name,
-                            form.fields.len(),
-                            args.len()
-                        ),
-                        e.span,
-                        format!("{} arguments", args.len()),
-                    ));
-                    return None;
                 }
                 let mut affine_args = Vec::new();
                 for a in args {
@@ -705,7 +846,7 @@ impl<'a> Compiler<'a> {
 
     fn is_form_sum(&self, e: &Expr) -> bool {
         match &e.kind {
-            ExprKind::Call(f, _) => matches!(self.prog.globals.get(&f.name), Some(Global::Form(_))),
+            ExprKind::Call(f, _) => self.is_slot(&f.name) || !SCHEME_FUNCTIONS.contains(&f.name.as_str()),
             ExprKind::Neg(a) => self.is_form_sum(a),
             ExprKind::Binary(BinOp::Add | BinOp::Sub, a, b) => self.is_form_sum(a) || self.is_form_sum(b),
             ExprKind::Binary(BinOp::Mul, a, b) => self.is_form_sum(a) || self.is_form_sum(b),
@@ -806,10 +947,10 @@ impl<'a> Compiler<'a> {
                 }
             }
             ExprKind::Call(f, args) => {
-                if matches!(self.prog.globals.get(&f.name), Some(Global::Form(_))) {
+                if self.is_slot(&f.name) {
                     self.error(Diagnostic::error(
                         "E0813",
-                        format!("form `{}` applied outside a residual", f.name),
+                        format!("slot `{}` applied outside a residual", f.name),
                         e.span,
                         "forms belong in `residual` lines",
                     ));

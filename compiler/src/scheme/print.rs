@@ -10,6 +10,12 @@ pub fn print(s: &SchemeIr) -> String {
     let mut out = String::new();
     let params: Vec<String> = s.params.iter().map(|p| format!("{} = {}", p.name, p.default)).collect();
     let _ = writeln!(out, "scheme {}({})", s.name, params.join(", "));
+    let slots: Vec<String> = s
+        .slots
+        .iter()
+        .map(|u| if u.fields == 0 { format!("{}(t)", u.name) } else { format!("{}/{}", u.name, u.fields) })
+        .collect();
+    let _ = writeln!(out, "  uses {}", slots.join(", "));
     let _ = writeln!(out, "  states {}", s.states.join(", "));
     let names = |q: Quantity| match q {
         Quantity::State(i) => s.states[i].clone(),

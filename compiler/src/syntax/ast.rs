@@ -162,6 +162,8 @@ pub enum Item {
     Scheme {
         name: Ident,
         params: Vec<SchemeParam>,
+        /// Slots (`uses mass, stiffness, contact, load`): the forms the scheme applies.
+        uses: Vec<Ident>,
         states: Vec<Ident>,
         /// Scalar lets shared by the stages.
         lets: Vec<(Ident, Expr)>,

@@ -328,11 +328,14 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::integrals => "an integral `int(REGION) ...`",
         Rule::form_args | Rule::ident_list => "argument names",
         Rule::state_decl
+        | Rule::uses_decl
         | Rule::unknown_decl
         | Rule::relate_decl
         | Rule::residual_decl
         | Rule::stage_block
-        | Rule::initial_decl => "a scheme item (`state`, `unknown`, `relate`, `residual`, `stage`, `initial`, `let`)",
+        | Rule::initial_decl => {
+            "a scheme item (`uses`, `state`, `unknown`, `relate`, `residual`, `stage`, `initial`, `let`)"
+        }
         Rule::scheme_params | Rule::scheme_param => "scheme parameters",
         _ => return None,
     })
@@ -447,6 +450,7 @@ impl Builder {
     ) -> Result<Item, Box<Diagnostic>> {
         let name = self.ident(name);
         let (mut params, mut states, mut initial, mut lets) = (Vec::new(), Vec::new(), None, Vec::new());
+        let mut uses = Vec::new();
         let mut stages: Vec<Stage> = Vec::new();
         // Items outside `stage` blocks form one implicit stage at t + dt.
         let mut implicit = Stage::default();
@@ -461,6 +465,10 @@ impl Builder {
                         let range = it.next().map(|r| self.range(r)).transpose()?;
                         params.push(SchemeParam { name, default, range, span });
                     }
+                }
+                Rule::uses_decl => {
+                    let list = p.into_inner().next().expect("slot names");
+                    uses.extend(list.into_inner().map(|i| self.ident(i)));
                 }
                 Rule::state_decl => {
                     let list = p.into_inner().next().expect("state names");
@@ -515,7 +523,7 @@ impl Builder {
                 return Err(Box::new(d));
             }
         }
-        Ok(Item::Scheme { name, params, states, lets, initial, stages, span })
+        Ok(Item::Scheme { name, params, uses, states, lets, initial, stages, span })
     }
 
     fn stage_item(&self, stage: &mut Stage, p: Pair<Rule>) -> Result<(), Box<Diagnostic>> {

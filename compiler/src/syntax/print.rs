@@ -31,10 +31,12 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 let ps: Vec<_> = params.iter().map(|p| p.name.as_str()).collect();
                 out.push_str(&format!("{head}fn {}({}) = {}\n", name.name, ps.join(", "), expr(body)));
             }
-            Item::Scheme { name, params, states, lets, initial, stages, .. } => {
+            Item::Scheme { name, params, uses, states, lets, initial, stages, .. } => {
                 let ps: Vec<String> =
                     params.iter().map(|p| format!("{} = {}", p.name.name, expr(&p.default))).collect();
                 out.push_str(&format!("{head}scheme {}({})\n", name.name, ps.join(", ")));
+                let us: Vec<&str> = uses.iter().map(|s| s.name.as_str()).collect();
+                out.push_str(&format!("  uses {}\n", us.join(", ")));
                 let ss: Vec<&str> = states.iter().map(|s| s.name.as_str()).collect();
                 out.push_str(&format!("  state {}\n", ss.join(", ")));
                 for (n, v) in lets {

@@ -1,0 +1,141 @@
+//! The registry entry of a generated module: its params (with docs and declaration sites), coefs
+//! and slots as data, and the functions that instantiate its forms and schemes by slot name.
+
+use std::fmt::Write;
+
+use super::names::ident;
+use crate::check::Program;
+use crate::docs;
+use crate::scheme::SchemeIr;
+use crate::source::Span;
+use crate::syntax::ast::Shape;
+
+fn owner(prog: &Program, span: Span) -> String {
+    crate::module_name(prog.sources.path(span.file))
+}
+
+fn param_info(name: &str, default: f64, range: &str, doc: &str, declared: &str, owner: &str) -> String {
+    format!(
+        "ParamInfo {{ name: {name:?}, default: {default:?}, range: {range}, doc: {doc:?}, declared: {declared:?}, owner: {owner:?} }}"
+    )
+}
+
+/// `PARAMS`, `COEFS`, `SLOTS` and `make` for the forms declared in the file (`own`: form index
+/// and struct name).
+pub fn forms_items(prog: &Program, own: &[(usize, &str)]) -> String {
+    let src = &prog.sources;
+    let mut s = String::new();
+    let params: Vec<String> = prog
+        .params
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            param_info(
+                &p.name,
+                p.default,
+                &format!("Params::RANGES[{i}]"),
+                &docs::declaration(src, p.span),
+                &docs::location(src, p.span),
+                &owner(prog, p.span),
+            )
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "/// Every param the forms read (imports included), in `Params` order.\npub const PARAMS: &[ParamInfo] = &[{}];",
+        params.join(", ")
+    );
+    let coefs: Vec<String> = prog
+        .coefs
+        .iter()
+        .map(|c| {
+            let rank = match c.shape {
+                Shape::Scalar => 0,
+                Shape::Vector => 1,
+                Shape::Tensor => 2,
+            };
+            format!(
+                "CoefInfo {{ name: {:?}, rank: {rank}, doc: {:?}, declared: {:?} }}",
+                c.name,
+                docs::declaration(src, c.span),
+                docs::location(src, c.span)
+            )
+        })
+        .collect();
+    let _ = writeln!(s, "/// The case data the forms read.\npub const COEFS: &[CoefInfo] = &[{}];", coefs.join(", "));
+    let slots: Vec<String> = own
+        .iter()
+        .map(|&(fi, _)| {
+            let f = &prog.forms[fi];
+            format!(
+                "SlotInfo {{ name: {:?}, fields: {}, functional: {}, doc: {:?}, declared: {:?} }}",
+                f.name,
+                f.fields.len(),
+                f.test.is_none(),
+                docs::declaration(src, f.span),
+                docs::location(src, f.span)
+            )
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "/// The forms and functionals of this file.\npub const SLOTS: &[SlotInfo] = &[{}];",
+        slots.join(", ")
+    );
+    s.push_str("/// Instantiates every form of this file on a mesh: param values in `PARAMS` order, coefs by name.\n");
+    s.push_str("pub fn make<'m>(values: &[f64], coefs: &dyn Fn(&str) -> Option<Coef>, bind: &Binding<'m>) -> Result<Made<'m>, LibraryError> {\n");
+    s.push_str("let mut params = Params::default();\n");
+    s.push_str("for (name, value) in Params::NAMES.iter().zip(values) { params.set(name, *value)?; }\n");
+    let fields: Vec<String> = prog
+        .coefs
+        .iter()
+        .enumerate()
+        .map(|(i, c)| format!("{}: need_coef(coefs, &COEFS[{i}])?", ident(&c.name)))
+        .collect();
+    let _ = writeln!(s, "let coefs = Coefficients {{ {} }};", fields.join(", "));
+    s.push_str("coefs.check(bind.dim).map_err(LibraryError::Coef)?;\n");
+    let made: Vec<String> = own
+        .iter()
+        .map(|&(fi, sname)| {
+            let f = &prog.forms[fi];
+            let how = if f.test.is_some() { "form" } else { "functional" };
+            format!("({:?}, bind.{how}({sname}::new(&params, &coefs))?)", f.name)
+        })
+        .collect();
+    let _ = writeln!(s, "Ok(vec![{}])\n}}", made.join(", "));
+    s
+}
+
+/// A scheme's `SchemeUnit` expression, after the items it refers to (its `make` function).
+pub fn scheme_unit(prog: &Program, sch: &SchemeIr, struct_name: &str) -> (String, String) {
+    let src = &prog.sources;
+    let make = format!("make_{}", ident(&sch.name));
+    let mut items = String::new();
+    let _ = writeln!(
+        items,
+        "/// Scheme `{}` with param values in declaration order.\nfn {make}(values: &[f64]) -> Result<Box<dyn TimeScheme>, LibraryError> {{\nlet mut scheme = {struct_name}::default();\nfor (name, value) in {struct_name}::NAMES.iter().zip(values) {{ scheme.set(name, *value)?; }}\nOk(Box::new(scheme))\n}}",
+        sch.name
+    );
+    let params: Vec<String> = sch
+        .params
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            param_info(
+                &p.name,
+                p.default,
+                &format!("{struct_name}::RANGES[{i}]"),
+                &docs::declaration(src, p.span),
+                &docs::location(src, p.span),
+                &sch.name,
+            )
+        })
+        .collect();
+    let unit = format!(
+        "SchemeUnit {{ name: {:?}, doc: {:?}, params: &[{}], desc: &{struct_name}::DESC, make: {make} }}",
+        sch.name,
+        docs::declaration(src, sch.span),
+        params.join(", ")
+    );
+    (items, unit)
+}

@@ -1,0 +1,217 @@
+//! The form library as data. Every `.wf` file, compiled by the macro or interpreted at run time,
+//! describes itself to the runtime with a [`Unit`]: its params (defaults, ranges, docs and where
+//! they are declared), its coefs, the slots its forms provide, its schemes and the slots they
+//! apply, and functions that instantiate them. Cases bind slots by name; nothing in Rust names a
+//! scheme, a contact law or a param.
+
+use std::fmt;
+
+use crate::assembly::{Assembler, Functional, Kernel, Quadrature};
+use crate::kernel::{Coef, ParamError, ParamRange};
+use crate::mesh::Facet;
+use crate::scheme::{Bound, BoundForm, TimeScheme};
+
+/// A param of a form file or a scheme.
+#[derive(Clone, Copy, Debug)]
+pub struct ParamInfo {
+    pub name: &'static str,
+    pub default: f64,
+    pub range: ParamRange,
+    /// The comment on the declaration's line (or the line above), if any.
+    pub doc: &'static str,
+    /// `file.wf:line`.
+    pub declared: &'static str,
+    /// The file stem or scheme that declares it: `owner.name` is its qualified name.
+    pub owner: &'static str,
+}
+
+/// A `coef` (case data) of a form file.
+#[derive(Clone, Copy, Debug)]
+pub struct CoefInfo {
+    pub name: &'static str,
+    /// 0 scalar, 1 vector, 2 tensor.
+    pub rank: u32,
+    pub doc: &'static str,
+    pub declared: &'static str,
+}
+
+/// A form or functional a file provides, under its name.
+#[derive(Clone, Copy, Debug)]
+pub struct SlotInfo {
+    pub name: &'static str,
+    /// Field arguments (time levels); 0 for a load.
+    pub fields: usize,
+    /// A functional (no test function): a value, not a residual.
+    pub functional: bool,
+    pub doc: &'static str,
+    pub declared: &'static str,
+}
+
+/// A slot a scheme applies.
+#[derive(Clone, Copy, Debug)]
+pub struct SlotUse {
+    pub name: &'static str,
+    /// Time levels it is applied to; 0 for a load.
+    pub fields: usize,
+    /// `file.wf:line:col` of its name in the `uses` line.
+    pub declared: &'static str,
+}
+
+/// What a form file's forms are bound to: the quadrature, and the mesh facets of every boundary
+/// region (by its name in the .wf files, e.g. `Gamma_C`).
+pub struct Binding<'m> {
+    pub quadrature: Quadrature,
+    pub regions: Vec<(String, &'m [Facet])>,
+    /// The space dimension (coef sizes are checked against it).
+    pub dim: usize,
+}
+
+/// A form or functional bound to a mesh.
+pub enum SlotForm<'m> {
+    Form(Box<dyn BoundForm + 'm>),
+    Functional(Box<dyn BoundFunctional + 'm>),
+}
+
+/// The forms of a file, instantiated: (slot name, bound form).
+pub type Made<'m> = Vec<(&'static str, SlotForm<'m>)>;
+
+/// Instantiates a file's forms: values of `params` in order, coefs by name.
+pub type MakeForms = for<'m> fn(&[f64], &dyn Fn(&str) -> Option<Coef>, &Binding<'m>) -> Result<Made<'m>, LibraryError>;
+
+/// Instantiates a scheme with the values of its params, in order.
+pub type MakeScheme = fn(&[f64]) -> Result<Box<dyn TimeScheme>, LibraryError>;
+
+/// The forms of one file.
+#[derive(Clone, Copy)]
+pub struct FormUnit {
+    /// Every param the file's forms read, its imports' included, in `Params` order.
+    pub params: &'static [ParamInfo],
+    pub coefs: &'static [CoefInfo],
+    /// The forms and functionals declared in the file itself.
+    pub slots: &'static [SlotInfo],
+    pub make: MakeForms,
+}
+
+/// A scheme of a file.
+#[derive(Clone, Copy)]
+pub struct SchemeUnit {
+    pub name: &'static str,
+    /// The comment block above the scheme.
+    pub doc: &'static str,
+    pub params: &'static [ParamInfo],
+    /// Its stages, terms and the slots it applies.
+    pub desc: &'static crate::scheme::SchemeDesc,
+    pub make: MakeScheme,
+}
+
+/// Everything a `.wf` file tells the runtime about itself.
+#[derive(Clone, Copy)]
+pub struct Unit {
+    /// The file stem.
+    pub name: &'static str,
+    /// The path as given to the compiler.
+    pub file: &'static str,
+    /// The comment block at the top of the file.
+    pub doc: &'static str,
+    pub forms: Option<FormUnit>,
+    pub schemes: &'static [SchemeUnit],
+}
+
+impl fmt::Debug for Unit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Unit").field("name", &self.name).field("file", &self.file).finish_non_exhaustive()
+    }
+}
+
+/// Why a file's forms or scheme could not be instantiated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LibraryError {
+    #[error("{0}")]
+    Param(#[from] ParamError),
+    #[error("the case provides no `{name}` (`coef {name}` declared at {declared})")]
+    MissingCoef { name: &'static str, declared: &'static str },
+    #[error("{0}")]
+    Coef(String),
+    #[error("form `{form}` integrates over `{region}`, which the case does not define (it defines: {defined})")]
+    MissingRegion { form: &'static str, region: &'static str, defined: String },
+}
+
+impl<'m> Binding<'m> {
+    fn regions_of(
+        &self,
+        form: &'static str,
+        names: &[(&'static str, [u32; 2])],
+    ) -> Result<Vec<(String, &'m [Facet])>, LibraryError> {
+        names
+            .iter()
+            .map(|(region, _)| {
+                self.regions.iter().find(|(n, _)| n == region).map(|(n, f)| (n.clone(), *f)).ok_or_else(|| {
+                    let defined: Vec<&str> = self.regions.iter().map(|(n, _)| n.as_str()).collect();
+                    LibraryError::MissingRegion {
+                        form,
+                        region,
+                        defined: if defined.is_empty() { "none".into() } else { defined.join(", ") },
+                    }
+                })
+            })
+            .collect()
+    }
+
+    /// A form kernel bound to this mesh.
+    pub fn form<K: Kernel + 'm>(&self, kernel: K) -> Result<SlotForm<'m>, LibraryError> {
+        let meta = *kernel.meta();
+        let regions = self.regions_of(meta.name, meta.facets)?;
+        Ok(SlotForm::Form(Box::new(Bound { kernel, quadrature: self.quadrature, regions })))
+    }
+
+    /// A functional kernel bound to this mesh.
+    pub fn functional<K: Functional + 'm>(&self, kernel: K) -> Result<SlotForm<'m>, LibraryError> {
+        let meta = *kernel.meta();
+        let regions = self.regions_of(meta.name, meta.facets)?;
+        Ok(SlotForm::Functional(Box::new(BoundValue { kernel, quadrature: self.quadrature, regions })))
+    }
+}
+
+/// The coef `name` from the case, or an error naming its declaration.
+pub fn need_coef(coefs: &dyn Fn(&str) -> Option<Coef>, info: &CoefInfo) -> Result<Coef, LibraryError> {
+    coefs(info.name).ok_or(LibraryError::MissingCoef { name: info.name, declared: info.declared })
+}
+
+/// A functional bound to a mesh: its integral, or its integral per cell.
+pub trait BoundFunctional {
+    fn name(&self) -> &str;
+    fn fields(&self) -> usize;
+    /// The integral over the cells (if it has a volume part) and its boundary regions.
+    fn value(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> f64;
+    /// The volume integral on each cell.
+    fn cell_values(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> Vec<f64>;
+}
+
+/// A functional kernel with its integration data.
+pub struct BoundValue<'m, K: Functional> {
+    pub kernel: K,
+    pub quadrature: Quadrature,
+    pub regions: Vec<(String, &'m [Facet])>,
+}
+
+impl<K: Functional> BoundFunctional for BoundValue<'_, K> {
+    fn name(&self) -> &str {
+        self.kernel.meta().name
+    }
+    fn fields(&self) -> usize {
+        self.kernel.meta().fields.len()
+    }
+    fn value(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> f64 {
+        let mut v = 0.0;
+        if self.kernel.meta().cell_degree.is_some() {
+            v += asm.cell_value(&self.kernel, self.quadrature, fields, t);
+        }
+        for (region, facets) in &self.regions {
+            v += asm.facet_value(&self.kernel, region, facets, self.quadrature, fields, t);
+        }
+        v
+    }
+    fn cell_values(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> Vec<f64> {
+        asm.cell_values(&self.kernel, self.quadrature, fields, t)
+    }
+}

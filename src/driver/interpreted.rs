@@ -1,0 +1,168 @@
+//! Scheme files given by path, run at once: compiled at run time to the same description the
+//! macro generates (`compiler::scheme::layout`), their coefficients evaluated from the
+//! expression DAG.
+
+use std::path::Path;
+
+use crate::compiler::ir::graph::{Graph, NodeId};
+use crate::compiler::scheme::layout::{self, Combination, TermLayout};
+use crate::compiler::scheme::{Quantity, SchemeIr};
+use crate::compiler::{FsLoader, check_path, docs};
+use crate::runtime::kernel::ParamRange;
+use crate::runtime::library::{LibraryError, ParamInfo, SlotUse};
+use crate::runtime::scheme::{self as rs, SchemeDesc, TimeScheme};
+
+/// A scheme compiled at run time.
+pub struct Interpreted {
+    pub desc: &'static SchemeDesc,
+    pub params: Vec<ParamInfo>,
+    pub doc: String,
+    graph: Graph,
+    coefficients: Vec<NodeId>,
+}
+
+/// Its instance with param values.
+struct Running {
+    desc: &'static SchemeDesc,
+    graph: Graph,
+    coefficients: Vec<NodeId>,
+    values: Vec<f64>,
+}
+
+impl TimeScheme for Running {
+    fn desc(&self) -> &SchemeDesc {
+        self.desc
+    }
+    fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]) {
+        let v = crate::compiler::scheme::eval_all(&self.graph, &self.coefficients, &self.values, dt, t);
+        out.copy_from_slice(&v);
+    }
+}
+
+// The runtime's scheme description borrows `'static` data, as generated code does; a scheme
+// loaded at run time leaks its (small) description once per load.
+fn leak<T>(v: Vec<T>) -> &'static [T] {
+    Vec::leak(v)
+}
+
+fn leak_str(s: &str) -> &'static str {
+    String::leak(s.to_string())
+}
+
+fn level(q: Quantity) -> rs::Level {
+    match q {
+        Quantity::State(i) => rs::Level::State(i),
+        Quantity::Stage { stage, index } => rs::Level::Stage(stage, index),
+    }
+}
+
+fn combination(c: &Combination) -> rs::Combination {
+    rs::Combination { unknown: c.unknown, known: leak(c.known.iter().map(|(q, k)| (level(*q), *k)).collect()) }
+}
+
+fn terms(ts: &[TermLayout]) -> &'static [rs::TermDesc] {
+    leak(
+        ts.iter()
+            .map(|t| rs::TermDesc {
+                coef: t.coef,
+                form: leak_str(&t.slot),
+                args: leak(t.args.iter().map(combination).collect()),
+                time: t.time,
+            })
+            .collect(),
+    )
+}
+
+/// Compiles the scheme file at `path` (its only scheme, or the one named `name`).
+pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
+    let (prog, warnings) = check_path(path, &FsLoader).map_err(|f| f.rendered)?;
+    if !warnings.is_empty() {
+        eprint!("{warnings}");
+    }
+    let s: &SchemeIr = match (name, prog.schemes.as_slice()) {
+        (_, []) => return Err(format!("{} declares no scheme", path.display())),
+        (None, [one]) => one,
+        (Some(n), all) => all.iter().find(|s| s.name == n).ok_or_else(|| {
+            let names: Vec<&str> = all.iter().map(|s| s.name.as_str()).collect();
+            format!("{} has no scheme `{n}` (it has: {})", path.display(), names.join(", "))
+        })?,
+        (None, all) => {
+            let names: Vec<&str> = all.iter().map(|s| s.name.as_str()).collect();
+            return Err(format!("{} declares several schemes ({}): name one", path.display(), names.join(", ")));
+        }
+    };
+    let lay = layout::layout(s);
+    let uses = s
+        .slots
+        .iter()
+        .map(|u| SlotUse {
+            name: leak_str(&u.name),
+            fields: u.fields,
+            declared: leak_str(&docs::location_col(&prog.sources, u.span)),
+        })
+        .collect();
+    let stages = lay
+        .stages
+        .iter()
+        .map(|st| rs::StageDesc {
+            name: leak_str(&st.name),
+            time: st.time,
+            quantities: leak(st.quantities.iter().map(|q| leak_str(q)).collect()),
+            values: leak(st.values.iter().map(combination).collect()),
+            terms: terms(&st.terms),
+        })
+        .collect();
+    let desc = SchemeDesc {
+        name: leak_str(&s.name),
+        uses: leak(uses),
+        states: leak(s.states.iter().map(|q| leak_str(q)).collect()),
+        initial: lay.initial.as_ref().map(|(state, ts)| rs::InitialDesc { state: *state, terms: terms(ts) }),
+        stages: leak(stages),
+        updates: leak(s.updates.iter().map(|q| level(*q)).collect()),
+        coefficients: lay.coefficients.len(),
+    };
+    let params = s
+        .params
+        .iter()
+        .map(|p| {
+            let name = leak_str(&p.name);
+            let r = p.range;
+            ParamInfo {
+                name,
+                default: p.default,
+                range: ParamRange {
+                    name,
+                    lo: r.map_or(f64::NEG_INFINITY, |r| r.lo),
+                    lo_closed: r.is_some_and(|r| r.lo_closed),
+                    hi: r.map_or(f64::INFINITY, |r| r.hi),
+                    hi_closed: r.is_some_and(|r| r.hi_closed),
+                },
+                doc: leak_str(&docs::declaration(&prog.sources, p.span)),
+                declared: leak_str(&docs::location(&prog.sources, p.span)),
+                owner: desc.name,
+            }
+        })
+        .collect();
+    Ok(Interpreted {
+        desc: Box::leak(Box::new(desc)),
+        params,
+        doc: docs::declaration(&prog.sources, s.span),
+        graph: s.graph.clone(),
+        coefficients: lay.coefficients,
+    })
+}
+
+impl Interpreted {
+    /// An instance with param values in declaration order (range-checked).
+    pub fn instance(&self, values: &[f64]) -> Result<Box<dyn TimeScheme>, LibraryError> {
+        for (p, v) in self.params.iter().zip(values) {
+            crate::runtime::kernel::check_param(&p.range, *v)?;
+        }
+        Ok(Box::new(Running {
+            desc: self.desc,
+            graph: self.graph.clone(),
+            coefficients: self.coefficients.clone(),
+            values: values.to_vec(),
+        }))
+    }
+}

@@ -1,0 +1,352 @@
+//! The simulation driver's library side: which scheme and form files a run uses (by name from
+//! `forms/`, or by path), the value of every param (one default, from its .wf file; a case's
+//! overrides; the user's settings), and the binding of the scheme's slots to forms by name.
+//! Nothing here names a scheme, a contact law or a param.
+
+pub mod interpreted;
+pub mod params;
+
+use std::path::{Path, PathBuf};
+
+use crate::cases::CaseError;
+use crate::forms::LIBRARY;
+use crate::runtime::kernel::Coef;
+use crate::runtime::library::{Binding, BoundFunctional, ParamInfo, SlotForm, Unit};
+use crate::runtime::scheme::{BoundForm, SchemeDesc, TimeScheme};
+
+pub use params::{ParamValue, Setting};
+
+/// What a run is made of, as the user chose it (CLI flags or case-file keys).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Setup {
+    /// A scheme of `forms/schemes/` by name, or a .wf file.
+    pub scheme: String,
+    /// A contact law of `forms/` by name (`nitsche` for `contact_nitsche`), or a .wf file.
+    pub contact: String,
+    /// The material's form file (by name or path).
+    pub material: String,
+    /// Extra form files whose slots the scheme applies.
+    pub forms: Vec<PathBuf>,
+    /// Param values set by the user, in order (a later setting of a param wins).
+    pub params: Vec<Setting>,
+}
+
+impl Default for Setup {
+    fn default() -> Self {
+        Setup {
+            scheme: "newmark".into(),
+            contact: "nitsche".into(),
+            material: "elasticity".into(),
+            forms: Vec::new(),
+            params: Vec::new(),
+        }
+    }
+}
+
+impl Setup {
+    /// Adds a user setting `name = value` (`name` may be qualified: `unit.name`).
+    pub fn set(mut self, name: &str, value: f64) -> Self {
+        self.params.push(Setting { name: name.into(), value, origin: "options".into() });
+        self
+    }
+}
+
+/// A scheme, compiled or loaded from a file.
+pub enum SchemeSource {
+    Compiled(&'static crate::runtime::library::SchemeUnit),
+    Interpreted(Box<interpreted::Interpreted>),
+}
+
+impl SchemeSource {
+    pub fn desc(&self) -> &'static SchemeDesc {
+        match self {
+            SchemeSource::Compiled(u) => u.desc,
+            SchemeSource::Interpreted(i) => i.desc,
+        }
+    }
+
+    pub fn params(&self) -> &[ParamInfo] {
+        match self {
+            SchemeSource::Compiled(u) => u.params,
+            SchemeSource::Interpreted(i) => &i.params,
+        }
+    }
+
+    pub fn interpreted(&self) -> bool {
+        matches!(self, SchemeSource::Interpreted(_))
+    }
+}
+
+fn is_path(s: &str) -> bool {
+    s.ends_with(".wf") || s.contains('/')
+}
+
+/// The library's units, for `list` and lookups.
+pub fn library() -> &'static [&'static Unit] {
+    LIBRARY
+}
+
+/// A library scheme by name (`hht-imex` finds `hht_imex`).
+fn library_scheme(name: &str) -> Option<&'static crate::runtime::library::SchemeUnit> {
+    let name = name.replace('-', "_");
+    LIBRARY.iter().flat_map(|u| u.schemes.iter()).find(|s| s.name == name)
+}
+
+/// A library form file by name; `prefix_name` also matches (`nitsche` → `contact_nitsche`).
+fn library_forms(name: &str, prefix: &str) -> Option<&'static Unit> {
+    let name = name.replace('-', "_");
+    let found = |n: &str| LIBRARY.iter().copied().find(|u| u.forms.is_some() && u.name == n);
+    found(&name).or_else(|| found(&format!("{prefix}{name}")))
+}
+
+fn scheme_names() -> Vec<&'static str> {
+    LIBRARY.iter().flat_map(|u| u.schemes.iter()).map(|s| s.name).collect()
+}
+
+/// Names of the library's contact laws (the files providing a `contact` slot), short form.
+pub fn contact_names() -> Vec<&'static str> {
+    LIBRARY
+        .iter()
+        .filter(|u| u.forms.is_some_and(|f| f.slots.iter().any(|s| s.name == "contact")))
+        .map(|u| u.name.strip_prefix("contact_").unwrap_or(u.name))
+        .collect()
+}
+
+/// Every scheme of the library, by name.
+pub fn all_schemes() -> Vec<&'static str> {
+    scheme_names()
+}
+
+fn unknown(what: &str, name: &str, known: &[&str]) -> CaseError {
+    let hint = crate::compiler::check::suggest_name(name, known.iter().copied())
+        .map_or(String::new(), |s| format!("; did you mean `{s}`?"));
+    CaseError::Option(format!(
+        "no {what} `{name}` in the library (known: {}){hint}; or give a .wf file",
+        known.join(", ")
+    ))
+}
+
+/// Resolves the scheme of a setup.
+pub fn scheme(setup: &Setup) -> Result<SchemeSource, CaseError> {
+    if is_path(&setup.scheme) {
+        let path = Path::new(&setup.scheme);
+        return interpreted::load(path, None)
+            .map(|i| SchemeSource::Interpreted(Box::new(i)))
+            .map_err(CaseError::CaseFile);
+    }
+    library_scheme(&setup.scheme)
+        .map(SchemeSource::Compiled)
+        .ok_or_else(|| unknown("scheme", &setup.scheme, &scheme_names()))
+}
+
+/// The form files of a setup (material, contact law, extras) and its contact law.
+pub fn form_units(setup: &Setup) -> Result<(Vec<&'static Unit>, &'static Unit), CaseError> {
+    let mut units = Vec::new();
+    let pick = |name: &str, prefix: &str, what: &str, known: Vec<&str>| -> Result<&'static Unit, CaseError> {
+        if is_path(name) {
+            return library_file(Path::new(name)).ok_or_else(|| {
+                CaseError::Option(format!(
+                    "{name}: form files outside the library run interpreted, which this build does not have yet; add the file to forms/ and rebuild to compile it"
+                ))
+            });
+        }
+        library_forms(name, prefix).ok_or_else(|| unknown(what, name, &known))
+    };
+    let form_files: Vec<&str> = LIBRARY.iter().filter(|u| u.forms.is_some()).map(|u| u.name).collect();
+    units.push(pick(&setup.material, "", "form file", form_files.clone())?);
+    let contact = pick(&setup.contact, "contact_", "contact law", contact_names())?;
+    units.push(contact);
+    for f in &setup.forms {
+        units.push(pick(&f.display().to_string(), "", "form file", form_files.clone())?);
+    }
+    let mut seen = Vec::new();
+    units.retain(|u| {
+        let new = !seen.contains(&u.name);
+        seen.push(u.name);
+        new
+    });
+    Ok((units, contact))
+}
+
+/// A path that is one of the library's own files (compiled already).
+fn library_file(path: &Path) -> Option<&'static Unit> {
+    let stem = path.file_stem()?.to_string_lossy().into_owned();
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("forms").join(format!("{stem}.wf"));
+    let same = std::fs::canonicalize(path).ok()? == std::fs::canonicalize(here).ok()?;
+    if same { LIBRARY.iter().copied().find(|u| u.name == stem && u.forms.is_some()) } else { None }
+}
+
+/// A run's scheme and form files with the value of every param.
+pub struct Active {
+    pub scheme: SchemeSource,
+    /// Material, contact law, extra forms.
+    pub units: Vec<&'static Unit>,
+    pub contact: &'static Unit,
+    pub params: params::Table,
+}
+
+/// The form files of a run without a scheme (static problems).
+pub struct ActiveForms {
+    pub units: Vec<&'static Unit>,
+    pub contact: &'static Unit,
+    pub params: params::Table,
+}
+
+impl Active {
+    /// Resolves a setup: files, then params (file defaults < `overrides` of the case < the
+    /// user's settings).
+    pub fn resolve(setup: &Setup, overrides: &[(&str, f64)]) -> Result<Active, CaseError> {
+        let scheme = scheme(setup)?;
+        let (units, contact) = form_units(setup)?;
+        let mut table = params::Table::new(Some(&scheme), &units);
+        table.apply_case(overrides)?;
+        table.apply_user(&setup.params)?;
+        Ok(Active { scheme, units, contact, params: table })
+    }
+
+    /// The form files of a setup and their params, without a scheme.
+    pub fn resolve_forms(setup: &Setup, overrides: &[(&str, f64)]) -> Result<ActiveForms, CaseError> {
+        let (units, contact) = form_units(setup)?;
+        let mut table = params::Table::new(None, &units);
+        table.apply_case(overrides)?;
+        table.apply_user(&setup.params)?;
+        Ok(ActiveForms { units, contact, params: table })
+    }
+
+    /// The scheme with its param values.
+    pub fn time_scheme(&self) -> Result<Box<dyn TimeScheme>, CaseError> {
+        let values = self.params.scheme_values(self.scheme.params());
+        let made = match &self.scheme {
+            SchemeSource::Compiled(u) => (u.make)(&values),
+            SchemeSource::Interpreted(i) => i.instance(&values),
+        };
+        made.map_err(|e| CaseError::Option(e.to_string()))
+    }
+
+    pub fn scheme_name(&self) -> &'static str {
+        self.scheme.desc().name
+    }
+
+    /// The contact law's name (its file stem).
+    pub fn contact_name(&self) -> &'static str {
+        self.contact.name
+    }
+
+    /// Every form and functional of the files in use, bound to a mesh.
+    pub fn instantiate<'m>(
+        &self,
+        coefs: &dyn Fn(&str) -> Option<Coef>,
+        binding: &Binding<'m>,
+    ) -> Result<Instance<'m>, CaseError> {
+        instantiate(&self.units, &self.params, coefs, binding)
+    }
+
+    /// The forms the scheme applies, bound; errors name the slot's declaration.
+    pub fn scheme_forms<'m>(
+        &self,
+        inst: &mut Instance<'m>,
+    ) -> Result<Vec<(&'static str, Box<dyn BoundForm + 'm>)>, CaseError> {
+        let desc = self.scheme.desc();
+        let mut out = Vec::new();
+        for slot in desc.uses {
+            let provided = || {
+                let list: Vec<String> = self
+                    .units
+                    .iter()
+                    .filter_map(|u| {
+                        let names: Vec<&str> = u.forms?.slots.iter().map(|s| s.name).collect();
+                        Some(format!("{}: {}", u.file, names.join(", ")))
+                    })
+                    .collect();
+                list.join("; ")
+            };
+            let Some(form) = inst.take_form(slot.name) else {
+                return Err(CaseError::Option(format!(
+                    "scheme `{}` applies slot `{}` ({}), which none of the form files in use provides ({}); add one with --forms FILE.wf",
+                    desc.name,
+                    slot.name,
+                    slot.declared,
+                    provided()
+                )));
+            };
+            if form.fields() != slot.fields {
+                return Err(CaseError::Option(format!(
+                    "scheme `{}` applies slot `{}` to {} time level(s) ({}), but form `{}` takes {}",
+                    desc.name,
+                    slot.name,
+                    slot.fields,
+                    slot.declared,
+                    form.name(),
+                    form.fields()
+                )));
+            }
+            out.push((slot.name, form));
+        }
+        Ok(out)
+    }
+}
+
+impl ActiveForms {
+    pub fn contact_name(&self) -> &'static str {
+        self.contact.name
+    }
+
+    /// Every form and functional of the files in use, bound to a mesh.
+    pub fn instantiate<'m>(
+        &self,
+        coefs: &dyn Fn(&str) -> Option<Coef>,
+        binding: &Binding<'m>,
+    ) -> Result<Instance<'m>, CaseError> {
+        instantiate(&self.units, &self.params, coefs, binding)
+    }
+}
+
+fn instantiate<'m>(
+    units: &[&'static Unit],
+    params: &params::Table,
+    coefs: &dyn Fn(&str) -> Option<Coef>,
+    binding: &Binding<'m>,
+) -> Result<Instance<'m>, CaseError> {
+    let mut slots: Vec<(&'static str, SlotForm<'m>, &'static str)> = Vec::new();
+    for unit in units {
+        let Some(forms) = unit.forms else { continue };
+        let values = params.unit_values(forms.params);
+        let made =
+            (forms.make)(&values, coefs, binding).map_err(|e| CaseError::Option(format!("{}: {e}", unit.file)))?;
+        for (name, form) in made {
+            if let Some((_, _, other)) = slots.iter().find(|(n, _, _)| *n == name) {
+                return Err(CaseError::Option(format!(
+                    "slot `{name}` is provided by both {other} and {}: a run binds each slot once",
+                    unit.file
+                )));
+            }
+            slots.push((name, form, unit.file));
+        }
+    }
+    Ok(Instance { slots })
+}
+
+/// The bound forms of a run, taken by slot name.
+pub struct Instance<'m> {
+    slots: Vec<(&'static str, SlotForm<'m>, &'static str)>,
+}
+
+impl<'m> Instance<'m> {
+    /// Takes the form of a slot (a functional or a missing slot: `None`).
+    pub fn take_form(&mut self, name: &str) -> Option<Box<dyn BoundForm + 'm>> {
+        let i = self.slots.iter().position(|(n, f, _)| *n == name && matches!(f, SlotForm::Form(_)))?;
+        match self.slots.remove(i).1 {
+            SlotForm::Form(f) => Some(f),
+            SlotForm::Functional(_) => unreachable!("matched a form"),
+        }
+    }
+
+    /// Takes the functional of a slot.
+    pub fn take_functional(&mut self, name: &str) -> Option<Box<dyn BoundFunctional + 'm>> {
+        let i = self.slots.iter().position(|(n, f, _)| *n == name && matches!(f, SlotForm::Functional(_)))?;
+        match self.slots.remove(i).1 {
+            SlotForm::Functional(f) => Some(f),
+            SlotForm::Form(_) => unreachable!("matched a functional"),
+        }
+    }
+}
