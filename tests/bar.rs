@@ -2,8 +2,7 @@
 //! HHT dissipation, the hybrid scheme's energy decay, and the exact energy identities of
 //! Crank–Nicolson and midpoint with contact.
 
-use signorini::cases::bar::{self, Options, SchemeChoice};
-use signorini::cases::static_block::ContactMethod;
+use signorini::cases::bar::{self, Options};
 
 fn run(f: impl FnOnce(&mut Options)) -> bar::Run {
     let mut o = Options::default();
@@ -20,7 +19,7 @@ fn initial_energy_is_one_eighth() {
 #[test]
 fn nitsche_penetrates_less_than_penalty() {
     let nitsche = run(|_| {}).summary.max_penetration;
-    let penalty = run(|o| o.contact = ContactMethod::Penalty).summary.max_penetration;
+    let penalty = run(|o| o.setup.contact = "penalty".into()).summary.max_penetration;
     assert!(nitsche < 0.9 * penalty, "Nitsche {nitsche} vs penalty {penalty}");
 }
 
@@ -42,8 +41,8 @@ fn hht_dissipation_grows_with_alpha() {
         .iter()
         .map(|&a| {
             run(|o| {
-                o.scheme = SchemeChoice::Hht;
-                o.alpha = Some(a);
+                o.setup.scheme = "hht".into();
+                o.setup = o.setup.clone().set("alpha", a);
             })
             .summary
             .energy_aug_final
@@ -56,7 +55,7 @@ fn hht_dissipation_grows_with_alpha() {
 fn hybrid_never_increases_the_augmented_energy() {
     for dt in [0.01, 0.05, 0.1] {
         let r = run(|o| {
-            o.scheme = SchemeChoice::Hybrid;
+            o.setup.scheme = "hybrid".into();
             o.dt = dt;
         });
         let e0 = r.summary.energy_aug_initial;
@@ -81,9 +80,8 @@ fn crank_nicolson_and_midpoint_energy_increments_match_the_formulas() {
     let mid = |p0: f64, p1: f64| {
         (neg(p1).powi(2) - neg(p0).powi(2)) / (2.0 * gamma) - neg(0.5 * (p0 + p1)) * (p1 - p0) / gamma
     };
-    for (scheme, formula) in [(SchemeChoice::Newmark, &cn as &dyn Fn(f64, f64) -> f64), (SchemeChoice::Midpoint, &mid)]
-    {
-        let r = run(|o| o.scheme = scheme);
+    for (scheme, formula) in [("newmark", &cn as &dyn Fn(f64, f64) -> f64), ("midpoint", &mid)] {
+        let r = run(|o| o.setup.scheme = scheme.into());
         let e0 = r.summary.energy_aug_initial;
         let (mut gains, mut losses) = (0, 0);
         for w in r.series.windows(2) {
@@ -111,10 +109,10 @@ fn mass_redistribution_calms_the_contact_stress() {
         let mean = lam.iter().sum::<f64>() / lam.len() as f64;
         (lam.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lam.len() as f64).sqrt()
     };
-    for scheme in [SchemeChoice::Hht, SchemeChoice::Trbdf2] {
-        let consistent = run(|o| o.scheme = scheme);
+    for scheme in ["hht", "trbdf2"] {
+        let consistent = run(|o| o.setup.scheme = scheme.into());
         let redistributed = run(|o| {
-            o.scheme = scheme;
+            o.setup.scheme = scheme.into();
             o.mass = MassChoice::Redistributed;
         });
         let (a, b) = (std(&consistent), std(&redistributed));
@@ -133,16 +131,16 @@ fn mass_redistribution_calms_the_contact_stress() {
 #[test]
 fn midpoint_schemes_measure_contact_at_half_steps() {
     use signorini::cases::bar::MassChoice;
-    for scheme in [SchemeChoice::Midpoint, SchemeChoice::Hybrid] {
+    for scheme in ["midpoint", "hybrid"] {
         let s = run(|o| {
-            o.scheme = scheme;
+            o.setup.scheme = scheme.into();
             o.mass = MassChoice::Redistributed;
         })
         .summary;
         assert!(s.err_l2_lambda_half < 0.45, "{scheme:?}: err_λ at half steps {}", s.err_l2_lambda_half);
     }
     let midpoint = run(|o| {
-        o.scheme = SchemeChoice::Midpoint;
+        o.setup.scheme = "midpoint".into();
         o.mass = MassChoice::Redistributed;
     })
     .summary;

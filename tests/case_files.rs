@@ -32,18 +32,52 @@ fn a_valid_file_runs_and_writes_its_results() {
     assert_eq!(s["steps"], 150);
 }
 
+/// `[params]` reaches every param of the files in use, qualified by file when asked.
+#[test]
+fn params_table_sets_scheme_and_form_params() {
+    let path = write(
+        "params_ok.toml",
+        "case = \"bar\"\nscheme = \"hht\"\nt_end = 0.5\nout = \"params-out\"\n[params]\nalpha = 0.2\n[params.contact_nitsche]\ntheta = -1\n",
+    );
+    let (code, err) = signorini(&["run", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path.parent().unwrap().join("params-out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s["params"]["alpha"]["value"], 0.2);
+    assert_eq!(s["params"]["alpha"]["source"], "user");
+    assert_eq!(s["params"]["theta"]["value"], -1.0);
+    assert_eq!(s["params"]["gamma0"]["source"], "file");
+    assert!(s["params"]["gamma0"]["declared"].as_str().unwrap().starts_with("contact_nitsche.wf:"));
+}
+
 #[test]
 fn mistakes_are_reported_with_their_line() {
     let cases = [
         ("unknown.toml", "case = \"bar\"\nscheme = \"hht\"\nthetta = 1\n", ":3: unknown field `thetta`"),
-        ("range.toml", "case = \"bar\"\n\ntheta = 2\n", ":3: `theta`: 2 is not in [-1, 1]"),
-        ("other_case.toml", "case = \"disc\"\nne = 5\n", ":2: `ne`: not an option of the disc case"),
-        ("name.toml", "case = \"bar\"\nscheme = \"rk4\"\n", ":2: `scheme`: `rk4` is not one of"),
         (
-            "alpha.toml",
-            "case = \"bar\"\nscheme = \"midpoint\"\nalpha = 0.1\n",
-            ":3: `alpha`: applies to the HHT schemes",
+            "range.toml",
+            "case = \"bar\"\n\ntheta = 2\n",
+            ":3: param `theta` = 2 is outside its range [-1, 1] (declared at contact_nitsche.wf:",
         ),
+        (
+            "params.toml",
+            "case = \"bar\"\n[params]\ngamma0 = 5\nthetta = 1\n",
+            ":4: unknown param `thetta`: the scheme and form files in use declare",
+        ),
+        (
+            "owner.toml",
+            "case = \"disc\"\n[params.elasticity]\nnu = 0.5\n",
+            ":3: param `nu` = 0.5 is outside its range [0, 0.5) (declared at elasticity.wf:",
+        ),
+        ("other_case.toml", "case = \"disc\"\nne = 5\n", ":2: `ne`: not an option of the disc case"),
+        (
+            "name.toml",
+            "case = \"bar\"\nscheme = \"rk4\"\n",
+            ":2: `scheme`: invalid option: no scheme `rk4` in the library",
+        ),
+        ("law.toml", "case = \"bar\"\ncontact = \"nitche\"\n", "did you mean `nitsche`?"),
+        ("alpha.toml", "case = \"bar\"\nscheme = \"midpoint\"\nalpha = 0.1\n", ":3: unknown param `alpha`"),
         ("type.toml", "case = \"disc\"\ndt = \"x\"\n", ":2: invalid type"),
         ("case.toml", "case = \"beam\"\n", ":1: `case`: `beam` is not a case"),
     ];

@@ -111,7 +111,7 @@ fn bar_writes_series_summary_and_plots() {
     }
     let (code, _, err) = signorini(&["run", "bar", "--scheme", "midpoint", "--alpha", "0.1"]);
     assert_eq!(code, 1);
-    assert!(err.contains("--alpha applies to the HHT schemes"), "{err}");
+    assert!(err.contains("--alpha: unknown param `alpha`"), "{err}");
 }
 
 #[test]
@@ -122,10 +122,14 @@ fn report_writes_markdown_with_its_figures() {
     assert!(out.contains("report.md"), "{out}");
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(md.contains("## 1. Compressed bar") && md.contains("## 2. Bouncing disc"));
-    // Every implicit scheme survives Δt up to 0.2 on the disc (spec §6.2).
+    // Every scheme of the library at three Δt; every implicit one survives Δt up to 0.2 on the
+    // disc (spec §6.2). Only IMEX-HHT, whose contact is explicit, may fail.
     let robust = md.split("### Robustness in Δt").nth(1).expect("robustness section");
-    assert_eq!(robust.lines().filter(|l| l.starts_with("| 0.")).count(), 18, "{robust}");
-    assert!(!robust.contains("failed:"), "{robust}");
+    let rows: Vec<&str> = robust.lines().filter(|l| l.starts_with("| 0.")).collect();
+    assert_eq!(rows.len(), 3 * signorini::driver::all_schemes().len(), "{robust}");
+    for row in rows.iter().filter(|r| r.contains("failed:")) {
+        assert!(row.contains("| hht_imex |"), "{row}");
+    }
     for png in
         ["bar_energies.png", "disc_energies.png", "bar/newmark-nitsche-consistent/contact.png", "disc/hybrid/disc.png"]
     {

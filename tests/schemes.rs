@@ -1,59 +1,43 @@
-//! The compiled schemes on a single oscillator (ü + u = 0 as a one-dof finite-element system:
-//! one P1 element, E = 1, ρ = 3, so M = ρh/3 = 1, K = E/h = 1): second order, spectral radius
-//! at ωΔt → ∞, exact energy conservation of midpoint and Crank–Nicolson. A scheme written only
-//! for these tests runs with nothing but its file.
+//! Every scheme of the library on a single oscillator (ü + u = 0 as a one-dof finite-element
+//! system: one P1 element, E = 1, ρ = 3, so M = ρh/3 = 1, K = E/h = 1): second order, spectral
+//! radius at ωΔt → ∞, exact energy conservation of midpoint and Crank–Nicolson. The schemes
+//! come from the library's registry; a scheme written only for these tests runs by path
+//! (interpreted) and compiled, with nothing but its file.
 
 use nalgebra::DMatrix;
-use signorini::forms::nitsche;
-use signorini::forms::schemes::{hht, hht_imex, hht_unweighted, hybrid, midpoint, newmark, trbdf2};
+use signorini::driver::{self, Active, Setup};
 use signorini::runtime::assembly::{Assembler, Quadrature};
 use signorini::runtime::kernel::Coef;
+use signorini::runtime::library::Binding;
 use signorini::runtime::linalg::Structure;
 use signorini::runtime::mesh::structured;
 use signorini::runtime::newton::NewtonOptions;
 use signorini::runtime::problem::Constraints;
-use signorini::runtime::scheme::{Bound, BoundForm, Stepper, TimeScheme};
+use signorini::runtime::scheme::{Stepper, TimeScheme};
 
 signorini::forms!("tests/wf/newmark_general.wf");
 
-fn stepper<'a, S: TimeScheme>(scheme: S, asm: &'a Assembler<'a>) -> Stepper<'a, S> {
-    let p = nitsche::Params::default().with("rho", 3.0).unwrap();
-    let c =
-        nitsche::Coefficients { f: Coef::constant(vec![0.0]), g: Coef::scalar(0.0), nc: Coef::constant(vec![-1.0]) };
-    let q = Quadrature::default();
-    let none: &[signorini::runtime::mesh::Facet] = &[];
-    let b = |k| -> Box<dyn BoundForm> { k };
-    let forms: Vec<(&'static str, Box<dyn BoundForm>)> = vec![
-        ("mass", b(Box::new(Bound { kernel: nitsche::Mass::new(&p, &c), quadrature: q, regions: vec![] }))),
-        ("stiffness", b(Box::new(Bound { kernel: nitsche::Stiffness::new(&p, &c), quadrature: q, regions: vec![] }))),
-        ("load", b(Box::new(Bound { kernel: nitsche::Load::new(&p, &c), quadrature: q, regions: vec![] }))),
-        // No contact facets: a free oscillator.
-        (
-            "contact",
-            b(Box::new(Bound {
-                kernel: nitsche::Contact::new(&p, &c),
-                quadrature: q,
-                regions: vec![("Gamma_C".into(), none)],
-            })),
-        ),
-        (
-            "hybrid_contact",
-            b(Box::new(Bound {
-                kernel: hybrid::HybridContact::new(
-                    &hybrid::Params::default(),
-                    &hybrid::Coefficients {
-                        f: Coef::constant(vec![0.0]),
-                        g: Coef::scalar(0.0),
-                        nc: Coef::constant(vec![-1.0]),
-                    },
-                ),
-                quadrature: q,
-                regions: vec![("Gamma_C".into(), none)],
-            })),
-        ),
-    ];
+const TEST_SCHEME: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/wf/newmark_general.wf");
+
+fn coefs(name: &str) -> Option<Coef> {
+    match name {
+        "f" => Some(Coef::constant(vec![0.0])),
+        "g" => Some(Coef::scalar(0.0)),
+        "nc" => Some(Coef::constant(vec![-1.0])),
+        _ => None,
+    }
+}
+
+/// A stepper for `scheme` (a name or a path) with `params`, or the given scheme object, on the
+/// oscillator. No contact facets: a free oscillator.
+fn stepper<'a>(setup: &Setup, scheme: Option<Box<dyn TimeScheme>>, asm: &'a Assembler<'a>) -> Stepper<'a> {
+    let active = Active::resolve(&setup.clone().set("rho", 3.0), &[]).unwrap();
+    let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
+    let mut inst = active.instantiate(&coefs, &binding).unwrap();
+    let forms = active.scheme_forms(&mut inst).unwrap();
     let mut constraints = Constraints::none(asm.size());
     constraints.fix(1);
+    let scheme = scheme.unwrap_or_else(|| active.time_scheme().unwrap());
     Stepper::new(scheme, asm, forms, constraints, Structure::General, NewtonOptions::default()).unwrap()
 }
 
@@ -63,11 +47,15 @@ fn with_mesh<R>(f: impl FnOnce(&Assembler) -> R) -> R {
     f(&asm)
 }
 
+fn setup(scheme: &str) -> Setup {
+    Setup { scheme: scheme.into(), ..Setup::default() }
+}
+
 /// Integrates from u = 1, v = 0 to t = T; returns |u(T) − cos T|.
-fn error<S: TimeScheme>(scheme: S, dt: f64, t_end: f64) -> f64 {
+fn error(setup: &Setup, dt: f64, t_end: f64) -> f64 {
     with_mesh(|asm| {
-        let mut st = stepper(scheme, asm);
-        let mut states: Vec<Vec<f64>> = S::DESC.states.iter().map(|_| vec![0.0; 2]).collect();
+        let mut st = stepper(setup, None, asm);
+        let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
         states[0][0] = 1.0;
         st.initialize(&mut states, 0.0).unwrap();
         let steps = (t_end / dt).round() as usize;
@@ -79,10 +67,10 @@ fn error<S: TimeScheme>(scheme: S, dt: f64, t_end: f64) -> f64 {
 }
 
 /// Spectral radius of the one-step map of (u, v[, a]) at step dt (ω = 1).
-fn spectral_radius<S: TimeScheme>(scheme: S, dt: f64) -> f64 {
+fn spectral_radius(setup: &Setup, dt: f64) -> f64 {
     with_mesh(|asm| {
-        let mut st = stepper(scheme, asm);
-        let m = S::DESC.states.len();
+        let mut st = stepper(setup, None, asm);
+        let m = st.desc().states.len();
         let mut a = DMatrix::<f64>::zeros(m, m);
         for j in 0..m {
             let mut states: Vec<Vec<f64>> = (0..m).map(|_| vec![0.0; 2]).collect();
@@ -96,28 +84,19 @@ fn spectral_radius<S: TimeScheme>(scheme: S, dt: f64) -> f64 {
     })
 }
 
-macro_rules! for_each_scheme {
-    ($f:ident) => {
-        vec![
-            ("newmark", $f(newmark::Newmark::default())),
-            ("hht", $f(hht::Hht::default())),
-            ("hht_imex", $f(hht_imex::HhtImex::default())),
-            ("hht_unweighted", $f(hht_unweighted::HhtUnweighted::default())),
-            ("midpoint", $f(midpoint::Midpoint::default())),
-            ("trbdf2", $f(trbdf2::Trbdf2::default())),
-            ("hybrid", $f(hybrid::Hybrid::default())),
-            ("newmark_general (test file)", $f(newmark_general::NewmarkGeneral::default())),
-        ]
-    };
+/// Every scheme of the library, and the test-only scheme by path.
+fn every_scheme() -> Vec<String> {
+    let mut all: Vec<String> = driver::all_schemes().iter().map(|s| s.to_string()).collect();
+    all.push(TEST_SCHEME.to_string());
+    all
 }
 
 #[test]
 fn every_scheme_is_second_order() {
-    fn ratio<S: TimeScheme + Clone>(s: S) -> f64 {
-        error(s.clone(), 0.02, 10.0) / error(s, 0.01, 10.0)
-    }
-    for (name, r) in for_each_scheme!(ratio) {
-        if name.starts_with("newmark_general") {
+    for name in every_scheme() {
+        let s = setup(&name);
+        let r = error(&s, 0.02, 10.0) / error(&s, 0.01, 10.0);
+        if name == TEST_SCHEME {
             // γ = 0.6 ≠ 1/2: first order, by design of the test scheme.
             assert!((r - 2.0).abs() < 0.15, "{name}: error ratio {r}");
         } else {
@@ -128,34 +107,35 @@ fn every_scheme_is_second_order() {
 
 #[test]
 fn spectral_radius_at_infinite_step() {
-    fn rho<S: TimeScheme>(s: S) -> f64 {
-        spectral_radius(s, 1e6)
-    }
     let alpha: f64 = 0.05;
     let hht_limit = (1.0 - alpha) / (1.0 + alpha);
-    for (name, r) in for_each_scheme!(rho) {
-        let expected = match name {
+    let mut checked = 0;
+    for name in every_scheme() {
+        let expected = match name.as_str() {
             "newmark" | "midpoint" | "hybrid" => 1.0,
             "hht" | "hht_imex" | "hht_unweighted" => hht_limit,
             "trbdf2" => 0.0,
             _ => continue,
         };
+        let r = spectral_radius(&setup(&name), 1e6);
         let tol = if name == "trbdf2" { 1e-5 } else { 1e-6 };
         assert!((r - expected).abs() < tol, "{name}: ρ∞ = {r}, expected {expected}");
+        checked += 1;
     }
+    assert_eq!(checked, 7);
     // At α = 1/3 the two principal roots meet at infinity (a double root), so the radius at
     // finite ωΔt approaches the limit like (ωΔt)^(-1/2): evaluate further out.
-    let third = spectral_radius(hht::Hht::default().with("alpha", 1.0 / 3.0).unwrap(), 1e12);
+    let third = spectral_radius(&setup("hht").set("alpha", 1.0 / 3.0), 1e12);
     assert!((third - 0.5).abs() < 1e-6, "HHT α = 1/3: ρ∞ = {third}");
 }
 
 /// Midpoint and Crank–Nicolson conserve ½Mv² + ½Ku² exactly (to round-off) for linear problems.
 #[test]
 fn midpoint_and_crank_nicolson_conserve_energy() {
-    fn drift<S: TimeScheme>(scheme: S) -> f64 {
+    let drift = |name: &str| {
         with_mesh(|asm| {
-            let mut st = stepper(scheme, asm);
-            let mut states: Vec<Vec<f64>> = S::DESC.states.iter().map(|_| vec![0.0; 2]).collect();
+            let mut st = stepper(&setup(name), None, asm);
+            let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
             states[0][0] = 1.0;
             st.initialize(&mut states, 0.0).unwrap();
             let energy = |s: &[Vec<f64>]| 0.5 * s[1][0] * s[1][0] + 0.5 * s[0][0] * s[0][0];
@@ -167,8 +147,37 @@ fn midpoint_and_crank_nicolson_conserve_energy() {
             }
             worst
         })
+    };
+    for name in ["newmark", "midpoint", "hybrid"] {
+        assert!(drift(name) < 1e-12, "{name}");
     }
-    assert!(drift(newmark::Newmark::default()) < 1e-12);
-    assert!(drift(midpoint::Midpoint::default()) < 1e-12);
-    assert!(drift(hybrid::Hybrid::default()) < 1e-12);
+}
+
+/// The test scheme run by path (interpreted: coefficients from the expression DAG) and compiled
+/// by `forms!` take the same steps to round-off, with non-default params.
+#[test]
+fn interpreted_and_compiled_schemes_agree() {
+    let run = |compiled: bool| {
+        with_mesh(|asm| {
+            let s = setup(TEST_SCHEME).set("beta", 0.35).set("gam", 0.7);
+            let scheme: Option<Box<dyn TimeScheme>> = compiled.then(|| {
+                let c = newmark_general::NewmarkGeneral::default();
+                Box::new(c.with("beta", 0.35).unwrap().with("gam", 0.7).unwrap()) as Box<dyn TimeScheme>
+            });
+            let mut st = stepper(&s, scheme, asm);
+            let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
+            states[0][0] = 1.0;
+            st.initialize(&mut states, 0.0).unwrap();
+            let mut series = Vec::new();
+            for k in 0..100 {
+                st.step(&mut states, k as f64 * 0.1, 0.1).unwrap();
+                series.push(states[0][0]);
+            }
+            series
+        })
+    };
+    let (a, b) = (run(false), run(true));
+    for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+        assert!((x - y).abs() <= 1e-14 * x.abs().max(1e-3), "step {k}: {x} vs {y}");
+    }
 }

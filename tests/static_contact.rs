@@ -2,27 +2,29 @@
 //! resultant with the weight, penetration under refinement, Newton iteration counts, and reuse
 //! of the factorization when the active set does not change.
 
-use signorini::cases::static_block::{self, ContactMethod, Options};
-use signorini::forms::nitsche;
+use signorini::cases::static_block::{self, Options};
+use signorini::driver::Setup;
+use signorini::forms::{contact_nitsche, elasticity};
 use signorini::runtime::assembly::{Assembler, Quadrature};
 use signorini::runtime::kernel::Coef;
 use signorini::runtime::linalg::Structure;
+use signorini::runtime::mesh::Facet;
 use signorini::runtime::newton::{Newton, NewtonOptions};
-use signorini::runtime::problem::{Constraints, ContactTerm, StaticContact};
+use signorini::runtime::problem::{Constraints, StaticContact};
+use signorini::runtime::scheme::Bound;
 
-fn methods() -> Vec<(ContactMethod, f64)> {
-    vec![
-        (ContactMethod::Nitsche, 1.0),
-        (ContactMethod::Nitsche, 0.0),
-        (ContactMethod::Nitsche, -1.0),
-        (ContactMethod::Penalty, 0.0),
-    ]
+fn methods() -> Vec<(&'static str, f64)> {
+    vec![("nitsche", 1.0), ("nitsche", 0.0), ("nitsche", -1.0), ("penalty", f64::NAN)]
 }
 
-fn run(contact: ContactMethod, theta: f64, f: impl FnOnce(&mut Options)) -> static_block::Summary {
-    let mut o = Options { contact, theta, ..Options::default() };
+fn run(contact: &str, theta: f64, f: impl FnOnce(&mut Options)) -> static_block::Summary {
+    let mut setup = Setup { contact: contact.into(), ..Setup::default() };
+    if !theta.is_nan() {
+        setup = setup.set("theta", theta);
+    }
+    let mut o = Options { setup, ..Options::default() };
     f(&mut o);
-    static_block::run(&o).unwrap_or_else(|e| panic!("{contact:?} θ = {theta}: {e}"))
+    static_block::run(&o).unwrap_or_else(|e| panic!("{contact} θ = {theta}: {e}"))
 }
 
 #[test]
@@ -37,12 +39,12 @@ fn contact_resultant_equals_the_weight_in_2d_and_3d() {
             let rel = (s.contact_force - s.weight).abs() / s.weight;
             assert!(
                 rel < 1e-8,
-                "{contact:?} θ = {theta}, {dim}D P{degree}: force {} vs weight {}",
+                "{contact} θ = {theta}, {dim}D P{degree}: force {} vs weight {}",
                 s.contact_force,
                 s.weight
             );
-            assert!(s.newton_iterations <= 10, "{contact:?} θ = {theta}, {dim}D: {} iterations", s.newton_iterations);
-            assert_eq!(s.symbolic_factorizations, 1, "{contact:?} θ = {theta}, {dim}D P{degree}");
+            assert!(s.newton_iterations <= 10, "{contact} θ = {theta}, {dim}D: {} iterations", s.newton_iterations);
+            assert_eq!(s.symbolic_factorizations, 1, "{contact} θ = {theta}, {dim}D P{degree}");
         }
     }
 }
@@ -52,7 +54,7 @@ fn penetration_decreases_under_refinement() {
     for (contact, theta) in methods() {
         let p: Vec<f64> =
             [0.25, 0.125, 0.0625].iter().map(|&h| run(contact, theta, |o| o.h = h).max_penetration).collect();
-        assert!(p[0] > p[1] && p[1] > p[2] && p[2] > 0.0, "{contact:?} θ = {theta}: {p:?}");
+        assert!(p[0] > p[1] && p[1] > p[2] && p[2] > 0.0, "{contact} θ = {theta}: {p:?}");
     }
 }
 
@@ -61,12 +63,12 @@ fn on_a_curved_obstacle_newton_finds_a_partial_contact_zone() {
     for (contact, theta) in methods() {
         let s = run(contact, theta, |o| o.curvature = 0.5);
         let rel = (s.contact_force - s.weight).abs() / s.weight;
-        assert!(rel < 1e-8, "{contact:?} θ = {theta}: force {} vs weight {}", s.contact_force, s.weight);
+        assert!(rel < 1e-8, "{contact} θ = {theta}: force {} vs weight {}", s.contact_force, s.weight);
         let points = 2 * 8 * 4; // bottom facets × Gauss points
         assert!(s.active_points > 0 && s.active_points < points / 2, "{} of {points} points active", s.active_points);
         // From the all-active start, semi-smooth Newton releases the edges a few points at a
         // time: more iterations than on the plane, but a bounded number.
-        assert!(s.newton_iterations <= 20, "{contact:?} θ = {theta}: {} iterations", s.newton_iterations);
+        assert!(s.newton_iterations <= 20, "{contact} θ = {theta}: {} iterations", s.newton_iterations);
     }
 }
 
@@ -75,34 +77,19 @@ fn on_a_curved_obstacle_newton_finds_a_partial_contact_zone() {
 #[test]
 fn factorization_is_reused_while_the_active_set_is_unchanged() {
     let mesh = static_block::mesh(&Options::default()).unwrap();
-    let p = nitsche::Params::default().with("E", 100.0).and_then(|p| p.with("gamma0", 5000.0)).unwrap();
-    let c = nitsche::Coefficients {
-        f: Coef::constant(vec![0.0, -1.0]),
-        g: Coef::function(1, |x, _, o| o[0] = x[1] + 0.5 * x[0] * x[0]),
-        nc: Coef::constant(vec![0.0, -1.0]),
-    };
     let asm = Assembler::new(&mesh);
     let n = asm.size();
-    let mut load = vec![0.0; n];
-    asm.cell_residual(&nitsche::Load::new(&p, &c), Quadrature::default(), &[], 0.0, &mut load);
-    let term = ContactTerm {
-        form: nitsche::Contact::new(&p, &c),
-        region: "Gamma_C".into(),
-        facets: asm.region("bottom").unwrap(),
-        quadrature: Quadrature { cell: None, facet: Some(7) },
-    };
+    let (stiffness, load) = elastic(&asm);
+    let contact = nitsche_contact(
+        asm.region("bottom").unwrap(),
+        Coef::function(1, |x, _, o| o[0] = x[1] + 0.5 * x[0] * x[0]),
+        Quadrature { cell: None, facet: Some(7) },
+    );
     let mut constraints = Constraints::none(n);
     let centre = (0..mesh.num_nodes()).find(|&i| mesh.node(i) == [0.0, 0.0]).unwrap();
     constraints.fix(2 * centre);
-    let mut problem = StaticContact::new(
-        &asm,
-        &nitsche::Stiffness::new(&p, &c),
-        Quadrature::default(),
-        load.clone(),
-        term,
-        constraints,
-        Structure::SymmetricPositiveDefinite,
-    );
+    let mut problem =
+        StaticContact::new(&asm, &stiffness, load.clone(), contact, constraints, Structure::SymmetricPositiveDefinite);
     let mut u = vec![0.0; n];
     // Below the deepest gap (0.5 at the corners): every contact point active at the start.
     u.iter_mut().skip(1).step_by(2).for_each(|x| *x = -0.5 - 1e-7);
@@ -140,31 +127,16 @@ fn newton_failures_are_typed_errors_with_history() {
     }
 
     let mesh = static_block::mesh(&Options::default()).unwrap();
-    let p = nitsche::Params::default().with("gamma0", 5000.0).unwrap();
-    let c = nitsche::Coefficients {
-        f: Coef::constant(vec![0.0, -1.0]),
-        g: Coef::function(1, |x, _, o| o[0] = x[1] + 10.0),
-        nc: Coef::constant(vec![0.0, -1.0]),
-    };
     let asm = Assembler::new(&mesh);
     let n = asm.size();
-    let mut load = vec![0.0; n];
-    asm.cell_residual(&nitsche::Load::new(&p, &c), Quadrature::default(), &[], 0.0, &mut load);
-    let term = ContactTerm {
-        form: nitsche::Contact::new(&p, &c),
-        region: "Gamma_C".into(),
-        facets: asm.region("bottom").unwrap(),
-        quadrature: Quadrature::default(),
-    };
-    let mut problem = StaticContact::new(
-        &asm,
-        &nitsche::Stiffness::new(&p, &c),
+    let (stiffness, load) = elastic(&asm);
+    let contact = nitsche_contact(
+        asm.region("bottom").unwrap(),
+        Coef::function(1, |x, _, o| o[0] = x[1] + 10.0),
         Quadrature::default(),
-        load,
-        term,
-        Constraints::none(n),
-        Structure::SymmetricPositiveDefinite,
     );
+    let mut problem =
+        StaticContact::new(&asm, &stiffness, load, contact, Constraints::none(n), Structure::SymmetricPositiveDefinite);
     let mut u = vec![0.0; n];
     match Newton::new(NewtonOptions::default()).solve(&mut problem, &mut u) {
         Err(NewtonError::Linear { report, source }) => {
@@ -173,4 +145,30 @@ fn newton_failures_are_typed_errors_with_history() {
         }
         other => panic!("expected a singular Jacobian, got {other:?}"),
     }
+}
+
+/// Stiffness (E = 100) and the load of f = (0, −1), from the compiled elasticity file.
+fn elastic<'a>(asm: &Assembler) -> (Bound<'a, elasticity::Stiffness>, Vec<f64>) {
+    let p = elasticity::Params::default().with("E", 100.0).unwrap();
+    let c = elasticity::Coefficients { f: Coef::constant(vec![0.0, -1.0]) };
+    let q = Quadrature::default();
+    let mut load = vec![0.0; asm.size()];
+    asm.cell_residual(&elasticity::Load::new(&p, &c), q, &[], 0.0, &mut load);
+    (Bound { kernel: elasticity::Stiffness::new(&p, &c), quadrature: q, regions: vec![] }, load)
+}
+
+/// Nitsche contact (θ = 1, γ0 = 5000, E = 100) with the obstacle below at gap `g`.
+fn nitsche_contact(
+    facets: &[Facet],
+    g: Coef,
+    quadrature: Quadrature,
+) -> Box<dyn signorini::runtime::scheme::BoundForm + '_> {
+    let p = contact_nitsche::Params::default().with("E", 100.0).and_then(|p| p.with("gamma0", 5000.0)).unwrap();
+    let c =
+        contact_nitsche::Coefficients { f: Coef::constant(vec![0.0, -1.0]), g, nc: Coef::constant(vec![0.0, -1.0]) };
+    Box::new(Bound {
+        kernel: contact_nitsche::Contact::new(&p, &c),
+        quadrature,
+        regions: vec![("Gamma_C".into(), facets)],
+    })
 }

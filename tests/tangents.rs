@@ -8,7 +8,6 @@ use signorini::runtime::kernel::{Coef, FacetTabulation, FormKernel, facet_matrix
 
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
-signorini::forms!("tests/wf/hybrid_contact.wf");
 
 /// Gap to the plane {x_d = 0} with the obstacle below: g = x_d, n_c = −e_d.
 fn gap(d: usize) -> Coef {
@@ -204,12 +203,11 @@ fn one_dimensional_contact_residual_is_the_spec_kernel() {
 /// differences with respect to that level only.
 #[test]
 fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
-    use signorini::runtime::kernel::Form;
-    let p = hybrid_contact::Params::default().with("gamma0", 5.0).and_then(|p| p.with("nu", 0.3)).unwrap();
-    let c = hybrid_contact::Coefficients { f: Coef::constant(vec![0.0; 2]), g: gap(2), nc: down(2) };
-    let k = hybrid_contact::HybridContact::new(&p, &c);
-    assert_eq!(hybrid_contact::HybridContact::META.fields, &["u0", "u1"]);
-    const { assert!(!hybrid_contact::HybridContact::META.linear) };
+    let p = contact_nitsche::Params::default().with("gamma0", 5.0).and_then(|p| p.with("nu", 0.3)).unwrap();
+    let c = contact_nitsche::Coefficients { f: Coef::constant(vec![0.0; 2]), g: gap(2), nc: down(2) };
+    let k = contact_nitsche::HybridContact::new(&p, &c);
+    assert_eq!(contact_nitsche::HybridContact::META.fields, &["u0", "u1"]);
+    const { assert!(!contact_nitsche::HybridContact::META.linear) };
     let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 7).unwrap();
     let x = cell_2d();
     let h = signorini::runtime::geometry::diameter(&x, 3);
@@ -243,7 +241,7 @@ fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
 /// the same switches have the same tangent, and the switches of a mixed state are mixed.
 #[test]
 fn equal_switches_mean_equal_tangents() {
-    use signorini::runtime::kernel::{FacetCtx, Form};
+    use signorini::runtime::kernel::FacetCtx;
     const { assert!(contact_nitsche::Contact::META.piecewise && contact_penalty::Contact::META.piecewise) };
     let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 7).unwrap();
     let x = cell_2d();

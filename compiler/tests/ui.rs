@@ -43,7 +43,7 @@ fn bad_files_render_their_diagnostics() {
     let expected = [
         "E0001", "E0002", "E0101", "E0102", "E0103", "E0104", "E0105", "E0106", "E0201", "E0204", "E0205", "E0206",
         "E0301", "E0303", "E0304", "E0401", "E0402", "E0403", "E0404", "E0405", "E0501", "E0502", "E0601", "E0602",
-        "E0603", "E0701", "E0702", "E0802", "E0806", "E0811", "E0813", "E0814", "W0001",
+        "E0603", "E0701", "E0702", "E0802", "E0806", "E0811", "E0813", "E0814", "E0816", "E0817", "W0001",
     ];
     for code in expected {
         assert!(codes.contains(code), "no corpus file exercises {code}");

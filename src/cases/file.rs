@@ -15,14 +15,6 @@ use super::disc;
 use crate::driver::{self, Setting, Setup};
 
 #[derive(Deserialize)]
-#[serde(untagged)]
-enum ParamEntry {
-    Value(Spanned<f64>),
-    /// `[params.OWNER]`: the params of one file or scheme.
-    Owner(std::collections::BTreeMap<String, Spanned<f64>>),
-}
-
-#[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CaseFile {
     case: Spanned<String>,
@@ -30,7 +22,8 @@ struct CaseFile {
     contact: Option<Spanned<String>>,
     material: Option<Spanned<String>>,
     forms: Option<Spanned<Vec<String>>>,
-    params: Option<std::collections::BTreeMap<String, ParamEntry>>,
+    /// `name = value`, or `[params.OWNER]` tables of them.
+    params: Option<std::collections::BTreeMap<String, Spanned<toml::Value>>>,
     /// Shorthands for `[params]` entries.
     alpha: Option<Spanned<f64>>,
     theta: Option<Spanned<f64>>,
@@ -180,19 +173,33 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
             setup.params.push(Setting { name: key.into(), value: *v.get_ref(), origin: at(v.span()) });
         }
     }
+    let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
     for (name, entry) in parsed.params.iter().flatten() {
-        match entry {
-            ParamEntry::Value(v) => {
-                setup.params.push(Setting { name: name.clone(), value: *v.get_ref(), origin: at(v.span()) })
-            }
-            ParamEntry::Owner(values) => {
+        let origin = at(entry.span());
+        let bad = |what: &str| CaseError::CaseFile(format!("{origin}: `params.{what}`: expected a number"));
+        match entry.get_ref() {
+            toml::Value::Table(values) => {
+                // Values inside a table carry no span of their own: find the key's line in it.
                 for (p, v) in values {
-                    setup.params.push(Setting {
-                        name: format!("{name}.{p}"),
-                        value: *v.get_ref(),
-                        origin: at(v.span()),
-                    });
+                    let value = number(v).ok_or_else(|| bad(&format!("{name}.{p}")))?;
+                    let span = entry.span();
+                    let body = &r.text[span.start.min(r.text.len())..];
+                    let line = body
+                        .match_indices('\n')
+                        .map(|(i, _)| i + 1)
+                        .find(|&i| {
+                            body[i..]
+                                .trim_start()
+                                .strip_prefix(p.as_str())
+                                .is_some_and(|t| t.trim_start().starts_with('='))
+                        })
+                        .map_or(origin.clone(), |i| at(span.start + i..span.start + i));
+                    setup.params.push(Setting { name: format!("{name}.{p}"), value, origin: line });
                 }
+            }
+            v => {
+                let value = number(v).ok_or_else(|| bad(name))?;
+                setup.params.push(Setting { name: name.clone(), value, origin });
             }
         }
     }

@@ -49,7 +49,7 @@ pub enum Command {
     #[command(args_conflicts_with_subcommands = true)]
     Run {
         #[command(subcommand)]
-        case: Option<Case>,
+        case: Option<Box<Case>>,
         /// A TOML case file (`case = "bar"` or `"disc"`, and the options as keys).
         file: Option<PathBuf>,
     },
@@ -266,9 +266,11 @@ pub fn run(cli: Cli) -> ExitCode {
                 ExitCode::FAILURE
             }
         },
-        Command::Run { case: Some(Case::StaticBlock(a)), .. } => static_block(a),
-        Command::Run { case: Some(Case::Bar(a)), .. } => run_bar(a),
-        Command::Run { case: Some(Case::Disc(a)), .. } => run_disc(a),
+        Command::Run { case: Some(case), .. } => match *case {
+            Case::StaticBlock(a) => static_block(a),
+            Case::Bar(a) => run_bar(a),
+            Case::Disc(a) => run_disc(a),
+        },
         Command::Run { case: None, file: Some(file) } => run_file(&file),
         Command::Run { case: None, file: None } => {
             eprintln!("error: name a case (static-block, bar, disc) or a case file");

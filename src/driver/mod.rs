@@ -16,6 +16,9 @@ use crate::runtime::scheme::{BoundForm, SchemeDesc, TimeScheme};
 
 pub use params::{ParamValue, Setting};
 
+/// A form bound to the slot name a scheme applies it by.
+pub type Slot<'m> = (&'static str, Box<dyn BoundForm + 'm>);
+
 /// What a run is made of, as the user chose it (CLI flags or case-file keys).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Setup {
@@ -242,10 +245,7 @@ impl Active {
     }
 
     /// The forms the scheme applies, bound; errors name the slot's declaration.
-    pub fn scheme_forms<'m>(
-        &self,
-        inst: &mut Instance<'m>,
-    ) -> Result<Vec<(&'static str, Box<dyn BoundForm + 'm>)>, CaseError> {
+    pub fn scheme_forms<'m>(&self, inst: &mut Instance<'m>) -> Result<Vec<Slot<'m>>, CaseError> {
         let desc = self.scheme.desc();
         let mut out = Vec::new();
         for slot in desc.uses {

@@ -269,9 +269,12 @@ impl<'a> Compiler<'a> {
             }
         }
         let mut slots = Vec::new();
+        let complete = self.diags.is_empty();
         for (u, applied) in def.uses.iter().zip(self.applied.clone()) {
             match applied {
                 Some((fields, _)) => slots.push(SlotUse { name: u.name.clone(), fields, span: u.span }),
+                // Reported only when every residual compiled (an error may hide an application).
+                None if !complete => {}
                 None => self.error(
                     Diagnostic::error("E0817", format!("slot `{}` is never applied", u.name), u.span, "unused slot")
                         .with_help("apply it in a residual, or remove it from the `uses` line"),
