@@ -14,6 +14,7 @@ pub mod bench;
 pub mod cases;
 pub mod cli;
 pub mod forms;
+pub mod interpret;
 pub mod output;
 pub mod plot;
 pub mod progress;
