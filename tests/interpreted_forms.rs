@@ -445,3 +445,50 @@ fn errors_name_the_problem() {
     assert!(f.set_param("gamma0", -1.0).is_err());
     assert_eq!(f.param("gamma0"), Some(9.0));
 }
+
+/// Interpreted against compiled assembly time on the bouncing-disc mesh (P2, h = 0.5):
+/// `cargo test --release --test interpreted_forms -- --ignored --nocapture`.
+#[test]
+#[ignore = "timing, not a check"]
+fn interpreted_speed() {
+    use std::time::Instant;
+    let lib = Library::load(Path::new("forms/contact_nitsche.wf")).unwrap();
+    let p = contact_nitsche::Params::default();
+    let coefs = vec![
+        ("f", Coef::constant(vec![0.0, -1.0])),
+        ("g", Coef::function(1, |x, _, out| out[0] = x[1])),
+        ("nc", Coef::constant(vec![0.0, -1.0])),
+    ];
+    let c = contact_nitsche::Coefficients { f: coefs[0].1.clone(), g: coefs[1].1.clone(), nc: coefs[2].1.clone() };
+    let mesh = signorini::runtime::mesh::disc::disc(10.0, [0.0, 12.0], 0.5);
+    let asm = Assembler::new(&mesh);
+    let contact = asm.region("contact").unwrap();
+    let mut rng = Rng(99);
+    // Pushed 2.05 down onto the ground (the disc's bottom is at y = 2): partly in contact.
+    let u: Vec<f64> = (0..asm.size()).map(|i| if i % 2 == 1 { -2.05 } else { 0.0 } + 0.01 * rng.next()).collect();
+    let time = |what: &str, f: &mut dyn FnMut()| {
+        let start = Instant::now();
+        for _ in 0..100 {
+            f();
+        }
+        let s = start.elapsed().as_secs_f64();
+        eprintln!("{what}: {:.3} ms per assembly", s * 10.0);
+        s
+    };
+    for name in ["contact", "stiffness"] {
+        let interp = bound(lib.form(name, 2, &[], &coefs).unwrap(), contact);
+        let compiled = if name == "contact" {
+            bound(contact_nitsche::Contact::new(&p, &c), contact)
+        } else {
+            bound(contact_nitsche::Stiffness::new(&p, &c), contact)
+        };
+        let mut r = vec![0.0; asm.size()];
+        let tc = time(&format!("compiled {name} residual"), &mut || compiled.residual(&asm, &[&u], 0.0, &mut r));
+        let ti = time(&format!("interpreted {name} residual"), &mut || interp.residual(&asm, &[&u], 0.0, &mut r));
+        eprintln!("  ratio {:.1}", ti / tc);
+        let mut m = asm.zero_matrix();
+        let tc = time(&format!("compiled {name} tangent"), &mut || compiled.tangent(&asm, &[&u], 0, 0.0, &mut m));
+        let ti = time(&format!("interpreted {name} tangent"), &mut || interp.tangent(&asm, &[&u], 0, 0.0, &mut m));
+        eprintln!("  ratio {:.1}", ti / tc);
+    }
+}

@@ -10,7 +10,7 @@ use signorini_compiler::ir::lower::components;
 use signorini_compiler::ir::{DimIr, FormIr, IntegralIr};
 
 /// Where the value of one leaf of a program comes from.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy)]
 pub(super) enum Leaf {
     Param(u16),
     /// Component `comp` of field argument `arg` at the point.
@@ -35,7 +35,7 @@ pub(super) enum Leaf {
 }
 
 /// The basis factor of a term: φ or ∂_l φ of a node.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy)]
 pub(super) enum Basis {
     Phi,
     Dphi(u8),
@@ -45,7 +45,6 @@ pub(super) enum Basis {
 pub(super) type Terms = Vec<(Basis, u32)>;
 
 /// How the weighted roots become kernel output.
-#[derive(Debug)]
 pub(super) enum Contract {
     /// `out[j][k] += Σ rows[k]`, with test basis functions at node j.
     Residual { rows: Vec<Terms> },
@@ -59,7 +58,6 @@ pub(super) enum Contract {
 }
 
 /// One kernel body: what the generated code writes for one (integral, mode).
-#[derive(Debug)]
 pub(super) struct Body {
     pub prog: Program,
     /// Source of each leaf of `prog`, in slot order.
@@ -75,7 +73,6 @@ pub(super) struct Body {
 }
 
 /// The kernels of one integral.
-#[derive(Debug)]
 pub(super) struct Integral {
     /// `None` where the generated body is empty (every output is zero).
     pub residual: Option<Body>,
@@ -85,7 +82,6 @@ pub(super) struct Integral {
 }
 
 /// The kernels of one form in one dimension.
-#[derive(Debug)]
 pub(super) struct DimKernels {
     pub cell: Option<Integral>,
     /// In the order of the form's boundary regions (`FormMeta::facets`).

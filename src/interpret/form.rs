@@ -10,7 +10,7 @@ use super::{InterpretError, Unit};
 /// A form of a [`super::Library`] with its parameters and coefs, for cells of one dimension.
 /// Implements `Form`, `FormKernel<D, N>` and `FunctionalKernel<D, N>` like a generated form;
 /// its kernels must be called with `D` equal to [`InterpretedForm::dim`].
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct InterpretedForm {
     unit: Arc<Unit>,
     form: usize,
@@ -100,6 +100,21 @@ impl InterpretedForm {
         // array: the coefs were checked for `dim` only.
         assert!(D == self.dim, "interpreted form `{}` is bound for dimension {}, not {D}", self.meta().name, self.dim);
         &self.unit.forms[self.form].dims[D - 1]
+    }
+}
+
+impl std::fmt::Debug for InterpretedForm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let params: Vec<(&str, f64)> =
+            self.unit.params.iter().map(|p| p.name.as_str()).zip(self.params.clone()).collect();
+        let coefs: Vec<(&str, &Coef)> = self.unit.coefs.iter().map(|c| c.name.as_str()).zip(&self.coefs).collect();
+        f.debug_struct("InterpretedForm")
+            .field("name", &self.meta().name)
+            .field("file", &self.unit.file)
+            .field("dim", &self.dim)
+            .field("params", &params)
+            .field("coefs", &coefs)
+            .finish()
     }
 }
 

@@ -4,6 +4,20 @@
 //! [`InterpretedForm`], which implements the runtime's `Form`, `FormKernel` and
 //! `FunctionalKernel` with the semantics of the generated kernels (so it works with
 //! `runtime::scheme::Bound` and the `Assembler`).
+//!
+//! ```no_run
+//! use signorini::interpret::Library;
+//! use signorini::runtime::kernel::Coef;
+//!
+//! let lib = Library::load("forms/contact_nitsche.wf".as_ref())?;
+//! let coefs = [
+//!     ("f", Coef::constant(vec![0.0, -9.81])),
+//!     ("g", Coef::function(1, |x, _, out| out[0] = x[1])),
+//!     ("nc", Coef::constant(vec![0.0, -1.0])),
+//! ];
+//! let contact = lib.form("contact", 2, &[("gamma0", 10.0)], &coefs)?;
+//! # Ok::<(), signorini::interpret::InterpretError>(())
+//! ```
 
 mod compile;
 mod form;
@@ -48,14 +62,19 @@ fn list(names: &[String]) -> String {
 }
 
 /// A checked `.wf` unit, lowered and ready to bind its forms.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Library {
     unit: Arc<Unit>,
     warnings: String,
 }
 
+impl std::fmt::Debug for Library {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Library").field("file", &self.unit.file).field("forms", &self.forms()).finish()
+    }
+}
+
 /// What every form of a unit shares.
-#[derive(Debug)]
 struct Unit {
     file: String,
     params: Vec<ParamDecl>,
@@ -63,7 +82,6 @@ struct Unit {
     forms: Vec<FormEntry>,
 }
 
-#[derive(Debug)]
 struct ParamDecl {
     name: String,
     default: f64,
@@ -88,7 +106,6 @@ impl ParamDecl {
     }
 }
 
-#[derive(Debug)]
 struct CoefDecl {
     name: String,
     /// 0, 1, 2 for scalar, vector, tensor.
@@ -96,7 +113,6 @@ struct CoefDecl {
     at: String,
 }
 
-#[derive(Debug)]
 struct FormEntry {
     meta: FormMeta,
     /// Kernels for dimensions 1, 2, 3.
