@@ -15,6 +15,7 @@ pub mod cases;
 pub mod cli;
 pub mod driver;
 pub mod forms;
+pub mod interpret;
 pub mod output;
 pub mod plot;
 pub mod progress;

@@ -7,6 +7,7 @@
 //! node of one hash-consed graph, so common subexpressions are shared.
 
 pub mod derive;
+pub mod eval;
 pub mod graph;
 pub mod lower;
 pub mod print;
