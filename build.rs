@@ -47,6 +47,15 @@ fn main() {
         "/// Every unit of `forms/`: form files first, then schemes, each sorted by name.\npub static LIBRARY: &[&crate::runtime::library::Unit] = &[{}];",
         units.join(", ")
     );
+    let texts: Vec<String> = forms
+        .iter()
+        .map(|f| format!("(\"{f}.wf\", include_str!(concat!(env!(\"CARGO_MANIFEST_DIR\"), \"/forms/{f}.wf\")))"))
+        .collect();
+    let _ = writeln!(
+        out,
+        "/// The text of every form file of `forms/`, so that `import elasticity` in a file run by path\n/// finds the library's file wherever the binary runs.\npub static SOURCES: &[(&str, &str)] = &[{}];",
+        texts.join(", ")
+    );
     let path = Path::new(&std::env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("library.rs");
     std::fs::write(&path, out).expect("OUT_DIR is writable");
 }

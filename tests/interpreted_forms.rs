@@ -409,7 +409,8 @@ fn errors_name_the_problem() {
     let err = |r: Result<InterpretedForm, InterpretError>| r.expect_err("an error").to_string();
     let e = err(lib.form("contakt", 2, &[], &coefs));
     assert!(
-        e.contains("`contakt`") && e.contains("contact, contact_energy, contact_pressure, contact_trial, hybrid_contact"),
+        e.contains("`contakt`")
+            && e.contains("contact, contact_energy, contact_pressure, contact_trial, hybrid_contact"),
         "{e}"
     );
     let e = err(lib.form("contact", 2, &[("gamma", 1.0)], &coefs));

@@ -31,7 +31,7 @@ fn coefs(name: &str) -> Option<Coef> {
 /// A stepper for `scheme` (a name or a path) with `params`, or the given scheme object, on the
 /// oscillator. No contact facets: a free oscillator.
 fn stepper<'a>(setup: &Setup, scheme: Option<Box<dyn TimeScheme>>, asm: &'a Assembler<'a>) -> Stepper<'a> {
-    let active = Active::resolve(&setup.clone().set("rho", 3.0), &[]).unwrap();
+    let active = Active::resolve(&setup.clone().set("elasticity.rho", 3.0), &[]).unwrap();
     let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
     let mut inst = active.instantiate(&coefs, &binding).unwrap();
     let forms = active.scheme_forms(&mut inst).unwrap();

@@ -36,12 +36,19 @@ fn above(before: &str) -> String {
     lines.join(" ")
 }
 
-/// The first sentence of a doc paragraph.
+/// The first sentence of a doc paragraph (without a trailing colon).
 pub fn first_sentence(doc: &str) -> &str {
-    match doc.find(". ").or_else(|| doc.find(": ")) {
+    let s = match doc.find(". ") {
         Some(i) => &doc[..=i],
         None => doc,
-    }
+    };
+    s.trim_end_matches(':')
+}
+
+/// A declaration's default and range as written (`0.05 in [0, 1/3]`): its text after `=`.
+pub fn written(sources: &SourceMap, span: Span) -> String {
+    let text = sources.slice(span);
+    text.split_once('=').map_or(text, |(_, rest)| rest).split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// `file.wf:line` of a span's start.

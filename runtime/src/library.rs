@@ -21,6 +21,8 @@ pub struct ParamInfo {
     pub doc: &'static str,
     /// `file.wf:line`.
     pub declared: &'static str,
+    /// The default and range as written in the file (`0.05 in [0, 1/3]`).
+    pub written: &'static str,
     /// The file stem or scheme that declares it: `owner.name` is its qualified name.
     pub owner: &'static str,
 }

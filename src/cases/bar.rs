@@ -81,8 +81,8 @@ pub struct Summary {
     pub scheme: String,
     /// The contact law (its file stem).
     pub contact: String,
-    /// The scheme was compiled at run time from a file.
-    pub interpreted: bool,
+    /// Files of the run compiled at run time (given by path, not in the library).
+    pub interpreted: Vec<String>,
     /// Every param of the scheme and form files, with its value and where it comes from.
     pub params: std::collections::BTreeMap<String, ParamValue>,
     pub mass: MassChoice,
@@ -262,7 +262,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         case: "bar",
         scheme: active.scheme_name().to_string(),
         contact: active.contact_name().to_string(),
-        interpreted: active.scheme.interpreted(),
+        interpreted: active.interpreted(),
         params: active.params.values(),
         mass: opts.mass,
         elements: ne,

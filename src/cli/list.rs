@@ -8,14 +8,7 @@ use crate::runtime::library::{ParamInfo, Unit};
 fn params(out: &mut String, params: &[ParamInfo]) {
     for p in params {
         let doc = if p.doc.is_empty() { String::new() } else { format!("  {}", first_sentence(p.doc)) };
-        let _ = writeln!(
-            out,
-            "    {:<8} = {:<10} in {:<12} {}{doc}",
-            p.name,
-            format!("{}", p.default),
-            p.range.to_string(),
-            p.declared
-        );
+        let _ = writeln!(out, "    {:<8} = {:<22} {:<22}{doc}", p.name, p.written, p.declared);
     }
 }
 

@@ -9,7 +9,7 @@ mod list;
 
 use crate::cases::bar::{self, MassChoice};
 use crate::cases::static_block;
-use crate::compiler::{self, FsLoader};
+use crate::compiler;
 use crate::driver::{Setting, Setup};
 
 #[derive(Parser)]
@@ -287,7 +287,7 @@ pub fn run(cli: Cli) -> ExitCode {
 fn check(files: &[PathBuf]) -> ExitCode {
     let mut failed = false;
     for f in files {
-        match compiler::check_path(f, &FsLoader) {
+        match compiler::check_path(f, &crate::driver::sources::LibraryLoader) {
             Ok((_, warnings)) => eprint!("{warnings}"),
             Err(e) => {
                 eprint!("{e}");
@@ -299,7 +299,7 @@ fn check(files: &[PathBuf]) -> ExitCode {
 }
 
 fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
-    let (prog, warnings) = match compiler::check_path(file, &FsLoader) {
+    let (prog, warnings) = match compiler::check_path(file, &crate::driver::sources::LibraryLoader) {
         Ok(p) => p,
         Err(e) => {
             eprint!("{e}");
@@ -567,10 +567,20 @@ fn run_file(file: &Path) -> ExitCode {
     }
 }
 
+/// Says which files ran interpreted, and how to compile them.
+fn interpreted_note(files: &[String]) {
+    for f in files {
+        eprintln!(
+            "note: {f} ran interpreted (compiled at run time, same results as compiled); to compile it, copy it into forms/ (a scheme: forms/schemes/) and rebuild"
+        );
+    }
+}
+
 fn finish_bar(result: Result<bar::Run, crate::cases::CaseError>) -> ExitCode {
     match result {
         Ok(r) => {
             let s = &r.summary;
+            interpreted_note(&s.interpreted);
             println!(
                 "bar: {} {}{}, {} steps: err_u {:.4}, err_λ {:.4}, E_aug {:.6} → {:.6}, penetration {:.3e}, Newton {} (max {}), {:.2} s",
                 s.scheme,
@@ -599,6 +609,7 @@ fn finish_disc(result: Result<crate::cases::disc::Run, crate::cases::CaseError>)
     match result {
         Ok(r) => {
             let s = &r.summary;
+            interpreted_note(&s.interpreted);
             println!(
                 "disc: {} {}{}, {} dofs, {} steps, first contact at t = {}, max penetration {:.3e}, E_aug {:.6} → {:.6}, Newton {} (max {}), {:.2} s ({:.3} ms/step)",
                 s.scheme,

@@ -7,13 +7,15 @@ use std::path::Path;
 use crate::compiler::ir::graph::{Graph, NodeId};
 use crate::compiler::scheme::layout::{self, Combination, TermLayout};
 use crate::compiler::scheme::{Quantity, SchemeIr};
-use crate::compiler::{FsLoader, check_path, docs};
+use crate::compiler::{check_path, docs};
+use crate::driver::sources::LibraryLoader;
 use crate::runtime::kernel::ParamRange;
 use crate::runtime::library::{LibraryError, ParamInfo, SlotUse};
 use crate::runtime::scheme::{self as rs, SchemeDesc, TimeScheme};
 
 /// A scheme compiled at run time.
 pub struct Interpreted {
+    pub file: String,
     pub desc: &'static SchemeDesc,
     pub params: Vec<ParamInfo>,
     pub doc: String,
@@ -75,7 +77,7 @@ fn terms(ts: &[TermLayout]) -> &'static [rs::TermDesc] {
 
 /// Compiles the scheme file at `path` (its only scheme, or the one named `name`).
 pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
-    let (prog, warnings) = check_path(path, &FsLoader).map_err(|f| f.rendered)?;
+    let (prog, warnings) = check_path(path, &LibraryLoader).map_err(|f| f.rendered)?;
     if !warnings.is_empty() {
         eprint!("{warnings}");
     }
@@ -139,11 +141,13 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
                 },
                 doc: leak_str(&docs::declaration(&prog.sources, p.span)),
                 declared: leak_str(&docs::location(&prog.sources, p.span)),
+                written: leak_str(&docs::written(&prog.sources, p.span)),
                 owner: desc.name,
             }
         })
         .collect();
     Ok(Interpreted {
+        file: path.display().to_string(),
         desc: Box::leak(Box::new(desc)),
         params,
         doc: docs::declaration(&prog.sources, s.span),

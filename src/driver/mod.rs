@@ -5,6 +5,7 @@
 
 pub mod interpreted;
 pub mod params;
+pub mod sources;
 
 use std::path::{Path, PathBuf};
 
@@ -15,6 +16,7 @@ use crate::runtime::library::{Binding, BoundFunctional, ParamInfo, SlotForm, Uni
 use crate::runtime::scheme::{BoundForm, SchemeDesc, TimeScheme};
 
 pub use params::{ParamValue, Setting};
+pub use sources::FormSource;
 
 /// A form bound to the slot name a scheme applies it by.
 pub type Slot<'m> = (&'static str, Box<dyn BoundForm + 'm>);
@@ -142,33 +144,33 @@ pub fn scheme(setup: &Setup) -> Result<SchemeSource, CaseError> {
         .ok_or_else(|| unknown("scheme", &setup.scheme, &scheme_names()))
 }
 
-/// The form files of a setup (material, contact law, extras) and its contact law.
-pub fn form_units(setup: &Setup) -> Result<(Vec<&'static Unit>, &'static Unit), CaseError> {
-    let mut units = Vec::new();
-    let pick = |name: &str, prefix: &str, what: &str, known: Vec<&str>| -> Result<&'static Unit, CaseError> {
-        if is_path(name) {
-            return library_file(Path::new(name)).ok_or_else(|| {
-                CaseError::Option(format!(
-                    "{name}: form files outside the library run interpreted, which this build does not have yet; add the file to forms/ and rebuild to compile it"
-                ))
-            });
-        }
-        library_forms(name, prefix).ok_or_else(|| unknown(what, name, &known))
-    };
+/// The form files of a setup (material, contact law, extras; the contact law's index).
+pub fn form_units(setup: &Setup) -> Result<(Vec<FormSource>, usize), CaseError> {
     let form_files: Vec<&str> = LIBRARY.iter().filter(|u| u.forms.is_some()).map(|u| u.name).collect();
-    units.push(pick(&setup.material, "", "form file", form_files.clone())?);
-    let contact = pick(&setup.contact, "contact_", "contact law", contact_names())?;
-    units.push(contact);
-    for f in &setup.forms {
-        units.push(pick(&f.display().to_string(), "", "form file", form_files.clone())?);
+    let pick = |name: &str, prefix: &str, what: &str, known: &[&str]| -> Result<FormSource, CaseError> {
+        if is_path(name) {
+            let path = Path::new(name);
+            if let Some(u) = library_file(path) {
+                return Ok(FormSource::Compiled(u));
+            }
+            return sources::interpret(path).map(|i| FormSource::Interpreted(Box::new(i))).map_err(CaseError::CaseFile);
+        }
+        library_forms(name, prefix).map(FormSource::Compiled).ok_or_else(|| unknown(what, name, known))
+    };
+    let mut units = vec![pick(&setup.material, "", "form file", &form_files)?];
+    let contact = pick(&setup.contact, "contact_", "contact law", &contact_names())?;
+    let mut contact_index = units.len();
+    match units.iter().position(|u| u.name() == contact.name() && u.file() == contact.file()) {
+        Some(i) => contact_index = i,
+        None => units.push(contact),
     }
-    let mut seen = Vec::new();
-    units.retain(|u| {
-        let new = !seen.contains(&u.name);
-        seen.push(u.name);
-        new
-    });
-    Ok((units, contact))
+    for f in &setup.forms {
+        let u = pick(&f.display().to_string(), "", "form file", &form_files)?;
+        if !units.iter().any(|v| v.name() == u.name() && v.file() == u.file()) {
+            units.push(u);
+        }
+    }
+    Ok((units, contact_index))
 }
 
 /// A path that is one of the library's own files (compiled already).
@@ -183,15 +185,16 @@ fn library_file(path: &Path) -> Option<&'static Unit> {
 pub struct Active {
     pub scheme: SchemeSource,
     /// Material, contact law, extra forms.
-    pub units: Vec<&'static Unit>,
-    pub contact: &'static Unit,
+    pub units: Vec<FormSource>,
+    /// Index of the contact law in `units`.
+    pub contact: usize,
     pub params: params::Table,
 }
 
 /// The form files of a run without a scheme (static problems).
 pub struct ActiveForms {
-    pub units: Vec<&'static Unit>,
-    pub contact: &'static Unit,
+    pub units: Vec<FormSource>,
+    pub contact: usize,
     pub params: params::Table,
 }
 
@@ -226,13 +229,22 @@ impl Active {
         made.map_err(|e| CaseError::Option(e.to_string()))
     }
 
+    /// The files of this run that were compiled at run time (given by path, not in the library).
+    pub fn interpreted(&self) -> Vec<String> {
+        let scheme = match &self.scheme {
+            SchemeSource::Interpreted(i) => Some(i.file.clone()),
+            SchemeSource::Compiled(_) => None,
+        };
+        scheme.into_iter().chain(self.units.iter().filter(|u| u.interpreted()).map(|u| u.file().to_string())).collect()
+    }
+
     pub fn scheme_name(&self) -> &'static str {
         self.scheme.desc().name
     }
 
     /// The contact law's name (its file stem).
     pub fn contact_name(&self) -> &'static str {
-        self.contact.name
+        self.units[self.contact].name()
     }
 
     /// Every form and functional of the files in use, bound to a mesh.
@@ -253,9 +265,9 @@ impl Active {
                 let list: Vec<String> = self
                     .units
                     .iter()
-                    .filter_map(|u| {
-                        let names: Vec<&str> = u.forms?.slots.iter().map(|s| s.name).collect();
-                        Some(format!("{}: {}", u.file, names.join(", ")))
+                    .map(|u| {
+                        let names: Vec<&str> = u.slots().iter().map(|s| s.name).collect();
+                        format!("{}: {}", u.file(), names.join(", "))
                     })
                     .collect();
                 list.join("; ")
@@ -288,7 +300,7 @@ impl Active {
 
 impl ActiveForms {
     pub fn contact_name(&self) -> &'static str {
-        self.contact.name
+        self.units[self.contact].name()
     }
 
     /// Every form and functional of the files in use, bound to a mesh.
@@ -302,25 +314,24 @@ impl ActiveForms {
 }
 
 fn instantiate<'m>(
-    units: &[&'static Unit],
+    units: &[FormSource],
     params: &params::Table,
     coefs: &dyn Fn(&str) -> Option<Coef>,
     binding: &Binding<'m>,
 ) -> Result<Instance<'m>, CaseError> {
     let mut slots: Vec<(&'static str, SlotForm<'m>, &'static str)> = Vec::new();
     for unit in units {
-        let Some(forms) = unit.forms else { continue };
-        let values = params.unit_values(forms.params);
+        let values = params.unit_values(unit.params());
         let made =
-            (forms.make)(&values, coefs, binding).map_err(|e| CaseError::Option(format!("{}: {e}", unit.file)))?;
+            unit.make(&values, coefs, binding).map_err(|e| CaseError::Option(format!("{}: {e}", unit.file())))?;
         for (name, form) in made {
             if let Some((_, _, other)) = slots.iter().find(|(n, _, _)| *n == name) {
                 return Err(CaseError::Option(format!(
                     "slot `{name}` is provided by both {other} and {}: a run binds each slot once",
-                    unit.file
+                    unit.file()
                 )));
             }
-            slots.push((name, form, unit.file));
+            slots.push((name, form, unit.file()));
         }
     }
     Ok(Instance { slots })

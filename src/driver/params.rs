@@ -7,9 +7,9 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::SchemeSource;
+use super::{FormSource, SchemeSource};
 use crate::cases::CaseError;
-use crate::runtime::library::{ParamInfo, Unit};
+use crate::runtime::library::ParamInfo;
 
 /// A user's `name = value`, with where it was written (for errors).
 #[derive(Clone, Debug, PartialEq)]
@@ -58,13 +58,13 @@ fn same(a: &ParamInfo, b: &ParamInfo) -> bool {
 }
 
 impl Table {
-    pub fn new(scheme: Option<&SchemeSource>, units: &[&'static Unit]) -> Table {
+    pub fn new(scheme: Option<&SchemeSource>, units: &[FormSource]) -> Table {
         let mut entries: Vec<Entry> = scheme
             .map_or(&[][..], |s| s.params())
             .iter()
             .map(|p| Entry { info: *p, scheme: true, value: p.default, source: Source::File })
             .collect();
-        for p in units.iter().filter_map(|u| u.forms).flat_map(|f| f.params.iter()) {
+        for p in units.iter().flat_map(|u| u.params().iter()) {
             if !entries.iter().any(|e| same(&e.info, p)) {
                 entries.push(Entry { info: *p, scheme: false, value: p.default, source: Source::File });
             }
@@ -77,8 +77,8 @@ impl Table {
             return Ok(());
         }
         Err(CaseError::Option(format!(
-            "{origin}: param `{}` = {value} is outside its range {} (declared at {})",
-            e.info.name, e.info.range, e.info.declared
+            "{origin}: param `{}` = {value} is outside its range {} (declared at {}: `{} = {}`)",
+            e.info.name, e.info.range, e.info.declared, e.info.name, e.info.written
         )))
     }
 

@@ -14,9 +14,14 @@ fn owner(prog: &Program, span: Span) -> String {
     crate::module_name(prog.sources.path(span.file))
 }
 
-fn param_info(name: &str, default: f64, range: &str, doc: &str, declared: &str, owner: &str) -> String {
+fn param_info(prog: &Program, name: &str, default: f64, range: &str, span: Span, owner: &str) -> String {
+    let (doc, declared, written) = (
+        docs::declaration(&prog.sources, span),
+        docs::location(&prog.sources, span),
+        docs::written(&prog.sources, span),
+    );
     format!(
-        "ParamInfo {{ name: {name:?}, default: {default:?}, range: {range}, doc: {doc:?}, declared: {declared:?}, owner: {owner:?} }}"
+        "ParamInfo {{ name: {name:?}, default: {default:?}, range: {range}, doc: {doc:?}, declared: {declared:?}, written: {written:?}, owner: {owner:?} }}"
     )
 }
 
@@ -30,14 +35,7 @@ pub fn forms_items(prog: &Program, own: &[(usize, &str)]) -> String {
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            param_info(
-                &p.name,
-                p.default,
-                &format!("Params::RANGES[{i}]"),
-                &docs::declaration(src, p.span),
-                &docs::location(src, p.span),
-                &owner(prog, p.span),
-            )
+            param_info(prog, &p.name, p.default, &format!("Params::RANGES[{i}]"), p.span, &owner(prog, p.span))
         })
         .collect();
     let _ = writeln!(
@@ -120,16 +118,7 @@ pub fn scheme_unit(prog: &Program, sch: &SchemeIr, struct_name: &str) -> (String
         .params
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            param_info(
-                &p.name,
-                p.default,
-                &format!("{struct_name}::RANGES[{i}]"),
-                &docs::declaration(src, p.span),
-                &docs::location(src, p.span),
-                &sch.name,
-            )
-        })
+        .map(|(i, p)| param_info(prog, &p.name, p.default, &format!("{struct_name}::RANGES[{i}]"), p.span, &sch.name))
         .collect();
     let unit = format!(
         "SchemeUnit {{ name: {:?}, doc: {:?}, params: &[{}], desc: &{struct_name}::DESC, make: {make} }}",

@@ -1,0 +1,172 @@
+//! Form files a run uses: compiled into the library, or given by path and interpreted (the IR
+//! evaluated on the runtime's tabulations, `crate::interpret`). Both describe themselves with
+//! the same param, coef and slot data and instantiate the same bound forms.
+
+use std::path::Path;
+
+use crate::compiler::{check_path, docs, module_name};
+use crate::interpret::Library;
+use crate::runtime::kernel::{Coef, ParamRange};
+use crate::runtime::library::{Binding, LibraryError, Made, ParamInfo, SlotInfo, Unit};
+
+/// A form file in use.
+pub enum FormSource {
+    Compiled(&'static Unit),
+    Interpreted(Box<Interpreted>),
+}
+
+/// A form file compiled at run time.
+pub struct Interpreted {
+    pub name: &'static str,
+    pub file: &'static str,
+    pub params: Vec<ParamInfo>,
+    pub slots: Vec<SlotInfo>,
+    lib: Library,
+}
+
+// Param and slot data hold `'static` strings, as generated constants do; a file loaded at run
+// time leaks its (few) names once per load.
+fn leak(s: String) -> &'static str {
+    String::leak(s)
+}
+
+/// Checks and lowers a form file given by path.
+pub fn interpret(path: &Path) -> Result<Interpreted, String> {
+    let (prog, warnings) = check_path(path, &LibraryLoader).map_err(|f| f.rendered)?;
+    if !warnings.is_empty() {
+        eprint!("{warnings}");
+    }
+    let src = &prog.sources;
+    let params = prog
+        .params
+        .iter()
+        .map(|p| {
+            let name = leak(p.name.clone());
+            let r = p.range;
+            ParamInfo {
+                name,
+                default: p.default,
+                range: ParamRange {
+                    name,
+                    lo: r.map_or(f64::NEG_INFINITY, |r| r.lo),
+                    lo_closed: r.is_some_and(|r| r.lo_closed),
+                    hi: r.map_or(f64::INFINITY, |r| r.hi),
+                    hi_closed: r.is_some_and(|r| r.hi_closed),
+                },
+                doc: leak(docs::declaration(src, p.span)),
+                declared: leak(docs::location(src, p.span)),
+                written: leak(docs::written(src, p.span)),
+                owner: leak(module_name(src.path(p.span.file))),
+            }
+        })
+        .collect();
+    let slots = prog
+        .forms
+        .iter()
+        .filter(|f| f.span.file == prog.root)
+        .map(|f| SlotInfo {
+            name: leak(f.name.clone()),
+            fields: f.fields.len(),
+            functional: f.test.is_none(),
+            doc: leak(docs::declaration(src, f.span)),
+            declared: leak(docs::location(src, f.span)),
+        })
+        .collect();
+    Ok(Interpreted {
+        name: leak(module_name(path)),
+        file: leak(path.display().to_string()),
+        params,
+        slots,
+        lib: Library::new(&prog),
+    })
+}
+
+impl Interpreted {
+    fn make<'m>(
+        &self,
+        values: &[f64],
+        coefs: &dyn Fn(&str) -> Option<Coef>,
+        binding: &Binding<'m>,
+    ) -> Result<Made<'m>, LibraryError> {
+        let params: Vec<(&str, f64)> = self.params.iter().map(|p| p.name).zip(values.iter().copied()).collect();
+        let mut data = Vec::new();
+        for name in self.lib.coefs() {
+            let c = coefs(name).ok_or_else(|| LibraryError::Coef(format!("the case provides no `{name}`")))?;
+            data.push((name, c));
+        }
+        let mut made = Vec::new();
+        for slot in &self.slots {
+            let form =
+                self.lib.form(slot.name, binding.dim, &params, &data).map_err(|e| LibraryError::Coef(e.to_string()))?;
+            let bound = if slot.functional { binding.functional(form)? } else { binding.form(form)? };
+            made.push((slot.name, bound));
+        }
+        Ok(made)
+    }
+}
+
+impl FormSource {
+    pub fn name(&self) -> &'static str {
+        match self {
+            FormSource::Compiled(u) => u.name,
+            FormSource::Interpreted(i) => i.name,
+        }
+    }
+
+    pub fn file(&self) -> &'static str {
+        match self {
+            FormSource::Compiled(u) => u.file,
+            FormSource::Interpreted(i) => i.file,
+        }
+    }
+
+    pub fn params(&self) -> &[ParamInfo] {
+        match self {
+            FormSource::Compiled(u) => u.forms.map_or(&[][..], |f| f.params),
+            FormSource::Interpreted(i) => &i.params,
+        }
+    }
+
+    pub fn slots(&self) -> &[SlotInfo] {
+        match self {
+            FormSource::Compiled(u) => u.forms.map_or(&[][..], |f| f.slots),
+            FormSource::Interpreted(i) => &i.slots,
+        }
+    }
+
+    pub fn interpreted(&self) -> bool {
+        matches!(self, FormSource::Interpreted(_))
+    }
+
+    /// Instantiates every form of the file: param values in `params()` order.
+    pub fn make<'m>(
+        &self,
+        values: &[f64],
+        coefs: &dyn Fn(&str) -> Option<Coef>,
+        binding: &Binding<'m>,
+    ) -> Result<Made<'m>, LibraryError> {
+        match self {
+            FormSource::Compiled(u) => match u.forms {
+                Some(f) => (f.make)(values, coefs, binding),
+                None => Ok(Vec::new()),
+            },
+            FormSource::Interpreted(i) => i.make(values, coefs, binding),
+        }
+    }
+}
+
+/// Reads files from disk; an import of a library file (`import elasticity`) that is not beside
+/// the importing file is served from the library's own text.
+pub struct LibraryLoader;
+
+impl crate::compiler::Loader for LibraryLoader {
+    fn load(&self, path: &Path) -> std::io::Result<String> {
+        match std::fs::read_to_string(path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+                crate::forms::SOURCES.iter().find(|(n, _)| *n == name).map(|(_, text)| text.to_string()).ok_or(e)
+            }
+            other => other,
+        }
+    }
+}
