@@ -119,6 +119,13 @@ pub struct Unit {
     pub schemes: &'static [SchemeUnit],
 }
 
+/// Units are constants: one is another if it has the same name and file.
+impl PartialEq for Unit {
+    fn eq(&self, other: &Unit) -> bool {
+        self.name == other.name && self.file == other.file
+    }
+}
+
 impl fmt::Debug for Unit {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Unit").field("name", &self.name).field("file", &self.file).finish_non_exhaustive()

@@ -165,6 +165,7 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
         contact: parsed.contact.as_ref().map_or(d.contact, |s| name_or_path(s.get_ref(), base)),
         material: parsed.material.as_ref().map_or(d.material, |s| name_or_path(s.get_ref(), base)),
         forms: parsed.forms.as_ref().map_or_else(Vec::new, |f| f.get_ref().iter().map(|p| base.join(p)).collect()),
+        compiled: Vec::new(),
         params: Vec::new(),
     };
     let at = |span: std::ops::Range<usize>| format!("{}:{}", r.file, r.line(span.start));

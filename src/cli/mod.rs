@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+mod compare;
 mod list;
 
 use crate::cases::bar::{self, MassChoice};
@@ -56,6 +57,14 @@ pub enum Command {
     /// Print every scheme and contact law of the library with its params (defaults, ranges,
     /// docs), and the other form files with their slots.
     List,
+    /// Compare two runs' series.csv (or their output directories) column by column.
+    Compare {
+        a: PathBuf,
+        b: PathBuf,
+        /// Fail (exit 1) when a column's relative difference exceeds this.
+        #[arg(long)]
+        tol: Option<f64>,
+    },
     /// Print a compilation stage of a .wf file.
     Emit {
         file: PathBuf,
@@ -163,6 +172,7 @@ impl MethodArgs {
             contact: self.contact.clone(),
             material: self.material.clone(),
             forms: self.forms.clone(),
+            compiled: Vec::new(),
             params,
         })
     }
@@ -256,6 +266,16 @@ pub fn run(cli: Cli) -> ExitCode {
             print!("{}", list::text());
             ExitCode::SUCCESS
         }
+        Command::Compare { a, b, tol } => match compare::compare(&a, &b) {
+            Ok((text, worst)) => {
+                print!("{text}");
+                match tol {
+                    Some(t) if worst > t => fail(format!("the runs differ by {worst:e} > {t:e}")),
+                    _ => ExitCode::SUCCESS,
+                }
+            }
+            Err(e) => fail(e),
+        },
         Command::Report { out } => match crate::report::write(&out, &mut |what| eprintln!("running {what}")) {
             Ok(()) => {
                 println!("wrote {}", out.join("report.md").display());

@@ -32,6 +32,9 @@ pub struct Setup {
     pub material: String,
     /// Extra form files whose slots the scheme applies.
     pub forms: Vec<PathBuf>,
+    /// Units compiled by the user's own crate (`forms!(...)::UNIT`): their schemes and form
+    /// files are found by name before the library's.
+    pub compiled: Vec<&'static Unit>,
     /// Param values set by the user, in order (a later setting of a param wins).
     pub params: Vec<Setting>,
 }
@@ -43,6 +46,7 @@ impl Default for Setup {
             contact: "nitsche".into(),
             material: "elasticity".into(),
             forms: Vec::new(),
+            compiled: Vec::new(),
             params: Vec::new(),
         }
     }
@@ -91,21 +95,26 @@ pub fn library() -> &'static [&'static Unit] {
     LIBRARY
 }
 
-/// A library scheme by name (`hht-imex` finds `hht_imex`).
-fn library_scheme(name: &str) -> Option<&'static crate::runtime::library::SchemeUnit> {
-    let name = name.replace('-', "_");
-    LIBRARY.iter().flat_map(|u| u.schemes.iter()).find(|s| s.name == name)
+/// The user's compiled units, then the library's.
+fn units(setup: &Setup) -> impl Iterator<Item = &'static Unit> + '_ {
+    setup.compiled.iter().copied().chain(LIBRARY.iter().copied())
 }
 
-/// A library form file by name; `prefix_name` also matches (`nitsche` → `contact_nitsche`).
-fn library_forms(name: &str, prefix: &str) -> Option<&'static Unit> {
+/// A compiled scheme by name (`hht-imex` finds `hht_imex`).
+fn library_scheme(setup: &Setup) -> Option<&'static crate::runtime::library::SchemeUnit> {
+    let name = setup.scheme.replace('-', "_");
+    units(setup).flat_map(|u| u.schemes.iter()).find(|s| s.name == name)
+}
+
+/// A compiled form file by name; `prefix_name` also matches (`nitsche` → `contact_nitsche`).
+fn library_forms(setup: &Setup, name: &str, prefix: &str) -> Option<&'static Unit> {
     let name = name.replace('-', "_");
-    let found = |n: &str| LIBRARY.iter().copied().find(|u| u.forms.is_some() && u.name == n);
+    let found = |n: &str| units(setup).find(|u| u.forms.is_some() && u.name == n);
     found(&name).or_else(|| found(&format!("{prefix}{name}")))
 }
 
-fn scheme_names() -> Vec<&'static str> {
-    LIBRARY.iter().flat_map(|u| u.schemes.iter()).map(|s| s.name).collect()
+fn scheme_names(setup: &Setup) -> Vec<&'static str> {
+    units(setup).flat_map(|u| u.schemes.iter()).map(|s| s.name).collect()
 }
 
 /// Names of the library's contact laws (the files providing a `contact` slot), short form.
@@ -119,7 +128,7 @@ pub fn contact_names() -> Vec<&'static str> {
 
 /// Every scheme of the library, by name.
 pub fn all_schemes() -> Vec<&'static str> {
-    scheme_names()
+    scheme_names(&Setup::default())
 }
 
 fn unknown(what: &str, name: &str, known: &[&str]) -> CaseError {
@@ -139,14 +148,14 @@ pub fn scheme(setup: &Setup) -> Result<SchemeSource, CaseError> {
             .map(|i| SchemeSource::Interpreted(Box::new(i)))
             .map_err(CaseError::CaseFile);
     }
-    library_scheme(&setup.scheme)
+    library_scheme(setup)
         .map(SchemeSource::Compiled)
-        .ok_or_else(|| unknown("scheme", &setup.scheme, &scheme_names()))
+        .ok_or_else(|| unknown("scheme", &setup.scheme, &scheme_names(setup)))
 }
 
 /// The form files of a setup (material, contact law, extras; the contact law's index).
 pub fn form_units(setup: &Setup) -> Result<(Vec<FormSource>, usize), CaseError> {
-    let form_files: Vec<&str> = LIBRARY.iter().filter(|u| u.forms.is_some()).map(|u| u.name).collect();
+    let form_files: Vec<&str> = units(setup).filter(|u| u.forms.is_some()).map(|u| u.name).collect();
     let pick = |name: &str, prefix: &str, what: &str, known: &[&str]| -> Result<FormSource, CaseError> {
         if is_path(name) {
             let path = Path::new(name);
@@ -155,7 +164,7 @@ pub fn form_units(setup: &Setup) -> Result<(Vec<FormSource>, usize), CaseError> 
             }
             return sources::interpret(path).map(|i| FormSource::Interpreted(Box::new(i))).map_err(CaseError::CaseFile);
         }
-        library_forms(name, prefix).map(FormSource::Compiled).ok_or_else(|| unknown(what, name, known))
+        library_forms(setup, name, prefix).map(FormSource::Compiled).ok_or_else(|| unknown(what, name, known))
     };
     let mut units = vec![pick(&setup.material, "", "form file", &form_files)?];
     let contact = pick(&setup.contact, "contact_", "contact law", &contact_names())?;

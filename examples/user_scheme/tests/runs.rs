@@ -1,0 +1,39 @@
+//! The user's crate: its binary runs the bar and a Gmsh disc; its compiled scheme equals the
+//! same file run by path (interpreted); with αB = 0 WBZ-α is Newmark.
+
+use signorini::cases::bar;
+use signorini::driver::Setup;
+
+signorini::forms!(mod wbz = "wbz.wf");
+
+fn series(setup: Setup) -> Vec<f64> {
+    let opts = bar::Options { setup, t_end: 3.0, ..bar::Options::default() };
+    bar::run(&opts).unwrap().series.iter().map(|r| r.u_c).collect()
+}
+
+fn compiled() -> Setup {
+    Setup { scheme: "wbz".into(), compiled: vec![&wbz::UNIT], ..Setup::default() }
+}
+
+#[test]
+fn the_binary_runs_the_bar_and_a_gmsh_disc() {
+    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/meshes/disc_r10_h1_groups_v41.msh");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_user-scheme")).arg(mesh).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("bar: err_u") && text.contains("disc: 3250 dofs, first contact at t = 6.3"), "{text}");
+}
+
+#[test]
+fn compiled_by_path_and_newmark_agree() {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/wbz.wf");
+    let by_path = Setup { scheme: file.into(), ..Setup::default() };
+    let (a, b) = (series(compiled().set("alpha_b", -0.2)), series(by_path.set("alpha_b", -0.2)));
+    assert_eq!(a, b, "compiled vs interpreted");
+    let newmark = series(Setup { scheme: "newmark".into(), ..Setup::default() });
+    let wbz0 = series(compiled().set("alpha_b", 0.0));
+    let scale = newmark.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for (k, (x, y)) in wbz0.iter().zip(&newmark).enumerate() {
+        assert!((x - y).abs() <= 1e-12 * scale, "step {k}: {x} vs {y}");
+    }
+}
