@@ -192,12 +192,14 @@ fn by_path_compiled_and_independent_agree() {
         };
         let reference = independent(contact.as_ref(), &asm, 0.8, steps, 0.01);
         let scale = reference.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let mut contact_steps = 0;
+        let (mut contact_steps, mut largest) = (0, 0.0f64);
         for (k, ((a, b), r)) in compiled.series.iter().zip(&by_path.series).zip(&reference).enumerate() {
             assert_eq!(a.u_c, b.u_c, "{law} θ = {theta}, step {k}: compiled vs by path");
             assert!((a.u_c - r).abs() < 1e-10 * scale, "{law} θ = {theta}, step {k}: {} vs independent {r}", a.u_c);
+            largest = largest.max((a.u_c - r).abs() / scale);
             contact_steps += usize::from(a.lambda < 0.0);
         }
+        eprintln!("{law} θ = {theta}: largest relative difference to the independent implementation {largest:e}");
         assert!(contact_steps > 10, "{law}: the run must include contact ({contact_steps} steps)");
     }
     let _ = std::fs::remove_dir_all(&dir);
