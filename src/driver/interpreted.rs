@@ -9,7 +9,6 @@ use crate::compiler::scheme::layout::{self, Combination, TermLayout};
 use crate::compiler::scheme::{Quantity, SchemeIr};
 use crate::compiler::{check_path, docs};
 use crate::driver::sources::LibraryLoader;
-use crate::runtime::kernel::ParamRange;
 use crate::runtime::library::{LibraryError, ParamInfo, SlotUse};
 use crate::runtime::scheme::{self as rs, SchemeDesc, TimeScheme};
 
@@ -126,25 +125,7 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
     let params = s
         .params
         .iter()
-        .map(|p| {
-            let name = leak_str(&p.name);
-            let r = p.range;
-            ParamInfo {
-                name,
-                default: p.default,
-                range: ParamRange {
-                    name,
-                    lo: r.map_or(f64::NEG_INFINITY, |r| r.lo),
-                    lo_closed: r.is_some_and(|r| r.lo_closed),
-                    hi: r.map_or(f64::INFINITY, |r| r.hi),
-                    hi_closed: r.is_some_and(|r| r.hi_closed),
-                },
-                doc: leak_str(&docs::declaration(&prog.sources, p.span)),
-                declared: leak_str(&docs::location(&prog.sources, p.span)),
-                written: leak_str(&docs::written(&prog.sources, p.span)),
-                owner: desc.name,
-            }
-        })
+        .map(|p| super::sources::param_info(&prog.sources, &p.name, p.default, p.range, p.span, desc.name))
         .collect();
     Ok(Interpreted {
         file: path.display().to_string(),

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::compiler::{check_path, docs, module_name};
+use crate::compiler::{SourceMap, Span, check_path, docs, module_name};
 use crate::interpret::Library;
 use crate::runtime::kernel::{Coef, ParamRange};
 use crate::runtime::library::{Binding, LibraryError, Made, ParamInfo, SlotInfo, Unit};
@@ -26,7 +26,7 @@ pub struct Interpreted {
 
 // Param and slot data hold `'static` strings, as generated constants do; a file loaded at run
 // time leaks its (few) names once per load.
-fn leak(s: String) -> &'static str {
+pub(super) fn leak(s: String) -> &'static str {
     String::leak(s)
 }
 
@@ -40,25 +40,7 @@ pub fn interpret(path: &Path) -> Result<Interpreted, String> {
     let params = prog
         .params
         .iter()
-        .map(|p| {
-            let name = leak(p.name.clone());
-            let r = p.range;
-            ParamInfo {
-                name,
-                default: p.default,
-                range: ParamRange {
-                    name,
-                    lo: r.map_or(f64::NEG_INFINITY, |r| r.lo),
-                    lo_closed: r.is_some_and(|r| r.lo_closed),
-                    hi: r.map_or(f64::INFINITY, |r| r.hi),
-                    hi_closed: r.is_some_and(|r| r.hi_closed),
-                },
-                doc: leak(docs::declaration(src, p.span)),
-                declared: leak(docs::location(src, p.span)),
-                written: leak(docs::written(src, p.span)),
-                owner: leak(module_name(src.path(p.span.file))),
-            }
-        })
+        .map(|p| param_info(src, &p.name, p.default, p.range, p.span, leak(module_name(src.path(p.span.file)))))
         .collect();
     let slots = prog
         .forms
@@ -79,6 +61,33 @@ pub fn interpret(path: &Path) -> Result<Interpreted, String> {
         slots,
         lib: Library::new(&prog),
     })
+}
+
+/// A param of a file loaded at run time, described as generated code describes it.
+pub(super) fn param_info(
+    src: &SourceMap,
+    name: &str,
+    default: f64,
+    range: Option<crate::compiler::check::ParamRange>,
+    span: Span,
+    owner: &'static str,
+) -> ParamInfo {
+    let name = leak(name.to_string());
+    ParamInfo {
+        name,
+        default,
+        range: ParamRange {
+            name,
+            lo: range.map_or(f64::NEG_INFINITY, |r| r.lo),
+            lo_closed: range.is_some_and(|r| r.lo_closed),
+            hi: range.map_or(f64::INFINITY, |r| r.hi),
+            hi_closed: range.is_some_and(|r| r.hi_closed),
+        },
+        doc: leak(docs::declaration(src, span)),
+        declared: leak(docs::location(src, span)),
+        written: leak(docs::written(src, span)),
+        owner,
+    }
 }
 
 impl Interpreted {
