@@ -6,9 +6,9 @@ use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
 
 use super::names::{Namer, ident};
-use crate::check::Program;
 use crate::ir::graph::{Graph, Node, NodeId, Sym};
 use crate::ir::{DimIr, FormIr, IntegralIr};
+use crate::program::Program;
 
 /// Locals every kernel may define.
 const RESERVED: &[&str] = &[

@@ -14,24 +14,12 @@ use std::collections::HashMap;
 
 pub use affine::{Affine, eval_all};
 
-use crate::check::{Global, ParamRange, Program, const_eval};
+pub use crate::check::SchemeDef;
+use crate::check::{Global, ParamRange, Unit, const_eval};
 use crate::diagnostic::Diagnostic;
 use crate::ir::graph::{Graph, NodeId, Sym};
 use crate::source::Span;
 use crate::syntax::ast::{self, BinOp, Expr, ExprKind, Ident};
-
-/// A scheme as written.
-#[derive(Clone, Debug)]
-pub struct SchemeDef {
-    pub name: Ident,
-    pub params: Vec<ast::SchemeParam>,
-    pub uses: Vec<Ident>,
-    pub states: Vec<Ident>,
-    pub lets: Vec<(Ident, Expr)>,
-    pub initial: Option<ast::Initial>,
-    pub stages: Vec<ast::Stage>,
-    pub span: Span,
-}
 
 /// A vector known when a stage starts, or one of its new quantities.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -108,7 +96,7 @@ pub struct SchemeIr {
 }
 
 /// Compiles every scheme; errors go to `diags`.
-pub fn compile(prog: &Program, defs: &[SchemeDef], diags: &mut Vec<Diagnostic>) -> Vec<SchemeIr> {
+pub fn compile(prog: &Unit, defs: &[SchemeDef], diags: &mut Vec<Diagnostic>) -> Vec<SchemeIr> {
     defs.iter().filter_map(|d| Compiler::new(prog, d).run().map_err(|mut e| diags.append(&mut e)).ok()).collect()
 }
 
@@ -120,7 +108,7 @@ enum Value {
 }
 
 struct Compiler<'a> {
-    prog: &'a Program,
+    prog: &'a Unit,
     def: &'a SchemeDef,
     g: Graph,
     params: Vec<SchemeParamInfo>,
@@ -139,7 +127,7 @@ const SCHEME_BUILTINS: &[&str] = &["dt", "t", "pi"];
 const SCHEME_FUNCTIONS: &[&str] = &["sqrt", "abs"];
 
 impl<'a> Compiler<'a> {
-    fn new(prog: &'a Program, def: &'a SchemeDef) -> Self {
+    fn new(prog: &'a Unit, def: &'a SchemeDef) -> Self {
         Compiler {
             prog,
             def,
