@@ -446,7 +446,7 @@ impl<'a> Compiler<'a> {
 
     fn stage(&mut self, st: &ast::Stage, last: bool) -> Option<StageIr> {
         let name = st.name.as_ref().map_or_else(|| format!("stage{}", self.stage_index + 1), |n| n.name.clone());
-        let at_span = st.span.unwrap_or(self.def.span);
+        let at_span = st.span.unwrap_or(self.def.name.span);
         let Some(unknown) = &st.unknown else {
             self.error(
                 Diagnostic::error("E0805", format!("stage `{name}` has no unknown"), at_span, "no `unknown` line")
@@ -585,12 +585,18 @@ impl<'a> Compiler<'a> {
             let candidates: Vec<usize> = (1..n_new).filter(|&q| solved[q].is_none() && eq.has_new(q)).collect();
             let pivot = own.filter(|o| candidates.contains(o)).or_else(|| candidates.first().copied());
             let Some(q) = pivot else {
-                self.error(Diagnostic::error(
-                    "E0812",
-                    "this relation determines no new quantity",
-                    span,
-                    "it repeats or contradicts the others",
-                ));
+                let open: Vec<String> =
+                    (1..n_new).filter(|&q| solved[q].is_none()).map(|q| format!("`{}`", self.new[q])).collect();
+                self.error(
+                    Diagnostic::error(
+                        "E0812",
+                        "this relation determines no new quantity",
+                        span,
+                        "it involves no quantity the relations before it leave open",
+                    )
+                    .with_note(format!("still undetermined: {}", open.join(", ")))
+                    .with_help("each relation must involve a new quantity not yet given by the others"),
+                );
                 self.scope = saved;
                 return None;
             };
