@@ -6,6 +6,61 @@ use codespan_reporting::term;
 
 use crate::source::{SourceMap, Span};
 
+/// Every diagnostic code the compiler can emit, with its meaning in one line, in code order.
+/// `Diagnostic::error`/`warning` check (in debug builds) that their code is listed here; the
+/// ui corpus (compiler/tests/ui) exercises each one, and docs/language.md lists them all.
+pub const CODES: &[(&str, &str)] = &[
+    ("E0001", "syntax error"),
+    ("E0002", "nesting or length limit exceeded (expression nested too deeply, item too long)"),
+    ("E0003", "number out of range (not a finite double-precision number)"),
+    ("E0101", "unknown name (with a suggestion when one is close)"),
+    ("E0102", "name defined twice"),
+    ("E0103", "duplicate argument, parameter or slot"),
+    ("E0104", "`let` defined in terms of itself"),
+    ("E0105", "recursive `fn`, or functions nested too deeply"),
+    ("E0106", "built-in name redefined or used as a name"),
+    ("E0201", "wrong number of arguments"),
+    ("E0204", "calling something that is not a function"),
+    ("E0205", "using a function, form or scheme as a value"),
+    ("E0206", "`inf` outside a parameter range"),
+    ("E0301", "shape mismatch (a vector or tensor where another shape is needed)"),
+    ("E0303", "exponent not a constant integer"),
+    ("E0304", "integrand not a scalar"),
+    ("E0401", "integrand does not depend on the test function"),
+    ("E0402", "test function inside a nonlinear function"),
+    ("E0403", "test function in a denominator"),
+    ("E0404", "test function multiplied by itself"),
+    ("E0405", "form not linear in the test function (a term without it)"),
+    ("E0501", "`n` or `h` in a volume integral"),
+    ("E0502", "derivative of something that has none"),
+    ("E0601", "parameter default outside its range"),
+    ("E0602", "empty parameter range"),
+    ("E0603", "parameter default or bound not a finite constant"),
+    ("E0701", "missing import"),
+    ("E0702", "import cycle"),
+    ("E0802", "scheme: solving a relation divides by a coefficient that can vanish in the parameter ranges"),
+    ("E0803", "scheme: items outside the `stage` blocks of a multi-stage scheme"),
+    ("E0804", "scheme: a stage with two unknowns or two residuals"),
+    ("E0805", "scheme: no state, no stage, or a stage without unknown or residual"),
+    ("E0806", "scheme: a state gets no new value"),
+    ("E0807", "scheme: a `let` that is not a scalar"),
+    ("E0808", "scheme: `initial` solves for something that is not a state"),
+    ("E0809", "scheme: a residual that does not depend on its unknown"),
+    ("E0810", "scheme: a quantity related twice, or one already known"),
+    ("E0811", "scheme: as many relations as new quantities besides the unknown are needed"),
+    ("E0812", "scheme: a relation that determines no new quantity"),
+    ("E0813", "scheme: a slot applied outside a residual, or a residual side not a sum of slot applications"),
+    ("E0814", "scheme: a relation that is not affine in the time levels"),
+    ("E0816", "scheme: a call to a name that is not one of its slots (`uses`)"),
+    ("E0817", "scheme: a slot that is never applied"),
+    ("W0001", "unused parameter (warning)"),
+];
+
+/// The meaning of a diagnostic code, from [`CODES`].
+pub fn describe(code: &str) -> Option<&'static str> {
+    CODES.iter().find(|(c, _)| *c == code).map(|(_, m)| *m)
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Severity {
     Error,
@@ -30,7 +85,9 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
+    /// An error; `code` must be listed in [`CODES`] (checked in debug builds).
     pub fn error(code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
+        debug_assert!(describe(code).is_some(), "diagnostic code {code} is not in diagnostic::CODES");
         Diagnostic {
             severity: Severity::Error,
             code,
@@ -42,6 +99,7 @@ impl Diagnostic {
         }
     }
 
+    /// A warning; `code` must be listed in [`CODES`] (checked in debug builds).
     pub fn warning(code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
         Diagnostic { severity: Severity::Warning, ..Diagnostic::error(code, message, span, label) }
     }
@@ -133,4 +191,20 @@ pub fn normalize(diags: &mut Vec<Diagnostic>) {
         ))
     });
     diags.dedup_by(|a, b| a.code == b.code && a.primary.span == b.primary.span && a.message == b.message);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::CODES;
+
+    #[test]
+    fn the_catalogue_is_sorted_and_has_no_duplicates() {
+        for w in CODES.windows(2) {
+            assert!(w[0].0 < w[1].0, "{} before {}", w[0].0, w[1].0);
+        }
+        for (code, meaning) in CODES {
+            assert!(code.len() == 5 && (code.starts_with('E') || code.starts_with('W')), "{code}");
+            assert!(!meaning.is_empty() && !meaning.contains('\n'), "{code}");
+        }
+    }
 }

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use signorini_compiler::{FsLoader, check_path, codegen, ir, syntax};
+use signorini_compiler::{FsLoader, codegen, compile, ir, syntax};
 
 fn library() -> Vec<PathBuf> {
     let mut files = Vec::new();
@@ -28,21 +28,21 @@ fn library_compiles_without_warnings() {
     let files = library();
     assert!(files.len() >= 3);
     for f in &files {
-        let (_, warnings) = check_path(f, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", f.display()));
-        assert!(warnings.is_empty(), "{}:\n{warnings}", f.display());
+        let compiled = compile(f, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", f.display()));
+        assert!(compiled.warnings.is_empty(), "{}:\n{}", f.display(), compiled.warnings);
     }
 }
 
 #[test]
 fn generated_rust_snapshots() {
     for f in library() {
-        let (prog, _) = check_path(&f, &FsLoader).unwrap();
+        let compiled = compile(&f, &FsLoader).unwrap();
         let opts = codegen::Options {
             runtime: codegen::DEFAULT_RUNTIME.into(),
             module: stem(&f),
             source_name: signorini_compiler::display_name(&f),
         };
-        let code = codegen::generate_pretty(&prog, &opts).unwrap();
+        let code = compiled.rust_pretty(&opts).unwrap();
         insta::with_settings!({ snapshot_path => "snapshots/rust", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(stem(&f), code);
         });
@@ -52,12 +52,12 @@ fn generated_rust_snapshots() {
 #[test]
 fn ast_ir_and_scheme_snapshots() {
     for f in library() {
-        let (prog, _) = check_path(&f, &FsLoader).unwrap();
-        let (ast, _) = syntax::parse(prog.root, prog.sources.text(prog.root));
-        let ast_text = syntax::print::print_file(&ast, &prog.sources);
+        let compiled = compile(&f, &FsLoader).unwrap();
+        let prog = &compiled.program;
+        let ast_text = syntax::print::print_file(&compiled.ast, &prog.sources);
         let params: Vec<String> = prog.params.iter().map(|p| p.name.clone()).collect();
         let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
-        let ir_text = ir::print::print(&ir::build(&prog, 2), &params, &coefs);
+        let ir_text = ir::print::print(compiled.ir(2), &params, &coefs);
         let schemes: Vec<String> = prog.schemes.iter().map(signorini_compiler::scheme::print::print).collect();
         insta::with_settings!({ snapshot_path => "snapshots/stages", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(format!("{}.ast", stem(&f)), ast_text);

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use proptest::prelude::*;
-use signorini_compiler::{MemLoader, check_text, codegen, render_all};
+use signorini_compiler::{MemLoader, codegen, compile_text};
 
 fn library() -> MemLoader {
     let mut loader = MemLoader::default();
@@ -20,16 +20,12 @@ fn library() -> MemLoader {
 
 /// Checks `text` as `forms/fuzz.wf`; if it passes, generates code, which must parse.
 fn run(text: &str, loader: &MemLoader) {
-    match check_text(Path::new("forms/fuzz.wf"), text, loader) {
-        Err((diags, sources)) => {
-            assert!(diags.iter().any(|d| d.is_error()));
-            let rendered = render_all(&diags, &sources);
-            assert!(rendered.contains("error["));
-        }
-        Ok(prog) => {
+    match compile_text(Path::new("forms/fuzz.wf"), text, loader) {
+        Err(failure) => assert!(failure.rendered.contains("error["), "{failure}"),
+        Ok(compiled) => {
             let opts =
                 codegen::Options { runtime: "::rt".into(), module: "fuzz".into(), source_name: "fuzz.wf".into() };
-            if let Err(e) = codegen::generate(&prog, &opts) {
+            if let Err(e) = compiled.rust(&opts) {
                 panic!("valid input generated bad code: {e}\ninput:\n{text}");
             }
         }

@@ -1,17 +1,19 @@
 //! Rendered diagnostics of a corpus of bad .wf files (tests/ui/*.wf), as insta snapshots.
-//! Every file must produce at least one diagnostic, and together they must exercise every
-//! diagnostic code the checker has.
+//! Every file must produce at least one diagnostic, and together they must exercise every code
+//! of the catalogue (`diagnostic::CODES`), which must list every code in the compiler's source
+//! and match the table in docs/language.md.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
+use signorini_compiler::diagnostic::CODES;
 use signorini_compiler::{FsLoader, check_file, render_all};
 
-fn corpus() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir("tests/ui")
-        .expect("tests/ui exists")
+fn files_in(dir: &str, ext: &str) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{dir}: {e}"))
         .map(|e| e.expect("readable entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "wf"))
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
         .collect();
     files.sort();
     files
@@ -19,7 +21,7 @@ fn corpus() -> Vec<PathBuf> {
 
 #[test]
 fn bad_files_render_their_diagnostics() {
-    let files = corpus();
+    let files = files_in("tests/ui", "wf");
     assert!(files.len() >= 25, "the corpus has {} files", files.len());
     let mut codes = BTreeSet::new();
     for path in &files {
@@ -30,7 +32,7 @@ fn bad_files_render_their_diagnostics() {
             }
             Ok(prog) => {
                 let r = render_all(&prog.warnings, &prog.sources);
-                (prog.warnings, r)
+                (prog.unit.warnings, r)
             }
         };
         assert!(!diags.is_empty(), "{} produced no diagnostic", path.display());
@@ -40,14 +42,53 @@ fn bad_files_render_their_diagnostics() {
             insta::assert_snapshot!(name, rendered);
         });
     }
-    let expected = [
-        "E0001", "E0002", "E0101", "E0102", "E0103", "E0104", "E0105", "E0106", "E0201", "E0204", "E0205", "E0206",
-        "E0301", "E0303", "E0304", "E0401", "E0402", "E0403", "E0404", "E0405", "E0501", "E0502", "E0601", "E0602",
-        "E0603", "E0701", "E0702", "E0802", "E0806", "E0811", "E0813", "E0814", "E0816", "E0817", "W0001",
-    ];
-    for code in expected {
-        assert!(codes.contains(code), "no corpus file exercises {code}");
+    let missing: Vec<&str> = CODES.iter().map(|(c, _)| *c).filter(|c| !codes.contains(c)).collect();
+    assert!(missing.is_empty(), "no corpus file exercises {missing:?}");
+}
+
+/// Every `"E0123"`/`"W0123"` literal in the compiler's source is in the catalogue, and every
+/// catalogue code is in the source.
+#[test]
+fn the_catalogue_lists_exactly_the_codes_of_the_source() {
+    let mut in_source = BTreeSet::new();
+    let mut dirs = vec![PathBuf::from("src")];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let p = entry.unwrap().path();
+            if p.is_dir() {
+                dirs.push(p);
+            } else if p.extension().is_some_and(|e| e == "rs") && !p.ends_with("diagnostic.rs") {
+                in_source.extend(code_literals(&std::fs::read_to_string(&p).unwrap()));
+            }
+        }
     }
+    let catalogue: BTreeSet<String> = CODES.iter().map(|(c, _)| c.to_string()).collect();
+    assert_eq!(in_source, catalogue);
+}
+
+/// docs/language.md has one table row `| CODE | meaning |` per catalogue entry, and no other
+/// code.
+#[test]
+fn the_language_docs_list_the_catalogue() {
+    let docs = std::fs::read_to_string("../docs/language.md").unwrap();
+    for (code, meaning) in CODES {
+        assert!(docs.contains(&format!("| {code} | {meaning} |")), "docs/language.md lacks `| {code} | {meaning} |`");
+    }
+    let catalogue: BTreeSet<String> = CODES.iter().map(|(c, _)| c.to_string()).collect();
+    let in_docs: BTreeSet<String> = words(&docs).filter(|w| is_code(w)).collect();
+    assert_eq!(in_docs, catalogue);
+}
+
+fn words(text: &str) -> impl Iterator<Item = String> + '_ {
+    text.split(|c: char| !c.is_ascii_alphanumeric()).map(str::to_string)
+}
+
+fn is_code(w: &str) -> bool {
+    w.len() == 5 && (w.starts_with('E') || w.starts_with('W')) && w[1..].bytes().all(|b| b.is_ascii_digit())
+}
+
+fn code_literals(text: &str) -> Vec<String> {
+    text.split('"').filter(|w| is_code(w)).map(str::to_string).collect()
 }
 
 fn source_of(path: &Path) -> String {

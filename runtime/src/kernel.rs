@@ -286,9 +286,12 @@ pub trait Form {
 }
 
 /// Element kernels of a form for cells of dimension D with N nodes. Each method adds its
-/// contribution to `out`; forms without a volume (facet) integral add nothing there.
+/// contribution to `out`. Every method defaults to adding nothing, so a form implements only
+/// what it has: one without a volume (facet) integral leaves the cell (facet) methods out, and
+/// one without active-set switches the `*_switches` methods.
+#[allow(unused_variables)]
 pub trait FormKernel<const D: usize, const N: usize>: Form {
-    fn cell_residual(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>], out: &mut LocalVector<D, N>);
+    fn cell_residual(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>], out: &mut LocalVector<D, N>) {}
     /// Derivative with respect to field argument `wrt`.
     fn cell_tangent(
         &self,
@@ -296,11 +299,12 @@ pub trait FormKernel<const D: usize, const N: usize>: Form {
         fields: &[&LocalVector<D, N>],
         wrt: usize,
         out: &mut LocalMatrix<D, N>,
-    );
+    ) {
+    }
     /// Pushes, at every quadrature point, the sign (`a > 0`) of each active-set switch H(a) of
     /// the tangent with respect to field `wrt`. For a `piecewise` form, equal switches mean
     /// an equal tangent.
-    fn cell_switches(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>], wrt: usize, out: &mut Vec<bool>);
+    fn cell_switches(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>], wrt: usize, out: &mut Vec<bool>) {}
     /// `region` indexes `META.facets`.
     fn facet_residual(
         &self,
@@ -308,7 +312,8 @@ pub trait FormKernel<const D: usize, const N: usize>: Form {
         ctx: &FacetCtx<'_, D, N>,
         fields: &[&LocalVector<D, N>],
         out: &mut LocalVector<D, N>,
-    );
+    ) {
+    }
     fn facet_tangent(
         &self,
         region: usize,
@@ -316,7 +321,8 @@ pub trait FormKernel<const D: usize, const N: usize>: Form {
         fields: &[&LocalVector<D, N>],
         wrt: usize,
         out: &mut LocalMatrix<D, N>,
-    );
+    ) {
+    }
     fn facet_switches(
         &self,
         region: usize,
@@ -324,14 +330,20 @@ pub trait FormKernel<const D: usize, const N: usize>: Form {
         fields: &[&LocalVector<D, N>],
         wrt: usize,
         out: &mut Vec<bool>,
-    );
+    ) {
+    }
 }
 
 /// Kernels of a functional (a form without a test function): the integral over one cell or
-/// one facet of region `region`.
+/// one facet of region `region`. Both default to 0 (no volume, no facet integral).
+#[allow(unused_variables)]
 pub trait FunctionalKernel<const D: usize, const N: usize>: Form {
-    fn cell_value(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>]) -> f64;
-    fn facet_value(&self, region: usize, ctx: &FacetCtx<'_, D, N>, fields: &[&LocalVector<D, N>]) -> f64;
+    fn cell_value(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>]) -> f64 {
+        0.0
+    }
+    fn facet_value(&self, region: usize, ctx: &FacetCtx<'_, D, N>, fields: &[&LocalVector<D, N>]) -> f64 {
+        0.0
+    }
 }
 
 /// H(a) = 1 if a > 0, else 0 (so H(0) = 0).

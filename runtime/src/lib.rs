@@ -26,6 +26,7 @@ pub mod library;
 pub mod linalg;
 pub mod mesh;
 pub mod newton;
+pub mod pattern;
 pub mod problem;
 pub mod quadrature;
 pub mod redistribute;

@@ -13,7 +13,7 @@ use faer::sparse::linalg::lu::{self, LuRef, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
-use crate::assembly::Pattern;
+use crate::pattern::Pattern;
 
 /// A square sparse matrix in compressed-column form over a shared pattern.
 #[derive(Clone, Debug)]

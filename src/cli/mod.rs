@@ -307,8 +307,8 @@ pub fn run(cli: Cli) -> ExitCode {
 fn check(files: &[PathBuf]) -> ExitCode {
     let mut failed = false;
     for f in files {
-        match compiler::check_path(f, &crate::driver::sources::LibraryLoader) {
-            Ok((_, warnings)) => eprint!("{warnings}"),
+        match compiler::compile(f, &crate::driver::sources::LibraryLoader) {
+            Ok(compiled) => eprint!("{}", compiled.warnings),
             Err(e) => {
                 eprint!("{e}");
                 failed = true;
@@ -319,33 +319,32 @@ fn check(files: &[PathBuf]) -> ExitCode {
 }
 
 fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
-    let (prog, warnings) = match compiler::check_path(file, &crate::driver::sources::LibraryLoader) {
-        Ok(p) => p,
+    let compiled = match compiler::compile(file, &crate::driver::sources::LibraryLoader) {
+        Ok(c) => c,
         Err(e) => {
             eprint!("{e}");
             return ExitCode::FAILURE;
         }
     };
-    eprint!("{warnings}");
+    eprint!("{}", compiled.warnings);
+    let prog = &compiled.program;
     let out = match stage {
-        Stage::Ast => {
-            let (ast, _) = compiler::syntax::parse(prog.root, prog.sources.text(prog.root));
-            Ok(compiler::syntax::print::print_file(&ast, &prog.sources))
-        }
+        Stage::Ast => Ok(compiler::syntax::print::print_file(&compiled.ast, &prog.sources)),
         Stage::Ir => {
-            let ir = compiler::ir::build(&prog, dim);
             let params: Vec<String> = prog.params.iter().map(|p| p.name.clone()).collect();
             let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
-            Ok(compiler::ir::print::print(&ir, &params, &coefs))
+            Ok(compiler::ir::print::print(compiled.ir(dim), &params, &coefs))
         }
-        Stage::Scheme => Ok(prog.schemes.iter().map(compiler::scheme::print::print).collect::<Vec<_>>().join("\n")),
+        Stage::Scheme => {
+            Ok(compiled.schemes().iter().map(compiler::scheme::print::print).collect::<Vec<_>>().join("\n"))
+        }
         Stage::Rust => {
             let opts = compiler::codegen::Options {
                 runtime: compiler::codegen::DEFAULT_RUNTIME.to_string(),
                 module: compiler::module_name(file),
                 source_name: compiler::display_name(file),
             };
-            compiler::codegen::generate_pretty(&prog, &opts)
+            compiled.rust_pretty(&opts)
         }
     };
     match out {
@@ -354,7 +353,7 @@ fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprint!("{e}");
             ExitCode::FAILURE
         }
     }

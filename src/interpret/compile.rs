@@ -3,7 +3,7 @@
 //! comes from, and how the weighted coefficients contract with the basis functions (the
 //! loops the generated kernels write out, with the same terms in the same order).
 
-use signorini_compiler::check::Program as Checked;
+use signorini_compiler::Program as Checked;
 use signorini_compiler::ir::eval::Program;
 use signorini_compiler::ir::graph::{Graph, NodeId, Sym};
 use signorini_compiler::ir::lower::components;

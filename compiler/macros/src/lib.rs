@@ -12,7 +12,7 @@ use quote::quote;
 use syn::parse::{Parse, ParseStream};
 use syn::{Ident, LitStr, Token, Visibility};
 
-use signorini_compiler::{FsLoader, check_path, codegen};
+use signorini_compiler::{FsLoader, codegen};
 
 struct Input {
     vis: Visibility,
@@ -61,20 +61,19 @@ fn error(span: Span, msg: &str) -> proc_macro2::TokenStream {
 fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     let manifest = std::env::var("CARGO_MANIFEST_DIR").map(PathBuf::from).unwrap_or_default();
     let rel = input.path.value();
-    let path = manifest.join(&rel);
-    let (prog, _warnings) = check_path(&path, &FsLoader).map_err(|f| f.rendered)?;
     let module = match &input.name {
         Some(n) => n.to_string(),
         None => signorini_compiler::module_name(Path::new(&rel)),
     };
     let opts = codegen::Options { runtime: codegen::DEFAULT_RUNTIME.to_string(), module, source_name: rel.clone() };
-    let mut file = codegen::generate(&prog, &opts)?;
+    let signorini_compiler::Expansion { mut file, sources } =
+        signorini_compiler::expand(&manifest.join(&rel), &FsLoader, &opts)?;
     if let Some(syn::Item::Mod(m)) = file.items.first_mut() {
         if input.name.is_some() {
             m.vis = input.vis.clone();
         }
         // Rebuild when any file of the unit changes.
-        let deps: Vec<String> = (0..prog.sources.len()).map(|f| prog.sources.path(f).display().to_string()).collect();
+        let deps: Vec<String> = sources.iter().map(|p| p.display().to_string()).collect();
         let track: syn::Item = syn::parse_quote! {
             const _: &[&[u8]] = &[#(include_bytes!(#deps)),*];
         };

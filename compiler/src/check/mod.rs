@@ -6,15 +6,13 @@
 //! (a test function passed into `pos`) is reported inside the function, with the call site.
 
 mod builtins;
-mod load;
+pub mod load;
 mod types;
 
-use std::collections::{BTreeSet, HashMap, HashSet};
-use std::path::Path;
-
 use crate::diagnostic::{self, Diagnostic};
-use crate::source::{FileId, Loader, SourceMap, Span};
+use crate::source::{FileId, SourceMap, Span};
 use crate::syntax::ast::{self, Expr, Ident, Shape};
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 pub use builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES};
 pub use types::{Ty, const_eval};
@@ -24,18 +22,32 @@ pub fn const_value(e: &Expr) -> Option<f64> {
     const_eval(e).ok()
 }
 
-/// A checked compilation unit: the root file and its imports.
-pub struct Program {
+/// A checked compilation unit: the root file and its imports. Its schemes are declared, not
+/// yet compiled (`crate::scheme::compile` does that; `crate::Program` holds the result).
+pub struct Unit {
     pub sources: SourceMap,
     pub root: FileId,
     pub params: Vec<Param>,
     pub coefs: Vec<Coef>,
     pub forms: Vec<Form>,
-    /// Time schemes, compiled (their affine relations solved).
-    pub schemes: Vec<crate::scheme::SchemeIr>,
+    /// Time schemes as written (`Global::Scheme` indexes them).
+    pub scheme_defs: Vec<SchemeDef>,
     pub globals: HashMap<String, Global>,
     /// Warnings (errors make `check` return `Err`).
     pub warnings: Vec<Diagnostic>,
+}
+
+/// A scheme as written.
+#[derive(Clone, Debug)]
+pub struct SchemeDef {
+    pub name: Ident,
+    pub params: Vec<ast::SchemeParam>,
+    pub uses: Vec<Ident>,
+    pub states: Vec<Ident>,
+    pub lets: Vec<(Ident, Expr)>,
+    pub initial: Option<ast::Initial>,
+    pub stages: Vec<ast::Stage>,
+    pub span: Span,
 }
 
 #[derive(Clone, Debug)]
@@ -140,39 +152,25 @@ impl Global {
 /// The region name of volume integrals.
 pub const CELL_REGION: &str = "Omega";
 
-/// Result of checking: the program (with warnings) or every diagnostic, errors first in source
-/// order, together with the sources needed to render them.
-pub type Checked = Result<Program, (Vec<Diagnostic>, SourceMap)>;
+/// Result of checking: the unit (with warnings) or every diagnostic, in source order, together
+/// with the sources needed to render them.
+pub type Checked = Result<Unit, (Vec<Diagnostic>, SourceMap)>;
 
-/// Checks the unit rooted at `path`.
-pub fn check_file(path: &Path, loader: &dyn Loader) -> Result<Checked, String> {
-    let mut diags = Vec::new();
-    let loaded = load::load(path, loader, &mut diags)?;
-    Ok(check_loaded(loaded, diags))
-}
-
-/// Checks `text` as if it were the file `path` (imports resolve through `loader`).
-pub fn check_text(path: &Path, text: &str, loader: &dyn Loader) -> Checked {
-    let mut diags = Vec::new();
-    let loaded = load::load_text(path, text, loader, &mut diags);
-    check_loaded(loaded, diags)
-}
-
-fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
-    let load::Loaded { sources, files, root } = loaded;
-    let mut prog = Program {
+/// Checks a loaded unit (`load::load`); `diags` holds what loading found (syntax errors,
+/// missing imports). Schemes are declared, not compiled.
+pub fn check(sources: SourceMap, root: FileId, files: &[(FileId, ast::File)], mut diags: Vec<Diagnostic>) -> Checked {
+    let mut prog = Unit {
         sources,
         root,
         params: Vec::new(),
         coefs: Vec::new(),
         forms: Vec::new(),
-        schemes: Vec::new(),
+        scheme_defs: Vec::new(),
         globals: HashMap::new(),
         warnings: Vec::new(),
     };
     let broken: HashSet<String> = files.iter().flat_map(|(_, f)| f.broken_names.iter().cloned()).collect();
-    let mut scheme_defs = Vec::new();
-    declare(&mut prog, &files, &mut scheme_defs, &mut diags);
+    declare(&mut prog, files, &mut diags);
     let used = {
         let mut c = types::Checker::new(&prog, &broken);
         let values = c.check_params();
@@ -202,9 +200,6 @@ fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
             );
         }
     }
-    if !diags.iter().any(Diagnostic::is_error) {
-        prog.schemes = crate::scheme::compile(&prog, &scheme_defs, &mut diags);
-    }
     diagnostic::normalize(&mut diags);
     if diags.iter().any(Diagnostic::is_error) {
         Err((diags, prog.sources))
@@ -215,12 +210,7 @@ fn check_loaded(loaded: load::Loaded, mut diags: Vec<Diagnostic>) -> Checked {
 }
 
 /// Builds the global name table; duplicate names and built-in names are errors.
-fn declare(
-    prog: &mut Program,
-    files: &[(FileId, ast::File)],
-    schemes: &mut Vec<crate::scheme::SchemeDef>,
-    diags: &mut Vec<Diagnostic>,
-) {
+fn declare(prog: &mut Unit, files: &[(FileId, ast::File)], diags: &mut Vec<Diagnostic>) {
     let mut first: HashMap<String, Span> = HashMap::new();
     for (_, file) in files {
         for item in &file.items {
@@ -286,7 +276,7 @@ fn declare(
                     Global::Form(prog.forms.len() - 1)
                 }
                 ast::Item::Scheme { name, params, uses, states, lets, initial, stages, span } => {
-                    schemes.push(crate::scheme::SchemeDef {
+                    prog.scheme_defs.push(SchemeDef {
                         name: name.clone(),
                         params: params.clone(),
                         uses: uses.clone(),
@@ -296,7 +286,7 @@ fn declare(
                         stages: stages.clone(),
                         span: *span,
                     });
-                    Global::Scheme(schemes.len() - 1)
+                    Global::Scheme(prog.scheme_defs.len() - 1)
                 }
                 ast::Item::Import { .. } => continue,
             };

@@ -4,7 +4,7 @@
 use std::collections::{HashMap, HashSet};
 
 use super::builtins::{self, BUILTIN_FUNCTIONS, BUILTIN_VALUES, NONLINEAR};
-use super::{CELL_REGION, Global, ParamRange, ParamSet, Program};
+use super::{CELL_REGION, Global, ParamRange, ParamSet, Unit};
 use crate::diagnostic::Diagnostic;
 use crate::source::Span;
 use crate::syntax::ast::{BinOp, Expr, ExprKind, Ident, Shape};
@@ -43,7 +43,7 @@ enum LetState {
 }
 
 pub(super) struct Checker<'p> {
-    prog: &'p Program,
+    prog: &'p Unit,
     broken: &'p HashSet<String>,
     pub diags: Vec<Diagnostic>,
     pub used_params: ParamSet,
@@ -57,7 +57,7 @@ pub(super) struct Checker<'p> {
 const MAX_INLINE_DEPTH: usize = 32;
 
 impl<'p> Checker<'p> {
-    pub fn new(prog: &'p Program, broken: &'p HashSet<String>) -> Self {
+    pub fn new(prog: &'p Unit, broken: &'p HashSet<String>) -> Self {
         Checker {
             prog,
             broken,

@@ -6,9 +6,9 @@ use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
 
 use super::names::{Namer, ident};
-use crate::check::Program;
 use crate::ir::graph::{Graph, Node, NodeId, Sym};
 use crate::ir::{DimIr, FormIr, IntegralIr};
+use crate::program::Program;
 
 /// Locals every kernel may define.
 const RESERVED: &[&str] = &[
@@ -44,66 +44,68 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
     let d = ir.dim;
     let g = &ir.graph;
     let body = |integral: &IntegralIr, mode: Mode| Body { prog, g, d, form, integral, mode }.emit();
-    // One `match wrt` arm per field argument.
+    // One `match wrt` arm per field argument with something to do; `None` if none has.
     let per_field = |integral: &IntegralIr, mode: fn(usize) -> Mode| {
-        let mut s = String::from("match wrt {\n");
-        for (a, field) in form.fields.iter().enumerate() {
-            let _ = writeln!(s, "{a} => {{ // d/d{field}\n{}}}", body(integral, mode(a)));
-        }
-        s.push_str("_ => {}\n}\n");
-        s
+        let arms: Vec<String> = (0..form.fields.len())
+            .filter_map(|a| {
+                let b = body(integral, mode(a));
+                (!b.is_empty()).then(|| format!("{a} => {{ // d/d{}\n{b}}}\n", form.fields[a]))
+            })
+            .collect();
+        (!arms.is_empty()).then(|| format!("match wrt {{\n{}_ => {{}}\n}}\n", arms.concat()))
     };
     let cell = form.integrals.iter().find(|i| i.cell);
     let facets: Vec<&IntegralIr> = form.integrals.iter().filter(|i| !i.cell).collect();
-    // One `match region` arm per boundary region.
-    let per_region = |f: &dyn Fn(&IntegralIr) -> String| {
-        if facets.is_empty() {
-            return String::new();
-        }
-        let mut s = String::from("match region {\n");
-        for (r, i) in facets.iter().enumerate() {
-            let _ = writeln!(s, "{r} => {{ // int({})\n{}}}", i.region, f(i));
-        }
-        s.push_str("_ => {}\n}\n");
-        s
+    // One `match region` arm per boundary region with something to do; `None` if none has.
+    let per_region = |f: &dyn Fn(&IntegralIr) -> Option<String>| {
+        let arms: Vec<String> = facets
+            .iter()
+            .enumerate()
+            .filter_map(|(r, i)| f(i).map(|b| format!("{r} => {{ // int({})\n{b}}}\n", i.region)))
+            .collect();
+        (!arms.is_empty()).then(|| format!("match region {{\n{}_ => {{}}\n}}\n", arms.concat()))
     };
+    let nonempty = |b: String| (!b.is_empty()).then_some(b);
     let (vec, mat, fields) =
         (format!("LocalVector<{d}, N>"), format!("LocalMatrix<{d}, N>"), format!("&[&LocalVector<{d}, N>]"));
     let (cctx, fctx) = (format!("&CellCtx<'_, {d}, N>"), format!("&FacetCtx<'_, {d}, N>"));
     let mut s = String::new();
     let _ = writeln!(s, "impl<const N: usize> FormKernel<{d}, N> for {struct_name} {{");
+    // Methods with nothing to add keep the trait's default (which adds nothing).
     let methods = [
         (
             format!("fn cell_residual(&self, ctx: {cctx}, fields: {fields}, out: &mut {vec})"),
-            cell.map(|i| body(i, Mode::Residual)),
+            cell.and_then(|i| nonempty(body(i, Mode::Residual))),
         ),
         (
             format!("fn cell_tangent(&self, ctx: {cctx}, fields: {fields}, wrt: usize, out: &mut {mat})"),
-            cell.map(|i| per_field(i, Mode::Tangent)),
+            cell.and_then(|i| per_field(i, Mode::Tangent)),
         ),
         (
             format!("fn cell_switches(&self, ctx: {cctx}, fields: {fields}, wrt: usize, out: &mut Vec<bool>)"),
-            cell.map(|i| per_field(i, Mode::Switches)),
+            cell.and_then(|i| per_field(i, Mode::Switches)),
         ),
         (
             format!("fn facet_residual(&self, region: usize, ctx: {fctx}, fields: {fields}, out: &mut {vec})"),
-            Some(per_region(&|i| body(i, Mode::Residual))),
+            per_region(&|i| nonempty(body(i, Mode::Residual))),
         ),
         (
             format!(
                 "fn facet_tangent(&self, region: usize, ctx: {fctx}, fields: {fields}, wrt: usize, out: &mut {mat})"
             ),
-            Some(per_region(&|i| per_field(i, Mode::Tangent))),
+            per_region(&|i| per_field(i, Mode::Tangent)),
         ),
         (
             format!(
                 "fn facet_switches(&self, region: usize, ctx: {fctx}, fields: {fields}, wrt: usize, out: &mut Vec<bool>)"
             ),
-            Some(per_region(&|i| per_field(i, Mode::Switches))),
+            per_region(&|i| per_field(i, Mode::Switches)),
         ),
     ];
     for (sig, text) in methods {
-        let _ = writeln!(s, "{sig} {{\n{}}}", text.unwrap_or_default());
+        if let Some(text) = text {
+            let _ = writeln!(s, "{sig} {{\n{text}}}");
+        }
     }
     s.push_str("}\n");
     s
@@ -121,16 +123,24 @@ pub fn functional_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &
     let fields = format!("&[&LocalVector<{d}, N>]");
     let mut s = String::new();
     let _ = writeln!(s, "impl<const N: usize> FunctionalKernel<{d}, N> for {struct_name} {{");
-    let cell = form.integrals.iter().find(|i| i.cell).map_or_else(|| "0.0\n".to_string(), body);
-    let _ = writeln!(s, "fn cell_value(&self, ctx: &CellCtx<'_, {d}, N>, fields: {fields}) -> f64 {{\n{cell}}}");
+    // A functional without a volume (facet) integral keeps the trait's default: 0.
+    if let Some(cell) = form.integrals.iter().find(|i| i.cell) {
+        let _ = writeln!(
+            s,
+            "fn cell_value(&self, ctx: &CellCtx<'_, {d}, N>, fields: {fields}) -> f64 {{\n{}}}",
+            body(cell)
+        );
+    }
     let mut arms = String::new();
     for (r, i) in form.integrals.iter().filter(|i| !i.cell).enumerate() {
         let _ = writeln!(arms, "{r} => {{ // int({})\n{}}}", i.region, body(i));
     }
-    let _ = writeln!(
-        s,
-        "fn facet_value(&self, region: usize, ctx: &FacetCtx<'_, {d}, N>, fields: {fields}) -> f64 {{\nmatch region {{\n{arms}_ => 0.0,\n}}\n}}"
-    );
+    if !arms.is_empty() {
+        let _ = writeln!(
+            s,
+            "fn facet_value(&self, region: usize, ctx: &FacetCtx<'_, {d}, N>, fields: {fields}) -> f64 {{\nmatch region {{\n{arms}_ => 0.0,\n}}\n}}"
+        );
+    }
     s.push_str("}\n");
     s
 }

@@ -4,8 +4,8 @@
 use std::fmt::Write;
 
 use super::names::ident;
-use crate::check::Program;
 use crate::docs;
+use crate::program::Program;
 use crate::scheme::SchemeIr;
 use crate::source::Span;
 use crate::syntax::ast::Shape;

@@ -12,8 +12,8 @@ mod scheme;
 
 use std::fmt::Write;
 
-use crate::check::Program;
-use crate::ir::{self, DimIr};
+use crate::ir::DimIr;
+use crate::program::Program;
 use crate::syntax::ast::Shape;
 use names::{camel, ident};
 
@@ -29,21 +29,20 @@ pub struct Options {
     pub source_name: String,
 }
 
-/// Generated code of a unit, as a syn file (one `pub mod`).
-pub fn generate(prog: &Program, opts: &Options) -> Result<syn::File, String> {
-    let irs: Vec<DimIr> = ir::DIMS.iter().map(|&d| ir::build(prog, d)).collect();
-    let text = module_text(prog, &irs, opts);
+/// Generated code of a unit, as a syn file (one `pub mod`), from its IR for every dimension of
+/// `ir::DIMS` (in order; `crate::Compiled::irs`).
+pub fn generate(prog: &Program, irs: &[&DimIr], opts: &Options) -> Result<syn::File, String> {
+    let text = module_text(prog, irs, opts);
     syn::parse_file(&text).map_err(|e| format!("internal error: generated code does not parse: {e}\n{text}"))
 }
 
 /// Generated code formatted for reading, with its line count in a header comment.
-pub fn generate_pretty(prog: &Program, opts: &Options) -> Result<String, String> {
-    let file = generate(prog, opts)?;
-    let code = prettyplease::unparse(&file);
-    Ok(format!("// {} lines generated from {}\n{code}", code.lines().count(), opts.source_name))
+pub fn pretty(file: &syn::File, source_name: &str) -> String {
+    let code = prettyplease::unparse(file);
+    format!("// {} lines generated from {source_name}\n{code}", code.lines().count())
 }
 
-fn module_text(prog: &Program, irs: &[DimIr], opts: &Options) -> String {
+fn module_text(prog: &Program, irs: &[&DimIr], opts: &Options) -> String {
     let rt = &opts.runtime;
     let mut s = String::new();
     let _ = writeln!(s, "/// Kernels compiled from `{}` by signorini.", opts.source_name);

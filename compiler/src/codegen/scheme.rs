@@ -5,8 +5,8 @@
 use std::fmt::Write;
 
 use super::names::ident;
-use crate::check::Program;
 use crate::ir::graph::{Graph, Node, NodeId, Sym};
+use crate::program::Program;
 use crate::scheme::layout::{self, Combination, Layout, TermLayout};
 use crate::scheme::{Quantity, SchemeIr};
 

@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 
 use super::graph::{Graph, NodeId, Sym};
-use crate::check::{CELL_REGION, Global, Program};
+use crate::check::{CELL_REGION, Global, Unit};
 use crate::syntax::ast::{BinOp, Expr, ExprKind, Shape};
 
 /// A scalar with its spatial gradient (`None` where no gradient exists: normal, case data,
@@ -43,14 +43,14 @@ pub struct LoweredForm {
 
 pub struct Lowerer<'p> {
     pub g: Graph,
-    prog: &'p Program,
+    prog: &'p Unit,
     d: usize,
     scope: Vec<(String, Val)>,
     lets: HashMap<String, Val>,
 }
 
 impl<'p> Lowerer<'p> {
-    pub fn new(prog: &'p Program, d: usize) -> Self {
+    pub fn new(prog: &'p Unit, d: usize) -> Self {
         Lowerer { g: Graph::default(), prog, d, scope: Vec::new(), lets: HashMap::new() }
     }
 

@@ -15,7 +15,7 @@ pub mod print;
 use derive::Derivative;
 use graph::{Graph, Node, NodeId, Sym};
 
-use crate::check::{CELL_REGION, Program};
+use crate::check::{CELL_REGION, Unit};
 
 /// Space dimensions the kernels are generated for.
 pub const DIMS: [usize; 3] = [1, 2, 3];
@@ -80,7 +80,7 @@ impl TangentIr {
 }
 
 /// Lowers every form of the program for dimension `d`, with tangents.
-pub fn build(prog: &Program, d: usize) -> DimIr {
+pub fn build(prog: &Unit, d: usize) -> DimIr {
     let mut lowerer = lower::Lowerer::new(prog, d);
     let lowered: Vec<_> = (0..prog.forms.len()).map(|i| lowerer.form(i)).collect();
     let mut g = lowerer.g;

@@ -14,24 +14,12 @@ use std::collections::HashMap;
 
 pub use affine::{Affine, eval_all};
 
-use crate::check::{Global, ParamRange, Program, const_eval};
+pub use crate::check::SchemeDef;
+use crate::check::{Global, ParamRange, Unit, const_eval};
 use crate::diagnostic::Diagnostic;
 use crate::ir::graph::{Graph, NodeId, Sym};
 use crate::source::Span;
 use crate::syntax::ast::{self, BinOp, Expr, ExprKind, Ident};
-
-/// A scheme as written.
-#[derive(Clone, Debug)]
-pub struct SchemeDef {
-    pub name: Ident,
-    pub params: Vec<ast::SchemeParam>,
-    pub uses: Vec<Ident>,
-    pub states: Vec<Ident>,
-    pub lets: Vec<(Ident, Expr)>,
-    pub initial: Option<ast::Initial>,
-    pub stages: Vec<ast::Stage>,
-    pub span: Span,
-}
 
 /// A vector known when a stage starts, or one of its new quantities.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -108,7 +96,7 @@ pub struct SchemeIr {
 }
 
 /// Compiles every scheme; errors go to `diags`.
-pub fn compile(prog: &Program, defs: &[SchemeDef], diags: &mut Vec<Diagnostic>) -> Vec<SchemeIr> {
+pub fn compile(prog: &Unit, defs: &[SchemeDef], diags: &mut Vec<Diagnostic>) -> Vec<SchemeIr> {
     defs.iter().filter_map(|d| Compiler::new(prog, d).run().map_err(|mut e| diags.append(&mut e)).ok()).collect()
 }
 
@@ -120,7 +108,7 @@ enum Value {
 }
 
 struct Compiler<'a> {
-    prog: &'a Program,
+    prog: &'a Unit,
     def: &'a SchemeDef,
     g: Graph,
     params: Vec<SchemeParamInfo>,
@@ -139,7 +127,7 @@ const SCHEME_BUILTINS: &[&str] = &["dt", "t", "pi"];
 const SCHEME_FUNCTIONS: &[&str] = &["sqrt", "abs"];
 
 impl<'a> Compiler<'a> {
-    fn new(prog: &'a Program, def: &'a SchemeDef) -> Self {
+    fn new(prog: &'a Unit, def: &'a SchemeDef) -> Self {
         Compiler {
             prog,
             def,
@@ -458,7 +446,7 @@ impl<'a> Compiler<'a> {
 
     fn stage(&mut self, st: &ast::Stage, last: bool) -> Option<StageIr> {
         let name = st.name.as_ref().map_or_else(|| format!("stage{}", self.stage_index + 1), |n| n.name.clone());
-        let at_span = st.span.unwrap_or(self.def.span);
+        let at_span = st.span.unwrap_or(self.def.name.span);
         let Some(unknown) = &st.unknown else {
             self.error(
                 Diagnostic::error("E0805", format!("stage `{name}` has no unknown"), at_span, "no `unknown` line")
@@ -597,12 +585,18 @@ impl<'a> Compiler<'a> {
             let candidates: Vec<usize> = (1..n_new).filter(|&q| solved[q].is_none() && eq.has_new(q)).collect();
             let pivot = own.filter(|o| candidates.contains(o)).or_else(|| candidates.first().copied());
             let Some(q) = pivot else {
-                self.error(Diagnostic::error(
-                    "E0812",
-                    "this relation determines no new quantity",
-                    span,
-                    "it repeats or contradicts the others",
-                ));
+                let open: Vec<String> =
+                    (1..n_new).filter(|&q| solved[q].is_none()).map(|q| format!("`{}`", self.new[q])).collect();
+                self.error(
+                    Diagnostic::error(
+                        "E0812",
+                        "this relation determines no new quantity",
+                        span,
+                        "it involves no quantity the relations before it leave open",
+                    )
+                    .with_note(format!("still undetermined: {}", open.join(", ")))
+                    .with_help("each relation must involve a new quantity not yet given by the others"),
+                );
                 self.scope = saved;
                 return None;
             };

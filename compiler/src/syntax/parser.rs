@@ -48,9 +48,15 @@ pub fn parse(file: FileId, text: &str) -> (File, Vec<Diagnostic>) {
                 let chunk_pair = pairs.next().expect("chunk rule always yields one pair");
                 for p in chunk_pair.into_inner() {
                     if p.as_rule() != Rule::EOI {
+                        let item_text = p.as_str();
                         match b.item(p) {
                             Ok(item) => out.items.push(item),
-                            Err(d) => diags.push(*d),
+                            Err(d) => {
+                                // An item that parsed but was refused (a number out of range,
+                                // two unknowns) still declares its name.
+                                diags.push(*d);
+                                note_broken_name(item_text, &mut out.broken_names);
+                            }
                         }
                     }
                 }

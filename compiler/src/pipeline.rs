@@ -1,0 +1,177 @@
+//! The compiler as one pipeline: load and parse the unit, check it, compile its schemes, lower
+//! its forms to IR (per dimension, on demand) and generate Rust. The CLI (`check`, `emit`), the
+//! `forms!` macro and the helpers below all go through [`compile`].
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use crate::check::{self, load};
+use crate::codegen;
+use crate::diagnostic::{self, Diagnostic, render_all};
+use crate::ir::{self, DimIr};
+use crate::program::Program;
+use crate::scheme::{self, SchemeIr};
+use crate::source::{Loader, SourceMap};
+use crate::syntax::ast;
+
+/// Why a unit did not compile: rendered diagnostics, or an I/O problem with the root file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Failure {
+    /// Human-readable, with file:line:col and carets.
+    pub rendered: String,
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.rendered)
+    }
+}
+
+impl Failure {
+    fn internal(e: impl std::fmt::Display) -> Failure {
+        Failure { rendered: format!("error: {e}\n") }
+    }
+}
+
+/// Every stage of a unit that compiled.
+pub struct Compiled {
+    /// The checked program, schemes compiled.
+    pub program: Program,
+    /// The root file's syntax tree (imports have their own).
+    pub ast: ast::File,
+    /// The warnings, rendered (empty if none).
+    pub warnings: String,
+    /// The IR for dimensions 1, 2, 3, built when first asked for.
+    irs: [OnceLock<DimIr>; 3],
+}
+
+impl Compiled {
+    /// The IR of every form for dimension `d` (1, 2 or 3; panics otherwise).
+    pub fn ir(&self, d: usize) -> &DimIr {
+        assert!(ir::DIMS.contains(&d), "dimension {d} is not one of {:?}", ir::DIMS);
+        self.irs[d - 1].get_or_init(|| ir::build(&self.program, d))
+    }
+
+    /// The IR for every dimension of [`ir::DIMS`], in order.
+    pub fn irs(&self) -> Vec<&DimIr> {
+        ir::DIMS.iter().map(|&d| self.ir(d)).collect()
+    }
+
+    /// The compiled time schemes.
+    pub fn schemes(&self) -> &[SchemeIr] {
+        &self.program.schemes
+    }
+
+    /// Every file of the unit (the root and its imports), as loaded.
+    pub fn source_paths(&self) -> Vec<PathBuf> {
+        let sources = &self.program.sources;
+        (0..sources.len()).map(|f| sources.path(f).to_path_buf()).collect()
+    }
+
+    /// The generated Rust: one `pub mod`.
+    pub fn rust(&self, opts: &codegen::Options) -> Result<syn::File, Failure> {
+        codegen::generate(&self.program, &self.irs(), opts).map_err(Failure::internal)
+    }
+
+    /// The generated Rust formatted for reading, with its line count in a header comment.
+    pub fn rust_pretty(&self, opts: &codegen::Options) -> Result<String, Failure> {
+        Ok(codegen::pretty(&self.rust(opts)?, &opts.source_name))
+    }
+}
+
+/// Result of the front end (loading, checking, schemes): the program with its warnings, or
+/// every diagnostic in source order with the sources needed to render them.
+pub type Checked = Result<Program, (Vec<Diagnostic>, SourceMap)>;
+
+/// Compiles the unit rooted at `path` (imports resolve through `loader`).
+pub fn compile(path: &Path, loader: &dyn Loader) -> Result<Compiled, Failure> {
+    let mut diags = Vec::new();
+    let loaded = load::load(path, loader, &mut diags).map_err(Failure::internal)?;
+    finish(front(loaded, diags))
+}
+
+/// Compiles `text` as if it were the file `path` (imports resolve through `loader`).
+pub fn compile_text(path: &Path, text: &str, loader: &dyn Loader) -> Result<Compiled, Failure> {
+    let mut diags = Vec::new();
+    let loaded = load::load_text(path, text, loader, &mut diags);
+    finish(front(loaded, diags))
+}
+
+/// The front end of [`compile`], with the diagnostics as values (for tests and tools).
+pub fn check_file(path: &Path, loader: &dyn Loader) -> Result<Checked, String> {
+    let mut diags = Vec::new();
+    let loaded = load::load(path, loader, &mut diags)?;
+    Ok(front(loaded, diags).map(|(prog, _)| prog))
+}
+
+/// The front end of [`compile_text`], with the diagnostics as values.
+pub fn check_text(path: &Path, text: &str, loader: &dyn Loader) -> Checked {
+    let mut diags = Vec::new();
+    let loaded = load::load_text(path, text, loader, &mut diags);
+    front(loaded, diags).map(|(prog, _)| prog)
+}
+
+/// Checks a unit; on success returns the program and its rendered warnings.
+pub fn check_path(path: &Path, loader: &dyn Loader) -> Result<(Program, String), Failure> {
+    compile(path, loader).map(|c| (c.program, c.warnings))
+}
+
+/// Compiles a unit to formatted Rust (the module named after the file stem).
+pub fn compile_to_rust(path: &Path, loader: &dyn Loader, runtime: &str) -> Result<String, Failure> {
+    let opts =
+        codegen::Options { runtime: runtime.to_string(), module: module_name(path), source_name: display_name(path) };
+    compile(path, loader)?.rust_pretty(&opts)
+}
+
+/// What `forms!` expands to: the generated module, and every file it was compiled from (for
+/// rebuild tracking).
+pub struct Expansion {
+    pub file: syn::File,
+    pub sources: Vec<PathBuf>,
+}
+
+/// The `forms!` macro without the macro: the module generated from `path`, or the rendered
+/// diagnostics.
+pub fn expand(path: &Path, loader: &dyn Loader, opts: &codegen::Options) -> Result<Expansion, String> {
+    let compiled = compile(path, loader).map_err(|f| f.rendered)?;
+    let file = compiled.rust(opts).map_err(|f| f.rendered)?;
+    Ok(Expansion { file, sources: compiled.source_paths() })
+}
+
+/// The default module name of a .wf file: its stem.
+pub fn module_name(path: &Path) -> String {
+    path.file_stem().map_or_else(|| "forms".to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// The file name shown in generated documentation (no machine-specific directories).
+pub fn display_name(path: &Path) -> String {
+    path.file_name().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Checks a loaded unit and compiles its schemes; returns the program and the root's AST.
+fn front(loaded: load::Loaded, diags: Vec<Diagnostic>) -> Result<(Program, ast::File), (Vec<Diagnostic>, SourceMap)> {
+    let load::Loaded { sources, mut files, root } = loaded;
+    let mut unit = check::check(sources, root, &files, diags)?;
+    let mut diags = std::mem::take(&mut unit.warnings);
+    let schemes = scheme::compile(&unit, &unit.scheme_defs, &mut diags);
+    diagnostic::normalize(&mut diags);
+    if diags.iter().any(Diagnostic::is_error) {
+        return Err((diags, unit.sources));
+    }
+    unit.warnings = diags;
+    let ast = match files.iter().position(|(id, _)| *id == root) {
+        Some(i) => files.swap_remove(i).1,
+        None => ast::File::default(),
+    };
+    Ok((Program { unit, schemes }, ast))
+}
+
+fn finish(front: Result<(Program, ast::File), (Vec<Diagnostic>, SourceMap)>) -> Result<Compiled, Failure> {
+    match front {
+        Err((diags, sources)) => Err(Failure { rendered: render_all(&diags, &sources) }),
+        Ok((program, ast)) => {
+            let warnings = render_all(&program.warnings, &program.sources);
+            Ok(Compiled { program, ast, warnings, irs: Default::default() })
+        }
+    }
+}

@@ -1,0 +1,124 @@
+//! The sparsity pattern of a vector field on a mesh, shared by assembly (which adds element
+//! matrices into it) and linear algebra (whose matrices live on it).
+//!
+//! For each cell it stores, for every pair of its nodes (i, j), the offset of node i's first
+//! row inside node j's columns, so element matrices are added in place without searching.
+
+use crate::kernel::LocalMatrix;
+use crate::mesh::Mesh;
+
+/// The sparsity pattern of a vector field on a mesh (CSC, rows sorted in each column).
+#[derive(Debug)]
+pub struct Pattern {
+    dim: usize,
+    pub col_ptr: Vec<usize>,
+    pub row_idx: Vec<usize>,
+    /// Per cell, `[j][i]`: offset of node i's first row within the columns of node j.
+    cell_offsets: Vec<u32>,
+}
+
+impl Pattern {
+    /// Couples every pair of nodes sharing a cell.
+    pub fn new(mesh: &Mesh) -> Pattern {
+        let d = mesh.dim();
+        let npc = mesh.kind.nodes();
+        let nodes = mesh.num_nodes();
+        let cells = mesh.num_cells();
+        // Node → cells incidence.
+        let mut inc_ptr = vec![0usize; nodes + 1];
+        for &n in &mesh.cells {
+            inc_ptr[n as usize + 1] += 1;
+        }
+        for i in 0..nodes {
+            inc_ptr[i + 1] += inc_ptr[i];
+        }
+        let mut fill = inc_ptr.clone();
+        let mut inc = vec![0u32; mesh.cells.len()];
+        for c in 0..cells {
+            for &n in mesh.cell(c) {
+                inc[fill[n as usize]] = c as u32;
+                fill[n as usize] += 1;
+            }
+        }
+        // Node adjacency, sorted.
+        let mut adj_ptr = Vec::with_capacity(nodes + 1);
+        adj_ptr.push(0usize);
+        let mut adj: Vec<u32> = Vec::with_capacity(nodes * 2 * npc);
+        let mut scratch: Vec<u32> = Vec::new();
+        for n in 0..nodes {
+            scratch.clear();
+            for &c in &inc[inc_ptr[n]..inc_ptr[n + 1]] {
+                scratch.extend_from_slice(mesh.cell(c as usize));
+            }
+            scratch.sort_unstable();
+            scratch.dedup();
+            adj.extend_from_slice(&scratch);
+            adj_ptr.push(adj.len());
+        }
+        // Columns: node j's d columns each hold rows (i, k) for i adjacent to j.
+        let size = nodes * d;
+        let mut col_ptr = Vec::with_capacity(size + 1);
+        col_ptr.push(0usize);
+        let mut row_idx = Vec::with_capacity(adj.len() * d * d);
+        for j in 0..nodes {
+            let neighbours = &adj[adj_ptr[j]..adj_ptr[j + 1]];
+            for _m in 0..d {
+                for &i in neighbours {
+                    for k in 0..d {
+                        row_idx.push(i as usize * d + k);
+                    }
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        let mut cell_offsets = Vec::with_capacity(cells * npc * npc);
+        for c in 0..cells {
+            let cell = mesh.cell(c);
+            for &nj in cell {
+                let neighbours = &adj[adj_ptr[nj as usize]..adj_ptr[nj as usize + 1]];
+                for &ni in cell {
+                    let pos = neighbours.binary_search(&ni).expect("nodes of a cell are adjacent");
+                    cell_offsets.push((pos * d) as u32);
+                }
+            }
+        }
+        Pattern { dim: d, col_ptr, row_idx, cell_offsets }
+    }
+
+    /// Number of rows (= columns).
+    pub fn size(&self) -> usize {
+        self.col_ptr.len() - 1
+    }
+
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Adds an element matrix of cell `c` with nodes `cell` into `values`.
+    #[inline]
+    pub(crate) fn scatter<const D: usize, const N: usize>(
+        &self,
+        c: usize,
+        cell: &[u32],
+        ke: &LocalMatrix<D, N>,
+        values: &mut [f64],
+    ) {
+        let off = &self.cell_offsets[c * N * N..(c + 1) * N * N];
+        for j in 0..N {
+            let nj = cell[j] as usize;
+            for m in 0..D {
+                let base = self.col_ptr[nj * D + m];
+                for i in 0..N {
+                    let o = base + off[j * N + i] as usize;
+                    for k in 0..D {
+                        values[o + k] += ke[i][k][j][m];
+                    }
+                }
+            }
+        }
+    }
+}
