@@ -9,6 +9,7 @@
 mod affine;
 pub mod layout;
 pub mod print;
+pub mod simplify;
 
 use std::collections::HashMap;
 
@@ -284,7 +285,7 @@ impl<'a> Compiler<'a> {
         if !self.diags.is_empty() {
             return Err(self.diags);
         }
-        Ok(SchemeIr {
+        let mut ir = SchemeIr {
             name: def.name.name.clone(),
             span: def.span,
             params: self.params,
@@ -294,7 +295,9 @@ impl<'a> Compiler<'a> {
             initial,
             stages,
             updates,
-        })
+        };
+        simplify::scheme(&mut ir);
+        Ok(ir)
     }
 
     fn is_slot(&self, name: &str) -> bool {
