@@ -360,7 +360,7 @@ impl Normalizer {
                 self.memo.insert(n, e);
             }
         }
-        self.memo[&id].clone()
+        self.memo.get(&id).cloned().unwrap_or(Err(GiveUp))
     }
 
     fn node(&self, g: &Graph, id: NodeId) -> Res<Expr> {
