@@ -87,6 +87,19 @@ impl Affine {
         self.add(g, &neg)
     }
 
+    /// Replaces every coefficient by `f` of it; coefficients that become zero drop out.
+    pub fn map_coefs(&mut self, g: &mut Graph, f: &mut impl FnMut(&mut Graph, NodeId) -> NodeId) {
+        self.unknown = f(g, self.unknown);
+        for (_, c) in &mut self.known {
+            *c = f(g, *c);
+        }
+        self.known.retain(|(_, c)| !g.is_zero(*c));
+        for (_, c) in &mut self.new {
+            *c = f(g, *c);
+        }
+        self.new.retain(|(_, c)| !g.is_zero(*c));
+    }
+
     /// Whether new quantity `index` appears (with a nonzero coefficient).
     pub fn has_new(&self, index: usize) -> bool {
         self.new.iter().any(|(i, _)| *i == index)

@@ -9,6 +9,7 @@
 mod affine;
 pub mod layout;
 pub mod print;
+pub mod simplify;
 
 use std::collections::HashMap;
 
@@ -272,7 +273,7 @@ impl<'a> Compiler<'a> {
         if !self.diags.is_empty() {
             return Err(self.diags);
         }
-        Ok(SchemeIr {
+        let mut ir = SchemeIr {
             name: def.name.name.clone(),
             span: def.span,
             params: self.params,
@@ -282,7 +283,9 @@ impl<'a> Compiler<'a> {
             initial,
             stages,
             updates,
-        })
+        };
+        simplify::scheme(&mut ir);
+        Ok(ir)
     }
 
     fn is_slot(&self, name: &str) -> bool {
