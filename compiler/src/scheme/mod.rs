@@ -273,7 +273,7 @@ impl<'a> Compiler<'a> {
         if !self.diags.is_empty() {
             return Err(self.diags);
         }
-        let mut ir = SchemeIr {
+        let ir = SchemeIr {
             name: def.name.name.clone(),
             span: def.span,
             params: self.params,
@@ -284,7 +284,6 @@ impl<'a> Compiler<'a> {
             stages,
             updates,
         };
-        simplify::scheme(&mut ir);
         Ok(ir)
     }
 

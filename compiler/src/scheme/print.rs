@@ -6,7 +6,14 @@ use std::fmt::Write;
 use super::{Affine, Quantity, SchemeIr, Term};
 use crate::ir::graph::{Graph, Node, NodeId, Sym};
 
+/// The scheme with every coefficient simplified (see `simplify::scheme`).
 pub fn print(s: &SchemeIr) -> String {
+    let mut shown = s.clone();
+    super::simplify::scheme(&mut shown);
+    print_as_is(&shown)
+}
+
+fn print_as_is(s: &SchemeIr) -> String {
     let mut out = String::new();
     let params: Vec<String> = s.params.iter().map(|p| format!("{} = {}", p.name, p.default)).collect();
     let _ = writeln!(out, "scheme {}({})", s.name, params.join(", "));
