@@ -127,15 +127,15 @@ pub enum Case {
 /// The scheme, the form files and their params (`signorini list` shows what there is).
 #[derive(clap::Args, Clone)]
 pub struct MethodArgs {
-    /// A scheme of the library by name, or a .wf file (run interpreted).
-    #[arg(long, default_value = "newmark")]
-    scheme: String,
-    /// A contact law of the library by name (nitsche, penalty), or a .wf file.
-    #[arg(long, default_value = "nitsche")]
-    contact: String,
-    /// The material's form file (by name or path).
-    #[arg(long, default_value = "elasticity")]
-    material: String,
+    /// A scheme of the library by name, or a .wf file (run interpreted) [default: newmark].
+    #[arg(long)]
+    scheme: Option<String>,
+    /// A contact law of the library by name (nitsche, penalty), or a .wf file [default: nitsche].
+    #[arg(long)]
+    contact: Option<String>,
+    /// The material's form file, by name or path [default: elasticity].
+    #[arg(long)]
+    material: Option<String>,
     /// Extra form files whose slots the scheme applies (repeatable).
     #[arg(long = "forms", value_name = "FILE.wf")]
     forms: Vec<PathBuf>,
@@ -167,10 +167,11 @@ impl MethodArgs {
                 value.trim().parse().map_err(|_| format!("--param {p}: `{}` is not a number", value.trim()))?;
             params.push(Setting { name: name.trim().into(), value, origin: format!("--param {p}") });
         }
+        let d = Setup::default();
         Ok(Setup {
-            scheme: self.scheme.clone(),
-            contact: self.contact.clone(),
-            material: self.material.clone(),
+            scheme: self.scheme.clone().unwrap_or(d.scheme),
+            contact: self.contact.clone().unwrap_or(d.contact),
+            material: self.material.clone().unwrap_or(d.material),
             forms: self.forms.clone(),
             compiled: Vec::new(),
             params,

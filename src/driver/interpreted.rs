@@ -4,8 +4,10 @@
 
 use std::path::Path;
 
+use crate::compiler::ir::eval::Program;
 use crate::compiler::ir::graph::{Graph, NodeId};
 use crate::compiler::scheme::layout::{self, Combination, TermLayout};
+use crate::compiler::scheme::scheme_leaf;
 use crate::compiler::scheme::{Quantity, SchemeIr};
 use crate::compiler::{check_path, docs};
 use crate::driver::sources::LibraryLoader;
@@ -22,11 +24,10 @@ pub struct Interpreted {
     coefficients: Vec<NodeId>,
 }
 
-/// Its instance with param values.
+/// Its instance with param values: the coefficients as one program of the IR evaluator.
 struct Running {
     desc: &'static SchemeDesc,
-    graph: Graph,
-    coefficients: Vec<NodeId>,
+    program: Program,
     values: Vec<f64>,
 }
 
@@ -35,8 +36,8 @@ impl TimeScheme for Running {
         self.desc
     }
     fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]) {
-        let v = crate::compiler::scheme::eval_all(&self.graph, &self.coefficients, &self.values, dt, t);
-        out.copy_from_slice(&v);
+        let leaves: Vec<f64> = self.program.syms().iter().map(|&s| scheme_leaf(s, &self.values, dt, t)).collect();
+        self.program.run(&leaves, &mut Vec::new(), out);
     }
 }
 
@@ -145,8 +146,7 @@ impl Interpreted {
         }
         Ok(Box::new(Running {
             desc: self.desc,
-            graph: self.graph.clone(),
-            coefficients: self.coefficients.clone(),
+            program: Program::new(&self.graph, &self.coefficients),
             values: values.to_vec(),
         }))
     }

@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use super::Quantity;
-use crate::ir::graph::{Graph, Node, NodeId, Sym};
+use crate::ir::graph::{Graph, NodeId, Sym};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Key {
@@ -142,26 +142,18 @@ pub fn eval(g: &Graph, id: NodeId, params: &[f64], dt: f64, t: f64) -> f64 {
     eval_all(g, &[id], params, dt, t)[0]
 }
 
-/// The values of scheme scalars (params, dt and t are the only leaves), in one pass.
+/// The values of scheme scalars (params, dt and t are the only leaves), by the IR's one
+/// evaluator.
 pub fn eval_all(g: &Graph, roots: &[NodeId], params: &[f64], dt: f64, t: f64) -> Vec<f64> {
-    let mut value = vec![f64::NAN; g.len()];
-    // `reachable` is sorted by id, and children have smaller ids than their parents.
-    for n in g.reachable(roots.iter().copied()) {
-        let v = |x: NodeId| value[x as usize];
-        value[n as usize] = match g.node(n) {
-            Node::Const(b) => f64::from_bits(b),
-            Node::Sym(Sym::Param(i)) => params.get(i as usize).copied().unwrap_or(f64::NAN),
-            Node::Sym(Sym::Dt) => dt,
-            Node::Sym(Sym::Time) => t,
-            Node::Sym(_) => f64::NAN,
-            Node::Add(a, b) => v(a) + v(b),
-            Node::Mul(a, b) => v(a) * v(b),
-            Node::Neg(a) => -v(a),
-            Node::Div(a, b) => v(a) / v(b),
-            Node::Powi(a, k) => v(a).powi(k),
-            Node::Sqrt(a) => v(a).sqrt(),
-            Node::Heaviside(a) => f64::from(v(a) > 0.0),
-        };
+    crate::ir::eval::evaluate(g, roots, |s| scheme_leaf(s, params, dt, t))
+}
+
+/// A scheme coefficient's leaf: a param, dt or t.
+pub fn scheme_leaf(s: Sym, params: &[f64], dt: f64, t: f64) -> f64 {
+    match s {
+        Sym::Param(i) => params.get(i as usize).copied().unwrap_or(f64::NAN),
+        Sym::Dt => dt,
+        Sym::Time => t,
+        _ => f64::NAN,
     }
-    roots.iter().map(|&r| value[r as usize]).collect()
 }

@@ -13,7 +13,7 @@ pub mod simplify;
 
 use std::collections::HashMap;
 
-pub use affine::{Affine, eval_all};
+pub use affine::{Affine, eval_all, scheme_leaf};
 
 pub use crate::check::SchemeDef;
 use crate::check::{Global, ParamRange, Unit, const_eval};
