@@ -146,3 +146,20 @@ fn midpoint_schemes_measure_contact_at_half_steps() {
     .summary;
     assert!(midpoint.err_l2_lambda > 4.0 * midpoint.err_l2_lambda_half, "{midpoint:?}");
 }
+
+/// In 1D σ(u)n = σ_N(u) n, so GetFEM's full-traction Nitsche law is the normal one, and GetFEM's
+/// cell size is the length: the same series, step for step, for every θ.
+#[test]
+fn full_traction_nitsche_is_the_normal_law_in_1d() {
+    for theta in [1.0, 0.0, -1.0] {
+        let normal = run(|o| o.setup = o.setup.clone().set("theta", theta));
+        let traction = run(|o| {
+            o.setup =
+                signorini::driver::Setup { contact: "nitsche-traction".into(), ..o.setup.clone() }.set("theta", theta);
+            o.cell_size = signorini::runtime::mesh::CellSize::GetFem;
+        });
+        for (a, b) in normal.series.iter().zip(&traction.series) {
+            assert!((a.u_c - b.u_c).abs() <= 1e-14, "θ = {theta}, t = {}: {} vs {}", a.t, a.u_c, b.u_c);
+        }
+    }
+}

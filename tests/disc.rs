@@ -17,6 +17,7 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
         for row in r.series.iter().filter(|row| row.t < t_star - 0.05) {
             let exact = -0.5 * GRAVITY * row.t * row.t;
             assert!((row.uy_mean - exact).abs() < 1e-10, "{scheme:?} t = {}: mean {} vs {exact}", row.t, row.uy_mean);
+            assert!((row.uy_mean_nodal - exact).abs() < 1e-10, "{scheme:?} t = {}: nodal mean", row.t);
             assert!(
                 (row.uy_lowest - exact).abs() < 1e-10,
                 "{scheme:?} t = {}: lowest {} vs {exact}",

@@ -21,6 +21,7 @@ use signorini::runtime::scheme::{Bound, BoundForm};
 signorini::forms!("forms/elasticity.wf");
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
+signorini::forms!("forms/contact_nitsche_traction.wf");
 
 const TOL: f64 = 1e-12;
 const T: f64 = 0.37;
@@ -317,6 +318,15 @@ unit_test!(
     contact_nitsche,
     "forms/contact_nitsche.wf",
     |d| contact_nitsche::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
+    forms: [Contact, HybridContact],
+    functionals: [ContactEnergy, ContactPressure, ContactTrial]
+);
+
+unit_test!(
+    traction_interpreted_matches_compiled,
+    contact_nitsche_traction,
+    "forms/contact_nitsche_traction.wf",
+    |d| contact_nitsche_traction::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact, HybridContact],
     functionals: [ContactEnergy, ContactPressure, ContactTrial]
 );

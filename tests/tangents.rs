@@ -8,6 +8,7 @@ use signorini::runtime::kernel::{Coef, FacetTabulation, FormKernel, facet_matrix
 
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
+signorini::forms!("forms/contact_nitsche_traction.wf");
 
 /// Gap to the plane {x_d = 0} with the obstacle below: g = x_d, n_c = −e_d.
 fn gap(d: usize) -> Coef {
@@ -28,6 +29,13 @@ fn nitsche(theta: f64, gamma0: f64, e: f64, nu: f64, d: usize) -> contact_nitsch
     let c = contact_nitsche::Coefficients { f: Coef::constant(vec![0.0; d]), g: gap(d), nc: down(d) };
     c.check(d).unwrap();
     contact_nitsche::Contact::new(&p, &c)
+}
+
+/// GetFEM's variant: the θ term with the full traction σ(u)n·σ(v)n.
+fn traction(theta: f64, d: usize) -> contact_nitsche_traction::Contact {
+    let p = contact_nitsche_traction::Params::default().with("theta", theta).and_then(|p| p.with("nu", 0.3)).unwrap();
+    let c = contact_nitsche_traction::Coefficients { f: Coef::constant(vec![0.0; d]), g: gap(d), nc: down(d) };
+    contact_nitsche_traction::Contact::new(&p, &c)
 }
 
 fn penalty(gamma0: f64, d: usize) -> contact_penalty::Contact {
@@ -123,6 +131,7 @@ fn check_2d<K: FormKernel<2, 6>>(k: &K, what: &str) {
 fn nitsche_tangent_matches_finite_differences_in_2d() {
     for theta in [1.0, 0.0, -1.0] {
         check_2d(&nitsche(theta, 5.0, 1.0, 0.3, 2), &format!("Nitsche θ = {theta}"));
+        check_2d(&traction(theta, 2), &format!("Nitsche (full traction) θ = {theta}"));
     }
 }
 

@@ -290,7 +290,7 @@ fn facet_ctx<'a, const D: usize, const N: usize>(
     t: f64,
 ) -> FacetCtx<'a, D, N> {
     let (tab, ref_normal) = &tabs.facets[f.local as usize];
-    FacetCtx { tab, ref_normal, coords, h: mesh.cell_diameter(f.cell as usize), t }
+    FacetCtx { tab, ref_normal, coords, h: mesh.cell_size(f.cell as usize), t }
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -71,3 +71,26 @@ fn disc_is_curved_p2_with_its_boundary_on_the_circle() {
     let lowest = m.region_nodes(contact).iter().map(|&n| m.node(n as usize)[1]).fold(f64::INFINITY, f64::min);
     assert!(close(lowest, 2.0, 1e-12));
 }
+
+/// GetFEM's cell size on straight triangles: J = (x₁ − x₀, x₂ − x₀) from the unit-leg simplex is
+/// constant, and h/√2 = σ_min(J) must satisfy σ_min·σ_max = |det J| and
+/// σ_min² + σ_max² = ‖J‖²_F; on P2 cells with straight edges the same value.
+#[test]
+fn getfem_cell_size_of_straight_triangles() {
+    use signorini_runtime::mesh::CellSize;
+    use signorini_runtime::mesh::structured::{Diagonal, rectangle};
+    for degree in [1, 2] {
+        let mut mesh = rectangle(4, 2, [0.0, 1.0], [0.0, 0.3], Diagonal::Right, degree);
+        mesh.cell_size = CellSize::GetFem;
+        for c in 0..mesh.num_cells() {
+            let v: Vec<&[f64]> = mesh.cell(c).iter().take(3).map(|&n| mesh.node(n as usize)).collect();
+            let (a, b) = ([v[1][0] - v[0][0], v[1][1] - v[0][1]], [v[2][0] - v[0][0], v[2][1] - v[0][1]]);
+            let det = (a[0] * b[1] - a[1] * b[0]).abs();
+            let frob2 = a[0] * a[0] + a[1] * a[1] + b[0] * b[0] + b[1] * b[1];
+            let smin = mesh.cell_size(c) / 2f64.sqrt();
+            let smax = det / smin;
+            assert!(smin <= smax + 1e-15, "P{degree} cell {c}");
+            assert!((smin * smin + smax * smax - frob2).abs() < 1e-13, "P{degree} cell {c}: {smin} {smax} {frob2}");
+        }
+    }
+}

@@ -13,7 +13,7 @@ use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
 use crate::runtime::library::Binding;
 use crate::runtime::linalg::{Matrix, Structure};
-use crate::runtime::mesh::structured;
+use crate::runtime::mesh::{CellSize, structured};
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
 use crate::runtime::scheme::{MatrixForm, Stepper};
@@ -37,6 +37,8 @@ pub struct Options {
     pub dt: f64,
     pub t_end: f64,
     pub mass: MassChoice,
+    /// What `h` means in γ = γ0/h.
+    pub cell_size: CellSize,
     pub newton: NewtonOptions,
     pub out: Option<PathBuf>,
     /// Show a progress bar on long runs (when stdout is a terminal).
@@ -51,6 +53,7 @@ impl Default for Options {
             dt: 0.01,
             t_end: 12.0,
             mass: MassChoice::Consistent,
+            cell_size: CellSize::Diameter,
             newton: NewtonOptions::default(),
             out: None,
             progress: false,
@@ -86,6 +89,7 @@ pub struct Summary {
     /// Every param of the scheme and form files, with its value and where it comes from.
     pub params: std::collections::BTreeMap<String, ParamValue>,
     pub mass: MassChoice,
+    pub cell_size: CellSize,
     pub elements: usize,
     pub dt: f64,
     pub t_end: f64,
@@ -147,7 +151,8 @@ fn coefs(name: &str) -> Option<Coef> {
 fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let start = Instant::now();
     let ne = opts.elements;
-    let mesh = structured::interval(ne, 0.0, 1.0);
+    let mut mesh = structured::interval(ne, 0.0, 1.0);
+    mesh.cell_size = opts.cell_size;
     let asm = Assembler::new(&mesh);
     let n = asm.size();
     let contact_facets = asm.region("left")?;
@@ -265,6 +270,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         interpreted: active.interpreted(),
         params: active.params.values(),
         mass: opts.mass,
+        cell_size: opts.cell_size,
         elements: ne,
         dt: opts.dt,
         t_end: t,

@@ -13,6 +13,7 @@ use super::CaseError;
 use super::bar::{self, MassChoice};
 use super::disc;
 use crate::driver::{self, Setting, Setup};
+use crate::runtime::mesh::CellSize;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -29,6 +30,8 @@ struct CaseFile {
     theta: Option<Spanned<f64>>,
     gamma0: Option<Spanned<f64>>,
     mass: Option<Spanned<String>>,
+    /// `diameter` or `getfem`.
+    cell_size: Option<Spanned<String>>,
     dt: Option<Spanned<f64>>,
     t_end: Option<Spanned<f64>>,
     out: Option<Spanned<String>>,
@@ -108,6 +111,10 @@ pub fn read(path: &Path) -> Result<Case, CaseError> {
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mass: MassChoice = r.choice(&parsed.mass, "mass", MassChoice::Consistent)?;
     let setup = setup(&r, &parsed, &base)?;
+    let cell_size = match &parsed.cell_size {
+        None => CellSize::default(),
+        Some(s) => CellSize::parse(s.get_ref()).map_err(|e| r.error(s, "cell_size", e))?,
+    };
     let out = parsed.out.as_ref().map(|o| base.join(o.get_ref()));
     match parsed.case.get_ref().as_str() {
         "bar" => {
@@ -125,6 +132,7 @@ pub fn read(path: &Path) -> Result<Case, CaseError> {
                 dt: r.number(&parsed.dt, "dt", |x| x > 0.0, "positive", d.dt)?,
                 t_end: r.number(&parsed.t_end, "t_end", |x| x > 0.0, "positive", d.t_end)?,
                 mass,
+                cell_size,
                 out,
                 ..d
             }))
@@ -135,6 +143,7 @@ pub fn read(path: &Path) -> Result<Case, CaseError> {
             Ok(Case::Disc(disc::Options {
                 setup,
                 mass,
+                cell_size,
                 mesh: parsed.mesh.as_ref().map(|m| base.join(m.get_ref())),
                 h: r.number(&parsed.h, "h", |x| x > 0.05 && x <= 10.0, "in (0.05, 10]", d.h)?,
                 dt: r.number(&parsed.dt, "dt", |x| x > 0.0, "positive", d.dt)?,

@@ -21,8 +21,8 @@ use crate::runtime::evaluate::facet_samples;
 use crate::runtime::kernel::Coef;
 use crate::runtime::library::Binding;
 use crate::runtime::linalg::Structure;
-use crate::runtime::mesh::Mesh;
 use crate::runtime::mesh::structured::{self, Diagonal};
+use crate::runtime::mesh::{CellSize, Mesh};
 use crate::runtime::newton::{Newton, NewtonOptions, NewtonReport};
 use crate::runtime::problem::{Constraints, StaticContact};
 
@@ -40,6 +40,8 @@ pub struct Options {
     pub gravity: f64,
     /// Curvature of the obstacle (0: the plane).
     pub curvature: f64,
+    /// What `h` means in γ = γ0/h.
+    pub cell_size: CellSize,
     pub newton: NewtonOptions,
     pub out: Option<PathBuf>,
 }
@@ -53,6 +55,7 @@ impl Default for Options {
             h: 0.125,
             gravity: 1.0,
             curvature: 0.0,
+            cell_size: CellSize::Diameter,
             newton: NewtonOptions::default(),
             out: None,
         }
@@ -108,6 +111,8 @@ pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
         }
         d => return Err(CaseError::Option(format!("--dim must be 2 or 3, not {d}"))),
     };
+    let mut mesh = mesh;
+    mesh.cell_size = opts.cell_size;
     mesh.validate()?;
     Ok(mesh)
 }

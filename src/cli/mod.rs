@@ -12,6 +12,7 @@ use crate::cases::bar::{self, MassChoice};
 use crate::cases::static_block;
 use crate::compiler;
 use crate::driver::{Setting, Setup};
+use crate::runtime::mesh::CellSize;
 
 #[derive(Parser)]
 #[command(
@@ -151,6 +152,10 @@ pub struct MethodArgs {
     /// Shorthand for --param gamma0=VALUE.
     #[arg(long, allow_hyphen_values = true)]
     gamma0: Option<f64>,
+    /// What h means in γ = γ0/h: diameter (largest vertex distance) or getfem (GetFEM's
+    /// element_size: √d · max over the cell's nodes of σ_min of the reference Jacobian).
+    #[arg(long, value_parser = CellSize::parse, default_value = "diameter")]
+    cell_size: CellSize,
 }
 
 impl MethodArgs {
@@ -373,6 +378,7 @@ fn static_block(a: StaticBlockArgs) -> ExitCode {
     };
     let opts = static_block::Options {
         setup,
+        cell_size: a.methods.cell_size,
         dim: a.dim as usize,
         degree: a.degree as u32,
         h: a.h,
@@ -475,6 +481,7 @@ fn run_bar(a: BarArgs) -> ExitCode {
         dt: a.dt,
         t_end: a.t_end,
         mass: a.mass,
+        cell_size: a.methods.cell_size,
         out: a.out,
         progress: true,
         ..Default::default()
@@ -515,6 +522,7 @@ fn run_bar_all(a: BarArgs, base: Setup) -> ExitCode {
                     dt: a.dt,
                     t_end: a.t_end,
                     mass,
+                    cell_size: a.methods.cell_size,
                     out: a.out.as_ref().map(|d| d.join(&label)),
                     ..Default::default()
                 };
@@ -555,6 +563,7 @@ fn run_disc(a: DiscArgs) -> ExitCode {
     let opts = crate::cases::disc::Options {
         setup,
         mass: a.mass,
+        cell_size: a.methods.cell_size,
         mesh: a.mesh,
         h: a.h,
         dt: a.dt,

@@ -664,7 +664,14 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         }
     }
     let cells_flat: Vec<u32> = cell_nodes.iter().map(|&i| new_index[i]).collect();
-    let mut mesh = Mesh { kind, coords, cells: cells_flat, regions: Vec::new(), cell_groups: Vec::new() };
+    let mut mesh = Mesh {
+        kind,
+        coords,
+        cells: cells_flat,
+        regions: Vec::new(),
+        cell_groups: Vec::new(),
+        cell_size: super::CellSize::Diameter,
+    };
     let name_of = |d: u32, tag: i64| raw.names.get(&(d, tag)).cloned().unwrap_or_else(|| format!("physical_{tag}"));
     // Cell groups.
     let mut groups: BTreeMap<String, Vec<u32>> = BTreeMap::new();

@@ -45,6 +45,32 @@ pub struct Mesh {
     pub regions: Vec<Region>,
     /// Named groups of cells (Gmsh physical groups of the cell dimension).
     pub cell_groups: Vec<(String, Vec<u32>)>,
+    /// What `h`, the size of the cell carrying a facet, means in the forms.
+    pub cell_size: CellSize,
+}
+
+/// The size `h` of a cell (in `gamma = gamma0/h`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CellSize {
+    /// The largest distance between two vertices.
+    #[default]
+    Diameter,
+    /// GetFEM's `element_size`: √d times the largest, over the cell's geometric nodes, of the
+    /// smallest singular value of the Jacobian of the map from the unit-leg reference simplex
+    /// (in 1D, the length). Curved cells included.
+    GetFem,
+}
+
+impl CellSize {
+    /// `diameter` or `getfem`.
+    pub fn parse(s: &str) -> Result<CellSize, String> {
+        match s {
+            "diameter" => Ok(CellSize::Diameter),
+            "getfem" => Ok(CellSize::GetFem),
+            _ => Err(format!("`{s}` is not a cell size (diameter, getfem)")),
+        }
+    }
 }
 
 impl Mesh {
@@ -77,6 +103,17 @@ impl Mesh {
     }
 
     /// Diameter of a cell (largest distance between two vertices).
+    /// The size `h` of cell `c`, as `cell_size` says.
+    pub fn cell_size(&self, c: usize) -> f64 {
+        match self.cell_size {
+            CellSize::Diameter => self.cell_diameter(c),
+            CellSize::GetFem => {
+                let nodes: Vec<&[f64]> = self.cell(c).iter().map(|&n| self.node(n as usize)).collect();
+                crate::geometry::getfem_size(self.kind, &nodes)
+            }
+        }
+    }
+
     pub fn cell_diameter(&self, c: usize) -> f64 {
         let d = self.dim();
         let nodes = self.cell(c);
@@ -251,7 +288,14 @@ impl Mesh {
                 cells.push(id);
             }
         }
-        Mesh { kind, coords, cells, regions: self.regions.clone(), cell_groups: self.cell_groups.clone() }
+        Mesh {
+            kind,
+            coords,
+            cells,
+            regions: self.regions.clone(),
+            cell_groups: self.cell_groups.clone(),
+            cell_size: self.cell_size,
+        }
     }
 }
 

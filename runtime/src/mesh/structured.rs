@@ -23,7 +23,14 @@ pub fn interval(n: usize, a: f64, b: f64) -> Mesh {
         Region { name: "left".into(), facets: vec![Facet { cell: 0, local: 0 }] },
         Region { name: "right".into(), facets: vec![Facet { cell: n as u32 - 1, local: 1 }] },
     ];
-    Mesh { kind: ElementKind::IntervalP1, coords, cells, regions, cell_groups: Vec::new() }
+    Mesh {
+        kind: ElementKind::IntervalP1,
+        coords,
+        cells,
+        regions,
+        cell_groups: Vec::new(),
+        cell_size: super::CellSize::Diameter,
+    }
 }
 
 /// `nx × ny` squares of [x0, x1] × [y0, y1], two triangles each, P1 or P2 (`degree`).
@@ -47,7 +54,14 @@ pub fn rectangle(nx: usize, ny: usize, x: [f64; 2], y: [f64; 2], diagonal: Diago
             }
         }
     }
-    let mesh = Mesh { kind: ElementKind::TriangleP1, coords, cells, regions: Vec::new(), cell_groups: Vec::new() };
+    let mesh = Mesh {
+        kind: ElementKind::TriangleP1,
+        coords,
+        cells,
+        regions: Vec::new(),
+        cell_groups: Vec::new(),
+        cell_size: super::CellSize::Diameter,
+    };
     let mut mesh = if degree >= 2 { mesh.to_p2(None) } else { mesh };
     name_sides(&mut mesh, &[("left", 0, -1.0), ("right", 0, 1.0), ("bottom", 1, -1.0), ("top", 1, 1.0)]);
     mesh
@@ -85,8 +99,14 @@ pub fn cuboid(n: [usize; 3], x: [f64; 2], y: [f64; 2], z: [f64; 2], degree: u32)
             }
         }
     }
-    let mut mesh =
-        Mesh { kind: ElementKind::TetrahedronP1, coords, cells, regions: Vec::new(), cell_groups: Vec::new() };
+    let mut mesh = Mesh {
+        kind: ElementKind::TetrahedronP1,
+        coords,
+        cells,
+        regions: Vec::new(),
+        cell_groups: Vec::new(),
+        cell_size: super::CellSize::Diameter,
+    };
     orient_positively(&mut mesh);
     let mut mesh = if degree >= 2 { mesh.to_p2(None) } else { mesh };
     name_sides(
