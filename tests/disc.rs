@@ -101,3 +101,41 @@ fn an_unstable_setting_fails_with_a_clear_error() {
     let e = disc::run(&o).err().expect("diverges").to_string();
     assert!(e.contains("time stepping failed") && e.contains("finite"), "{e}");
 }
+
+/// Discrete energy laws on the disc with consistent mass and a constant load (docs/mathematics.md
+/// §5): for Crank–Nicolson (Newmark β = 1/4) and midpoint with Nitsche θ = 1, and with penalty,
+/// the augmented energy changes only on steps where the active set at the quadrature points
+/// changes; on every other step it is conserved to round-off and Newton's tolerance.
+#[test]
+fn energy_is_conserved_on_steps_with_an_unchanged_active_set() {
+    for scheme in ["newmark", "midpoint"] {
+        for contact in ["nitsche", "penalty"] {
+            let setup = Setup { scheme: scheme.into(), contact: contact.into(), ..Setup::default() };
+            let r = disc::run(&Options { setup, h: 2.0, t_end: 16.0, ..Options::default() }).unwrap();
+            let scale = r.series.iter().map(|row| row.energy.abs()).fold(0.0, f64::max);
+            let (mut kept, mut changed, mut in_contact, mut largest) = (0, 0, 0, 0.0f64);
+            for w in r.series.windows(2) {
+                let delta = (w[1].energy_aug - w[0].energy_aug).abs();
+                if w[0].switches == w[1].switches {
+                    kept += 1;
+                    in_contact += usize::from(w[1].active_points > 0);
+                    largest = largest.max(delta / scale);
+                    assert!(
+                        delta <= 1e-9 * scale,
+                        "{scheme} {contact} t = {}: ΔE_aug = {delta:e} (scale {scale})",
+                        w[1].t
+                    );
+                } else {
+                    changed += 1;
+                }
+            }
+            assert!(
+                in_contact > 50 && changed > 5,
+                "{scheme} {contact}: {in_contact} steps in contact, {changed} with changes"
+            );
+            eprintln!(
+                "{scheme} {contact}: {kept} steps with an unchanged active set ({in_contact} in contact, largest |ΔE_aug|/scale {largest:e}), {changed} with changes"
+            );
+        }
+    }
+}

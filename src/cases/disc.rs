@@ -79,6 +79,9 @@ pub struct Row {
     pub uy_lowest: f64,
     pub fy_contact: f64,
     pub active_points: usize,
+    /// The contact switches at every contact quadrature point (the active set).
+    #[serde(skip)]
+    pub switches: Vec<bool>,
     pub penetration: f64,
     pub newton: usize,
 }
@@ -249,6 +252,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
             // C(u) tested with e_y is minus the upward force on the disc.
             fy_contact: -c.iter().skip(1).step_by(2).sum::<f64>(),
             active_points: switches.iter().filter(|b| **b).count(),
+            switches,
             penetration,
             newton,
         }
