@@ -20,4 +20,5 @@ pub mod output;
 pub mod plot;
 pub mod progress;
 pub mod report;
+pub mod verify;
 pub mod vtu;

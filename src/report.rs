@@ -136,6 +136,10 @@ pub fn write(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<(), CaseError
     .map_err(|e| CaseError::Write { path: out.display().to_string(), source: std::io::Error::other(e) })?;
     md.push_str("\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `disc/<scheme>/disc.png` (energies, displacements, contact force, Newton).\n\n");
     disc_robustness(&mut md, progress);
+    progress("verify");
+    md.push_str("## 3. Verification (`signorini verify`)\n\n");
+    md.push_str(&crate::verify::markdown(&crate::verify::schemes()?, &crate::verify::energy_laws()?));
+    md.push('\n');
     let _ = writeln!(md, "_Run time: {:.1} s._", start.elapsed().as_secs_f64());
     crate::output::write_atomic(&out.join("report.md"), md.as_bytes())
         .map_err(|source| CaseError::Write { path: out.join("report.md").display().to_string(), source })

@@ -4,7 +4,6 @@
 //! come from the library's registry; a scheme written only for these tests runs by path
 //! (interpreted) and compiled, with nothing but its file.
 
-use nalgebra::DMatrix;
 use signorini::driver::{self, Active, Setup};
 use signorini::runtime::assembly::{Assembler, Quadrature};
 use signorini::runtime::kernel::Coef;
@@ -51,37 +50,14 @@ fn setup(scheme: &str) -> Setup {
     Setup { scheme: scheme.into(), ..Setup::default() }
 }
 
-/// Integrates from u = 1, v = 0 to t = T; returns |u(T) − cos T|.
+/// |u(T) − cos T| from u = 1, v = 0 (`signorini verify`'s oscillator).
 fn error(setup: &Setup, dt: f64, t_end: f64) -> f64 {
-    with_mesh(|asm| {
-        let mut st = stepper(setup, None, asm);
-        let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
-        states[0][0] = 1.0;
-        st.initialize(&mut states, 0.0).unwrap();
-        let steps = (t_end / dt).round() as usize;
-        for k in 0..steps {
-            st.step(&mut states, k as f64 * dt, dt).unwrap();
-        }
-        (states[0][0] - t_end.cos()).abs()
-    })
+    signorini::verify::oscillator_error(setup, dt, t_end).unwrap()
 }
 
-/// Spectral radius of the one-step map of (u, v[, a]) at step dt (ω = 1).
+/// Spectral radius of the one-step map at step dt (ω = 1).
 fn spectral_radius(setup: &Setup, dt: f64) -> f64 {
-    with_mesh(|asm| {
-        let mut st = stepper(setup, None, asm);
-        let m = st.desc().states.len();
-        let mut a = DMatrix::<f64>::zeros(m, m);
-        for j in 0..m {
-            let mut states: Vec<Vec<f64>> = (0..m).map(|_| vec![0.0; 2]).collect();
-            states[j][0] = 1.0;
-            st.step(&mut states, 0.0, dt).unwrap();
-            for i in 0..m {
-                a[(i, j)] = states[i][0];
-            }
-        }
-        a.complex_eigenvalues().iter().map(|z| z.norm()).fold(0.0, f64::max)
-    })
+    signorini::verify::spectral_radius(setup, dt).unwrap()
 }
 
 /// Every scheme of the library, and the test-only scheme by path.

@@ -58,6 +58,12 @@ pub enum Command {
     /// Print every scheme and contact law of the library with its params (defaults, ranges,
     /// docs), and the other form files with their slots.
     List,
+    /// Measure what the mathematics claims: every scheme's time order and spectral radius,
+    /// and the energy laws with contact on the bar and the disc; writes DIR/verify.md.
+    Verify {
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
     /// Compare two runs' series.csv (or their output directories) column by column.
     Compare {
         a: PathBuf,
@@ -271,6 +277,24 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::List => {
             print!("{}", list::text());
             ExitCode::SUCCESS
+        }
+        Command::Verify { out } => {
+            let result = crate::verify::schemes().and_then(|s| Ok((s, crate::verify::energy_laws()?)));
+            match result {
+                Ok((schemes, energies)) => {
+                    let md = crate::verify::markdown(&schemes, &energies);
+                    print!("{md}");
+                    let path = out.join("verify.md");
+                    match crate::output::write_atomic(&path, md.as_bytes()) {
+                        Ok(()) => {
+                            println!("wrote {}", path.display());
+                            ExitCode::SUCCESS
+                        }
+                        Err(e) => fail(format!("cannot write {}: {e}", path.display())),
+                    }
+                }
+                Err(e) => fail(e),
+            }
         }
         Command::Compare { a, b, tol } => match compare::compare(&a, &b) {
             Ok((text, worst)) => {
