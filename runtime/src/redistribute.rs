@@ -1,4 +1,4 @@
-//! Mass redistribution (spec §5; Khenous–Laborde–Renard): remove the inertia of the contact
+//! Mass redistribution (docs/mathematics.md §4; Khenous–Laborde–Renard): remove the inertia of the contact
 //! nodes while keeping the total mass, the centre of gravity and the second moments.
 //!
 //! On the scalar consistent mass M: D⁰ cancels every entry in a contact row or column; the

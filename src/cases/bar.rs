@@ -1,4 +1,4 @@
-//! `signorini run bar`: the compressed bar of spec §6.1 with any compiled scheme, Nitsche or
+//! `signorini run bar`: the compressed bar of docs/mathematics.md §6 with any compiled scheme, Nitsche or
 //! penalty contact, against its exact solution.
 
 use std::path::PathBuf;
@@ -25,7 +25,7 @@ pub const OVERRIDES: &[(&str, f64)] = &[];
 #[serde(rename_all = "lowercase")]
 pub enum MassChoice {
     Consistent,
-    /// Mass redistribution (spec §5): no inertia at the contact node.
+    /// Mass redistribution (docs/mathematics.md §4): no inertia at the contact node.
     Redistributed,
 }
 
@@ -100,7 +100,7 @@ pub struct Summary {
     /// (Σ (λⁿ − σ_ex(0, tⁿ))²)^½ / (Σ σ_ex(0, tⁿ)²)^½.
     pub err_l2_lambda: f64,
     /// The same with λ evaluated at u^{n+½} = (uⁿ + uⁿ⁺¹)/2 against σ_ex(0, t^{n+½}): where the
-    /// midpoint and hybrid schemes impose contact (spec §6.1 [P]; with redistributed mass their
+    /// midpoint and hybrid schemes impose contact (docs/mathematics.md §6 [P]; with redistributed mass their
     /// contact node oscillates with period 2 at integer steps).
     pub err_l2_lambda_half: f64,
     pub energy_initial: f64,
@@ -180,7 +180,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let mut stepper =
         Stepper::new(active.time_scheme()?, &asm, forms, constraints.clone(), Structure::Auto, opts.newton)?;
     if redistributed {
-        // The contact node carries no inertia: a⁰ = 0 there (spec §4, initial acceleration).
+        // The contact node carries no inertia: a⁰ = 0 there (docs/mathematics.md §5, initial acceleration).
         let mut initial = constraints;
         initial.fix(0);
         stepper.initial_constraints = Some(initial);
@@ -201,7 +201,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     stepper.initialize(&mut states, 0.0)?;
     let steps = (opts.t_end / opts.dt).round() as usize;
     let mut series = Vec::with_capacity(steps + 1);
-    // λ and P at the contact point (spec §3.4), from the contact law's functionals: in 1D the
+    // λ and P at the contact point (docs/mathematics.md §2), from the contact law's functionals: in 1D the
     // integral over Γ_C is the value at x = 0. NaN when the law does not provide them.
     let value = |f: &Option<Box<dyn crate::runtime::library::BoundFunctional + '_>>, u: &[f64]| {
         f.as_ref().map_or(f64::NAN, |f| f.value(&asm, &[u], 0.0))

@@ -1,4 +1,4 @@
-//! `signorini run disc`: the elastic disc bouncing on a rigid plane (spec §6.2). A disc of
+//! `signorini run disc`: the elastic disc bouncing on a rigid plane (docs/mathematics.md §6). A disc of
 //! radius 10 centred at (0, 12) falls from rest under f = (0, −0.1) onto {y = 0}; plane strain
 //! with λ = μ = 20 (E = 50, ν = 1/4), ρ = 1; curved P2 triangles; no Dirichlet condition.
 

@@ -1,4 +1,4 @@
-//! The exact solution of the compressed bar (spec §6.1): Ω = (0, 1), E = ρ = 1, u(1, t) = 0,
+//! The exact solution of the compressed bar (docs/mathematics.md §6): Ω = (0, 1), E = ρ = 1, u(1, t) = 0,
 //! contact at x = 0, u₀(x) = (1 − x)/2, v₀ = 0. Period 3; zones by s = τ − ⌊τ⌋, τ = t mod 3.
 
 /// u(x, t).

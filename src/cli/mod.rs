@@ -125,9 +125,9 @@ pub enum MeshCommand {
 pub enum Case {
     /// An elastic block resting on a rigid plane under its own weight (static contact).
     StaticBlock(StaticBlockArgs),
-    /// The compressed 1D bar against its exact solution (spec §6.1).
+    /// The compressed 1D bar against its exact solution (docs/mathematics.md §6).
     Bar(BarArgs),
-    /// The elastic disc bouncing on a rigid plane (spec §6.2).
+    /// The elastic disc bouncing on a rigid plane (docs/mathematics.md §6).
     Disc(DiscArgs),
 }
 
