@@ -31,7 +31,7 @@ pub fn with_oscillator<R>(setup: &Setup, f: impl FnOnce(&mut Stepper) -> R) -> R
         _ => None,
     };
     let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
-    let mut inst = active.instantiate(&coefs, &binding)?;
+    let mut inst = active.forms.instantiate(&coefs, &binding)?;
     let forms = active.scheme_forms(&mut inst)?;
     let mut constraints = Constraints::none(asm.size());
     constraints.fix(1);

@@ -40,7 +40,7 @@ fn spectral_radius(rho: f64) -> f64 {
         _ => None,
     };
     let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
-    let mut inst = active.instantiate(&coefs, &binding).unwrap();
+    let mut inst = active.forms.instantiate(&coefs, &binding).unwrap();
     let forms = active.scheme_forms(&mut inst).unwrap();
     let mut constraints = Constraints::none(2);
     constraints.fix(1);

@@ -32,7 +32,7 @@ fn coefs(name: &str) -> Option<Coef> {
 fn stepper<'a>(setup: &Setup, scheme: Option<Box<dyn TimeScheme>>, asm: &'a Assembler<'a>) -> Stepper<'a> {
     let active = Active::resolve(&setup.clone().set("elasticity.rho", 3.0), &[]).unwrap();
     let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
-    let mut inst = active.instantiate(&coefs, &binding).unwrap();
+    let mut inst = active.forms.instantiate(&coefs, &binding).unwrap();
     let forms = active.scheme_forms(&mut inst).unwrap();
     let mut constraints = Constraints::none(asm.size());
     constraints.fix(1);

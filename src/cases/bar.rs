@@ -158,7 +158,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let contact_facets = asm.region("left")?;
     let binding =
         Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), contact_facets)], dim: 1 };
-    let mut inst = active.instantiate(&coefs, &binding)?;
+    let mut inst = active.forms.instantiate(&coefs, &binding)?;
     let mut forms = active.scheme_forms(&mut inst)?;
     let contact_energy = inst.take_functional("contact_energy");
     let pressure = inst.take_functional("contact_pressure");
@@ -266,9 +266,9 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let summary = Summary {
         case: "bar",
         scheme: active.scheme_name().to_string(),
-        contact: active.contact_name().to_string(),
+        contact: active.forms.contact_name().to_string(),
         interpreted: active.interpreted(),
-        params: active.params.values(),
+        params: active.forms.params.values(),
         mass: opts.mass,
         cell_size: opts.cell_size,
         elements: ne,

@@ -181,13 +181,13 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let n = asm.size();
     let contact_facets = asm.region("contact")?;
     let binding = Binding { quadrature: QUADRATURE, regions: vec![("Gamma_C".into(), contact_facets)], dim: 2 };
-    let mut inst = active.instantiate(&coefs, &binding)?;
+    let mut inst = active.forms.instantiate(&coefs, &binding)?;
     let mut forms = active.scheme_forms(&mut inst)?;
     let missing = |what: &str| {
         CaseError::Option(format!("the disc measures `{what}`, which the form files in use do not provide"))
     };
     let contact_energy = inst.take_functional("contact_energy");
-    let probe = active.instantiate(&coefs, &binding)?.take_form("contact").ok_or_else(|| missing("contact"))?;
+    let probe = active.forms.instantiate(&coefs, &binding)?.take_form("contact").ok_or_else(|| missing("contact"))?;
     let von_mises = inst.take_functional("von_mises");
     let cell_measure = inst.take_functional("measure");
     // Consistent mass and stiffness, the load: for the measurements.
@@ -315,9 +315,9 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let summary = Summary {
         case: "disc",
         scheme: active.scheme_name().to_string(),
-        contact: active.contact_name().to_string(),
+        contact: active.forms.contact_name().to_string(),
         interpreted: active.interpreted(),
-        params: active.params.values(),
+        params: active.forms.params.values(),
         mass: opts.mass,
         cell_size: opts.cell_size,
         mesh: opts.mesh.as_ref().map_or_else(|| format!("built-in disc, h = {}", opts.h), |p| p.display().to_string()),

@@ -193,16 +193,15 @@ fn library_file(path: &Path) -> Option<&'static Unit> {
 /// A run's scheme and form files with the value of every param.
 pub struct Active {
     pub scheme: SchemeSource,
+    /// The form files and every param's value (the scheme's included).
+    pub forms: ActiveForms,
+}
+
+/// The form files of a run, with the value of every param.
+pub struct ActiveForms {
     /// Material, contact law, extra forms.
     pub units: Vec<FormSource>,
     /// Index of the contact law in `units`.
-    pub contact: usize,
-    pub params: params::Table,
-}
-
-/// The form files of a run without a scheme (static problems).
-pub struct ActiveForms {
-    pub units: Vec<FormSource>,
     pub contact: usize,
     pub params: params::Table,
 }
@@ -216,7 +215,7 @@ impl Active {
         let mut table = params::Table::new(Some(&scheme), &units);
         table.apply_case(overrides)?;
         table.apply_user(&setup.params)?;
-        Ok(Active { scheme, units, contact, params: table })
+        Ok(Active { scheme, forms: ActiveForms { units, contact, params: table } })
     }
 
     /// The form files of a setup and their params, without a scheme.
@@ -230,7 +229,7 @@ impl Active {
 
     /// The scheme with its param values.
     pub fn time_scheme(&self) -> Result<Box<dyn TimeScheme>, CaseError> {
-        let values = self.params.scheme_values(self.scheme.params());
+        let values = self.forms.params.scheme_values(self.scheme.params());
         let made = match &self.scheme {
             SchemeSource::Compiled(u) => (u.make)(&values),
             SchemeSource::Interpreted(i) => i.instance(&values),
@@ -244,25 +243,12 @@ impl Active {
             SchemeSource::Interpreted(i) => Some(i.file.clone()),
             SchemeSource::Compiled(_) => None,
         };
-        scheme.into_iter().chain(self.units.iter().filter(|u| u.interpreted()).map(|u| u.file().to_string())).collect()
+        let forms = self.forms.units.iter().filter(|u| u.interpreted()).map(|u| u.file().to_string());
+        scheme.into_iter().chain(forms).collect()
     }
 
     pub fn scheme_name(&self) -> &'static str {
         self.scheme.desc().name
-    }
-
-    /// The contact law's name (its file stem).
-    pub fn contact_name(&self) -> &'static str {
-        self.units[self.contact].name()
-    }
-
-    /// Every form and functional of the files in use, bound to a mesh.
-    pub fn instantiate<'m>(
-        &self,
-        coefs: &dyn Fn(&str) -> Option<Coef>,
-        binding: &Binding<'m>,
-    ) -> Result<Instance<'m>, CaseError> {
-        instantiate(&self.units, &self.params, coefs, binding)
     }
 
     /// The forms the scheme applies, bound; errors name the slot's declaration.
@@ -272,6 +258,7 @@ impl Active {
         for slot in desc.uses {
             let provided = || {
                 let list: Vec<String> = self
+                    .forms
                     .units
                     .iter()
                     .map(|u| {
@@ -308,6 +295,7 @@ impl Active {
 }
 
 impl ActiveForms {
+    /// The contact law's name (its file stem).
     pub fn contact_name(&self) -> &'static str {
         self.units[self.contact].name()
     }
@@ -318,32 +306,23 @@ impl ActiveForms {
         coefs: &dyn Fn(&str) -> Option<Coef>,
         binding: &Binding<'m>,
     ) -> Result<Instance<'m>, CaseError> {
-        instantiate(&self.units, &self.params, coefs, binding)
-    }
-}
-
-fn instantiate<'m>(
-    units: &[FormSource],
-    params: &params::Table,
-    coefs: &dyn Fn(&str) -> Option<Coef>,
-    binding: &Binding<'m>,
-) -> Result<Instance<'m>, CaseError> {
-    let mut slots: Vec<(&'static str, SlotForm<'m>, &'static str)> = Vec::new();
-    for unit in units {
-        let values = params.unit_values(unit.params());
-        let made =
-            unit.make(&values, coefs, binding).map_err(|e| CaseError::Option(format!("{}: {e}", unit.file())))?;
-        for (name, form) in made {
-            if let Some((_, _, other)) = slots.iter().find(|(n, _, _)| *n == name) {
-                return Err(CaseError::Option(format!(
-                    "slot `{name}` is provided by both {other} and {}: a run binds each slot once",
-                    unit.file()
-                )));
+        let mut slots: Vec<(&'static str, SlotForm<'m>, &'static str)> = Vec::new();
+        for unit in &self.units {
+            let values = self.params.unit_values(unit.params());
+            let made =
+                unit.make(&values, coefs, binding).map_err(|e| CaseError::Option(format!("{}: {e}", unit.file())))?;
+            for (name, form) in made {
+                if let Some((_, _, other)) = slots.iter().find(|(n, _, _)| *n == name) {
+                    return Err(CaseError::Option(format!(
+                        "slot `{name}` is provided by both {other} and {}: a run binds each slot once",
+                        unit.file()
+                    )));
+                }
+                slots.push((name, form, unit.file()));
             }
-            slots.push((name, form, unit.file()));
         }
+        Ok(Instance { slots })
     }
-    Ok(Instance { slots })
 }
 
 /// The bound forms of a run, taken by slot name.
