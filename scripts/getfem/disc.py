@@ -1,0 +1,249 @@
+#!/usr/bin/python3
+"""The bouncing-disc benchmark with GetFEM's own bricks, for comparison with signorini.
+
+Run with Debian's python (apt-get install python3-getfem, GetFEM 5.4):
+
+    /usr/bin/python3 scripts/getfem/disc.py --theta 1 --out /tmp/gf/getfem-newmark-t1.csv
+    (--scheme newmark|hht|midpoint, --alpha 0.05, --contact nitsche|penalty, --theta 1|0|-1)
+    signorini run disc --scheme newmark --contact nitsche-traction --cell-size getfem \
+        --param theta=1 --mesh disc_r10_h1_v22.msh --t-end 20 --out /tmp/gf/ours-newmark-t1
+    signorini compare /tmp/gf/getfem-newmark-t1.csv /tmp/gf/ours-newmark-t1
+
+The problem (spec §6.2): disc of radius 10 centred at (0, 12), f = (0, -0.1), plane strain,
+lambda = mu = 20, rho = 1, no Dirichlet condition, rigid ground {y = 0}; contact zone = the
+boundary facets whose outward normal at the facet centre has n_y < 0.
+
+GetFEM pieces (no hand-written weak form in the dynamics):
+  - add_isotropic_linearized_elasticity_brick (2D: plane strain with the given Lame coefficients),
+  - add_source_term_brick (body force), add_mass_brick on Dot2_u,
+  - add_Nitsche_contact_with_rigid_obstacle_brick(mim, 'u', Neumann_term('u', GC), 'obs',
+    'gamma0', GC, theta): obstacle level set obs = y (a P2 fem datum, exact on the isoparametric
+    mesh), frictionless, gamma = gamma0/element_size;
+  - add_Newmark_scheme('u', 1/4, 1/2) + set_time_step + solve + shift_variables_for_time_integration;
+    HHT and the implicit midpoint rule are GetFEM's Newmark scheme used as an affine map (see
+    "Time scheme" below), with add_explicit_rhs/set_private_rhs for HHT's explicit part;
+  - --contact penalty: add_nonlinear_term with eps [u_N - g]_+ v_N, eps = gamma0/element_size
+    (GetFEM's add_penalized_contact_with_rigid_obstacle_brick takes a constant r instead).
+GetFEM's own linear solver choice matters in Debian's 5.4.2 build: 'superlu' (and
+linsolve_superlu) segfault, so the script uses 'mumps', and scipy for the mass solve. Newton's
+max_res is 1e-9: GetFEM's relative criterion has a round-off floor near 1e-11 on this problem,
+and at max_res 1e-12 Newton stalls for 50 iterations and then diverges.
+The initial acceleration is not GetFEM's perform_init_time_derivative (an approximation: one
+backward-Euler-like step of length ddt) but exactly M a0 = F - K u0 - C(u0): the rhs of the model
+without its mass brick (md.assembly('build_rhs')), solved with the consistent mass matrix.
+
+Quadrature: IM_TRIANGLE(6), the 12-point degree-6 rule (the same Dunavant rule as signorini),
+whose face rule is IM_GAUSS1D(6), i.e. 4 Gauss points per edge (degree 7), as signorini's facets.
+
+Measures (per step, t = 0 first), the columns of signorini's series.csv:
+  energy      = 1/2 v.M v + 1/2 u.K u - F.u  (M, K, F assembled by GetFEM)
+  energy_aug  = energy - theta/(2 gamma) ||sigma(u)n||^2_GC + 1/(2 gamma) ||[P_1,gamma(u)]_-||^2_GC
+  uy_mean     = e_y.M u / e_y.M e_y (centre of mass), uy_mean_nodal = plain mean of nodal u_y
+  fy_contact  = the vertical resultant of the contact term = -int_GC [P_1,gamma(u)]_-
+  (penalty: energy_aug = energy + 1/2 int_GC eps [u_N - g]_+^2, fy_contact = int_GC eps [u_N - g]_+)
+"""
+import argparse
+import sys
+
+import numpy as np
+import scipy.sparse
+import scipy.sparse.linalg
+import getfem as gf
+
+GC = 10  # region number of the contact zone
+
+p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+p.add_argument("--mesh", default="/work/shared/meshes/disc_r10_h1_v22.msh")
+p.add_argument("--contact", choices=["nitsche", "penalty"], default="nitsche",
+               help="nitsche: GetFEM's Nitsche brick; penalty: a GWFL term, eps = gamma0/element_size "
+                    "(GetFEM's penalized contact brick takes a constant r, not gamma0/h)")
+p.add_argument("--theta", type=float, default=1.0)
+p.add_argument("--gamma0", type=float, default=1000.0)
+p.add_argument("--dt", type=float, default=0.02)
+p.add_argument("--t-end", type=float, default=20.0)
+p.add_argument("--scheme", choices=["newmark", "hht", "midpoint", "trbdf2"], default="newmark")
+p.add_argument("--alpha", type=float, default=0.05, help="HHT, talk's convention alpha = -alpha_HHT")
+p.add_argument("--beta", type=float, default=0.25)
+p.add_argument("--gam", type=float, default=0.5)
+p.add_argument("--integ", default="IM_TRIANGLE(6)")
+p.add_argument("--max-res", type=float, default=1e-9)
+p.add_argument("--lsearch", default="default", help="GetFEM's Newton line search")
+p.add_argument("--noisy", action="store_true")
+p.add_argument("--out", default="-")
+args = p.parse_args()
+
+lam, mu, rho, grav = 20.0, 20.0, 1.0, 0.1
+
+# Mesh, fem, integration -------------------------------------------------------------------
+m = gf.Mesh("import", "gmsh", args.mesh)
+mf = gf.MeshFem(m, 2)
+mf.set_classical_fem(2)  # FEM_PK(2,2), isoparametric on the GT_PK(2,2) cells
+mfs = gf.MeshFem(m, 1)
+mfs.set_classical_fem(2)
+mim = gf.MeshIm(m, gf.Integ(args.integ))
+
+faces = m.outer_faces()
+normals = m.normal_of_faces(faces)  # at face centres: on a P2 edge, the chord normal
+m.set_region(GC, faces[:, normals[1, :] < 0])
+print(f"# {m.nbcvs()} cells, {mf.nbdof()} dofs, {faces.shape[1]} boundary facets, "
+      f"{int(np.sum(normals[1, :] < 0))} in contact zone, min |n_y| on the boundary "
+      f"{np.min(np.abs(normals[1, :])):.3e}", file=sys.stderr)
+
+# Model --------------------------------------------------------------------------------------
+md = gf.Model("real")
+md.add_fem_variable("u", mf)
+md.add_initialized_data("lambda", [lam])
+md.add_initialized_data("mu", [mu])
+md.add_initialized_data("rho", [rho])
+md.add_initialized_data("f", [0.0, -grav])
+md.add_initialized_data("gamma0", [args.gamma0])
+md.add_initialized_fem_data("obs", mfs, mfs.basic_dof_nodes()[1, :])  # gap to {y = 0}
+md.add_isotropic_linearized_elasticity_brick(mim, "u", "lambda", "mu")
+md.add_source_term_brick(mim, "u", "f")
+neumann = md.Neumann_term("u", GC)  # sigma(u) n, as the elasticity brick declares it
+nc = "(-Normalized(Grad_obs))"
+gamma = "(gamma0/element_size)"
+pen = f"pos_part(u.{nc} - obs)"  # [u_N - g]_+
+if args.contact == "nitsche":
+    md.add_Nitsche_contact_with_rigid_obstacle_brick(mim, "u", neumann, "obs", "gamma0", GC, args.theta)
+else:
+    md.add_nonlinear_term(mim, f"{gamma}*{pen}*(Test_u.{nc})", GC)
+
+# Matrices for the measures ----------------------------------------------------------------
+n = mf.nbdof()
+U0 = np.zeros(n)
+V0 = np.zeros(n)
+Mmat = gf.asm_generic(mim, 2, "rho*u.Test_u", -1, "rho", 0, [rho], "u", 1, mf, U0)
+Kmat = gf.asm_generic(mim, 2, "(lambda*Div_u*Id(2)+2*mu*Sym(Grad_u)):Grad_Test_u", -1,
+                      "lambda", 0, [lam], "mu", 0, [mu], "u", 1, mf, U0)
+Fvec = gf.asm_generic(mim, 1, "f.Test_u", -1, "f", 0, [0.0, -grav], "u", 1, mf, U0)
+ey = np.zeros(n)
+ey[1::2] = 1.0
+Mey = Mmat.mult(ey)
+total_mass = ey @ Mey
+
+P1 = f"(({neumann}).{nc} + {gamma}*(obs - u.{nc}))"
+
+
+def boundary(expr, U):
+    return gf.asm_generic(mim, 0, expr, GC, "u", 0, mf, U, "obs", 0, mfs, md.variable("obs"),
+                          "lambda", 0, [lam], "mu", 0, [mu], "gamma0", 0, [args.gamma0])
+
+
+def measure(t, U, V):
+    energy = 0.5 * V @ Mmat.mult(V) + 0.5 * U @ Kmat.mult(U) - Fvec @ U
+    if args.contact == "nitsche":
+        ce = boundary(f"-{args.theta}/(2*{gamma})*Norm_sqr({neumann})"
+                      f" + 1/(2*{gamma})*sqr(neg_part({P1}))", U)
+        fy = boundary(f"neg_part({P1})", U)  # GWFL neg_part(x) = max(-x, 0) = -[x]_-
+    else:
+        ce = boundary(f"{gamma}/2*sqr({pen})", U)
+        fy = boundary(f"{gamma}*{pen}", U)
+    return (t, energy, energy + ce, (Mey @ U) / total_mass, np.mean(U[1::2]), fy)
+
+
+# Initial acceleration: M a0 = F - K u0 - C(u0), the rhs of the model before the mass brick.
+md.set_variable("u", U0)
+md.assembly("build_rhs")
+r0 = md.rhs()
+jc, ir = Mmat.csc_ind()
+A0 = scipy.sparse.linalg.spsolve(scipy.sparse.csc_matrix((Mmat.csc_val(), ir, jc), shape=(n, n)), r0)
+
+# Time scheme --------------------------------------------------------------------------------
+# newmark:  GetFEM's Newmark scheme as is (beta, gam), the mass brick on Dot2_u.
+# hht:      (talk's convention alpha = -alpha_HHT) M a' + (1-alpha) B(u') + alpha B(u) = F with
+#           Newmark kinematics, beta = (1+alpha)^2/4, gam = 1/2 + alpha: GetFEM's Newmark scheme, the
+#           mass brick with density rho/(1-alpha), and an explicit rhs brick carrying
+#           (F - alpha B(u^n))/(1-alpha) - F; B(u^n) = K u^n + C(u^n) follows from the previous step's
+#           equation, B(u^n) = (F - M a^n - alpha B(u^{n-1}))/(1-alpha), B(u^0) = F - M a^0.
+# midpoint: M (v'-v)/dt + B((u+u')/2) = F, (u'-u)/dt = (v+v')/2. The unknown is w = (u+u')/2:
+#           (4/dt^2) M (w - u - dt/2 v) + B(w) = F, which is GetFEM's Newmark scheme with time step
+#           dt/2, beta = 1 and Previous_Dot2_u = 0 (its Dot2_u is then exactly that affine map);
+#           then u' = 2w - u, v' = 4(w - u)/dt - v.
+# trbdf2:   gs = 2 - sqrt(2); trapezoidal stage to t + gs dt = GetFEM's Newmark (1/4, 1/2) with
+#           time step gs dt; BDF2 stage: a' = (u' - P)/c^2 with c = (1-gs)/(2-gs) dt, k = gs(2-gs),
+#           P = um/k - (1-gs)^2/k u + c (vm/k - (1-gs)^2/k v): the same Newmark scheme with time
+#           step 2c and Previous_u = P, Previous_Dot_u = Previous_Dot2_u = 0; then
+#           v' = vm/k - (1-gs)^2/k v + c a'.
+alpha = args.alpha if args.scheme == "hht" else 0.0
+if args.scheme in ("newmark", "trbdf2"):
+    md.add_Newmark_scheme("u", args.beta, args.gam)
+elif args.scheme == "hht":
+    md.add_Newmark_scheme("u", (1 + alpha) ** 2 / 4, 0.5 + alpha)
+    md.set_variable("rho", [rho / (1 - alpha)])
+    ib_explicit = md.add_explicit_rhs("u", np.zeros(n))
+else:
+    md.add_Newmark_scheme("u", 1.0, 0.5)
+md.add_mass_brick(mim, "Dot2_u", "rho")
+md.set_time_step(args.dt / 2 if args.scheme == "midpoint" else args.dt)
+
+
+
+def solve(t):
+    md.set_time(t)
+    it = md.solve("max_res", args.max_res, "max_iter", 50, "lsolver", "mumps",
+                  "lsearch", args.lsearch, *(["noisy"] if args.noisy else []))
+    if not it[1]:
+        print(f"# Newton did not converge at t = {t:g}: {it}", file=sys.stderr)
+    return md.variable("u")
+
+
+def trbdf2_step(U, V, A, t):
+    dt = args.dt
+    gs = 2 - np.sqrt(2)
+    c, kk = (1 - gs) / (2 - gs) * dt, gs * (2 - gs)
+    md.set_time_step(gs * dt)
+    md.set_variable("Previous_u", U)
+    md.set_variable("Previous_Dot_u", V)
+    md.set_variable("Previous_Dot2_u", A)
+    Um = solve(t - dt + gs * dt)
+    Am = 4 / (gs * dt) ** 2 * (Um - U - gs * dt * V) - A
+    Vm = V + gs * dt / 2 * (A + Am)
+    P = Um / kk - (1 - gs) ** 2 / kk * U + c * (Vm / kk - (1 - gs) ** 2 / kk * V)
+    md.set_time_step(2 * c)
+    md.set_variable("Previous_u", P)
+    md.set_variable("Previous_Dot_u", np.zeros(n))
+    md.set_variable("Previous_Dot2_u", np.zeros(n))
+    U1 = solve(t)
+    A1 = (U1 - P) / c ** 2
+    V1 = Vm / kk - (1 - gs) ** 2 / kk * V + c * A1
+    return U1, V1, A1
+
+
+U, V, A = U0.copy(), V0.copy(), A0.copy()
+B = Fvec - Mmat.mult(A0)  # B(u^0) = K u^0 + C(u^0)
+rows = [measure(0.0, U, V)]
+steps = int(round(args.t_end / args.dt))
+for k in range(steps):
+    t = (k + 1) * args.dt
+    if args.scheme == "trbdf2":
+        U, V, A = trbdf2_step(U, V, A, t)
+        rows.append(measure(t, U, V))
+        continue
+    md.set_variable("Previous_u", U)
+    md.set_variable("Previous_Dot_u", V)
+    md.set_variable("Previous_Dot2_u", np.zeros(n) if args.scheme == "midpoint" else A)
+    if args.scheme == "hht":
+        md.set_private_rhs(ib_explicit, (Fvec - alpha * B) / (1 - alpha) - Fvec)
+    md.set_time(t)
+    it = md.solve("max_res", args.max_res, "max_iter", 50, "lsolver", "mumps",
+                  "lsearch", args.lsearch, *(["noisy"] if args.noisy else []))
+    if not it[1]:
+        print(f"# Newton did not converge at t = {t:g}: {it}", file=sys.stderr)
+    if args.scheme == "midpoint":
+        W = md.variable("u")
+        U, V = 2 * W - U, 4 * (W - U) / args.dt - V
+    else:
+        md.shift_variables_for_time_integration()
+        U = md.variable("Previous_u")
+        V = md.variable("Previous_Dot_u")
+        A = md.variable("Previous_Dot2_u")
+        B = (Fvec - Mmat.mult(A) - alpha * B) / (1 - alpha)
+    rows.append(measure(t, U, V))
+
+out = sys.stdout if args.out == "-" else open(args.out, "w")
+out.write("t,energy,energy_aug,uy_mean,uy_mean_nodal,fy_contact\n")
+for r in rows:
+    out.write(",".join(repr(float(x)) for x in r) + "\n")
+if out is not sys.stdout:
+    out.close()
