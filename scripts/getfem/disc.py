@@ -9,7 +9,7 @@ Run with Debian's python (apt-get install python3-getfem, GetFEM 5.4):
         --param theta=1 --mesh disc_r10_h1_v22.msh --t-end 20 --out /tmp/gf/ours-newmark-t1
     signorini compare /tmp/gf/getfem-newmark-t1.csv /tmp/gf/ours-newmark-t1
 
-The problem (spec §6.2): disc of radius 10 centred at (0, 12), f = (0, -0.1), plane strain,
+The problem (docs/mathematics.md §6): disc of radius 10 centred at (0, 12), f = (0, -0.1), plane strain,
 lambda = mu = 20, rho = 1, no Dirichlet condition, rigid ground {y = 0}; contact zone = the
 boundary facets whose outward normal at the facet centre has n_y < 0.
 
@@ -53,7 +53,7 @@ import getfem as gf
 GC = 10  # region number of the contact zone
 
 p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-p.add_argument("--mesh", default="/work/shared/meshes/disc_r10_h1_v22.msh")
+p.add_argument("--mesh", required=True, help="the benchmark mesh, disc_r10_h1_v22.msh (Gmsh 2.2)")
 p.add_argument("--contact", choices=["nitsche", "penalty"], default="nitsche",
                help="nitsche: GetFEM's Nitsche brick; penalty: a GWFL term, eps = gamma0/element_size "
                     "(GetFEM's penalized contact brick takes a constant r, not gamma0/h)")
