@@ -20,5 +20,6 @@ pub mod output;
 pub mod plot;
 pub mod progress;
 pub mod report;
+pub mod settings;
 pub mod verify;
 pub mod vtu;

@@ -134,13 +134,13 @@ pub enum Case {
 /// The scheme, the form files and their params (`signorini list` shows what there is).
 #[derive(clap::Args, Clone)]
 pub struct MethodArgs {
-    /// A scheme of the library by name, or a .wf file (run interpreted) [default: newmark].
+    /// A scheme of the library by name, or a .wf file (run interpreted); default: forms/library.toml.
     #[arg(long)]
     scheme: Option<String>,
-    /// A contact law of the library by name (nitsche, penalty), or a .wf file [default: nitsche].
+    /// A contact law of the library by name (nitsche, penalty), or a .wf file; default: forms/library.toml.
     #[arg(long)]
     contact: Option<String>,
-    /// The material's form file, by name or path [default: elasticity].
+    /// The material's form file, by name or path; default: forms/library.toml.
     #[arg(long)]
     material: Option<String>,
     /// Extra form files whose slots the scheme applies (repeatable).

@@ -41,10 +41,11 @@ pub struct Setup {
 
 impl Default for Setup {
     fn default() -> Self {
+        let d = &crate::settings::get().defaults;
         Setup {
-            scheme: "newmark".into(),
-            contact: "nitsche".into(),
-            material: "elasticity".into(),
+            scheme: d.scheme.clone(),
+            contact: d.contact.clone(),
+            material: d.material.clone(),
             forms: Vec::new(),
             compiled: Vec::new(),
             params: Vec::new(),

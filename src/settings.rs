@@ -1,0 +1,51 @@
+//! `forms/library.toml`: the library's defaults and the runs the report and `verify` make, as
+//! data (no scheme or law name is written in Rust).
+
+use std::sync::OnceLock;
+
+use serde::Deserialize;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Settings {
+    pub defaults: Defaults,
+    pub report: Report,
+    pub verify: Verify,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Defaults {
+    pub scheme: String,
+    pub contact: String,
+    pub material: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Report {
+    pub bar: Vec<BarRuns>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BarRuns {
+    /// (scheme, contact law, mass matrix).
+    pub runs: Vec<(String, String, String)>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Verify {
+    pub energy_conserving: Vec<String>,
+    pub contacts: Vec<String>,
+}
+
+/// The parsed file (compiled in; `tests/settings` checks that it parses and names library
+/// files only).
+pub fn get() -> &'static Settings {
+    static SETTINGS: OnceLock<Settings> = OnceLock::new();
+    SETTINGS.get_or_init(|| {
+        toml::from_str(include_str!("../forms/library.toml")).expect("forms/library.toml is checked by its test")
+    })
+}

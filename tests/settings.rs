@@ -1,0 +1,27 @@
+//! forms/library.toml parses, and every scheme, contact law, material and mass matrix it names
+//! exists in the library.
+
+use signorini::cases::bar::MassChoice;
+use signorini::driver::{self, Setup};
+
+#[test]
+fn library_settings_name_library_files() {
+    let s = signorini::settings::get();
+    let schemes = driver::all_schemes();
+    let laws = driver::contact_names();
+    let known = |scheme: &str, contact: &str| {
+        assert!(schemes.contains(&scheme), "unknown scheme `{scheme}`");
+        assert!(laws.contains(&contact), "unknown contact law `{contact}`");
+    };
+    known(&s.defaults.scheme, &s.defaults.contact);
+    driver::Active::resolve(&Setup::default(), &[]).unwrap();
+    for (scheme, contact, mass) in s.report.bar.iter().flat_map(|b| b.runs.iter()) {
+        known(scheme, contact);
+        <MassChoice as clap::ValueEnum>::from_str(mass, true).unwrap_or_else(|e| panic!("mass `{mass}`: {e}"));
+    }
+    for scheme in &s.verify.energy_conserving {
+        for contact in &s.verify.contacts {
+            known(scheme, contact);
+        }
+    }
+}
