@@ -137,7 +137,7 @@ pub struct MethodArgs {
     /// A scheme of the library by name, or a .wf file (run interpreted); default: forms/library.toml.
     #[arg(long)]
     scheme: Option<String>,
-    /// A contact law of the library by name (nitsche, penalty), or a .wf file; default: forms/library.toml.
+    /// A contact law of the library by name (see `signorini list`), or a .wf file; default: forms/library.toml.
     #[arg(long)]
     contact: Option<String>,
     /// The material's form file, by name or path; default: forms/library.toml.
