@@ -16,11 +16,21 @@ use crate::runtime::linalg::Structure;
 use crate::runtime::mesh::structured;
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
-use crate::runtime::scheme::Stepper;
+use crate::runtime::scheme::{Stepper, TimeScheme};
 
 /// Runs `f` with a stepper of `setup`'s scheme on the oscillator: one P1 element, E = 1,
 /// ρ = 3, so M = ρh/3 = 1 and K = E/h = 1 on the free dof; no contact facets.
 pub fn with_oscillator<R>(setup: &Setup, f: impl FnOnce(&mut Stepper) -> R) -> Result<R, CaseError> {
+    with_oscillator_scheme(setup, None, f)
+}
+
+/// As [`with_oscillator`], stepping `scheme` (e.g. one compiled by a crate's own `forms!`)
+/// instead of `setup`'s when given; the forms still come from `setup`.
+pub fn with_oscillator_scheme<R>(
+    setup: &Setup,
+    scheme: Option<Box<dyn TimeScheme>>,
+    f: impl FnOnce(&mut Stepper) -> R,
+) -> Result<R, CaseError> {
     let mesh = structured::interval(1, 0.0, 1.0);
     let asm = Assembler::new(&mesh);
     let active = Active::resolve(&setup.clone().set("elasticity.rho", 3.0), &[])?;
@@ -35,8 +45,11 @@ pub fn with_oscillator<R>(setup: &Setup, f: impl FnOnce(&mut Stepper) -> R) -> R
     let forms = active.scheme_forms(&mut inst)?;
     let mut constraints = Constraints::none(asm.size());
     constraints.fix(1);
-    let mut stepper =
-        Stepper::new(active.time_scheme()?, &asm, forms, constraints, Structure::General, NewtonOptions::default())?;
+    let scheme = match scheme {
+        Some(s) => s,
+        None => active.time_scheme()?,
+    };
+    let mut stepper = Stepper::new(scheme, &asm, forms, constraints, Structure::General, NewtonOptions::default())?;
     Ok(f(&mut stepper))
 }
 

@@ -24,44 +24,21 @@ fn genalpha(rho: f64) -> Setup {
 /// One-step map of the free oscillator ü + u = 0 (one P1 element, E = 1, ρ = 3) at ωΔt = 1e12
 /// (with ρ∞ = 0 the three roots meet at 0 and approach it like (ωΔt)^(-2/3): evaluate far out).
 fn spectral_radius(rho: f64) -> f64 {
-    use signorini::driver::Active;
-    use signorini::runtime::library::Binding;
-    use signorini::runtime::linalg::Structure;
-    use signorini::runtime::newton::NewtonOptions;
-    use signorini::runtime::problem::Constraints;
-    use signorini::runtime::scheme::Stepper;
-    let mesh = structured::interval(1, 0.0, 1.0);
-    let asm = Assembler::new(&mesh);
-    let active = Active::resolve(&genalpha(rho).set("elasticity.rho", 3.0), &[]).unwrap();
-    let coefs = |n: &str| match n {
-        "f" => Some(Coef::constant(vec![0.0])),
-        "g" => Some(Coef::scalar(0.0)),
-        "nc" => Some(Coef::constant(vec![-1.0])),
-        _ => None,
-    };
-    let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
-    let mut inst = active.forms.instantiate(&coefs, &binding).unwrap();
-    let forms = active.scheme_forms(&mut inst).unwrap();
-    let mut constraints = Constraints::none(2);
-    constraints.fix(1);
-    let mut st = Stepper::new(
-        active.time_scheme().unwrap(),
-        &asm,
-        forms,
-        constraints,
-        Structure::General,
-        NewtonOptions::default(),
-    )
-    .unwrap();
-    let mut a = DMatrix::<f64>::zeros(3, 3);
-    for j in 0..3 {
-        let mut states: Vec<Vec<f64>> = (0..3).map(|_| vec![0.0; 2]).collect();
-        states[j][0] = 1.0;
-        st.step(&mut states, 0.0, 1e12).unwrap();
-        for i in 0..3 {
-            a[(i, j)] = states[i][0];
+    // The one-step map on `signorini verify`'s oscillator; its eigenvalues by nalgebra (an
+    // independent method from verify's repeated squaring).
+    let a = signorini::verify::with_oscillator(&genalpha(rho), |st| {
+        let mut a = DMatrix::<f64>::zeros(3, 3);
+        for j in 0..3 {
+            let mut states: Vec<Vec<f64>> = (0..3).map(|_| vec![0.0; 2]).collect();
+            states[j][0] = 1.0;
+            st.step(&mut states, 0.0, 1e12).unwrap();
+            for i in 0..3 {
+                a[(i, j)] = states[i][0];
+            }
         }
-    }
+        a
+    })
+    .unwrap();
     a.complex_eigenvalues().iter().map(|z| z.norm()).fold(0.0, f64::max)
 }
 

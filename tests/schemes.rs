@@ -4,46 +4,17 @@
 //! come from the library's registry; a scheme written only for these tests runs by path
 //! (interpreted) and compiled, with nothing but its file.
 
-use signorini::driver::{self, Active, Setup};
-use signorini::runtime::assembly::{Assembler, Quadrature};
-use signorini::runtime::kernel::Coef;
-use signorini::runtime::library::Binding;
-use signorini::runtime::linalg::Structure;
-use signorini::runtime::mesh::structured;
-use signorini::runtime::newton::NewtonOptions;
-use signorini::runtime::problem::Constraints;
+use signorini::driver::{self, Setup};
 use signorini::runtime::scheme::{Stepper, TimeScheme};
 
 signorini::forms!("tests/wf/newmark_general.wf");
 
 const TEST_SCHEME: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/wf/newmark_general.wf");
 
-fn coefs(name: &str) -> Option<Coef> {
-    match name {
-        "f" => Some(Coef::constant(vec![0.0])),
-        "g" => Some(Coef::scalar(0.0)),
-        "nc" => Some(Coef::constant(vec![-1.0])),
-        _ => None,
-    }
-}
-
-/// A stepper for `scheme` (a name or a path) with `params`, or the given scheme object, on the
-/// oscillator. No contact facets: a free oscillator.
-fn stepper<'a>(setup: &Setup, scheme: Option<Box<dyn TimeScheme>>, asm: &'a Assembler<'a>) -> Stepper<'a> {
-    let active = Active::resolve(&setup.clone().set("elasticity.rho", 3.0), &[]).unwrap();
-    let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
-    let mut inst = active.forms.instantiate(&coefs, &binding).unwrap();
-    let forms = active.scheme_forms(&mut inst).unwrap();
-    let mut constraints = Constraints::none(asm.size());
-    constraints.fix(1);
-    let scheme = scheme.unwrap_or_else(|| active.time_scheme().unwrap());
-    Stepper::new(scheme, asm, forms, constraints, Structure::General, NewtonOptions::default()).unwrap()
-}
-
-fn with_mesh<R>(f: impl FnOnce(&Assembler) -> R) -> R {
-    let mesh = structured::interval(1, 0.0, 1.0);
-    let asm = Assembler::new(&mesh);
-    f(&asm)
+/// Runs `f` on a stepper of the oscillator (`signorini verify`'s), with `scheme` instead of
+/// `setup`'s when given.
+fn with_stepper<R>(setup: &Setup, scheme: Option<Box<dyn TimeScheme>>, f: impl FnOnce(&mut Stepper) -> R) -> R {
+    signorini::verify::with_oscillator_scheme(setup, scheme, f).unwrap()
 }
 
 fn setup(scheme: &str) -> Setup {
@@ -109,8 +80,7 @@ fn spectral_radius_at_infinite_step() {
 #[test]
 fn midpoint_and_crank_nicolson_conserve_energy() {
     let drift = |name: &str| {
-        with_mesh(|asm| {
-            let mut st = stepper(&setup(name), None, asm);
+        with_stepper(&setup(name), None, |st| {
             let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
             states[0][0] = 1.0;
             st.initialize(&mut states, 0.0).unwrap();
@@ -134,13 +104,12 @@ fn midpoint_and_crank_nicolson_conserve_energy() {
 #[test]
 fn interpreted_and_compiled_schemes_agree() {
     let run = |compiled: bool| {
-        with_mesh(|asm| {
-            let s = setup(TEST_SCHEME).set("beta", 0.35).set("gam", 0.7);
-            let scheme: Option<Box<dyn TimeScheme>> = compiled.then(|| {
-                let c = newmark_general::NewmarkGeneral::default();
-                Box::new(c.with("beta", 0.35).unwrap().with("gam", 0.7).unwrap()) as Box<dyn TimeScheme>
-            });
-            let mut st = stepper(&s, scheme, asm);
+        let s = setup(TEST_SCHEME).set("beta", 0.35).set("gam", 0.7);
+        let scheme: Option<Box<dyn TimeScheme>> = compiled.then(|| {
+            let c = newmark_general::NewmarkGeneral::default();
+            Box::new(c.with("beta", 0.35).unwrap().with("gam", 0.7).unwrap()) as Box<dyn TimeScheme>
+        });
+        with_stepper(&s, scheme, |st| {
             let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
             states[0][0] = 1.0;
             st.initialize(&mut states, 0.0).unwrap();

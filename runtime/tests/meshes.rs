@@ -81,7 +81,7 @@ fn getfem_cell_size_of_straight_triangles() {
     use signorini_runtime::mesh::structured::{Diagonal, rectangle};
     for degree in [1, 2] {
         let mut mesh = rectangle(4, 2, [0.0, 1.0], [0.0, 0.3], Diagonal::Right, degree);
-        mesh.cell_size = CellSize::GetFem;
+        mesh.set_cell_size(CellSize::GetFem);
         for c in 0..mesh.num_cells() {
             let v: Vec<&[f64]> = mesh.cell(c).iter().take(3).map(|&n| mesh.node(n as usize)).collect();
             let (a, b) = ([v[1][0] - v[0][0], v[1][1] - v[0][1]], [v[2][0] - v[0][0], v[2][1] - v[0][1]]);

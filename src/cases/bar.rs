@@ -152,7 +152,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let start = Instant::now();
     let ne = opts.elements;
     let mut mesh = structured::interval(ne, 0.0, 1.0);
-    mesh.cell_size = opts.cell_size;
+    mesh.set_cell_size(opts.cell_size);
     let asm = Assembler::new(&mesh);
     let n = asm.size();
     let contact_facets = asm.region("left")?;

@@ -144,7 +144,7 @@ pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
     if mesh.region("contact").is_err() {
         mesh.add_region_where("contact", |n, _| n[1] < 0.0);
     }
-    mesh.cell_size = opts.cell_size;
+    mesh.set_cell_size(opts.cell_size);
     mesh.validate()?;
     Ok(mesh)
 }

@@ -214,7 +214,7 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
         }
     }
     // Resolve now, so that a bad name is reported at its key.
-    let scheme = driver::scheme(&setup).map_err(|e| match &parsed.scheme {
+    driver::scheme(&setup).map_err(|e| match &parsed.scheme {
         Some(s) => r.error(s, "scheme", e),
         None => e,
     })?;
@@ -225,7 +225,6 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
         (Some(s), _, _) => r.error(s, "contact", e),
         _ => e,
     })?;
-    let _ = scheme;
     Ok(setup)
 }
 

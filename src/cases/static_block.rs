@@ -112,7 +112,7 @@ pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
         d => return Err(CaseError::Option(format!("--dim must be 2 or 3, not {d}"))),
     };
     let mut mesh = mesh;
-    mesh.cell_size = opts.cell_size;
+    mesh.set_cell_size(opts.cell_size);
     mesh.validate()?;
     Ok(mesh)
 }

@@ -28,7 +28,6 @@ use std::sync::Arc;
 
 use signorini_compiler::check::ParamRange;
 use signorini_compiler::ir::{self, DimIr};
-use signorini_compiler::syntax::ast::Shape;
 use signorini_compiler::{FsLoader, Program, Span};
 use signorini_runtime::kernel::{Coef, FormMeta};
 
@@ -145,11 +144,7 @@ impl Library {
             .coefs
             .iter()
             .map(|c| {
-                let rank = match c.shape {
-                    Shape::Scalar => 0,
-                    Shape::Vector => 1,
-                    Shape::Tensor => 2,
-                };
+                let rank = c.shape.rank();
                 CoefDecl { name: c.name.clone(), rank, at: at(c.span) }
             })
             .collect();

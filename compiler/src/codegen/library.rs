@@ -8,7 +8,6 @@ use crate::docs;
 use crate::program::Program;
 use crate::scheme::SchemeIr;
 use crate::source::Span;
-use crate::syntax::ast::Shape;
 
 fn owner(prog: &Program, span: Span) -> String {
     crate::module_name(prog.sources.path(span.file))
@@ -47,11 +46,7 @@ pub fn forms_items(prog: &Program, own: &[(usize, &str)]) -> String {
         .coefs
         .iter()
         .map(|c| {
-            let rank = match c.shape {
-                Shape::Scalar => 0,
-                Shape::Vector => 1,
-                Shape::Tensor => 2,
-            };
+            let rank = c.shape.rank();
             format!(
                 "CoefInfo {{ name: {:?}, rank: {rank}, doc: {:?}, declared: {:?} }}",
                 c.name,

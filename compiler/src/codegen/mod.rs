@@ -14,7 +14,6 @@ use std::fmt::Write;
 
 use crate::ir::DimIr;
 use crate::program::Program;
-use crate::syntax::ast::Shape;
 use names::{camel, ident};
 
 /// Where the generated code finds the runtime (the facade re-exports it).
@@ -265,11 +264,7 @@ fn coefs_text(prog: &Program) -> String {
     s.push_str("impl Coefficients {\n/// Checks that every coef has the number of components its shape needs in dimension `dim`.\n");
     s.push_str("pub fn check(&self, dim: usize) -> Result<(), ::std::string::String> {\n");
     for c in &prog.coefs {
-        let rank = match c.shape {
-            Shape::Scalar => 0,
-            Shape::Vector => 1,
-            Shape::Tensor => 2,
-        };
+        let rank = c.shape.rank();
         let _ =
             writeln!(s, "check_coef({:?}, &self.{}, {rank}, dim).map_err(|e| e.to_string())?;", c.name, ident(&c.name));
     }

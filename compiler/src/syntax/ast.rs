@@ -52,6 +52,15 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// Tensor rank: 0 scalar, 1 vector, 2 tensor (a coef has dim^rank components).
+    pub fn rank(self) -> u32 {
+        match self {
+            Shape::Scalar => 0,
+            Shape::Vector => 1,
+            Shape::Tensor => 2,
+        }
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Shape::Scalar => "scalar",

@@ -50,6 +50,7 @@ pub fn disc(radius: f64, center: [f64; 2], h: f64) -> Mesh {
         regions: Vec::new(),
         cell_groups: Vec::new(),
         cell_size: super::CellSize::Diameter,
+        sizes: Vec::new(),
     };
     let onto_circle = |p: &mut [f64]| {
         let (dx, dy) = (p[0] - center[0], p[1] - center[1]);

@@ -671,6 +671,7 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         regions: Vec::new(),
         cell_groups: Vec::new(),
         cell_size: super::CellSize::Diameter,
+        sizes: Vec::new(),
     };
     let name_of = |d: u32, tag: i64| raw.names.get(&(d, tag)).cloned().unwrap_or_else(|| format!("physical_{tag}"));
     // Cell groups.

@@ -45,8 +45,11 @@ pub struct Mesh {
     pub regions: Vec<Region>,
     /// Named groups of cells (Gmsh physical groups of the cell dimension).
     pub cell_groups: Vec<(String, Vec<u32>)>,
-    /// What `h`, the size of the cell carrying a facet, means in the forms.
-    pub cell_size: CellSize,
+    /// What `h`, the size of the cell carrying a facet, means in the forms (`set_cell_size`).
+    cell_size: CellSize,
+    /// Per cell, `h` when it is not the diameter (computed once: assembly reads it at every
+    /// facet of every Newton iteration).
+    sizes: Vec<f64>,
 }
 
 /// The size `h` of a cell (in `gamma = gamma0/h`).
@@ -103,15 +106,31 @@ impl Mesh {
     }
 
     /// Diameter of a cell (largest distance between two vertices).
-    /// The size `h` of cell `c`, as `cell_size` says.
+    /// The size `h` of cell `c`, as `set_cell_size` chose.
     pub fn cell_size(&self, c: usize) -> f64 {
         match self.cell_size {
             CellSize::Diameter => self.cell_diameter(c),
-            CellSize::GetFem => {
-                let nodes: Vec<&[f64]> = self.cell(c).iter().map(|&n| self.node(n as usize)).collect();
-                crate::geometry::getfem_size(self.kind, &nodes)
-            }
+            CellSize::GetFem => self.sizes[c],
         }
+    }
+
+    /// Chooses what `h` means, and computes it for every cell.
+    pub fn set_cell_size(&mut self, rule: CellSize) {
+        self.cell_size = rule;
+        self.sizes = match rule {
+            CellSize::Diameter => Vec::new(),
+            CellSize::GetFem => (0..self.num_cells())
+                .map(|c| {
+                    let nodes: Vec<&[f64]> = self.cell(c).iter().map(|&n| self.node(n as usize)).collect();
+                    crate::geometry::getfem_size(self.kind, &nodes)
+                })
+                .collect(),
+        };
+    }
+
+    /// What `h` means.
+    pub fn cell_size_rule(&self) -> CellSize {
+        self.cell_size
     }
 
     pub fn cell_diameter(&self, c: usize) -> f64 {
@@ -288,14 +307,17 @@ impl Mesh {
                 cells.push(id);
             }
         }
-        Mesh {
+        let mut p2 = Mesh {
             kind,
             coords,
             cells,
             regions: self.regions.clone(),
             cell_groups: self.cell_groups.clone(),
-            cell_size: self.cell_size,
-        }
+            cell_size: CellSize::Diameter,
+            sizes: Vec::new(),
+        };
+        p2.set_cell_size(self.cell_size);
+        p2
     }
 }
 

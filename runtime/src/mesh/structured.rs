@@ -30,6 +30,7 @@ pub fn interval(n: usize, a: f64, b: f64) -> Mesh {
         regions,
         cell_groups: Vec::new(),
         cell_size: super::CellSize::Diameter,
+        sizes: Vec::new(),
     }
 }
 
@@ -61,6 +62,7 @@ pub fn rectangle(nx: usize, ny: usize, x: [f64; 2], y: [f64; 2], diagonal: Diago
         regions: Vec::new(),
         cell_groups: Vec::new(),
         cell_size: super::CellSize::Diameter,
+        sizes: Vec::new(),
     };
     let mut mesh = if degree >= 2 { mesh.to_p2(None) } else { mesh };
     name_sides(&mut mesh, &[("left", 0, -1.0), ("right", 0, 1.0), ("bottom", 1, -1.0), ("top", 1, 1.0)]);
@@ -106,6 +108,7 @@ pub fn cuboid(n: [usize; 3], x: [f64; 2], y: [f64; 2], z: [f64; 2], degree: u32)
         regions: Vec::new(),
         cell_groups: Vec::new(),
         cell_size: super::CellSize::Diameter,
+        sizes: Vec::new(),
     };
     orient_positively(&mut mesh);
     let mut mesh = if degree >= 2 { mesh.to_p2(None) } else { mesh };
