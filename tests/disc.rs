@@ -25,6 +25,26 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
                 row.uy_lowest
             );
             assert_eq!(row.active_points, 0);
+            // The centre of mass falls at v_y = −g t.
+            assert!((row.vy_mean + GRAVITY * row.t).abs() < 1e-10, "{scheme:?} t = {}: v {}", row.t, row.vy_mean);
+        }
+        // A multi-stage scheme reports each intermediate stage, which is exact in free fall too.
+        // TR-BDF2's trapezoidal stage ends at t + (2 − √2)Δt.
+        let expected = if scheme == "trbdf2" { r.summary.steps } else { 0 };
+        assert_eq!(r.stages.len(), expected, "{scheme:?}");
+        for (k, s) in r.stages.iter().enumerate() {
+            let t = (k as f64 + 2.0 - 2f64.sqrt()) * opts.dt;
+            assert!((s.row.t - t).abs() < 1e-12, "{scheme:?} stage {k} at t = {}, expected {t}", s.row.t);
+        }
+        for s in r.stages.iter().filter(|s| s.row.t < t_star - 0.05) {
+            let exact = -0.5 * GRAVITY * s.row.t * s.row.t;
+            assert!((s.row.uy_mean - exact).abs() < 1e-10, "{scheme:?} stage {} at t = {}", s.stage, s.row.t);
+            assert!(
+                (s.row.vy_mean + GRAVITY * s.row.t).abs() < 1e-10,
+                "{scheme:?} stage {} at t = {}",
+                s.stage,
+                s.row.t
+            );
         }
         let first = r.summary.first_contact.expect("the disc reaches the ground");
         assert!(first - opts.dt < t_star && t_star <= first, "{scheme:?}: first contact at {first}, t* = {t_star}");

@@ -1,16 +1,36 @@
-//! `signorini verify`'s measurements as CI checks: every scheme of the library is second order
-//! on the oscillator with ρ∞ ≤ 1; Crank–Nicolson and midpoint conserve the augmented energy
-//! on every step whose active set is unchanged, on the bar and the disc, with Nitsche θ = 1
-//! and penalty (docs/mathematics.md §5).
+//! `signorini verify`'s measurements as CI checks (docs/mathematics.md §5): every scheme of the
+//! library is second order on the oscillator and on the bar before impact, with ρ∞ ≤ 1;
+//! Crank–Nicolson and midpoint conserve the augmented energy on every step whose active set is
+//! unchanged, on the bar and the disc, with Nitsche θ = 1 and penalty; without contact every
+//! scheme's energy decays per step like the square of its spectral radius.
 
 use signorini::verify;
 
 #[test]
 fn every_scheme_is_second_order_and_stable_at_infinity() {
-    let rows = verify::schemes().unwrap();
+    let rows = verify::time::orders(&mut |_| {}).unwrap();
     assert_eq!(rows.len(), signorini::driver::all_schemes().len());
     for r in &rows {
-        assert!((r.order - 2.0).abs() < 0.05, "{}: order {}", r.scheme, r.order);
+        assert!((r.oscillator_order - 2.0).abs() < 0.05, "{}: oscillator order {}", r.scheme, r.oscillator_order);
+        // The bar's free end starts with a stress jump: every mode of the mesh is excited, and
+        // the finest pair of steps is in the asymptotic range (ω_max Δt ≤ 0.07).
+        for b in &r.bar {
+            // Nitsche's θ term acts before impact: the schemes that apply the contact slot
+            // unlike the stiffness (explicitly; without HHT's weighting) lose order there.
+            let inconsistent = b.contact == "nitsche" && matches!(r.scheme.as_str(), "hht_imex" | "hht_unweighted");
+            if inconsistent {
+                assert!(
+                    b.order > 0.9 && b.order < 1.8,
+                    "{} with {}: bar order {} ({b:?})",
+                    r.scheme,
+                    b.contact,
+                    b.order
+                );
+            } else {
+                assert!((b.order - 2.0).abs() < 0.1, "{} with {}: bar order {} ({b:?})", r.scheme, b.contact, b.order);
+            }
+        }
+        assert_eq!(r.bar.len(), 2);
         assert!(r.rho_infinity <= 1.0 + 1e-9, "{}: ρ∞ = {}", r.scheme, r.rho_infinity);
     }
     // The radius by repeated squaring against the closed forms (the one-step map at
@@ -23,12 +43,30 @@ fn every_scheme_is_second_order_and_stable_at_infinity() {
 
 #[test]
 fn crank_nicolson_and_midpoint_conserve_energy_while_the_active_set_is_kept() {
-    let rows = verify::energy_laws().unwrap();
+    let rows = verify::energy::contact_laws(&mut |_| {}).unwrap();
     assert_eq!(rows.len(), 8);
     for r in &rows {
         // Newton stops at a relative residual of 1e-10: the disc's steps keep E_aug to ~3e-11
         // of its energy scale, the bar's to ~4e-14.
         assert!(r.kept_largest < 1e-9, "{r:?}");
         assert!(r.kept_steps > 500 && r.changed_steps > 5, "{r:?}");
+    }
+}
+
+#[test]
+fn without_contact_energy_decays_like_the_spectral_radius_squared() {
+    let rows = verify::energy::dissipation(&mut |_| {}).unwrap();
+    assert_eq!(rows.len(), signorini::driver::all_schemes().len() * verify::energy::DISSIPATION_STEPS.len());
+    for r in &rows {
+        if r.rho > 1.0 - 1e-12 {
+            // Conserving (Crank–Nicolson, midpoint, hybrid without contact): to round-off.
+            assert!((r.final_ratio - 1.0).abs() < 1e-10, "{r:?}");
+        } else {
+            // Dissipating: E never grows, and its mean decay rate is ρ (transients of the
+            // non-normal one-step map account for the tolerance).
+            assert!(r.final_ratio < 1.0, "{r:?}");
+            assert!((r.measured_rate - r.rho).abs() < 1e-3 * r.rho.max(1e-3), "{r:?}");
+        }
+        assert!(r.rho <= 1.0 + 1e-12, "{r:?}");
     }
 }

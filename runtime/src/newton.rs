@@ -127,7 +127,9 @@ impl Newton {
         if !r0.is_finite() {
             return Err(NewtonError::NonFinite { report });
         }
-        let threshold = self.options.tol * r0.max(p.load_scale());
+        // Floored at the smallest normal number: a state decaying to zero (a damped scheme run
+        // for long) makes tol·r0 underflow to 0, which no subnormal residual could reach.
+        let threshold = (self.options.tol * r0.max(p.load_scale())).max(f64::MIN_POSITIVE);
         let mut res = r0;
         while res > threshold {
             if report.history.len() >= self.options.max_iterations {

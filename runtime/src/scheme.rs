@@ -69,6 +69,27 @@ pub struct SchemeDesc {
     pub coefficients: usize,
 }
 
+/// A solved stage: its name, its time and its quantities (the unknown first), named as in the
+/// scheme's file.
+pub struct StageView<'v> {
+    pub name: &'static str,
+    pub time: f64,
+    pub quantities: &'static [&'static str],
+    pub values: &'v [Vec<f64>],
+}
+
+impl StageView<'_> {
+    /// The stage's value of `state` (u, v, ...): its quantity named after the state, with a
+    /// suffix (`um` for `u` in TR-BDF2's `um, vm, am`; `u'` for `u`). The scheme's file names
+    /// these; the rule is documented in docs/language.md.
+    pub fn value_of(&self, state: &str) -> Option<&[f64]> {
+        self.quantities
+            .iter()
+            .position(|q| q.starts_with(state) && q.len() > state.len())
+            .map(|i| self.values[i].as_slice())
+    }
+}
+
 /// Implemented by every generated scheme, and by schemes interpreted at run time.
 pub trait TimeScheme {
     fn desc(&self) -> &SchemeDesc;
@@ -320,6 +341,17 @@ impl<'a> Stepper<'a> {
 
     /// Advances `states` from t to t + dt.
     pub fn step(&mut self, states: &mut [Vec<f64>], t: f64, dt: f64) -> Result<StepReport, StepError> {
+        self.step_observed(states, t, dt, &mut |_| {})
+    }
+
+    /// As [`Stepper::step`], showing each stage's quantities to `observe` once solved.
+    pub fn step_observed(
+        &mut self,
+        states: &mut [Vec<f64>],
+        t: f64,
+        dt: f64,
+        observe: &mut dyn FnMut(&StageView),
+    ) -> Result<StepReport, StepError> {
         let desc = self.desc;
         self.scheme.coefficients(dt, t, &mut self.coefs);
         let mut quantities: Vec<Vec<Vec<f64>>> = Vec::with_capacity(desc.stages.len());
@@ -335,6 +367,8 @@ impl<'a> Stepper<'a> {
             report.stages.push(r);
             let values: Vec<Vec<f64>> =
                 stage.values.iter().map(|c| self.combine(c, Some(&w), states, &quantities)).collect();
+            let time = self.coefs.get(stage.time).copied().unwrap_or(t + dt);
+            observe(&StageView { name: stage.name, time, quantities: stage.quantities, values: &values });
             quantities.push(values);
         }
         let new_states: Vec<Vec<f64>> = desc

@@ -58,8 +58,10 @@ pub enum Command {
     /// Print every scheme and contact law of the library with its params (defaults, ranges,
     /// docs), and the other form files with their slots.
     List,
-    /// Measure what the mathematics claims: every scheme's time order and spectral radius,
-    /// and the energy laws with contact on the bar and the disc; writes DIR/verify.md.
+    /// Measure what the mathematics claims: every scheme's time orders and spectral radius,
+    /// P1/P2 space orders in 1D/2D/3D, the energy laws with and without contact, and the
+    /// disc's convergence under Δt and h refinement; writes DIR/verify.md, verify.json and
+    /// figures in DIR/verify/.
     Verify {
         #[arg(long, default_value = "results")]
         out: PathBuf,
@@ -278,24 +280,17 @@ pub fn run(cli: Cli) -> ExitCode {
             print!("{}", list::text());
             ExitCode::SUCCESS
         }
-        Command::Verify { out } => {
-            let result = crate::verify::schemes().and_then(|s| Ok((s, crate::verify::energy_laws()?)));
-            match result {
-                Ok((schemes, energies)) => {
-                    let md = crate::verify::markdown(&schemes, &energies);
-                    print!("{md}");
-                    let path = out.join("verify.md");
-                    match crate::output::write_atomic(&path, md.as_bytes()) {
-                        Ok(()) => {
-                            println!("wrote {}", path.display());
-                            ExitCode::SUCCESS
-                        }
-                        Err(e) => fail(format!("cannot write {}: {e}", path.display())),
-                    }
+        Command::Verify { out } => match crate::verify::run(&mut |what| eprintln!("running {what}")) {
+            Ok(v) => match v.write(&out) {
+                Ok(()) => {
+                    print!("{}", v.markdown());
+                    println!("wrote {}", out.join("verify.md").display());
+                    ExitCode::SUCCESS
                 }
                 Err(e) => fail(e),
-            }
-        }
+            },
+            Err(e) => fail(e),
+        },
         Command::Compare { a, b, tol } => match compare::compare(&a, &b) {
             Ok((text, worst)) => {
                 print!("{text}");

@@ -1,7 +1,7 @@
 //! `signorini report`: the talk's comparisons, run and written up as DIR/report.md with tables
-//! and figures (bar: Nitsche against penalty with Crank–Nicolson and HHT, midpoint with and
-//! without mass redistribution, TR-BDF2, hybrid, every scheme's energy; disc: energies and
-//! Newton iterations per scheme, and the disc at Δt ∈ {0.01, 0.05, 0.2}).
+//! and figures: the bar (Nitsche against penalty with Crank–Nicolson and HHT, midpoint with and
+//! without mass redistribution, TR-BDF2, hybrid, every scheme's energy), the disc (energies and
+//! Newton iterations per scheme), `signorini verify`, and the Δt sweeps of both cases.
 
 use std::fmt::Write;
 use std::path::Path;
@@ -11,6 +11,8 @@ use crate::cases::bar::{self, MassChoice};
 use crate::cases::{CaseError, disc};
 use crate::driver::Setup;
 use crate::plot::Curve;
+
+mod sweep;
 
 fn mass_name(m: MassChoice) -> &'static str {
     match m {
@@ -78,7 +80,6 @@ pub fn write(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<(), CaseError
     crate::plot::panels(&out.join("bar_energies.png"), "t", &[("E_Θ of every scheme (Nitsche θ = 1)", "E_Θ", curves)])
         .map_err(|e| CaseError::Write { path: out.display().to_string(), source: std::io::Error::other(e) })?;
     md.push_str("\nIMEX-HHT (explicit contact) is only conditionally stable: its energy grows.\n\n### Energy of every scheme\n\n![energies](bar_energies.png)\n\n");
-    bar_dt_sweep(&mut md, progress);
     md.push_str("### Contact displacement and stress against the exact solution\n\n");
     md.push_str(&figures);
 
@@ -133,88 +134,17 @@ pub fn write(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<(), CaseError
     )
     .map_err(|e| CaseError::Write { path: out.display().to_string(), source: std::io::Error::other(e) })?;
     md.push_str("\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `disc/<scheme>/disc.png` (energies, displacements, contact force, Newton).\n\n");
-    disc_robustness(&mut md, progress);
-    progress("verify");
     md.push_str("## 3. Verification (`signorini verify`)\n\n");
-    md.push_str(&crate::verify::markdown(&crate::verify::schemes()?, &crate::verify::energy_laws()?));
+    let verification = crate::verify::run(progress)?;
+    verification.figures(&out.join("verify"))?;
+    md.push_str(&verification.markdown());
+    md.push('\n');
+    md.push_str("## 4. The talk's conclusions: Δt sweeps\n\n");
+    let sweeps = sweep::run(progress);
+    sweeps.figures(out)?;
+    md.push_str(&sweeps.markdown());
     md.push('\n');
     let _ = writeln!(md, "_Run time: {:.1} s._", start.elapsed().as_secs_f64());
     crate::output::write_atomic(&out.join("report.md"), md.as_bytes())
         .map_err(|source| CaseError::Write { path: out.join("report.md").display().to_string(), source })
-}
-
-/// The disc at Δt ∈ {0.01, 0.05, 0.2} for every implicit scheme (docs/mathematics.md §6): a failure (Newton
-/// not converging, blow-up) is a result here, reported in the table, not an error.
-fn disc_robustness(md: &mut String, progress: &mut dyn FnMut(&str)) {
-    md.push_str(
-        "### Robustness in Δt
-
-Same disc, T = 20. `Newton/step in contact`: mean iterations over the steps that end with an active contact point.\n\n",
-    );
-    md.push_str("| Δt | scheme | min mean u_y | E_Θ(0) → E_Θ(20) | max penetration | Newton/step in contact | max/step |\n|---|---|---|---|---|---|---|\n");
-    for dt in [0.01, 0.05, 0.2] {
-        for scheme in crate::driver::all_schemes() {
-            progress(&format!("disc {scheme} Δt = {dt}"));
-            let setup = Setup { scheme: scheme.into(), ..Setup::default() };
-            match disc::run(&disc::Options { setup, dt, ..Default::default() }) {
-                Ok(r) => {
-                    let s = &r.summary;
-                    let contact: Vec<usize> =
-                        r.series.iter().filter(|row| row.active_points > 0).map(|row| row.newton).collect();
-                    let mean = contact.iter().sum::<usize>() as f64 / contact.len().max(1) as f64;
-                    let _ = writeln!(
-                        md,
-                        "| {dt} | {scheme} | {:.4} | {:.4} → {:.4} | {:.2e} | {:.2} | {} |",
-                        s.min_uy_mean, s.energy_aug_initial, s.energy_aug_final, s.max_penetration, mean, s.newton_max
-                    );
-                }
-                Err(e) => {
-                    let _ = writeln!(md, "| {dt} | {scheme} | failed: {} | | | | |", e.to_string().replace('|', "/"));
-                }
-            }
-        }
-    }
-    md.push('\n');
-}
-
-/// The talk's conclusions on the bar, in numbers: for every scheme, Δt and mass matrix, the
-/// augmented energy's change over T = 12, the spurious oscillation of the contact stress (its
-/// total variation over the first contact phase, t ∈ [0.5, 2.5], against the exact solution's,
-/// which jumps by ½ on entry and on release: 1), and Newton iterations. A failure is a result.
-fn bar_dt_sweep(md: &mut String, progress: &mut dyn FnMut(&str)) {
-    md.push_str("### Δt sweep (Nitsche θ = 1, N = 20)\n\n`ΔE_aug`: (E_aug(12) − E_aug(0))/E_aug(0). `TV(λ)`: total variation of λ over t ∈ [0.5, 2.5] divided by the exact value 1 (1 = no spurious oscillation). `Newton`: mean iterations per step.\n\n| scheme | mass | Δt | ΔE_aug | TV(λ) | err_λ | Newton |\n|---|---|---|---|---|---|---|\n");
-    for scheme in crate::driver::all_schemes() {
-        for mass in [MassChoice::Consistent, MassChoice::Redistributed] {
-            for dt in [0.005, 0.01, 0.02, 0.05, 0.1] {
-                progress(&format!("bar Δt sweep {scheme} {} Δt = {dt}", mass_name(mass)));
-                let setup = Setup { scheme: scheme.into(), ..Setup::default() };
-                match bar::run(&bar::Options { setup, mass, dt, ..Default::default() }) {
-                    Ok(r) => {
-                        let s = &r.summary;
-                        let phase: Vec<f64> =
-                            r.series.iter().filter(|row| (0.5..=2.5).contains(&row.t)).map(|row| row.lambda).collect();
-                        let tv: f64 = phase.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
-                        let _ = writeln!(
-                            md,
-                            "| {scheme} | {} | {dt} | {:+.2e} | {:.2} | {:.3} | {:.2} |",
-                            mass_name(mass),
-                            s.energy_aug_drift_final,
-                            tv,
-                            s.err_l2_lambda,
-                            s.newton_total as f64 / s.steps.max(1) as f64
-                        );
-                    }
-                    Err(e) => {
-                        let _ = writeln!(
-                            md,
-                            "| {scheme} | {} | {dt} | failed: {} | | | |",
-                            mass_name(mass),
-                            e.to_string().replace('|', "/")
-                        );
-                    }
-                }
-            }
-        }
-    }
-    md.push('\n');
 }

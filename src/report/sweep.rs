@@ -1,0 +1,229 @@
+//! The talk's conclusions in numbers: the bar and the disc for every scheme of the library, with
+//! the consistent and the redistributed mass, over a ladder of Δt. Per run: the change of E_aug,
+//! the spurious oscillation of the contact pressure, Newton's iterations; per scheme and mass:
+//! the largest Δt of the ladder at which the run still converges. A failure is a result.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::mass_name;
+use crate::cases::bar::{self, MassChoice};
+use crate::cases::{CaseError, disc};
+use crate::driver::Setup;
+use crate::plot::Curve;
+
+const BAR_STEPS: [f64; 7] = [0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5];
+const DISC_STEPS: [f64; 6] = [0.01, 0.02, 0.05, 0.1, 0.2, 0.5];
+const MASSES: [MassChoice; 2] = [MassChoice::Consistent, MassChoice::Redistributed];
+/// A run whose |E_aug(T) − E_aug(0)| exceeds this fraction of E_aug(0) has not converged to
+/// anything physical (explicit contact blows up slowly rather than failing Newton).
+const BOUNDED: f64 = 0.5;
+
+/// One run of the sweep.
+#[derive(Clone, Debug, Serialize)]
+pub struct Point {
+    pub case: &'static str,
+    pub scheme: String,
+    pub mass: &'static str,
+    pub dt: f64,
+    /// The measures, or why the run failed.
+    pub outcome: Result<Measures, String>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Measures {
+    /// (E_aug(T) − E_aug(0)) / E_aug(0).
+    pub energy_change: f64,
+    /// Total variation of the contact pressure over the first contact phase over that of a
+    /// clean pulse (bar: the exact solution's, 1; disc: 2 max f_y, one rise and one fall).
+    /// 1 = no spurious oscillation.
+    pub oscillation: f64,
+    /// Mean and largest Newton iterations per step.
+    pub newton_mean: f64,
+    pub newton_max: usize,
+    pub max_penetration: f64,
+}
+
+impl Point {
+    fn converged(&self) -> bool {
+        self.outcome.as_ref().is_ok_and(|m| m.energy_change.abs() < BOUNDED)
+    }
+}
+
+fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
+    let setup = Setup { scheme: scheme.into(), ..Setup::default() };
+    let r = bar::run(&bar::Options { setup, mass, dt, ..Default::default() })?;
+    let s = &r.summary;
+    // The first contact phase of the exact solution is t ∈ [1, 2]: look at [0.5, 2.5].
+    let phase: Vec<f64> = r.series.iter().filter(|row| (0.5..=2.5).contains(&row.t)).map(|row| row.lambda).collect();
+    Ok(Measures {
+        energy_change: s.energy_aug_drift_final,
+        oscillation: phase.windows(2).map(|w| (w[1] - w[0]).abs()).sum(),
+        newton_mean: s.newton_total as f64 / s.steps.max(1) as f64,
+        newton_max: s.newton_max,
+        max_penetration: s.max_penetration,
+    })
+}
+
+fn disc_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
+    let setup = Setup { scheme: scheme.into(), ..Setup::default() };
+    let r = disc::run(&disc::Options { setup, mass, dt, ..Default::default() })?;
+    let s = &r.summary;
+    // The first contact phase: from the first step with an active point to the next without.
+    let start = r.series.iter().position(|row| row.active_points > 0);
+    let phase: Vec<f64> = start.map_or(Vec::new(), |k| {
+        r.series[k.saturating_sub(1)..]
+            .iter()
+            .enumerate()
+            .take_while(|(i, row)| *i < 2 || row.active_points > 0)
+            .map(|(_, row)| row.fy_contact)
+            .collect()
+    });
+    let peak = phase.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    let tv: f64 = phase.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
+    Ok(Measures {
+        energy_change: (s.energy_aug_final - s.energy_aug_initial) / s.energy_aug_initial.abs(),
+        oscillation: if peak > 0.0 { tv / (2.0 * peak) } else { f64::NAN },
+        newton_mean: s.newton_total as f64 / s.steps.max(1) as f64,
+        newton_max: s.newton_max,
+        max_penetration: s.max_penetration,
+    })
+}
+
+/// Every run of both sweeps.
+pub struct Sweeps {
+    pub points: Vec<Point>,
+}
+
+pub fn run(progress: &mut dyn FnMut(&str)) -> Sweeps {
+    let mut points = Vec::new();
+    type Measure = fn(&str, MassChoice, f64) -> Result<Measures, CaseError>;
+    let cases: [(&'static str, &[f64], Measure); 2] =
+        [("bar", &BAR_STEPS, bar_point), ("disc", &DISC_STEPS, disc_point)];
+    for (case, steps, measure) in cases {
+        for scheme in crate::driver::all_schemes() {
+            for mass in MASSES {
+                progress(&format!("{case} Δt sweep {scheme} {}", mass_name(mass)));
+                for &dt in steps {
+                    let outcome = measure(scheme, mass, dt).map_err(|e| e.to_string());
+                    points.push(Point { case, scheme: scheme.into(), mass: mass_name(mass), dt, outcome });
+                }
+            }
+        }
+    }
+    Sweeps { points }
+}
+
+impl Sweeps {
+    /// The runs of one case, scheme and mass, in Δt order.
+    fn series<'a>(&'a self, case: &'a str, scheme: &'a str, mass: &'a str) -> impl Iterator<Item = &'a Point> + 'a {
+        self.points.iter().filter(move |p| p.case == case && p.scheme == scheme && p.mass == mass)
+    }
+
+    /// The largest Δt at which the run and every run with a smaller Δt converged.
+    fn largest_converging(&self, case: &str, scheme: &str, mass: &str) -> Option<f64> {
+        self.series(case, scheme, mass).take_while(|p| p.converged()).last().map(|p| p.dt)
+    }
+
+    pub fn markdown(&self) -> String {
+        let mut md = String::from(
+            "Every scheme, consistent and redistributed mass (docs/mathematics.md §5), Nitsche θ = 1. Bar: N = 20, γ0 = 5, T = 12; disc: built-in h = 1 mesh, γ0 = 1000, T = 20. `ΔE_aug` = (E_aug(T) − E_aug(0))/E_aug(0). `osc` = total variation of the contact pressure over the first contact phase divided by a clean pulse's (bar: λ over t ∈ [0.5, 2.5] against the exact 1; disc: f_y from first contact to release against 2 max f_y): 1 = no spurious oscillation. A run converges when Newton converges at every step and |ΔE_aug| < 0.5.\n\n### Largest converging Δt\n\n| scheme | bar, consistent | bar, redistributed | disc, consistent | disc, redistributed |\n|---|---|---|---|---|\n",
+        );
+        for scheme in crate::driver::all_schemes() {
+            let cell = |case, mass| {
+                self.largest_converging(case, scheme, mass).map_or("none".to_string(), |dt| format!("{dt}"))
+            };
+            let _ = writeln!(
+                md,
+                "| {scheme} | {} | {} | {} | {} |",
+                cell("bar", "consistent"),
+                cell("bar", "redistributed"),
+                cell("disc", "consistent"),
+                cell("disc", "redistributed")
+            );
+        }
+        for case in ["bar", "disc"] {
+            let _ = write!(
+                md,
+                "\n### {case}\n\n![{case} Δt sweep]({case}_dt_sweep.png)\n\n| scheme | mass | Δt | ΔE_aug | osc | max penetration | Newton mean/max |\n|---|---|---|---|---|---|---|\n"
+            );
+            for p in self.points.iter().filter(|p| p.case == case) {
+                match &p.outcome {
+                    Ok(m) => {
+                        let _ = writeln!(
+                            md,
+                            "| {} | {} | {} | {:+.2e} | {:.2} | {:.2e} | {:.2}/{} |",
+                            p.scheme,
+                            p.mass,
+                            p.dt,
+                            m.energy_change,
+                            m.oscillation,
+                            m.max_penetration,
+                            m.newton_mean,
+                            m.newton_max
+                        );
+                    }
+                    Err(e) => {
+                        let _ = writeln!(
+                            md,
+                            "| {} | {} | {} | failed: {} | | | |",
+                            p.scheme,
+                            p.mass,
+                            p.dt,
+                            e.replace('|', "/")
+                        );
+                    }
+                }
+            }
+        }
+        md
+    }
+
+    /// `dir/bar_dt_sweep.png` and `dir/disc_dt_sweep.png`: |ΔE_aug|, the oscillation and Newton
+    /// iterations against Δt (solid: consistent mass; dashed: redistributed).
+    pub fn figures(&self, dir: &Path) -> Result<(), CaseError> {
+        for case in ["bar", "disc"] {
+            let path = dir.join(format!("{case}_dt_sweep.png"));
+            let labels: Vec<(String, &str, &str)> = MASSES
+                .iter()
+                .flat_map(|&m| {
+                    crate::driver::all_schemes().into_iter().map(move |s| {
+                        let tag = if m == MassChoice::Redistributed { " (redistributed)" } else { "" };
+                        (format!("{s}{tag}"), s, mass_name(m))
+                    })
+                })
+                .collect();
+            let curves = |f: fn(&Measures) -> f64| -> Vec<Curve> {
+                labels
+                    .iter()
+                    .map(|(label, scheme, mass)| Curve {
+                        label,
+                        points: self
+                            .series(case, scheme, mass)
+                            .filter_map(|p| p.outcome.as_ref().ok().map(|m| (p.dt.log10(), f(m))))
+                            .filter(|(_, y)| y.is_finite())
+                            .collect(),
+                        dashed: *mass == "redistributed",
+                    })
+                    .collect()
+            };
+            crate::plot::panels(
+                &path,
+                "log₁₀ Δt",
+                &[
+                    (
+                        format!("{case}: log₁₀ |ΔE_aug| over T").as_str(),
+                        "log₁₀ |ΔE_aug|",
+                        curves(|m| m.energy_change.abs().max(1e-16).log10()),
+                    ),
+                    (format!("{case}: pressure oscillation (1 = none)").as_str(), "osc", curves(|m| m.oscillation)),
+                    (format!("{case}: Newton iterations per step").as_str(), "mean", curves(|m| m.newton_mean)),
+                ],
+            )
+            .map_err(|e| CaseError::Write { path: path.display().to_string(), source: std::io::Error::other(e) })?;
+        }
+        Ok(())
+    }
+}
