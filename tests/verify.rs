@@ -50,6 +50,16 @@ fn crank_nicolson_and_midpoint_conserve_energy_while_the_active_set_is_kept() {
         // of its energy scale, the bar's to ~4e-14.
         assert!(r.kept_largest < 1e-9, "{r:?}");
         assert!(r.kept_steps > 500 && r.changed_steps > 5, "{r:?}");
+        // The jumps' signs (docs/mathematics.md §5): Crank–Nicolson loses energy when points
+        // enter contact and gains it when they leave; midpoint the reverse.
+        let sign = if r.scheme == "newmark" { 1.0 } else { -1.0 };
+        assert!(r.entering_steps > 0 && r.releasing_steps > 0, "{r:?}");
+        let (entering, releasing) = if sign > 0.0 {
+            (r.entering_range.1, -r.releasing_range.0)
+        } else {
+            (-r.entering_range.0, r.releasing_range.1)
+        };
+        assert!(entering <= 1e-9 && releasing <= 1e-9, "{r:?}");
     }
 }
 

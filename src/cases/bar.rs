@@ -68,6 +68,9 @@ pub struct Row {
     pub u_c: f64,
     pub v_c: f64,
     pub lambda: f64,
+    /// λ at t − Δt/2 from (u(t − Δt) + u(t))/2, where midpoint and hybrid impose contact
+    /// (NaN at t = 0).
+    pub lambda_half: f64,
     pub energy: f64,
     pub energy_aug: f64,
     pub penetration: f64,
@@ -218,6 +221,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
             u_c: u0,
             v_c: v.map_or(f64::NAN, |v| v[0]),
             lambda,
+            lambda_half: f64::NAN,
             energy,
             energy_aug: energy + aug,
             penetration: (-u0).max(0.0),
@@ -254,7 +258,8 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         }
         let half: Vec<f64> = before.iter().zip(&states[0]).map(|(a, b)| 0.5 * (a + b)).collect();
         let s = exact::contact_stress(t - 0.5 * opts.dt);
-        half_err += (contact_stress(&half).0 - s).powi(2);
+        row.lambda_half = contact_stress(&half).0;
+        half_err += (row.lambda_half - s).powi(2);
         half_norm += s * s;
         track(&states[0], &row);
         series.push(row);
@@ -304,11 +309,11 @@ fn quad(a: &Matrix, x: &[f64]) -> f64 {
 }
 
 fn write_outputs(dir: &std::path::Path, summary: &Summary, series: &[Row]) -> Result<(), CaseError> {
-    let mut csv = String::from("t,u_c,v_c,lambda,energy,energy_aug,penetration,newton\n");
+    let mut csv = String::from("t,u_c,v_c,lambda,lambda_half,energy,energy_aug,penetration,newton\n");
     for r in series {
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{}\n",
-            r.t, r.u_c, r.v_c, r.lambda, r.energy, r.energy_aug, r.penetration, r.newton
+            "{},{},{},{},{},{},{},{},{}\n",
+            r.t, r.u_c, r.v_c, r.lambda, r.lambda_half, r.energy, r.energy_aug, r.penetration, r.newton
         ));
     }
     let write = |name: &str, bytes: &[u8]| {

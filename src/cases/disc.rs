@@ -71,6 +71,8 @@ impl Default for Options {
 pub struct Row {
     pub t: f64,
     pub energy: f64,
+    /// ½vᵀMv (with the mass the scheme uses).
+    pub kinetic: f64,
     pub energy_aug: f64,
     /// Mass-weighted mean of u_y (the centre of mass).
     pub uy_mean: f64,
@@ -111,6 +113,9 @@ pub struct Summary {
     pub min_uy_mean: f64,
     pub energy_aug_initial: f64,
     pub energy_aug_final: f64,
+    /// The largest kinetic energy ½vᵀMv over the run (at impact): the disc's energy scale, as
+    /// E_aug(0) = 0.
+    pub kinetic_energy_max: f64,
     pub newton_total: usize,
     pub newton_max: usize,
     pub wall_seconds: f64,
@@ -246,8 +251,8 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let total_mass: f64 = mass_ey.iter().zip(&ey).map(|(a, b)| a * b).sum();
     let lowest = (0..mesh.num_nodes()).min_by(|&a, &b| mesh.node(a)[1].total_cmp(&mesh.node(b)[1])).expect("nodes");
     let measure = |u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
-        let energy = 0.5 * quad(&stiffness, u, u) + v.map_or(0.0, |v| 0.5 * quad(&energy_mass, v, v))
-            - load.iter().zip(u).map(|(l, x)| l * x).sum::<f64>();
+        let kinetic = v.map_or(0.0, |v| 0.5 * quad(&energy_mass, v, v));
+        let energy = 0.5 * quad(&stiffness, u, u) + kinetic - load.iter().zip(u).map(|(l, x)| l * x).sum::<f64>();
         let mut c = vec![0.0; n];
         probe.residual(&asm, &[u], t, &mut c);
         let mut switches = Vec::new();
@@ -257,6 +262,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         Row {
             t,
             energy,
+            kinetic,
             energy_aug: energy + contact_energy.as_ref().map_or(f64::NAN, |e| e.value(&asm, &[u], 0.0)),
             // Area-weighted mean of u_y: e_yᵀ M u / e_yᵀ M e_y.
             uy_mean: mass_ey.iter().zip(u).map(|(a, b)| a * b).sum::<f64>() / total_mass,
@@ -353,6 +359,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         min_uy_mean: series.iter().map(|r| r.uy_mean).fold(f64::INFINITY, f64::min),
         energy_aug_initial: series[0].energy_aug,
         energy_aug_final: last.energy_aug,
+        kinetic_energy_max: series.iter().map(|r| r.kinetic).fold(0.0, f64::max),
         newton_total: series.iter().map(|r| r.newton).sum(),
         newton_max: series.iter().map(|r| r.newton).max().unwrap_or(0),
         wall_seconds: wall,

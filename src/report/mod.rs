@@ -12,7 +12,7 @@ use crate::cases::{CaseError, disc};
 use crate::driver::Setup;
 use crate::plot::Curve;
 
-mod sweep;
+pub mod sweep;
 
 fn mass_name(m: MassChoice) -> &'static str {
     match m {
@@ -22,7 +22,8 @@ fn mass_name(m: MassChoice) -> &'static str {
 }
 
 /// Runs everything and writes `out/report.md` (and the runs' files below `out`).
-pub fn write(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<(), CaseError> {
+/// `quick`: sections 1 and 2 only.
+pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<(), CaseError> {
     let start = Instant::now();
     let mut md = String::from("# signorini report\n\n");
     let _ = writeln!(
@@ -134,16 +135,21 @@ pub fn write(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<(), CaseError
     )
     .map_err(|e| CaseError::Write { path: out.display().to_string(), source: std::io::Error::other(e) })?;
     md.push_str("\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `disc/<scheme>/disc.png` (energies, displacements, contact force, Newton).\n\n");
-    md.push_str("## 3. Verification (`signorini verify`)\n\n");
-    let verification = crate::verify::run(progress)?;
-    verification.figures(&out.join("verify"))?;
-    md.push_str(&verification.markdown());
-    md.push('\n');
-    md.push_str("## 4. The talk's conclusions: Δt sweeps\n\n");
-    let sweeps = sweep::run(progress);
-    sweeps.figures(out)?;
-    md.push_str(&sweeps.markdown());
-    md.push('\n');
+    if !quick {
+        md.push_str("## 3. Verification (`signorini verify`)\n\n");
+        let verification = crate::verify::run(progress)?;
+        verification.figures(&out.join("verify"))?;
+        md.push_str(&verification.markdown());
+        md.push('\n');
+        md.push_str("## 4. The talk's conclusions: Δt sweeps\n\n");
+        let sweeps = sweep::run(progress, &sweep::CASES);
+        sweeps.figures(out)?;
+        let json = out.join("dt_sweep.json");
+        crate::output::write_json(&json, &sweeps)
+            .map_err(|source| CaseError::Write { path: json.display().to_string(), source })?;
+        md.push_str(&sweeps.markdown());
+        md.push('\n');
+    }
     let _ = writeln!(md, "_Run time: {:.1} s._", start.elapsed().as_secs_f64());
     crate::output::write_atomic(&out.join("report.md"), md.as_bytes())
         .map_err(|source| CaseError::Write { path: out.join("report.md").display().to_string(), source })

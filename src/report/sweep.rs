@@ -15,10 +15,10 @@ use crate::driver::Setup;
 use crate::plot::Curve;
 
 const BAR_STEPS: [f64; 7] = [0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5];
-const DISC_STEPS: [f64; 6] = [0.01, 0.02, 0.05, 0.1, 0.2, 0.5];
+const DISC_STEPS: [f64; 7] = [0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0];
 const MASSES: [MassChoice; 2] = [MassChoice::Consistent, MassChoice::Redistributed];
-/// A run whose |E_aug(T) − E_aug(0)| exceeds this fraction of E_aug(0) has not converged to
-/// anything physical (explicit contact blows up slowly rather than failing Newton).
+/// A run whose |E_aug(T) − E_aug(0)| exceeds this fraction of its energy scale has not converged
+/// to anything physical (explicit contact blows up slowly rather than failing Newton).
 const BOUNDED: f64 = 0.5;
 
 /// One run of the sweep.
@@ -34,12 +34,15 @@ pub struct Point {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Measures {
-    /// (E_aug(T) − E_aug(0)) / E_aug(0).
+    /// (E_aug(T) − E_aug(0)) / E_aug(0) on the bar; over the largest kinetic energy on the disc,
+    /// which starts at rest with E_aug(0) = 0.
     pub energy_change: f64,
     /// Total variation of the contact pressure over the first contact phase over that of a
     /// clean pulse (bar: the exact solution's, 1; disc: 2 max f_y, one rise and one fall).
     /// 1 = no spurious oscillation.
     pub oscillation: f64,
+    /// The same from the pressure at t^{n+1/2}, where midpoint and hybrid impose contact (bar).
+    pub oscillation_half: f64,
     /// Mean and largest Newton iterations per step.
     pub newton_mean: f64,
     pub newton_max: usize,
@@ -47,7 +50,7 @@ pub struct Measures {
 }
 
 impl Point {
-    fn converged(&self) -> bool {
+    pub fn converged(&self) -> bool {
         self.outcome.as_ref().is_ok_and(|m| m.energy_change.abs() < BOUNDED)
     }
 }
@@ -57,10 +60,14 @@ fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseEr
     let r = bar::run(&bar::Options { setup, mass, dt, ..Default::default() })?;
     let s = &r.summary;
     // The first contact phase of the exact solution is t ∈ [1, 2]: look at [0.5, 2.5].
-    let phase: Vec<f64> = r.series.iter().filter(|row| (0.5..=2.5).contains(&row.t)).map(|row| row.lambda).collect();
+    let variation = |f: fn(&bar::Row) -> f64| -> f64 {
+        let phase: Vec<f64> = r.series.iter().filter(|row| (0.5..=2.5).contains(&row.t)).map(f).collect();
+        phase.windows(2).map(|w| (w[1] - w[0]).abs()).sum()
+    };
     Ok(Measures {
         energy_change: s.energy_aug_drift_final,
-        oscillation: phase.windows(2).map(|w| (w[1] - w[0]).abs()).sum(),
+        oscillation: variation(|row| row.lambda),
+        oscillation_half: variation(|row| row.lambda_half),
         newton_mean: s.newton_total as f64 / s.steps.max(1) as f64,
         newton_max: s.newton_max,
         max_penetration: s.max_penetration,
@@ -84,25 +91,41 @@ fn disc_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseE
     let peak = phase.iter().fold(0.0f64, |m, f| m.max(f.abs()));
     let tv: f64 = phase.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
     Ok(Measures {
-        energy_change: (s.energy_aug_final - s.energy_aug_initial) / s.energy_aug_initial.abs(),
+        // E_aug(0) = 0 (at rest, u = 0): relative to the kinetic energy at impact.
+        energy_change: (s.energy_aug_final - s.energy_aug_initial) / s.kinetic_energy_max,
         oscillation: if peak > 0.0 { tv / (2.0 * peak) } else { f64::NAN },
+        oscillation_half: f64::NAN,
         newton_mean: s.newton_total as f64 / s.steps.max(1) as f64,
         newton_max: s.newton_max,
         max_penetration: s.max_penetration,
     })
 }
 
-/// Every run of both sweeps.
+/// Every run of the sweeps.
+#[derive(Serialize)]
 pub struct Sweeps {
     pub points: Vec<Point>,
 }
 
-pub fn run(progress: &mut dyn FnMut(&str)) -> Sweeps {
+pub type Measure = fn(&str, MassChoice, f64) -> Result<Measures, CaseError>;
+
+/// One sweep: the case, its Δt ladder, its measurement.
+pub struct Case {
+    pub name: &'static str,
+    pub steps: &'static [f64],
+    pub measure: Measure,
+}
+
+/// The bar's and the disc's sweeps.
+pub const CASES: [Case; 2] = [
+    Case { name: "bar", steps: &BAR_STEPS, measure: bar_point },
+    Case { name: "disc", steps: &DISC_STEPS, measure: disc_point },
+];
+
+/// Runs `cases` for every scheme and both masses.
+pub fn run(progress: &mut dyn FnMut(&str), cases: &[Case]) -> Sweeps {
     let mut points = Vec::new();
-    type Measure = fn(&str, MassChoice, f64) -> Result<Measures, CaseError>;
-    let cases: [(&'static str, &[f64], Measure); 2] =
-        [("bar", &BAR_STEPS, bar_point), ("disc", &DISC_STEPS, disc_point)];
-    for (case, steps, measure) in cases {
+    for &Case { name: case, steps, measure } in cases {
         for scheme in crate::driver::all_schemes() {
             for mass in MASSES {
                 progress(&format!("{case} Δt sweep {scheme} {}", mass_name(mass)));
@@ -118,48 +141,61 @@ pub fn run(progress: &mut dyn FnMut(&str)) -> Sweeps {
 
 impl Sweeps {
     /// The runs of one case, scheme and mass, in Δt order.
-    fn series<'a>(&'a self, case: &'a str, scheme: &'a str, mass: &'a str) -> impl Iterator<Item = &'a Point> + 'a {
-        self.points.iter().filter(move |p| p.case == case && p.scheme == scheme && p.mass == mass)
+    pub fn series(&self, case: &str, scheme: &str, mass: &str) -> Vec<&Point> {
+        self.points.iter().filter(|p| p.case == case && p.scheme == scheme && p.mass == mass).collect()
     }
 
     /// The largest Δt at which the run and every run with a smaller Δt converged.
-    fn largest_converging(&self, case: &str, scheme: &str, mass: &str) -> Option<f64> {
-        self.series(case, scheme, mass).take_while(|p| p.converged()).last().map(|p| p.dt)
+    pub fn largest_converging(&self, case: &str, scheme: &str, mass: &str) -> Option<f64> {
+        self.series(case, scheme, mass).into_iter().take_while(|p| p.converged()).last().map(|p| p.dt)
     }
 
     pub fn markdown(&self) -> String {
         let mut md = String::from(
-            "Every scheme, consistent and redistributed mass (docs/mathematics.md §5), Nitsche θ = 1. Bar: N = 20, γ0 = 5, T = 12; disc: built-in h = 1 mesh, γ0 = 1000, T = 20. `ΔE_aug` = (E_aug(T) − E_aug(0))/E_aug(0). `osc` = total variation of the contact pressure over the first contact phase divided by a clean pulse's (bar: λ over t ∈ [0.5, 2.5] against the exact 1; disc: f_y from first contact to release against 2 max f_y): 1 = no spurious oscillation. A run converges when Newton converges at every step and |ΔE_aug| < 0.5.\n\n### Largest converging Δt\n\n| scheme | bar, consistent | bar, redistributed | disc, consistent | disc, redistributed |\n|---|---|---|---|---|\n",
+            "Every scheme, consistent and redistributed mass (docs/mathematics.md §5), Nitsche θ = 1. Bar: N = 20, γ0 = 5, T = 12; disc: built-in h = 1 mesh, γ0 = 1000, T = 20. `ΔE_aug` = (E_aug(T) − E_aug(0)) over the energy scale: E_aug(0) on the bar, the largest kinetic energy on the disc (which starts at rest, E_aug(0) = 0). `osc` = total variation of the contact pressure over the first contact phase divided by a clean pulse's (bar: λ over t ∈ [0.5, 2.5] against the exact 1; disc: f_y from first contact to release against 2 max f_y): 1 = no spurious oscillation. `osc½`: the same on the bar from λ at t^{n+½}, computed from (uⁿ + uⁿ⁺¹)/2, where midpoint and hybrid impose contact. A run converges when Newton converges at every step and |ΔE_aug| < 0.5.\n\n### Largest converging Δt\n\n",
         );
-        for scheme in crate::driver::all_schemes() {
-            let cell = |case, mass| {
-                self.largest_converging(case, scheme, mass).map_or("none".to_string(), |dt| format!("{dt}"))
-            };
-            let _ = writeln!(
-                md,
-                "| {scheme} | {} | {} | {} | {} |",
-                cell("bar", "consistent"),
-                cell("bar", "redistributed"),
-                cell("disc", "consistent"),
-                cell("disc", "redistributed")
-            );
+        let mut cases: Vec<&str> = self.points.iter().map(|p| p.case).collect();
+        cases.dedup();
+        let columns: Vec<(&str, &str)> =
+            cases.iter().flat_map(|&c| MASSES.iter().map(move |&m| (c, mass_name(m)))).collect();
+        md.push_str("| scheme |");
+        for (case, mass) in &columns {
+            let _ = write!(md, " {case}, {mass} |");
         }
-        for case in ["bar", "disc"] {
+        md.push_str("\n|---|");
+        md.push_str(&"---|".repeat(columns.len()));
+        md.push('\n');
+        for scheme in crate::driver::all_schemes() {
+            let _ = write!(md, "| {scheme} |");
+            for (case, mass) in &columns {
+                let cell = self.largest_converging(case, scheme, mass).map_or("none".to_string(), |dt| format!("{dt}"));
+                let _ = write!(md, " {cell} |");
+            }
+            md.push('\n');
+        }
+        let mut cases: Vec<&str> = self.points.iter().map(|p| p.case).collect();
+        cases.dedup();
+        for case in cases {
             let _ = write!(
                 md,
-                "\n### {case}\n\n![{case} Δt sweep]({case}_dt_sweep.png)\n\n| scheme | mass | Δt | ΔE_aug | osc | max penetration | Newton mean/max |\n|---|---|---|---|---|---|---|\n"
+                "\n### {case}\n\n![{case} Δt sweep]({case}_dt_sweep.png)\n\n| scheme | mass | Δt | ΔE_aug | osc | osc½ | max penetration | Newton mean/max |\n|---|---|---|---|---|---|---|---|\n"
             );
             for p in self.points.iter().filter(|p| p.case == case) {
                 match &p.outcome {
                     Ok(m) => {
                         let _ = writeln!(
                             md,
-                            "| {} | {} | {} | {:+.2e} | {:.2} | {:.2e} | {:.2}/{} |",
+                            "| {} | {} | {} | {:+.2e} | {:.2} | {} | {:.2e} | {:.2}/{} |",
                             p.scheme,
                             p.mass,
                             p.dt,
                             m.energy_change,
                             m.oscillation,
+                            if m.oscillation_half.is_nan() {
+                                "—".into()
+                            } else {
+                                format!("{:.2}", m.oscillation_half)
+                            },
                             m.max_penetration,
                             m.newton_mean,
                             m.newton_max
@@ -168,7 +204,7 @@ impl Sweeps {
                     Err(e) => {
                         let _ = writeln!(
                             md,
-                            "| {} | {} | {} | failed: {} | | | |",
+                            "| {} | {} | {} | failed: {} | | | | |",
                             p.scheme,
                             p.mass,
                             p.dt,
@@ -184,7 +220,9 @@ impl Sweeps {
     /// `dir/bar_dt_sweep.png` and `dir/disc_dt_sweep.png`: |ΔE_aug|, the oscillation and Newton
     /// iterations against Δt (solid: consistent mass; dashed: redistributed).
     pub fn figures(&self, dir: &Path) -> Result<(), CaseError> {
-        for case in ["bar", "disc"] {
+        let mut cases: Vec<&str> = self.points.iter().map(|p| p.case).collect();
+        cases.dedup();
+        for case in cases {
             let path = dir.join(format!("{case}_dt_sweep.png"));
             let labels: Vec<(String, &str, &str)> = MASSES
                 .iter()
@@ -202,6 +240,7 @@ impl Sweeps {
                         label,
                         points: self
                             .series(case, scheme, mass)
+                            .into_iter()
                             .filter_map(|p| p.outcome.as_ref().ok().map(|m| (p.dt.log10(), f(m))))
                             .filter(|(_, y)| y.is_finite())
                             .collect(),

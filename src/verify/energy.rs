@@ -24,11 +24,21 @@ pub struct EnergyRow {
     /// Steps whose active set changed, and their total ΔE_aug (relative).
     pub changed_steps: usize,
     pub changed_total: f64,
+    /// Steps on which points only entered contact, and the extreme ΔE_aug over them (the
+    /// largest for Crank–Nicolson, whose jumps there are ≤ 0; the smallest for midpoint, ≥ 0).
+    pub entering_steps: usize,
+    pub entering_range: (f64, f64),
+    /// Steps on which points only left contact, and the range of ΔE_aug over them.
+    pub releasing_steps: usize,
+    pub releasing_range: (f64, f64),
 }
 
 fn energy_row(case: &'static str, scheme: &str, contact: &str, rows: &[(Vec<bool>, f64, f64)]) -> EnergyRow {
     let scale = rows.iter().map(|r| r.2.abs()).fold(0.0f64, f64::max).max(1e-300);
     let (mut kept, mut largest, mut changed, mut total) = (0, 0.0f64, 0, 0.0);
+    let empty = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut entering, mut entering_range, mut releasing, mut releasing_range) = (0, empty, 0, empty);
+    let widen = |r: &mut (f64, f64), x: f64| *r = (r.0.min(x), r.1.max(x));
     for w in rows.windows(2) {
         let delta = (w[1].1 - w[0].1) / scale;
         if w[0].0 == w[1].0 {
@@ -37,6 +47,16 @@ fn energy_row(case: &'static str, scheme: &str, contact: &str, rows: &[(Vec<bool
         } else {
             changed += 1;
             total += delta;
+            let pairs = || w[0].0.iter().zip(&w[1].0);
+            let enters = pairs().any(|(a, b)| !a && *b);
+            let leaves = pairs().any(|(a, b)| *a && !b);
+            if enters && !leaves {
+                entering += 1;
+                widen(&mut entering_range, delta);
+            } else if leaves && !enters {
+                releasing += 1;
+                widen(&mut releasing_range, delta);
+            }
         }
     }
     EnergyRow {
@@ -47,6 +67,10 @@ fn energy_row(case: &'static str, scheme: &str, contact: &str, rows: &[(Vec<bool
         kept_largest: largest,
         changed_steps: changed,
         changed_total: total,
+        entering_steps: entering,
+        entering_range,
+        releasing_steps: releasing,
+        releasing_range,
     }
 }
 

@@ -180,12 +180,22 @@ impl Verification {
             );
         }
         md.push_str("\n![space orders](verify/space_orders.png)\n\n");
-        md.push_str("### (c) Energy laws\n\nWith contact: Crank–Nicolson (Newmark β = ¼) and midpoint conserve E_aug on every step whose active set (contact status at the quadrature points) does not change; the other steps carry the jumps D of docs/mathematics.md §5. Relative to the largest |E| of the run. Bar: N = 20, Δt = 0.01, T = 12; disc: built-in h = 2 mesh, Δt = 0.02, T = 16.\n\n| case | scheme | contact | steps, active set kept | max \\|ΔE_aug\\| there | steps, active set changed | total ΔE_aug there |\n|---|---|---|---|---|---|---|\n");
+        md.push_str("### (c) Energy laws\n\nWith contact: Crank–Nicolson (Newmark β = ¼) and midpoint conserve E_aug on every step whose active set (contact status at the quadrature points) does not change; the other steps carry the jumps D of docs/mathematics.md §5. Relative to the largest |E| of the run. Bar: N = 20, Δt = 0.01, T = 12; disc: built-in h = 2 mesh, Δt = 0.02, T = 16.\n\nOf the changed steps, those on which points only enter contact and those on which they only leave it (Crank–Nicolson: ΔE_aug ≤ 0 entering, ≥ 0 leaving; midpoint: the reverse), with the range of ΔE_aug over them.\n\n| case | scheme | contact | steps, active set kept | max \\|ΔE_aug\\| there | steps, active set changed | total ΔE_aug there | entering: steps, ΔE_aug range | leaving: steps, ΔE_aug range |\n|---|---|---|---|---|---|---|---|---|\n");
+        let range =
+            |n: usize, r: (f64, f64)| if n == 0 { "0".to_string() } else { format!("{n}: [{:.1e}, {:.1e}]", r.0, r.1) };
         for r in &self.energy {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {:.1e} | {} | {:.2e} |",
-                r.case, r.scheme, r.contact, r.kept_steps, r.kept_largest, r.changed_steps, r.changed_total
+                "| {} | {} | {} | {} | {:.1e} | {} | {:.2e} | {} | {} |",
+                r.case,
+                r.scheme,
+                r.contact,
+                r.kept_steps,
+                r.kept_largest,
+                r.changed_steps,
+                r.changed_total,
+                range(r.entering_steps, r.entering_range),
+                range(r.releasing_steps, r.releasing_range)
             );
         }
         md.push_str("\nWithout contact (oscillator, 2000 steps): the energy decays per step like ρ², ρ the spectral radius of the one-step map at that ωΔt; `rate` = (E_N/E_0)^(1/2N). `max step increase`: the largest E_{n+1} − E_n over E_0. TR-BDF2's E decreases at every step; HHT's and generalized-α's E oscillates while it decays (their monotone energy is an algorithmic one, not E).\n\n| scheme | ωΔt | ρ | rate | E_N/E_0 | max step increase |\n|---|---|---|---|---|---|\n");
