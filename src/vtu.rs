@@ -5,19 +5,7 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use crate::runtime::element::ElementKind;
 use crate::runtime::mesh::Mesh;
-
-/// VTK cell type of an element kind (node orders agree with Gmsh's for these).
-fn vtk_type(kind: ElementKind) -> u8 {
-    match kind {
-        ElementKind::IntervalP1 => 3,
-        ElementKind::TriangleP1 => 5,
-        ElementKind::TriangleP2 => 22,
-        ElementKind::TetrahedronP1 => 10,
-        ElementKind::TetrahedronP2 => 24,
-    }
-}
 
 /// A data array: name, components, values (`len = count × components`).
 pub struct Field<'a> {
@@ -40,8 +28,11 @@ pub fn write(path: &Path, mesh: &Mesh, point_data: &[Field], cell_data: &[Field]
         let _ = writeln!(s, "{} {} {}", p[0], p.get(1).copied().unwrap_or(0.0), p.get(2).copied().unwrap_or(0.0));
     }
     s.push_str("</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
+    // VTK's node order (its cell type's), from the element catalogue.
+    let info = mesh.kind.info();
     for c in 0..cells {
-        let ids: Vec<String> = mesh.cell(c).iter().map(|n| n.to_string()).collect();
+        let cell = mesh.cell(c);
+        let ids: Vec<String> = info.vtk_order.iter().map(|&k| cell[k].to_string()).collect();
         let _ = writeln!(s, "{}", ids.join(" "));
     }
     s.push_str("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
@@ -49,7 +40,7 @@ pub fn write(path: &Path, mesh: &Mesh, point_data: &[Field], cell_data: &[Field]
     let offsets: Vec<String> = (1..=cells).map(|c| (c * npc).to_string()).collect();
     let _ = writeln!(s, "{}", offsets.join(" "));
     s.push_str("</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-    let _ = writeln!(s, "{}", vec![vtk_type(mesh.kind).to_string(); cells].join(" "));
+    let _ = writeln!(s, "{}", vec![info.vtk.to_string(); cells].join(" "));
     s.push_str("</DataArray>\n</Cells>\n");
     let arrays = |s: &mut String, fields: &[Field], count: usize| {
         for f in fields {

@@ -50,3 +50,31 @@ fn snapshots_read_back_with_vtkio() {
         assert!((values[1] + 0.05 * t * t).abs() < 1e-10, "{name}: u_y = {}", values[1]);
     }
 }
+
+/// VTK's quadratic tetrahedron numbers its edge nodes (0,1), (1,2), (2,0), (0,3), (1,3), (2,3)
+/// (VTK's VTK_QUADRATIC_TETRA), unlike Gmsh: on a straight P2 mesh every edge node written must
+/// be the midpoint of the vertices VTK pairs it with.
+#[test]
+fn quadratic_tetrahedra_follow_vtk_node_order() {
+    let unit = [0.0, 1.0];
+    let mesh = signorini::runtime::mesh::structured::cuboid([2, 2, 2], unit, unit, unit, 2);
+    let path = std::env::temp_dir().join(format!("signorini-tet10-{}.vtu", std::process::id()));
+    signorini::vtu::write(&path, &mesh, &[], &[]).unwrap();
+    let vtk = vtkio::Vtk::import(&path).unwrap();
+    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else { panic!("not an unstructured grid") };
+    let Piece::Inline(piece) = &pieces[0] else { panic!("piece not inline") };
+    assert!(piece.cells.types.iter().all(|t| *t == CellType::QuadraticTetra));
+    let VertexNumbers::XML { connectivity, .. } = &piece.cells.cell_verts else { panic!("not XML cells") };
+    let points: Vec<f64> = piece.points.clone().cast_into::<f64>().unwrap();
+    let p = |i: u64| &points[3 * i as usize..3 * i as usize + 3];
+    const VTK_EDGES: [[usize; 2]; 6] = [[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]];
+    for cell in connectivity.chunks(10) {
+        for (k, [a, b]) in VTK_EDGES.iter().enumerate() {
+            let (m, pa, pb) = (p(cell[4 + k]), p(cell[*a]), p(cell[*b]));
+            for j in 0..3 {
+                assert!((m[j] - 0.5 * (pa[j] + pb[j])).abs() < 1e-14, "edge node {} of {cell:?}", 4 + k);
+            }
+        }
+    }
+    let _ = std::fs::remove_file(path);
+}

@@ -1,5 +1,6 @@
 //! The element catalogue: reference cells, Lagrange P1/P2 basis functions and their
-//! gradients, local facets with their reference outward normals. Node order is Gmsh's.
+//! gradients, local facets with their reference outward normals, and the catalogue
+//! [`ELEMENTS`] of every kind's facts (sizes, Gmsh and VTK codes and orders). Node order is Gmsh's.
 //!
 //! Reference cells: interval [0, 1]; triangle (0,0), (1,0), (0,1); tetrahedron (0,0,0),
 //! (1,0,0), (0,1,0), (0,0,1). P2 edge nodes: triangle 3:(0,1) 4:(1,2) 5:(2,0); tetrahedron
@@ -15,14 +16,107 @@ pub enum ElementKind {
     TetrahedronP2,
 }
 
-/// Vertices of the reference triangle's edges, in facet order.
-const TRIANGLE_FACETS: [[usize; 2]; 3] = [[0, 1], [1, 2], [2, 0]];
-/// Vertices of the reference tetrahedron's faces, in facet order.
-const TET_FACETS: [[usize; 3]; 4] = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
-/// Vertex pairs of the P2 tetrahedron's edge nodes 4..10.
-const TET_EDGES: [[usize; 2]; 6] = [[0, 1], [1, 2], [0, 2], [0, 3], [2, 3], [1, 3]];
+/// Everything the code knows about one element kind, in one row of [`ELEMENTS`]: the
+/// dispatch, the Gmsh reader, the VTU writer and P2 promotion all read it from here.
+#[derive(Debug)]
+pub struct ElementInfo {
+    pub kind: ElementKind,
+    pub name: &'static str,
+    pub dim: usize,
+    /// Polynomial degree of the basis (and of the isoparametric geometry).
+    pub degree: u32,
+    /// Nodes per cell (scalar basis functions).
+    pub nodes: usize,
+    /// Local facets as lists of local vertex indices.
+    pub facets: &'static [&'static [usize]],
+    /// Vertex pairs of the edge nodes, which follow the vertices (empty for P1).
+    pub edge_nodes: &'static [[usize; 2]],
+    /// Gmsh's element type number (node order: Gmsh's, which is ours).
+    pub gmsh: u32,
+    /// VTK's cell type, and for each VTK node position the local node of ours it shows.
+    pub vtk: u8,
+    pub vtk_order: &'static [usize],
+    /// The P2 kind on the same cell, for promotion (`Mesh::to_p2`).
+    pub p2: Option<ElementKind>,
+}
+
 /// Vertex pairs of the P2 triangle's edge nodes 3..6.
 const TRIANGLE_EDGES: [[usize; 2]; 3] = [[0, 1], [1, 2], [2, 0]];
+/// Vertex pairs of the P2 tetrahedron's edge nodes 4..10 (Gmsh's order).
+const TET_EDGES: [[usize; 2]; 6] = [[0, 1], [1, 2], [0, 2], [0, 3], [2, 3], [1, 3]];
+const INTERVAL_FACETS: &[&[usize]] = &[&[0], &[1]];
+const TRIANGLE_FACETS: &[&[usize]] = &[&[0, 1], &[1, 2], &[2, 0]];
+const TET_FACETS: &[&[usize]] = &[&[0, 1, 2], &[0, 1, 3], &[0, 2, 3], &[1, 2, 3]];
+
+/// The catalogue, indexed by `ElementKind as usize`.
+pub const ELEMENTS: [ElementInfo; 5] = [
+    ElementInfo {
+        kind: ElementKind::IntervalP1,
+        name: "P1 interval",
+        dim: 1,
+        degree: 1,
+        nodes: 2,
+        facets: INTERVAL_FACETS,
+        edge_nodes: &[],
+        gmsh: 1,
+        vtk: 3,
+        vtk_order: &[0, 1],
+        p2: None,
+    },
+    ElementInfo {
+        kind: ElementKind::TriangleP1,
+        name: "P1 triangle",
+        dim: 2,
+        degree: 1,
+        nodes: 3,
+        facets: TRIANGLE_FACETS,
+        edge_nodes: &[],
+        gmsh: 2,
+        vtk: 5,
+        vtk_order: &[0, 1, 2],
+        p2: Some(ElementKind::TriangleP2),
+    },
+    ElementInfo {
+        kind: ElementKind::TriangleP2,
+        name: "P2 triangle",
+        dim: 2,
+        degree: 2,
+        nodes: 6,
+        facets: TRIANGLE_FACETS,
+        edge_nodes: &TRIANGLE_EDGES,
+        gmsh: 9,
+        vtk: 22,
+        vtk_order: &[0, 1, 2, 3, 4, 5],
+        p2: Some(ElementKind::TriangleP2),
+    },
+    ElementInfo {
+        kind: ElementKind::TetrahedronP1,
+        name: "P1 tetrahedron",
+        dim: 3,
+        degree: 1,
+        nodes: 4,
+        facets: TET_FACETS,
+        edge_nodes: &[],
+        gmsh: 4,
+        vtk: 10,
+        vtk_order: &[0, 1, 2, 3],
+        p2: Some(ElementKind::TetrahedronP2),
+    },
+    ElementInfo {
+        kind: ElementKind::TetrahedronP2,
+        name: "P2 tetrahedron",
+        dim: 3,
+        degree: 2,
+        nodes: 10,
+        facets: TET_FACETS,
+        edge_nodes: &TET_EDGES,
+        gmsh: 11,
+        // VTK_QUADRATIC_TETRA's edges 8 and 9 are (1,3) and (2,3): Gmsh's 9 and 8.
+        vtk: 24,
+        vtk_order: &[0, 1, 2, 3, 4, 5, 6, 7, 9, 8],
+        p2: Some(ElementKind::TetrahedronP2),
+    },
+];
 
 impl ElementKind {
     pub const ALL: [ElementKind; 5] = [
@@ -33,30 +127,27 @@ impl ElementKind {
         ElementKind::TetrahedronP2,
     ];
 
+    /// This kind's row of the catalogue.
+    pub fn info(self) -> &'static ElementInfo {
+        &ELEMENTS[self as usize]
+    }
+
+    /// The kind of a Gmsh element type number, if it is one of ours.
+    pub fn from_gmsh(code: u32) -> Option<ElementKind> {
+        ELEMENTS.iter().find(|e| e.gmsh == code).map(|e| e.kind)
+    }
+
     pub fn dim(self) -> usize {
-        match self {
-            ElementKind::IntervalP1 => 1,
-            ElementKind::TriangleP1 | ElementKind::TriangleP2 => 2,
-            ElementKind::TetrahedronP1 | ElementKind::TetrahedronP2 => 3,
-        }
+        self.info().dim
     }
 
     pub fn degree(self) -> u32 {
-        match self {
-            ElementKind::IntervalP1 | ElementKind::TriangleP1 | ElementKind::TetrahedronP1 => 1,
-            ElementKind::TriangleP2 | ElementKind::TetrahedronP2 => 2,
-        }
+        self.info().degree
     }
 
     /// Number of nodes (scalar basis functions).
     pub fn nodes(self) -> usize {
-        match self {
-            ElementKind::IntervalP1 => 2,
-            ElementKind::TriangleP1 => 3,
-            ElementKind::TriangleP2 => 6,
-            ElementKind::TetrahedronP1 => 4,
-            ElementKind::TetrahedronP2 => 10,
-        }
+        self.info().nodes
     }
 
     pub fn vertices(self) -> usize {
@@ -64,13 +155,7 @@ impl ElementKind {
     }
 
     pub fn name(self) -> &'static str {
-        match self {
-            ElementKind::IntervalP1 => "P1 interval",
-            ElementKind::TriangleP1 => "P1 triangle",
-            ElementKind::TriangleP2 => "P2 triangle",
-            ElementKind::TetrahedronP1 => "P1 tetrahedron",
-            ElementKind::TetrahedronP2 => "P2 tetrahedron",
-        }
+        self.info().name
     }
 
     /// Reference coordinates of the vertices.
@@ -87,32 +172,20 @@ impl ElementKind {
         let v = self.reference_vertices();
         let mid = |a: usize, b: usize| v[a].iter().zip(&v[b]).map(|(x, y)| 0.5 * (x + y)).collect::<Vec<f64>>();
         let mut nodes = v.clone();
-        match self {
-            ElementKind::TriangleP2 => nodes.extend(TRIANGLE_EDGES.iter().map(|e| mid(e[0], e[1]))),
-            ElementKind::TetrahedronP2 => nodes.extend(TET_EDGES.iter().map(|e| mid(e[0], e[1]))),
-            _ => {}
-        }
+        nodes.extend(self.info().edge_nodes.iter().map(|e| mid(e[0], e[1])));
         nodes
     }
 
     /// Local facets as lists of local vertex indices.
     pub fn facets(self) -> Vec<Vec<usize>> {
-        match self.dim() {
-            1 => vec![vec![0], vec![1]],
-            2 => TRIANGLE_FACETS.iter().map(|f| f.to_vec()).collect(),
-            _ => TET_FACETS.iter().map(|f| f.to_vec()).collect(),
-        }
+        self.info().facets.iter().map(|f| f.to_vec()).collect()
     }
 
     /// Local nodes lying on each facet (vertices, then edge nodes for P2).
     pub fn facet_nodes(self, facet: usize) -> Vec<usize> {
         let verts = &self.facets()[facet];
         let mut nodes = verts.clone();
-        let edges: &[[usize; 2]] = match self {
-            ElementKind::TriangleP2 => &TRIANGLE_EDGES,
-            ElementKind::TetrahedronP2 => &TET_EDGES,
-            _ => &[],
-        };
+        let edges = self.info().edge_nodes;
         let offset = self.vertices();
         for (e, pair) in edges.iter().enumerate() {
             if verts.contains(&pair[0]) && verts.contains(&pair[1]) {
@@ -142,10 +215,9 @@ impl ElementKind {
     /// Values of all basis functions at a reference point.
     pub fn basis(self, xi: &[f64]) -> Vec<f64> {
         let l = barycentric(xi);
-        match self {
-            ElementKind::IntervalP1 | ElementKind::TriangleP1 | ElementKind::TetrahedronP1 => l,
-            ElementKind::TriangleP2 => p2(&l, &TRIANGLE_EDGES),
-            ElementKind::TetrahedronP2 => p2(&l, &TET_EDGES),
+        match self.degree() {
+            1 => l,
+            _ => p2(&l, self.info().edge_nodes),
         }
     }
 
@@ -154,10 +226,10 @@ impl ElementKind {
         let d = self.dim();
         let l = barycentric(xi);
         let dl = barycentric_gradients(d);
-        match self {
-            ElementKind::IntervalP1 | ElementKind::TriangleP1 | ElementKind::TetrahedronP1 => dl,
-            ElementKind::TriangleP2 | ElementKind::TetrahedronP2 => {
-                let edges: &[[usize; 2]] = if d == 2 { &TRIANGLE_EDGES } else { &TET_EDGES };
+        match self.degree() {
+            1 => dl,
+            _ => {
+                let edges = self.info().edge_nodes;
                 let mut g: Vec<Vec<f64>> =
                     (0..=d).map(|i| dl[i].iter().map(|x| (4.0 * l[i] - 1.0) * x).collect()).collect();
                 for &[a, b] in edges {
@@ -218,6 +290,26 @@ fn p2(l: &[f64], edges: &[[usize; 2]]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_catalogue_is_indexed_by_kind_and_agrees_with_the_dispatch() {
+        fn shape<const D: usize, const N: usize>() -> (usize, usize) {
+            (D, N)
+        }
+        for (i, e) in ELEMENTS.iter().enumerate() {
+            assert_eq!(e.kind as usize, i);
+            assert_eq!(e.kind.info().kind, e.kind);
+            assert_eq!(dispatch!(e.kind, shape()), (e.dim, e.nodes), "{}", e.name);
+            assert_eq!(e.nodes, e.dim + 1 + e.edge_nodes.len(), "{}", e.name);
+            assert_eq!(ElementKind::from_gmsh(e.gmsh), Some(e.kind));
+            let mut order = e.vtk_order.to_vec();
+            order.sort_unstable();
+            assert_eq!(order, (0..e.nodes).collect::<Vec<_>>(), "{}: VTK order is a permutation", e.name);
+            if let Some(p2) = e.p2 {
+                assert_eq!((p2.dim(), p2.degree()), (e.dim, 2));
+            }
+        }
+    }
 
     #[test]
     fn basis_is_nodal_and_a_partition_of_unity() {

@@ -608,19 +608,16 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
     let mut cells: Vec<&RawElement> =
         raw.elements.iter().filter(|e| element_info(e.kind).is_some_and(|(d, _)| d == dim)).collect();
     cells.sort_by_key(|e| e.tag);
-    let kind = match cells[0].kind {
-        1 => ElementKind::IntervalP1,
-        2 => ElementKind::TriangleP1,
-        9 => ElementKind::TriangleP2,
-        4 => ElementKind::TetrahedronP1,
-        11 => ElementKind::TetrahedronP2,
-        k => {
+    let kind = match ElementKind::from_gmsh(cells[0].kind) {
+        Some(kind) => kind,
+        None => {
+            let k = cells[0].kind;
+            let supported: Vec<String> =
+                crate::element::ELEMENTS.iter().map(|e| format!("{} ({})", e.name, e.gmsh)).collect();
             return Err(err(
                 file,
                 cells[0].at,
-                format!(
-                    "element type {k} cannot be a cell (supported: lines (1), triangles (2, 9), tetrahedra (4, 11))"
-                ),
+                format!("element type {k} cannot be a cell (supported: {})", supported.join(", ")),
             ));
         }
     };

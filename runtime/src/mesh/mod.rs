@@ -256,11 +256,8 @@ impl Mesh {
     /// Promotes a P1 mesh to P2 by adding edge midpoints (straight edges), keeping regions.
     /// `project` may move each new boundary-edge midpoint (e.g. onto a circle).
     pub fn to_p2(&self, project: Option<&Projection<'_>>) -> Mesh {
-        let (kind, edges): (ElementKind, &[[usize; 2]]) = match self.kind {
-            ElementKind::TriangleP1 => (ElementKind::TriangleP2, &[[0, 1], [1, 2], [2, 0]]),
-            ElementKind::TetrahedronP1 => {
-                (ElementKind::TetrahedronP2, &[[0, 1], [1, 2], [0, 2], [0, 3], [2, 3], [1, 3]])
-            }
+        let (kind, edges) = match self.kind.info().p2 {
+            Some(p2) if self.kind.degree() == 1 => (p2, p2.info().edge_nodes),
             _ => return self.clone(),
         };
         let d = self.dim();
