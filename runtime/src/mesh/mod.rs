@@ -3,6 +3,7 @@
 //! and named cell groups. Built by the structured generators, the disc generator, or read from
 //! Gmsh files.
 
+pub mod ball;
 mod boundary;
 pub mod disc;
 pub mod gmsh;

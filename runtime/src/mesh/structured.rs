@@ -127,7 +127,7 @@ pub fn cuboid(n: [usize; 3], x: [f64; 2], y: [f64; 2], z: [f64; 2], degree: u32)
 }
 
 /// Swaps two vertices of every P1 cell with a negative Jacobian determinant.
-fn orient_positively(mesh: &mut Mesh) {
+pub(super) fn orient_positively(mesh: &mut Mesh) {
     let d = mesh.dim();
     let nn = mesh.kind.nodes();
     for c in 0..mesh.num_cells() {
