@@ -21,5 +21,6 @@ pub mod plot;
 pub mod progress;
 pub mod report;
 pub mod settings;
+pub mod simulation;
 pub mod verify;
 pub mod vtu;

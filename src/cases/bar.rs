@@ -11,12 +11,10 @@ use super::exact;
 use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
-use crate::runtime::library::Binding;
-use crate::runtime::linalg::{Matrix, Structure};
 use crate::runtime::mesh::{CellSize, structured};
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
-use crate::runtime::scheme::{MatrixForm, Stepper};
+use crate::simulation::{Problem, Simulation, Tools};
 
 /// The bar's material is the form files' default (E = ρ = 1, ν = 0): no overrides.
 pub const OVERRIDES: &[(&str, f64)] = &[];
@@ -158,64 +156,31 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     mesh.set_cell_size(opts.cell_size);
     let asm = Assembler::new(&mesh);
     let n = asm.size();
-    let contact_facets = asm.region("left")?;
-    let binding =
-        Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), contact_facets)], dim: 1 };
-    let mut inst = active.forms.instantiate(&coefs, &binding)?;
-    let mut forms = active.scheme_forms(&mut inst)?;
-    let contact_energy = inst.take_functional("contact_energy");
-    let pressure = inst.take_functional("contact_pressure");
-    let trial = inst.take_functional("contact_trial");
-    let redistributed = opts.mass == MassChoice::Redistributed;
-    if redistributed {
-        let slot = forms
-            .iter()
-            .position(|(name, _)| *name == "mass")
-            .ok_or_else(|| CaseError::Option("mass redistribution needs a `mass` slot in the scheme".into()))?;
-        let mut m = asm.zero_matrix();
-        forms[slot].1.tangent(&asm, &[&vec![0.0; n]], 0, 0.0, &mut m);
-        let r = crate::runtime::redistribute::redistribute(&mesh, &m, &[0])
-            .map_err(|e| CaseError::Option(e.to_string()))?;
-        forms[slot] = ("mass", Box::new(MatrixForm { name: "mass".into(), matrix: r.matrix }));
-    }
     let mut constraints = Constraints::none(n);
     constraints.fix(ne); // u(1) = 0
-    let mut stepper =
-        Stepper::new(active.time_scheme()?, &asm, forms, constraints.clone(), Structure::Auto, opts.newton)?;
-    if redistributed {
-        // The contact node carries no inertia: a⁰ = 0 there (docs/mathematics.md §5, initial acceleration).
-        let mut initial = constraints;
-        initial.fix(0);
-        stepper.initial_constraints = Some(initial);
-    }
-    let linear = |name: &str| {
-        stepper.matrix(name).cloned().ok_or_else(|| {
-            CaseError::Option(format!(
-                "the bar measures energies with a linear `{name}` slot, which the scheme does not apply"
-            ))
-        })
+    let problem = Problem {
+        coefs: &coefs,
+        quadrature: Quadrature::default(),
+        contact: "left",
+        constraints,
+        mass: opts.mass,
+        newton: opts.newton,
     };
-    let mass = linear("mass")?;
-    let stiffness = linear("stiffness")?;
+    let mut sim = Simulation::new(&asm, problem, active)?;
+    let redistributed = opts.mass == MassChoice::Redistributed;
     // Initial state: u₀ = (1 − x)/2, v₀ = 0, a₀ from the scheme's initial problem.
-    let states_names = stepper.desc().states;
-    let mut states: Vec<Vec<f64>> = states_names.iter().map(|_| vec![0.0; n]).collect();
-    states[0] = (0..n).map(|i| 0.5 * (1.0 - mesh.node(i)[0])).collect();
-    stepper.initialize(&mut states, 0.0)?;
+    sim.initialize((0..n).map(|i| 0.5 * (1.0 - mesh.node(i)[0])).collect())?;
     let steps = (opts.t_end / opts.dt).round() as usize;
     let mut series = Vec::with_capacity(steps + 1);
     // λ and P at the contact point (docs/mathematics.md §2), from the contact law's functionals: in 1D the
     // integral over Γ_C is the value at x = 0. NaN when the law does not provide them.
-    let value = |f: &Option<Box<dyn crate::runtime::library::BoundFunctional + '_>>, u: &[f64]| {
-        f.as_ref().map_or(f64::NAN, |f| f.value(&asm, &[u], 0.0))
+    let contact_stress = |tools: &Tools, u: &[f64]| -> (f64, f64) {
+        (tools.value(&tools.contact_pressure, u), tools.value(&tools.contact_trial, u))
     };
-    let contact_stress = |u: &[f64]| -> (f64, f64) { (value(&pressure, u), value(&trial, u)) };
-    let measure = |u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
+    let measure = |tools: &Tools, u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
         let u0 = u[0];
-        let (lambda, p1) = contact_stress(u);
-        // The energy from the contact law's functional.
-        let aug = value(&contact_energy, u);
-        let energy = 0.5 * quad(&stiffness, u) + v.map_or(0.0, |v| 0.5 * quad(&mass, v));
+        let (lambda, p1) = contact_stress(tools, u);
+        let energy = tools.energy(u, v);
         Row {
             t,
             u_c: u0,
@@ -223,48 +188,46 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
             lambda,
             lambda_half: f64::NAN,
             energy,
-            energy_aug: energy + aug,
+            energy_aug: energy + tools.value(&tools.contact_energy, u),
             penetration: (-u0).max(0.0),
             newton,
             p1,
         }
     };
-    let v_index = states_names.iter().position(|s| *s == "v");
-    series.push(measure(&states[0], v_index.map(|i| states[i].as_slice()), 0, 0.0));
+    series.push(measure(&sim.tools, &sim.states[0], sim.velocity(), 0, 0.0));
     let (mut err_max, mut exact_max) = (0.0f64, 0.0f64);
     let (mut lam_err, mut lam_norm) = (0.0, 0.0);
-    let mut track = |u: &[f64], row: &Row| {
+    // The error in the norm of the mass the scheme steps with.
+    let mut track = |tools: &Tools, u: &[f64], row: &Row| {
         let interp: Vec<f64> = (0..n).map(|i| exact::displacement(mesh.node(i)[0], row.t)).collect();
         let diff: Vec<f64> = u.iter().zip(&interp).map(|(a, b)| a - b).collect();
-        err_max = err_max.max(quad(&mass, &diff).sqrt());
-        exact_max = exact_max.max(quad(&mass, &interp).sqrt());
+        err_max = err_max.max(Tools::quad(&tools.scheme_mass, &diff, &diff).sqrt());
+        exact_max = exact_max.max(Tools::quad(&tools.scheme_mass, &interp, &interp).sqrt());
         let s = exact::contact_stress(row.t);
         lam_err += (row.lambda - s).powi(2);
         lam_norm += s * s;
     };
-    track(&states[0], &series[0]);
+    track(&sim.tools, &sim.states[0], &series[0]);
     let (mut half_err, mut half_norm) = (0.0, 0.0);
+    let v_index = sim.v_index;
     let mut t = 0.0;
-    let mut progress = crate::progress::Progress::new(steps, opts.progress);
-    for k in 0..steps {
-        progress.tick(k);
-        let before = states[0].clone();
-        let report = stepper.step(&mut states, t, opts.dt)?;
-        t = (k + 1) as f64 * opts.dt;
-        let mut row = measure(&states[0], v_index.map(|i| states[i].as_slice()), report.iterations(), t);
+    sim.run(opts.dt, steps, opts.progress, &mut |_, _, _| {}, &mut |tools, step| {
+        t = step.k as f64 * opts.dt;
+        let mut row =
+            measure(tools, &step.states[0], v_index.map(|i| step.states[i].as_slice()), step.report.iterations(), t);
         if redistributed {
             // The massless contact node's velocity is not meaningful: report its mean velocity.
-            row.v_c = (states[0][0] - before[0]) / opts.dt;
+            row.v_c = (step.states[0][0] - step.before[0]) / opts.dt;
         }
-        let half: Vec<f64> = before.iter().zip(&states[0]).map(|(a, b)| 0.5 * (a + b)).collect();
+        let half: Vec<f64> = step.before.iter().zip(&step.states[0]).map(|(a, b)| 0.5 * (a + b)).collect();
         let s = exact::contact_stress(t - 0.5 * opts.dt);
-        row.lambda_half = contact_stress(&half).0;
+        row.lambda_half = contact_stress(tools, &half).0;
         half_err += (row.lambda_half - s).powi(2);
         half_norm += s * s;
-        track(&states[0], &row);
+        track(tools, &step.states[0], &row);
         series.push(row);
-    }
-    progress.finish();
+        Ok(())
+    })?;
     let first = &series[0];
     let last = series.last().expect("at least the initial row");
     let e0 = first.energy_aug;
@@ -299,13 +262,6 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         write_outputs(dir, &summary, &series)?;
     }
     Ok(Run { summary, series })
-}
-
-/// xᵀ A x.
-fn quad(a: &Matrix, x: &[f64]) -> f64 {
-    let mut y = vec![0.0; x.len()];
-    a.mul_vec(x, &mut y);
-    x.iter().zip(&y).map(|(p, q)| p * q).sum()
 }
 
 fn write_outputs(dir: &std::path::Path, summary: &Summary, series: &[Row]) -> Result<(), CaseError> {

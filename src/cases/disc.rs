@@ -13,12 +13,10 @@ use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::evaluate::facet_samples;
 use crate::runtime::kernel::Coef;
-use crate::runtime::library::Binding;
-use crate::runtime::linalg::{Matrix, Structure};
 use crate::runtime::mesh::{CellSize, Mesh, disc::disc, gmsh};
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
-use crate::runtime::scheme::{MatrixForm, Stepper};
+use crate::simulation::{Problem, Simulation, Snapshots, Tools};
 
 /// Gravity of the benchmark.
 pub const GRAVITY: f64 = 0.1;
@@ -186,84 +184,46 @@ fn coefs(name: &str) -> Option<Coef> {
     }
 }
 
-fn quad(a: &Matrix, x: &[f64], y: &[f64]) -> f64 {
-    let mut ay = vec![0.0; y.len()];
-    a.mul_vec(y, &mut ay);
-    x.iter().zip(&ay).map(|(p, q)| p * q).sum()
-}
-
 fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let start = Instant::now();
     let mesh = mesh(opts)?;
     let asm = Assembler::new(&mesh);
     let n = asm.size();
-    let contact_facets = asm.region("contact")?;
-    let binding = Binding { quadrature: QUADRATURE, regions: vec![("Gamma_C".into(), contact_facets)], dim: 2 };
-    let mut inst = active.forms.instantiate(&coefs, &binding)?;
-    let mut forms = active.scheme_forms(&mut inst)?;
-    let missing = |what: &str| {
-        CaseError::Option(format!("the disc measures `{what}`, which the form files in use do not provide"))
+    let problem = Problem {
+        coefs: &coefs,
+        quadrature: QUADRATURE,
+        contact: "contact",
+        constraints: Constraints::none(n),
+        mass: opts.mass,
+        newton: opts.newton,
     };
-    let contact_energy = inst.take_functional("contact_energy");
-    let probe = active.forms.instantiate(&coefs, &binding)?.take_form("contact").ok_or_else(|| missing("contact"))?;
-    let von_mises = inst.take_functional("von_mises");
-    let cell_measure = inst.take_functional("measure");
-    // Consistent mass and stiffness, the load: for the measurements.
-    let zero = vec![0.0; n];
-    let slot = |forms: &[(&str, Box<dyn crate::runtime::scheme::BoundForm + '_>)], name: &str| {
-        forms.iter().position(|(s, _)| *s == name).ok_or_else(|| missing(name))
-    };
-    let mut mass = asm.zero_matrix();
-    forms[slot(&forms, "mass")?].1.tangent(&asm, &[&zero], 0, 0.0, &mut mass);
-    let mut stiffness = asm.zero_matrix();
-    forms[slot(&forms, "stiffness")?].1.tangent(&asm, &[&zero], 0, 0.0, &mut stiffness);
-    let mut load = vec![0.0; n];
-    forms[slot(&forms, "load")?].1.residual(&asm, &[], 0.0, &mut load);
-    let redistributed = opts.mass == MassChoice::Redistributed;
-    let constraints = Constraints::none(n);
-    let contact_nodes = mesh.region_nodes(mesh.region("contact")?);
-    let energy_mass = if redistributed {
-        let r = crate::runtime::redistribute::redistribute(&mesh, &mass, &contact_nodes)
-            .map_err(|e| CaseError::Option(e.to_string()))?;
-        let i = slot(&forms, "mass")?;
-        forms[i] = ("mass", Box::new(MatrixForm { name: "mass".into(), matrix: r.matrix.clone() }));
-        r.matrix
-    } else {
-        mass.clone()
-    };
-    let mut stepper =
-        Stepper::new(active.time_scheme()?, &asm, forms, constraints.clone(), Structure::Auto, opts.newton)?;
-    if redistributed {
-        let mut initial = constraints;
-        for &c in &contact_nodes {
-            initial.fix(2 * c as usize);
-            initial.fix(2 * c as usize + 1);
-        }
-        stepper.initial_constraints = Some(initial);
+    let mut sim = Simulation::new(&asm, problem, active)?;
+    if sim.tools.probe.is_none() {
+        return Err(CaseError::Option(
+            "the disc measures `contact`, which the form files in use do not provide".into(),
+        ));
     }
-    let names = stepper.desc().states;
-    let mut states: Vec<Vec<f64>> = names.iter().map(|_| vec![0.0; n]).collect();
-    stepper.initialize(&mut states, 0.0)?;
-    let v_index = names.iter().position(|s| *s == "v");
+    sim.initialize(vec![0.0; n])?;
     let ey: Vec<f64> = (0..n).map(|i| if i % 2 == 1 { 1.0 } else { 0.0 }).collect();
     let mut mass_ey = vec![0.0; n];
-    mass.mul_vec(&ey, &mut mass_ey);
+    sim.tools.mass.mul_vec(&ey, &mut mass_ey);
     let total_mass: f64 = mass_ey.iter().zip(&ey).map(|(a, b)| a * b).sum();
     let lowest = (0..mesh.num_nodes()).min_by(|&a, &b| mesh.node(a)[1].total_cmp(&mesh.node(b)[1])).expect("nodes");
-    let measure = |u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
-        let kinetic = v.map_or(0.0, |v| 0.5 * quad(&energy_mass, v, v));
-        let energy = 0.5 * quad(&stiffness, u, u) + kinetic - load.iter().zip(u).map(|(l, x)| l * x).sum::<f64>();
+    let measure = |tools: &Tools, u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
+        let kinetic = tools.kinetic(v);
+        let energy = tools.energy(u, v);
+        let probe = tools.probe.as_ref().expect("checked above");
         let mut c = vec![0.0; n];
         probe.residual(&asm, &[u], t, &mut c);
         let mut switches = Vec::new();
         probe.switches(&asm, &[u], 0, t, &mut switches);
-        let samples = facet_samples(&mesh, contact_facets, QUADRATURE.facet.unwrap_or(7), u);
+        let samples = facet_samples(&mesh, tools.contact_facets, QUADRATURE.facet.unwrap_or(7), u);
         let penetration = samples.iter().map(|s| (-s.value[1] - s.x[1]).max(0.0)).fold(0.0, f64::max);
         Row {
             t,
             energy,
             kinetic,
-            energy_aug: energy + contact_energy.as_ref().map_or(f64::NAN, |e| e.value(&asm, &[u], 0.0)),
+            energy_aug: energy + tools.value(&tools.contact_energy, u),
             // Area-weighted mean of u_y: e_yᵀ M u / e_yᵀ M e_y.
             uy_mean: mass_ey.iter().zip(u).map(|(a, b)| a * b).sum::<f64>() / total_mass,
             uy_mean_nodal: u.iter().skip(1).step_by(2).sum::<f64>() / (n / 2) as f64,
@@ -277,68 +237,38 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
             newton,
         }
     };
-    let mut series = vec![measure(&states[0], v_index.map(|i| states[i].as_slice()), 0, 0.0)];
+    let mut series = vec![measure(&sim.tools, &sim.states[0], sim.velocity(), 0, 0.0)];
     let steps = (opts.t_end / opts.dt).round() as usize;
-    let mut progress = crate::progress::Progress::new(steps, opts.progress);
-    let vtu_dir = opts.out.as_ref().filter(|_| opts.vtu_every > 0).map(|d| d.join("vtu"));
-    let mut snapshots: Vec<(f64, String)> = Vec::new();
-    let mut snapshot = |k: usize, t: f64, u: &[f64], v: &[f64]| -> Result<(), CaseError> {
-        let Some(dir) = &vtu_dir else { return Ok(()) };
-        if !k.is_multiple_of(opts.vtu_every) {
-            return Ok(());
-        }
-        let name = format!("disc_{k:06}.vtu");
-        let vm = match (&von_mises, &cell_measure) {
-            (Some(vm), Some(measure)) => {
-                let area = measure.cell_values(&asm, &[], 0.0);
-                vm.cell_values(&asm, &[u], 0.0).iter().zip(&area).map(|(v, a)| v / a).collect()
-            }
-            _ => vec![f64::NAN; mesh.num_cells()],
-        };
-        let point = [
-            crate::vtu::Field { name: "displacement", components: 2, values: u },
-            crate::vtu::Field { name: "velocity", components: 2, values: v },
-        ];
-        let cell = [crate::vtu::Field { name: "von_mises", components: 1, values: &vm }];
-        let path = dir.join(&name);
-        crate::vtu::write(&path, &mesh, &point, &cell)
-            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
-        snapshots.push((t, format!("vtu/{name}")));
-        Ok(())
-    };
-    let velocity = |states: &[Vec<f64>], before: &[f64]| -> Vec<f64> {
+    let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, "disc");
+    // A scheme without a velocity state: the step's mean velocity.
+    let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64]| -> Vec<f64> {
         match v_index {
             Some(i) => states[i].clone(),
             None => states[0].iter().zip(before).map(|(a, b)| (a - b) / opts.dt).collect(),
         }
     };
-    snapshot(0, 0.0, &states[0], &velocity(&states, &states[0]))?;
-    let mut step_times = Vec::with_capacity(steps);
+    let v_index = sim.v_index;
+    snapshots.write(&sim.tools, 0, 0.0, &sim.states[0], &velocity(&sim.states, v_index, &sim.states[0]))?;
     // Multi-stage schemes: the state at each intermediate stage's time (stages.csv).
-    let desc_stages = stepper.desc().stages;
-    let intermediate: Vec<&str> = desc_stages.iter().rev().skip(1).map(|s| s.name).collect();
     let mut stage_rows: Vec<StageRow> = Vec::new();
-    for k in 0..steps {
-        progress.tick(k);
-        let t = k as f64 * opts.dt;
-        let before = states[0].clone();
-        let clock = Instant::now();
-        let report = stepper.step_observed(&mut states, t, opts.dt, &mut |stage| {
-            if let (true, Some(u)) = (intermediate.contains(&stage.name), stage.value_of(names[0])) {
+    let names = sim.stepper.desc().states;
+    let step_times = sim.run(
+        opts.dt,
+        steps,
+        opts.progress,
+        &mut |tools, stage, v_index| {
+            if let Some(u) = stage.value_of(names[0]) {
                 let v = v_index.and_then(|i| stage.value_of(names[i]));
-                stage_rows.push(StageRow { stage: stage.name, row: measure(u, v, 0, stage.time) });
+                stage_rows.push(StageRow { stage: stage.name, row: measure(tools, u, v, 0, stage.time) });
             }
-        })?;
-        step_times.push(clock.elapsed().as_secs_f64());
-        series.push(measure(&states[0], v_index.map(|i| states[i].as_slice()), report.iterations(), t + opts.dt));
-        snapshot(k + 1, t + opts.dt, &states[0], &velocity(&states, &before))?;
-    }
-    if let (Some(out), false) = (&opts.out, snapshots.is_empty()) {
-        let path = out.join("disc.pvd");
-        crate::vtu::write_collection(&path, &snapshots)
-            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
-    }
-    progress.finish();
+        },
+        &mut |tools, step| {
+            let v = v_index.map(|i| step.states[i].as_slice());
+            series.push(measure(tools, &step.states[0], v, step.report.iterations(), step.t));
+            snapshots.write(tools, step.k, step.t, &step.states[0], &velocity(step.states, v_index, step.before))
+        },
+    )?;
+    snapshots.finish()?;
     let wall = start.elapsed().as_secs_f64();
     let last = series.last().expect("initial row");
     let summary = Summary {
@@ -366,7 +296,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         seconds_per_step: wall / steps.max(1) as f64,
         stepping_seconds: step_times.iter().sum(),
         step_median_seconds: crate::bench::median(step_times),
-        factorizations: stepper.counters().numeric,
+        factorizations: sim.stepper.counters().numeric,
     };
     if let Some(dir) = &opts.out {
         write_outputs(dir, &summary, &series, &stage_rows)?;

@@ -1,0 +1,270 @@
+//! The simulation driver every dynamic case shares: a mesh and the case's data → the forms of
+//! the files in use bound by slot name → optional mass redistribution on the contact nodes → a
+//! stepper → a time loop that shows each step (and each intermediate stage) to the case's
+//! observer. A case (bar, disc, ...) is its mesh, its data, its initial state and what it
+//! measures; VTU/PVD snapshots are [`Snapshots`].
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use crate::cases::CaseError;
+use crate::cases::bar::MassChoice;
+use crate::driver::Active;
+use crate::runtime::assembly::{Assembler, Quadrature};
+use crate::runtime::kernel::Coef;
+use crate::runtime::library::{Binding, BoundFunctional};
+use crate::runtime::linalg::{Matrix, Structure};
+use crate::runtime::mesh::{Facet, Mesh};
+use crate::runtime::newton::NewtonOptions;
+use crate::runtime::problem::Constraints;
+use crate::runtime::scheme::{BoundForm, MatrixForm, StageView, StepReport, Stepper};
+
+/// What a case gives the driver.
+pub struct Problem<'p> {
+    /// The case's coefficients by name (`f`, `g`, `nc`, ...).
+    pub coefs: &'p dyn Fn(&str) -> Option<Coef>,
+    pub quadrature: Quadrature,
+    /// The mesh region bound to the forms' `Gamma_C`.
+    pub contact: &'p str,
+    /// Dirichlet conditions of the dynamics.
+    pub constraints: Constraints,
+    pub mass: MassChoice,
+    pub newton: NewtonOptions,
+}
+
+/// What the observers measure with: bound functionals, a fresh contact form, and the linear
+/// operators.
+pub struct Tools<'m> {
+    pub asm: &'m Assembler<'m>,
+    pub contact_facets: &'m [Facet],
+    /// The `contact` slot, for its residual (the contact force) and its switches (the active set).
+    pub probe: Option<Box<dyn BoundForm + 'm>>,
+    pub contact_energy: Option<Box<dyn BoundFunctional + 'm>>,
+    pub contact_pressure: Option<Box<dyn BoundFunctional + 'm>>,
+    pub contact_trial: Option<Box<dyn BoundFunctional + 'm>>,
+    pub von_mises: Option<Box<dyn BoundFunctional + 'm>>,
+    pub cell_measure: Option<Box<dyn BoundFunctional + 'm>>,
+    /// The consistent mass, the mass the scheme steps with (redistributed or not), the
+    /// stiffness and the load vector at t = 0.
+    pub mass: Matrix,
+    pub scheme_mass: Matrix,
+    pub stiffness: Matrix,
+    pub load: Vec<f64>,
+    /// The nodes of the contact region.
+    pub contact_nodes: Vec<u32>,
+}
+
+impl Tools<'_> {
+    /// xᵀ A y.
+    pub fn quad(a: &Matrix, x: &[f64], y: &[f64]) -> f64 {
+        let mut ay = vec![0.0; y.len()];
+        a.mul_vec(y, &mut ay);
+        x.iter().zip(&ay).map(|(p, q)| p * q).sum()
+    }
+
+    /// ½vᵀMv with the scheme's mass (0 without a velocity).
+    pub fn kinetic(&self, v: Option<&[f64]>) -> f64 {
+        v.map_or(0.0, |v| 0.5 * Self::quad(&self.scheme_mass, v, v))
+    }
+
+    /// E = ½uᵀKu + ½vᵀMv − Fᵀu.
+    pub fn energy(&self, u: &[f64], v: Option<&[f64]>) -> f64 {
+        0.5 * Self::quad(&self.stiffness, u, u) + self.kinetic(v)
+            - self.load.iter().zip(u).map(|(l, x)| l * x).sum::<f64>()
+    }
+
+    /// The value of a functional at u (NaN when the files in use do not provide it).
+    pub fn value(&self, f: &Option<Box<dyn BoundFunctional + '_>>, u: &[f64]) -> f64 {
+        f.as_ref().map_or(f64::NAN, |f| f.value(self.asm, &[u], 0.0))
+    }
+}
+
+/// The stepper, its states and the tools, ready to run.
+pub struct Simulation<'m> {
+    pub stepper: Stepper<'m>,
+    pub tools: Tools<'m>,
+    /// One vector per state of the scheme; `states[0]` is the displacement.
+    pub states: Vec<Vec<f64>>,
+    /// The index of the velocity state `v`, if the scheme has one.
+    pub v_index: Option<usize>,
+}
+
+/// One finished step, as the observer sees it.
+pub struct Step<'s> {
+    /// The step's number (1 for the first) and its end time.
+    pub k: usize,
+    pub t: f64,
+    pub states: &'s [Vec<f64>],
+    /// The displacement at the start of the step.
+    pub before: &'s [f64],
+    pub report: &'s StepReport,
+}
+
+impl<'m> Simulation<'m> {
+    /// Binds the files in use on `asm`'s mesh, redistributes the mass when asked (the contact
+    /// nodes carry none; a⁰ = 0 there), and builds the stepper.
+    pub fn new(asm: &'m Assembler<'m>, problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
+        let mesh: &Mesh = asm.mesh;
+        let n = asm.size();
+        let contact_facets = asm.region(problem.contact)?;
+        let binding = Binding {
+            quadrature: problem.quadrature,
+            regions: vec![("Gamma_C".into(), contact_facets)],
+            dim: mesh.dim(),
+        };
+        let mut inst = active.forms.instantiate(problem.coefs, &binding)?;
+        let mut forms = active.scheme_forms(&mut inst)?;
+        let missing = |what: &str| {
+            CaseError::Option(format!("the case needs `{what}`, which the form files in use do not provide"))
+        };
+        let slot = |forms: &[(&str, Box<dyn BoundForm + 'm>)], name: &str| {
+            forms.iter().position(|(s, _)| *s == name).ok_or_else(|| missing(name))
+        };
+        let zero = vec![0.0; n];
+        let mut mass = asm.zero_matrix();
+        forms[slot(&forms, "mass")?].1.tangent(asm, &[&zero], 0, 0.0, &mut mass);
+        let mut stiffness = asm.zero_matrix();
+        forms[slot(&forms, "stiffness")?].1.tangent(asm, &[&zero], 0, 0.0, &mut stiffness);
+        let mut load = vec![0.0; n];
+        forms[slot(&forms, "load")?].1.residual(asm, &[], 0.0, &mut load);
+        let contact_nodes = mesh.region_nodes(mesh.region(problem.contact)?);
+        let redistributed = problem.mass == MassChoice::Redistributed;
+        let scheme_mass = if redistributed {
+            let r = crate::runtime::redistribute::redistribute(mesh, &mass, &contact_nodes)
+                .map_err(|e| CaseError::Option(e.to_string()))?;
+            let i = slot(&forms, "mass")?;
+            forms[i] = ("mass", Box::new(MatrixForm { name: "mass".into(), matrix: r.matrix.clone() }));
+            r.matrix
+        } else {
+            mass.clone()
+        };
+        let constraints = problem.constraints;
+        let mut stepper =
+            Stepper::new(active.time_scheme()?, asm, forms, constraints.clone(), Structure::Auto, problem.newton)?;
+        if redistributed {
+            let d = mesh.dim();
+            let mut initial = constraints;
+            for &c in &contact_nodes {
+                for k in 0..d {
+                    initial.fix(d * c as usize + k);
+                }
+            }
+            stepper.initial_constraints = Some(initial);
+        }
+        let tools = Tools {
+            asm,
+            contact_facets,
+            probe: active.forms.instantiate(problem.coefs, &binding)?.take_form("contact"),
+            contact_energy: inst.take_functional("contact_energy"),
+            contact_pressure: inst.take_functional("contact_pressure"),
+            contact_trial: inst.take_functional("contact_trial"),
+            von_mises: inst.take_functional("von_mises"),
+            cell_measure: inst.take_functional("measure"),
+            mass,
+            scheme_mass,
+            stiffness,
+            load,
+            contact_nodes,
+        };
+        let names = stepper.desc().states;
+        let states = names.iter().map(|_| vec![0.0; n]).collect();
+        let v_index = names.iter().position(|s| *s == "v");
+        Ok(Simulation { stepper, tools, states, v_index })
+    }
+
+    /// Sets the displacement and solves the scheme's initial problem (the acceleration).
+    pub fn initialize(&mut self, u0: Vec<f64>) -> Result<(), CaseError> {
+        self.states[0] = u0;
+        self.stepper.initialize(&mut self.states, 0.0)?;
+        Ok(())
+    }
+
+    /// The velocity state, if the scheme has one.
+    pub fn velocity(&self) -> Option<&[f64]> {
+        self.v_index.map(|i| self.states[i].as_slice())
+    }
+
+    /// Runs `steps` steps of `dt` from t = 0, showing every step to `on_step` and every
+    /// intermediate stage of a multi-stage scheme to `on_stage`. Returns each step's wall time.
+    pub fn run(
+        &mut self,
+        dt: f64,
+        steps: usize,
+        progress: bool,
+        on_stage: &mut dyn FnMut(&Tools, &StageView, Option<usize>),
+        on_step: &mut dyn FnMut(&Tools, &Step) -> Result<(), CaseError>,
+    ) -> Result<Vec<f64>, CaseError> {
+        let stages = self.stepper.desc().stages;
+        let intermediate: Vec<&str> = stages.iter().rev().skip(1).map(|s| s.name).collect();
+        let mut times = Vec::with_capacity(steps);
+        let mut bar = crate::progress::Progress::new(steps, progress);
+        let Simulation { stepper, tools, states, v_index } = self;
+        for k in 0..steps {
+            bar.tick(k);
+            let t = k as f64 * dt;
+            let before = states[0].clone();
+            let clock = Instant::now();
+            let report = stepper.step_observed(states, t, dt, &mut |stage| {
+                if intermediate.contains(&stage.name) {
+                    on_stage(tools, stage, *v_index);
+                }
+            })?;
+            times.push(clock.elapsed().as_secs_f64());
+            on_step(tools, &Step { k: k + 1, t: t + dt, states, before: &before, report: &report })?;
+        }
+        bar.finish();
+        Ok(times)
+    }
+}
+
+/// VTU snapshots every `every` steps into `dir`/vtu, and the PVD collection of them.
+pub struct Snapshots {
+    dir: Option<PathBuf>,
+    every: usize,
+    name: &'static str,
+    written: Vec<(f64, String)>,
+}
+
+impl Snapshots {
+    /// Writes nothing unless `out` is given and `every` > 0.
+    pub fn new(out: Option<&PathBuf>, every: usize, name: &'static str) -> Snapshots {
+        Snapshots { dir: out.filter(|_| every > 0).cloned(), every, name, written: Vec::new() }
+    }
+
+    /// The displacement and velocity at step `k`, and the cell-mean von Mises stress when the
+    /// files in use provide it.
+    pub fn write(&mut self, tools: &Tools, k: usize, t: f64, u: &[f64], v: &[f64]) -> Result<(), CaseError> {
+        let Some(dir) = &self.dir else { return Ok(()) };
+        if !k.is_multiple_of(self.every) {
+            return Ok(());
+        }
+        let mesh = tools.asm.mesh;
+        let file = format!("{}_{k:06}.vtu", self.name);
+        let vm = match (&tools.von_mises, &tools.cell_measure) {
+            (Some(vm), Some(measure)) => {
+                let size = measure.cell_values(tools.asm, &[], 0.0);
+                vm.cell_values(tools.asm, &[u], 0.0).iter().zip(&size).map(|(v, a)| v / a).collect()
+            }
+            _ => vec![f64::NAN; mesh.num_cells()],
+        };
+        let d = mesh.dim();
+        let point = [
+            crate::vtu::Field { name: "displacement", components: d, values: u },
+            crate::vtu::Field { name: "velocity", components: d, values: v },
+        ];
+        let cell = [crate::vtu::Field { name: "von_mises", components: 1, values: &vm }];
+        let path = dir.join("vtu").join(&file);
+        crate::vtu::write(&path, mesh, &point, &cell)
+            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
+        self.written.push((t, format!("vtu/{file}")));
+        Ok(())
+    }
+
+    /// Writes the collection `dir`/NAME.pvd (if any snapshot was written).
+    pub fn finish(self) -> Result<(), CaseError> {
+        let (Some(dir), false) = (&self.dir, self.written.is_empty()) else { return Ok(()) };
+        let path = dir.join(format!("{}.pvd", self.name));
+        crate::vtu::write_collection(&path, &self.written)
+            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })
+    }
+}
