@@ -5,6 +5,15 @@
 //! stage's unknown). The engine precomputes the known parts once per stage, assembles the
 //! constant operator Σ coef·α·K of the linear forms once per time step size, and runs Newton on
 //! the rest (the contact terms), reusing the factorization while the active set is unchanged.
+//!
+//! Newton solves for the increment δ = w − w₀ from a known reference level w₀ (the state the
+//! unknown updates, e.g. u for u'), and every combination is evaluated in increments: the
+//! levels whose coefficients (the unknown's counted at w₀) sum to zero enter as
+//! Σ βₖ·(knownₖ − reference). Such sums are zero in exact arithmetic (a' and v' of a rigid
+//! translation), but not once the coefficients are rounded: TR-BDF2's BDF2 stage writes
+//! a' = 29142·u' + 6036·u − 35178·um + …, whose rounded coefficients sum to 7e-12, a spurious
+//! force proportional to the displacement on every step. The increment form drops that sum
+//! and cancels the large terms before scaling them (see `zero_sum_groups`).
 
 use std::collections::HashMap;
 
@@ -326,11 +335,16 @@ impl<'a> Stepper<'a> {
     pub fn initialize(&mut self, states: &mut [Vec<f64>], t: f64) -> Result<Option<NewtonReport>, StepError> {
         let Some(init) = self.desc.initial else { return Ok(None) };
         self.scheme.coefficients(1.0, t, &mut self.coefs);
-        let guess = states[init.state].clone();
+        let reference = Level::State(init.state);
         let stage = StageDesc { name: "initial", time: 0, quantities: &[], values: &[], terms: init.terms };
         let cache = self.stages.len() - 1;
         let saved = self.initial_constraints.as_ref().map(|c| std::mem::replace(&mut self.constraints, c.clone()));
-        let result = self.solve_stage(&stage, cache, states, &[], guess, 1.0, t);
+        let result = self.solve_stage(&stage, cache, states, &[], reference, 1.0, t);
+        let result = result.map(|(delta, report)| {
+            let mut w: Vec<f64> = states[init.state].iter().zip(&delta).map(|(r, d)| r + d).collect();
+            self.constraints.impose(&mut w);
+            (w, report)
+        });
         if let Some(c) = saved {
             self.constraints = c;
         }
@@ -357,16 +371,14 @@ impl<'a> Stepper<'a> {
         let mut quantities: Vec<Vec<Vec<f64>>> = Vec::with_capacity(desc.stages.len());
         let mut report = StepReport::default();
         for (s, stage) in desc.stages.iter().enumerate() {
+            // Newton starts from the state the unknown updates (u for u'), else the first state.
             let name = stage.quantities[0];
-            let guess = desc
-                .states
-                .iter()
-                .position(|st| name.trim_end_matches('\'') == *st)
-                .map_or_else(|| states[0].clone(), |i| states[i].clone());
-            let (w, r) = self.solve_stage(stage, s, states, &quantities, guess, dt, t)?;
+            let reference =
+                Level::State(desc.states.iter().position(|st| name.trim_end_matches('\'') == *st).unwrap_or(0));
+            let (delta, r) = self.solve_stage(stage, s, states, &quantities, reference, dt, t)?;
             report.stages.push(r);
             let values: Vec<Vec<f64>> =
-                stage.values.iter().map(|c| self.combine(c, Some(&w), states, &quantities)).collect();
+                stage.values.iter().map(|c| self.combine(c, reference, Some(&delta), states, &quantities)).collect();
             let time = self.coefs.get(stage.time).copied().unwrap_or(t + dt);
             observe(&StageView { name: stage.name, time, quantities: stage.quantities, values: &values });
             quantities.push(values);
@@ -388,27 +400,55 @@ impl<'a> Stepper<'a> {
         Ok(report)
     }
 
-    /// Σ c·level (+ c_w·w).
+    /// `c_w·w + Σ c·level` with the unknown w = reference + δ (δ = 0 if `delta` is `None`):
+    /// `c_w·δ`, plus the levels (the reference with c_w added to its coefficient) grouped by
+    /// [`zero_sum_groups`], each group as Σ c·(level − its reference level), each other level as
+    /// c·level.
     fn combine(
         &self,
         c: &Combination,
-        w: Option<&[f64]>,
+        reference: Level,
+        delta: Option<&[f64]>,
         states: &[Vec<f64>],
         quantities: &[Vec<Vec<f64>>],
     ) -> Vec<f64> {
         let n = self.asm.size();
         let mut out = vec![0.0; n];
-        if let (Some(k), Some(w)) = (c.unknown, w) {
-            let a = self.coefs[k];
-            out.iter_mut().zip(w).for_each(|(o, x)| *o += a * x);
-        }
-        for &(level, k) in c.known {
-            let v = match level {
+        let level = |l: Level| -> &[f64] {
+            match l {
                 Level::State(i) => &states[i],
                 Level::Stage(s, q) => &quantities[s][q],
-            };
+            }
+        };
+        let mut terms: Vec<(Level, f64)> = Vec::with_capacity(c.known.len() + 1);
+        let mut add = |l: Level, a: f64| match terms.iter_mut().find(|(m, _)| *m == l) {
+            Some((_, b)) => *b += a,
+            None => terms.push((l, a)),
+        };
+        if let Some(k) = c.unknown {
             let a = self.coefs[k];
-            out.iter_mut().zip(v).for_each(|(o, x)| *o += a * x);
+            if let Some(d) = delta {
+                out.iter_mut().zip(d).for_each(|(o, x)| *o += a * x);
+            }
+            add(reference, a);
+        }
+        for &(l, k) in c.known {
+            add(l, self.coefs[k]);
+        }
+        terms.retain(|(_, a)| *a != 0.0);
+        let coefs: Vec<f64> = terms.iter().map(|(_, a)| *a).collect();
+        for group in zero_sum_groups(&coefs) {
+            if group.len() == 1 {
+                let (l, a) = terms[group[0]];
+                out.iter_mut().zip(level(l)).for_each(|(o, x)| *o += a * x);
+                continue;
+            }
+            let r = group.iter().copied().find(|&i| terms[i].0 == reference).unwrap_or(group[0]);
+            let x0 = level(terms[r].0);
+            for &i in group.iter().filter(|&&i| i != r) {
+                let (l, a) = terms[i];
+                out.iter_mut().zip(level(l)).zip(x0).for_each(|((o, x), y)| *o += a * (x - y));
+            }
         }
         out
     }
@@ -420,7 +460,7 @@ impl<'a> Stepper<'a> {
         cache: usize,
         states: &[Vec<f64>],
         quantities: &[Vec<Vec<f64>>],
-        guess: Vec<f64>,
+        reference: Level,
         dt: f64,
         t: f64,
     ) -> Result<(Vec<f64>, NewtonReport), StepError> {
@@ -453,7 +493,8 @@ impl<'a> Stepper<'a> {
                 constant_rhs.iter_mut().zip(b).for_each(|(r, x)| *r += coef * x);
                 continue;
             }
-            let bases: Vec<Vec<f64>> = term.args.iter().map(|c| self.combine(c, None, states, quantities)).collect();
+            let bases: Vec<Vec<f64>> =
+                term.args.iter().map(|c| self.combine(c, reference, None, states, quantities)).collect();
             let alphas: Vec<f64> = term.args.iter().map(|c| c.unknown.map_or(0.0, |k| self.coefs[k])).collect();
             match self.matrices.get(term.form) {
                 Some(k) if alphas.len() == 1 => {
@@ -493,15 +534,53 @@ impl<'a> Stepper<'a> {
             piecewise,
             scratch: None,
         };
-        let mut w = guess;
-        self.constraints.impose(&mut w);
-        let report = stage_cache.newton.solve(&mut problem, &mut w).map_err(|source| StepError::Newton {
+        // δ = w − reference, with the constrained values of w imposed.
+        let w0 = match reference {
+            Level::State(i) => &states[i],
+            Level::Stage(s, q) => &quantities[s][q],
+        };
+        let mut delta = w0.clone();
+        self.constraints.impose(&mut delta);
+        delta.iter_mut().zip(w0).for_each(|(d, r)| *d -= r);
+        let report = stage_cache.newton.solve(&mut problem, &mut delta).map_err(|source| StepError::Newton {
             stage: stage.name,
             t: stage_t,
             source,
         })?;
-        Ok((w, report))
+        Ok((delta, report))
     }
+}
+
+/// Largest |Σ c| / Σ |c| of a group of coefficients treated as summing to zero: a few roundings
+/// of each coefficient. A sum that is zero in exact arithmetic evaluates to ~1e-16 of Σ |c|;
+/// dropping a sum this small that is not exactly zero perturbs the combination by no more than
+/// rounding its terms does.
+const ZERO_SUM: f64 = 64.0 * f64::EPSILON;
+
+/// Partitions coefficients (nonzero) into groups: subsets of at least two whose sum is zero to
+/// [`ZERO_SUM`], taken greedily (smallest first, then in index order), and singletons.
+/// Beyond 10 coefficients every one is a singleton.
+fn zero_sum_groups(coefs: &[f64]) -> Vec<Vec<usize>> {
+    let n = coefs.len();
+    if n > 10 {
+        return (0..n).map(|i| vec![i]).collect();
+    }
+    let members = |mask: u32| (0..n).filter(move |i| mask & (1 << i) != 0);
+    let zero_sum = |mask: u32| {
+        let (sum, abs) = members(mask).fold((0.0, 0.0), |(s, a), i| (s + coefs[i], a + f64::abs(coefs[i])));
+        sum.abs() <= ZERO_SUM * abs
+    };
+    let mut left: u32 = (1 << n) - 1;
+    let mut groups = Vec::new();
+    // The smallest zero-sum subset of what is left, the first in index order.
+    while let Some(mask) = (2..=left.count_ones())
+        .find_map(|size| (1..=left).find(|&m| m & !left == 0 && m.count_ones() == size && zero_sum(m)))
+    {
+        groups.push(members(mask).collect());
+        left &= !mask;
+    }
+    groups.extend(members(left).map(|i| vec![i]));
+    groups
 }
 
 /// Cholesky if every form's tangent is symmetric, LU otherwise. Nonlinear tangents are probed at
@@ -636,5 +715,25 @@ impl NonlinearProblem for StageProblem<'_, '_> {
 
     fn structure(&self) -> Structure {
         self.structure
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::zero_sum_groups;
+
+    #[test]
+    fn zero_sum_groups_of_trbdf2_and_newmark() {
+        // TR-BDF2's a' at Δt = 0.02 (u', u, v, um, vm): the displacement levels sum to 7e-12.
+        let a = [29142.13562373094, 6035.533905932739, 35.355339059327385, -35177.669529663675, -206.06601717798208];
+        assert_eq!(zero_sum_groups(&a), vec![vec![0, 1, 3], vec![2], vec![4]]);
+        // Newmark's v' (u' merged into u, v, a): no group.
+        assert_eq!(zero_sum_groups(&[1.0, -1.0 / 3.0, 0.01]), vec![vec![0], vec![1], vec![2]]);
+        // Two groups, the smaller first.
+        assert_eq!(zero_sum_groups(&[1.0, 2.0, -3.0, 0.5, -0.5]), vec![vec![3, 4], vec![0, 1, 2]]);
+        assert_eq!(zero_sum_groups(&[]), Vec::<Vec<usize>>::new());
+        // Too many to search: singletons.
+        let many = [1.0, -1.0, 2.0, -2.0, 3.0, -3.0, 4.0, -4.0, 5.0, -5.0, 6.0];
+        assert_eq!(zero_sum_groups(&many), (0..11).map(|i| vec![i]).collect::<Vec<_>>());
     }
 }

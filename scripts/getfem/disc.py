@@ -4,7 +4,8 @@
 Run with Debian's python (apt-get install python3-getfem, GetFEM 5.4):
 
     /usr/bin/python3 scripts/getfem/disc.py --theta 1 --out /tmp/gf/getfem-newmark-t1.csv
-    (--scheme newmark|hht|midpoint, --alpha 0.05, --contact nitsche|penalty, --theta 1|0|-1)
+    (--scheme newmark|hht|midpoint|trbdf2, --alpha 0.05, --contact nitsche|nitsche-normal|penalty,
+     --theta 1|0|-1)
     signorini run disc --scheme newmark --contact nitsche-traction --cell-size getfem \
         --param theta=1 --mesh disc_r10_h1_v22.msh --t-end 20 --out /tmp/gf/ours-newmark-t1
     signorini compare /tmp/gf/getfem-newmark-t1.csv /tmp/gf/ours-newmark-t1
@@ -23,7 +24,12 @@ GetFEM pieces (no hand-written weak form in the dynamics):
     HHT and the implicit midpoint rule are GetFEM's Newmark scheme used as an affine map (see
     "Time scheme" below), with add_explicit_rhs/set_private_rhs for HHT's explicit part;
   - --contact penalty: add_nonlinear_term with eps [u_N - g]_+ v_N, eps = gamma0/element_size
-    (GetFEM's add_penalized_contact_with_rigid_obstacle_brick takes a constant r instead).
+    (GetFEM's add_penalized_contact_with_rigid_obstacle_brick takes a constant r instead);
+  - --contact nitsche-normal: signorini's normal form (forms/contact_nitsche.wf, compared with
+    `signorini run disc --contact nitsche`) as an add_nonlinear_term in GWFL:
+    -theta/gamma sigma_N(u) sigma_N(v) + 1/gamma [P_1,gamma(u)]_- (theta sigma_N(v) - gamma v.n_c),
+    sigma_N(u) = (sigma(u) n).n_c with n the outward normal (GWFL's Normal) and n_c = -e_y the
+    obstacle normal, P_1,gamma(u) = sigma_N(u) + gamma (g - u.n_c), gamma = gamma0/element_size.
 GetFEM's own linear solver choice matters in Debian's 5.4.2 build: 'superlu' (and
 linsolve_superlu) segfault, so the script uses 'mumps', and scipy for the mass solve. Newton's
 max_res is 1e-9: GetFEM's relative criterion has a round-off floor near 1e-11 on this problem,
@@ -38,6 +44,7 @@ whose face rule is IM_GAUSS1D(6), i.e. 4 Gauss points per edge (degree 7), as si
 Measures (per step, t = 0 first), the columns of signorini's series.csv:
   energy      = 1/2 v.M v + 1/2 u.K u - F.u  (M, K, F assembled by GetFEM)
   energy_aug  = energy - theta/(2 gamma) ||sigma(u)n||^2_GC + 1/(2 gamma) ||[P_1,gamma(u)]_-||^2_GC
+                (nitsche-normal: sigma_N(u)^2 in place of |sigma(u)n|^2, the normal form's E_Theta)
   uy_mean     = e_y.M u / e_y.M e_y (centre of mass), uy_mean_nodal = plain mean of nodal u_y
   fy_contact  = the vertical resultant of the contact term = -int_GC [P_1,gamma(u)]_-
   (penalty: energy_aug = energy + 1/2 int_GC eps [u_N - g]_+^2, fy_contact = int_GC eps [u_N - g]_+)
@@ -54,9 +61,10 @@ GC = 10  # region number of the contact zone
 
 p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
 p.add_argument("--mesh", required=True, help="the benchmark mesh, disc_r10_h1_v22.msh (Gmsh 2.2)")
-p.add_argument("--contact", choices=["nitsche", "penalty"], default="nitsche",
-               help="nitsche: GetFEM's Nitsche brick; penalty: a GWFL term, eps = gamma0/element_size "
-                    "(GetFEM's penalized contact brick takes a constant r, not gamma0/h)")
+p.add_argument("--contact", choices=["nitsche", "nitsche-normal", "penalty"], default="nitsche",
+               help="nitsche: GetFEM's Nitsche brick (full-traction theta term); nitsche-normal: signorini's "
+                    "normal form (forms/contact_nitsche.wf) as a GWFL term; penalty: a GWFL term, "
+                    "eps = gamma0/element_size (GetFEM's penalized contact brick takes a constant r, not gamma0/h)")
 p.add_argument("--theta", type=float, default=1.0)
 p.add_argument("--gamma0", type=float, default=1000.0)
 p.add_argument("--dt", type=float, default=0.02)
@@ -103,9 +111,19 @@ md.add_source_term_brick(mim, "u", "f")
 neumann = md.Neumann_term("u", GC)  # sigma(u) n, as the elasticity brick declares it
 nc = "(-Normalized(Grad_obs))"
 gamma = "(gamma0/element_size)"
+theta = f"({args.theta!r})"
 pen = f"pos_part(u.{nc} - obs)"  # [u_N - g]_+
+# sigma_N = (sigma n).nc of u and of the test function (the brick's Neumann term with u -> Test_u).
+sn_u = f"(({neumann}).{nc})"
+sn_v = "(((lambda*Div_Test_u*Id(2) + 2*mu*Sym(Grad_Test_u))*Normal).{})".format(nc)
+P1 = f"({sn_u} + {gamma}*(obs - u.{nc}))"  # P_1,gamma(u) + gamma g, the trial value
 if args.contact == "nitsche":
     md.add_Nitsche_contact_with_rigid_obstacle_brick(mim, "u", neumann, "obs", "gamma0", GC, args.theta)
+elif args.contact == "nitsche-normal":
+    # forms/contact_nitsche.wf: C(u).v = -theta/gamma sn(u) sn(v) + 1/gamma [P_1(u) + gamma g]_- P_theta(v),
+    # P_theta(v) = theta sn(v) - gamma v.nc; GWFL's neg_part(x) = max(-x, 0) = -[x]_-.
+    md.add_nonlinear_term(mim, f"-{theta}/{gamma}*{sn_u}*{sn_v}"
+                               f" - 1/{gamma}*neg_part({P1})*({theta}*{sn_v} - {gamma}*(Test_u.{nc}))", GC)
 else:
     md.add_nonlinear_term(mim, f"{gamma}*{pen}*(Test_u.{nc})", GC)
 
@@ -122,8 +140,6 @@ ey[1::2] = 1.0
 Mey = Mmat.mult(ey)
 total_mass = ey @ Mey
 
-P1 = f"(({neumann}).{nc} + {gamma}*(obs - u.{nc}))"
-
 
 def boundary(expr, U):
     return gf.asm_generic(mim, 0, expr, GC, "u", 0, mf, U, "obs", 0, mfs, md.variable("obs"),
@@ -132,8 +148,9 @@ def boundary(expr, U):
 
 def measure(t, U, V):
     energy = 0.5 * V @ Mmat.mult(V) + 0.5 * U @ Kmat.mult(U) - Fvec @ U
-    if args.contact == "nitsche":
-        ce = boundary(f"-{args.theta}/(2*{gamma})*Norm_sqr({neumann})"
+    if args.contact.startswith("nitsche"):
+        theta_term = f"Norm_sqr({neumann})" if args.contact == "nitsche" else f"sqr({sn_u})"
+        ce = boundary(f"-{theta}/(2*{gamma})*{theta_term}"
                       f" + 1/(2*{gamma})*sqr(neg_part({P1}))", U)
         fy = boundary(f"neg_part({P1})", U)  # GWFL neg_part(x) = max(-x, 0) = -[x]_-
     else:
