@@ -240,7 +240,7 @@ impl ElementKind {
         }
     }
 
-    /// Maps a point of the reference facet (interval [0,1] or triangle) into the reference cell,
+    /// Maps a point of the reference facet (the interval \[0, 1\] or the triangle) into the reference cell,
     /// and returns it with the facet's measure scaling (reference facet → cell facet).
     pub fn facet_point(self, facet: usize, s: &[f64]) -> (Vec<f64>, f64) {
         let v = self.reference_vertices();
