@@ -1,6 +1,11 @@
-//! `signorini run disc`: the elastic disc bouncing on a rigid plane (docs/mathematics.md §6). A disc of
-//! radius 10 centred at (0, 12) falls from rest under f = (0, −0.1) onto {y = 0}; plane strain
-//! with λ = μ = 20 (E = 50, ν = 1/4), ρ = 1; curved P2 triangles; no Dirichlet condition.
+//! `signorini run disc` and `run sphere`: an elastic body bouncing on a rigid plane
+//! (docs/mathematics.md §6). The disc of radius 10 centred at (0, 12) falls from rest under
+//! f = (0, −0.1) onto {y = 0}: plane strain with λ = μ = 20 (E = 50, ν = 1/4), ρ = 1, curved P2
+//! triangles, no Dirichlet condition. The sphere is the same in 3D: the ball of radius 10
+//! centred at (0, 0, 12), f = (0, 0, −0.1), the plane {z = 0}, curved P2 tetrahedra. The
+//! series' vertical columns (the fields `uy_*`, `vy_mean`, `fy_contact` of [`Row`], which
+//! hold the vertical component in both) are named after the axis (`uy_mean`, `fy_contact` for the disc;
+//! `uz_mean`, `fz_contact` for the sphere).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -13,20 +18,60 @@ use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::evaluate::facet_samples;
 use crate::runtime::kernel::Coef;
-use crate::runtime::mesh::{CellSize, Mesh, disc::disc, gmsh};
+use crate::runtime::mesh::{CellSize, Mesh, ball::ball, disc::disc, gmsh};
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
 use crate::simulation::{Problem, Simulation, Snapshots, Tools};
 
 /// Gravity of the benchmark.
 pub const GRAVITY: f64 = 0.1;
-/// Cell and contact-facet quadrature degrees (12-point triangle rule; 4 Gauss points per edge).
-const QUADRATURE: Quadrature = Quadrature { cell: Some(6), facet: Some(7) };
+/// The body: the 2D disc or the 3D sphere.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Body {
+    Disc,
+    Sphere,
+}
+
+impl Body {
+    pub fn name(self) -> &'static str {
+        match self {
+            Body::Disc => "disc",
+            Body::Sphere => "sphere",
+        }
+    }
+
+    pub fn dim(self) -> usize {
+        match self {
+            Body::Disc => 2,
+            Body::Sphere => 3,
+        }
+    }
+
+    /// The vertical axis's letter, for column names.
+    pub fn axis(self) -> char {
+        match self {
+            Body::Disc => 'y',
+            Body::Sphere => 'z',
+        }
+    }
+
+    /// Cell and contact-facet quadrature degrees. Disc: the 12-point triangle rule and 4 Gauss
+    /// points per edge (GetFEM's IM_TRIANGLE(6)). Sphere: degree 4 in the cells (the P2 mass on
+    /// straight cells), 5 on the contact faces.
+    fn quadrature(self) -> Quadrature {
+        match self {
+            Body::Disc => Quadrature { cell: Some(6), facet: Some(7) },
+            Body::Sphere => Quadrature { cell: Some(4), facet: Some(5) },
+        }
+    }
+}
 /// The disc's material (λ = μ = 20) and its Nitsche/penalty parameter, over the files' defaults.
 pub const OVERRIDES: &[(&str, f64)] = &[("E", 50.0), ("nu", 0.25), ("rho", 1.0), ("gamma0", 1000.0)];
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
+    pub body: Body,
     /// Scheme, contact law, extra forms and params.
     pub setup: Setup,
     pub mass: MassChoice,
@@ -49,6 +94,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
+            body: Body::Disc,
             setup: Setup::default(),
             mass: MassChoice::Consistent,
             cell_size: CellSize::Diameter,
@@ -80,6 +126,9 @@ pub struct Row {
     pub vy_mean: f64,
     pub uy_lowest: f64,
     pub fy_contact: f64,
+    /// The measure of the contact zone's points where the gap is closed (u_N ≥ g): a length
+    /// for the disc, an area for the sphere.
+    pub contact_area: f64,
     pub active_points: usize,
     /// The contact switches at every contact quadrature point (the active set).
     #[serde(skip)]
@@ -143,22 +192,28 @@ pub struct StageRow {
 }
 
 /// The mesh: read or generated, validated, with its `contact` region (the Gmsh group of that
-/// name, else the facets whose outward normal has n_y < 0).
+/// name, else the facets whose outward normal points down).
 pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
+    let d = opts.body.dim();
     let mut mesh = match &opts.mesh {
         Some(path) => gmsh::read(path)?,
         None => {
-            if !(opts.h > 0.05 && opts.h <= 10.0) {
-                return Err(CaseError::Option(format!("--h must be in (0.05, 10], not {}", opts.h)));
+            // The sphere's P2 dofs grow like (20/h)³: h = 0.3 is about 3 million.
+            let smallest = if d == 2 { 0.05 } else { 0.3 };
+            if !(opts.h >= smallest && opts.h <= 10.0) {
+                return Err(CaseError::Option(format!("--h must be in [{smallest}, 10], not {}", opts.h)));
             }
-            disc(10.0, [0.0, 12.0], opts.h)
+            match opts.body {
+                Body::Disc => disc(10.0, [0.0, 12.0], opts.h),
+                Body::Sphere => ball(10.0, [0.0, 0.0, 12.0], opts.h),
+            }
         }
     };
-    if mesh.dim() != 2 {
-        return Err(CaseError::Option(format!("the disc case needs a 2D mesh, not {}D", mesh.dim())));
+    if mesh.dim() != d {
+        return Err(CaseError::Option(format!("the {} case needs a {d}D mesh, not {}D", opts.body.name(), mesh.dim())));
     }
     if mesh.region("contact").is_err() {
-        mesh.add_region_where("contact", |n, _| n[1] < 0.0);
+        mesh.add_region_where("contact", |n, _| n[d - 1] < 0.0);
     }
     mesh.set_cell_size(opts.cell_size);
     mesh.validate()?;
@@ -174,12 +229,14 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     simulate(opts, &active)
 }
 
-/// Case data: gravity, the gap to {y = 0} and the obstacle normal −e_y.
-fn coefs(name: &str) -> Option<Coef> {
+/// Case data in dimension d: gravity, the gap to the plane {x_d = 0} and the obstacle normal
+/// −e_d.
+fn coefs(d: usize, name: &str) -> Option<Coef> {
+    let down = |size: f64| (0..d).map(|k| if k == d - 1 { -size } else { 0.0 }).collect::<Vec<f64>>();
     match name {
-        "f" => Some(Coef::constant(vec![0.0, -GRAVITY])),
-        "g" => Some(Coef::function(1, |x, _, out| out[0] = x[1])),
-        "nc" => Some(Coef::constant(vec![0.0, -1.0])),
+        "f" => Some(Coef::constant(down(GRAVITY))),
+        "g" => Some(Coef::function(1, move |x, _, out| out[0] = x[d - 1])),
+        "nc" => Some(Coef::constant(down(1.0))),
         _ => None,
     }
 }
@@ -189,9 +246,12 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let mesh = mesh(opts)?;
     let asm = Assembler::new(&mesh);
     let n = asm.size();
+    let (d, vert) = (opts.body.dim(), opts.body.dim() - 1);
+    let quadrature = opts.body.quadrature();
+    let coefs = |name: &str| coefs(d, name);
     let problem = Problem {
         coefs: &coefs,
-        quadrature: QUADRATURE,
+        quadrature,
         contact: "contact",
         constraints: Constraints::none(n),
         mass: opts.mass,
@@ -204,11 +264,12 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         ));
     }
     sim.initialize(vec![0.0; n])?;
-    let ey: Vec<f64> = (0..n).map(|i| if i % 2 == 1 { 1.0 } else { 0.0 }).collect();
+    let ey: Vec<f64> = (0..n).map(|i| if i % d == vert { 1.0 } else { 0.0 }).collect();
     let mut mass_ey = vec![0.0; n];
     sim.tools.mass.mul_vec(&ey, &mut mass_ey);
     let total_mass: f64 = mass_ey.iter().zip(&ey).map(|(a, b)| a * b).sum();
-    let lowest = (0..mesh.num_nodes()).min_by(|&a, &b| mesh.node(a)[1].total_cmp(&mesh.node(b)[1])).expect("nodes");
+    let lowest =
+        (0..mesh.num_nodes()).min_by(|&a, &b| mesh.node(a)[vert].total_cmp(&mesh.node(b)[vert])).expect("nodes");
     let measure = |tools: &Tools, u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
         let kinetic = tools.kinetic(v);
         let energy = tools.energy(u, v);
@@ -217,8 +278,10 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         probe.residual(&asm, &[u], t, &mut c);
         let mut switches = Vec::new();
         probe.switches(&asm, &[u], 0, t, &mut switches);
-        let samples = facet_samples(&mesh, tools.contact_facets, QUADRATURE.facet.unwrap_or(7), u);
-        let penetration = samples.iter().map(|s| (-s.value[1] - s.x[1]).max(0.0)).fold(0.0, f64::max);
+        let samples = facet_samples(&mesh, tools.contact_facets, quadrature.facet.unwrap_or(7), u);
+        // The gap u_N − g at each point: −u_d − x_d.
+        let gaps: Vec<f64> = samples.iter().map(|s| -s.value[vert] - s.x[vert]).collect();
+        let penetration = gaps.iter().fold(0.0f64, |m, g| m.max(*g));
         Row {
             t,
             energy,
@@ -226,11 +289,13 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
             energy_aug: energy + tools.value(&tools.contact_energy, u),
             // Area-weighted mean of u_y: e_yᵀ M u / e_yᵀ M e_y.
             uy_mean: mass_ey.iter().zip(u).map(|(a, b)| a * b).sum::<f64>() / total_mass,
-            uy_mean_nodal: u.iter().skip(1).step_by(2).sum::<f64>() / (n / 2) as f64,
+            uy_mean_nodal: u.iter().skip(vert).step_by(d).sum::<f64>() / (n / d) as f64,
             vy_mean: v.map_or(f64::NAN, |v| mass_ey.iter().zip(v).map(|(a, b)| a * b).sum::<f64>() / total_mass),
-            uy_lowest: u[2 * lowest + 1],
+            uy_lowest: u[d * lowest + vert],
+            // Where the body touches or penetrates the plane: the gap closed.
+            contact_area: samples.iter().zip(&gaps).filter(|(_, g)| **g >= 0.0).map(|(s, _)| s.weight).sum(),
             // C(u) tested with e_y is minus the upward force on the disc.
-            fy_contact: -c.iter().skip(1).step_by(2).sum::<f64>(),
+            fy_contact: -c.iter().skip(vert).step_by(d).sum::<f64>(),
             active_points: switches.iter().filter(|b| **b).count(),
             switches,
             penetration,
@@ -239,7 +304,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     };
     let mut series = vec![measure(&sim.tools, &sim.states[0], sim.velocity(), 0, 0.0)];
     let steps = (opts.t_end / opts.dt).round() as usize;
-    let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, "disc");
+    let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, opts.body.name());
     // A scheme without a velocity state: the step's mean velocity.
     let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64]| -> Vec<f64> {
         match v_index {
@@ -272,7 +337,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let wall = start.elapsed().as_secs_f64();
     let last = series.last().expect("initial row");
     let summary = Summary {
-        case: "disc",
+        case: opts.body.name(),
         scheme: active.scheme_name().to_string(),
         contact: active.forms.contact_name().to_string(),
         interpreted: active.interpreted(),
@@ -299,23 +364,25 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         factorizations: sim.stepper.counters().numeric,
     };
     if let Some(dir) = &opts.out {
-        write_outputs(dir, &summary, &series, &stage_rows)?;
+        write_outputs(dir, opts.body, &summary, &series, &stage_rows)?;
     }
     Ok(Run { summary, series, stages: stage_rows })
 }
 
 fn write_outputs(
     dir: &std::path::Path,
+    body: Body,
     summary: &Summary,
     series: &[Row],
     stages: &[StageRow],
 ) -> Result<(), CaseError> {
-    let mut csv = String::from(
-        "t,energy,energy_aug,uy_mean,uy_mean_nodal,vy_mean,uy_lowest,fy_contact,active_points,penetration,newton\n",
+    let a = body.axis();
+    let mut csv = format!(
+        "t,energy,energy_aug,u{a}_mean,u{a}_mean_nodal,v{a}_mean,u{a}_lowest,f{a}_contact,contact_area,active_points,penetration,newton\n",
     );
     for r in series {
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.t,
             r.energy,
             r.energy_aug,
@@ -324,6 +391,7 @@ fn write_outputs(
             r.vy_mean,
             r.uy_lowest,
             r.fy_contact,
+            r.contact_area,
             r.active_points,
             r.penetration,
             r.newton
@@ -333,8 +401,8 @@ fn write_outputs(
     crate::output::write_atomic(&dir.join("series.csv"), csv.as_bytes()).map_err(err(dir.join("series.csv")))?;
     crate::output::write_json(&dir.join("summary.json"), summary).map_err(err(dir.join("summary.json")))?;
     if !stages.is_empty() {
-        let mut csv = String::from(
-            "stage,t,energy,energy_aug,uy_mean,uy_mean_nodal,vy_mean,fy_contact,active_points,penetration\n",
+        let mut csv = format!(
+            "stage,t,energy,energy_aug,u{a}_mean,u{a}_mean_nodal,v{a}_mean,f{a}_contact,active_points,penetration\n",
         );
         for StageRow { stage, row: r } in stages {
             csv.push_str(&format!(
@@ -357,7 +425,7 @@ fn write_outputs(
     let plot_err = |e: String| CaseError::Write { path: dir.display().to_string(), source: std::io::Error::other(e) };
     let aug = "E + contact energy";
     crate::plot::panels(
-        &dir.join("disc.png"),
+        &dir.join(format!("{}.png", body.name())),
         "t",
         &[
             (
@@ -370,13 +438,17 @@ fn write_outputs(
             ),
             (
                 "vertical displacement",
-                "u_y",
+                &format!("u_{a}"),
                 vec![
                     Curve { label: "mean", points: pts(&|r| r.uy_mean), dashed: false },
                     Curve { label: "lowest point", points: pts(&|r| r.uy_lowest), dashed: false },
                 ],
             ),
-            ("contact force", "F_y", vec![Curve { label: "F_y", points: pts(&|r| r.fy_contact), dashed: false }]),
+            (
+                "contact force",
+                &format!("F_{a}"),
+                vec![Curve { label: "vertical", points: pts(&|r| r.fy_contact), dashed: false }],
+            ),
             (
                 "Newton iterations",
                 "iterations",

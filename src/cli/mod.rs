@@ -9,6 +9,7 @@ mod compare;
 mod list;
 
 use crate::cases::bar::{self, MassChoice};
+use crate::cases::disc::Body;
 use crate::cases::static_block;
 use crate::compiler;
 use crate::driver::{Setting, Setup};
@@ -135,6 +136,8 @@ pub enum Case {
     Bar(BarArgs),
     /// The elastic disc bouncing on a rigid plane (docs/mathematics.md §6).
     Disc(DiscArgs),
+    /// The elastic ball bouncing on a rigid plane: the disc in 3D (curved P2 tetrahedra).
+    Sphere(DiscArgs),
 }
 
 /// The scheme, the form files and their params (`signorini list` shows what there is).
@@ -205,17 +208,17 @@ pub struct DiscArgs {
     /// A Gmsh mesh (MSH 2.2 or 4.1); default: the built-in curved P2 disc.
     #[arg(long)]
     mesh: Option<PathBuf>,
-    /// Mesh size of the built-in disc.
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
-    h: f64,
+    /// Mesh size of the built-in mesh (default: 1 for the disc, 2.5 for the sphere).
+    #[arg(long, allow_hyphen_values = true)]
+    h: Option<f64>,
     #[arg(long, default_value_t = 0.02, allow_hyphen_values = true)]
     dt: f64,
     #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
     t_end: f64,
-    /// Directory for series.csv, summary.json and disc.png.
+    /// Directory for series.csv, summary.json and disc.png (sphere.png).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Write a VTU snapshot every K steps into DIR/vtu, and DIR/disc.pvd for ParaView.
+    /// Write a VTU snapshot every K steps into DIR/vtu, and DIR/disc.pvd (sphere.pvd) for ParaView.
     #[arg(long, default_value_t = 0)]
     vtu_every: usize,
 }
@@ -320,7 +323,8 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Run { case: Some(case), .. } => match *case {
             Case::StaticBlock(a) => static_block(a),
             Case::Bar(a) => run_bar(a),
-            Case::Disc(a) => run_disc(a),
+            Case::Disc(a) => run_disc(a, Body::Disc),
+            Case::Sphere(a) => run_disc(a, Body::Sphere),
         },
         Command::Run { case: None, file: Some(file) } => run_file(&file),
         Command::Run { case: None, file: None } => {
@@ -580,17 +584,21 @@ fn run_bar_all(a: BarArgs, base: Setup) -> ExitCode {
     if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
 }
 
-fn run_disc(a: DiscArgs) -> ExitCode {
+fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
     let setup = match a.methods.setup() {
         Ok(s) => s,
         Err(e) => return fail(e),
     };
     let opts = crate::cases::disc::Options {
+        body,
         setup,
         mass: a.mass,
         cell_size: a.methods.cell_size,
         mesh: a.mesh,
-        h: a.h,
+        h: a.h.unwrap_or(match body {
+            Body::Disc => 1.0,
+            Body::Sphere => 2.5,
+        }),
         dt: a.dt,
         t_end: a.t_end,
         out: a.out,
@@ -665,7 +673,8 @@ fn finish_disc(result: Result<crate::cases::disc::Run, crate::cases::CaseError>)
             let s = &r.summary;
             interpreted_note(&s.interpreted);
             println!(
-                "disc: {} {}{}, {} dofs, {} steps, first contact at t = {}, max penetration {:.3e}, E_aug {:.6} → {:.6}, Newton {} (max {}), {:.2} s ({:.3} ms/step)",
+                "{}: {} {}{}, {} dofs, {} steps, first contact at t = {}, max penetration {:.3e}, E_aug {:.6} → {:.6}, Newton {} (max {}), {:.2} s ({:.3} ms/step)",
+                s.case,
                 s.scheme,
                 s.contact,
                 params_text(&s.params),
