@@ -1,0 +1,128 @@
+//! Semi-smooth Newton through the runtime alone: a membrane −u″ = f on (0, 1), u(0) = u(1) = 0,
+//! pushed onto the obstacle u ≥ ψ by a nodal penalty ε[u − ψ]₋. R is the gradient of the convex
+//! J(u) = ½uᵀKu − Fᵀu + ½ε Σ [u_i − ψ]₋², so Newton's answer must minimise J; it must also be
+//! symmetric, touch the obstacle in the middle and nowhere near the ends, and not depend on
+//! whether the Jacobian is reused while the active set is unchanged.
+
+mod common;
+
+use common::{MassStiffness, pseudo_random};
+use signorini_runtime::assembly::{Assembler, Quadrature};
+use signorini_runtime::linalg::{Matrix, Structure};
+use signorini_runtime::mesh::structured::interval;
+use signorini_runtime::newton::{Newton, NewtonOptions, NonlinearProblem};
+use signorini_runtime::problem::Constraints;
+
+const EPS: f64 = 1e4;
+const PSI: f64 = -0.25;
+
+struct Membrane {
+    k: Matrix,
+    f: Vec<f64>,
+    constraints: Constraints,
+    /// Report the active set (reuse the factorization) or not (refactor every iteration).
+    piecewise: bool,
+}
+
+impl Membrane {
+    fn energy(&self, u: &[f64]) -> f64 {
+        let mut ku = vec![0.0; u.len()];
+        self.k.mul_vec(u, &mut ku);
+        let quad: f64 = u.iter().zip(&ku).map(|(a, b)| a * b).sum();
+        let load: f64 = u.iter().zip(&self.f).map(|(a, b)| a * b).sum();
+        0.5 * quad - load + 0.5 * EPS * u.iter().map(|x| (x - PSI).min(0.0).powi(2)).sum::<f64>()
+    }
+}
+
+fn diagonal_index(m: &Matrix, i: usize) -> usize {
+    let p = &m.pattern;
+    let rows = &p.row_idx[p.col_ptr[i]..p.col_ptr[i + 1]];
+    p.col_ptr[i] + rows.binary_search(&i).expect("the diagonal is in the pattern")
+}
+
+impl NonlinearProblem for Membrane {
+    fn residual(&mut self, w: &[f64], r: &mut [f64]) {
+        self.k.mul_vec(w, r);
+        for (i, ri) in r.iter_mut().enumerate() {
+            *ri += -self.f[i] + EPS * (w[i] - PSI).min(0.0);
+        }
+        self.constraints.zero(r);
+    }
+    fn load_scale(&self) -> f64 {
+        self.f.iter().fold(0.0, |m, x| m.max(x.abs()))
+    }
+    fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool {
+        out.extend(w.iter().map(|x| *x < PSI));
+        self.piecewise
+    }
+    fn jacobian(&mut self, w: &[f64], j: &mut Matrix) {
+        j.add_scaled(1.0, &self.k);
+        for (i, x) in w.iter().enumerate() {
+            if *x < PSI {
+                let k = diagonal_index(j, i);
+                j.values[k] += EPS;
+            }
+        }
+        self.constraints.apply(j);
+    }
+    fn jacobian_matrix(&self) -> Matrix {
+        Matrix::zeros(self.k.pattern.clone())
+    }
+    fn structure(&self) -> Structure {
+        Structure::SymmetricPositiveDefinite
+    }
+}
+
+fn solve(piecewise: bool) -> (Vec<f64>, usize, Membrane) {
+    let n_el = 64;
+    let mesh = interval(n_el, 0.0, 1.0);
+    let asm = Assembler::new(&mesh);
+    let n = asm.size();
+    let zero = vec![0.0; n];
+    let mut k = asm.zero_matrix();
+    asm.cell_tangent(&MassStiffness { rho: 0.0, k: 1.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut k);
+    // F = M (−8): a uniform load pushing the membrane down (alone it would reach −1).
+    let mut f = vec![0.0; n];
+    asm.cell_residual(&MassStiffness { rho: 1.0, k: 0.0 }, Quadrature::default(), &[&vec![-8.0; n]], 0.0, &mut f);
+    let mut constraints = Constraints::none(n);
+    constraints.fix(0);
+    constraints.fix(n_el);
+    constraints.zero(&mut f);
+    let mut problem = Membrane { k, f, constraints, piecewise };
+    let mut u = vec![0.0; n];
+    let report = Newton::new(NewtonOptions::default()).solve(&mut problem, &mut u).unwrap();
+    (u, report.iterations(), problem)
+}
+
+#[test]
+fn newton_minimises_the_penalised_energy() {
+    let (u, iterations, problem) = solve(true);
+    let n = u.len();
+    // From u = 0 (no contact) the active set grows by a few nodes per iteration: 13 measured.
+    assert!(iterations <= 20, "{iterations} iterations");
+    // Symmetric, in contact in the middle, free near the ends.
+    for i in 0..n {
+        assert!((u[i] - u[n - 1 - i]).abs() < 1e-10, "asymmetric at node {i}");
+    }
+    assert!(u[n / 2] < PSI && u[n / 2] > PSI - 1e-3, "centre {}", u[n / 2]);
+    assert!(u[n / 8] > PSI, "near the end {}", u[n / 8]);
+    // A minimum of J: no perturbation (zero at the fixed ends) lowers it.
+    let j0 = problem.energy(&u);
+    for seed in 0..20 {
+        let mut d = pseudo_random(n, seed);
+        d[0] = 0.0;
+        d[n - 1] = 0.0;
+        for t in [1e-3, -1e-3, 1e-5] {
+            let v: Vec<f64> = u.iter().zip(&d).map(|(a, b)| a + t * b).collect();
+            assert!(problem.energy(&v) >= j0 - 1e-12 * j0.abs(), "seed {seed}, t = {t}");
+        }
+    }
+}
+
+#[test]
+fn reusing_the_factorization_does_not_change_the_answer() {
+    let (a, _, _) = solve(true);
+    let (b, _, _) = solve(false);
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9 * scale));
+}
