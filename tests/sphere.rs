@@ -48,3 +48,27 @@ fn crank_nicolson_keeps_the_augmented_energy_while_the_active_set_is_kept() {
     // In contact: a positive contact area and an upward force.
     assert!(r.series.iter().any(|row| row.contact_area > 0.0 && row.fy_contact > 0.0));
 }
+
+/// The iterative path (CG for θ = 1, BiCGStab for the unsymmetric θ = −1) gives the direct
+/// path's series to Newton's tolerance.
+#[test]
+fn iterative_and_direct_solvers_agree() {
+    use signorini::runtime::linalg::Solver;
+    use signorini::runtime::newton::NewtonOptions;
+    for theta in [1.0, -1.0] {
+        let run = |solver| {
+            let setup = Setup::default().set("theta", theta);
+            let newton = NewtonOptions { solver, ..NewtonOptions::default() };
+            disc::run(&Options { body: Body::Sphere, setup, h: 5.0, t_end: 8.0, newton, ..Options::default() }).unwrap()
+        };
+        let (d, i) = (run(Solver::Direct), run(Solver::Iterative));
+        assert_eq!(d.summary.krylov_iterations, 0);
+        assert!(i.summary.krylov_iterations > 0);
+        let scale = d.series.iter().map(|r| r.energy.abs()).fold(0.0, f64::max);
+        for (a, b) in d.series.iter().zip(&i.series) {
+            assert!((a.energy_aug - b.energy_aug).abs() < 1e-6 * scale, "θ = {theta}, t = {}", a.t);
+            assert!((a.uy_mean - b.uy_mean).abs() < 1e-9, "θ = {theta}, t = {}", a.t);
+            assert_eq!(a.active_points, b.active_points, "θ = {theta}, t = {}", a.t);
+        }
+    }
+}

@@ -22,6 +22,7 @@ pub mod element;
 pub mod evaluate;
 pub mod geometry;
 pub mod kernel;
+pub mod krylov;
 pub mod library;
 pub mod linalg;
 pub mod mesh;

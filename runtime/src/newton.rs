@@ -8,7 +8,7 @@
 
 use tracing::debug;
 
-use crate::linalg::{Factorization, LinalgError, Matrix, Structure};
+use crate::linalg::{Factorization, LinalgError, Matrix, Solver, Structure};
 
 /// Largest accepted ‖J δ + R‖∞ / ‖R‖∞ of a Newton step; above it the Jacobian is treated as
 /// singular (round-off in a sound solve stays orders of magnitude below).
@@ -37,11 +37,13 @@ pub struct NewtonOptions {
     pub max_iterations: usize,
     /// Backtracking on ‖R‖₂ (halving the step up to 10 times).
     pub line_search: bool,
+    /// How the Jacobian systems are solved.
+    pub solver: Solver,
 }
 
 impl Default for NewtonOptions {
     fn default() -> Self {
-        NewtonOptions { tol: 1e-10, max_iterations: 25, line_search: false }
+        NewtonOptions { tol: 1e-10, max_iterations: 25, line_search: false, solver: Solver::Auto }
     }
 }
 
@@ -106,12 +108,7 @@ impl Newton {
     /// Symbolic and numeric factorizations and solves so far.
     pub fn counters(&self) -> crate::linalg::Counters {
         let c = |f: &Option<Factorization>| f.as_ref().map(|f| f.counters).unwrap_or_default();
-        let (a, b) = (c(&self.factorization), c(&self.spare));
-        crate::linalg::Counters {
-            symbolic: a.symbolic + b.symbolic,
-            numeric: a.numeric + b.numeric,
-            solves: a.solves + b.solves,
-        }
+        c(&self.factorization) + c(&self.spare)
     }
 
     /// Solves R(w) = 0 starting from `w`, which holds the solution on success.
@@ -187,7 +184,7 @@ impl Newton {
         let f = match &mut self.factorization {
             Some(f) if f.structure() == want => f,
             slot => {
-                let old = slot.replace(Factorization::new(want));
+                let old = slot.replace(Factorization::new(want).with_solver(self.options.solver));
                 if old.is_some() {
                     self.spare = old;
                 }
@@ -199,7 +196,7 @@ impl Newton {
                 debug!("Jacobian not positive definite: switching to LU");
                 self.spd_failed = true;
                 let counters = f.counters;
-                let mut lu = Factorization::new(Structure::General);
+                let mut lu = Factorization::new(Structure::General).with_solver(self.options.solver);
                 lu.counters = counters;
                 lu.factor(j)?;
                 *f = lu;

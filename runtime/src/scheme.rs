@@ -319,11 +319,7 @@ impl<'a> Stepper<'a> {
 
     /// Factorizations and solves of all stages so far.
     pub fn counters(&self) -> crate::linalg::Counters {
-        self.stages.iter().map(|s| s.newton.counters()).fold(Default::default(), |a, c| crate::linalg::Counters {
-            symbolic: a.symbolic + c.symbolic,
-            numeric: a.numeric + c.numeric,
-            solves: a.solves + c.solves,
-        })
+        self.stages.iter().map(|s| s.newton.counters()).fold(Default::default(), |a, c| a + c)
     }
 
     /// The matrix of a linear one-field form (e.g. `mass`, for energies).

@@ -171,8 +171,14 @@ pub struct Summary {
     /// the median over steps.
     pub stepping_seconds: f64,
     pub step_median_seconds: f64,
-    /// Numeric factorizations of the stage Jacobians (the rest of the Newton iterations reuse one).
+    /// Numeric factorizations of the stage Jacobians (the rest of the Newton iterations reuse one;
+    /// with the iterative solver: preconditioner setups).
     pub factorizations: usize,
+    /// The linear solver asked for, and the Krylov iterations over the run (0: direct).
+    pub solver: crate::runtime::linalg::Solver,
+    pub krylov_iterations: usize,
+    /// The process's peak resident memory at the end of the run (Linux), in bytes.
+    pub peak_memory_bytes: Option<u64>,
 }
 
 pub struct Run {
@@ -362,6 +368,9 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         stepping_seconds: step_times.iter().sum(),
         step_median_seconds: crate::bench::median(step_times),
         factorizations: sim.stepper.counters().numeric,
+        solver: opts.newton.solver,
+        krylov_iterations: sim.stepper.counters().iterations,
+        peak_memory_bytes: crate::bench::peak_memory(),
     };
     if let Some(dir) = &opts.out {
         write_outputs(dir, opts.body, &summary, &series, &stage_rows)?;

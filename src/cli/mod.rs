@@ -13,6 +13,7 @@ use crate::cases::disc::Body;
 use crate::cases::static_block;
 use crate::compiler;
 use crate::driver::{Setting, Setup};
+use crate::runtime::linalg::Solver;
 use crate::runtime::mesh::CellSize;
 
 #[derive(Parser)]
@@ -221,6 +222,11 @@ pub struct DiscArgs {
     /// Write a VTU snapshot every K steps into DIR/vtu, and DIR/disc.pvd (sphere.pvd) for ParaView.
     #[arg(long, default_value_t = 0)]
     vtu_every: usize,
+    /// Linear solver of each step: direct (sparse Cholesky/LU), iterative (Jacobi-preconditioned
+    /// CG, or BiCGStab for unsymmetric tangents; memory of the matrix only), or auto (iterative
+    /// above 30 000 unknowns).
+    #[arg(long, value_parser = Solver::parse, default_value = "auto")]
+    solver: Solver,
 }
 
 #[derive(clap::Args)]
@@ -604,7 +610,7 @@ fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
         out: a.out,
         vtu_every: a.vtu_every,
         progress: true,
-        ..Default::default()
+        newton: crate::runtime::newton::NewtonOptions { solver: a.solver, ..Default::default() },
     };
     finish_disc(crate::cases::disc::run(&opts))
 }
@@ -673,7 +679,7 @@ fn finish_disc(result: Result<crate::cases::disc::Run, crate::cases::CaseError>)
             let s = &r.summary;
             interpreted_note(&s.interpreted);
             println!(
-                "{}: {} {}{}, {} dofs, {} steps, first contact at t = {}, max penetration {:.3e}, E_aug {:.6} → {:.6}, Newton {} (max {}), {:.2} s ({:.3} ms/step)",
+                "{}: {} {}{}, {} dofs, {} steps, first contact at t = {}, max penetration {:.3e}, E_aug {:.6} → {:.6}, Newton {} (max {}), {:.2} s ({:.3} ms/step){}",
                 s.case,
                 s.scheme,
                 s.contact,
@@ -687,7 +693,8 @@ fn finish_disc(result: Result<crate::cases::disc::Run, crate::cases::CaseError>)
                 s.newton_total,
                 s.newton_max,
                 s.wall_seconds,
-                1e3 * s.seconds_per_step
+                1e3 * s.seconds_per_step,
+                s.peak_memory_bytes.map_or(String::new(), |b| format!(", peak memory {:.0} MB", b as f64 / 1e6))
             );
             ExitCode::SUCCESS
         }
