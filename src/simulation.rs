@@ -179,15 +179,27 @@ impl<'m> Simulation<'m> {
         Ok(())
     }
 
+    /// Sets the displacement and the velocity (if the scheme has one) at time `t0`, and solves
+    /// the initial problem.
+    pub fn initialize_at(&mut self, t0: f64, u0: Vec<f64>, v0: Vec<f64>) -> Result<(), CaseError> {
+        self.states[0] = u0;
+        if let Some(i) = self.v_index {
+            self.states[i] = v0;
+        }
+        self.stepper.initialize(&mut self.states, t0)?;
+        Ok(())
+    }
+
     /// The velocity state, if the scheme has one.
     pub fn velocity(&self) -> Option<&[f64]> {
         self.v_index.map(|i| self.states[i].as_slice())
     }
 
-    /// Runs `steps` steps of `dt` from t = 0, showing every step to `on_step` and every
+    /// Runs `steps` steps of `dt` from `t0`, showing every step to `on_step` and every
     /// intermediate stage of a multi-stage scheme to `on_stage`. Returns each step's wall time.
     pub fn run(
         &mut self,
+        t0: f64,
         dt: f64,
         steps: usize,
         progress: bool,
@@ -201,7 +213,7 @@ impl<'m> Simulation<'m> {
         let Simulation { stepper, tools, states, v_index } = self;
         for k in 0..steps {
             bar.tick(k);
-            let t = k as f64 * dt;
+            let t = t0 + k as f64 * dt;
             let before = states[0].clone();
             let clock = Instant::now();
             let report = stepper.step_observed(states, t, dt, &mut |stage| {

@@ -151,3 +151,24 @@ fn bench_disc_times_the_stepper_and_reports_missing_meshes() {
         assert!(json.contains(key), "{key} missing from {json}");
     }
 }
+
+#[test]
+fn bench_sphere_runs_each_size_in_its_own_process() {
+    let dir = std::env::temp_dir().join(format!("signorini-bench-sphere-{}", std::process::id()));
+    // The smallest ball only (14 739 unknowns), with both solvers.
+    let (code, out, err) = signorini(&["bench", "sphere", "--max-dofs", "20000", "--out", dir.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("14739 dofs, direct") && out.contains("14739 dofs, iterative"), "{out}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("bench_sphere.json")).unwrap()).unwrap();
+    let runs = json["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    for r in runs {
+        // 50 steps from t = 6 through the first contact, in a process of its own.
+        assert_eq!(r["steps"], 50);
+        assert!(r["first_contact"].as_f64().is_some_and(|t| t > 6.3 && t < 6.5), "{r}");
+        assert!(r["peak_memory_bytes"].as_u64().is_some_and(|b| b > 1_000_000), "{r}");
+    }
+    assert!(runs.iter().any(|r| r["solver"] == "iterative" && r["krylov_iterations"].as_u64() > Some(0)));
+    assert!(std::fs::read(dir.join("bench_sphere.png")).unwrap().starts_with(b"\x89PNG"));
+}

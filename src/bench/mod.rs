@@ -2,6 +2,7 @@
 
 pub mod assemble;
 pub mod disc;
+pub mod sphere;
 
 pub use assemble::assemble;
 

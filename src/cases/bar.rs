@@ -211,7 +211,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let (mut half_err, mut half_norm) = (0.0, 0.0);
     let v_index = sim.v_index;
     let mut t = 0.0;
-    sim.run(opts.dt, steps, opts.progress, &mut |_, _, _| {}, &mut |tools, step| {
+    sim.run(0.0, opts.dt, steps, opts.progress, &mut |_, _, _| {}, &mut |tools, step| {
         t = step.k as f64 * opts.dt;
         let mut row =
             measure(tools, &step.states[0], v_index.map(|i| step.states[i].as_slice()), step.report.iterations(), t);

@@ -1,0 +1,138 @@
+//! `signorini bench sphere`: time per step and peak memory of the bouncing sphere against its
+//! size, for the direct and the iterative solver. Each run is its own process (`run sphere`),
+//! so that its peak memory is its own: 50 steps of Δt = 0.02 from exact free fall at t = 6,
+//! through the first contact at √40 ≈ 6.32 (Newmark, Nitsche θ = 1, `--cell-size getfem`, whose
+//! h keeps θ = 1 stable on the finer built-in balls). Balls of 2·half cells per diameter have
+//! 3(4·half + 1)³ P2 unknowns.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde::Serialize;
+
+use crate::cases::CaseError;
+use crate::plot::Curve;
+
+/// Cells per radius of the balls tried, smallest first: 15k, 47k, 108k, 274k, 824k, 985k dofs.
+const HALVES: [usize; 6] = [4, 6, 8, 11, 16, 17];
+/// The direct solver is tried up to this many unknowns: through contact it refactors at every
+/// change of the active set, 35 times in 50 steps at 47k unknowns (135 s), and one
+/// factorization at 108k takes about 100 s and 4.6 GB.
+pub const DIRECT_LIMIT: usize = 60_000;
+
+pub fn dofs(half: usize) -> usize {
+    3 * (4 * half + 1).pow(3)
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SphereTiming {
+    pub dofs: usize,
+    pub h: f64,
+    pub solver: String,
+    pub steps: usize,
+    /// Median step time of the stepping, and the whole run (setup included) per step.
+    pub median_step_ms: f64,
+    pub ms_per_step_with_setup: f64,
+    pub newton_total: usize,
+    pub factorizations: usize,
+    pub krylov_iterations: usize,
+    pub peak_memory_bytes: Option<u64>,
+    pub first_contact: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    pub max_dofs: usize,
+    pub runs: Vec<SphereTiming>,
+}
+
+fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTiming, CaseError> {
+    let h = 10.0 / half as f64;
+    let out = dir.join(format!("sphere-{}-{solver}", dofs(half)));
+    let status = Command::new(exe)
+        .args(["run", "sphere", "--h", &h.to_string(), "--t-start", "6", "--t-end", "7", "--cell-size", "getfem"])
+        .args(["--solver", solver, "--out"])
+        .arg(&out)
+        .output()
+        .map_err(|e| CaseError::Option(format!("cannot run {}: {e}", exe.display())))?;
+    if !status.status.success() {
+        return Err(CaseError::Option(format!(
+            "run sphere --h {h} --solver {solver} failed: {}",
+            String::from_utf8_lossy(&status.stderr).trim()
+        )));
+    }
+    let path = out.join("summary.json");
+    let text = std::fs::read_to_string(&path)
+        .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
+    let s: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| CaseError::Option(format!("{}: {e}", path.display())))?;
+    let num = |k: &str| s.get(k).and_then(serde_json::Value::as_f64).unwrap_or(f64::NAN);
+    let int = |k: &str| s.get(k).and_then(serde_json::Value::as_u64).unwrap_or(0) as usize;
+    Ok(SphereTiming {
+        dofs: int("dofs"),
+        h,
+        solver: solver.into(),
+        steps: int("steps"),
+        median_step_ms: 1e3 * num("step_median_seconds"),
+        ms_per_step_with_setup: 1e3 * num("seconds_per_step"),
+        newton_total: int("newton_total"),
+        factorizations: int("factorizations"),
+        krylov_iterations: int("krylov_iterations"),
+        peak_memory_bytes: s.get("peak_memory_bytes").and_then(serde_json::Value::as_u64),
+        first_contact: s.get("first_contact").and_then(serde_json::Value::as_f64),
+    })
+}
+
+/// Every ball up to `max_dofs` unknowns, with both solvers where the direct one fits.
+pub fn sphere(max_dofs: usize, dir: &Path, progress: &mut dyn FnMut(&str)) -> Result<Report, CaseError> {
+    let exe: PathBuf = std::env::current_exe().map_err(|e| CaseError::Option(format!("cannot find myself: {e}")))?;
+    let mut runs = Vec::new();
+    for half in HALVES.into_iter().filter(|&h| dofs(h) <= max_dofs) {
+        for solver in ["direct", "iterative"] {
+            if solver == "direct" && dofs(half) > DIRECT_LIMIT {
+                continue;
+            }
+            let r = run_one(&exe, half, solver, &dir.join("bench_sphere_runs"))?;
+            progress(&format!(
+                "{} dofs, {solver}: {:.1} ms/step (median), {:.1} ms/step with setup, peak {:.0} MB",
+                r.dofs,
+                r.median_step_ms,
+                r.ms_per_step_with_setup,
+                r.peak_memory_bytes.map_or(f64::NAN, |b| b as f64 / 1e6)
+            ));
+            runs.push(r);
+        }
+    }
+    Ok(Report { max_dofs, runs })
+}
+
+/// `dir/bench_sphere.png`: log-log time per step and peak memory against unknowns.
+pub fn figure(report: &Report, dir: &Path) -> Result<(), CaseError> {
+    let series = |solver: &str, f: fn(&SphereTiming) -> f64| -> Vec<(f64, f64)> {
+        report
+            .runs
+            .iter()
+            .filter(|r| r.solver == solver)
+            .map(|r| ((r.dofs as f64).log10(), f(r)))
+            .filter(|(_, y)| y.is_finite() && *y > 0.0)
+            .map(|(x, y)| (x, y.log10()))
+            .collect()
+    };
+    let curves = |f: fn(&SphereTiming) -> f64| {
+        vec![
+            Curve { label: "direct", points: series("direct", f), dashed: false },
+            Curve { label: "iterative", points: series("iterative", f), dashed: true },
+        ]
+    };
+    let path = dir.join("bench_sphere.png");
+    crate::plot::panels(
+        &path,
+        "log₁₀ unknowns",
+        &[
+            ("sphere: time per step (whole run, setup included)", "log₁₀ ms", curves(|r| r.ms_per_step_with_setup)),
+            ("sphere: median step", "log₁₀ ms", curves(|r| r.median_step_ms)),
+            ("sphere: peak memory", "log₁₀ MB", curves(|r| r.peak_memory_bytes.map_or(f64::NAN, |b| b as f64 / 1e6))),
+        ],
+    )
+    .map_err(|e| CaseError::Write { path: path.display().to_string(), source: std::io::Error::other(e) })
+}
