@@ -8,7 +8,7 @@
 //! once curved). Regions: `boundary` (all) and `contact` (outward normal with n_z < 0).
 
 use super::Mesh;
-use super::structured::orient_positively;
+use super::structured::{kuhn, orient_positively};
 use crate::element::ElementKind;
 
 /// The ball of `radius` about `center`, with about `radius/h` cells along each half axis.
@@ -31,35 +31,18 @@ pub fn ball(radius: f64, center: [f64; 3], h: f64) -> Mesh {
             }
         }
     }
-    const PATHS: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
     let mut cells = Vec::with_capacity(24 * n * n * n);
     for k in 0..n {
         for j in 0..n {
             for i in 0..n {
-                // Start at the corner nearest the centre; step away from it.
+                // From the corner nearest the centre, away from it.
                 let cell = [i, j, k];
                 let start = cell.map(|a| if a < half { a + 1 } else { a });
-                for path in PATHS {
-                    let mut p = start;
-                    let mut tet = [v(p[0], p[1], p[2]); 4];
-                    for (s, &axis) in path.iter().enumerate() {
-                        p[axis] = if cell[axis] < half { p[axis] - 1 } else { p[axis] + 1 };
-                        tet[s + 1] = v(p[0], p[1], p[2]);
-                    }
-                    cells.extend_from_slice(&tet);
-                }
+                kuhn(start, cell.map(|a| a >= half), &|p| v(p[0], p[1], p[2]), &mut cells);
             }
         }
     }
-    let mut mesh = Mesh {
-        kind: ElementKind::TetrahedronP1,
-        coords,
-        cells,
-        regions: Vec::new(),
-        cell_groups: Vec::new(),
-        cell_size: super::CellSize::Diameter,
-        sizes: Vec::new(),
-    };
+    let mut mesh = Mesh::from_cells(ElementKind::TetrahedronP1, coords, cells);
     orient_positively(&mut mesh);
     let onto_sphere = |p: &mut [f64]| {
         let r = (0..3).map(|k| (p[k] - center[k]).powi(2)).sum::<f64>().sqrt();

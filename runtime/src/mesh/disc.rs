@@ -43,15 +43,7 @@ pub fn disc(radius: f64, center: [f64; 2], h: f64) -> Mesh {
             }
         }
     }
-    let p1 = Mesh {
-        kind: ElementKind::TriangleP1,
-        coords,
-        cells,
-        regions: Vec::new(),
-        cell_groups: Vec::new(),
-        cell_size: super::CellSize::Diameter,
-        sizes: Vec::new(),
-    };
+    let p1 = Mesh::from_cells(ElementKind::TriangleP1, coords, cells);
     let onto_circle = |p: &mut [f64]| {
         let (dx, dy) = (p[0] - center[0], p[1] - center[1]);
         let r = (dx * dx + dy * dy).sqrt();

@@ -78,6 +78,19 @@ impl CellSize {
 }
 
 impl Mesh {
+    /// A mesh of `kind` cells on `coords`, without regions; h is the cell diameter.
+    pub fn from_cells(kind: ElementKind, coords: Vec<f64>, cells: Vec<u32>) -> Mesh {
+        Mesh {
+            kind,
+            coords,
+            cells,
+            regions: Vec::new(),
+            cell_groups: Vec::new(),
+            cell_size: CellSize::Diameter,
+            sizes: Vec::new(),
+        }
+    }
+
     pub fn dim(&self) -> usize {
         self.kind.dim()
     }

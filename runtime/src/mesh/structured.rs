@@ -23,15 +23,7 @@ pub fn interval(n: usize, a: f64, b: f64) -> Mesh {
         Region { name: "left".into(), facets: vec![Facet { cell: 0, local: 0 }] },
         Region { name: "right".into(), facets: vec![Facet { cell: n as u32 - 1, local: 1 }] },
     ];
-    Mesh {
-        kind: ElementKind::IntervalP1,
-        coords,
-        cells,
-        regions,
-        cell_groups: Vec::new(),
-        cell_size: super::CellSize::Diameter,
-        sizes: Vec::new(),
-    }
+    Mesh { regions, ..Mesh::from_cells(ElementKind::IntervalP1, coords, cells) }
 }
 
 /// `nx × ny` squares of [x0, x1] × [y0, y1], two triangles each, P1 or P2 (`degree`).
@@ -55,15 +47,7 @@ pub fn rectangle(nx: usize, ny: usize, x: [f64; 2], y: [f64; 2], diagonal: Diago
             }
         }
     }
-    let mesh = Mesh {
-        kind: ElementKind::TriangleP1,
-        coords,
-        cells,
-        regions: Vec::new(),
-        cell_groups: Vec::new(),
-        cell_size: super::CellSize::Diameter,
-        sizes: Vec::new(),
-    };
+    let mesh = Mesh::from_cells(ElementKind::TriangleP1, coords, cells);
     let mut mesh = if degree >= 2 { mesh.to_p2(None) } else { mesh };
     name_sides(&mut mesh, &[("left", 0, -1.0), ("right", 0, 1.0), ("bottom", 1, -1.0), ("top", 1, 1.0)]);
     mesh
@@ -83,33 +67,15 @@ pub fn cuboid(n: [usize; 3], x: [f64; 2], y: [f64; 2], z: [f64; 2], degree: u32)
         }
     }
     let v = |i: usize, j: usize, k: usize| ((k * (ny + 1) + j) * (nx + 1) + i) as u32;
-    // Kuhn subdivision: each tetrahedron follows one monotone path from corner 000 to 111.
-    const PATHS: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
     let mut cells = Vec::with_capacity(24 * nx * ny * nz);
     for k in 0..nz {
         for j in 0..ny {
             for i in 0..nx {
-                for path in PATHS {
-                    let mut p = [i, j, k];
-                    let mut tet = [v(i, j, k); 4];
-                    for (s, axis) in path.iter().enumerate() {
-                        p[*axis] += 1;
-                        tet[s + 1] = v(p[0], p[1], p[2]);
-                    }
-                    cells.extend_from_slice(&tet);
-                }
+                kuhn([i, j, k], [true; 3], &|p| v(p[0], p[1], p[2]), &mut cells);
             }
         }
     }
-    let mut mesh = Mesh {
-        kind: ElementKind::TetrahedronP1,
-        coords,
-        cells,
-        regions: Vec::new(),
-        cell_groups: Vec::new(),
-        cell_size: super::CellSize::Diameter,
-        sizes: Vec::new(),
-    };
+    let mut mesh = Mesh::from_cells(ElementKind::TetrahedronP1, coords, cells);
     orient_positively(&mut mesh);
     let mut mesh = if degree >= 2 { mesh.to_p2(None) } else { mesh };
     name_sides(
@@ -124,6 +90,23 @@ pub fn cuboid(n: [usize; 3], x: [f64; 2], y: [f64; 2], z: [f64; 2], degree: u32)
         ],
     );
     mesh
+}
+
+/// The six Kuhn tetrahedra of a grid cube: each follows one monotone path from the cube's corner
+/// `from` to the opposite one, stepping up (`true`) or down along each axis. Cubes cut from
+/// corresponding corners (here: all from their lowest, or all from the one nearest a centre)
+/// fit together conformingly.
+pub(super) fn kuhn(from: [usize; 3], up: [bool; 3], vertex: &dyn Fn([usize; 3]) -> u32, cells: &mut Vec<u32>) {
+    const PATHS: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+    for path in PATHS {
+        let mut p = from;
+        let mut tet = [vertex(p); 4];
+        for (s, &axis) in path.iter().enumerate() {
+            p[axis] = if up[axis] { p[axis] + 1 } else { p[axis] - 1 };
+            tet[s + 1] = vertex(p);
+        }
+        cells.extend_from_slice(&tet);
+    }
 }
 
 /// Swaps two vertices of every P1 cell with a negative Jacobian determinant.
