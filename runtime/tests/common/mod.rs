@@ -71,6 +71,7 @@ impl<const D: usize, const N: usize> FormKernel<D, N> for MassStiffness {
 }
 
 /// A deterministic pseudo-random vector in [−1, 1].
+#[allow(dead_code)] // each test crate compiles this module; not all of them use this
 pub fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
     let mut s = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
     (0..n)
