@@ -397,11 +397,11 @@ fn write_outputs(
     stages: &[StageRow],
 ) -> Result<(), CaseError> {
     let a = body.axis();
-    let mut csv = format!(
-        "t,energy,energy_aug,u{a}_mean,u{a}_mean_nodal,v{a}_mean,u{a}_lowest,f{a}_contact,contact_area,active_points,penetration,newton\n",
+    let header = format!(
+        "t,energy,energy_aug,u{a}_mean,u{a}_mean_nodal,v{a}_mean,u{a}_lowest,f{a}_contact,contact_area,active_points,penetration,newton"
     );
-    for r in series {
-        csv.push_str(&format!(
+    let line = |r: &Row| {
+        format!(
             "{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.t,
             r.energy,
@@ -415,28 +415,18 @@ fn write_outputs(
             r.active_points,
             r.penetration,
             r.newton
-        ));
-    }
+        )
+    };
+    let mut csv = format!("{header}\n");
+    series.iter().for_each(|r| csv.push_str(&line(r)));
     let err = |path: std::path::PathBuf| move |source| CaseError::Write { path: path.display().to_string(), source };
     crate::output::write_atomic(&dir.join("series.csv"), csv.as_bytes()).map_err(err(dir.join("series.csv")))?;
     crate::output::write_json(&dir.join("summary.json"), summary).map_err(err(dir.join("summary.json")))?;
     if !stages.is_empty() {
-        let mut csv = format!(
-            "stage,t,energy,energy_aug,u{a}_mean,u{a}_mean_nodal,v{a}_mean,f{a}_contact,active_points,penetration\n",
-        );
-        for StageRow { stage, row: r } in stages {
-            csv.push_str(&format!(
-                "{stage},{},{},{},{},{},{},{},{},{}\n",
-                r.t,
-                r.energy,
-                r.energy_aug,
-                r.uy_mean,
-                r.uy_mean_nodal,
-                r.vy_mean,
-                r.fy_contact,
-                r.active_points,
-                r.penetration
-            ));
+        // The series' columns, after the stage's name (Newton: 0, counted per step).
+        let mut csv = format!("stage,{header}\n");
+        for StageRow { stage, row } in stages {
+            csv.push_str(&format!("{stage},{}", line(row)));
         }
         crate::output::write_atomic(&dir.join("stages.csv"), csv.as_bytes()).map_err(err(dir.join("stages.csv")))?;
     }
