@@ -14,9 +14,8 @@ pub struct Krylov {
     inv_diag: Vec<f64>,
     symmetric: bool,
     last: Vec<f64>,
-    /// Iterations of the last solve, and of all solves.
+    /// Iterations of the last solve (`Factorization` counts them all).
     pub iterations: usize,
-    pub total_iterations: usize,
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -36,7 +35,7 @@ impl Krylov {
             let index = inv_diag.iter().position(|d| *d < 0.0).unwrap_or(0);
             return Err(LinalgError::NotPositiveDefinite { index });
         }
-        Ok(Krylov { matrix, inv_diag, symmetric, last: vec![0.0; n], iterations: 0, total_iterations: 0 })
+        Ok(Krylov { matrix, inv_diag, symmetric, last: vec![0.0; n], iterations: 0 })
     }
 
     /// Starts from `old`'s last solution (same size).
@@ -44,11 +43,39 @@ impl Krylov {
         if old.last.len() == self.last.len() {
             self.last.copy_from_slice(&old.last);
         }
-        self.total_iterations = old.total_iterations;
     }
 
-    fn max_iterations(&self) -> usize {
-        1000 + 20 * (self.inv_diag.len() as f64).sqrt() as usize
+    /// b − A x.
+    fn residual(&self, b: &[f64], x: &[f64]) -> Vec<f64> {
+        let mut r = vec![0.0; b.len()];
+        self.matrix.mul_vec(x, &mut r);
+        r.iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
+        r
+    }
+
+    /// Whether `method` has converged with residual `r`; an error once it never will.
+    fn converged(&self, method: &str, r: &[f64], norm_b: f64) -> Result<bool, LinalgError> {
+        let res = dot(r, r).sqrt();
+        if !res.is_finite() {
+            return Err(LinalgError::Other(format!("{method} produced non-finite values")));
+        }
+        if res <= TOLERANCE * norm_b {
+            return Ok(true);
+        }
+        let limit = 1000 + 20 * (self.inv_diag.len() as f64).sqrt() as usize;
+        if self.iterations >= limit {
+            return Err(LinalgError::Other(format!(
+                "{method} did not converge in {} iterations (relative residual {:.1e})",
+                self.iterations,
+                res / norm_b
+            )));
+        }
+        Ok(false)
+    }
+
+    /// out = D⁻¹ v.
+    fn precondition(&self, v: &[f64], out: &mut [f64]) {
+        out.iter_mut().zip(v.iter().zip(&self.inv_diag)).for_each(|(o, (a, d))| *o = a * d);
     }
 
     /// Solves A x = b in place, from the last solution.
@@ -59,9 +86,7 @@ impl Krylov {
             return Ok(());
         }
         let mut x = self.last.clone();
-        let result = if self.symmetric { self.cg(b, &mut x, norm_b) } else { self.bicgstab(b, &mut x, norm_b) };
-        self.total_iterations += self.iterations;
-        result?;
+        if self.symmetric { self.cg(b, &mut x, norm_b) } else { self.bicgstab(b, &mut x, norm_b) }?;
         self.last.copy_from_slice(&x);
         b.copy_from_slice(&x);
         Ok(())
@@ -69,29 +94,14 @@ impl Krylov {
 
     fn cg(&mut self, b: &[f64], x: &mut [f64], norm_b: f64) -> Result<(), LinalgError> {
         let n = b.len();
-        let mut r = vec![0.0; n];
-        self.matrix.mul_vec(x, &mut r);
-        r.iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
-        let mut z: Vec<f64> = r.iter().zip(&self.inv_diag).map(|(a, d)| a * d).collect();
+        let mut r = self.residual(b, x);
+        let mut z = vec![0.0; n];
+        self.precondition(&r, &mut z);
         let mut p = z.clone();
         let mut rz = dot(&r, &z);
         let mut ap = vec![0.0; n];
         self.iterations = 0;
-        loop {
-            let res = dot(&r, &r).sqrt();
-            if !res.is_finite() {
-                return Err(LinalgError::Other("conjugate gradients produced non-finite values".into()));
-            }
-            if res <= TOLERANCE * norm_b {
-                break;
-            }
-            if self.iterations >= self.max_iterations() {
-                return Err(LinalgError::Other(format!(
-                    "conjugate gradients did not converge in {} iterations (relative residual {:.1e})",
-                    self.iterations,
-                    dot(&r, &r).sqrt() / norm_b
-                )));
-            }
+        while !self.converged("conjugate gradients", &r, norm_b)? {
             self.matrix.mul_vec(&p, &mut ap);
             let pap = dot(&p, &ap);
             if pap <= 0.0 || !pap.is_finite() {
@@ -100,7 +110,7 @@ impl Krylov {
             let alpha = rz / pap;
             x.iter_mut().zip(&p).for_each(|(xi, pi)| *xi += alpha * pi);
             r.iter_mut().zip(&ap).for_each(|(ri, api)| *ri -= alpha * api);
-            z.iter_mut().zip(r.iter().zip(&self.inv_diag)).for_each(|(zi, (ri, di))| *zi = ri * di);
+            self.precondition(&r, &mut z);
             let rz_new = dot(&r, &z);
             let beta = rz_new / rz;
             rz = rz_new;
@@ -112,30 +122,12 @@ impl Krylov {
 
     fn bicgstab(&mut self, b: &[f64], x: &mut [f64], norm_b: f64) -> Result<(), LinalgError> {
         let n = b.len();
-        let precondition = |v: &[f64], d: &[f64]| -> Vec<f64> { v.iter().zip(d).map(|(a, b)| a * b).collect() };
-        let mut r = vec![0.0; n];
-        self.matrix.mul_vec(x, &mut r);
-        r.iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
+        let mut r = self.residual(b, x);
         let r0 = r.clone();
         let (mut rho, mut alpha, mut omega) = (1.0, 1.0, 1.0);
-        let (mut v, mut p) = (vec![0.0; n], vec![0.0; n]);
-        let mut t = vec![0.0; n];
+        let [mut v, mut p, mut t, mut y, mut s, mut zs] = std::array::from_fn(|_| vec![0.0; n]);
         self.iterations = 0;
-        loop {
-            let res = dot(&r, &r).sqrt();
-            if !res.is_finite() {
-                return Err(LinalgError::Other("BiCGStab produced non-finite values".into()));
-            }
-            if res <= TOLERANCE * norm_b {
-                break;
-            }
-            if self.iterations >= self.max_iterations() {
-                return Err(LinalgError::Other(format!(
-                    "BiCGStab did not converge in {} iterations (relative residual {:.1e})",
-                    self.iterations,
-                    dot(&r, &r).sqrt() / norm_b
-                )));
-            }
+        while !self.converged("BiCGStab", &r, norm_b)? {
             let rho_new = dot(&r0, &r);
             if rho_new == 0.0 || omega == 0.0 || !rho_new.is_finite() {
                 return Err(LinalgError::Other("BiCGStab broke down".into()));
@@ -143,11 +135,11 @@ impl Krylov {
             let beta = (rho_new / rho) * (alpha / omega);
             rho = rho_new;
             p.iter_mut().zip(r.iter().zip(&v)).for_each(|(pi, (ri, vi))| *pi = ri + beta * (*pi - omega * vi));
-            let y = precondition(&p, &self.inv_diag);
+            self.precondition(&p, &mut y);
             self.matrix.mul_vec(&y, &mut v);
             alpha = rho / dot(&r0, &v);
-            let s: Vec<f64> = r.iter().zip(&v).map(|(ri, vi)| ri - alpha * vi).collect();
-            let zs = precondition(&s, &self.inv_diag);
+            s.iter_mut().zip(r.iter().zip(&v)).for_each(|(si, (ri, vi))| *si = ri - alpha * vi);
+            self.precondition(&s, &mut zs);
             self.matrix.mul_vec(&zs, &mut t);
             let tt = dot(&t, &t);
             omega = if tt > 0.0 { dot(&t, &s) / tt } else { 0.0 };
