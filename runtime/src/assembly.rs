@@ -16,6 +16,7 @@ use crate::kernel::{
 use crate::linalg::Matrix;
 use crate::mesh::{Facet, Mesh, MeshError};
 pub use crate::pattern::Pattern;
+use crate::quadrature::Rule;
 
 /// A kernel usable on every element kind of the catalogue (every generated form is).
 pub trait Kernel:
@@ -188,10 +189,38 @@ impl<'m> Assembler<'m> {
         dispatch!(self.mesh.kind, facet_value::<K>(self.mesh, k, r, facets, degree, fields, t))
     }
 
+    /// The integrand of a functional's boundary region `region` at the points of `rule` (a rule
+    /// on the reference facet) on each of `facets`, with the point, the outward normal and the
+    /// weight that integrates over the physical facet: a contact pressure profile, say.
+    #[allow(clippy::too_many_arguments)]
+    pub fn facet_point_values<K: Functional>(
+        &self,
+        k: &K,
+        region: &str,
+        facets: &[Facet],
+        rule: &Rule,
+        fields: &[&[f64]],
+        t: f64,
+    ) -> Vec<PointValue> {
+        let Some(r) = region_index(k.meta(), region) else { return Vec::new() };
+        dispatch!(self.mesh.kind, facet_points::<K>(self.mesh, k, r, facets, rule, fields, t))
+    }
+
     /// Facets of a named mesh region.
     pub fn region(&self, name: &str) -> Result<&'m [Facet], MeshError> {
         Ok(&self.mesh.region(name)?.facets)
     }
+}
+
+/// A functional's integrand at one point of a boundary facet.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointValue {
+    pub x: Vec<f64>,
+    /// The outward unit normal of the (curved) facet at `x`.
+    pub normal: Vec<f64>,
+    /// The rule's weight times the facet's measure scaling at `x`.
+    pub weight: f64,
+    pub value: f64,
 }
 
 fn region_index(meta: &FormMeta, region: &str) -> Option<usize> {
@@ -392,6 +421,47 @@ fn cell_values<const D: usize, const N: usize, K: FunctionalKernel<D, N>>(
             with_refs(&local, |refs| k.cell_value(&CellCtx { tab: &tab, coords: &coords, t }, refs))
         })
         .collect()
+}
+
+#[allow(clippy::too_many_arguments)]
+fn facet_points<const D: usize, const N: usize, K: FunctionalKernel<D, N>>(
+    mesh: &Mesh,
+    k: &K,
+    region: usize,
+    facets: &[Facet],
+    rule: &Rule,
+    fields: &[&[f64]],
+    t: f64,
+) -> Vec<PointValue> {
+    let tabs = FacetTabulation::<D, N>::with_rule(mesh.kind, rule).expect("kind matches D and N");
+    // One-point tabulations of unit weight: the kernel's facet integral is then the integrand
+    // at that point times the facet's measure scaling there.
+    let single: Vec<Vec<Tabulation<D, N>>> = tabs
+        .facets
+        .iter()
+        .map(|(tab, _)| {
+            (0..tab.len())
+                .map(|q| Tabulation { weights: vec![1.0], phi: vec![tab.phi[q]], dphi: vec![tab.dphi[q]] })
+                .collect()
+        })
+        .collect();
+    let mut local = locals::<D, N>(fields.len());
+    let mut out = Vec::with_capacity(facets.len() * rule.weights.len());
+    for &f in facets {
+        let c = f.cell as usize;
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(mesh.cell(c), fields, &mut local);
+        let (tab, ref_normal) = &tabs.facets[f.local as usize];
+        for (q, one) in single[f.local as usize].iter().enumerate() {
+            let jac = crate::geometry::jacobian(&coords, &tab.dphi[q]);
+            let (normal, scale) = crate::geometry::facet_normal(&jac, ref_normal);
+            let ctx = FacetCtx { tab: one, ref_normal, coords: &coords, h: mesh.cell_size(c), t };
+            let value = with_refs(&local, |refs| k.facet_value(region, &ctx, refs)) / scale;
+            let x = crate::geometry::interpolate(&coords, &tab.phi[q]);
+            out.push(PointValue { x: x.to_vec(), normal: normal.to_vec(), weight: tab.weights[q] * scale, value });
+        }
+    }
+    out
 }
 
 #[allow(clippy::too_many_arguments)]

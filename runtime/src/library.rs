@@ -6,9 +6,10 @@
 
 use std::fmt;
 
-use crate::assembly::{Assembler, Functional, Kernel, Quadrature};
+use crate::assembly::{Assembler, Functional, Kernel, PointValue, Quadrature};
 use crate::kernel::{Coef, ParamError, ParamRange};
 use crate::mesh::Facet;
+use crate::quadrature::Rule;
 use crate::scheme::{Bound, BoundForm, TimeScheme};
 
 /// A param of a form file or a scheme.
@@ -194,6 +195,9 @@ pub trait BoundFunctional {
     fn value(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> f64;
     /// The volume integral on each cell.
     fn cell_values(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> Vec<f64>;
+    /// The integrand of its boundary regions at the points of `rule` on each facet
+    /// ([`Assembler::facet_point_values`]).
+    fn facet_point_values(&self, asm: &Assembler, rule: &Rule, fields: &[&[f64]], t: f64) -> Vec<PointValue>;
 }
 
 /// A functional kernel with its integration data.
@@ -222,5 +226,12 @@ impl<K: Functional> BoundFunctional for BoundValue<'_, K> {
     }
     fn cell_values(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> Vec<f64> {
         asm.cell_values(&self.kernel, self.quadrature, fields, t)
+    }
+    fn facet_point_values(&self, asm: &Assembler, rule: &Rule, fields: &[&[f64]], t: f64) -> Vec<PointValue> {
+        let mut out = Vec::new();
+        for (region, facets) in &self.regions {
+            out.extend(asm.facet_point_values(&self.kernel, region, facets, rule, fields, t));
+        }
+        out
     }
 }

@@ -32,6 +32,30 @@ pub fn simplex_rule(dim: usize, degree: u32) -> Rule {
     }
 }
 
+/// A rule of many evenly spread points on the reference simplex of dimension `dim` ≤ 2, for
+/// sampling (a pressure profile, the measure of a contact zone) rather than for exactness: the
+/// n-point Gauss rule on edges, the centroids of the n² congruent sub-triangles on triangles.
+pub fn sampling_rule(dim: usize, n: usize) -> Rule {
+    let n = n.max(1);
+    match dim {
+        0 | 1 => simplex_rule(dim, 2 * n as u32 - 1),
+        _ => {
+            let (mut points, h) = (Vec::with_capacity(n * n), 1.0 / n as f64);
+            for i in 0..n {
+                for j in 0..n - i {
+                    let (x, y) = (i as f64 * h, j as f64 * h);
+                    points.push(vec![x + h / 3.0, y + h / 3.0]);
+                    if i + j + 1 < n {
+                        points.push(vec![x + 2.0 * h / 3.0, y + 2.0 * h / 3.0]);
+                    }
+                }
+            }
+            let weights = vec![0.5 / (n * n) as f64; n * n];
+            Rule { points, weights, degree: 1 }
+        }
+    }
+}
+
 /// n-point Gauss–Legendre rule on [0, 1] (exact to degree 2n − 1); nodes by Newton's method on
 /// the Legendre polynomial from Chebyshev guesses.
 pub fn gauss_legendre(n: usize) -> Rule {
@@ -206,5 +230,19 @@ mod tests {
         assert_eq!(simplex_rule(2, 2).len(), 3);
         assert_eq!(simplex_rule(2, 4).len(), 6);
         assert_eq!(simplex_rule(2, 6).len(), 12);
+    }
+
+    #[test]
+    fn the_sampling_rule_covers_the_triangle_evenly_and_integrates_linear_functions() {
+        for n in [1, 2, 5, 8] {
+            let r = sampling_rule(2, n);
+            assert_eq!(r.points.len(), n * n);
+            assert!(r.points.iter().all(|p| p[0] > 0.0 && p[1] > 0.0 && p[0] + p[1] < 1.0));
+            let integral =
+                |f: &dyn Fn(&[f64]) -> f64| r.points.iter().zip(&r.weights).map(|(p, w)| w * f(p)).sum::<f64>();
+            assert!((integral(&|_| 1.0) - 0.5).abs() < 1e-15);
+            assert!((integral(&|p| 3.0 * p[0] - p[1]) - 1.0 / 3.0).abs() < 1e-14);
+        }
+        assert_eq!(sampling_rule(1, 7).points.len(), 7);
     }
 }

@@ -4,6 +4,7 @@ pub mod bar;
 pub mod disc;
 pub mod exact;
 pub mod file;
+pub mod hertz;
 pub mod static_block;
 
 /// Why a case did not run.

@@ -16,15 +16,14 @@ use serde::Serialize;
 
 use super::CaseError;
 use crate::driver::{Active, ParamValue, Setup};
-use crate::runtime::assembly::{Assembler, Quadrature};
+use crate::runtime::assembly::Assembler;
 use crate::runtime::evaluate::facet_samples;
 use crate::runtime::kernel::Coef;
-use crate::runtime::library::Binding;
-use crate::runtime::linalg::Structure;
 use crate::runtime::mesh::structured::{self, Diagonal};
 use crate::runtime::mesh::{CellSize, Mesh};
-use crate::runtime::newton::{Newton, NewtonOptions, NewtonReport};
-use crate::runtime::problem::{Constraints, StaticContact};
+use crate::runtime::newton::{NewtonOptions, NewtonReport};
+use crate::runtime::problem::Constraints;
+use crate::simulation::statics::{self, StaticProblem};
 
 /// The block's material (E = 100, ν = 0.3, ρ = 1) and γ0 (θ = 1 needs γ0 ≳ 20 E), over the
 /// files' defaults.
@@ -141,44 +140,29 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
     };
     let asm = Assembler::new(&mesh);
     let n = asm.size();
-    let facets = asm.region("bottom")?;
-    // Four Gauss points per edge in 2D, a degree-4 rule on faces in 3D: exact for the smooth
-    // parts, and resolves the edge of the contact zone.
-    let contact_quad = Quadrature { cell: None, facet: Some(if d == 2 { 7 } else { 4 }) };
-    let regions = vec![("Gamma_C".to_string(), facets)];
-    let volume = Binding { quadrature: Quadrature::default(), regions: regions.clone(), dim: d };
-    let boundary = Binding { quadrature: contact_quad, regions, dim: d };
-    let missing = |what: &str| {
-        CaseError::Option(format!("the static block needs a `{what}` form, which the files in use do not provide"))
-    };
-    let mut inst = active.instantiate(&coefs, &volume)?;
-    let stiffness = inst.take_form("stiffness").ok_or_else(|| missing("stiffness"))?;
-    let load_form = inst.take_form("load").ok_or_else(|| missing("load"))?;
-    let contact = active.instantiate(&coefs, &boundary)?.take_form("contact").ok_or_else(|| missing("contact"))?;
-    let mut l = vec![0.0; n];
-    load_form.residual(&asm, &[], 0.0, &mut l);
-    let constraints = sliding_constraints(&mesh);
-    let mut problem = StaticContact::new(&asm, stiffness.as_ref(), l, contact, constraints, Structure::Auto);
+    let gap = |x: &[f64]| x[d - 1] + opts.curvature * x[..d - 1].iter().map(|v| v * v).sum::<f64>();
     // Start with the block pushed into the obstacle below its largest gap, so that every contact
     // point is active and the first Jacobian is not singular (at u = 0 the block would float,
     // or pivot on one point of a curved obstacle: H(0) = 0). Newton then releases points.
-    let gap = |x: &[f64]| x[d - 1] + opts.curvature * x[..d - 1].iter().map(|v| v * v).sum::<f64>();
     let deepest =
         mesh.region_nodes(mesh.region("bottom")?).iter().map(|&i| gap(mesh.node(i as usize))).fold(0.0, f64::max);
     let mut u = vec![0.0; n];
     u.iter_mut().skip(d - 1).step_by(d).for_each(|x| *x = -(deepest + 1e-6 * opts.h));
-    problem.constraints.zero(&mut u);
-    let mut newton = Newton::new(opts.newton);
-    let report = newton.solve(&mut problem, &mut u)?;
-    // Vertical resultant: C(u) tested with e_d is minus the upward force on the block.
-    let cres = problem.contact_residual(&u);
-    let contact_force = -cres.iter().skip(d - 1).step_by(d).sum::<f64>();
-    let samples = facet_samples(&mesh, facets, contact_quad.facet.unwrap_or(4), &u);
+    // Four Gauss points per edge in 2D, a degree-4 rule on faces in 3D: exact for the smooth
+    // parts, and resolves the edge of the contact zone.
+    let contact_degree = if d == 2 { 7 } else { 4 };
+    let problem = StaticProblem {
+        coefs: &coefs,
+        contact: "bottom",
+        contact_degree: Some(contact_degree),
+        constraints: sliding_constraints(&mesh),
+        newton: opts.newton,
+    };
+    let solution = statics::solve(&asm, problem, &active, u)?;
+    let u = &solution.u;
+    let samples = facet_samples(&mesh, solution.contact_facets, contact_degree, u);
     let max_penetration = samples.iter().map(|s| (-s.value[d - 1] - gap(&s.x)).max(0.0)).fold(0.0, f64::max);
-    let mut set = Vec::new();
-    use crate::runtime::newton::NonlinearProblem;
-    problem.active_set(&u, &mut set);
-    let counters = newton.counters();
+    let counters = solution.counters;
     let summary = Summary {
         case: "static-block",
         contact: active.contact_name().to_string(),
@@ -190,11 +174,11 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
         cells: mesh.num_cells(),
         dofs: n,
         weight: density * opts.gravity * mesh.measure(),
-        contact_force,
+        contact_force: solution.contact_force[d - 1],
         max_penetration,
-        active_points: set.iter().filter(|b| **b).count(),
-        newton_iterations: report.iterations(),
-        newton: report,
+        active_points: solution.active_points,
+        newton_iterations: solution.newton.iterations(),
+        newton: solution.newton,
         symbolic_factorizations: counters.symbolic,
         numeric_factorizations: counters.numeric,
         wall_seconds: start.elapsed().as_secs_f64(),

@@ -1,7 +1,8 @@
 //! `signorini report`: the talk's comparisons, run and written up as DIR/report.md with tables
 //! and figures: the bar (Nitsche against penalty with Crank–Nicolson and HHT, midpoint with and
 //! without mass redistribution, TR-BDF2, hybrid, every scheme's energy), the disc (energies and
-//! Newton iterations per scheme), `signorini verify`, and the Δt sweeps of both cases.
+//! Newton iterations per scheme), `signorini verify`, the Δt sweeps of both cases, the Hertz
+//! cases, and the last `bench sphere` run.
 
 use std::fmt::Write;
 use std::path::Path;
@@ -12,6 +13,7 @@ use crate::cases::{CaseError, disc};
 use crate::driver::Setup;
 use crate::plot::Curve;
 
+mod hertz;
 pub mod sweep;
 
 fn mass_name(m: MassChoice) -> &'static str {
@@ -149,6 +151,18 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
             .map_err(|source| CaseError::Write { path: json.display().to_string(), source })?;
         md.push_str(&sweeps.markdown());
         md.push('\n');
+        md.push_str(&hertz::section(out, progress)?);
+    }
+    // `bench sphere` takes an hour at full size: the report shows its last run in this directory.
+    md.push_str("## 6. Solvers for size (`signorini bench sphere`)\n\n");
+    if out.join("bench_sphere.png").exists() {
+        md.push_str("Time per step and peak memory of the bouncing sphere against its size, direct and iterative (from `bench_sphere.json` in this directory):\n\n![bench sphere](bench_sphere.png)\n\n");
+    } else {
+        let _ = writeln!(
+            md,
+            "Not run: `signorini bench sphere --out {}` writes bench_sphere.json and the log-log plot this section shows.\n",
+            out.display()
+        );
     }
     let _ = writeln!(md, "_Run time: {:.1} s._", start.elapsed().as_secs_f64());
     crate::output::write_atomic(&out.join("report.md"), md.as_bytes())

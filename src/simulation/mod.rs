@@ -19,6 +19,8 @@ use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
 use crate::runtime::scheme::{BoundForm, MatrixForm, StageView, StepReport, Stepper};
 
+pub mod statics;
+
 /// What a case gives the driver.
 pub struct Problem<'p> {
     /// The case's coefficients by name (`f`, `g`, `nc`, ...).

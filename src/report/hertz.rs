@@ -1,0 +1,97 @@
+//! Section 5 of the report: the Hertz cases. Static contact on every level of the graded
+//! meshes (observed orders of the errors against Hertz), and the impact at several speeds.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use crate::cases::CaseError;
+use crate::cases::hertz::{impact, meshes, statics};
+use crate::driver::Setup;
+
+/// The finest 3D level the report solves (level 3 has 132k unknowns: minutes per Newton solve).
+const FINEST_3D: usize = 2;
+/// Impact speeds of the regime study (on the coarsest mesh), fastest first.
+const SPEEDS: [f64; 3] = [0.02, 0.005, impact::SPEED];
+
+/// log(e_{k−1}/e_k) / log(ratio) for successive errors.
+fn orders(errors: &[f64], ratio: f64) -> Vec<String> {
+    errors.windows(2).map(|w| format!("{:.2}", (w[0].abs() / w[1].abs()).ln() / ratio.ln())).collect()
+}
+
+pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, CaseError> {
+    let mut md = String::from("## 5. Hertz validation (`run hertz-static`, `run hertz-impact`)\n\n");
+    md.push_str("Half cylinder (2D, plane strain) and quarter ball (3D) of radius 10, E = 50, ν = 0.25, γ0 = 5000, pressed onto the plane by a body force whose resultant gives Hertz's a = R/10; graded Gmsh meshes (assets/meshes/hertz_*.geo: one cell size h_c in the contact zone, each level divides every size by 2 in 2D, √2 in 3D). a: the half-width (2D) or radius (3D) of the zone where the pressure is positive; p₀: the centre pressure; profile: ‖p_h − p‖/‖p‖ in L²(Γ_C). Errors are against Hertz; the orders are log(e_{k−1}/e_k)/log(size ratio).\n\n");
+    let contacts = &crate::settings::get().verify.contacts;
+    for dim in [2, 3] {
+        let levels = if dim == 2 { meshes::levels(2) } else { FINEST_3D + 1 };
+        let ratio = meshes::level_ratio(dim);
+        for contact in contacts {
+            let _ = writeln!(md, "### {dim}D, {contact}\n");
+            md.push_str("| level | unknowns | h_c | a (error) | p₀ (error) | profile error | Newton | s |\n|---|---|---|---|---|---|---|---|\n");
+            let mut errors: [Vec<f64>; 3] = Default::default();
+            let mut figure = String::new();
+            for level in 0..levels {
+                progress(&format!("hertz-static {dim}D {contact} level {level}"));
+                let dir = out.join("hertz").join(format!("static_{dim}d_{contact}_{level}"));
+                let setup = Setup { contact: contact.clone(), ..Setup::default() };
+                let opts = statics::Options { setup, dim, level, out: Some(dir), ..Default::default() };
+                let s = statics::run(&opts)?;
+                let (m, e) = (&s.measured, &s.relative_error);
+                let _ = writeln!(
+                    md,
+                    "| {level} | {} | {:.3} | {:.4} ({:+.2}%) | {:.4} ({:+.2}%) | {:.2}% | {} | {:.1} |",
+                    s.dofs,
+                    s.h_contact,
+                    m.figures.size(),
+                    100.0 * e.size(),
+                    m.figures.peak_pressure,
+                    100.0 * e.peak_pressure,
+                    100.0 * m.profile_l2_error,
+                    s.newton_iterations,
+                    s.wall_seconds
+                );
+                errors[0].push(e.size());
+                errors[1].push(e.peak_pressure);
+                errors[2].push(m.profile_l2_error);
+                figure = format!("![profile](hertz/static_{dim}d_{contact}_{level}/profile.png)\n");
+            }
+            let _ = writeln!(
+                md,
+                "\nObserved orders (successive levels): a {}; p₀ {}; profile {}.\n\nFinest level:\n\n{figure}",
+                orders(&errors[0], ratio).join(", "),
+                orders(&errors[1], ratio).join(", "),
+                orders(&errors[2], ratio).join(", ")
+            );
+        }
+    }
+    md.push_str("### Impact\n\nThe quarter ball hits the plane at speed v without gravity (Newmark, Nitsche θ = 1, Δt = Hertz's contact time / 200). Hertz's impact formulas are quasi-static; the regime columns say how far a run is from that limit (δ_max/R and the contact time over R/c_p), and the errors shrink with v.\n\n");
+    md.push_str("| level | v | δ_max/R | t_c c_p/R | contact time (error) | peak force (error) | contact radius (error) | restitution | s |\n|---|---|---|---|---|---|---|---|---|\n");
+    let mut runs: Vec<(usize, f64)> = SPEEDS.iter().map(|&v| (0, v)).collect();
+    runs.push((1, impact::SPEED));
+    let mut figure = String::new();
+    for (level, speed) in runs {
+        progress(&format!("hertz-impact level {level} v = {speed}"));
+        let name = format!("impact_{level}_{speed}");
+        let dir = out.join("hertz").join(&name);
+        let opts = impact::Options { level, speed, out: Some(dir), ..Default::default() };
+        let s = impact::run(&opts)?.summary;
+        let (m, e) = (&s.measured, &s.relative_error);
+        let _ = writeln!(
+            md,
+            "| {level} | {speed} | {:.4} | {:.1} | {:.3} ({:+.2}%) | {:.4} ({:+.2}%) | {:.4} ({:+.2}%) | {:.5} | {:.0} |",
+            s.regime.indentation_ratio,
+            s.regime.contact_time_over_wave_time,
+            m.contact_duration,
+            100.0 * e.contact_duration,
+            m.peak_force,
+            100.0 * e.peak_force,
+            m.contact_radius,
+            100.0 * e.contact_radius,
+            s.restitution,
+            s.wall_seconds
+        );
+        figure = format!("![force](hertz/{name}/force.png)\n");
+    }
+    let _ = writeln!(md, "\nThe last run's force history against Hertz's:\n\n{figure}");
+    Ok(md)
+}

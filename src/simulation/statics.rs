@@ -1,0 +1,89 @@
+//! The static driver every static case shares: the `stiffness`, `load` and `contact` forms of
+//! the files in use, bound by slot name on a mesh, and semi-smooth Newton on K u + C(u) = F.
+
+use crate::cases::CaseError;
+use crate::driver::ActiveForms;
+use crate::runtime::assembly::{Assembler, Quadrature};
+use crate::runtime::kernel::Coef;
+use crate::runtime::library::{Binding, BoundFunctional};
+use crate::runtime::linalg::{Counters, Structure};
+use crate::runtime::mesh::Facet;
+use crate::runtime::newton::{Newton, NewtonOptions, NewtonReport, NonlinearProblem};
+use crate::runtime::problem::{Constraints, StaticContact};
+
+/// What a static case gives the driver.
+pub struct StaticProblem<'p> {
+    /// The case's coefficients by name (`f`, `g`, `nc`, ...).
+    pub coefs: &'p dyn Fn(&str) -> Option<Coef>,
+    /// The mesh region bound to the forms' `Gamma_C`.
+    pub contact: &'p str,
+    /// Degree of the contact term's facet rule (None: the form's own choice).
+    pub contact_degree: Option<u32>,
+    pub constraints: Constraints,
+    pub newton: NewtonOptions,
+}
+
+/// The converged state and what the cases measure with.
+pub struct StaticSolution<'m> {
+    pub u: Vec<f64>,
+    pub newton: NewtonReport,
+    pub counters: Counters,
+    /// The resultant of the contact force on the body, per direction.
+    pub contact_force: Vec<f64>,
+    /// Contact quadrature points whose switch is on.
+    pub active_points: usize,
+    pub contact_facets: &'m [Facet],
+    /// `contact_pressure` and `contact_trial` of the contact law, bound on the contact region.
+    pub contact_pressure: Option<Box<dyn BoundFunctional + 'm>>,
+    pub contact_trial: Option<Box<dyn BoundFunctional + 'm>>,
+}
+
+/// Binds the files in use on `asm`'s mesh and solves from `initial` (which should put some
+/// contact point in contact: with none, K alone is singular along the free directions).
+pub fn solve<'m>(
+    asm: &'m Assembler<'m>,
+    problem: StaticProblem<'_>,
+    active: &ActiveForms,
+    initial: Vec<f64>,
+) -> Result<StaticSolution<'m>, CaseError> {
+    let d = asm.mesh.dim();
+    let n = asm.size();
+    let facets = asm.region(problem.contact)?;
+    let regions = vec![("Gamma_C".to_string(), facets)];
+    let volume = Binding { quadrature: Quadrature::default(), regions: regions.clone(), dim: d };
+    let boundary = Binding { quadrature: Quadrature { cell: None, facet: problem.contact_degree }, regions, dim: d };
+    let missing = |what: &str| {
+        CaseError::Option(format!("a static case needs a `{what}` form, which the files in use do not provide"))
+    };
+    let mut inst = active.instantiate(problem.coefs, &volume)?;
+    let stiffness = inst.take_form("stiffness").ok_or_else(|| missing("stiffness"))?;
+    let load_form = inst.take_form("load").ok_or_else(|| missing("load"))?;
+    let mut on_boundary = active.instantiate(problem.coefs, &boundary)?;
+    let contact = on_boundary.take_form("contact").ok_or_else(|| missing("contact"))?;
+    let mut load = vec![0.0; n];
+    load_form.residual(asm, &[], 0.0, &mut load);
+    let mut static_problem =
+        StaticContact::new(asm, stiffness.as_ref(), load, contact, problem.constraints, Structure::Auto);
+    let mut u = initial;
+    if u.len() != n {
+        return Err(CaseError::Option(format!("the initial state has {} values, the mesh {n} unknowns", u.len())));
+    }
+    static_problem.constraints.zero(&mut u);
+    let mut newton = Newton::new(problem.newton);
+    let report = newton.solve(&mut static_problem, &mut u)?;
+    // C(u) tested with e_k is minus the force on the body along e_k.
+    let c = static_problem.contact_residual(&u);
+    let contact_force = (0..d).map(|k| -c.iter().skip(k).step_by(d).sum::<f64>()).collect();
+    let mut set = Vec::new();
+    static_problem.active_set(&u, &mut set);
+    Ok(StaticSolution {
+        u,
+        newton: report,
+        counters: newton.counters(),
+        contact_force,
+        active_points: set.iter().filter(|b| **b).count(),
+        contact_facets: facets,
+        contact_pressure: on_boundary.take_functional("contact_pressure"),
+        contact_trial: on_boundary.take_functional("contact_trial"),
+    })
+}
