@@ -82,6 +82,49 @@ fn static_block_writes_its_summary() {
     assert!(err.contains("--h must be in (0, 1]"), "{err}");
 }
 
+/// The Hertz cases write the case parameters and the `measured` and `hertz` objects the
+/// validation compares.
+#[test]
+fn hertz_cases_write_their_summaries_and_plots() {
+    let dir = std::env::temp_dir().join(format!("signorini-cli-hertz-{}", std::process::id()));
+    let read = |path: std::path::PathBuf| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    };
+    for (dim, size) in [("2", "half_width"), ("3", "contact_radius")] {
+        let out = dir.join(format!("static{dim}"));
+        let (code, text, err) =
+            signorini(&["run", "hertz-static", "--dim", dim, "--level", "0", "--out", out.to_str().unwrap()]);
+        assert_eq!(code, 0, "{err}");
+        assert!(text.contains("hertz-static"), "{text}");
+        let s = read(out.join("summary.json"));
+        for key in ["radius", "young", "poisson", "density", "force"] {
+            assert!(s[key].is_number(), "summary.json lacks {key}");
+        }
+        for object in ["measured", "hertz"] {
+            assert!(s[object][size].is_number() && s[object]["peak_pressure"].is_number(), "{object}: {s}");
+        }
+        assert!(s["measured"]["profile_l2_error"].is_number());
+        assert!(out.join("profile.png").exists());
+    }
+    let out = dir.join("impact");
+    let (code, _, err) = signorini(&["run", "hertz-impact", "--dt", "1.4", "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let s = read(out.join("summary.json"));
+    for key in ["radius", "young", "poisson", "density", "impact_velocity"] {
+        assert!(s[key].is_number(), "summary.json lacks {key}");
+    }
+    for object in ["measured", "hertz"] {
+        for key in ["contact_duration", "peak_force", "contact_radius"] {
+            assert!(s[object][key].is_number(), "{object}.{key}: {s}");
+        }
+    }
+    assert!(out.join("force.png").exists() && out.join("series.csv").exists());
+    let (code, _, err) = signorini(&["run", "hertz-static", "--level", "9"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("--level must be below 4"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn bar_writes_series_summary_and_plots() {
     let dir = std::env::temp_dir().join(format!("signorini-bar-{}", std::process::id()));

@@ -1,0 +1,120 @@
+//! The Hertz cases against the closed forms (docs/mathematics.md §6): static contact of a
+//! cylinder (2D) and a ball (3D) under a body force, by Nitsche and by penalty, and the
+//! low-velocity impact of a ball. The tolerances are what the committed meshes reach, with a
+//! margin; the report's refinement study shows the rates.
+
+use signorini::cases::hertz::closed_form::{Impact, Material};
+use signorini::cases::hertz::{impact, meshes, profile, statics};
+use signorini::driver::Setup;
+use signorini::runtime::assembly::{Assembler, Quadrature};
+use signorini::runtime::kernel::Coef;
+use signorini::runtime::library::Binding;
+use signorini::runtime::quadrature::simplex_rule;
+
+fn pressed(dim: usize, contact: &str, level: usize) -> statics::Summary {
+    let setup = Setup { contact: contact.into(), ..Setup::default() };
+    statics::run(&statics::Options { setup, dim, level, ..Default::default() }).unwrap()
+}
+
+#[test]
+fn the_pressed_cylinder_has_hertz_half_width_peak_pressure_and_profile() {
+    for contact in ["nitsche", "penalty"] {
+        let s = pressed(2, contact, 1);
+        assert_eq!(s.case, "hertz-static");
+        let e = &s.relative_error;
+        // Equilibrium: the contact force carries the weight (the mesh's measure is exact to 1e-6).
+        assert!(
+            (s.measured.force / s.force - 1.0).abs() < 1e-5,
+            "{contact}: force {} vs {}",
+            s.measured.force,
+            s.force
+        );
+        assert!(e.half_width.unwrap().abs() < 0.02, "{contact}: half-width error {}", e.size());
+        assert!(e.peak_pressure.abs() < 0.01, "{contact}: peak pressure error {}", e.peak_pressure);
+        assert!(s.measured.profile_l2_error < 0.03, "{contact}: profile error {}", s.measured.profile_l2_error);
+        // The default force makes Hertz's half-width R/10 = 1.
+        assert!(e.contact_radius.is_none() && s.hertz.half_width.is_some_and(|a| (a - 1.0).abs() < 1e-12));
+    }
+}
+
+#[test]
+fn the_cylinder_profile_error_decreases_under_refinement() {
+    // The pointwise pressure's oscillation at the edge of the zone keeps the decrease uneven
+    // from level to level (report: 4.9 %, 1.44 %, 1.44 %, 0.92 %); over two levels it is clear.
+    let coarse = pressed(2, "nitsche", 0).measured.profile_l2_error;
+    let fine = pressed(2, "nitsche", 2).measured.profile_l2_error;
+    assert!(fine < 0.5 * coarse, "{coarse} → {fine}");
+}
+
+#[test]
+fn the_pressed_ball_has_hertz_contact_radius_and_peak_pressure() {
+    for contact in ["nitsche", "penalty"] {
+        let s = pressed(3, contact, 0);
+        let e = &s.relative_error;
+        assert!(
+            (s.measured.force / s.force - 1.0).abs() < 1e-4,
+            "{contact}: force {} vs {}",
+            s.measured.force,
+            s.force
+        );
+        // The coarsest ball has 4 cells across the contact radius: its zone is 4 % short.
+        assert!(e.contact_radius.unwrap().abs() < 0.05, "{contact}: radius error {}", e.size());
+        assert!(e.peak_pressure.abs() < 0.02, "{contact}: peak pressure error {}", e.peak_pressure);
+    }
+}
+
+#[test]
+fn the_impact_lasts_hertz_contact_time_and_reaches_hertz_peak_force() {
+    let hertz = Impact::new(meshes::RADIUS, &Material { young: 50.0, poisson: 0.25, density: 1.0 }, impact::SPEED);
+    // 50 steps per contact time (the default is 200; the figures move by < 1 %).
+    let opts = impact::Options { dt: Some(hertz.contact_duration / 50.0), ..Default::default() };
+    let run = impact::run(&opts).unwrap();
+    let s = &run.summary;
+    assert!(s.regime.indentation_ratio <= 0.02 && s.regime.contact_time_over_wave_time >= 10.0);
+    assert!(s.relative_error.contact_duration.abs() < 0.03, "contact time error {}", s.relative_error.contact_duration);
+    assert!(s.relative_error.peak_force.abs() < 0.03, "peak force error {}", s.relative_error.peak_force);
+    // Crank–Nicolson with Nitsche θ = 1: the ball leaves with its speed (the waves left in it
+    // take 10⁻⁴ of the energy), and free flight before contact is exact.
+    assert!((s.restitution - 1.0).abs() < 1e-3, "restitution {}", s.restitution);
+    for row in run.series.iter().take(2) {
+        // σ(u) of a translation is round-off: so is the −θ/γ σ_N(u) σ_N(v) term.
+        assert!(row.force.abs() < 1e-20, "force before contact {}", row.force);
+        assert!((row.velocity + impact::SPEED).abs() < 1e-12);
+    }
+}
+
+/// The pointwise integrand of a boundary functional, summed with the weights of the rule it was
+/// sampled at, is the functional integrated with that rule.
+#[test]
+fn point_values_integrate_to_the_functional() {
+    let (mesh, _) = meshes::load(2, 0, None).unwrap();
+    let asm = Assembler::new(&mesh);
+    let active = signorini::driver::Active::resolve_forms(&Setup::default(), statics::OVERRIDES).unwrap();
+    let facets = asm.region(meshes::CONTACT).unwrap();
+    let degree = 7;
+    let binding = Binding {
+        quadrature: Quadrature { cell: None, facet: Some(degree) },
+        regions: vec![("Gamma_C".to_string(), facets)],
+        dim: 2,
+    };
+    let coefs = |name: &str| match name {
+        "g" => Some(Coef::function(1, |x, _, out| out[0] = x[1])),
+        "nc" => Some(Coef::constant(vec![0.0, -1.0])),
+        "f" => Some(Coef::constant(vec![0.0, 0.0])),
+        _ => None,
+    };
+    let pressure = active.instantiate(&coefs, &binding).unwrap().take_functional("contact_pressure").unwrap();
+    // Pushed 0.05 into the plane: a zone of half-width about √(2R·0.05) = 1.
+    let u: Vec<f64> = (0..asm.size()).map(|i| if i % 2 == 1 { -0.05 } else { 0.0 }).collect();
+    let points = pressure.facet_point_values(&asm, &simplex_rule(1, degree), &[&u], 0.0);
+    let sum: f64 = points.iter().map(|p| p.weight * p.value).sum();
+    let value = pressure.value(&asm, &[&u], 0.0);
+    assert!(value < 0.0 && (sum - value).abs() < 1e-12 * value.abs(), "{sum} vs {value}");
+    // And the profile reads them as pressures on the part facing the plane.
+    let samples = profile::sample(&asm, pressure.as_ref(), &u);
+    assert!(samples.iter().all(|s| s.p >= 0.0) && samples.iter().any(|s| s.p > 0.0));
+    // Rigidly pushed, the zone is where the circle is below 0.05: |x| < √(2R·0.05 − 0.05²).
+    let zone = profile::zone(2, &samples, 1.0);
+    let exact = (2.0 * meshes::RADIUS * 0.05 - 0.05f64.powi(2)).sqrt();
+    assert!((zone.size - exact).abs() < 5e-3, "zone {} vs {exact}", zone.size);
+}
