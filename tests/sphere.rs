@@ -72,3 +72,21 @@ fn iterative_and_direct_solvers_agree() {
         }
     }
 }
+
+/// The committed graded ball (assets/meshes/sphere_graded.geo, made with Gmsh): free fall is
+/// exact on it too, from its lowest point at the pole z = 2.
+#[test]
+fn the_graded_gmsh_ball_falls_exactly() {
+    let mesh = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/sphere_graded.msh");
+    let m = signorini::runtime::mesh::gmsh::read(&mesh).unwrap();
+    let lowest = (0..m.num_nodes()).map(|i| m.node(i)[2]).fold(f64::INFINITY, f64::min);
+    assert!((lowest - 2.0).abs() < 1e-9, "the mesh's lowest point is at z = {lowest}");
+    let opts = Options { body: Body::Sphere, mesh: Some(mesh), t_end: 0.4, ..Options::default() };
+    let r = disc::run(&opts).unwrap();
+    assert!(r.summary.dofs > 20_000);
+    for row in &r.series {
+        let exact = -0.5 * GRAVITY * row.t * row.t;
+        assert!((row.uy_mean - exact).abs() < 1e-10, "t = {}: mean u_z {} vs {exact}", row.t, row.uy_mean);
+        assert!((row.uy_lowest - exact).abs() < 1e-10, "t = {}: lowest point", row.t);
+    }
+}
