@@ -39,7 +39,7 @@ pub fn sampling_rule(dim: usize, n: usize) -> Rule {
     let n = n.max(1);
     match dim {
         0 | 1 => simplex_rule(dim, 2 * n as u32 - 1),
-        _ => {
+        2 => {
             let (mut points, h) = (Vec::with_capacity(n * n), 1.0 / n as f64);
             for i in 0..n {
                 for j in 0..n - i {
@@ -53,6 +53,7 @@ pub fn sampling_rule(dim: usize, n: usize) -> Rule {
             let weights = vec![0.5 / (n * n) as f64; n * n];
             Rule { points, weights, degree: 1 }
         }
+        _ => panic!("sampling rules are for facets (dimension ≤ 2), not dimension {dim}"),
     }
 }
 

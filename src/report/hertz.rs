@@ -13,22 +13,33 @@ const FINEST_3D: usize = 2;
 /// Impact speeds of the regime study (on the coarsest mesh), fastest first.
 const SPEEDS: [f64; 3] = [0.02, 0.005, impact::SPEED];
 
-/// log(e_{k−1}/e_k) / log(ratio) for successive errors.
-fn orders(errors: &[f64], ratio: f64) -> Vec<String> {
-    errors.windows(2).map(|w| format!("{:.2}", (w[0].abs() / w[1].abs()).ln() / ratio.ln())).collect()
+/// log(e_{k−1}/e_k) / log(h_{k−1}/h_k) for successive levels.
+fn orders(errors: &[f64], sizes: &[f64]) -> Vec<String> {
+    errors
+        .windows(2)
+        .zip(sizes.windows(2))
+        .map(|(e, h)| format!("{:.2}", (e[0].abs() / e[1].abs()).ln() / (h[0] / h[1]).ln()))
+        .collect()
 }
 
 pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, CaseError> {
     let mut md = String::from("## 5. Hertz validation (`run hertz-static`, `run hertz-impact`)\n\n");
-    md.push_str("Half cylinder (2D, plane strain) and quarter ball (3D) of radius 10, E = 50, ν = 0.25, γ0 = 5000, pressed onto the plane by a body force whose resultant gives Hertz's a = R/10; graded Gmsh meshes (assets/meshes/hertz_*.geo: one cell size h_c in the contact zone, each level divides every size by 2 in 2D, √2 in 3D). a: the half-width (2D) or radius (3D) of the zone where the pressure is positive; p₀: the centre pressure; profile: ‖p_h − p‖/‖p‖ in L²(Γ_C). Errors are against Hertz; the orders are log(e_{k−1}/e_k)/log(size ratio).\n\n");
+    let params: Vec<String> = statics::OVERRIDES.iter().map(|(name, value)| format!("{name} = {value}")).collect();
+    let _ = write!(
+        md,
+        "Half cylinder (2D, plane strain) and quarter ball (3D) of radius {}, {}, pressed",
+        meshes::RADIUS,
+        params.join(", ")
+    );
+    md.push_str(" onto the plane by a body force whose resultant gives Hertz's a = R/10; graded Gmsh meshes (assets/meshes/hertz_*.geo: one cell size h_c in the contact zone, each level divides every size by 2 in 2D, √2 in 3D). a: the half-width (2D) or radius (3D) of the zone where the pressure is positive; p₀: the centre pressure; profile: ‖p_h − p‖/‖p‖ in L² on Γ_C's projection onto the plane. h: the smallest cell diameter on Γ_C. Errors are against Hertz, whose own error, O((a/R)²), does not shrink with h: the orders log(e_{k−1}/e_k)/log(h_{k−1}/h_k) fall once the discretisation error reaches it (the 2D peak pressure already has).\n\n");
     let contacts = &crate::settings::get().verify.contacts;
     for dim in [2, 3] {
         let levels = if dim == 2 { meshes::levels(2) } else { FINEST_3D + 1 };
-        let ratio = meshes::level_ratio(dim);
         for contact in contacts {
             let _ = writeln!(md, "### {dim}D, {contact}\n");
-            md.push_str("| level | unknowns | h_c | a (error) | p₀ (error) | profile error | Newton | s |\n|---|---|---|---|---|---|---|---|\n");
+            md.push_str("| level | unknowns | h | a (error) | p₀ (error) | profile error | Newton | s |\n|---|---|---|---|---|---|---|---|\n");
             let mut errors: [Vec<f64>; 3] = Default::default();
+            let mut sizes = Vec::new();
             let mut figure = String::new();
             for level in 0..levels {
                 progress(&format!("hertz-static {dim}D {contact} level {level}"));
@@ -50,6 +61,7 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
                     s.newton_iterations,
                     s.wall_seconds
                 );
+                sizes.push(s.h_contact);
                 errors[0].push(e.size());
                 errors[1].push(e.peak_pressure);
                 errors[2].push(m.profile_l2_error);
@@ -58,13 +70,18 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
             let _ = writeln!(
                 md,
                 "\nObserved orders (successive levels): a {}; p₀ {}; profile {}.\n\nFinest level:\n\n{figure}",
-                orders(&errors[0], ratio).join(", "),
-                orders(&errors[1], ratio).join(", "),
-                orders(&errors[2], ratio).join(", ")
+                orders(&errors[0], &sizes).join(", "),
+                orders(&errors[1], &sizes).join(", "),
+                orders(&errors[2], &sizes).join(", ")
             );
         }
     }
-    md.push_str("### Impact\n\nThe quarter ball hits the plane at speed v without gravity (Newmark, Nitsche θ = 1, Δt = Hertz's contact time / 200). Hertz's impact formulas are quasi-static; the regime columns say how far a run is from that limit (δ_max/R and the contact time over R/c_p), and the errors shrink with v.\n\n");
+    let _ = write!(
+        md,
+        "### Impact\n\nThe quarter ball hits the plane at speed v without gravity (the library's default scheme and contact law, Δt = Hertz's contact time / {}). Hertz's",
+        impact::STEPS_PER_CONTACT
+    );
+    md.push_str(" impact formulas are quasi-static; the regime columns say how far a run is from that limit (δ_max/R and the contact time over R/c_p), and the errors shrink with v.\n\n");
     md.push_str("| level | v | δ_max/R | t_c c_p/R | contact time (error) | peak force (error) | contact radius (error) | restitution | s |\n|---|---|---|---|---|---|---|---|---|\n");
     let mut runs: Vec<(usize, f64)> = SPEEDS.iter().map(|&v| (0, v)).collect();
     runs.push((1, impact::SPEED));

@@ -9,12 +9,13 @@ use crate::cases::CaseError;
 use crate::runtime::mesh::{Mesh, gmsh};
 use crate::runtime::problem::Constraints;
 
-/// The radius of the bodies of the .geo files.
+/// The radius of the bodies of the .geo files (checked on every mesh through its measure).
 pub const RADIUS: f64 = 10.0;
 /// The region bound to `Gamma_C`, and the symmetry planes x = 0 and y = 0.
 pub const CONTACT: &str = "contact";
 const SYMMETRY: [&str; 2] = ["symmetry_x", "symmetry_y"];
 
+/// Level k of each set was made with `gmsh -d -setnumber level k` from the .geo file.
 const CYLINDER: [&[u8]; 4] = [
     include_bytes!("../../../assets/meshes/hertz_cylinder_0.msh"),
     include_bytes!("../../../assets/meshes/hertz_cylinder_1.msh"),
@@ -27,11 +28,6 @@ const BALL: [&[u8]; 4] = [
     include_bytes!("../../../assets/meshes/hertz_ball_2.msh"),
     include_bytes!("../../../assets/meshes/hertz_ball_3.msh"),
 ];
-
-/// The ratio of the cell sizes of two successive levels.
-pub fn level_ratio(dim: usize) -> f64 {
-    if dim == 2 { 2.0 } else { std::f64::consts::SQRT_2 }
-}
 
 /// The number of built-in levels in `dim` dimensions.
 pub fn levels(dim: usize) -> usize {
@@ -55,15 +51,40 @@ pub fn load(dim: usize, level: usize, path: Option<&Path>) -> Result<(Mesh, Stri
             (gmsh::parse(bytes, &name)?, name)
         }
     };
+    let mut mesh = mesh;
     if mesh.dim() != dim {
         return Err(CaseError::Option(format!("{name} is a {}D mesh, the case is {dim}D", mesh.dim())));
     }
-    mesh.region(CONTACT)?;
-    for plane in &SYMMETRY[..dim - 1] {
-        mesh.region(plane)?;
+    let missing = |e| CaseError::Option(format!("{name}: {e}"));
+    for region in std::iter::once(&CONTACT).chain(&SYMMETRY[..dim - 1]) {
+        mesh.region(region).map_err(missing)?;
     }
     mesh.validate()?;
+    // The half (quarter) of a body of radius R: the closed forms and the load assume it.
+    let exact = if dim == 2 {
+        std::f64::consts::PI * RADIUS * RADIUS / 2.0
+    } else {
+        std::f64::consts::PI * RADIUS.powi(3) / 3.0
+    };
+    if (mesh.measure() / exact - 1.0).abs() > 0.01 {
+        return Err(CaseError::Option(format!(
+            "{name} measures {:.6}, not the {} of a body of radius {RADIUS} ({exact:.6})",
+            mesh.measure(),
+            if dim == 2 { "half" } else { "quarter" }
+        )));
+    }
+    lower_half(&mut mesh, dim);
     Ok((mesh, name))
+}
+
+/// Keeps in the contact region only the facets facing the plane (outward normal pointing
+/// down): Nitsche's −θ/γ σ_N(u) σ_N(v) term has no switch, and on the upper half, where the
+/// cells are coarsest, it would only cost time and stability.
+fn lower_half(mesh: &mut Mesh, dim: usize) {
+    let Some(i) = mesh.regions.iter().position(|r| r.name == CONTACT) else { return };
+    let facets = std::mem::take(&mut mesh.regions[i].facets);
+    let kept = facets.into_iter().filter(|&f| mesh.facet_normal_and_centroid(f).0[dim - 1] < 0.0).collect();
+    mesh.regions[i].facets = kept;
 }
 
 /// The normal displacement held at zero on the symmetry planes.

@@ -51,7 +51,7 @@ pub struct Zone {
 /// within a/4 of the first contact point, Σ w p_h / Σ w s(r) with Hertz's shape s(r) =
 /// √(1 − r²/a²) ≥ 0.968 there: a single sample carries the discrete pressure's oscillation
 /// between quadrature points (a penalty's especially), this mean does not.
-pub fn zone(dim: usize, samples: &[Sample], hertz_size: f64) -> Zone {
+pub fn zone(dim: usize, samples: &[Sample], hertz_size: f64) -> Result<Zone, String> {
     let measure: f64 = samples.iter().filter(|s| s.p > 0.0).map(|s| s.weight).sum();
     // The reduced model holds half the strip [−a, a] in 2D, a quarter of the disc r < a in 3D.
     let size = if dim == 2 { measure } else { (4.0 * measure / std::f64::consts::PI).sqrt() };
@@ -60,10 +60,19 @@ pub fn zone(dim: usize, samples: &[Sample], hertz_size: f64) -> Zone {
         pw += s.weight * s.p;
         sw += s.weight * (1.0 - (s.r / hertz_size).powi(2)).sqrt();
     }
-    Zone { size, peak_pressure: if sw > 0.0 { pw / sw } else { f64::NAN } }
+    if size == 0.0 || sw == 0.0 {
+        return Err(format!(
+            "no contact pressure to measure: of {} samples facing the plane, {} press on it and {} lie within a/4 = {:.4} of the first contact point",
+            samples.len(),
+            samples.iter().filter(|s| s.p > 0.0).count(),
+            samples.iter().filter(|s| s.r < hertz_size / 4.0).count(),
+            hertz_size / 4.0
+        ));
+    }
+    Ok(Zone { size, peak_pressure: pw / sw })
 }
 
-/// ‖p_h − p‖ / ‖p‖ in L²(Γ_C) against a profile p(r).
+/// ‖p_h − p‖ / ‖p‖ in L² on Γ_C's projection onto the plane, against a profile p(r).
 pub fn l2_error(samples: &[Sample], exact: impl Fn(f64) -> f64) -> f64 {
     let (mut err, mut norm) = (0.0, 0.0);
     for s in samples {

@@ -87,7 +87,7 @@ impl Figures {
 pub struct Measured {
     #[serde(flatten)]
     pub figures: Figures,
-    /// ‖p_h − p_Hertz‖ / ‖p_Hertz‖ in L²(Γ_C).
+    /// ‖p_h − p_Hertz‖ / ‖p_Hertz‖ in L² on Γ_C's projection onto the plane.
     pub profile_l2_error: f64,
     /// The vertical resultant of the contact force on the whole body.
     pub force: f64,
@@ -170,7 +170,7 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
         CaseError::Option("the contact law provides no `contact_pressure` functional to measure".into())
     })?;
     let samples = profile::sample(&asm, pressure.as_ref(), &solution.u);
-    let zone = profile::zone(d, &samples, a);
+    let zone = profile::zone(d, &samples, a).map_err(CaseError::Option)?;
     let copies = if d == 2 { 2.0 } else { 4.0 };
     let measured = Measured {
         figures: Figures::new(d, zone.size, zone.peak_pressure),
