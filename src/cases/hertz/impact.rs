@@ -112,6 +112,9 @@ pub struct Row {
     pub t: f64,
     /// The vertical contact force on the whole ball.
     pub force: f64,
+    /// Contact quadrature points whose switch is on (the ball touches when there are any:
+    /// the force's sign alone is round-off before contact, from Nitsche's unswitched term).
+    pub active_points: usize,
     /// The centre of mass's vertical velocity.
     pub velocity: f64,
     pub energy_aug: f64,
@@ -179,9 +182,15 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         -4.0 * c.iter().skip(2).step_by(3).sum::<f64>()
     };
     let mean_velocity = |v: &[f64]| mass_ez.iter().zip(v).map(|(m, v)| m * v).sum::<f64>() / total_mass;
+    let active_points = |tools: &Tools, u: &[f64], t: f64| {
+        let mut switches = Vec::new();
+        tools.probe.as_ref().expect("checked above").switches(&asm, &[u], 0, t, &mut switches);
+        switches.iter().filter(|b| **b).count()
+    };
     let row = |tools: &Tools, u: &[f64], v: Option<&[f64]>, t: f64| Row {
         t,
         force: force(tools, u, t),
+        active_points: active_points(tools, u, t),
         velocity: v.map_or(f64::NAN, mean_velocity),
         energy_aug: tools.energy(u, v) + tools.value(&tools.contact_energy, u),
     };
@@ -264,11 +273,11 @@ enum Contact {
     Lasted(f64),
 }
 
-/// From the step before the force first turns positive to the first step after it where it is
-/// zero again, each end taken half a step before the first step past it.
+/// From the step before the first with an active contact point to the first step after it with
+/// none, each end taken half a step before the first step past it.
 fn contact_duration(series: &[Row], dt: f64) -> Contact {
-    let Some(first) = series.iter().position(|r| r.force > 0.0) else { return Contact::Never };
-    let Some(length) = series[first..].iter().position(|r| r.force <= 0.0) else { return Contact::Unfinished };
+    let Some(first) = series.iter().position(|r| r.active_points > 0) else { return Contact::Never };
+    let Some(length) = series[first..].iter().position(|r| r.active_points == 0) else { return Contact::Unfinished };
     Contact::Lasted((series[first + length].t - 0.5 * dt) - (series[first].t - 0.5 * dt))
 }
 
@@ -282,9 +291,9 @@ fn write(
     let err =
         |path: &std::path::Path, source: std::io::Error| CaseError::Write { path: path.display().to_string(), source };
     let path = dir.join("series.csv");
-    let mut csv = String::from("t,fz_contact,vz_mean,energy_aug\n");
+    let mut csv = String::from("t,fz_contact,active_points,vz_mean,energy_aug\n");
     for r in series {
-        csv.push_str(&format!("{:e},{:e},{:e},{:e}\n", r.t, r.force, r.velocity, r.energy_aug));
+        csv.push_str(&format!("{:e},{:e},{},{:e},{:e}\n", r.t, r.force, r.active_points, r.velocity, r.energy_aug));
     }
     crate::output::write_atomic(&path, csv.as_bytes()).map_err(|e| err(&path, e))?;
     let path = dir.join("summary.json");
