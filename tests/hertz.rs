@@ -3,7 +3,7 @@
 //! low-velocity impact of a ball. The tolerances are what the committed meshes reach, with a
 //! margin; the report's refinement study shows the rates.
 
-use signorini::cases::hertz::closed_form::{Impact, Material};
+use signorini::cases::hertz::closed_form::Impact;
 use signorini::cases::hertz::{impact, meshes, profile, statics};
 use signorini::driver::Setup;
 use signorini::runtime::assembly::{Assembler, Quadrature};
@@ -65,7 +65,8 @@ fn the_pressed_ball_has_hertz_contact_radius_and_peak_pressure() {
 
 #[test]
 fn the_impact_lasts_hertz_contact_time_and_reaches_hertz_peak_force() {
-    let hertz = Impact::new(meshes::RADIUS, &Material { young: 50.0, poisson: 0.25, density: 1.0 }, impact::SPEED);
+    let forms = signorini::driver::Active::resolve_forms(&Setup::default(), statics::OVERRIDES).unwrap();
+    let hertz = Impact::new(meshes::RADIUS, &statics::material(&forms).unwrap(), impact::SPEED);
     // 50 steps per contact time (the default is 200; the figures move by < 1 %).
     let opts = impact::Options { dt: Some(hertz.contact_duration / 50.0), ..Default::default() };
     let run = impact::run(&opts).unwrap();
