@@ -4,7 +4,7 @@
 //! margin; the report's refinement study shows the rates.
 
 use signorini::cases::hertz::closed_form::Impact;
-use signorini::cases::hertz::{impact, meshes, profile, statics};
+use signorini::cases::hertz::{self, impact, meshes, profile, statics};
 use signorini::driver::Setup;
 use signorini::runtime::assembly::{Assembler, Quadrature};
 use signorini::runtime::kernel::Coef;
@@ -65,8 +65,8 @@ fn the_pressed_ball_has_hertz_contact_radius_and_peak_pressure() {
 
 #[test]
 fn the_impact_lasts_hertz_contact_time_and_reaches_hertz_peak_force() {
-    let forms = signorini::driver::Active::resolve_forms(&Setup::default(), statics::OVERRIDES).unwrap();
-    let hertz = Impact::new(meshes::RADIUS, &statics::material(&forms).unwrap(), impact::SPEED);
+    let forms = signorini::driver::Active::resolve_forms(&Setup::default(), hertz::OVERRIDES).unwrap();
+    let hertz = Impact::new(meshes::RADIUS, &hertz::material(&forms).unwrap(), impact::SPEED);
     // 50 steps per contact time (the default is 200; the figures move by < 1 %).
     let opts = impact::Options { dt: Some(hertz.contact_duration / 50.0), ..Default::default() };
     let run = impact::run(&opts).unwrap();
@@ -90,7 +90,7 @@ fn the_impact_lasts_hertz_contact_time_and_reaches_hertz_peak_force() {
 fn point_values_integrate_to_the_functional() {
     let (mesh, _) = meshes::load(2, 0, None).unwrap();
     let asm = Assembler::new(&mesh);
-    let active = signorini::driver::Active::resolve_forms(&Setup::default(), statics::OVERRIDES).unwrap();
+    let active = signorini::driver::Active::resolve_forms(&Setup::default(), hertz::OVERRIDES).unwrap();
     let facets = asm.region(meshes::CONTACT).unwrap();
     let degree = 7;
     let binding = Binding {

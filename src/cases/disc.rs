@@ -17,7 +17,6 @@ use super::bar::MassChoice;
 use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::evaluate::facet_samples;
-use crate::runtime::kernel::Coef;
 use crate::runtime::mesh::{CellSize, Mesh, ball::ball, disc::disc, gmsh};
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
@@ -242,18 +241,6 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     simulate(opts, &active)
 }
 
-/// Case data in dimension d: gravity, the gap to the plane {x_d = 0} and the obstacle normal
-/// −e_d.
-fn coefs(d: usize, name: &str) -> Option<Coef> {
-    let down = |size: f64| (0..d).map(|k| if k == d - 1 { -size } else { 0.0 }).collect::<Vec<f64>>();
-    match name {
-        "f" => Some(Coef::constant(down(GRAVITY))),
-        "g" => Some(Coef::function(1, move |x, _, out| out[0] = x[d - 1])),
-        "nc" => Some(Coef::constant(down(1.0))),
-        _ => None,
-    }
-}
-
 fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let start = Instant::now();
     let mesh = mesh(opts)?;
@@ -261,7 +248,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let n = asm.size();
     let (d, vert) = (opts.body.dim(), opts.body.dim() - 1);
     let quadrature = opts.body.quadrature();
-    let coefs = |name: &str| coefs(d, name);
+    let coefs = super::above_plane(d, 0.0, GRAVITY);
     let problem = Problem {
         coefs: &coefs,
         quadrature,
@@ -280,20 +267,13 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let t0 = opts.t_start;
     let fall = |size: f64| (0..n).map(|i| if i % d == d - 1 && size != 0.0 { size } else { 0.0 }).collect::<Vec<f64>>();
     sim.initialize_at(t0, fall(-0.5 * GRAVITY * t0 * t0), fall(-GRAVITY * t0))?;
-    let ey: Vec<f64> = (0..n).map(|i| if i % d == vert { 1.0 } else { 0.0 }).collect();
-    let mut mass_ey = vec![0.0; n];
-    sim.tools.mass.mul_vec(&ey, &mut mass_ey);
-    let total_mass: f64 = mass_ey.iter().zip(&ey).map(|(a, b)| a * b).sum();
+    let vertical_mean = sim.tools.axis_mean(vert);
     let lowest =
         (0..mesh.num_nodes()).min_by(|&a, &b| mesh.node(a)[vert].total_cmp(&mesh.node(b)[vert])).expect("nodes");
     let measure = |tools: &Tools, u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
         let kinetic = tools.kinetic(v);
         let energy = tools.energy(u, v);
-        let probe = tools.probe.as_ref().expect("checked above");
-        let mut c = vec![0.0; n];
-        probe.residual(&asm, &[u], t, &mut c);
-        let mut switches = Vec::new();
-        probe.switches(&asm, &[u], 0, t, &mut switches);
+        let switches = tools.contact_switches(u, t);
         let samples = facet_samples(&mesh, tools.contact_facets, quadrature.facet.unwrap_or(7), u);
         // The gap u_N − g at each point: −u_d − x_d.
         let gaps: Vec<f64> = samples.iter().map(|s| -s.value[vert] - s.x[vert]).collect();
@@ -304,14 +284,13 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
             kinetic,
             energy_aug: energy + tools.value(&tools.contact_energy, u),
             // Area-weighted mean of u_y: e_yᵀ M u / e_yᵀ M e_y.
-            uy_mean: mass_ey.iter().zip(u).map(|(a, b)| a * b).sum::<f64>() / total_mass,
+            uy_mean: vertical_mean.of(u),
             uy_mean_nodal: u.iter().skip(vert).step_by(d).sum::<f64>() / (n / d) as f64,
-            vy_mean: v.map_or(f64::NAN, |v| mass_ey.iter().zip(v).map(|(a, b)| a * b).sum::<f64>() / total_mass),
+            vy_mean: v.map_or(f64::NAN, |v| vertical_mean.of(v)),
             uy_lowest: u[d * lowest + vert],
             // Where the body touches or penetrates the plane: the gap closed.
             contact_area: samples.iter().zip(&gaps).filter(|(_, g)| **g >= 0.0).map(|(s, _)| s.weight).sum(),
-            // C(u) tested with e_y is minus the upward force on the disc.
-            fy_contact: -c.iter().skip(vert).step_by(d).sum::<f64>(),
+            fy_contact: tools.contact_force(u, t)[vert],
             active_points: switches.iter().filter(|b| **b).count(),
             switches,
             penetration,

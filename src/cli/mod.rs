@@ -6,15 +6,17 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 mod compare;
+mod hertz;
 mod list;
 
 use crate::cases::bar::{self, MassChoice};
 use crate::cases::disc::Body;
-use crate::cases::{hertz, static_block};
+use crate::cases::static_block;
 use crate::compiler;
 use crate::driver::{Setting, Setup};
 use crate::runtime::linalg::Solver;
 use crate::runtime::mesh::CellSize;
+use hertz::{HertzImpactArgs, HertzStaticArgs};
 
 #[derive(Parser)]
 #[command(
@@ -293,58 +295,6 @@ pub struct StaticBlockArgs {
     out: Option<PathBuf>,
 }
 
-#[derive(clap::Args)]
-pub struct HertzStaticArgs {
-    /// The contact law and params (E = 50, ν = 0.25, γ0 = 5000 here); the scheme is not used.
-    #[command(flatten)]
-    methods: MethodArgs,
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
-    dim: u8,
-    /// Level of the built-in graded mesh (0: coarsest; 2D 0–3, 3D 0–3).
-    #[arg(long, default_value_t = 2)]
-    level: usize,
-    /// A Gmsh mesh of the half cylinder (quarter ball) with regions contact, symmetry_x
-    /// (and symmetry_y), like assets/meshes/hertz_*.geo; default: the built-in level.
-    #[arg(long)]
-    mesh: Option<PathBuf>,
-    /// The force on the whole body (per unit length in 2D); default: Hertz's a = R/10.
-    #[arg(long, allow_hyphen_values = true)]
-    force: Option<f64>,
-    /// Directory for summary.json and profile.png.
-    #[arg(long)]
-    out: Option<PathBuf>,
-    /// Linear solver of each Newton iteration: direct, iterative or auto (as for `run sphere`).
-    /// Direct by default: without a mass term, Jacobi-CG on the stiffness converges slowly.
-    #[arg(long, value_parser = Solver::parse, default_value = "direct")]
-    solver: Solver,
-}
-
-#[derive(clap::Args)]
-pub struct HertzImpactArgs {
-    /// Scheme, contact law and params (E = 50, ν = 0.25, γ0 = 5000 here).
-    #[command(flatten)]
-    methods: MethodArgs,
-    #[arg(long, value_enum, default_value_t = MassChoice::Consistent)]
-    mass: MassChoice,
-    /// Level of the built-in graded quarter ball (0–3).
-    #[arg(long, default_value_t = 0)]
-    level: usize,
-    /// A Gmsh mesh of the quarter ball with regions contact, symmetry_x and symmetry_y.
-    #[arg(long)]
-    mesh: Option<PathBuf>,
-    /// Impact speed.
-    #[arg(long, default_value_t = hertz::impact::SPEED, allow_hyphen_values = true)]
-    speed: f64,
-    /// Time step (default: Hertz's contact time / 200).
-    #[arg(long, allow_hyphen_values = true)]
-    dt: Option<f64>,
-    /// Directory for series.csv, summary.json and force.png.
-    #[arg(long)]
-    out: Option<PathBuf>,
-    #[arg(long, value_parser = Solver::parse, default_value = "auto")]
-    solver: Solver,
-}
-
 #[derive(Clone, Copy, ValueEnum)]
 pub enum Stage {
     Ast,
@@ -400,8 +350,8 @@ pub fn run(cli: Cli) -> ExitCode {
             Case::Bar(a) => run_bar(a),
             Case::Disc(a) => run_disc(a, Body::Disc),
             Case::Sphere(a) => run_disc(a, Body::Sphere),
-            Case::HertzStatic(a) => hertz_static(a),
-            Case::HertzImpact(a) => hertz_impact(a),
+            Case::HertzStatic(a) => hertz::run_static(a),
+            Case::HertzImpact(a) => hertz::run_impact(a),
         },
         Command::Run { case: None, file: Some(file) } => run_file(&file),
         Command::Run { case: None, file: None } => {
@@ -506,92 +456,6 @@ fn static_block(a: StaticBlockArgs) -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
-    }
-}
-
-fn hertz_static(a: HertzStaticArgs) -> ExitCode {
-    let setup = match a.methods.setup() {
-        Ok(s) => s,
-        Err(e) => return fail(e),
-    };
-    let opts = hertz::statics::Options {
-        setup,
-        cell_size: a.methods.cell_size,
-        dim: a.dim as usize,
-        level: a.level,
-        mesh: a.mesh,
-        force: a.force,
-        out: a.out,
-        newton: crate::runtime::newton::NewtonOptions { solver: a.solver, ..Default::default() },
-    };
-    match hertz::statics::run(&opts) {
-        Ok(s) => {
-            let what = if s.dim == 2 { "half-width" } else { "contact radius" };
-            println!(
-                "hertz-static {}D ({}, {}, {} dofs): {what} {:.5} (Hertz {:.5}, {:+.2}%), peak pressure {:.5} (Hertz {:.5}, {:+.2}%), profile L2 error {:.2}%, {} Newton iterations, {:.2} s",
-                s.dim,
-                s.contact,
-                s.mesh,
-                s.dofs,
-                s.measured.figures.size(),
-                s.hertz.size(),
-                100.0 * s.relative_error.size(),
-                s.measured.figures.peak_pressure,
-                s.hertz.peak_pressure,
-                100.0 * s.relative_error.peak_pressure,
-                100.0 * s.measured.profile_l2_error,
-                s.newton_iterations,
-                s.wall_seconds
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => fail(e),
-    }
-}
-
-fn hertz_impact(a: HertzImpactArgs) -> ExitCode {
-    let setup = match a.methods.setup() {
-        Ok(s) => s,
-        Err(e) => return fail(e),
-    };
-    let opts = hertz::impact::Options {
-        setup,
-        cell_size: a.methods.cell_size,
-        level: a.level,
-        mesh: a.mesh,
-        speed: a.speed,
-        dt: a.dt,
-        mass: a.mass,
-        newton: crate::runtime::newton::NewtonOptions { solver: a.solver, ..Default::default() },
-        out: a.out,
-        progress: std::io::IsTerminal::is_terminal(&std::io::stdout()),
-    };
-    match hertz::impact::run(&opts) {
-        Ok(run) => {
-            let s = &run.summary;
-            let (m, h, e) = (&s.measured, &s.hertz, &s.relative_error);
-            println!(
-                "hertz-impact ({}, {}, {}, {} dofs, Δt {:.4}): contact duration {:.4} (Hertz {:.4}, {:+.2}%), peak force {:.4} (Hertz {:.4}, {:+.2}%), contact radius {:.4} (Hertz {:.4}, {:+.2}%), restitution {:.4}, {:.1} s",
-                s.scheme,
-                s.contact,
-                s.mesh,
-                s.dofs,
-                s.dt,
-                m.contact_duration,
-                h.contact_duration,
-                100.0 * e.contact_duration,
-                m.peak_force,
-                h.peak_force,
-                100.0 * e.peak_force,
-                m.contact_radius,
-                h.contact_radius,
-                100.0 * e.contact_radius,
-                s.restitution,
-                s.wall_seconds
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => fail(e),
     }
 }
 

@@ -24,7 +24,8 @@ fn orders(errors: &[f64], sizes: &[f64]) -> Vec<String> {
 
 pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, CaseError> {
     let mut md = String::from("## 5. Hertz validation (`run hertz-static`, `run hertz-impact`)\n\n");
-    let params: Vec<String> = statics::OVERRIDES.iter().map(|(name, value)| format!("{name} = {value}")).collect();
+    let params: Vec<String> =
+        crate::cases::hertz::OVERRIDES.iter().map(|(name, value)| format!("{name} = {value}")).collect();
     let _ = write!(
         md,
         "Half cylinder (2D, plane strain) and quarter ball (3D) of radius {}, {}, pressed",

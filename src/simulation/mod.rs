@@ -75,10 +75,57 @@ impl Tools<'_> {
             - self.load.iter().zip(u).map(|(l, x)| l * x).sum::<f64>()
     }
 
+    /// The resultant of the contact term on the body along each axis (zeros without a
+    /// `contact` slot).
+    pub fn contact_force(&self, u: &[f64], t: f64) -> Vec<f64> {
+        let mut c = vec![0.0; u.len()];
+        if let Some(probe) = &self.probe {
+            probe.residual(self.asm, &[u], t, &mut c);
+        }
+        resultant(&c, self.asm.mesh.dim())
+    }
+
+    /// The contact slot's switch at each of its quadrature points (none without the slot).
+    pub fn contact_switches(&self, u: &[f64], t: f64) -> Vec<bool> {
+        let mut switches = Vec::new();
+        if let Some(probe) = &self.probe {
+            probe.switches(self.asm, &[u], 0, t, &mut switches);
+        }
+        switches
+    }
+
+    /// The mass-weighted mean along `axis` (of the displacement: the centre of mass's).
+    pub fn axis_mean(&self, axis: usize) -> AxisMean {
+        let d = self.asm.mesh.dim();
+        let e: Vec<f64> = (0..self.mass.size()).map(|i| if i % d == axis { 1.0 } else { 0.0 }).collect();
+        let mut weights = vec![0.0; e.len()];
+        self.mass.mul_vec(&e, &mut weights);
+        let total = weights.iter().zip(&e).map(|(a, b)| a * b).sum();
+        AxisMean { weights, total }
+    }
+
     /// The value of a functional at u (NaN when the files in use do not provide it).
     pub fn value(&self, f: &Option<Box<dyn BoundFunctional + '_>>, u: &[f64]) -> f64 {
         f.as_ref().map_or(f64::NAN, |f| f.value(self.asm, &[u], 0.0))
     }
+}
+
+/// eᵀ M x / eᵀ M e for the unit field e along one axis.
+pub struct AxisMean {
+    weights: Vec<f64>,
+    total: f64,
+}
+
+impl AxisMean {
+    pub fn of(&self, x: &[f64]) -> f64 {
+        self.weights.iter().zip(x).map(|(a, b)| a * b).sum::<f64>() / self.total
+    }
+}
+
+/// The force on the body along each axis from a contact residual C(u): C(u) tested with e_k
+/// is minus the force along e_k.
+pub fn resultant(c: &[f64], d: usize) -> Vec<f64> {
+    (0..d).map(|k| -c.iter().skip(k).step_by(d).sum::<f64>()).collect()
 }
 
 /// The stepper, its states and the tools, ready to run.

@@ -71,9 +71,7 @@ pub fn solve<'m>(
     static_problem.constraints.zero(&mut u);
     let mut newton = Newton::new(problem.newton);
     let report = newton.solve(&mut static_problem, &mut u)?;
-    // C(u) tested with e_k is minus the force on the body along e_k.
-    let c = static_problem.contact_residual(&u);
-    let contact_force = (0..d).map(|k| -c.iter().skip(k).step_by(d).sum::<f64>()).collect();
+    let contact_force = super::resultant(&static_problem.contact_residual(&u), d);
     let mut set = Vec::new();
     static_problem.active_set(&u, &mut set);
     Ok(StaticSolution {

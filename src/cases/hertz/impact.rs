@@ -9,12 +9,11 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::closed_form::{Impact, Material};
-use super::{meshes, profile, statics};
+use super::{meshes, profile};
 use crate::cases::CaseError;
 use crate::cases::bar::MassChoice;
 use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
-use crate::runtime::kernel::Coef;
 use crate::runtime::mesh::CellSize;
 use crate::runtime::newton::NewtonOptions;
 use crate::simulation::{Problem, Simulation, Tools};
@@ -133,8 +132,8 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     }
     let (mut mesh, mesh_name) = meshes::load(3, opts.level, opts.mesh.as_deref())?;
     mesh.set_cell_size(opts.cell_size);
-    let active = Active::resolve(&opts.setup, statics::OVERRIDES)?;
-    let material: Material = statics::material(&active.forms)?;
+    let active = Active::resolve(&opts.setup, super::OVERRIDES)?;
+    let material: Material = super::material(&active.forms)?;
     let radius = meshes::RADIUS;
     let hertz = Impact::new(radius, &material, opts.speed);
     let dt = opts.dt.unwrap_or(hertz.contact_duration / STEPS_PER_CONTACT);
@@ -147,12 +146,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     // The first contact 2.5 steps after the start: free flight is exact, so it begins at a
     // known time, between two steps.
     let gap0 = 2.5 * dt * opts.speed;
-    let coefs = move |name: &str| match name {
-        "f" => Some(Coef::constant(vec![0.0; 3])),
-        "g" => Some(Coef::function(1, move |x, _, out| out[0] = x[2] + gap0)),
-        "nc" => Some(Coef::constant(vec![0.0, 0.0, -1.0])),
-        _ => None,
-    };
+    let coefs = crate::cases::above_plane(3, gap0, 0.0);
     let asm = Assembler::new(&mesh);
     let n = asm.size();
     let problem = Problem {
@@ -171,27 +165,12 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     };
     let v0: Vec<f64> = (0..n).map(|i| if i % 3 == 2 { -opts.speed } else { 0.0 }).collect();
     sim.initialize_at(0.0, vec![0.0; n], v0)?;
-    let ez: Vec<f64> = (0..n).map(|i| if i % 3 == 2 { 1.0 } else { 0.0 }).collect();
-    let mut mass_ez = vec![0.0; n];
-    sim.tools.mass.mul_vec(&ez, &mut mass_ez);
-    let total_mass: f64 = mass_ez.iter().sum();
-    let force = |tools: &Tools, u: &[f64], t: f64| {
-        let mut c = vec![0.0; n];
-        tools.probe.as_ref().expect("checked above").residual(&asm, &[u], t, &mut c);
-        // C(u) tested with e_z is minus the upward force; four quarters.
-        -4.0 * c.iter().skip(2).step_by(3).sum::<f64>()
-    };
-    let mean_velocity = |v: &[f64]| mass_ez.iter().zip(v).map(|(m, v)| m * v).sum::<f64>() / total_mass;
-    let active_points = |tools: &Tools, u: &[f64], t: f64| {
-        let mut switches = Vec::new();
-        tools.probe.as_ref().expect("checked above").switches(&asm, &[u], 0, t, &mut switches);
-        switches.iter().filter(|b| **b).count()
-    };
+    let vertical_mean = sim.tools.axis_mean(2);
     let row = |tools: &Tools, u: &[f64], v: Option<&[f64]>, t: f64| Row {
         t,
-        force: force(tools, u, t),
-        active_points: active_points(tools, u, t),
-        velocity: v.map_or(f64::NAN, mean_velocity),
+        force: meshes::copies(3) * tools.contact_force(u, t)[2],
+        active_points: tools.contact_switches(u, t).iter().filter(|b| **b).count(),
+        velocity: v.map_or(f64::NAN, |v| vertical_mean.of(v)),
         energy_aug: tools.energy(u, v) + tools.value(&tools.contact_energy, u),
     };
     let mut series = vec![row(&sim.tools, &sim.states[0], sim.velocity(), 0.0)];
@@ -210,7 +189,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         Ok(())
     })?;
     let end = series.last().map_or(0.0, |r| r.t);
-    let duration = match contact_duration(&series, dt) {
+    let duration = match contact_duration(&series) {
         Contact::Never => {
             return Err(CaseError::Option(format!("the ball never touched the plane by t = {end:.4}")));
         }
@@ -273,12 +252,12 @@ enum Contact {
     Lasted(f64),
 }
 
-/// From the step before the first with an active contact point to the first step after it with
-/// none, each end taken half a step before the first step past it.
-fn contact_duration(series: &[Row], dt: f64) -> Contact {
+/// From the first step with an active contact point to the first after it with none: each end
+/// is taken half a step before that step, and the two halves cancel.
+fn contact_duration(series: &[Row]) -> Contact {
     let Some(first) = series.iter().position(|r| r.active_points > 0) else { return Contact::Never };
     let Some(length) = series[first..].iter().position(|r| r.active_points == 0) else { return Contact::Unfinished };
-    Contact::Lasted((series[first + length].t - 0.5 * dt) - (series[first].t - 0.5 * dt))
+    Contact::Lasted(series[first + length].t - series[first].t)
 }
 
 fn write(

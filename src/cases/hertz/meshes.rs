@@ -29,6 +29,17 @@ const BALL: [&[u8]; 4] = [
     include_bytes!("../../../assets/meshes/hertz_ball_3.msh"),
 ];
 
+/// How many copies of the model make the whole body: the half cylinder in 2D, the quarter
+/// ball in 3D.
+pub fn copies(dim: usize) -> f64 {
+    if dim == 2 { 2.0 } else { 4.0 }
+}
+
+/// The measure of the whole body (its area in 2D).
+pub fn body_measure(dim: usize) -> f64 {
+    if dim == 2 { std::f64::consts::PI * RADIUS * RADIUS } else { 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3) }
+}
+
 /// The number of built-in levels in `dim` dimensions.
 pub fn levels(dim: usize) -> usize {
     if dim == 2 { CYLINDER.len() } else { BALL.len() }

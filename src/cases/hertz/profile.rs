@@ -53,8 +53,9 @@ pub struct Zone {
 /// between quadrature points (a penalty's especially), this mean does not.
 pub fn zone(dim: usize, samples: &[Sample], hertz_size: f64) -> Result<Zone, String> {
     let measure: f64 = samples.iter().filter(|s| s.p > 0.0).map(|s| s.weight).sum();
-    // The reduced model holds half the strip [−a, a] in 2D, a quarter of the disc r < a in 3D.
-    let size = if dim == 2 { measure } else { (4.0 * measure / std::f64::consts::PI).sqrt() };
+    // The whole body's zone is the strip [−a, a] in 2D, the disc r < a in 3D.
+    let whole = super::meshes::copies(dim) * measure;
+    let size = if dim == 2 { whole / 2.0 } else { (whole / std::f64::consts::PI).sqrt() };
     let (mut pw, mut sw) = (0.0, 0.0);
     for s in samples.iter().filter(|s| s.r < hertz_size / 4.0) {
         pw += s.weight * s.p;

@@ -10,20 +10,15 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::closed_form::{self, Material};
-use super::{meshes, profile};
+use super::closed_form;
+use super::{OVERRIDES, material, meshes, profile};
 use crate::cases::CaseError;
 use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::Assembler;
-use crate::runtime::kernel::Coef;
 use crate::runtime::linalg::Solver;
 use crate::runtime::mesh::CellSize;
 use crate::runtime::newton::NewtonOptions;
 use crate::simulation::statics::{self, StaticProblem};
-
-/// The material (λ = μ = 20, the sphere's) and γ0 = 100 E (Nitsche with θ = 1 is unstable at
-/// 10 E on the 3D meshes), over the files' defaults.
-pub const OVERRIDES: &[(&str, f64)] = &[("E", 50.0), ("nu", 0.25), ("rho", 1.0), ("gamma0", 5000.0)];
 
 /// The default force makes Hertz's contact zone a tenth of the radius: small enough for the
 /// half-space theory (its neglected terms are O((a/R)²)), large enough to resolve.
@@ -118,16 +113,6 @@ pub struct Summary {
     pub wall_seconds: f64,
 }
 
-/// The closed forms' material: the files' E, ν and ρ.
-pub fn material(active: &crate::driver::ActiveForms) -> Result<Material, CaseError> {
-    let get = |name: &str| {
-        active.params.get(name).ok_or_else(|| {
-            CaseError::Option(format!("Hertz's formulas need the material's `{name}`, which the files in use lack"))
-        })
-    };
-    Ok(Material { young: get("E")?, poisson: get("nu")?, density: get("rho")? })
-}
-
 /// Solves the case; writes summary.json and profile.png into `opts.out` if set.
 pub fn run(opts: &Options) -> Result<Summary, CaseError> {
     let start = Instant::now();
@@ -144,15 +129,7 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
     }
     let (a, p0) = closed_form::static_contact(d, radius, e_star, force);
     // The body force whose resultant on the whole body (of exact measure) is F.
-    let volume =
-        if d == 2 { std::f64::consts::PI * radius * radius } else { 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3) };
-    let body = force / volume;
-    let coefs = move |name: &str| match name {
-        "g" => Some(Coef::function(1, move |x, _, out| out[0] = x[d - 1])),
-        "nc" => Some(Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>())),
-        "f" => Some(Coef::constant((0..d).map(|k| if k == d - 1 { -body } else { 0.0 }).collect::<Vec<_>>())),
-        _ => None,
-    };
+    let coefs = crate::cases::above_plane(d, 0.0, force / meshes::body_measure(d));
     let asm = Assembler::new(&mesh);
     // Start pushed down by Hertz's approach scale a²/R: the points within about √2 a are in
     // contact, so the first Jacobian is regular along x_d.
@@ -171,11 +148,10 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
     })?;
     let samples = profile::sample(&asm, pressure.as_ref(), &solution.u);
     let zone = profile::zone(d, &samples, a).map_err(CaseError::Option)?;
-    let copies = if d == 2 { 2.0 } else { 4.0 };
     let measured = Measured {
         figures: Figures::new(d, zone.size, zone.peak_pressure),
         profile_l2_error: profile::l2_error(&samples, |r| closed_form::pressure(a, p0, r)),
-        force: copies * solution.contact_force[d - 1],
+        force: meshes::copies(d) * solution.contact_force[d - 1],
     };
     let hertz = Figures::new(d, a, p0);
     let summary = Summary {
