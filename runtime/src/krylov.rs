@@ -1,17 +1,30 @@
-//! Jacobi-preconditioned Krylov solvers for the step matrices of large problems: conjugate
-//! gradients for symmetric positive definite matrices, BiCGStab otherwise. A time step's
-//! matrix is c·M + K + J_C with c = O(1/Δt²), mass-dominated on fine meshes, so the diagonal
-//! preconditioner keeps the iteration count small and the memory is that of the matrix.
+//! Block-Jacobi-preconditioned Krylov solvers for the step matrices of large problems:
+//! conjugate gradients for symmetric positive definite matrices, BiCGStab otherwise. A time
+//! step's matrix is c·M + K + J_C with c = O(1/Δt²), mass-dominated on fine meshes, so the
+//! inverse of each node's d×d diagonal block keeps the iteration count small and the memory
+//! is that of the matrix.
+//!
+//! The work is memory-bound: the matrix–vector product reads the values once and one index
+//! per d×d node block, and it, the vector updates and the dot products are split over
+//! rayon's threads in fixed chunks whose partial sums are added in order, so the iterates
+//! have the same bits for any number of threads.
+
+use rayon::prelude::*;
 
 use crate::linalg::{LinalgError, Matrix};
 
 /// Relative residual ‖b − A x‖₂ ≤ TOLERANCE ‖b‖₂ at which a solve stops.
 pub const TOLERANCE: f64 = 1e-12;
 
-/// The matrix, its inverted diagonal, and the last solution (the next solve's first guess).
+/// Entries per task of the vector operations (a fixed size: the reductions' bits depend on it).
+const CHUNK: usize = 1 << 13;
+
+/// The matrix, its inverted diagonal blocks, and the last solution (the next solve's first
+/// guess).
 pub struct Krylov {
     pub matrix: Matrix,
-    inv_diag: Vec<f64>,
+    /// Per node, the inverse of its d×d diagonal block, row-major.
+    inv_blocks: Vec<f64>,
     symmetric: bool,
     last: Vec<f64>,
     /// Iterations of the last solve (`Factorization` counts them all).
@@ -19,23 +32,77 @@ pub struct Krylov {
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+    let partial: Vec<f64> =
+        a.par_chunks(CHUNK).zip(b.par_chunks(CHUNK)).map(|(x, y)| x.iter().zip(y).map(|(p, q)| p * q).sum()).collect();
+    partial.iter().sum()
+}
+
+/// `y[i] = f(y[i], x[i])` over chunks in parallel.
+fn update(y: &mut [f64], x: &[f64], f: impl Fn(f64, f64) -> f64 + Sync) {
+    y.par_chunks_mut(CHUNK)
+        .zip(x.par_chunks(CHUNK))
+        .for_each(|(ys, xs)| ys.iter_mut().zip(xs).for_each(|(a, b)| *a = f(*a, *b)));
+}
+
+/// Inverts the d×d row-major block `a` in place (Gauss–Jordan with partial pivoting); false if
+/// it is singular.
+fn invert_block(a: &mut [f64], d: usize) -> bool {
+    let mut inv = vec![0.0; d * d];
+    (0..d).for_each(|i| inv[i * d + i] = 1.0);
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for c in 0..d {
+        let p = (c..d).max_by(|&i, &j| a[i * d + c].abs().total_cmp(&a[j * d + c].abs())).unwrap_or(c);
+        let pivot = a[p * d + c].abs();
+        if pivot.is_nan() || pivot <= 1e-300 + 1e-15 * scale {
+            return false;
+        }
+        for k in 0..d {
+            a.swap(c * d + k, p * d + k);
+            inv.swap(c * d + k, p * d + k);
+        }
+        let piv = a[c * d + c];
+        for k in 0..d {
+            a[c * d + k] /= piv;
+            inv[c * d + k] /= piv;
+        }
+        for r in (0..d).filter(|&r| r != c) {
+            let f = a[r * d + c];
+            for k in 0..d {
+                a[r * d + k] -= f * a[c * d + k];
+                inv[r * d + k] -= f * inv[c * d + k];
+            }
+        }
+    }
+    a.copy_from_slice(&inv);
+    true
 }
 
 impl Krylov {
     pub fn new(matrix: Matrix, symmetric: bool) -> Result<Krylov, LinalgError> {
         let n = matrix.size();
-        let inv_diag = (0..n)
-            .map(|i| {
-                let d = matrix.get(i, i);
-                if d == 0.0 || !d.is_finite() { Err(LinalgError::Singular { index: Some(i) }) } else { Ok(1.0 / d) }
-            })
-            .collect::<Result<Vec<f64>, _>>()?;
-        if symmetric && inv_diag.iter().any(|d| *d < 0.0) {
-            let index = inv_diag.iter().position(|d| *d < 0.0).unwrap_or(0);
-            return Err(LinalgError::NotPositiveDefinite { index });
+        let p = matrix.pattern.clone();
+        let d = p.dim();
+        for i in 0..n {
+            let a = matrix.get(i, i);
+            if !a.is_finite() || a == 0.0 {
+                return Err(LinalgError::Singular { index: Some(i) });
+            }
+            if symmetric && a < 0.0 {
+                return Err(LinalgError::NotPositiveDefinite { index: i });
+            }
         }
-        Ok(Krylov { matrix, inv_diag, symmetric, last: vec![0.0; n], iterations: 0 })
+        let mut inv_blocks = vec![0.0; n * d];
+        for (j, block) in inv_blocks.chunks_exact_mut(d * d).enumerate() {
+            let pos = p.neighbours(j).binary_search(&(j as u32)).expect("a node is its own neighbour");
+            for m in 0..d {
+                let column = &matrix.values[p.col_ptr[j * d + m] + pos * d..][..d];
+                column.iter().enumerate().for_each(|(k, v)| block[k * d + m] = *v);
+            }
+            if !invert_block(block, d) {
+                return Err(LinalgError::Singular { index: Some(j * d) });
+            }
+        }
+        Ok(Krylov { matrix, inv_blocks, symmetric, last: vec![0.0; n], iterations: 0 })
     }
 
     /// Starts from `old`'s last solution (same size).
@@ -45,11 +112,47 @@ impl Krylov {
         }
     }
 
+    /// `y = A x`: for a symmetric matrix as `Aᵀ x`, one gather per column in parallel;
+    /// otherwise the sequential column scatter.
+    fn mul(&self, x: &[f64], y: &mut [f64]) {
+        if !self.symmetric {
+            return self.matrix.mul_vec(x, y);
+        }
+        match self.matrix.pattern.dim() {
+            1 => self.gather::<1>(x, y),
+            2 => self.gather::<2>(x, y),
+            _ => self.gather::<3>(x, y),
+        }
+    }
+
+    fn gather<const D: usize>(&self, x: &[f64], y: &mut [f64]) {
+        let p = &self.matrix.pattern;
+        let values = &self.matrix.values;
+        let nodes_per_task = CHUNK / (8 * D);
+        y.par_chunks_mut(nodes_per_task * D).enumerate().for_each(|(t, ys)| {
+            for (jj, yj) in ys.chunks_exact_mut(D).enumerate() {
+                let j = t * nodes_per_task + jj;
+                let neighbours = p.neighbours(j);
+                for (m, ym) in yj.iter_mut().enumerate() {
+                    let column = &values[p.col_ptr[j * D + m]..p.col_ptr[j * D + m + 1]];
+                    let mut s = 0.0;
+                    for (&i, a) in neighbours.iter().zip(column.chunks_exact(D)) {
+                        let xi = &x[i as usize * D..][..D];
+                        for k in 0..D {
+                            s += a[k] * xi[k];
+                        }
+                    }
+                    *ym = s;
+                }
+            }
+        });
+    }
+
     /// b − A x.
     fn residual(&self, b: &[f64], x: &[f64]) -> Vec<f64> {
         let mut r = vec![0.0; b.len()];
-        self.matrix.mul_vec(x, &mut r);
-        r.iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
+        self.mul(x, &mut r);
+        update(&mut r, b, |ax, bi| bi - ax);
         r
     }
 
@@ -62,7 +165,7 @@ impl Krylov {
         if res <= TOLERANCE * norm_b {
             return Ok(true);
         }
-        let limit = 1000 + 20 * (self.inv_diag.len() as f64).sqrt() as usize;
+        let limit = 1000 + 20 * (self.last.len() as f64).sqrt() as usize;
         if self.iterations >= limit {
             return Err(LinalgError::Other(format!(
                 "{method} did not converge in {} iterations (relative residual {:.1e})",
@@ -73,9 +176,20 @@ impl Krylov {
         Ok(false)
     }
 
-    /// out = D⁻¹ v.
+    /// out = D⁻¹ v, D the block diagonal.
     fn precondition(&self, v: &[f64], out: &mut [f64]) {
-        out.iter_mut().zip(v.iter().zip(&self.inv_diag)).for_each(|(o, (a, d))| *o = a * d);
+        let d = self.matrix.pattern.dim();
+        let per_task = CHUNK / d * d;
+        out.par_chunks_mut(per_task)
+            .zip(v.par_chunks(per_task))
+            .zip(self.inv_blocks.par_chunks(per_task * d))
+            .for_each(|((os, vs), bs)| {
+                for ((o, a), b) in os.chunks_exact_mut(d).zip(vs.chunks_exact(d)).zip(bs.chunks_exact(d * d)) {
+                    for (k, ok) in o.iter_mut().enumerate() {
+                        *ok = (0..d).map(|m| b[k * d + m] * a[m]).sum();
+                    }
+                }
+            });
     }
 
     /// Solves A x = b in place, from the last solution.
@@ -102,19 +216,19 @@ impl Krylov {
         let mut ap = vec![0.0; n];
         self.iterations = 0;
         while !self.converged("conjugate gradients", &r, norm_b)? {
-            self.matrix.mul_vec(&p, &mut ap);
+            self.mul(&p, &mut ap);
             let pap = dot(&p, &ap);
             if pap <= 0.0 || !pap.is_finite() {
                 return Err(LinalgError::NotPositiveDefinite { index: 0 });
             }
             let alpha = rz / pap;
-            x.iter_mut().zip(&p).for_each(|(xi, pi)| *xi += alpha * pi);
-            r.iter_mut().zip(&ap).for_each(|(ri, api)| *ri -= alpha * api);
+            update(x, &p, |xi, pi| xi + alpha * pi);
+            update(&mut r, &ap, |ri, api| ri - alpha * api);
             self.precondition(&r, &mut z);
             let rz_new = dot(&r, &z);
             let beta = rz_new / rz;
             rz = rz_new;
-            p.iter_mut().zip(&z).for_each(|(pi, zi)| *pi = zi + beta * *pi);
+            update(&mut p, &z, |pi, zi| zi + beta * pi);
             self.iterations += 1;
         }
         Ok(())
@@ -136,11 +250,11 @@ impl Krylov {
             rho = rho_new;
             p.iter_mut().zip(r.iter().zip(&v)).for_each(|(pi, (ri, vi))| *pi = ri + beta * (*pi - omega * vi));
             self.precondition(&p, &mut y);
-            self.matrix.mul_vec(&y, &mut v);
+            self.mul(&y, &mut v);
             alpha = rho / dot(&r0, &v);
             s.iter_mut().zip(r.iter().zip(&v)).for_each(|(si, (ri, vi))| *si = ri - alpha * vi);
             self.precondition(&s, &mut zs);
-            self.matrix.mul_vec(&zs, &mut t);
+            self.mul(&zs, &mut t);
             let tt = dot(&t, &t);
             omega = if tt > 0.0 { dot(&t, &s) / tt } else { 0.0 };
             x.iter_mut().zip(y.iter().zip(&zs)).for_each(|(xi, (yi, zi))| *xi += alpha * yi + omega * zi);

@@ -25,6 +25,7 @@ pub mod kernel;
 pub mod krylov;
 pub mod library;
 pub mod linalg;
+pub mod lowrank;
 pub mod mesh;
 pub mod newton;
 pub mod pattern;

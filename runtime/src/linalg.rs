@@ -123,6 +123,8 @@ pub struct Counters {
     pub solves: usize,
     /// Krylov iterations over all solves (iterative solver).
     pub iterations: usize,
+    /// Low-rank corrections of a factorization in place of a refactorization (Newton).
+    pub updates: usize,
 }
 
 impl std::ops::Add for Counters {
@@ -133,6 +135,7 @@ impl std::ops::Add for Counters {
             numeric: self.numeric + o.numeric,
             solves: self.solves + o.solves,
             iterations: self.iterations + o.iterations,
+            updates: self.updates + o.updates,
         }
     }
 }
@@ -303,6 +306,45 @@ impl Factorization {
             Factors::None | Factors::Krylov(_) => unreachable!("symbolic analysis done above"),
         }
         Ok(())
+    }
+
+    /// Stored values of the Cholesky factor L, if that is what was computed.
+    pub fn factor_nnz(&self) -> Option<usize> {
+        match &self.factors {
+            Factors::Llt { symbolic, factored: true, .. } => Some(symbolic.len_val()),
+            _ => None,
+        }
+    }
+
+    /// Whether the last `factor` computed sparse factors (not a Krylov solver).
+    pub fn is_direct(&self) -> bool {
+        matches!(self.factors, Factors::Llt { factored: true, .. } | Factors::Lu { factored: true, .. })
+    }
+
+    /// Solves `A X = B` in place for the `ncols` columns of `b` (column-major) with the last
+    /// direct factorization.
+    pub fn solve_many_in_place(&mut self, b: &mut [f64], ncols: usize) -> Result<(), LinalgError> {
+        let n = b.len() / ncols.max(1);
+        let par = self.par;
+        let rhs = MatMut::from_column_major_slice_mut(b, n, ncols);
+        match &self.factors {
+            Factors::Llt { symbolic, values, factored: true } => {
+                let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(ncols, par));
+                LltRef::new(symbolic, values).solve_in_place_with_conj(Conj::No, rhs, par, MemStack::new(&mut mem));
+            }
+            Factors::Lu { symbolic, numeric, factored: true } => {
+                let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(ncols, par));
+                LuRef::new_unchecked(symbolic, numeric).solve_in_place_with_conj(
+                    Conj::No,
+                    rhs,
+                    par,
+                    MemStack::new(&mut mem),
+                );
+            }
+            _ => return Err(LinalgError::NotFactored),
+        }
+        self.counters.solves += ncols;
+        if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(LinalgError::Singular { index: None }) }
     }
 
     /// Solves `A x = b` in place with the last factorization; a non-finite result (a

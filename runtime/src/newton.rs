@@ -2,13 +2,16 @@
 //!
 //! Stops when ‖R(w)‖∞ ≤ tol · max(‖R(w⁰)‖∞, ‖b‖∞), b the loads. The contact tangent depends
 //! on the state only through the active set, so the problem reports its active set at each
-//! iterate; while it is the one the current factorization was computed for, the Jacobian is
-//! neither reassembled nor refactored. The factorization survives between solves (time steps)
+//! iterate; while it is the one the current operator was built for, the Jacobian is neither
+//! reassembled nor refactored. When it changes, the new Jacobian is assembled and, if it
+//! differs from the factored one on at most `max_rank` dofs, the factorization is corrected
+//! (`lowrank`) instead of recomputed. The factorization survives between solves (time steps)
 //! until `invalidate` is called.
 
 use tracing::debug;
 
 use crate::linalg::{Factorization, LinalgError, Matrix, Solver, Structure};
+use crate::lowrank::LowRank;
 
 /// Largest accepted ‖J δ + R‖∞ / ‖R‖∞ of a Newton step; above it the Jacobian is treated as
 /// singular (round-off in a sound solve stays orders of magnitude below).
@@ -39,11 +42,17 @@ pub struct NewtonOptions {
     pub line_search: bool,
     /// How the Jacobian systems are solved.
     pub solver: Solver,
+    /// Largest number of dofs on which a new Jacobian may differ from the factored one and be
+    /// solved by a low-rank correction instead of a refactorization (0: always refactor).
+    pub max_rank: usize,
 }
+
+/// Default `max_rank`: measured with `bench disc` (see docs/mathematics.md).
+pub const MAX_RANK: usize = 256;
 
 impl Default for NewtonOptions {
     fn default() -> Self {
-        NewtonOptions { tol: 1e-10, max_iterations: 25, line_search: false, solver: Solver::Auto }
+        NewtonOptions { tol: 1e-10, max_iterations: 25, line_search: false, solver: Solver::Auto, max_rank: MAX_RANK }
     }
 }
 
@@ -54,8 +63,11 @@ pub struct Iteration {
     pub residual: f64,
     /// Active contact points at the iterate the step was computed from.
     pub active: usize,
-    /// The Jacobian was refactored for this step (the active set changed).
+    /// The Jacobian was refactored for this step (the active set changed and the change was
+    /// too large for a low-rank correction).
     pub refactored: bool,
+    /// The factorization was corrected for a changed active set instead.
+    pub updated: bool,
     /// Step length (1 without line search).
     pub step: f64,
 }
@@ -91,24 +103,45 @@ pub struct Newton {
     spare: Option<Factorization>,
     spd_failed: bool,
     jacobian: Option<Matrix>,
-    /// The active set the current factorization was computed for.
+    /// The active set the current operator (factorization and correction) was built for.
     factored_for: Option<Vec<bool>>,
+    /// The correction of the factorization towards the current Jacobian (direct solver,
+    /// piecewise problems), and how many corrections were made.
+    low_rank: Option<LowRank>,
+    updates: usize,
 }
 
 impl Newton {
     pub fn new(options: NewtonOptions) -> Self {
-        Newton { options, factorization: None, spare: None, spd_failed: false, jacobian: None, factored_for: None }
+        Newton {
+            options,
+            factorization: None,
+            spare: None,
+            spd_failed: false,
+            jacobian: None,
+            factored_for: None,
+            low_rank: None,
+            updates: 0,
+        }
     }
 
     /// Forgets the factorization's validity (the linear part of the problem changed).
     pub fn invalidate(&mut self) {
         self.factored_for = None;
+        self.low_rank = None;
     }
 
-    /// Symbolic and numeric factorizations and solves so far.
+    /// Stored values of the current Cholesky factor, if there is one.
+    pub fn factor_nnz(&self) -> Option<usize> {
+        self.factorization.as_ref().and_then(Factorization::factor_nnz)
+    }
+
+    /// Symbolic and numeric factorizations, low-rank corrections and solves so far.
     pub fn counters(&self) -> crate::linalg::Counters {
         let c = |f: &Option<Factorization>| f.as_ref().map(|f| f.counters).unwrap_or_default();
-        c(&self.factorization) + c(&self.spare)
+        let mut all = c(&self.factorization) + c(&self.spare);
+        all.updates = self.updates;
+        all
     }
 
     /// Solves R(w) = 0 starting from `w`, which holds the solution on success.
@@ -128,17 +161,26 @@ impl Newton {
         // for long) makes tol·r0 underflow to 0, which no subnormal residual could reach.
         let threshold = (self.options.tol * r0.max(p.load_scale())).max(f64::MIN_POSITIVE);
         let mut res = r0;
+        let mut piecewise = false;
+        let mut next: Option<Vec<bool>> = None;
         while res > threshold {
             if report.history.len() >= self.options.max_iterations {
                 return Err(NewtonError::IterationLimit { report, threshold });
             }
-            set.clear();
-            let piecewise = p.active_set(w, &mut set);
+            match next.take() {
+                Some(known) => set = known,
+                None => {
+                    set.clear();
+                    piecewise = p.active_set(w, &mut set);
+                }
+            }
             let active = set.iter().filter(|b| **b).count();
-            let refactor = !piecewise || self.factored_for.as_deref() != Some(&set);
-            if refactor {
-                if let Err(source) = self.refactor(p, w) {
-                    return Err(NewtonError::Linear { source, report });
+            let changed = !piecewise || self.factored_for.as_deref() != Some(&set);
+            let (mut refactor, mut updated) = (false, false);
+            if changed {
+                match self.new_operator(p, w, piecewise) {
+                    Ok(full) => (refactor, updated) = (full, !full),
+                    Err(source) => return Err(NewtonError::Linear { source, report }),
                 }
                 self.factored_for = piecewise.then(|| set.clone());
             }
@@ -146,6 +188,9 @@ impl Newton {
             let f = self.factorization.as_mut().expect("factored above");
             if let Err(source) = f.solve_in_place(&mut delta) {
                 return Err(NewtonError::Linear { source, report });
+            }
+            if let Some(lr) = &self.low_rank {
+                lr.correct(&mut delta);
             }
             // A (numerically) singular Jacobian still yields numbers: check that the step
             // solves the linear system. J δ + R is small for any usable factorization.
@@ -157,15 +202,53 @@ impl Newton {
                 debug!(linear_residual = linear, "the Jacobian is singular to working precision");
                 return Err(NewtonError::Linear { source, report });
             }
-            let step = self.step(p, w, &delta, &mut r);
+            let step = if piecewise && !self.options.line_search {
+                // R is affine wherever the active set is the one J was built for: if it still
+                // is at the new iterate, R there is R + J δ, and no assembly is needed.
+                w.iter_mut().zip(&delta).for_each(|(x, d)| *x += d);
+                let mut after = Vec::with_capacity(set.len());
+                p.active_set(w, &mut after);
+                if after == set {
+                    r.iter_mut().zip(&jd).for_each(|(ri, x)| *ri += x);
+                } else {
+                    p.residual(w, &mut r);
+                }
+                next = Some(after);
+                1.0
+            } else {
+                self.step(p, w, &delta, &mut r)
+            };
             res = norm_inf(&r);
-            debug!(iteration = report.history.len() + 1, residual = res, active, refactored = refactor, step, "newton");
-            report.history.push(Iteration { residual: res, active, refactored: refactor, step });
+            debug!(iteration = report.history.len() + 1, residual = res, active, refactor, updated, step, "newton");
+            report.history.push(Iteration { residual: res, active, refactored: refactor, updated, step });
             if !res.is_finite() || w.iter().any(|x| !x.is_finite()) {
                 return Err(NewtonError::NonFinite { report });
             }
         }
         Ok(report)
+    }
+
+    /// Makes the operator the Jacobian at w: a low-rank correction of the factored reference
+    /// when the problem is piecewise, the factorization direct and the change small enough,
+    /// else a refactorization (which becomes the new reference). Returns whether it refactored.
+    fn new_operator(&mut self, p: &mut impl NonlinearProblem, w: &[f64], piecewise: bool) -> Result<bool, LinalgError> {
+        if let (true, Some(lr), Some(f)) = (piecewise, self.low_rank.as_mut(), self.factorization.as_mut()) {
+            let j = self.jacobian.as_mut().expect("assembled with the reference");
+            j.values.iter_mut().for_each(|v| *v = 0.0);
+            p.jacobian(w, j);
+            let dofs = lr.changed_dofs(j);
+            if dofs.len() <= self.options.max_rank && lr.update(j, dofs, f).is_ok() {
+                self.updates += 1;
+                return Ok(false);
+            }
+        }
+        self.low_rank = None;
+        self.refactor(p, w)?;
+        let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
+        if piecewise && direct && self.options.max_rank > 0 {
+            self.low_rank = Some(LowRank::new(self.jacobian.as_ref().expect("assembled by refactor")));
+        }
+        Ok(true)
     }
 
     /// Assembles and factors the Jacobian at w; a failed Cholesky falls back to LU.

@@ -13,6 +13,10 @@ pub struct Pattern {
     dim: usize,
     pub col_ptr: Vec<usize>,
     pub row_idx: Vec<usize>,
+    /// Node adjacency (sorted neighbours of each node, itself included): column `j·d + m` holds,
+    /// in this order, the d rows of each neighbour of node j.
+    node_ptr: Vec<usize>,
+    node_adj: Vec<u32>,
     /// Per cell, `[j][i]`: offset of node i's first row within the columns of node j.
     cell_offsets: Vec<u32>,
 }
@@ -82,7 +86,7 @@ impl Pattern {
                 }
             }
         }
-        Pattern { dim: d, col_ptr, row_idx, cell_offsets }
+        Pattern { dim: d, col_ptr, row_idx, node_ptr: adj_ptr, node_adj: adj, cell_offsets }
     }
 
     /// Number of rows (= columns).
@@ -96,6 +100,15 @@ impl Pattern {
 
     pub fn dim(&self) -> usize {
         self.dim
+    }
+
+    pub fn num_nodes(&self) -> usize {
+        self.node_ptr.len() - 1
+    }
+
+    /// The nodes coupled to node `j`, sorted (`j` among them).
+    pub fn neighbours(&self, j: usize) -> &[u32] {
+        &self.node_adj[self.node_ptr[j]..self.node_ptr[j + 1]]
     }
 
     /// Adds an element matrix of cell `c` with nodes `cell` into `values`.

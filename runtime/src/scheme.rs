@@ -322,6 +322,11 @@ impl<'a> Stepper<'a> {
         self.stages.iter().map(|s| s.newton.counters()).fold(Default::default(), |a, c| a + c)
     }
 
+    /// The largest stage's Cholesky factor (stored values), if the stages factor by Cholesky.
+    pub fn factor_nnz(&self) -> Option<usize> {
+        self.stages.iter().filter_map(|s| s.newton.factor_nnz()).max()
+    }
+
     /// The matrix of a linear one-field form (e.g. `mass`, for energies).
     pub fn matrix(&self, form: &str) -> Option<&Matrix> {
         self.matrices.get(form)
@@ -658,8 +663,13 @@ struct StageProblem<'p, 'a> {
 
 impl NonlinearProblem for StageProblem<'_, '_> {
     fn residual(&mut self, w: &[f64], r: &mut [f64]) {
-        self.constant.mul_vec(w, r);
-        r.iter_mut().zip(&self.rhs).for_each(|(ri, c)| *ri += c);
+        // Newton starts from δ = 0 unless a constraint moves: no product then.
+        if w.iter().all(|x| *x == 0.0) {
+            r.copy_from_slice(&self.rhs);
+        } else {
+            self.constant.mul_vec(w, r);
+            r.iter_mut().zip(&self.rhs).for_each(|(ri, c)| *ri += c);
+        }
         for term in &self.terms {
             let args = term.args(w);
             let refs: Vec<&[f64]> = args.iter().map(Vec::as_slice).collect();

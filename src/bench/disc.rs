@@ -3,16 +3,25 @@
 //! stepper alone is timed (mesh reading, assembly of the linear forms, measurements and output
 //! are not); per run we record the mean and the median over steps, and report the medians of
 //! these over the repeated runs.
+//!
+//! Cost model: a step whose active set does not change needs one residual (a sparse product
+//! with the step matrix's pattern, plus the contact facets) and one pair of triangular solves
+//! with the stored factor. The model is the bytes these read (8 per stored value of L for each
+//! of the two solves; 8 per value and 8 per row index of the matrix; three vectors) divided by
+//! the bandwidth of a STREAM triad over arrays of the same total size, measured here: the
+//! working set of the small meshes lives in cache, and this is the speed it can be read at.
 
 use std::path::PathBuf;
 
-use serde::Serialize;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
 
 use super::median;
 use crate::cases::CaseError;
 use crate::cases::disc::{self, Options};
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DiscTiming {
     pub mesh: String,
     pub dofs: usize,
@@ -25,9 +34,23 @@ pub struct DiscTiming {
     pub median_step_ms: f64,
     /// Median over runs of the whole run (setup and measurements included) / steps.
     pub ms_per_step_with_setup: f64,
+    /// Per 1000 steps: full numeric factorizations, and active-set changes absorbed by a
+    /// low-rank correction instead.
+    pub factorizations_per_1000: f64,
+    pub low_rank_updates_per_1000: f64,
+    /// Stored entries of the step matrix and of its Cholesky factor.
+    pub matrix_nnz: usize,
+    pub factor_nnz: Option<usize>,
+    /// The cost model: bytes read by one residual product and one solve pair, the triad
+    /// bandwidth over a working set of that size (GB/s), the time this gives, and
+    /// `ms_per_step` / `model_ms`.
+    pub model_bytes: f64,
+    pub bandwidth_gb_s: f64,
+    pub model_ms: f64,
+    pub measured_over_model: f64,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Report {
     pub dt: f64,
     pub t_end: f64,
@@ -51,28 +74,80 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             last = Some(s);
         }
         let s = last.expect("at least one run");
+        let per_1000 = |count: usize| 1000.0 * count as f64 / s.steps.max(1) as f64;
+        let model_bytes = (16 * s.factor_nnz.unwrap_or(0) + 16 * s.matrix_nnz + 24 * s.dofs) as f64;
+        let bandwidth = triad_bandwidth(model_bytes as usize);
+        let model_ms = 1e3 * model_bytes / bandwidth;
+        let ms_per_step = median(mean);
         let t = DiscTiming {
             mesh: path.display().to_string(),
             dofs: s.dofs,
             steps: s.steps,
             newton_total: s.newton_total,
             factorizations: s.factorizations,
-            ms_per_step: median(mean),
+            ms_per_step,
             median_step_ms: median(med),
             ms_per_step_with_setup: median(whole),
+            factorizations_per_1000: per_1000(s.factorizations),
+            low_rank_updates_per_1000: per_1000(s.low_rank_updates),
+            matrix_nnz: s.matrix_nnz,
+            factor_nnz: s.factor_nnz,
+            model_bytes,
+            bandwidth_gb_s: bandwidth / 1e9,
+            model_ms,
+            measured_over_model: ms_per_step / model_ms,
         };
         progress(&format!(
-            "{}: {} dofs, {} steps, {} Newton iterations, {} factorizations; {:.3} ms/step stepping (median step {:.3} ms), {:.3} ms/step whole run",
+            "{}: {} dofs, {} steps, {} Newton iterations, {} factorizations, {} low-rank updates; {:.3} ms/step stepping (median step {:.3} ms), {:.3} ms/step whole run; model {:.3} ms ({:.2} MB at {:.1} GB/s), measured/model {:.2}",
             t.mesh,
             t.dofs,
             t.steps,
             t.newton_total,
             t.factorizations,
+            s.low_rank_updates,
             t.ms_per_step,
             t.median_step_ms,
-            t.ms_per_step_with_setup
+            t.ms_per_step_with_setup,
+            t.model_ms,
+            t.model_bytes / 1e6,
+            t.bandwidth_gb_s,
+            t.measured_over_model
         ));
         out.push(t);
     }
     Ok(Report { dt: base.dt, t_end: base.t_end, repeats, meshes: out })
+}
+
+/// The last run's `dir/bench_disc.json`, if there is one.
+pub fn read(dir: &std::path::Path) -> Option<Result<Report, String>> {
+    let path = dir.join("bench_disc.json");
+    let text = std::fs::read_to_string(&path).ok()?;
+    Some(serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display())))
+}
+
+/// Bytes per second of the triad a = b + s·c over three arrays of `bytes` in all (at least
+/// 64 KiB): the median of 15 timings, each repeating the triad for at least a millisecond.
+pub fn triad_bandwidth(bytes: usize) -> f64 {
+    let n = (bytes / 24).max(8192);
+    let (b, c) = (vec![1.0f64; n], vec![2.0f64; n]);
+    let mut a = vec![0.0f64; n];
+    let mut triad = |s: f64| {
+        a.iter_mut().zip(b.iter().zip(&c)).for_each(|(x, (y, z))| *x = y + s * z);
+        std::hint::black_box(&mut a);
+    };
+    // Repetitions for a millisecond, from a first timing.
+    let clock = Instant::now();
+    triad(0.5);
+    let once = clock.elapsed().as_secs_f64().max(1e-9);
+    let reps = ((1e-3 / once).ceil() as usize).max(1);
+    let timings: Vec<f64> = (0..15)
+        .map(|k| {
+            let clock = Instant::now();
+            for r in 0..reps {
+                triad(1.0 + (k * reps + r) as f64 * 1e-9);
+            }
+            (24 * n * reps) as f64 / clock.elapsed().as_secs_f64()
+        })
+        .collect();
+    median(timings)
 }

@@ -8,13 +8,13 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::cases::CaseError;
 use crate::plot::Curve;
 
-/// Cells per radius of the balls tried, smallest first: 15k, 47k, 108k, 274k, 824k, 985k dofs.
-const HALVES: [usize; 6] = [4, 6, 8, 11, 16, 17];
+/// Cells per radius of the balls tried, smallest first: 15k, 47k, 108k, 274k, 555k, 985k dofs.
+const HALVES: [usize; 6] = [4, 6, 8, 11, 14, 17];
 /// The direct solver is tried up to this many unknowns: through contact it refactors at every
 /// change of the active set, 35 times in 50 steps at 47k unknowns (135 s), and one
 /// factorization at 108k takes about 100 s and 4.6 GB.
@@ -24,7 +24,7 @@ pub fn dofs(half: usize) -> usize {
     3 * (4 * half + 1).pow(3)
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SphereTiming {
     pub dofs: usize,
     pub h: f64,
@@ -40,7 +40,7 @@ pub struct SphereTiming {
     pub first_contact: Option<f64>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Report {
     pub max_dofs: usize,
     pub runs: Vec<SphereTiming>,
@@ -104,6 +104,13 @@ pub fn sphere(max_dofs: usize, dir: &Path, progress: &mut dyn FnMut(&str)) -> Re
         }
     }
     Ok(Report { max_dofs, runs })
+}
+
+/// The last run's `dir/bench_sphere.json`, if there is one.
+pub fn read(dir: &Path) -> Option<Result<Report, String>> {
+    let path = dir.join("bench_sphere.json");
+    let text = std::fs::read_to_string(&path).ok()?;
+    Some(serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display())))
 }
 
 /// `dir/bench_sphere.png`: log-log time per step and peak memory against unknowns.

@@ -47,6 +47,14 @@ impl Body {
         }
     }
 
+    /// What the built-in mesh is called.
+    pub fn mesh_name(self) -> &'static str {
+        match self {
+            Body::Disc => "disc",
+            Body::Sphere => "ball",
+        }
+    }
+
     /// The vertical axis's letter, for column names.
     pub fn axis(self) -> char {
         match self {
@@ -177,6 +185,12 @@ pub struct Summary {
     /// Numeric factorizations of the stage Jacobians (the rest of the Newton iterations reuse one;
     /// with the iterative solver: preconditioner setups).
     pub factorizations: usize,
+    /// Changes of the active set solved by a low-rank correction of the last factorization
+    /// instead of a new one.
+    pub low_rank_updates: usize,
+    /// Stored entries of the step matrix and of its Cholesky factor (direct solver).
+    pub matrix_nnz: usize,
+    pub factor_nnz: Option<usize>,
     /// The linear solver asked for, and the Krylov iterations over the run (0: direct).
     pub solver: crate::runtime::linalg::Solver,
     pub krylov_iterations: usize,
@@ -340,7 +354,10 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         params: active.forms.params.values(),
         mass: opts.mass,
         cell_size: opts.cell_size,
-        mesh: opts.mesh.as_ref().map_or_else(|| format!("built-in disc, h = {}", opts.h), |p| p.display().to_string()),
+        mesh: opts
+            .mesh
+            .as_ref()
+            .map_or_else(|| format!("built-in {}, h = {}", opts.body.mesh_name(), opts.h), |p| p.display().to_string()),
         cells: mesh.num_cells(),
         dofs: n,
         dt: opts.dt,
@@ -358,6 +375,9 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         stepping_seconds: step_times.iter().sum(),
         step_median_seconds: crate::bench::median(step_times),
         factorizations: sim.stepper.counters().numeric,
+        low_rank_updates: sim.stepper.counters().updates,
+        matrix_nnz: sim.tools.asm.pattern.nnz(),
+        factor_nnz: sim.stepper.factor_nnz(),
         solver: opts.newton.solver,
         krylov_iterations: sim.stepper.counters().iterations,
         peak_memory_bytes: crate::bench::peak_memory(),

@@ -155,14 +155,75 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     }
     // `bench sphere` takes an hour at full size: the report shows its last run in this directory.
     md.push_str("## 6. Solvers for size (`signorini bench sphere`)\n\n");
-    if out.join("bench_sphere.png").exists() {
-        md.push_str("Time per step and peak memory of the bouncing sphere against its size, direct and iterative (from `bench_sphere.json` in this directory):\n\n![bench sphere](bench_sphere.png)\n\n");
-    } else {
-        let _ = writeln!(
-            md,
-            "Not run: `signorini bench sphere --out {}` writes bench_sphere.json and the log-log plot this section shows.\n",
-            out.display()
-        );
+    match crate::bench::sphere::read(out) {
+        Some(Ok(bench)) => {
+            md.push_str("Time per step and peak memory of the bouncing sphere against its size (Newmark, Nitsche θ = 1, 50 steps of Δt = 0.02 through the first contact), from `bench_sphere.json` in this directory:\n\n");
+            md.push_str("| unknowns | solver | ms/step, whole run | median step (ms) | Newton | factorizations | Krylov iterations | peak memory (MB) |\n|---|---|---|---|---|---|---|---|\n");
+            for r in &bench.runs {
+                let iterations = if r.solver == "direct" { "—".to_string() } else { r.krylov_iterations.to_string() };
+                let memory = r.peak_memory_bytes.map_or("—".to_string(), |b| format!("{:.0}", b as f64 / 1e6));
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {:.0} | {:.0} | {} | {} | {iterations} | {memory} |",
+                    r.dofs, r.solver, r.ms_per_step_with_setup, r.median_step_ms, r.newton_total, r.factorizations
+                );
+            }
+            if out.join("bench_sphere.png").exists() {
+                md.push_str("\n![bench sphere](bench_sphere.png)\n");
+            }
+            md.push('\n');
+        }
+        Some(Err(e)) => {
+            let _ = writeln!(md, "`bench_sphere.json` in this directory cannot be read: {e}\n");
+        }
+        None => {
+            let _ = writeln!(
+                md,
+                "Not run: `signorini bench sphere --out {}` writes bench_sphere.json and the log-log plot this section shows.\n",
+                out.display()
+            );
+        }
+    }
+    md.push_str("## 7. Time per step of the disc (`signorini bench disc`)\n\n");
+    match crate::bench::disc::read(out) {
+        Some(Ok(bench)) => {
+            let _ = writeln!(
+                md,
+                "Newmark, Nitsche θ = 1, Δt = {}, to t = {}, the stepper alone, medians of {} runs, from `bench_disc.json` in this directory. The model: one residual product and one pair of triangular solves per step, as bytes read at the triad bandwidth of a working set of that size.\n",
+                bench.dt, bench.t_end, bench.repeats
+            );
+            md.push_str("| mesh | unknowns | ms/step (mean) | median step (ms) | factorizations /1000 steps | low-rank updates /1000 steps | nnz(K) | nnz(L) | model (ms) | triad GB/s | measured/model |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+            for m in &bench.meshes {
+                let name = std::path::Path::new(&m.mesh)
+                    .file_name()
+                    .map_or(m.mesh.clone(), |f| f.to_string_lossy().into_owned());
+                let _ = writeln!(
+                    md,
+                    "| {name} | {} | {:.3} | {:.3} | {:.0} | {:.0} | {} | {} | {:.3} | {:.1} | {:.2} |",
+                    m.dofs,
+                    m.ms_per_step,
+                    m.median_step_ms,
+                    m.factorizations_per_1000,
+                    m.low_rank_updates_per_1000,
+                    m.matrix_nnz,
+                    m.factor_nnz.map_or("—".into(), |n| n.to_string()),
+                    m.model_ms,
+                    m.bandwidth_gb_s,
+                    m.measured_over_model
+                );
+            }
+            md.push('\n');
+        }
+        Some(Err(e)) => {
+            let _ = writeln!(md, "`bench_disc.json` in this directory cannot be read: {e}\n");
+        }
+        None => {
+            let _ = writeln!(
+                md,
+                "Not run: `signorini bench disc --mesh FILE.msh ... --out {}` writes bench_disc.json, which this section tabulates.\n",
+                out.display()
+            );
+        }
     }
     let _ = writeln!(md, "_Run time: {:.1} s._", start.elapsed().as_secs_f64());
     crate::output::write_atomic(&out.join("report.md"), md.as_bytes())
