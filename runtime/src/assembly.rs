@@ -3,10 +3,16 @@
 //! Dofs are node-major (`node * d + component`, one vector Lagrange node per mesh node). The
 //! sparsity pattern of a mesh is built once; for each cell it stores, for every pair of its
 //! nodes (i, j), the offset of node i's first row inside node j's columns, so element matrices
-//! are added in place without searching. Cells and facets are visited in a fixed order, so
-//! results are deterministic.
+//! are added in place without searching.
+//!
+//! Cell loops run on rayon's threads, colour by colour: the cells of a colour share no node,
+//! so they add into disjoint entries, and every entry receives its cells' contributions in
+//! colour order whatever the number of threads: results have the same bits on one thread or
+//! many. Facet loops visit a region's facets in their order (contact regions are small).
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
+
+use rayon::prelude::*;
 
 use crate::element::ElementKind;
 use crate::kernel::{
@@ -76,11 +82,19 @@ impl Quadrature {
 pub struct Assembler<'m> {
     pub mesh: &'m Mesh,
     pub pattern: Arc<Pattern>,
+    /// The cells by colour (computed on first use).
+    colours: OnceLock<Vec<Vec<u32>>>,
 }
 
 impl<'m> Assembler<'m> {
     pub fn new(mesh: &'m Mesh) -> Self {
-        Assembler { mesh, pattern: Arc::new(Pattern::new(mesh)) }
+        Assembler { mesh, pattern: Arc::new(Pattern::new(mesh)), colours: OnceLock::new() }
+    }
+
+    /// The cells grouped so that no two cells of a group share a node, each group in
+    /// increasing order.
+    pub fn colours(&self) -> &[Vec<u32>] {
+        self.colours.get_or_init(|| colour_cells(self.mesh))
     }
 
     /// Number of dofs.
@@ -95,13 +109,16 @@ impl<'m> Assembler<'m> {
     /// Adds the volume part of `k`'s residual at `fields` to `out`.
     pub fn cell_residual<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64, out: &mut [f64]) {
         let degree = q.cell_degree(k.meta(), self.mesh.kind);
-        dispatch!(self.mesh.kind, cell_residual::<K>(self.mesh, k, degree, fields, t, out))
+        dispatch!(self.mesh.kind, cell_residual::<K>(self.mesh, self.colours(), k, degree, fields, t, out))
     }
 
     /// Adds the volume part of `k`'s tangent with respect to field `wrt` to `m`.
     pub fn cell_tangent<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
         let degree = q.cell_degree(k.meta(), self.mesh.kind);
-        dispatch!(self.mesh.kind, cell_tangent::<K>(self.mesh, &self.pattern, k, degree, fields, wrt, t, &mut m.values))
+        dispatch!(
+            self.mesh.kind,
+            cell_tangent::<K>(self.mesh, self.colours(), &self.pattern, k, degree, fields, wrt, t, &mut m.values)
+        )
     }
 
     /// Adds the residual of `k`'s integral over `region` (a name of `K::META.facets`) on the
@@ -257,8 +274,75 @@ fn with_refs<const D: usize, const N: usize, R>(
     }
 }
 
-fn cell_residual<const D: usize, const N: usize, K: FormKernel<D, N>>(
+/// Greedy colouring of the cells: each takes the smallest colour none of the cells sharing one
+/// of its nodes has taken.
+fn colour_cells(mesh: &Mesh) -> Vec<Vec<u32>> {
+    let nodes = mesh.num_nodes();
+    let mut inc_ptr = vec![0usize; nodes + 1];
+    for &n in &mesh.cells {
+        inc_ptr[n as usize + 1] += 1;
+    }
+    for i in 0..nodes {
+        inc_ptr[i + 1] += inc_ptr[i];
+    }
+    let mut fill = inc_ptr.clone();
+    let mut inc = vec![0u32; mesh.cells.len()];
+    for c in 0..mesh.num_cells() {
+        for &n in mesh.cell(c) {
+            inc[fill[n as usize]] = c as u32;
+            fill[n as usize] += 1;
+        }
+    }
+    let mut colour = vec![u32::MAX; mesh.num_cells()];
+    // taken[k] == c + 1: colour k is used by a neighbour of cell c.
+    let mut taken: Vec<usize> = Vec::new();
+    let mut groups: Vec<Vec<u32>> = Vec::new();
+    for c in 0..mesh.num_cells() {
+        for &n in mesh.cell(c) {
+            for &other in &inc[inc_ptr[n as usize]..inc_ptr[n as usize + 1]] {
+                let k = colour[other as usize];
+                if k != u32::MAX {
+                    taken[k as usize] = c + 1;
+                }
+            }
+        }
+        let k = (0..taken.len()).find(|&k| taken[k] != c + 1).unwrap_or(taken.len());
+        if k == taken.len() {
+            taken.push(0);
+            groups.push(Vec::new());
+        }
+        colour[c] = k as u32;
+        groups[k].push(c as u32);
+    }
+    groups
+}
+
+/// Cells per rayon task.
+const CELLS_PER_TASK: usize = 64;
+
+/// A vector or matrix's values written by the cells of one colour from several threads.
+#[derive(Clone, Copy)]
+struct Disjoint(*mut f64);
+// SAFETY: the cells of a colour share no node, so the entries they add into are disjoint: no
+// two threads touch the same value (see `add_at`).
+unsafe impl Send for Disjoint {}
+unsafe impl Sync for Disjoint {}
+
+impl Disjoint {
+    /// Adds `v` to entry `i`.
+    ///
+    /// # Safety
+    /// `i` is in bounds and no other thread accesses entry `i` concurrently.
+    #[inline]
+    unsafe fn add_at(self, i: usize, v: f64) {
+        unsafe { *self.0.add(i) += v }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn cell_residual<const D: usize, const N: usize, K: FormKernel<D, N> + Sync>(
     mesh: &Mesh,
+    colours: &[Vec<u32>],
     k: &K,
     degree: u32,
     fields: &[&[f64]],
@@ -266,14 +350,29 @@ fn cell_residual<const D: usize, const N: usize, K: FormKernel<D, N>>(
     out: &mut [f64],
 ) {
     let tab = Tabulation::<D, N>::cell(mesh.kind, degree).expect("kind matches D and N");
-    let mut local = locals::<D, N>(fields.len());
-    for c in 0..mesh.num_cells() {
-        let cell = mesh.cell(c);
-        let coords = mesh.cell_coords::<D, N>(c);
-        gather(cell, fields, &mut local);
-        let mut re = [[0.0; D]; N];
-        with_refs(&local, |refs| k.cell_residual(&CellCtx { tab: &tab, coords: &coords, t }, refs, &mut re));
-        add_local(cell, &re, out);
+    let len = out.len();
+    let target = Disjoint(out.as_mut_ptr());
+    for cells in colours {
+        cells.par_chunks(CELLS_PER_TASK).for_each_init(
+            || locals::<D, N>(fields.len()),
+            |local, chunk| {
+                for &c in chunk {
+                    let (c, cell) = (c as usize, mesh.cell(c as usize));
+                    let coords = mesh.cell_coords::<D, N>(c);
+                    gather(cell, fields, local);
+                    let mut re = [[0.0; D]; N];
+                    with_refs(local, |refs| k.cell_residual(&CellCtx { tab: &tab, coords: &coords, t }, refs, &mut re));
+                    for j in 0..N {
+                        for a in 0..D {
+                            let i = cell[j] as usize * D + a;
+                            assert!(i < len);
+                            // SAFETY: in bounds, and this colour's other cells have other nodes.
+                            unsafe { target.add_at(i, re[j][a]) };
+                        }
+                    }
+                }
+            },
+        );
     }
 }
 
@@ -288,8 +387,9 @@ fn add_local<const D: usize, const N: usize>(cell: &[u32], re: &LocalVector<D, N
 }
 
 #[allow(clippy::too_many_arguments)]
-fn cell_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
+fn cell_tangent<const D: usize, const N: usize, K: FormKernel<D, N> + Sync>(
     mesh: &Mesh,
+    colours: &[Vec<u32>],
     pattern: &Pattern,
     k: &K,
     degree: u32,
@@ -299,15 +399,27 @@ fn cell_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
     values: &mut [f64],
 ) {
     let tab = Tabulation::<D, N>::cell(mesh.kind, degree).expect("kind matches D and N");
-    let mut local = locals::<D, N>(fields.len());
-    let mut ke: Box<LocalMatrix<D, N>> = Box::new([[[[0.0; D]; N]; D]; N]);
-    for c in 0..mesh.num_cells() {
-        let cell = mesh.cell(c);
-        let coords = mesh.cell_coords::<D, N>(c);
-        gather(cell, fields, &mut local);
-        *ke = [[[[0.0; D]; N]; D]; N];
-        with_refs(&local, |refs| k.cell_tangent(&CellCtx { tab: &tab, coords: &coords, t }, refs, wrt, &mut ke));
-        pattern.scatter(c, cell, &ke, values);
+    let len = values.len();
+    let target = Disjoint(values.as_mut_ptr());
+    for cells in colours {
+        cells.par_chunks(CELLS_PER_TASK).for_each_init(
+            || (locals::<D, N>(fields.len()), Box::new([[[[0.0; D]; N]; D]; N])),
+            |(local, ke), chunk| {
+                for &c in chunk {
+                    let (c, cell) = (c as usize, mesh.cell(c as usize));
+                    let coords = mesh.cell_coords::<D, N>(c);
+                    gather(cell, fields, local);
+                    **ke = [[[[0.0; D]; N]; D]; N];
+                    with_refs(local, |refs| k.cell_tangent(&CellCtx { tab: &tab, coords: &coords, t }, refs, wrt, ke));
+                    pattern.scatter_with(c, cell, ke, |i, v| {
+                        assert!(i < len);
+                        // SAFETY: in bounds, and the entries of this cell's node pairs belong to
+                        // no other cell of its colour.
+                        unsafe { target.add_at(i, v) }
+                    });
+                }
+            },
+        );
     }
 }
 

@@ -138,7 +138,12 @@ pub type CoefFn = Arc<dyn Fn(&[f64], f64, &mut [f64]) + Send + Sync>;
 #[derive(Clone)]
 pub enum Coef {
     Constant(Vec<f64>),
-    Function { components: usize, f: CoefFn },
+    /// `steady`: the function ignores the time.
+    Function {
+        components: usize,
+        f: CoefFn,
+        steady: bool,
+    },
 }
 
 impl Coef {
@@ -153,7 +158,18 @@ impl Coef {
 
     /// `f(x, t, out)` writes the `components` values at position `x` and time `t`.
     pub fn function(components: usize, f: impl Fn(&[f64], f64, &mut [f64]) + Send + Sync + 'static) -> Self {
-        Coef::Function { components, f: Arc::new(f) }
+        Coef::Function { components, f: Arc::new(f), steady: false }
+    }
+
+    /// `f(x, out)` writes the `components` values at position `x`, at every time (loads made
+    /// of steady coefs are assembled once, not at every step).
+    pub fn of_position(components: usize, f: impl Fn(&[f64], &mut [f64]) + Send + Sync + 'static) -> Self {
+        Coef::Function { components, f: Arc::new(move |x, _, out| f(x, out)), steady: true }
+    }
+
+    /// Whether the values may change with time.
+    pub fn time_dependent(&self) -> bool {
+        matches!(self, Coef::Function { steady: false, .. })
     }
 
     pub fn components(&self) -> usize {
@@ -283,6 +299,12 @@ pub struct FormMeta {
 pub trait Form {
     /// Generated forms return their `META` constant; interpreted forms, what they were built with.
     fn meta(&self) -> &FormMeta;
+
+    /// Whether the integrands may change with time (they read `t`, or a coef that does) other
+    /// than through the fields. A load that does not is assembled once.
+    fn time_dependent(&self) -> bool {
+        true
+    }
 }
 
 /// Element kernels of a form for cells of dimension D with N nodes. Each method adds its

@@ -182,8 +182,8 @@ impl Solver {
 enum Factors {
     None,
     Krylov(Box<crate::krylov::Krylov>),
-    Llt { symbolic: SymbolicCholesky<usize>, values: Vec<f64>, factored: bool },
-    Lu { symbolic: SymbolicLu<usize>, numeric: NumericLu<usize, f64>, factored: bool },
+    Llt { symbolic: Arc<SymbolicCholesky<usize>>, values: Vec<f64>, factored: bool },
+    Lu { symbolic: Arc<SymbolicLu<usize>>, numeric: Box<NumericLu<usize, f64>>, factored: bool },
 }
 
 /// A reusable sparse factorization.
@@ -253,12 +253,16 @@ impl Factorization {
                     let symbolic =
                         cholesky::factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
                             .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
-                    Factors::Llt { values: vec![0.0; symbolic.len_val()], symbolic, factored: false }
+                    Factors::Llt {
+                        values: vec![0.0; symbolic.len_val()],
+                        symbolic: Arc::new(symbolic),
+                        factored: false,
+                    }
                 }
                 Structure::General | Structure::Auto => {
                     let symbolic = lu::factorize_symbolic_lu(sym, Default::default())
                         .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
-                    Factors::Lu { symbolic, numeric: NumericLu::new(), factored: false }
+                    Factors::Lu { symbolic: Arc::new(symbolic), numeric: Box::new(NumericLu::new()), factored: false }
                 }
             };
             self.pattern = Some(a.pattern.clone());
@@ -306,6 +310,29 @@ impl Factorization {
             Factors::None | Factors::Krylov(_) => unreachable!("symbolic analysis done above"),
         }
         Ok(())
+    }
+
+    /// A second factorization of the same structure that shares this one's symbolic analysis
+    /// (with its own counters, starting at zero).
+    pub fn fork(&self) -> Factorization {
+        let factors = match &self.factors {
+            Factors::Llt { symbolic, .. } => {
+                Factors::Llt { symbolic: symbolic.clone(), values: vec![0.0; symbolic.len_val()], factored: false }
+            }
+            Factors::Lu { symbolic, .. } => {
+                Factors::Lu { symbolic: symbolic.clone(), numeric: Box::new(NumericLu::new()), factored: false }
+            }
+            Factors::None | Factors::Krylov(_) => Factors::None,
+        };
+        let pattern = if matches!(factors, Factors::None) { None } else { self.pattern.clone() };
+        Factorization {
+            structure: self.structure,
+            solver: self.solver,
+            factors,
+            pattern,
+            par: self.par,
+            counters: Counters::default(),
+        }
     }
 
     /// Stored values of the Cholesky factor L, if that is what was computed.

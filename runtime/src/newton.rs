@@ -50,6 +50,15 @@ pub struct NewtonOptions {
 /// Default `max_rank`: measured with `bench disc` (see docs/mathematics.md).
 pub const MAX_RANK: usize = 256;
 
+/// A numeric refactorization costs about this many solve pairs with its factor (measured with
+/// `bench disc` on the disc meshes): once the corrections applied since the last
+/// factorization have read as many bytes, refactoring at the current active set pays.
+const FACTOR_SOLVES: usize = 20;
+
+/// The previous reference factorization is kept (for an active set that comes back, such as
+/// no contact between bounces) while its factor takes at most this many bytes.
+const KEEP_BYTES: usize = 512 << 20;
+
 impl Default for NewtonOptions {
     fn default() -> Self {
         NewtonOptions { tol: 1e-10, max_iterations: 25, line_search: false, solver: Solver::Auto, max_rank: MAX_RANK }
@@ -109,6 +118,21 @@ pub struct Newton {
     /// piecewise problems), and how many corrections were made.
     low_rank: Option<LowRank>,
     updates: usize,
+    /// Σ over solves of the correction's size since the last factorization, and whether it
+    /// has grown past the cost of refactoring.
+    overhead: usize,
+    force_refactor: bool,
+    /// The reference before the last refactorization, with its correction.
+    previous: Option<Reference>,
+    /// Counters of factorizations no longer kept.
+    retired: crate::linalg::Counters,
+}
+
+/// A factored Jacobian, its correction towards the current one, and the correction's cost so far.
+struct Reference {
+    factorization: Option<Factorization>,
+    low_rank: Option<LowRank>,
+    overhead: usize,
 }
 
 impl Newton {
@@ -122,6 +146,10 @@ impl Newton {
             factored_for: None,
             low_rank: None,
             updates: 0,
+            overhead: 0,
+            force_refactor: false,
+            previous: None,
+            retired: Default::default(),
         }
     }
 
@@ -129,6 +157,31 @@ impl Newton {
     pub fn invalidate(&mut self) {
         self.factored_for = None;
         self.low_rank = None;
+        self.overhead = 0;
+        self.force_refactor = false;
+        self.retire_previous();
+    }
+
+    fn retire_previous(&mut self) {
+        if let Some(f) = self.previous.take().and_then(|r| r.factorization) {
+            self.retired = self.retired + f.counters;
+        }
+    }
+
+    /// Exchanges the current reference with the previous one.
+    fn swap_references(&mut self) {
+        if let Some(prev) = self.previous.as_mut() {
+            std::mem::swap(&mut self.factorization, &mut prev.factorization);
+            std::mem::swap(&mut self.low_rank, &mut prev.low_rank);
+            std::mem::swap(&mut self.overhead, &mut prev.overhead);
+        }
+    }
+
+    /// Σ of correction sizes over solves that costs as much as a refactorization: a correction
+    /// of size k reads 8·n·k bytes, a solve pair 16·nnz(L).
+    fn overhead_budget(&self, n: usize) -> usize {
+        let nnz = self.factorization.as_ref().and_then(Factorization::factor_nnz);
+        nnz.map_or(usize::MAX, |nnz| FACTOR_SOLVES * 2 * nnz / n.max(1))
     }
 
     /// Stored values of the current Cholesky factor, if there is one.
@@ -139,7 +192,8 @@ impl Newton {
     /// Symbolic and numeric factorizations, low-rank corrections and solves so far.
     pub fn counters(&self) -> crate::linalg::Counters {
         let c = |f: &Option<Factorization>| f.as_ref().map(|f| f.counters).unwrap_or_default();
-        let mut all = c(&self.factorization) + c(&self.spare);
+        let previous = self.previous.as_ref().map(|r| c(&r.factorization)).unwrap_or_default();
+        let mut all = c(&self.factorization) + c(&self.spare) + previous + self.retired;
         all.updates = self.updates;
         all
     }
@@ -175,7 +229,7 @@ impl Newton {
                 }
             }
             let active = set.iter().filter(|b| **b).count();
-            let changed = !piecewise || self.factored_for.as_deref() != Some(&set);
+            let changed = !piecewise || self.force_refactor || self.factored_for.as_deref() != Some(&set);
             let (mut refactor, mut updated) = (false, false);
             if changed {
                 match self.new_operator(p, w, piecewise) {
@@ -191,6 +245,8 @@ impl Newton {
             }
             if let Some(lr) = &self.low_rank {
                 lr.correct(&mut delta);
+                self.overhead += lr.rank();
+                self.force_refactor = self.overhead > self.overhead_budget(n);
             }
             // A (numerically) singular Jacobian still yields numbers: check that the step
             // solves the linear system. J δ + R is small for any usable factorization.
@@ -232,17 +288,44 @@ impl Newton {
     /// when the problem is piecewise, the factorization direct and the change small enough,
     /// else a refactorization (which becomes the new reference). Returns whether it refactored.
     fn new_operator(&mut self, p: &mut impl NonlinearProblem, w: &[f64], piecewise: bool) -> Result<bool, LinalgError> {
-        if let (true, Some(lr), Some(f)) = (piecewise, self.low_rank.as_mut(), self.factorization.as_mut()) {
-            let j = self.jacobian.as_mut().expect("assembled with the reference");
+        if piecewise && !self.force_refactor && self.low_rank.is_some() {
+            let mut j = self.jacobian.take().expect("assembled with the reference");
             j.values.iter_mut().for_each(|v| *v = 0.0);
-            p.jacobian(w, j);
-            let dofs = lr.changed_dofs(j);
-            if dofs.len() <= self.options.max_rank && lr.update(j, dofs, f).is_ok() {
+            p.jacobian(w, &mut j);
+            let mut dofs = self.low_rank.as_ref().map(|lr| lr.changed_dofs(&j)).unwrap_or_default();
+            // The previous reference, if the active set has come back near it.
+            if let Some(other) = self.previous.as_ref().and_then(|r| r.low_rank.as_ref()).map(|lr| lr.changed_dofs(&j))
+                && other.len() < dofs.len()
+            {
+                self.swap_references();
+                dofs = other;
+            }
+            let updated = dofs.len() <= self.options.max_rank
+                && match (self.low_rank.as_mut(), self.factorization.as_mut()) {
+                    (Some(lr), Some(f)) => lr.update(&j, dofs, f).is_ok(),
+                    _ => false,
+                };
+            self.jacobian = Some(j);
+            if updated {
                 self.updates += 1;
                 return Ok(false);
             }
         }
+        self.force_refactor = false;
+        // The factored reference becomes the previous one, if it is worth keeping; the new
+        // factorization shares its symbolic analysis.
+        let keep = piecewise
+            && self.low_rank.is_some()
+            && self.factorization.as_ref().and_then(Factorization::factor_nnz).is_some_and(|nnz| 8 * nnz <= KEEP_BYTES);
+        if keep && let Some(f) = self.factorization.as_ref() {
+            let fork = f.fork();
+            self.retire_previous();
+            let old = self.factorization.replace(fork);
+            self.previous =
+                Some(Reference { factorization: old, low_rank: self.low_rank.take(), overhead: self.overhead });
+        }
         self.low_rank = None;
+        self.overhead = 0;
         self.refactor(p, w)?;
         let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
         if piecewise && direct && self.options.max_rank > 0 {

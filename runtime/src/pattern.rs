@@ -120,6 +120,19 @@ impl Pattern {
         ke: &LocalMatrix<D, N>,
         values: &mut [f64],
     ) {
+        self.scatter_with(c, cell, ke, |i, v| values[i] += v);
+    }
+
+    /// Calls `add(i, v)` for each entry `v` of an element matrix of cell `c` and its position
+    /// `i` among the values.
+    #[inline]
+    pub(crate) fn scatter_with<const D: usize, const N: usize>(
+        &self,
+        c: usize,
+        cell: &[u32],
+        ke: &LocalMatrix<D, N>,
+        mut add: impl FnMut(usize, f64),
+    ) {
         let off = &self.cell_offsets[c * N * N..(c + 1) * N * N];
         for j in 0..N {
             let nj = cell[j] as usize;
@@ -128,7 +141,7 @@ impl Pattern {
                 for i in 0..N {
                     let o = base + off[j * N + i] as usize;
                     for k in 0..D {
-                        values[o + k] += ke[i][k][j][m];
+                        add(o + k, ke[i][k][j][m]);
                     }
                 }
             }

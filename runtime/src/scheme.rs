@@ -116,6 +116,10 @@ pub trait BoundForm {
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]);
     fn tangent(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix);
     fn switches(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, out: &mut Vec<bool>);
+    /// Whether the form changes with time other than through its fields.
+    fn time_dependent(&self) -> bool {
+        true
+    }
 }
 
 /// A kernel with its integration data.
@@ -160,6 +164,9 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
             asm.facet_switches(&self.kernel, region, facets, self.quadrature, fields, wrt, t, out);
         }
     }
+    fn time_dependent(&self) -> bool {
+        self.kernel.time_dependent()
+    }
 }
 
 /// A linear form given by its matrix (e.g. a redistributed mass matrix).
@@ -190,6 +197,9 @@ impl BoundForm for MatrixForm {
         m.add_scaled(1.0, &self.matrix);
     }
     fn switches(&self, _asm: &Assembler, _fields: &[&[f64]], _wrt: usize, _t: f64, _out: &mut Vec<bool>) {}
+    fn time_dependent(&self) -> bool {
+        false
+    }
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -477,8 +487,9 @@ impl<'a> Stepper<'a> {
             let form = &self.forms[term.form];
             let term_t = self.coefs[term.time];
             if term.args.is_empty() {
-                // Loads depend on time only: the one at t + dt this step is the one at t next step.
-                let key = (term.form, term_t.to_bits());
+                // Loads depend on time only: the one at t + dt this step is the one at t next step,
+                // and a steady one is the same at every time.
+                let key = (term.form, if form.time_dependent() { term_t.to_bits() } else { u64::MAX });
                 let b = match self.loads.iter().position(|(k, _)| *k == key) {
                     Some(i) => &self.loads[i].1,
                     None => {

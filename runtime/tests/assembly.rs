@@ -81,3 +81,52 @@ fn the_curved_ball_has_the_mass_of_its_volume() {
     // The isoparametric ball's volume error at h = R/4 (O(h⁴): 2.8e-5 at h = R/4).
     assert!((mesh.measure() - volume).abs() < 5e-5 * volume, "{}", mesh.measure());
 }
+
+#[test]
+fn colours_share_no_node_and_cover_every_cell_once() {
+    for mesh in unit_meshes().into_iter().chain([ball(1.0, [0.0, 0.0, 0.0], 0.4)]) {
+        let asm = Assembler::new(&mesh);
+        let mut seen = vec![0usize; mesh.num_cells()];
+        for cells in asm.colours() {
+            let mut owner = vec![usize::MAX; mesh.num_nodes()];
+            assert!(cells.windows(2).all(|w| w[0] < w[1]), "sorted");
+            for &c in cells {
+                seen[c as usize] += 1;
+                for &n in mesh.cell(c as usize) {
+                    assert_eq!(
+                        owner[n as usize],
+                        usize::MAX,
+                        "{}: node {n} in two cells of a colour",
+                        mesh.kind.name()
+                    );
+                    owner[n as usize] = c as usize;
+                }
+            }
+        }
+        assert!(seen.iter().all(|&k| k == 1), "every cell once");
+    }
+}
+
+#[test]
+fn threaded_assembly_has_the_same_bits_on_one_and_two_threads() {
+    let mesh = ball(1.0, [0.0, 0.0, 0.0], 0.25);
+    let asm = Assembler::new(&mesh);
+    let n = asm.size();
+    let u = pseudo_random(n, 3);
+    let form = MassStiffness { rho: 1.5, k: 0.7 };
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a pool");
+        pool.install(|| {
+            let mut m = asm.zero_matrix();
+            asm.cell_tangent(&form, Quadrature::default(), &[&u], 0, 0.0, &mut m);
+            let mut r = vec![0.0; n];
+            asm.cell_residual(&form, Quadrature::default(), &[&u], 0.0, &mut r);
+            (m.values, r)
+        })
+    };
+    let (m1, r1) = run(1);
+    let (m2, r2) = run(2);
+    assert!(mesh.num_cells() > 1000, "enough cells for several tasks per colour");
+    assert!(m1.iter().zip(&m2).all(|(a, b)| a.to_bits() == b.to_bits()), "matrix bits");
+    assert!(r1.iter().zip(&r2).all(|(a, b)| a.to_bits() == b.to_bits()), "residual bits");
+}

@@ -1,5 +1,6 @@
 //! `signorini bench assemble`: assembly and factorization timings of the P2 plane-strain
-//! benchmark (issue 3). Single thread. The unit square is cut into N×N squares along the
+//! benchmark (issue 3). Assembly on one thread and on all of them (`--threads`), whose
+//! matrices must have the same bits; the factorization on one thread. The unit square is cut into N×N squares along the
 //! (i,j)–(i+1,j+1) diagonals (2N² cells); stiffness with the 3-point rule (degree 2), mass
 //! with the 6-point rule (degree 4), E = 1, ν = 0.3, ρ = 1. Pattern building is timed apart
 //! from assembly. Then M/(β dt²) + K at one N (β = 1/4, dt = 1e-3) is factored by sparse
@@ -23,8 +24,15 @@ pub struct AssemblyTiming {
     pub dofs: usize,
     pub nnz: usize,
     pub pattern_seconds: f64,
+    /// One thread.
     pub stiffness_us_per_cell: f64,
     pub mass_us_per_cell: f64,
+    /// `threads` threads, and the speedups over one.
+    pub threads: usize,
+    pub stiffness_us_per_cell_threaded: f64,
+    pub mass_us_per_cell_threaded: f64,
+    pub stiffness_speedup: f64,
+    pub mass_speedup: f64,
     pub stiffness_frobenius: f64,
 }
 
@@ -73,32 +81,58 @@ pub fn assemble(sizes: &[usize], factor_n: Option<usize>, repeats: usize, progre
         }
         let asm = asm.expect("at least one repeat");
         let zero = vec![0.0; asm.size()];
-        let mut kmat = asm.zero_matrix();
-        let mut mmat = asm.zero_matrix();
-        let (mut tk, mut tm) = (Vec::new(), Vec::new());
-        for _ in 0..repeats {
-            kmat.values.iter_mut().for_each(|v| *v = 0.0);
-            let t = Instant::now();
-            asm.cell_tangent(&k, Quadrature { cell: Some(2), facet: None }, &[&zero], 0, 0.0, &mut kmat);
-            tk.push(t.elapsed().as_secs_f64());
-            mmat.values.iter_mut().for_each(|v| *v = 0.0);
-            let t = Instant::now();
-            asm.cell_tangent(&m, Quadrature { cell: Some(4), facet: None }, &[&zero], 0, 0.0, &mut mmat);
-            tm.push(t.elapsed().as_secs_f64());
-        }
+        // Medians of the stiffness and mass assembly times on a pool of `threads`, and K.
+        let time = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+            pool.install(|| {
+                let mut kmat = asm.zero_matrix();
+                let mut mmat = asm.zero_matrix();
+                let (mut tk, mut tm) = (Vec::new(), Vec::new());
+                for _ in 0..repeats {
+                    kmat.values.iter_mut().for_each(|v| *v = 0.0);
+                    let t = Instant::now();
+                    asm.cell_tangent(&k, Quadrature { cell: Some(2), facet: None }, &[&zero], 0, 0.0, &mut kmat);
+                    tk.push(t.elapsed().as_secs_f64());
+                    mmat.values.iter_mut().for_each(|v| *v = 0.0);
+                    let t = Instant::now();
+                    asm.cell_tangent(&m, Quadrature { cell: Some(4), facet: None }, &[&zero], 0, 0.0, &mut mmat);
+                    tm.push(t.elapsed().as_secs_f64());
+                }
+                (median(tk), median(tm), kmat)
+            })
+        };
+        let threads = rayon::current_num_threads();
+        let (k1, m1, kmat) = time(1);
+        let (kt, mt, kmat_threaded) = time(threads);
+        assert!(
+            kmat.values.iter().zip(&kmat_threaded.values).all(|(a, b)| a.to_bits() == b.to_bits()),
+            "threaded assembly changed the bits"
+        );
         let timing = AssemblyTiming {
             n,
             cells,
             dofs: asm.size(),
             nnz: asm.pattern.nnz(),
             pattern_seconds: median(pattern_times),
-            stiffness_us_per_cell: median(tk) * 1e6 / cells as f64,
-            mass_us_per_cell: median(tm) * 1e6 / cells as f64,
+            stiffness_us_per_cell: k1 * 1e6 / cells as f64,
+            mass_us_per_cell: m1 * 1e6 / cells as f64,
+            threads,
+            stiffness_us_per_cell_threaded: kt * 1e6 / cells as f64,
+            mass_us_per_cell_threaded: mt * 1e6 / cells as f64,
+            stiffness_speedup: k1 / kt,
+            mass_speedup: m1 / mt,
             stiffness_frobenius: kmat.frobenius(),
         };
         progress(&format!(
-            "N = {n:4}: {cells:8} cells, pattern {:.3} s, K {:.3} µs/cell, M {:.3} µs/cell, ‖K‖_F = {:.6}",
-            timing.pattern_seconds, timing.stiffness_us_per_cell, timing.mass_us_per_cell, timing.stiffness_frobenius
+            "N = {n:4}: {cells:8} cells, pattern {:.3} s, K {:.3} µs/cell, M {:.3} µs/cell; {threads} threads: K {:.3} µs/cell (×{:.2}), M {:.3} µs/cell (×{:.2}), same bits; ‖K‖_F = {:.6}",
+            timing.pattern_seconds,
+            timing.stiffness_us_per_cell,
+            timing.mass_us_per_cell,
+            timing.stiffness_us_per_cell_threaded,
+            timing.stiffness_speedup,
+            timing.mass_us_per_cell_threaded,
+            timing.mass_speedup,
+            timing.stiffness_frobenius
         ));
         assembly.push(timing);
     }

@@ -143,7 +143,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
 fn coefs(name: &str) -> Option<Coef> {
     match name {
         "f" => Some(Coef::constant(vec![0.0])),
-        "g" => Some(Coef::function(1, |x, _, out| out[0] = x[0])),
+        "g" => Some(Coef::of_position(1, |x, out| out[0] = x[0])),
         "nc" => Some(Coef::constant(vec![-1.0])),
         _ => None,
     }

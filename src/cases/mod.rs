@@ -16,7 +16,7 @@ pub fn above_plane(d: usize, lift: f64, load: f64) -> impl Fn(&str) -> Option<Co
     let down = move |size: f64| (0..d).map(|k| if k == d - 1 { -size } else { 0.0 }).collect::<Vec<f64>>();
     move |name| match name {
         "f" => Some(Coef::constant(down(load))),
-        "g" => Some(Coef::function(1, move |x, _, out| out[0] = x[d - 1] + lift)),
+        "g" => Some(Coef::of_position(1, move |x, out| out[0] = x[d - 1] + lift)),
         "nc" => Some(Coef::constant(down(1.0))),
         _ => None,
     }

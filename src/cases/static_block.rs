@@ -129,7 +129,7 @@ pub fn run(opts: &Options) -> Result<Summary, CaseError> {
     let density = active.params.get("rho").unwrap_or(1.0);
     let gravity = opts.gravity;
     let coefs = move |name: &str| match name {
-        "g" => Some(Coef::function(1, move |x, _, out| {
+        "g" => Some(Coef::of_position(1, move |x, out| {
             out[0] = x[d - 1] + c * x[..d - 1].iter().map(|v| v * v).sum::<f64>()
         })),
         "nc" => Some(Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>())),

@@ -27,6 +27,10 @@ use hertz::{HertzImpactArgs, HertzStaticArgs};
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// Threads for assembly and the iterative solvers (default: all cores). Results have the
+    /// same bits for any number.
+    #[arg(long, global = true, value_parser = clap::value_parser!(u16).range(1..))]
+    pub threads: Option<u16>,
 }
 
 #[derive(Subcommand)]
@@ -36,7 +40,7 @@ pub enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
-    /// Benchmarks (single thread; medians of repeated runs).
+    /// Benchmarks (medians of repeated runs).
     Bench {
         #[command(subcommand)]
         what: BenchCommand,
@@ -305,6 +309,12 @@ pub enum Stage {
 }
 
 pub fn run(cli: Cli) -> ExitCode {
+    if let Some(n) = cli.threads
+        && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n as usize).build_global()
+    {
+        eprintln!("error: cannot start {n} threads: {e}");
+        return ExitCode::FAILURE;
+    }
     match cli.command {
         Command::Check { files } => check(&files),
         Command::Emit { file, stage, dim } => emit(&file, stage, dim as usize),

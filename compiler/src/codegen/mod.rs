@@ -13,6 +13,7 @@ mod scheme;
 use std::fmt::Write;
 
 use crate::ir::DimIr;
+use crate::ir::graph::{Node, Sym};
 use crate::program::Program;
 use names::{camel, ident};
 
@@ -114,13 +115,14 @@ fn module_text(prog: &Program, irs: &[&DimIr], opts: &Options) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: &[{}] }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }} }}",
+            "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: &[{}] }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }}\n{} }}",
             form.name,
             fields.join(", "),
             form.test.as_ref().map_or("", |t| t.name.as_str()),
             irs.iter().all(|ir| ir.forms[fi].linear),
             irs.iter().all(|ir| ir.forms[fi].integrals.iter().all(|i| i.tangents.iter().all(|t| t.piecewise))),
-            facets.join(", ")
+            facets.join(", "),
+            time_dependence(prog, irs, fi)
         );
         for ir in irs {
             if form.test.is_some() {
@@ -247,6 +249,39 @@ fn float(v: f64) -> String {
     } else {
         format!("{v:?}")
     }
+}
+
+/// `Form::time_dependent` of form `fi`: whether its integrands (in any dimension) read `t`, or
+/// which coefs they read.
+fn time_dependence(prog: &Program, irs: &[&DimIr], fi: usize) -> String {
+    let mut time = false;
+    let mut coefs: Vec<u16> = Vec::new();
+    for ir in irs {
+        let integrals = &ir.forms[fi].integrals;
+        let roots = integrals.iter().flat_map(|i| i.f0.iter().chain(&i.f1).chain(&i.value).copied());
+        for n in ir.graph.reachable(roots) {
+            match ir.graph.node(n) {
+                Node::Sym(Sym::Time) => time = true,
+                Node::Sym(Sym::Coef { id, .. }) => coefs.push(id),
+                _ => {}
+            }
+        }
+    }
+    if time {
+        return String::new(); // the default: true
+    }
+    coefs.sort_unstable();
+    coefs.dedup();
+    let body = if coefs.is_empty() {
+        "false".to_string()
+    } else {
+        coefs
+            .iter()
+            .map(|&id| format!("self.coefs.{}.time_dependent()", ident(&prog.coefs[id as usize].name)))
+            .collect::<Vec<_>>()
+            .join(" || ")
+    };
+    format!("fn time_dependent(&self) -> bool {{ {body} }}")
 }
 
 fn coefs_text(prog: &Program) -> String {
