@@ -4,10 +4,10 @@
 //! inverse of each node's d×d diagonal block keeps the iteration count small and the memory
 //! is that of the matrix.
 //!
-//! The work is memory-bound: the matrix–vector product reads the values once and one index
-//! per d×d node block, and it, the vector updates and the dot products are split over
-//! rayon's threads in fixed chunks whose partial sums are added in order, so the iterates
-//! have the same bits for any number of threads.
+//! The work is memory-bound: the matrix–vector product (`Matrix::mul_vec_transposed`) reads
+//! the values once and one index per d×d node block, and it, the vector updates and the dot
+//! products are split over rayon's threads in fixed chunks whose partial sums are added in
+//! order, so the iterates have the same bits for any number of threads.
 
 use rayon::prelude::*;
 
@@ -112,40 +112,10 @@ impl Krylov {
         }
     }
 
-    /// `y = A x`: for a symmetric matrix as `Aᵀ x`, one gather per column in parallel;
-    /// otherwise the sequential column scatter.
+    /// `y = A x`: for a symmetric matrix as `Aᵀ x` (threaded), otherwise the sequential column
+    /// scatter.
     fn mul(&self, x: &[f64], y: &mut [f64]) {
-        if !self.symmetric {
-            return self.matrix.mul_vec(x, y);
-        }
-        match self.matrix.pattern.dim() {
-            1 => self.gather::<1>(x, y),
-            2 => self.gather::<2>(x, y),
-            _ => self.gather::<3>(x, y),
-        }
-    }
-
-    fn gather<const D: usize>(&self, x: &[f64], y: &mut [f64]) {
-        let p = &self.matrix.pattern;
-        let values = &self.matrix.values;
-        let nodes_per_task = CHUNK / (8 * D);
-        y.par_chunks_mut(nodes_per_task * D).enumerate().for_each(|(t, ys)| {
-            for (jj, yj) in ys.chunks_exact_mut(D).enumerate() {
-                let j = t * nodes_per_task + jj;
-                let neighbours = p.neighbours(j);
-                for (m, ym) in yj.iter_mut().enumerate() {
-                    let column = &values[p.col_ptr[j * D + m]..p.col_ptr[j * D + m + 1]];
-                    let mut s = 0.0;
-                    for (&i, a) in neighbours.iter().zip(column.chunks_exact(D)) {
-                        let xi = &x[i as usize * D..][..D];
-                        for k in 0..D {
-                            s += a[k] * xi[k];
-                        }
-                    }
-                    *ym = s;
-                }
-            }
-        });
+        if self.symmetric { self.matrix.mul_vec_transposed(x, y) } else { self.matrix.mul_vec(x, y) }
     }
 
     /// b − A x.

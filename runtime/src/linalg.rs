@@ -43,6 +43,41 @@ impl Matrix {
         }
     }
 
+    /// `y = Aᵀ x`, which is `A x` for a symmetric matrix: each entry of y is one column's dot
+    /// product with x, read in node blocks (one index per d×d block), on rayon's threads in
+    /// fixed chunks (the same bits for any number of threads).
+    pub fn mul_vec_transposed(&self, x: &[f64], y: &mut [f64]) {
+        match self.pattern.dim() {
+            1 => self.gather::<1>(x, y),
+            2 => self.gather::<2>(x, y),
+            _ => self.gather::<3>(x, y),
+        }
+    }
+
+    fn gather<const D: usize>(&self, x: &[f64], y: &mut [f64]) {
+        use rayon::prelude::*;
+        const NODES_PER_TASK: usize = 512;
+        let p = &self.pattern;
+        let values = &self.values;
+        y.par_chunks_mut(NODES_PER_TASK * D).enumerate().for_each(|(t, ys)| {
+            for (jj, yj) in ys.chunks_exact_mut(D).enumerate() {
+                let j = t * NODES_PER_TASK + jj;
+                let neighbours = p.neighbours(j);
+                for (m, ym) in yj.iter_mut().enumerate() {
+                    let column = &values[p.col_ptr[j * D + m]..p.col_ptr[j * D + m + 1]];
+                    let mut s = 0.0;
+                    for (&i, a) in neighbours.iter().zip(column.chunks_exact(D)) {
+                        let xi = &x[i as usize * D..][..D];
+                        for k in 0..D {
+                            s += a[k] * xi[k];
+                        }
+                    }
+                    *ym = s;
+                }
+            }
+        });
+    }
+
     /// `self += alpha * other` (same pattern).
     pub fn add_scaled(&mut self, alpha: f64, other: &Matrix) {
         debug_assert!(Arc::ptr_eq(&self.pattern, &other.pattern) || self.pattern.nnz() == other.pattern.nnz());

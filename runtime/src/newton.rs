@@ -251,7 +251,11 @@ impl Newton {
             // A (numerically) singular Jacobian still yields numbers: check that the step
             // solves the linear system. J δ + R is small for any usable factorization.
             let j = self.jacobian.as_ref().expect("assembled above");
-            j.mul_vec(&delta, &mut jd);
+            if self.factorization.as_ref().is_some_and(|f| f.structure() == Structure::SymmetricPositiveDefinite) {
+                j.mul_vec_transposed(&delta, &mut jd);
+            } else {
+                j.mul_vec(&delta, &mut jd);
+            }
             let linear = jd.iter().zip(&r).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(&r);
             if linear.is_nan() || linear > LINEAR_TOLERANCE {
                 let source = LinalgError::Singular { index: None };

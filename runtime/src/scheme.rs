@@ -512,7 +512,7 @@ impl<'a> Stepper<'a> {
                 Some(k) if alphas.len() == 1 => {
                     // Linear: coef·K·(α w + base).
                     let mut kb = vec![0.0; n];
-                    k.mul_vec(&bases[0], &mut kb);
+                    mul(k, self.structure, &bases[0], &mut kb);
                     constant_rhs.iter_mut().zip(&kb).for_each(|(r, x)| *r += coef * x);
                     if let Some(c) = constant.as_mut() {
                         c.add_scaled(coef * alphas[0], k);
@@ -545,6 +545,8 @@ impl<'a> Stepper<'a> {
             structure: self.structure,
             piecewise,
             scratch: None,
+            args: Vec::new(),
+            term: Vec::new(),
         };
         // δ = w − reference, with the constrained values of w imposed.
         let w0 = match reference {
@@ -640,6 +642,12 @@ fn probe_structure(
     Structure::SymmetricPositiveDefinite
 }
 
+/// `y = A x`; as `Aᵀ x` (threaded, reading half the bytes) when the stage matrices are
+/// symmetric.
+fn mul(a: &Matrix, structure: Structure, x: &[f64], y: &mut [f64]) {
+    if structure == Structure::SymmetricPositiveDefinite { a.mul_vec_transposed(x, y) } else { a.mul_vec(x, y) }
+}
+
 /// A nonlinear term of a stage: coef·form(α₁w + b₁, ...).
 struct ActiveTerm {
     form: &'static str,
@@ -650,12 +658,13 @@ struct ActiveTerm {
 }
 
 impl ActiveTerm {
-    fn args(&self, w: &[f64]) -> Vec<Vec<f64>> {
-        self.alphas
-            .iter()
-            .zip(&self.bases)
-            .map(|(a, b)| b.iter().zip(w).map(|(bi, wi)| bi + a * wi).collect())
-            .collect()
+    /// Writes the arguments α w + b into `out` (resized, reused across calls).
+    fn args_into(&self, w: &[f64], out: &mut Vec<Vec<f64>>) {
+        out.resize_with(self.alphas.len(), Vec::new);
+        for ((o, a), b) in out.iter_mut().zip(&self.alphas).zip(&self.bases) {
+            o.clear();
+            o.extend(b.iter().zip(w).map(|(bi, wi)| bi + a * wi));
+        }
     }
 }
 
@@ -668,8 +677,10 @@ struct StageProblem<'p, 'a> {
     constraints: &'p Constraints,
     structure: Structure,
     piecewise: bool,
-    /// Reused for the nonlinear terms' tangents.
+    /// Reused for the nonlinear terms' tangents, arguments and residuals.
     scratch: Option<Matrix>,
+    args: Vec<Vec<f64>>,
+    term: Vec<f64>,
 }
 
 impl NonlinearProblem for StageProblem<'_, '_> {
@@ -678,15 +689,16 @@ impl NonlinearProblem for StageProblem<'_, '_> {
         if w.iter().all(|x| *x == 0.0) {
             r.copy_from_slice(&self.rhs);
         } else {
-            self.constant.mul_vec(w, r);
+            mul(self.constant, self.structure, w, r);
             r.iter_mut().zip(&self.rhs).for_each(|(ri, c)| *ri += c);
         }
         for term in &self.terms {
-            let args = term.args(w);
-            let refs: Vec<&[f64]> = args.iter().map(Vec::as_slice).collect();
-            let mut b = vec![0.0; r.len()];
-            self.forms[term.form].residual(self.asm, &refs, term.t, &mut b);
-            r.iter_mut().zip(&b).for_each(|(ri, x)| *ri += term.coef * x);
+            term.args_into(w, &mut self.args);
+            let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
+            self.term.clear();
+            self.term.resize(r.len(), 0.0);
+            self.forms[term.form].residual(self.asm, &refs, term.t, &mut self.term);
+            r.iter_mut().zip(&self.term).for_each(|(ri, x)| *ri += term.coef * x);
         }
         self.constraints.zero(r);
     }
@@ -697,8 +709,8 @@ impl NonlinearProblem for StageProblem<'_, '_> {
 
     fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool {
         for term in &self.terms {
-            let args = term.args(w);
-            let refs: Vec<&[f64]> = args.iter().map(Vec::as_slice).collect();
+            term.args_into(w, &mut self.args);
+            let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
                     self.forms[term.form].switches(self.asm, &refs, k, term.t, out);
@@ -711,8 +723,8 @@ impl NonlinearProblem for StageProblem<'_, '_> {
     fn jacobian(&mut self, w: &[f64], j: &mut Matrix) {
         j.values.copy_from_slice(&self.constant.values);
         for term in &self.terms {
-            let args = term.args(w);
-            let refs: Vec<&[f64]> = args.iter().map(Vec::as_slice).collect();
+            term.args_into(w, &mut self.args);
+            let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
                     // Kernels add unscaled: assemble into the scratch matrix, then scale in.

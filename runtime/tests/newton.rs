@@ -2,13 +2,14 @@
 //! pushed onto the obstacle u ≥ ψ by a nodal penalty ε[u − ψ]₋. R is the gradient of the convex
 //! J(u) = ½uᵀKu − Fᵀu + ½ε Σ [u_i − ψ]₋², so Newton's answer must minimise J; it must also be
 //! symmetric, touch the obstacle in the middle and nowhere near the ends, and not depend on
-//! whether the Jacobian is reused while the active set is unchanged.
+//! whether the Jacobian is reused while the active set is unchanged, nor on whether active-set
+//! changes are solved by a low-rank correction of the factorization or by refactoring.
 
 mod common;
 
 use common::{MassStiffness, pseudo_random};
 use signorini_runtime::assembly::{Assembler, Quadrature};
-use signorini_runtime::linalg::{Matrix, Structure};
+use signorini_runtime::linalg::{Counters, Matrix, Solver, Structure};
 use signorini_runtime::mesh::structured::interval;
 use signorini_runtime::newton::{Newton, NewtonOptions, NonlinearProblem};
 use signorini_runtime::problem::Constraints;
@@ -74,6 +75,11 @@ impl NonlinearProblem for Membrane {
 }
 
 fn solve(piecewise: bool) -> (Vec<f64>, usize, Membrane) {
+    let (u, iterations, problem, _) = solve_with(piecewise, NewtonOptions::default());
+    (u, iterations, problem)
+}
+
+fn solve_with(piecewise: bool, options: NewtonOptions) -> (Vec<f64>, usize, Membrane, Counters) {
     let n_el = 64;
     let mesh = interval(n_el, 0.0, 1.0);
     let asm = Assembler::new(&mesh);
@@ -90,8 +96,9 @@ fn solve(piecewise: bool) -> (Vec<f64>, usize, Membrane) {
     constraints.zero(&mut f);
     let mut problem = Membrane { k, f, constraints, piecewise };
     let mut u = vec![0.0; n];
-    let report = Newton::new(NewtonOptions::default()).solve(&mut problem, &mut u).unwrap();
-    (u, report.iterations(), problem)
+    let mut newton = Newton::new(options);
+    let report = newton.solve(&mut problem, &mut u).unwrap();
+    (u, report.iterations(), problem, newton.counters())
 }
 
 #[test]
@@ -125,4 +132,19 @@ fn reusing_the_factorization_does_not_change_the_answer() {
     let (b, _, _) = solve(false);
     let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9 * scale));
+}
+
+#[test]
+fn low_rank_corrections_replace_refactorizations_without_changing_the_answer() {
+    let direct = NewtonOptions { solver: Solver::Direct, ..NewtonOptions::default() };
+    let (a, ia, _, with) = solve_with(true, direct);
+    let (b, ib, _, without) = solve_with(true, NewtonOptions { max_rank: 0, ..direct });
+    assert_eq!(ia, ib, "the same Newton iterates");
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let diff = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    assert!(diff < 1e-12 * scale, "the answers differ by {diff:.1e}");
+    assert_eq!(without.updates, 0);
+    assert!(with.updates > 0, "{with:?}");
+    assert_eq!(with.numeric + with.updates, without.numeric, "each change of the active set: one or the other");
+    assert!(with.numeric < without.numeric / 2, "{with:?} against {without:?}");
 }
