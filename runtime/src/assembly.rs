@@ -445,7 +445,7 @@ fn facet_residual<const D: usize, const N: usize, K: FormKernel<D, N>>(
     t: f64,
     out: &mut [f64],
 ) {
-    let tabs = FacetTabulation::<D, N>::new(mesh.kind, degree).expect("kind matches D and N");
+    let tabs = FacetTabulation::<D, N>::shared(mesh.kind, degree).expect("kind matches D and N");
     let mut local = locals::<D, N>(fields.len());
     for &f in facets {
         let c = f.cell as usize;
@@ -471,7 +471,7 @@ fn facet_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
     t: f64,
     values: &mut [f64],
 ) {
-    let tabs = FacetTabulation::<D, N>::new(mesh.kind, degree).expect("kind matches D and N");
+    let tabs = FacetTabulation::<D, N>::shared(mesh.kind, degree).expect("kind matches D and N");
     let mut local = locals::<D, N>(fields.len());
     let mut ke: Box<LocalMatrix<D, N>> = Box::new([[[[0.0; D]; N]; D]; N]);
     for &f in facets {
@@ -497,7 +497,7 @@ fn facet_switches<const D: usize, const N: usize, K: FormKernel<D, N>>(
     t: f64,
     out: &mut Vec<bool>,
 ) {
-    let tabs = FacetTabulation::<D, N>::new(mesh.kind, degree).expect("kind matches D and N");
+    let tabs = FacetTabulation::<D, N>::shared(mesh.kind, degree).expect("kind matches D and N");
     let mut local = locals::<D, N>(fields.len());
     for &f in facets {
         let c = f.cell as usize;
@@ -586,7 +586,7 @@ fn facet_value<const D: usize, const N: usize, K: FunctionalKernel<D, N>>(
     fields: &[&[f64]],
     t: f64,
 ) -> f64 {
-    let tabs = FacetTabulation::<D, N>::new(mesh.kind, degree).expect("kind matches D and N");
+    let tabs = FacetTabulation::<D, N>::shared(mesh.kind, degree).expect("kind matches D and N");
     let mut local = locals::<D, N>(fields.len());
     let mut total = 0.0;
     for &f in facets {

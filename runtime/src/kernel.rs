@@ -95,6 +95,30 @@ impl<const D: usize, const N: usize> FacetTabulation<D, N> {
         Self::with_rule(kind, &simplex_rule(D - 1, degree))
     }
 
+    /// As `new`, computed once per (kind, degree) and shared: facet loops over a contact region
+    /// run at every Newton iteration, and tabulating costs more than a few facets' kernels.
+    pub fn shared(kind: ElementKind, degree: u32) -> Result<std::sync::Arc<Self>, ShapeError>
+    where
+        Self: Send + Sync + 'static,
+    {
+        use std::any::Any;
+        use std::collections::HashMap;
+        use std::sync::{Arc, Mutex, OnceLock};
+        type Cache = Mutex<HashMap<(ElementKind, u32), Arc<dyn Any + Send + Sync>>>;
+        static CACHE: OnceLock<Cache> = OnceLock::new();
+        let cache = CACHE.get_or_init(Default::default);
+        if let Some(t) = cache.lock().ok().and_then(|c| c.get(&(kind, degree)).cloned())
+            && let Ok(t) = t.downcast::<Self>()
+        {
+            return Ok(t);
+        }
+        let t = Arc::new(Self::new(kind, degree)?);
+        if let Ok(mut c) = cache.lock() {
+            c.insert((kind, degree), t.clone());
+        }
+        Ok(t)
+    }
+
     /// As `new`, with an explicit rule on the reference facet.
     pub fn with_rule(kind: ElementKind, rule: &Rule) -> Result<Self, ShapeError> {
         check_kind::<D, N>(kind)?;

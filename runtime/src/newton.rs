@@ -42,18 +42,18 @@ pub struct NewtonOptions {
     pub line_search: bool,
     /// How the Jacobian systems are solved.
     pub solver: Solver,
-    /// Largest number of dofs on which a new Jacobian may differ from the factored one and be
-    /// solved by a low-rank correction instead of a refactorization (0: always refactor).
+    /// Cap on the number of dofs on which a new Jacobian may differ from the factored one and
+    /// be solved by a low-rank correction instead of a refactorization (0: always refactor).
+    /// Below the cap the limit is the factor's mean column count c = nnz(L)/n (see
+    /// `Newton::rank_limit`).
     pub max_rank: usize,
 }
 
-/// Default `max_rank`: measured with `bench disc` (see docs/mathematics.md).
-pub const MAX_RANK: usize = 256;
+/// Default `max_rank`.
+pub const MAX_RANK: usize = 1024;
 
-/// A numeric refactorization costs about this many solve pairs with its factor (measured with
-/// `bench disc` on the disc meshes): once the corrections applied since the last
-/// factorization have read as many bytes, refactoring at the current active set pays.
-const FACTOR_SOLVES: usize = 20;
+/// The cached columns of a correction (8·n bytes each) take at most this much memory.
+const COLUMN_BYTES: usize = 256 << 20;
 
 /// The previous reference factorization is kept (for an active set that comes back, such as
 /// no contact between bounces) while its factor takes at most this many bytes.
@@ -177,11 +177,26 @@ impl Newton {
         }
     }
 
-    /// Σ of correction sizes over solves that costs as much as a refactorization: a correction
-    /// of size k reads 8·n·k bytes, a solve pair 16·nnz(L).
+    /// The factor's mean column count c = nnz(L)/n. A solve pair reads 16·n·c bytes, a
+    /// factorization does about n·c² flops (c/2 solve pairs' worth), and a correction of size k
+    /// reads 8·n·k bytes per solve (k/2c solve pairs): so a correction is worth it while
+    /// k ≲ c, and until the corrections since the factorization have cost c/2 solve pairs
+    /// (Σ k ≈ c²). Measured with `bench disc` (c = 79 on its 12 490-unknown mesh, where 64 beat
+    /// 256 as a fixed limit) and `bench sphere` (c = 740 at 14 739 unknowns).
+    fn mean_column_count(&self, n: usize) -> Option<usize> {
+        let nnz = self.factorization.as_ref().and_then(Factorization::factor_nnz)?;
+        Some(nnz / n.max(1))
+    }
+
+    /// Largest correction size accepted instead of a refactorization.
+    fn rank_limit(&self, n: usize) -> usize {
+        let c = self.mean_column_count(n).unwrap_or(0);
+        self.options.max_rank.min(c.max(32)).min(COLUMN_BYTES / (8 * n.max(1)))
+    }
+
+    /// Σ of correction sizes over solves that costs as much as a refactorization.
     fn overhead_budget(&self, n: usize) -> usize {
-        let nnz = self.factorization.as_ref().and_then(Factorization::factor_nnz);
-        nnz.map_or(usize::MAX, |nnz| FACTOR_SOLVES * 2 * nnz / n.max(1))
+        self.mean_column_count(n).map_or(usize::MAX, |c| c.max(32).pow(2))
     }
 
     /// Stored values of the current Cholesky factor, if there is one.
@@ -304,7 +319,7 @@ impl Newton {
                 self.swap_references();
                 dofs = other;
             }
-            let updated = dofs.len() <= self.options.max_rank
+            let updated = dofs.len() <= self.rank_limit(j.size())
                 && match (self.low_rank.as_mut(), self.factorization.as_mut()) {
                     (Some(lr), Some(f)) => lr.update(&j, dofs, f).is_ok(),
                     _ => false,
