@@ -80,8 +80,10 @@ impl Quadrature {
 
 /// Assembles forms on one mesh into vectors and matrices sharing one pattern.
 pub struct Assembler<'m> {
-    pub mesh: &'m Mesh,
-    pub pattern: Arc<Pattern>,
+    // Private: the colours and the pattern's cell offsets belong to this mesh, and the threaded
+    // cell loops rely on that (their writes are disjoint only for the mesh they were built for).
+    mesh: &'m Mesh,
+    pattern: Arc<Pattern>,
     /// The cells by colour (computed on first use).
     colours: OnceLock<Vec<Vec<u32>>>,
 }
@@ -95,6 +97,15 @@ impl<'m> Assembler<'m> {
     /// increasing order.
     pub fn colours(&self) -> &[Vec<u32>] {
         self.colours.get_or_init(|| colour_cells(self.mesh))
+    }
+
+    pub fn mesh(&self) -> &'m Mesh {
+        self.mesh
+    }
+
+    /// The sparsity pattern of every matrix assembled here.
+    pub fn pattern(&self) -> &Arc<Pattern> {
+        &self.pattern
     }
 
     /// Number of dofs.

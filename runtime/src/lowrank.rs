@@ -36,6 +36,16 @@ impl LowRank {
         }
     }
 
+    /// Columns computed so far.
+    pub fn cached(&self) -> usize {
+        self.columns.iter().filter(|c| c.is_some()).count()
+    }
+
+    /// How many of `dofs` have no column yet.
+    pub fn missing(&self, dofs: &[usize]) -> usize {
+        dofs.iter().filter(|&&d| self.columns[d].is_none()).count()
+    }
+
     /// Size of the current correction.
     pub fn rank(&self) -> usize {
         self.dofs.len()

@@ -191,12 +191,23 @@ impl Newton {
     /// Largest correction size accepted instead of a refactorization.
     fn rank_limit(&self, n: usize) -> usize {
         let c = self.mean_column_count(n).unwrap_or(0);
-        self.options.max_rank.min(c.max(32)).min(COLUMN_BYTES / (8 * n.max(1)))
+        self.options.max_rank.min(c.max(32)).min(self.column_limit(n))
+    }
+
+    /// Columns the corrections may cache in all (current and previous reference).
+    fn column_limit(&self, n: usize) -> usize {
+        COLUMN_BYTES / (8 * n.max(1))
+    }
+
+    /// Columns cached by both references' corrections.
+    fn cached_columns(&self) -> usize {
+        let current = self.low_rank.as_ref().map_or(0, LowRank::cached);
+        current + self.previous.as_ref().and_then(|r| r.low_rank.as_ref()).map_or(0, LowRank::cached)
     }
 
     /// Σ of correction sizes over solves that costs as much as a refactorization.
     fn overhead_budget(&self, n: usize) -> usize {
-        self.mean_column_count(n).map_or(usize::MAX, |c| c.max(32).pow(2))
+        self.mean_column_count(n).unwrap_or(0).max(32).pow(2)
     }
 
     /// Stored values of the current Cholesky factor, if there is one.
@@ -247,6 +258,7 @@ impl Newton {
             let changed = !piecewise || self.force_refactor || self.factored_for.as_deref() != Some(&set);
             let (mut refactor, mut updated) = (false, false);
             if changed {
+                self.factored_for = None;
                 match self.new_operator(p, w, piecewise) {
                     Ok(full) => (refactor, updated) = (full, !full),
                     Err(source) => return Err(NewtonError::Linear { source, report }),
@@ -266,13 +278,22 @@ impl Newton {
             // A (numerically) singular Jacobian still yields numbers: check that the step
             // solves the linear system. J δ + R is small for any usable factorization.
             let j = self.jacobian.as_ref().expect("assembled above");
-            if self.factorization.as_ref().is_some_and(|f| f.structure() == Structure::SymmetricPositiveDefinite) {
+            // Aᵀ δ reads half the bytes, but only a problem declared symmetric is sure to stay so
+            // (under Structure::Auto a corrected Cholesky reference may meet a nonsymmetric J).
+            if p.structure() == Structure::SymmetricPositiveDefinite {
                 j.mul_vec_transposed(&delta, &mut jd);
             } else {
                 j.mul_vec(&delta, &mut jd);
             }
             let linear = jd.iter().zip(&r).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(&r);
             if linear.is_nan() || linear > LINEAR_TOLERANCE {
+                if self.low_rank.as_ref().is_some_and(|lr| lr.rank() > 0) {
+                    // An ill-conditioned correction: refactor at this iterate and retry.
+                    debug!(linear_residual = linear, "low-rank correction inaccurate: refactoring");
+                    self.force_refactor = true;
+                    self.factored_for = None;
+                    continue;
+                }
                 let source = LinalgError::Singular { index: None };
                 debug!(linear_residual = linear, "the Jacobian is singular to working precision");
                 return Err(NewtonError::Linear { source, report });
@@ -313,13 +334,21 @@ impl Newton {
             p.jacobian(w, &mut j);
             let mut dofs = self.low_rank.as_ref().map(|lr| lr.changed_dofs(&j)).unwrap_or_default();
             // The previous reference, if the active set has come back near it.
-            if let Some(other) = self.previous.as_ref().and_then(|r| r.low_rank.as_ref()).map(|lr| lr.changed_dofs(&j))
+            let budget = self.overhead_budget(j.size());
+            if let Some(other) = self
+                .previous
+                .as_ref()
+                .filter(|r| r.overhead <= budget)
+                .and_then(|r| r.low_rank.as_ref())
+                .map(|lr| lr.changed_dofs(&j))
                 && other.len() < dofs.len()
             {
                 self.swap_references();
                 dofs = other;
             }
+            let new_columns = self.low_rank.as_ref().map_or(0, |lr| lr.missing(&dofs));
             let updated = dofs.len() <= self.rank_limit(j.size())
+                && self.cached_columns() + new_columns <= self.column_limit(j.size())
                 && match (self.low_rank.as_mut(), self.factorization.as_mut()) {
                     (Some(lr), Some(f)) => lr.update(&j, dofs, f).is_ok(),
                     _ => false,
@@ -370,8 +399,10 @@ impl Newton {
             Some(f) if f.structure() == want => f,
             slot => {
                 let old = slot.replace(Factorization::new(want).with_solver(self.options.solver));
-                if old.is_some() {
-                    self.spare = old;
+                if let Some(old) = old
+                    && let Some(replaced) = self.spare.replace(old)
+                {
+                    self.retired = self.retired + replaced.counters;
                 }
                 slot.as_mut().expect("just set")
             }

@@ -609,7 +609,7 @@ fn probe_structure(
         return Structure::General;
     }
     let n = asm.size();
-    let scale = 10.0 * asm.mesh.max_diameter() * asm.mesh.num_cells().max(1) as f64;
+    let scale = 10.0 * asm.mesh().max_diameter() * asm.mesh().num_cells().max(1) as f64;
     let mut seed = 0x9E37_79B9_7F4A_7C15u64;
     let mut random = || {
         seed ^= seed << 13;

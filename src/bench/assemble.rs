@@ -112,7 +112,7 @@ pub fn assemble(sizes: &[usize], factor_n: Option<usize>, repeats: usize, progre
             n,
             cells,
             dofs: asm.size(),
-            nnz: asm.pattern.nnz(),
+            nnz: asm.pattern().nnz(),
             pattern_seconds: median(pattern_times),
             stiffness_us_per_cell: k1 * 1e6 / cells as f64,
             mass_us_per_cell: m1 * 1e6 / cells as f64,

@@ -376,7 +376,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         step_median_seconds: crate::bench::median(step_times),
         factorizations: sim.stepper.counters().numeric,
         low_rank_updates: sim.stepper.counters().updates,
-        matrix_nnz: sim.tools.asm.pattern.nnz(),
+        matrix_nnz: sim.tools.asm.pattern().nnz(),
         factor_nnz: sim.stepper.factor_nnz(),
         solver: opts.newton.solver,
         krylov_iterations: sim.stepper.counters().iterations,

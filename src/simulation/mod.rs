@@ -82,7 +82,7 @@ impl Tools<'_> {
         if let Some(probe) = &self.probe {
             probe.residual(self.asm, &[u], t, &mut c);
         }
-        resultant(&c, self.asm.mesh.dim())
+        resultant(&c, self.asm.mesh().dim())
     }
 
     /// The contact slot's switch at each of its quadrature points (none without the slot).
@@ -96,7 +96,7 @@ impl Tools<'_> {
 
     /// The mass-weighted mean along `axis` (of the displacement: the centre of mass's).
     pub fn axis_mean(&self, axis: usize) -> AxisMean {
-        let d = self.asm.mesh.dim();
+        let d = self.asm.mesh().dim();
         let e: Vec<f64> = (0..self.mass.size()).map(|i| if i % d == axis { 1.0 } else { 0.0 }).collect();
         let mut weights = vec![0.0; e.len()];
         self.mass.mul_vec(&e, &mut weights);
@@ -153,7 +153,7 @@ impl<'m> Simulation<'m> {
     /// Binds the files in use on `asm`'s mesh, redistributes the mass when asked (the contact
     /// nodes carry none; a⁰ = 0 there), and builds the stepper.
     pub fn new(asm: &'m Assembler<'m>, problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
-        let mesh: &Mesh = asm.mesh;
+        let mesh: &Mesh = asm.mesh();
         let n = asm.size();
         let contact_facets = asm.region(problem.contact)?;
         let binding = Binding {
@@ -299,7 +299,7 @@ impl Snapshots {
         if !k.is_multiple_of(self.every) {
             return Ok(());
         }
-        let mesh = tools.asm.mesh;
+        let mesh = tools.asm.mesh();
         let file = format!("{}_{k:06}.vtu", self.name);
         let vm = match (&tools.von_mises, &tools.cell_measure) {
             (Some(vm), Some(measure)) => {

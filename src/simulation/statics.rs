@@ -46,7 +46,7 @@ pub fn solve<'m>(
     active: &ActiveForms,
     initial: Vec<f64>,
 ) -> Result<StaticSolution<'m>, CaseError> {
-    let d = asm.mesh.dim();
+    let d = asm.mesh().dim();
     let n = asm.size();
     let facets = asm.region(problem.contact)?;
     let regions = vec![("Gamma_C".to_string(), facets)];

@@ -24,7 +24,7 @@ pub struct Sample {
 /// of the contact boundary that faces the plane (outward normal pointing down), where the
 /// horizontal distance names a point.
 pub fn sample(asm: &Assembler, pressure: &dyn BoundFunctional, u: &[f64]) -> Vec<Sample> {
-    let d = asm.mesh.dim();
+    let d = asm.mesh().dim();
     let rule = sampling_rule(d - 1, if d == 2 { SAMPLES } else { SAMPLES / 2 });
     pressure
         .facet_point_values(asm, &rule, &[u], 0.0)
