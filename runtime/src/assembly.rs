@@ -288,22 +288,7 @@ fn with_refs<const D: usize, const N: usize, R>(
 /// Greedy colouring of the cells: each takes the smallest colour none of the cells sharing one
 /// of its nodes has taken.
 fn colour_cells(mesh: &Mesh) -> Vec<Vec<u32>> {
-    let nodes = mesh.num_nodes();
-    let mut inc_ptr = vec![0usize; nodes + 1];
-    for &n in &mesh.cells {
-        inc_ptr[n as usize + 1] += 1;
-    }
-    for i in 0..nodes {
-        inc_ptr[i + 1] += inc_ptr[i];
-    }
-    let mut fill = inc_ptr.clone();
-    let mut inc = vec![0u32; mesh.cells.len()];
-    for c in 0..mesh.num_cells() {
-        for &n in mesh.cell(c) {
-            inc[fill[n as usize]] = c as u32;
-            fill[n as usize] += 1;
-        }
-    }
+    let (inc_ptr, inc) = crate::pattern::cells_of_nodes(mesh);
     let mut colour = vec![u32::MAX; mesh.num_cells()];
     // taken[k] == c + 1: colour k is used by a neighbour of cell c.
     let mut taken: Vec<usize> = Vec::new();

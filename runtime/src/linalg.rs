@@ -434,32 +434,12 @@ impl Factorization {
     /// Solves `A x = b` in place with the last factorization; a non-finite result (a
     /// numerically singular matrix) is an error.
     pub fn solve_in_place(&mut self, b: &mut [f64]) -> Result<(), LinalgError> {
-        let n = b.len();
-        let par = self.par;
         if let Factors::Krylov(k) = &mut self.factors {
             let result = k.solve_in_place(b);
             self.counters.iterations += k.iterations;
             self.counters.solves += 1;
             return result;
         }
-        let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
-        match &self.factors {
-            Factors::Llt { symbolic, values, factored: true } => {
-                let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
-                LltRef::new(symbolic, values).solve_in_place_with_conj(Conj::No, rhs, par, MemStack::new(&mut mem));
-            }
-            Factors::Lu { symbolic, numeric, factored: true } => {
-                let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
-                LuRef::new_unchecked(symbolic, numeric).solve_in_place_with_conj(
-                    Conj::No,
-                    rhs,
-                    par,
-                    MemStack::new(&mut mem),
-                );
-            }
-            _ => return Err(LinalgError::NotFactored),
-        }
-        self.counters.solves += 1;
-        if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(LinalgError::Singular { index: None }) }
+        self.solve_many_in_place(b, 1)
     }
 }

@@ -328,7 +328,9 @@ impl Newton {
     /// when the problem is piecewise, the factorization direct and the change small enough,
     /// else a refactorization (which becomes the new reference). Returns whether it refactored.
     fn new_operator(&mut self, p: &mut impl NonlinearProblem, w: &[f64], piecewise: bool) -> Result<bool, LinalgError> {
+        let mut assembled = false;
         if piecewise && !self.force_refactor && self.low_rank.is_some() {
+            assembled = true;
             let mut j = self.jacobian.take().expect("assembled with the reference");
             j.values.iter_mut().for_each(|v| *v = 0.0);
             p.jacobian(w, &mut j);
@@ -374,7 +376,7 @@ impl Newton {
         }
         self.low_rank = None;
         self.overhead = 0;
-        self.refactor(p, w)?;
+        self.refactor(p, w, assembled)?;
         let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
         if piecewise && direct && self.options.max_rank > 0 {
             self.low_rank = Some(LowRank::new(self.jacobian.as_ref().expect("assembled by refactor")));
@@ -383,10 +385,13 @@ impl Newton {
     }
 
     /// Assembles and factors the Jacobian at w; a failed Cholesky falls back to LU.
-    fn refactor(&mut self, p: &mut impl NonlinearProblem, w: &[f64]) -> Result<(), LinalgError> {
+    /// `assembled`: the Jacobian at w is already in place (from a low-rank attempt).
+    fn refactor(&mut self, p: &mut impl NonlinearProblem, w: &[f64], assembled: bool) -> Result<(), LinalgError> {
         let j = self.jacobian.get_or_insert_with(|| p.jacobian_matrix());
-        j.values.iter_mut().for_each(|v| *v = 0.0);
-        p.jacobian(w, j);
+        if !assembled {
+            j.values.iter_mut().for_each(|v| *v = 0.0);
+            p.jacobian(w, j);
+        }
         let want = match p.structure() {
             Structure::Auto if self.spd_failed || !j.is_symmetric(1e-12) => Structure::General,
             Structure::Auto => Structure::SymmetricPositiveDefinite,

@@ -21,6 +21,27 @@ pub struct Pattern {
     cell_offsets: Vec<u32>,
 }
 
+/// The cells of each node: node i's are `cells[ptr[i]..ptr[i + 1]]`, in increasing order.
+pub(crate) fn cells_of_nodes(mesh: &Mesh) -> (Vec<usize>, Vec<u32>) {
+    let nodes = mesh.num_nodes();
+    let mut ptr = vec![0usize; nodes + 1];
+    for &n in &mesh.cells {
+        ptr[n as usize + 1] += 1;
+    }
+    for i in 0..nodes {
+        ptr[i + 1] += ptr[i];
+    }
+    let mut fill = ptr.clone();
+    let mut cells = vec![0u32; mesh.cells.len()];
+    for c in 0..mesh.num_cells() {
+        for &n in mesh.cell(c) {
+            cells[fill[n as usize]] = c as u32;
+            fill[n as usize] += 1;
+        }
+    }
+    (ptr, cells)
+}
+
 impl Pattern {
     /// Couples every pair of nodes sharing a cell.
     pub fn new(mesh: &Mesh) -> Pattern {
@@ -28,22 +49,7 @@ impl Pattern {
         let npc = mesh.kind.nodes();
         let nodes = mesh.num_nodes();
         let cells = mesh.num_cells();
-        // Node → cells incidence.
-        let mut inc_ptr = vec![0usize; nodes + 1];
-        for &n in &mesh.cells {
-            inc_ptr[n as usize + 1] += 1;
-        }
-        for i in 0..nodes {
-            inc_ptr[i + 1] += inc_ptr[i];
-        }
-        let mut fill = inc_ptr.clone();
-        let mut inc = vec![0u32; mesh.cells.len()];
-        for c in 0..cells {
-            for &n in mesh.cell(c) {
-                inc[fill[n as usize]] = c as u32;
-                fill[n as usize] += 1;
-            }
-        }
+        let (inc_ptr, inc) = cells_of_nodes(mesh);
         // Node adjacency, sorted.
         let mut adj_ptr = Vec::with_capacity(nodes + 1);
         adj_ptr.push(0usize);
