@@ -72,16 +72,22 @@ impl Matrix {
             for (jj, yj) in ys.chunks_exact_mut(D).enumerate() {
                 let j = t * NODES_PER_TASK + jj;
                 let neighbours = p.neighbours(j);
-                for (m, ym) in yj.iter_mut().enumerate() {
-                    let column = &values[p.col_ptr[j * D + m]..p.col_ptr[j * D + m + 1]];
-                    let mut s = 0.0;
-                    for (&i, a) in neighbours.iter().zip(column.chunks_exact(D)) {
-                        let xi = &x[i as usize * D..][..D];
+                let columns: [&[f64]; D] =
+                    std::array::from_fn(|m| &values[p.col_ptr[j * D + m]..p.col_ptr[j * D + m + 1]]);
+                // D² independent sums (one per block entry) instead of one chain of dependent
+                // additions per column: 1.4 times faster on P2 plane strain (benches/linalg.rs).
+                let mut acc = [[0.0f64; D]; D];
+                for (n, &i) in neighbours.iter().enumerate() {
+                    let xi = &x[i as usize * D..][..D];
+                    for m in 0..D {
+                        let a = &columns[m][n * D..][..D];
                         for k in 0..D {
-                            s += a[k] * xi[k];
+                            acc[m][k] += a[k] * xi[k];
                         }
                     }
-                    *ym = s;
+                }
+                for (ym, row) in yj.iter_mut().zip(&acc) {
+                    *ym = row.iter().sum();
                 }
             }
         };
