@@ -163,3 +163,41 @@ fn full_traction_nitsche_is_the_normal_law_in_1d() {
         }
     }
 }
+
+/// Newton's stopping scale is the residual's own, not the inertial right-hand side's (∝ 1/Δt²):
+/// from Δt = 1 down to 1e-7 every step iterates, and the error against the exact solution on
+/// [0, 0.01] falls like Δt² onto the space error (the Δt = 1e-7 run's).
+#[test]
+fn time_steps_from_one_to_1e_minus_7_converge_onto_the_space_error() {
+    for dt in [1.0, 0.1] {
+        let r = run(|o| {
+            o.dt = dt;
+            o.t_end = dt;
+        });
+        assert!(r.series[1..].iter().all(|row| row.newton >= 1), "Δt = {dt}: a step without a Newton iteration");
+        assert!(r.series.iter().all(|row| row.u_c.is_finite()), "Δt = {dt}");
+    }
+    let steps = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7];
+    let errors: Vec<f64> = steps
+        .iter()
+        .map(|&dt| {
+            let r = run(|o| {
+                o.dt = dt;
+                o.t_end = 0.01;
+            });
+            assert!(r.series[1..].iter().all(|row| row.newton >= 1), "Δt = {dt}: a step without a Newton iteration");
+            r.summary.err_linf_l2_u
+        })
+        .collect();
+    let space = errors[errors.len() - 1];
+    let time: Vec<f64> = errors.iter().map(|e| e - space).collect();
+    // Second order: each tenth of Δt divides the time error by ~100, until round-off (1e-12).
+    for k in 0..steps.len() - 1 {
+        if time[k] > 1e-11 {
+            assert!(time[k + 1] < time[k] / 50.0, "Δt {} → {}: time errors {time:?}", steps[k], steps[k + 1]);
+        } else {
+            assert!(time[k + 1].abs() < 1e-11, "Δt {}: {time:?}", steps[k + 1]);
+        }
+    }
+    assert!(time[0] > 1e-7, "the largest step has a visible time error: {time:?}");
+}

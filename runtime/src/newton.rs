@@ -1,6 +1,10 @@
 //! Semi-smooth Newton for R(w) = 0 with contact.
 //!
-//! Stops when ‖R(w)‖∞ ≤ tol · max(‖R(w⁰)‖∞, ‖b‖∞), b the loads. The contact tangent depends
+//! Stops when ‖R(w)‖∞ ≤ tol·‖R(w⁰)‖∞, when the last step kept the active set and changed w by
+//! at most tol·‖w‖∞, or when R is at round-off: ‖R‖∞ ≤ 512ε times the largest term summed in
+//! R (the problem's `magnitude`). The scale is R's own: a right-hand side dominated by inertia
+//! (∝ 1/Δt²) does not set it. It iterates at least once unless R(w⁰) is at round-off already.
+//! The contact tangent depends
 //! on the state only through the active set, so the problem reports its active set at each
 //! iterate; while it is the one the current operator was built for, the Jacobian is neither
 //! reassembled nor refactored. When it changes, the new Jacobian is assembled and, if it
@@ -13,16 +17,26 @@ use tracing::debug;
 use crate::linalg::{Factorization, LinalgError, Matrix, Solver, Structure};
 use crate::lowrank::LowRank;
 
+/// A residual at most this times its terms' magnitude is round-off (a few hundred roundings).
+pub const ROUNDOFF: f64 = 512.0 * f64::EPSILON;
+
 /// Largest accepted ‖J δ + R‖∞ / ‖R‖∞ of a Newton step; above it the Jacobian is treated as
 /// singular (round-off in a sound solve stays orders of magnitude below).
 const LINEAR_TOLERANCE: f64 = 1e-6;
+
+/// At round-off, or after at least one iteration below the relative threshold or with a step
+/// too small to matter.
+fn converged(res: f64, floor: f64, threshold: f64, iterated: bool, small_step: bool) -> bool {
+    res <= floor || (iterated && (res <= threshold || small_step))
+}
 
 /// A nonlinear system R(w) = 0 with a (semi-smooth) Jacobian.
 pub trait NonlinearProblem {
     /// Writes R(w) (zero on constrained dofs).
     fn residual(&mut self, w: &[f64], r: &mut [f64]);
-    /// ‖b‖∞ of the loads, for the stopping criterion.
-    fn load_scale(&self) -> f64;
+    /// The largest ∞-norm among the terms summed in the last `residual` (stiffness, inertia,
+    /// contact, loads): the residual's round-off is about ε times this.
+    fn magnitude(&self) -> f64;
     /// Writes the active set at w. Returns false if the Jacobian depends on w otherwise (then
     /// it is rebuilt at every iteration).
     fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool;
@@ -238,12 +252,14 @@ impl Newton {
             return Err(NewtonError::NonFinite { report });
         }
         // Floored at the smallest normal number: a state decaying to zero (a damped scheme run
-        // for long) makes tol·r0 underflow to 0, which no subnormal residual could reach.
-        let threshold = (self.options.tol * r0.max(p.load_scale())).max(f64::MIN_POSITIVE);
+        // for long) makes the thresholds underflow to 0, which no subnormal residual could reach.
+        let floor = (ROUNDOFF * p.magnitude()).max(f64::MIN_POSITIVE);
+        let threshold = (self.options.tol * r0).max(floor);
         let mut res = r0;
         let mut piecewise = false;
         let mut next: Option<Vec<bool>> = None;
-        while res > threshold {
+        let mut small_step = false;
+        while !converged(res, floor, threshold, !report.history.is_empty(), small_step) {
             if report.history.len() >= self.options.max_iterations {
                 return Err(NewtonError::IterationLimit { report, threshold });
             }
@@ -304,15 +320,21 @@ impl Newton {
                 w.iter_mut().zip(&delta).for_each(|(x, d)| *x += d);
                 let mut after = Vec::with_capacity(set.len());
                 p.active_set(w, &mut after);
-                if after == set {
+                let kept = after == set;
+                if kept {
                     r.iter_mut().zip(&jd).for_each(|(ri, x)| *ri += x);
                 } else {
                     p.residual(w, &mut r);
                 }
+                small_step = kept && norm_inf(&delta) <= self.options.tol * norm_inf(w);
                 next = Some(after);
                 1.0
             } else {
-                self.step(p, w, &delta, &mut r)
+                let step = self.step(p, w, &delta, &mut r);
+                let mut after = Vec::with_capacity(set.len());
+                p.active_set(w, &mut after);
+                small_step = after == set && step * norm_inf(&delta) <= self.options.tol * norm_inf(w);
+                step
             };
             res = norm_inf(&r);
             debug!(iteration = report.history.len() + 1, residual = res, active, refactor, updated, step, "newton");

@@ -101,7 +101,8 @@ pub struct StaticContact<'m> {
     asm: &'m Assembler<'m>,
     stiffness: Matrix,
     load: Vec<f64>,
-    load_scale: f64,
+    /// The largest term of the last residual.
+    magnitude: f64,
     /// The contact form, bound to its boundary region.
     pub contact: Box<dyn BoundForm + 'm>,
     pub constraints: Constraints,
@@ -124,14 +125,12 @@ impl<'m> StaticContact<'m> {
         stiffness.tangent(asm, &[&zero], 0, 0.0, &mut k);
         let mut load = load;
         constraints.zero(&mut load);
-        let load_scale = crate::newton::norm_inf(&load);
-        StaticContact { asm, stiffness: k, load, load_scale, contact, constraints, structure }
+        StaticContact { asm, stiffness: k, load, magnitude: 0.0, contact, constraints, structure }
     }
 
     /// Replaces the loads (the stiffness, and so a factorization, stay valid).
     pub fn set_load(&mut self, mut load: Vec<f64>) {
         self.constraints.zero(&mut load);
-        self.load_scale = crate::newton::norm_inf(&load);
         self.load = load;
     }
 
@@ -145,14 +144,18 @@ impl<'m> StaticContact<'m> {
 
 impl NonlinearProblem for StaticContact<'_> {
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
+        use crate::newton::norm_inf;
         self.stiffness.mul_vec(u, r);
+        let stiffness = norm_inf(r);
         self.contact.residual(self.asm, &[u], 0.0, r);
+        // The contact term's size is that of K u + C(u) at worst plus K u's.
+        self.magnitude = stiffness.max(norm_inf(r)).max(norm_inf(&self.load));
         r.iter_mut().zip(&self.load).for_each(|(ri, li)| *ri -= li);
         self.constraints.zero(r);
     }
 
-    fn load_scale(&self) -> f64 {
-        self.load_scale
+    fn magnitude(&self) -> f64 {
+        self.magnitude
     }
 
     fn active_set(&mut self, u: &[f64], out: &mut Vec<bool>) -> bool {

@@ -547,6 +547,7 @@ impl<'a> Stepper<'a> {
             scratch: None,
             args: Vec::new(),
             term: Vec::new(),
+            magnitude: 0.0,
         };
         // δ = w − reference, with the constrained values of w imposed.
         let w0 = match reference {
@@ -681,15 +682,20 @@ struct StageProblem<'p, 'a> {
     scratch: Option<Matrix>,
     args: Vec<Vec<f64>>,
     term: Vec<f64>,
+    /// The largest term of the last residual.
+    magnitude: f64,
 }
 
 impl NonlinearProblem for StageProblem<'_, '_> {
     fn residual(&mut self, w: &[f64], r: &mut [f64]) {
+        use crate::newton::norm_inf;
         // Newton starts from δ = 0 unless a constraint moves: no product then.
+        self.magnitude = norm_inf(&self.rhs);
         if w.iter().all(|x| *x == 0.0) {
             r.copy_from_slice(&self.rhs);
         } else {
             mul(self.constant, self.structure, w, r);
+            self.magnitude = self.magnitude.max(norm_inf(r));
             r.iter_mut().zip(&self.rhs).for_each(|(ri, c)| *ri += c);
         }
         for term in &self.terms {
@@ -698,13 +704,14 @@ impl NonlinearProblem for StageProblem<'_, '_> {
             self.term.clear();
             self.term.resize(r.len(), 0.0);
             self.forms[term.form].residual(self.asm, &refs, term.t, &mut self.term);
+            self.magnitude = self.magnitude.max(term.coef.abs() * norm_inf(&self.term));
             r.iter_mut().zip(&self.term).for_each(|(ri, x)| *ri += term.coef * x);
         }
         self.constraints.zero(r);
     }
 
-    fn load_scale(&self) -> f64 {
-        crate::newton::norm_inf(&self.rhs)
+    fn magnitude(&self) -> f64 {
+        self.magnitude
     }
 
     fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool {

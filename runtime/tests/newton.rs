@@ -49,7 +49,7 @@ impl NonlinearProblem for Membrane {
         }
         self.constraints.zero(r);
     }
-    fn load_scale(&self) -> f64 {
+    fn magnitude(&self) -> f64 {
         self.f.iter().fold(0.0, |m, x| m.max(x.abs()))
     }
     fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool {
@@ -147,4 +147,69 @@ fn low_rank_corrections_replace_refactorizations_without_changing_the_answer() {
     assert!(with.updates > 0, "{with:?}");
     assert_eq!(with.numeric + with.updates, without.numeric, "each change of the active set: one or the other");
     assert!(with.numeric < without.numeric / 2, "{with:?} against {without:?}");
+}
+
+/// R(w) = (cM + K) w − (cM w̃ + f), an implicit step with c = 1/(βΔt²) for Δt ≈ 1e-7: the
+/// right-hand side is 10¹³ times the force balance M a + K w − f that Newton must satisfy.
+struct InertiaDominated {
+    a: Matrix,
+    rhs: Vec<f64>,
+    magnitude: f64,
+}
+
+impl NonlinearProblem for InertiaDominated {
+    fn residual(&mut self, w: &[f64], r: &mut [f64]) {
+        self.a.mul_vec(w, r);
+        self.magnitude = r.iter().chain(&self.rhs).fold(0.0, |m, x| m.max(x.abs()));
+        r.iter_mut().zip(&self.rhs).for_each(|(ri, b)| *ri -= b);
+    }
+    fn magnitude(&self) -> f64 {
+        self.magnitude
+    }
+    fn active_set(&mut self, _: &[f64], _: &mut Vec<bool>) -> bool {
+        true
+    }
+    fn jacobian(&mut self, _: &[f64], j: &mut Matrix) {
+        j.values.copy_from_slice(&self.a.values);
+    }
+    fn jacobian_matrix(&self) -> Matrix {
+        Matrix::zeros(self.a.pattern.clone())
+    }
+    fn structure(&self) -> Structure {
+        Structure::SymmetricPositiveDefinite
+    }
+}
+
+#[test]
+fn an_inertial_right_hand_side_does_not_set_the_stopping_scale() {
+    let mesh = interval(64, 0.0, 1.0);
+    let asm = Assembler::new(&mesh);
+    let n = asm.size();
+    let zero = vec![0.0; n];
+    let c = 1e15;
+    let (mut m, mut k) = (asm.zero_matrix(), asm.zero_matrix());
+    asm.cell_tangent(&MassStiffness { rho: 1.0, k: 0.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut m);
+    asm.cell_tangent(&MassStiffness { rho: 0.0, k: 1.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut k);
+    let mut a = k.clone();
+    a.add_scaled(c, &m);
+    // A rough predictor w̃ (so K w̃ is not small) and a unit load.
+    let predictor: Vec<f64> = pseudo_random(n, 7).iter().map(|x| 1.0 + x).collect();
+    let mut f = vec![0.0; n];
+    m.mul_vec(&vec![1.0; n], &mut f);
+    let mut rhs = vec![0.0; n];
+    m.mul_vec(&predictor, &mut rhs);
+    rhs.iter_mut().zip(&f).for_each(|(r, fi)| *r = c * *r + fi);
+    let mut problem = InertiaDominated { a, rhs, magnitude: 0.0 };
+    let mut w = predictor.clone();
+    let report = Newton::new(NewtonOptions::default()).solve(&mut problem, &mut w).unwrap();
+    assert!(report.iterations() >= 1, "no iteration from a residual of {:.2e}", report.initial_residual);
+    // The force balance M a + K w = f with a = c (w − w̃), to the precision w − w̃ ≈ 1e-11
+    // keeps against w ≈ 1 (about 1e-5).
+    let accel: Vec<f64> = w.iter().zip(&predictor).map(|(x, p)| c * (x - p)).collect();
+    let (mut ma, mut kw) = (vec![0.0; n], vec![0.0; n]);
+    m.mul_vec(&accel, &mut ma);
+    k.mul_vec(&w, &mut kw);
+    let defect = (0..n).map(|i| (ma[i] + kw[i] - f[i]).abs()).fold(0.0, f64::max);
+    let scale = (0..n).map(|i| (kw[i] - f[i]).abs()).fold(0.0, f64::max);
+    assert!(defect < 1e-3 * scale, "force balance off by {defect:.2e} of {scale:.2e}");
 }
