@@ -137,14 +137,16 @@ fn midpoint_schemes_measure_contact_at_half_steps() {
             o.mass = MassChoice::Redistributed;
         })
         .summary;
-        assert!(s.err_l2_lambda_half < 0.45, "{scheme:?}: err_λ at half steps {}", s.err_l2_lambda_half);
+        let half = s.err_l2_lambda_half.expect("contact on [0, 12]");
+        assert!(half < 0.45, "{scheme:?}: err_λ at half steps {half}");
     }
     let midpoint = run(|o| {
         o.setup.scheme = "midpoint".into();
         o.mass = MassChoice::Redistributed;
     })
     .summary;
-    assert!(midpoint.err_l2_lambda > 4.0 * midpoint.err_l2_lambda_half, "{midpoint:?}");
+    let (full, half) = (midpoint.err_l2_lambda.unwrap(), midpoint.err_l2_lambda_half.unwrap());
+    assert!(full > 4.0 * half, "{midpoint:?}");
 }
 
 /// In 1D σ(u)n = σ_N(u) n, so GetFEM's full-traction Nitsche law is the normal one, and GetFEM's
@@ -200,4 +202,42 @@ fn time_steps_from_one_to_1e_minus_7_converge_onto_the_space_error() {
         }
     }
     assert!(time[0] > 1e-7, "the largest step has a visible time error: {time:?}");
+}
+
+/// Nitsche θ = −1 with γ0 = 1e-6 is not coercive: the energy explodes (to 1e140 by t = 12).
+/// The run stops at the first check past 10× the initial energy, with the cause, and writes the
+/// series up to there and a summary that says why.
+#[test]
+fn an_unstable_run_stops_with_its_cause_and_its_results_so_far() {
+    let dir = std::env::temp_dir().join(format!("signorini-blowup-{}", std::process::id()));
+    let mut o = Options { out: Some(dir.clone()), ..Options::default() };
+    o.setup = o.setup.clone().set("theta", -1.0).set("gamma0", 1e-6);
+    let err = bar::run(&o).err().expect("the run must stop");
+    let text = err.to_string();
+    assert!(text.contains("unstable") && text.contains("gamma0 = 0.000001"), "{text}");
+    let csv = std::fs::read_to_string(dir.join("series.csv")).unwrap();
+    let last_t: f64 = csv.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
+    assert!(last_t > 0.0 && last_t < 1.0, "stopped at {last_t}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["stopped"].as_str().unwrap().contains("unstable"), "{summary}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A Newton allowed one iteration cannot follow the active set's change at first contact at
+/// any Δt: the step is retried at Δt/2 ... Δt/64, then the run stops saying where, with the
+/// residual history, after writing the series up to the last good step.
+#[test]
+fn a_step_that_fails_at_every_cut_stops_the_run_with_its_history() {
+    let dir = std::env::temp_dir().join(format!("signorini-cuts-{}", std::process::id()));
+    let mut o = Options { t_end: 2.0, out: Some(dir.clone()), ..Options::default() };
+    o.newton.max_iterations = 1;
+    let text = bar::run(&o).err().expect("no step converges in one iteration at contact").to_string();
+    assert!(text.contains("after 6 step cuts") && text.contains("Newton: residual"), "{text}");
+    let csv = std::fs::read_to_string(dir.join("series.csv")).unwrap();
+    let times: Vec<f64> = csv.lines().skip(1).map(|l| l.split(',').next().unwrap().parse().unwrap()).collect();
+    // Up to just before the impact at t = 1, the cut steps included.
+    assert!(times.last().is_some_and(|t| *t > 0.99 && *t < 1.0), "{:?}", &times[times.len() - 3..]);
+    assert!(times.windows(2).any(|w| w[1] - w[0] < 0.5 * o.dt), "no cut step in the series");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -125,3 +125,22 @@ fn an_unstable_setting_fails_with_a_clear_error() {
     let e = disc::run(&o).err().expect("diverges").to_string();
     assert!(e.contains("time stepping failed") && e.contains("finite"), "{e}");
 }
+
+/// With Newton held to two iterations, Δt = 0.1 cannot follow the first impact: those steps
+/// are retried with Δt halved, the step size returns to 0.1 afterwards, and the run reaches
+/// t_end on the nominal time levels with the cuts counted.
+#[test]
+fn steps_cut_at_impact_return_to_the_nominal_step() {
+    let mut o = Options { t_end: 9.0, dt: 0.1, ..Options::default() };
+    o.newton.max_iterations = 2;
+    let r = disc::run(&o).unwrap();
+    let s = &r.summary;
+    assert!(s.step_cuts > 0, "no cut at Δt = 0.1");
+    let times: Vec<f64> = r.series.iter().map(|row| row.t).collect();
+    let short = times.windows(2).filter(|w| w[1] - w[0] < 0.99 * o.dt).count();
+    assert!(short >= 2, "{short} short steps for {} cuts", s.step_cuts);
+    assert!((times.last().unwrap() - 9.0).abs() < 1e-12, "ends at {}", times.last().unwrap());
+    // After the cuts the steps are whole again.
+    let tail = &times[times.len() - 10..];
+    assert!(tail.windows(2).all(|w| (w[1] - w[0] - o.dt).abs() < 1e-9), "{tail:?}");
+}

@@ -98,12 +98,15 @@ pub struct Summary {
     pub steps: usize,
     /// max_n ‖u_h − I_h u‖_M / max_n ‖I_h u‖_M.
     pub err_linf_l2_u: f64,
-    /// (Σ (λⁿ − σ_ex(0, tⁿ))²)^½ / (Σ σ_ex(0, tⁿ)²)^½.
-    pub err_l2_lambda: f64,
+    /// (Σ (λⁿ − σ_ex(0, tⁿ))²)^½ / (Σ σ_ex(0, tⁿ)²)^½; absent (see `notes`) when the exact
+    /// contact stress is zero on [0, t_end].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub err_l2_lambda: Option<f64>,
     /// The same with λ evaluated at u^{n+½} = (uⁿ + uⁿ⁺¹)/2 against σ_ex(0, t^{n+½}): where the
     /// midpoint and hybrid schemes impose contact (docs/mathematics.md §6 [P]; with redistributed mass their
     /// contact node oscillates with period 2 at integer steps).
-    pub err_l2_lambda_half: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub err_l2_lambda_half: Option<f64>,
     pub energy_initial: f64,
     pub energy_final: f64,
     pub energy_aug_initial: f64,
@@ -116,6 +119,14 @@ pub struct Summary {
     pub newton_total: usize,
     pub newton_max: usize,
     pub wall_seconds: f64,
+    /// Halvings of Δt after a failed Newton (the series has the actual time levels).
+    pub step_cuts: usize,
+    /// Why the run ended before t_end, if it did (the series stops at the last good step).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
+    /// Why a metric is absent.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 pub struct Run {
@@ -211,16 +222,16 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let (mut half_err, mut half_norm) = (0.0, 0.0);
     let v_index = sim.v_index;
     let mut t = 0.0;
-    sim.run(0.0, opts.dt, steps, opts.progress, &mut |_, _, _| {}, &mut |tools, step| {
-        t = step.k as f64 * opts.dt;
+    let outcome = sim.run(0.0, opts.dt, steps, opts.progress, &mut |_, _, _| {}, &mut |tools, step| {
+        t = step.t;
         let mut row =
             measure(tools, &step.states[0], v_index.map(|i| step.states[i].as_slice()), step.report.iterations(), t);
         if redistributed {
             // The massless contact node's velocity is not meaningful: report its mean velocity.
-            row.v_c = (step.states[0][0] - step.before[0]) / opts.dt;
+            row.v_c = (step.states[0][0] - step.before[0]) / step.dt;
         }
         let half: Vec<f64> = step.before.iter().zip(&step.states[0]).map(|(a, b)| 0.5 * (a + b)).collect();
-        let s = exact::contact_stress(t - 0.5 * opts.dt);
+        let s = exact::contact_stress(t - 0.5 * step.dt);
         row.lambda_half = contact_stress(tools, &half).0;
         half_err += (row.lambda_half - s).powi(2);
         half_norm += s * s;
@@ -245,8 +256,8 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         dofs: n,
         steps,
         err_linf_l2_u: err_max / exact_max,
-        err_l2_lambda: (lam_err / lam_norm).sqrt(),
-        err_l2_lambda_half: (half_err / half_norm).sqrt(),
+        err_l2_lambda: relative(lam_err, lam_norm),
+        err_l2_lambda_half: relative(half_err, half_norm),
         energy_initial: first.energy,
         energy_final: last.energy,
         energy_aug_initial: e0,
@@ -257,11 +268,29 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         newton_total: series.iter().map(|r| r.newton).sum(),
         newton_max: series.iter().map(|r| r.newton).max().unwrap_or(0),
         wall_seconds: start.elapsed().as_secs_f64(),
+        step_cuts: outcome.cuts,
+        stopped: outcome.stopped.as_ref().map(ToString::to_string),
+        notes: Vec::new(),
     };
+    let mut summary = summary;
+    if summary.err_l2_lambda.is_none() {
+        summary.notes.push(format!(
+            "err_l2_lambda and err_l2_lambda_half omitted: the exact contact stress is zero on [0, {}] (first contact at t = 1)",
+            summary.t_end
+        ));
+    }
     if let Some(dir) = &opts.out {
         write_outputs(dir, &summary, &series)?;
     }
+    if let Some(e) = outcome.stopped {
+        return Err(e);
+    }
     Ok(Run { summary, series })
+}
+
+/// (err/norm)^½, undefined when the exact quantity is zero.
+fn relative(err: f64, norm: f64) -> Option<f64> {
+    (norm > 0.0).then(|| (err / norm).sqrt()).filter(|e| e.is_finite())
 }
 
 fn write_outputs(dir: &std::path::Path, summary: &Summary, series: &[Row]) -> Result<(), CaseError> {

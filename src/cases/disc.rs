@@ -196,6 +196,11 @@ pub struct Summary {
     pub krylov_iterations: usize,
     /// The process's peak resident memory at the end of the run (Linux), in bytes.
     pub peak_memory_bytes: Option<u64>,
+    /// Halvings of Δt after a failed Newton (the series has the actual time levels).
+    pub step_cuts: usize,
+    /// Why the run ended before t_end, if it did (the series stops at the last good step).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
 }
 
 pub struct Run {
@@ -315,18 +320,18 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let steps = ((opts.t_end - t0) / opts.dt).round() as usize;
     let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, opts.body.name());
     // A scheme without a velocity state: the step's mean velocity.
-    let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64]| -> Vec<f64> {
+    let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64], dt: f64| -> Vec<f64> {
         match v_index {
             Some(i) => states[i].clone(),
-            None => states[0].iter().zip(before).map(|(a, b)| (a - b) / opts.dt).collect(),
+            None => states[0].iter().zip(before).map(|(a, b)| (a - b) / dt).collect(),
         }
     };
     let v_index = sim.v_index;
-    snapshots.write(&sim.tools, 0, t0, &sim.states[0], &velocity(&sim.states, v_index, &sim.states[0]))?;
+    snapshots.write(&sim.tools, 0, t0, &sim.states[0], &velocity(&sim.states, v_index, &sim.states[0], opts.dt))?;
     // Multi-stage schemes: the state at each intermediate stage's time (stages.csv).
     let mut stage_rows: Vec<StageRow> = Vec::new();
     let names = sim.stepper.desc().states;
-    let step_times = sim.run(
+    let outcome = sim.run(
         t0,
         opts.dt,
         steps,
@@ -340,7 +345,13 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         &mut |tools, step| {
             let v = v_index.map(|i| step.states[i].as_slice());
             series.push(measure(tools, &step.states[0], v, step.report.iterations(), step.t));
-            snapshots.write(tools, step.k, step.t, &step.states[0], &velocity(step.states, v_index, step.before))
+            snapshots.write(
+                tools,
+                step.k,
+                step.t,
+                &step.states[0],
+                &velocity(step.states, v_index, step.before, step.dt),
+            )
         },
     )?;
     snapshots.finish()?;
@@ -372,8 +383,8 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         newton_max: series.iter().map(|r| r.newton).max().unwrap_or(0),
         wall_seconds: wall,
         seconds_per_step: wall / steps.max(1) as f64,
-        stepping_seconds: step_times.iter().sum(),
-        step_median_seconds: crate::bench::median(step_times),
+        stepping_seconds: outcome.step_seconds.iter().sum(),
+        step_median_seconds: crate::bench::median(outcome.step_seconds),
         factorizations: sim.stepper.counters().numeric,
         low_rank_updates: sim.stepper.counters().updates,
         matrix_nnz: sim.tools.asm.pattern().nnz(),
@@ -381,9 +392,14 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         solver: opts.newton.solver,
         krylov_iterations: sim.stepper.counters().iterations,
         peak_memory_bytes: crate::bench::peak_memory(),
+        step_cuts: outcome.cuts,
+        stopped: outcome.stopped.as_ref().map(ToString::to_string),
     };
     if let Some(dir) = &opts.out {
         write_outputs(dir, opts.body, &summary, &series, &stage_rows)?;
+    }
+    if let Some(e) = outcome.stopped {
+        return Err(e);
     }
     Ok(Run { summary, series, stages: stage_rows })
 }

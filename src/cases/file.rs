@@ -40,6 +40,9 @@ struct CaseFile {
     /// disc only.
     mesh: Option<Spanned<String>>,
     h: Option<Spanned<f64>>,
+    /// Step cuts and the energy check (`--max-step-cuts`, `--max-energy-growth`).
+    max_step_cuts: Option<Spanned<i64>>,
+    max_energy_growth: Option<Spanned<f64>>,
 }
 
 /// A case read from a file.
@@ -176,6 +179,20 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
         forms: parsed.forms.as_ref().map_or_else(Vec::new, |f| f.get_ref().iter().map(|p| base.join(p)).collect()),
         compiled: Vec::new(),
         params: Vec::new(),
+        guard: crate::simulation::Guard {
+            max_step_cuts: match &parsed.max_step_cuts {
+                None => d.guard.max_step_cuts,
+                Some(s) if (0..=40).contains(s.get_ref()) => *s.get_ref() as usize,
+                Some(s) => return Err(r.error(s, "max_step_cuts", format!("{} is not in 0..=40", s.get_ref()))),
+            },
+            max_energy_growth: r.number(
+                &parsed.max_energy_growth,
+                "max_energy_growth",
+                |x| x >= 0.0,
+                "0 (off) or positive",
+                d.guard.max_energy_growth,
+            )?,
+        },
     };
     let at = |span: std::ops::Range<usize>| format!("{}:{}", r.file, r.line(span.start));
     for (key, v) in [("alpha", &parsed.alpha), ("theta", &parsed.theta), ("gamma0", &parsed.gamma0)] {

@@ -38,4 +38,14 @@ pub enum CaseError {
     Step(#[from] crate::runtime::scheme::StepError),
     #[error("cannot write {path}: {source}")]
     Write { path: String, source: std::io::Error },
+    /// Newton failed at a step even after `cuts` halvings of Δt.
+    #[error(
+        "stopped at t = {t} after {cuts} step cuts (Δt = {dt:.3e}): {cause}\n  Newton: {history}\n  results up to the last good step are written; more cuts: --max-step-cuts, or try a smaller Δt"
+    )]
+    Stopped { t: f64, cuts: usize, dt: f64, cause: String, history: String },
+    /// The energy grew past what a stable scheme allows.
+    #[error(
+        "stopped at t = {t}: the energy ½uᵀKu + ½vᵀMv = {energy:.3e} exceeds {growth} × {bound:.3e} (its initial value plus the work of the loads): the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Nitsche with θ = −1 or 0 and γ0 too small for its coercivity, a penalty too stiff for Δt with an explicit contact treatment, Δt beyond a conditionally stable scheme's limit, or degenerate cells. Results up to here are written; --max-energy-growth 0 turns this check off"
+    )]
+    BlowUp { t: f64, energy: f64, bound: f64, growth: f64, params: String },
 }

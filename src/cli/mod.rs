@@ -193,6 +193,13 @@ pub struct MethodArgs {
     /// element_size: √d · max over the cell's nodes of σ_min of the reference Jacobian).
     #[arg(long, value_parser = CellSize::parse, default_value = "diameter")]
     cell_size: CellSize,
+    /// Halvings of Δt allowed when a step's Newton fails (Δt doubles back after two good steps).
+    #[arg(long, default_value_t = 6)]
+    max_step_cuts: usize,
+    /// Stop when ½uᵀKu + ½vᵀMv exceeds this many times its initial value plus the loads' work
+    /// (0: never).
+    #[arg(long, default_value_t = 10.0)]
+    max_energy_growth: f64,
 }
 
 impl MethodArgs {
@@ -217,6 +224,10 @@ impl MethodArgs {
             forms: self.forms.clone(),
             compiled: Vec::new(),
             params,
+            guard: crate::simulation::Guard {
+                max_step_cuts: self.max_step_cuts,
+                max_energy_growth: self.max_energy_growth,
+            },
         })
     }
 }
@@ -610,12 +621,12 @@ fn run_bar_all(a: BarArgs, base: Setup) -> ExitCode {
                     Ok(r) => {
                         let s = r.summary;
                         println!(
-                            "{:<15} {:<16} {:<13} {:>8.4} {:>8.4} {:>9.6} {:>9.6} {:>10.2e} {:>10.2e} {:>7} {:>4}",
+                            "{:<15} {:<16} {:<13} {:>8.4} {:>8} {:>9.6} {:>9.6} {:>10.2e} {:>10.2e} {:>7} {:>4}",
                             scheme,
                             contact,
                             mass_name,
                             s.err_linf_l2_u,
-                            s.err_l2_lambda,
+                            optional(s.err_l2_lambda, 4),
                             s.energy_aug_initial,
                             s.energy_aug_final,
                             s.energy_aug_drift_max * s.energy_aug_initial,
@@ -696,13 +707,13 @@ fn finish_bar(result: Result<bar::Run, crate::cases::CaseError>) -> ExitCode {
             let s = &r.summary;
             interpreted_note(&s.interpreted);
             println!(
-                "bar: {} {}{}, {} steps: err_u {:.4}, err_λ {:.4}, E_aug {:.6} → {:.6}, penetration {:.3e}, Newton {} (max {}), {:.2} s",
+                "bar: {} {}{}, {} steps: err_u {:.4}, err_λ {}, E_aug {:.6} → {:.6}, penetration {:.3e}, Newton {} (max {}), {:.2} s",
                 s.scheme,
                 s.contact,
                 params_text(&s.params),
                 s.steps,
                 s.err_linf_l2_u,
-                s.err_l2_lambda,
+                optional(s.err_l2_lambda, 4),
                 s.energy_aug_initial,
                 s.energy_aug_final,
                 s.max_penetration,
@@ -759,4 +770,9 @@ fn params_text(params: &std::collections::BTreeMap<String, crate::driver::ParamV
         .map(|(n, p)| format!("{n} = {}", p.value))
         .collect();
     if set.is_empty() { String::new() } else { format!(" ({})", set.join(", ")) }
+}
+
+/// A metric with `digits` decimals, or "—" where it is undefined.
+pub fn optional(value: Option<f64>, digits: usize) -> String {
+    value.map_or("—".to_string(), |v| format!("{v:.digits$}"))
 }

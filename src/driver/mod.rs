@@ -37,6 +37,8 @@ pub struct Setup {
     pub compiled: Vec<&'static Unit>,
     /// Param values set by the user, in order (a later setting of a param wins).
     pub params: Vec<Setting>,
+    /// Step cuts and the energy check.
+    pub guard: crate::simulation::Guard,
 }
 
 impl Default for Setup {
@@ -49,6 +51,7 @@ impl Default for Setup {
             forms: Vec::new(),
             compiled: Vec::new(),
             params: Vec::new(),
+            guard: Default::default(),
         }
     }
 }
@@ -196,6 +199,7 @@ pub struct Active {
     pub scheme: SchemeSource,
     /// The form files and every param's value (the scheme's included).
     pub forms: ActiveForms,
+    pub guard: crate::simulation::Guard,
 }
 
 /// The form files of a run, with the value of every param.
@@ -216,7 +220,7 @@ impl Active {
         let mut table = params::Table::new(Some(&scheme), &units);
         table.apply_case(overrides)?;
         table.apply_user(&setup.params)?;
-        Ok(Active { scheme, forms: ActiveForms { units, contact, params: table } })
+        Ok(Active { scheme, forms: ActiveForms { units, contact, params: table }, guard: setup.guard })
     }
 
     /// The form files of a setup and their params, without a scheme.

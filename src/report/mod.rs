@@ -60,11 +60,11 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         let s = &r.summary;
         let _ = writeln!(
             md,
-            "| {scheme} {contact} {} | {:.4} | {:.4} | {:.4} | {:.5} | {:.5} | {:.2e} | {}/{} |",
+            "| {scheme} {contact} {} | {:.4} | {} | {} | {:.5} | {:.5} | {:.2e} | {}/{} |",
             mass_name(mass),
             s.err_linf_l2_u,
-            s.err_l2_lambda,
-            s.err_l2_lambda_half,
+            crate::cli::optional(s.err_l2_lambda, 4),
+            crate::cli::optional(s.err_l2_lambda_half, 4),
             s.energy_aug_initial,
             s.energy_aug_final,
             s.max_penetration,

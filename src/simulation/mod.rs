@@ -136,6 +136,9 @@ pub struct Simulation<'m> {
     pub states: Vec<Vec<f64>>,
     /// The index of the velocity state `v`, if the scheme has one.
     pub v_index: Option<usize>,
+    guard: Guard,
+    /// The params in use, for messages.
+    params: String,
 }
 
 /// One finished step, as the observer sees it.
@@ -143,6 +146,8 @@ pub struct Step<'s> {
     /// The step's number (1 for the first) and its end time.
     pub k: usize,
     pub t: f64,
+    /// Its size: the nominal Δt, or a fraction of it after a failed Newton.
+    pub dt: f64,
     pub states: &'s [Vec<f64>],
     /// The displacement at the start of the step.
     pub before: &'s [f64],
@@ -218,7 +223,15 @@ impl<'m> Simulation<'m> {
         let names = stepper.desc().states;
         let states = names.iter().map(|_| vec![0.0; n]).collect();
         let v_index = names.iter().position(|s| *s == "v");
-        Ok(Simulation { stepper, tools, states, v_index })
+        let params = active
+            .forms
+            .params
+            .values()
+            .iter()
+            .map(|(name, p)| format!("{name} = {}", p.value))
+            .collect::<Vec<_>>()
+            .join(", ");
+        Ok(Simulation { stepper, tools, states, v_index, guard: active.guard, params })
     }
 
     /// Sets the displacement and solves the scheme's initial problem (the acceleration).
@@ -244,8 +257,17 @@ impl<'m> Simulation<'m> {
         self.v_index.map(|i| self.states[i].as_slice())
     }
 
-    /// Runs `steps` steps of `dt` from `t0`, showing every step to `on_step` and every
-    /// intermediate stage of a multi-stage scheme to `on_stage`. Returns each step's wall time.
+    /// Runs `steps` steps of `dt` from `t0`, showing every accepted step to `on_step` and every
+    /// intermediate stage of a multi-stage scheme to `on_stage`.
+    ///
+    /// A step whose Newton fails is retried from its start with Δt halved, up to
+    /// `guard.max_step_cuts` halvings; the step size then doubles back after two accepted steps
+    /// that end on a multiple of the doubled size, so the run returns to the nominal time levels.
+    /// Every 16 steps (and at the end) the energy ½uᵀKu + ½vᵀMv is checked against
+    /// `guard.max_energy_growth` × (its initial value + the work of the loads so far). A run
+    /// that cannot go on ends with `Outcome::stopped` set, after the observer saw every good
+    /// step, so that the case can write its results up to there; an observer's error ends it at
+    /// once.
     pub fn run(
         &mut self,
         t0: f64,
@@ -254,27 +276,186 @@ impl<'m> Simulation<'m> {
         progress: bool,
         on_stage: &mut dyn FnMut(&Tools, &StageView, Option<usize>),
         on_step: &mut dyn FnMut(&Tools, &Step) -> Result<(), CaseError>,
-    ) -> Result<Vec<f64>, CaseError> {
+    ) -> Result<Outcome, CaseError> {
         let stages = self.stepper.desc().stages;
         let intermediate: Vec<&str> = stages.iter().rev().skip(1).map(|s| s.name).collect();
-        let mut times = Vec::with_capacity(steps);
+        let mut outcome = Outcome { step_seconds: Vec::with_capacity(steps), cuts: 0, stopped: None };
         let mut bar = crate::progress::Progress::new(steps, progress);
-        let Simulation { stepper, tools, states, v_index } = self;
-        for k in 0..steps {
+        let guard = self.guard;
+        let mut energy = EnergyWatch::new(&self.tools, &self.states, self.v_index);
+        let Simulation { stepper, tools, states, v_index, params, .. } = self;
+        // Progress through a nominal step in units of dt / 2^max_cuts.
+        let max_cuts = guard.max_step_cuts.min(40);
+        let full: u64 = 1 << max_cuts;
+        let (mut level, mut streak, mut accepted) = (0usize, 0usize, 0usize);
+        'steps: for k in 0..steps {
             bar.tick(k);
-            let t = t0 + k as f64 * dt;
-            let before = states[0].clone();
-            let clock = Instant::now();
-            let report = stepper.step_observed(states, t, dt, &mut |stage| {
-                if intermediate.contains(&stage.name) {
-                    on_stage(tools, stage, *v_index);
+            let mut done: u64 = 0;
+            while done < full {
+                let units = full >> level;
+                let h = dt * units as f64 / full as f64;
+                let t = t0 + (k as f64 + done as f64 / full as f64) * dt;
+                let saved = (max_cuts > 0).then(|| states.to_vec());
+                let before = states[0].clone();
+                let clock = Instant::now();
+                let result = stepper.step_observed(states, t, h, &mut |stage| {
+                    if intermediate.contains(&stage.name) {
+                        on_stage(tools, stage, *v_index);
+                    }
+                });
+                let report = match result {
+                    Ok(report) => report,
+                    Err(e) => {
+                        if let Some(saved) = saved {
+                            states.clone_from_slice(&saved);
+                        }
+                        if level < max_cuts {
+                            level += 1;
+                            streak = 0;
+                            outcome.cuts += 1;
+                            tracing::warn!(t, dt = h / 2.0, "step failed ({e}); retrying with Δt halved");
+                            continue;
+                        }
+                        outcome.stopped = Some(CaseError::Stopped {
+                            t,
+                            cuts: level,
+                            dt: h,
+                            cause: e.to_string(),
+                            history: history(&e),
+                        });
+                        break 'steps;
+                    }
+                };
+                outcome.step_seconds.push(clock.elapsed().as_secs_f64());
+                done += units;
+                accepted += 1;
+                let t_end = if done == full { t0 + (k + 1) as f64 * dt } else { t + h };
+                on_step(tools, &Step { k: accepted, t: t_end, dt: h, states, before: &before, report: &report })?;
+                streak += 1;
+                if level > 0 && streak >= 2 && done.is_multiple_of(2 * units) {
+                    level -= 1;
+                    streak = 0;
                 }
-            })?;
-            times.push(clock.elapsed().as_secs_f64());
-            on_step(tools, &Step { k: k + 1, t: t + dt, states, before: &before, report: &report })?;
+                let last = k + 1 == steps && done == full;
+                if let Some(grown) = energy.check(tools, states, *v_index, &before, h, accepted, last)
+                    && guard.max_energy_growth > 0.0
+                    && grown.ratio > guard.max_energy_growth
+                {
+                    outcome.stopped = Some(CaseError::BlowUp {
+                        t: t_end,
+                        energy: grown.energy,
+                        bound: grown.bound,
+                        growth: guard.max_energy_growth,
+                        params: params.clone(),
+                    });
+                    break 'steps;
+                }
+            }
         }
         bar.finish();
-        Ok(times)
+        Ok(outcome)
+    }
+}
+
+/// How a run ended.
+pub struct Outcome {
+    /// Wall time of each accepted step.
+    pub step_seconds: Vec<f64>,
+    /// Step halvings after a failed Newton.
+    pub cuts: usize,
+    /// Why the run stopped early, if it did (the observer has seen every step before).
+    pub stopped: Option<CaseError>,
+}
+
+/// When a step may fail and how much energy a run may gain (`--max-step-cuts`,
+/// `--max-energy-growth`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Guard {
+    pub max_step_cuts: usize,
+    /// 0 turns the check off.
+    pub max_energy_growth: f64,
+}
+
+impl Default for Guard {
+    fn default() -> Self {
+        Guard { max_step_cuts: 6, max_energy_growth: 10.0 }
+    }
+}
+
+/// The residual history of a failed Newton, for the stop message.
+fn history(e: &crate::runtime::scheme::StepError) -> String {
+    use crate::runtime::newton::NewtonError;
+    use crate::runtime::scheme::StepError;
+    let StepError::Newton { source, .. } = e else { return String::new() };
+    let report = match source {
+        NewtonError::IterationLimit { report, .. } | NewtonError::NonFinite { report } => report,
+        NewtonError::Linear { report, .. } => report,
+    };
+    let mut text = format!("residual {:.3e}", report.initial_residual);
+    for it in &report.history {
+        text.push_str(&format!(" → {:.3e} ({} active)", it.residual, it.active));
+    }
+    text
+}
+
+/// The energy check: E = ½uᵀKu + ½vᵀMv against E(0) + the work of the loads.
+struct EnergyWatch {
+    initial: f64,
+    u0: Vec<f64>,
+    work: f64,
+}
+
+/// An energy above its bound.
+struct Grown {
+    energy: f64,
+    bound: f64,
+    ratio: f64,
+}
+
+/// Steps between two energy checks: a blow-up grows geometrically, so a few steps' delay costs
+/// nothing, and the check's two products stay off most steps.
+const ENERGY_EVERY: usize = 16;
+
+impl EnergyWatch {
+    fn new(tools: &Tools, states: &[Vec<f64>], v_index: Option<usize>) -> Self {
+        let u = &states[0];
+        let v = v_index.map(|i| states[i].as_slice());
+        EnergyWatch { initial: Self::energy(tools, u, v), u0: u.clone(), work: 0.0 }
+    }
+
+    fn energy(tools: &Tools, u: &[f64], v: Option<&[f64]>) -> f64 {
+        0.5 * Tools::quad(&tools.stiffness, u, u) + tools.kinetic(v)
+    }
+
+    /// Every `ENERGY_EVERY` accepted steps and at the last: the energy and its bound.
+    #[allow(clippy::too_many_arguments)]
+    fn check(
+        &mut self,
+        tools: &Tools,
+        states: &[Vec<f64>],
+        v_index: Option<usize>,
+        before: &[f64],
+        h: f64,
+        accepted: usize,
+        last: bool,
+    ) -> Option<Grown> {
+        if !last && !accepted.is_multiple_of(ENERGY_EVERY) {
+            return None;
+        }
+        let u = &states[0];
+        let fd: Vec<f64>;
+        let v = match v_index {
+            Some(i) => states[i].as_slice(),
+            None => {
+                fd = u.iter().zip(before).map(|(a, b)| (a - b) / h).collect();
+                &fd
+            }
+        };
+        let energy = Self::energy(tools, u, Some(v));
+        let work: f64 = tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum();
+        self.work = self.work.max(work.abs());
+        let bound = (self.initial + self.work).max(f64::MIN_POSITIVE);
+        Some(Grown { energy, bound, ratio: energy / bound })
     }
 }
 

@@ -177,7 +177,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     let steps = ((gap0 / opts.speed + 1.3 * hertz.contact_duration) / dt).ceil() as usize;
     let (mut peak, mut peak_state, mut newton) = (0.0, Vec::new(), 0);
     let v_index = sim.v_index;
-    sim.run(0.0, dt, steps, opts.progress, &mut |_, _, _| {}, &mut |tools, step| {
+    let outcome = sim.run(0.0, dt, steps, opts.progress, &mut |_, _, _| {}, &mut |tools, step| {
         let v = v_index.map(|i| step.states[i].as_slice());
         let r = row(tools, &step.states[0], v, step.t);
         newton += step.report.iterations();
@@ -188,6 +188,13 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         series.push(r);
         Ok(())
     })?;
+    if let Some(e) = outcome.stopped {
+        // Its figures need the whole contact: keep what was computed for a look.
+        if let Some(dir) = &opts.out {
+            write_series(dir, &series)?;
+        }
+        return Err(e);
+    }
     let end = series.last().map_or(0.0, |r| r.t);
     let duration = match contact_duration(&series) {
         Contact::Never => {
@@ -260,6 +267,16 @@ fn contact_duration(series: &[Row]) -> Contact {
     Contact::Lasted(series[first + length].t - series[first].t)
 }
 
+fn write_series(dir: &std::path::Path, series: &[Row]) -> Result<(), CaseError> {
+    let path = dir.join("series.csv");
+    let mut csv = String::from("t,fz_contact,active_points,vz_mean,energy_aug\n");
+    for r in series {
+        csv.push_str(&format!("{:e},{:e},{},{:e},{:e}\n", r.t, r.force, r.active_points, r.velocity, r.energy_aug));
+    }
+    crate::output::write_atomic(&path, csv.as_bytes())
+        .map_err(|source| CaseError::Write { path: path.display().to_string(), source })
+}
+
 fn write(
     dir: &std::path::Path,
     summary: &Summary,
@@ -269,12 +286,7 @@ fn write(
 ) -> Result<(), CaseError> {
     let err =
         |path: &std::path::Path, source: std::io::Error| CaseError::Write { path: path.display().to_string(), source };
-    let path = dir.join("series.csv");
-    let mut csv = String::from("t,fz_contact,active_points,vz_mean,energy_aug\n");
-    for r in series {
-        csv.push_str(&format!("{:e},{:e},{},{:e},{:e}\n", r.t, r.force, r.active_points, r.velocity, r.energy_aug));
-    }
-    crate::output::write_atomic(&path, csv.as_bytes()).map_err(|e| err(&path, e))?;
+    write_series(dir, series)?;
     let path = dir.join("summary.json");
     crate::output::write_json(&path, summary).map_err(|e| err(&path, e))?;
     use crate::plot::Curve;
