@@ -16,6 +16,7 @@ pub mod cli;
 pub mod driver;
 pub mod forms;
 pub mod interpret;
+pub mod interrupt;
 pub mod output;
 pub mod plot;
 pub mod progress;

@@ -8,6 +8,7 @@ fn main() -> std::process::ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    signorini::interrupt::install();
     // Logs (Newton iterations, ...) with RUST_LOG=signorini_runtime=debug.
     tracing_subscriber::fmt()
         .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())

@@ -2,7 +2,50 @@
 //! then renamed over the target.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// The file that marks a directory as one of our runs' outputs (and proves it writable).
+pub const MARKER: &str = ".signorini-output";
+
+/// Where a run writes, decided before it computes anything: `dir` itself if it is new or
+/// empty; with `force`, `dir` emptied if it holds an earlier run of ours (never a directory we
+/// did not write); otherwise the first free `dir/run-N`, so that results of two runs never mix.
+/// The directory is created and written to (the marker) here: an unwritable `--out` fails now,
+/// not after the computation. Returns the directory and, if it is not `dir`, a note saying so.
+pub fn prepare(dir: &Path, force: bool) -> Result<(PathBuf, Option<String>), String> {
+    let cannot = |d: &Path, e: std::io::Error| format!("cannot write to {}: {e}", d.display());
+    let entries = match std::fs::read_dir(dir) {
+        Ok(list) => list.filter_map(Result::ok).map(|e| e.file_name()).filter(|n| n != MARKER).collect::<Vec<_>>(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(e) => return Err(cannot(dir, e)),
+    };
+    let ours = dir.join(MARKER).is_file();
+    let (target, note) = if entries.is_empty() {
+        (dir.to_path_buf(), None)
+    } else if force && ours {
+        std::fs::remove_dir_all(dir).map_err(|e| cannot(dir, e))?;
+        (dir.to_path_buf(), None)
+    } else if force {
+        return Err(format!(
+            "{} is not empty and was not written by signorini (no {MARKER}): not removing it; choose another --out",
+            dir.display()
+        ));
+    } else {
+        let fresh = (2..).map(|n| dir.join(format!("run-{n}"))).find(|d| !d.exists()).expect("unbounded");
+        let note = format!(
+            "{} holds {}: writing to {} (--force replaces {})",
+            dir.display(),
+            if ours { "an earlier run" } else { "other files" },
+            fresh.display(),
+            if ours { "it" } else { "nothing that signorini did not write" }
+        );
+        (fresh, Some(note))
+    };
+    std::fs::create_dir_all(&target).map_err(|e| cannot(&target, e))?;
+    write_atomic(&target.join(MARKER), b"written by signorini; `--force` may replace this directory\n")
+        .map_err(|e| cannot(&target, e))?;
+    Ok((target, note))
+}
 
 /// Writes `bytes` to `path` atomically (creating the directory if needed).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
@@ -65,6 +108,39 @@ fn drop_nulls(value: &mut serde_json::Value, path: &str, omitted: &mut Vec<Strin
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_second_run_never_mixes_with_the_first() {
+        let root = std::env::temp_dir().join(format!("signorini-prepare-{}", std::process::id()));
+        let (first, note) = super::prepare(&root, false).unwrap();
+        assert_eq!((first.as_path(), note), (root.as_path(), None));
+        std::fs::write(root.join("series.csv"), "t\n").unwrap();
+        // Occupied: a fresh subdirectory, said so.
+        let (second, note) = super::prepare(&root, false).unwrap();
+        assert_eq!(second, root.join("run-2"));
+        assert!(note.unwrap().contains("an earlier run"));
+        // --force replaces our earlier run entirely.
+        let (forced, _) = super::prepare(&root, true).unwrap();
+        assert_eq!(forced, root);
+        assert!(!root.join("series.csv").exists() && !root.join("run-2").exists());
+        // A directory we did not write is never removed.
+        let foreign = root.join("foreign");
+        std::fs::create_dir_all(&foreign).unwrap();
+        std::fs::write(foreign.join("thesis.tex"), "").unwrap();
+        assert!(super::prepare(&foreign, true).unwrap_err().contains("not removing"));
+        assert!(foreign.join("thesis.tex").exists());
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn an_unwritable_directory_is_an_error_before_any_work() {
+        // A path below a regular file cannot be created.
+        let file = std::env::temp_dir().join(format!("signorini-plain-{}", std::process::id()));
+        std::fs::write(&file, "").unwrap();
+        let err = super::prepare(&file.join("out"), false).unwrap_err();
+        assert!(err.starts_with("cannot write to"), "{err}");
+        std::fs::remove_file(&file).unwrap();
+    }
+
     #[test]
     fn non_finite_numbers_are_left_out_and_named() {
         #[derive(serde::Serialize)]

@@ -218,3 +218,49 @@ fn bench_sphere_runs_each_size_in_its_own_process() {
     assert!(runs.iter().any(|r| r["solver"] == "iterative" && r["krylov_iterations"].as_u64() > Some(0)));
     assert!(std::fs::read(dir.join("bench_sphere.png")).unwrap().starts_with(b"\x89PNG"));
 }
+
+/// SIGINT ends a run after its current step: exit status 130, and the series, the summary
+/// (saying it was interrupted) and no temporary file in the output directory. A second run into
+/// the same directory writes to a fresh subdirectory; `--force` replaces the first.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_run_leaves_consistent_results_and_runs_never_mix() {
+    let dir = std::env::temp_dir().join(format!("signorini-sigint-{}", std::process::id()));
+    let child = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["run", "disc", "--t-end", "1000", "--out", dir.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until it steps (the marker is written before the computation starts).
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    assert!(dir.join(".signorini-output").exists());
+    // SAFETY: signalling our own child process.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted at t = "), "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["stopped"].as_str().unwrap().starts_with("interrupted"), "{summary}");
+    let rows = std::fs::read_to_string(dir.join("series.csv")).unwrap().lines().count();
+    assert!(rows > 2, "{rows} rows");
+    let names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert!(!names.iter().any(|n| n.ends_with(".tmp")), "{names:?}");
+
+    let d = dir.to_str().unwrap();
+    let (code, _, err) = signorini(&["run", "bar", "--t-end", "0.1", "--out", d]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("run-2") && dir.join("run-2").join("summary.json").exists(), "{err}");
+    let (code, _, err) = signorini(&["run", "bar", "--t-end", "0.1", "--force", "--out", d]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!dir.join("run-2").exists(), "{err}");
+    // Nothing of the disc run is left beside the bar's.
+    let series = std::fs::read_to_string(dir.join("series.csv")).unwrap();
+    assert!(series.starts_with("t,u_c,"), "{}", series.lines().next().unwrap());
+    let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    assert!(summary.contains("\"case\": \"bar\""), "{summary}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

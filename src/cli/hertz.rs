@@ -24,7 +24,7 @@ pub struct HertzStaticArgs {
     #[arg(long)]
     mesh: Option<PathBuf>,
     /// The force on the whole body (per unit length in 2D); default: Hertz's a = R/10.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long = "load", allow_hyphen_values = true)]
     force: Option<f64>,
     /// Directory for summary.json and profile.png.
     #[arg(long)]
@@ -73,7 +73,10 @@ pub(super) fn run_static(a: HertzStaticArgs) -> ExitCode {
         level: a.level,
         mesh: a.mesh,
         force: a.force,
-        out: a.out,
+        out: match super::out_dir(a.out) {
+            Ok(dir) => dir,
+            Err(e) => return fail(e),
+        },
         newton: NewtonOptions { solver: a.solver, ..Default::default() },
     };
     match statics::run(&opts) {
@@ -115,7 +118,10 @@ pub(super) fn run_impact(a: HertzImpactArgs) -> ExitCode {
         dt: a.dt,
         mass: a.mass,
         newton: NewtonOptions { solver: a.solver, ..Default::default() },
-        out: a.out,
+        out: match super::out_dir(a.out) {
+            Ok(dir) => dir,
+            Err(e) => return fail(e),
+        },
         progress: std::io::IsTerminal::is_terminal(&std::io::stdout()),
     };
     match impact::run(&opts) {

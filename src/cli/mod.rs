@@ -31,6 +31,23 @@ pub struct Cli {
     /// same bits for any number.
     #[arg(long, global = true, value_parser = clap::value_parser!(u16).range(1..))]
     pub threads: Option<u16>,
+    /// Replace an earlier run's output directory (without it, a non-empty --out gets a fresh
+    /// run-N subdirectory; a directory signorini did not write is never removed).
+    #[arg(long, global = true)]
+    pub force: bool,
+}
+
+/// `--force`, for the output directories of every command.
+static FORCE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+
+/// The directory a run writes to (see `output::prepare`), announced when it is not `--out`.
+fn out_dir(out: Option<PathBuf>) -> Result<Option<PathBuf>, String> {
+    let Some(dir) = out else { return Ok(None) };
+    let (dir, note) = crate::output::prepare(&dir, FORCE.get().copied().unwrap_or(false))?;
+    if let Some(note) = note {
+        eprintln!("note: {note}");
+    }
+    Ok(Some(dir))
 }
 
 #[derive(Subcommand)]
@@ -321,6 +338,12 @@ pub enum Stage {
 }
 
 pub fn run(cli: Cli) -> ExitCode {
+    let _ = FORCE.set(cli.force);
+    let code = dispatch(cli);
+    if crate::interrupt::requested() { ExitCode::from(crate::interrupt::EXIT_CODE) } else { code }
+}
+
+fn dispatch(cli: Cli) -> ExitCode {
     if let Some(n) = cli.threads
         && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n as usize).build_global()
     {
@@ -356,6 +379,10 @@ pub fn run(cli: Cli) -> ExitCode {
             Err(e) => fail(e),
         },
         Command::Report { out, quick } => {
+            let out = match out_dir(Some(out)) {
+                Ok(dir) => dir.expect("given"),
+                Err(e) => return fail(e),
+            };
             match crate::report::write(&out, quick, &mut |what| eprintln!("running {what}")) {
                 Ok(()) => {
                     println!("wrote {}", out.join("report.md").display());
@@ -463,7 +490,10 @@ fn static_block(a: StaticBlockArgs) -> ExitCode {
         h: a.h,
         curvature: a.curvature,
         newton: crate::runtime::newton::NewtonOptions { line_search: a.line_search, ..Default::default() },
-        out: a.out,
+        out: match out_dir(a.out) {
+            Ok(dir) => dir,
+            Err(e) => return fail(e),
+        },
         ..Default::default()
     };
     match static_block::run(&opts) {
@@ -561,6 +591,11 @@ fn write_bench(path: &Path, report: &impl serde::Serialize) -> ExitCode {
 fn run_bar(a: BarArgs) -> ExitCode {
     let setup = match a.methods.setup() {
         Ok(s) => s,
+        Err(e) => return fail(e),
+    };
+    let mut a = a;
+    a.out = match out_dir(a.out) {
+        Ok(dir) => dir,
         Err(e) => return fail(e),
     };
     if a.all {
@@ -664,7 +699,10 @@ fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
         dt: a.dt,
         t_start: a.t_start,
         t_end: a.t_end,
-        out: a.out,
+        out: match out_dir(a.out) {
+            Ok(dir) => dir,
+            Err(e) => return fail(e),
+        },
         vtu_every: a.vtu_every,
         progress: true,
         newton: crate::runtime::newton::NewtonOptions { solver: a.solver, ..Default::default() },
@@ -674,14 +712,22 @@ fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
 
 fn run_file(file: &Path) -> ExitCode {
     use crate::cases::file::{self, Case};
+    let out = |opts_out: &mut Option<PathBuf>| -> Result<(), String> {
+        *opts_out = out_dir(Some(opts_out.take().unwrap_or_else(|| file::default_out(file))))?;
+        Ok(())
+    };
     match file::read(file) {
         Ok(Case::Bar(mut opts)) => {
-            opts.out.get_or_insert_with(|| file::default_out(file));
+            if let Err(e) = out(&mut opts.out) {
+                return fail(e);
+            }
             opts.progress = true;
             finish_bar(bar::run(&opts))
         }
         Ok(Case::Disc(mut opts)) => {
-            opts.out.get_or_insert_with(|| file::default_out(file));
+            if let Err(e) = out(&mut opts.out) {
+                return fail(e);
+            }
             opts.progress = true;
             finish_disc(crate::cases::disc::run(&opts))
         }

@@ -350,6 +350,10 @@ impl<'m> Simulation<'m> {
                     });
                     break 'steps;
                 }
+                if crate::interrupt::requested() {
+                    outcome.stopped = Some(CaseError::Interrupted { t: t_end });
+                    break 'steps;
+                }
             }
         }
         bar.finish();

@@ -1,0 +1,32 @@
+//! SIGINT and SIGTERM: the first asks the run to stop after its current step (it then writes
+//! its results up to there and exits with [`EXIT_CODE`]); a second one ends the process at once.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// The exit status of an interrupted run (128 + SIGINT, as shells report it).
+pub const EXIT_CODE: u8 = 130;
+
+static REQUESTED: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(signal: libc::c_int) {
+    REQUESTED.store(true, Ordering::SeqCst);
+    // SAFETY: signal() is async-signal-safe; the next such signal takes the default action.
+    unsafe {
+        libc::signal(signal, libc::SIG_DFL);
+    }
+}
+
+/// Installs the handlers (once, at start-up).
+pub fn install() {
+    #[cfg(unix)]
+    // SAFETY: the handler only stores to an atomic and resets its own disposition.
+    unsafe {
+        libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
+        libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
+    }
+}
+
+/// Whether a stop was asked for.
+pub fn requested() -> bool {
+    REQUESTED.load(Ordering::SeqCst)
+}
