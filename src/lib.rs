@@ -21,6 +21,7 @@ pub mod output;
 pub mod plot;
 pub mod progress;
 pub mod report;
+pub mod resources;
 pub mod settings;
 pub mod simulation;
 pub mod verify;

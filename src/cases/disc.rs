@@ -231,12 +231,21 @@ pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
             if !(opts.h >= smallest && opts.h <= 10.0) {
                 return Err(CaseError::Option(format!("--h must be in [{smallest}, 10], not {}", opts.h)));
             }
+            // P2 nodes: the disc's rings (3m² vertices), the ball's (2n+1)³ lattice.
+            let dofs = match opts.body {
+                Body::Disc => 2.0 * 4.0 * 3.0 * (10.0 / opts.h).ceil().powi(2),
+                Body::Sphere => 3.0 * (4.0 * (10.0 / opts.h).round() + 1.0).powi(3),
+            };
+            crate::resources::check(opts.body.name(), dofs, d, Some(opts.h))?;
             match opts.body {
                 Body::Disc => disc(10.0, [0.0, 12.0], opts.h),
                 Body::Sphere => ball(10.0, [0.0, 0.0, 12.0], opts.h),
             }
         }
     };
+    if opts.mesh.is_some() {
+        crate::resources::check(opts.body.name(), (mesh.num_nodes() * mesh.dim()) as f64, mesh.dim(), None)?;
+    }
     if mesh.dim() != d {
         return Err(CaseError::Option(format!("the {} case needs a {d}D mesh, not {}D", opts.body.name(), mesh.dim())));
     }

@@ -94,6 +94,14 @@ pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
         return Err(CaseError::Option(format!("--h must be in (0, 1], not {}", opts.h)));
     }
     let n = |len: f64| ((len / opts.h).round() as usize).max(1);
+    let dofs = match opts.dim {
+        2 => 2.0 * (4 * n(1.0) + 1) as f64 * (2 * n(1.0) + 1) as f64,
+        _ => {
+            let p = opts.degree.clamp(1, 2) as usize;
+            3.0 * ((p * 2 * n(0.5) + 1).pow(2) * (p * n(1.0) + 1)) as f64
+        }
+    };
+    crate::resources::check("static-block", dofs, opts.dim, Some(opts.h))?;
     let mesh = match opts.dim {
         2 => {
             if opts.degree != 2 {
