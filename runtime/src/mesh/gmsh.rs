@@ -807,7 +807,9 @@ fn skipped_elements(raw: &Raw, dim: u32, file: &str) -> Result<Vec<String>, Mesh
                 ),
             ));
         }
-        let w = format!("{file}: skipped {count} {name} element(s) (type {kind}), which a {dim}D simplex mesh does not use");
+        let w = format!(
+            "{file}: skipped {count} {name} element(s) (type {kind}), which a {dim}D simplex mesh does not use"
+        );
         tracing::warn!("{w}");
         warnings.push(w);
     }

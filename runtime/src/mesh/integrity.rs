@@ -66,7 +66,8 @@ fn shared_facets(mesh: &Mesh) -> Result<(), MeshError> {
             1 => {}
             2 => {
                 let (a, b) = (all[i], all[i + 1]);
-                let (sa, sb) = (side(mesh, &a.0, a.1, &local[a.2 as usize]), side(mesh, &b.0, b.1, &local[b.2 as usize]));
+                let (sa, sb) =
+                    (side(mesh, &a.0, a.1, &local[a.2 as usize]), side(mesh, &b.0, b.1, &local[b.2 as usize]));
                 // A zero side is a flat vertex simplex (a curved cell's chord): undecided.
                 if sa * sb > 0.0 {
                     return Err(MeshError::SameSide { first: a.1 as usize, second: b.1 as usize });

@@ -5,9 +5,9 @@
 
 pub mod ball;
 mod boundary;
-mod integrity;
 pub mod disc;
 pub mod gmsh;
+mod integrity;
 pub mod structured;
 mod validate;
 
@@ -186,9 +186,11 @@ impl Mesh {
         if region.facets.is_empty() {
             return Err(empty("has no facets"));
         }
-        if let Some(f) = region.facets.iter().find(|f| {
-            f.cell as usize >= self.num_cells() || f.local as usize >= self.kind.vertices()
-        }) {
+        if let Some(f) = region
+            .facets
+            .iter()
+            .find(|f| f.cell as usize >= self.num_cells() || f.local as usize >= self.kind.vertices())
+        {
             return Err(empty(&format!("names facet {} of cell {}, which the mesh does not have", f.local, f.cell)));
         }
         // Measure of the straight (vertex) facets, against the scale of their cells.
@@ -196,7 +198,7 @@ impl Mesh {
             let h = self.cell_diameter(f.cell as usize);
             (m + self.straight_facet_measure(*f), s + h.powi(self.dim() as i32 - 1))
         });
-        if !(measure > 1e-12 * scale) {
+        if measure.is_nan() || measure <= 1e-12 * scale {
             return Err(empty(&format!("has measure {measure:e} over {} facets", region.facets.len())));
         }
         Ok(region)
