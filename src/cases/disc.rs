@@ -17,7 +17,7 @@ use super::bar::MassChoice;
 use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::evaluate::facet_samples;
-use crate::runtime::mesh::{CellSize, Mesh, ball::ball, disc::disc, gmsh};
+use crate::runtime::mesh::{CellSize, Mesh, ball::ball, disc::disc};
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
 use crate::simulation::{Problem, Simulation, Snapshots, Tools};
@@ -224,7 +224,7 @@ pub struct StageRow {
 pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
     let d = opts.body.dim();
     let mut mesh = match &opts.mesh {
-        Some(path) => gmsh::read(path)?,
+        Some(path) => super::read_mesh(path)?,
         None => {
             // The sphere's P2 dofs grow like (20/h)³: h = 0.3 is about 3 million.
             let smallest = if d == 2 { 0.05 } else { 0.3 };
@@ -249,7 +249,7 @@ pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
     if mesh.dim() != d {
         return Err(CaseError::Option(format!("the {} case needs a {d}D mesh, not {}D", opts.body.name(), mesh.dim())));
     }
-    if mesh.region("contact").is_err() {
+    if !mesh.has_region("contact") {
         mesh.add_region_where("contact", |n, _| n[d - 1] < 0.0);
     }
     mesh.set_cell_size(opts.cell_size);

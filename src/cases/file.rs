@@ -104,13 +104,18 @@ impl Reader<'_> {
 
 /// Reads and checks a case file. Relative paths in it are relative to the file.
 pub fn read(path: &Path) -> Result<Case, CaseError> {
+    let text = std::fs::read_to_string(path).map_err(|e| CaseError::CaseFile(format!("{}: {e}", path.display())))?;
+    parse(&text, path)
+}
+
+/// Checks the text of a case file read from `path` (for messages and relative paths).
+pub fn parse(text: &str, path: &Path) -> Result<Case, CaseError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| CaseError::CaseFile(format!("{file}: {e}")))?;
-    let parsed: CaseFile = toml::from_str(&text).map_err(|e| {
+    let parsed: CaseFile = toml::from_str(text).map_err(|e| {
         let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
         CaseError::CaseFile(format!("{file}:{}: {}", line.map_or("?".into(), |l| l.to_string()), e.message()))
     })?;
-    let r = Reader { file: &file, text: &text };
+    let r = Reader { file: &file, text };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mass: MassChoice = r.choice(&parsed.mass, "mass", MassChoice::Consistent)?;
     let setup = setup(&r, &parsed, &base)?;

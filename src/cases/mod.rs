@@ -9,6 +9,15 @@ pub mod file;
 pub mod hertz;
 pub mod static_block;
 
+/// Reads a Gmsh file, showing on stderr what the reader skipped (also logged as a warning).
+pub fn read_mesh(path: &std::path::Path) -> Result<crate::runtime::mesh::Mesh, crate::runtime::mesh::MeshError> {
+    let mesh = crate::runtime::mesh::gmsh::read(path)?;
+    for w in &mesh.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(mesh)
+}
+
 /// The coefficients of a body above the rigid plane {x_d = −lift} (x_d the last coordinate):
 /// the gap `g` = x_d + lift along the obstacle normal `nc` = −e_d, and the body force `f` =
 /// −load e_d per unit volume.

@@ -531,6 +531,7 @@ fn mesh_info(file: &Path) -> ExitCode {
                 "cell_groups": groups,
                 "measure": mesh.measure(),
                 "max_cell_diameter": mesh.max_diameter(),
+                "warnings": mesh.warnings,
             });
             println!("{}", serde_json::to_string_pretty(&info).expect("JSON of plain values"));
             ExitCode::SUCCESS

@@ -54,6 +54,8 @@ struct Raw {
     nodes: Vec<(u64, [f64; 3], At)>,
     elements: Vec<RawElement>,
     names: HashMap<(u32, i64), String>,
+    /// Elements of types we do not use: (type, tag, position).
+    skipped: Vec<(u32, u64, At)>,
 }
 
 /// Gmsh element types we read: (type, dimension, node count).
@@ -70,18 +72,24 @@ fn element_info(kind: u32) -> Option<(u32, usize)> {
     })
 }
 
-/// Node count of element types we skip (so that their data can be stepped over).
-fn other_element_nodes(kind: u32) -> Option<usize> {
+/// Element types we skip: (dimension, node count, name), so that their data can be stepped
+/// over and the skip reported.
+fn other_element_info(kind: u32) -> Option<(u32, usize, &'static str)> {
     Some(match kind {
-        3 => 4,   // quadrangle
-        5 => 8,   // hexahedron
-        6 => 6,   // prism
-        7 => 5,   // pyramid
-        10 => 9,  // 9-node quadrangle
-        16 => 8,  // 8-node quadrangle
-        17 => 20, // 20-node hexahedron
+        3 => (2, 4, "quadrangle"),
+        5 => (3, 8, "hexahedron"),
+        6 => (3, 6, "prism"),
+        7 => (3, 5, "pyramid"),
+        10 => (2, 9, "9-node quadrangle"),
+        16 => (2, 8, "8-node quadrangle"),
+        17 => (3, 20, "20-node hexahedron"),
         _ => return None,
     })
+}
+
+/// Node count of any element type we can step over.
+fn node_count(kind: u32) -> Option<usize> {
+    element_info(kind).map(|(_, c)| c).or_else(|| other_element_info(kind).map(|(_, c, _)| c))
 }
 
 struct Parser<'a> {
@@ -516,10 +524,7 @@ impl<'a> Parser<'a> {
             for _ in 0..ntags {
                 tags.push(self.int("an element tag")?);
             }
-            let count = match (element_info(kind), other_element_nodes(kind)) {
-                (Some((_, c)), _) | (None, Some(c)) => c,
-                (None, None) => return Err(err(self.file, at, format!("unknown element type {kind}"))),
-            };
+            let count = node_count(kind).ok_or_else(|| err(self.file, at, format!("unknown element type {kind}")))?;
             let mut nodes = Vec::new();
             for _ in 0..count {
                 nodes.push(self.uint("a node tag")?);
@@ -528,6 +533,8 @@ impl<'a> Parser<'a> {
             let physicals = tags.first().filter(|&&p| p != 0).map(|&p| vec![p]).unwrap_or_default();
             if element_info(kind).is_some() {
                 raw.elements.push(RawElement { tag, kind, nodes, physicals, at });
+            } else {
+                raw.skipped.push((kind, tag, at));
             }
         }
         Ok(())
@@ -546,8 +553,8 @@ impl<'a> Parser<'a> {
             let at = self.here();
             let kind = self.small("an element type")? as u32;
             let count = self.uint("the number of elements in the block")?;
-            let nodes_per = match (element_info(kind), other_element_nodes(kind)) {
-                (Some((d, c)), _) => {
+            let nodes_per = match (element_info(kind), other_element_info(kind)) {
+                (Some((d, c)), _) | (None, Some((d, c, _))) => {
                     if u64::from(d) != dim {
                         return Err(err(
                             self.file,
@@ -557,7 +564,6 @@ impl<'a> Parser<'a> {
                     }
                     c
                 }
-                (None, Some(c)) => c,
                 (None, None) => return Err(err(self.file, at, format!("unknown element type {kind}"))),
             };
             let physicals = entity_physicals.get(&(dim as u32, entity)).cloned().unwrap_or_default();
@@ -570,6 +576,8 @@ impl<'a> Parser<'a> {
                 }
                 if element_info(kind).is_some() {
                     raw.elements.push(RawElement { tag, kind, nodes, physicals: physicals.clone(), at });
+                } else {
+                    raw.skipped.push((kind, tag, at));
                 }
                 read += 1;
             }
@@ -599,6 +607,7 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
     }
     let index_of = |tag: u64| raw.nodes.binary_search_by_key(&tag, |(t, _, _)| *t).ok();
     let dim = raw.elements.iter().filter_map(|e| element_info(e.kind)).map(|(d, _)| d).max().unwrap_or(0);
+    let warnings = skipped_elements(&raw, dim, file)?;
     if dim == 0 {
         return Err(MeshError::File {
             file: file.to_string(),
@@ -667,9 +676,11 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         cells: cells_flat,
         regions: Vec::new(),
         cell_groups: Vec::new(),
+        warnings,
         cell_size: super::CellSize::Diameter,
         sizes: Vec::new(),
     };
+    mesh.validate().map_err(|e| located(e, &cells, file))?;
     let name_of = |d: u32, tag: i64| raw.names.get(&(d, tag)).cloned().unwrap_or_else(|| format!("physical_{tag}"));
     // Cell groups.
     let mut groups: BTreeMap<String, Vec<u32>> = BTreeMap::new();
@@ -679,19 +690,38 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         }
     }
     mesh.cell_groups = groups.into_iter().collect();
-    // Boundary regions from physical groups of facet elements, matched by vertices.
-    let facet_elements: Vec<&RawElement> = raw
-        .elements
-        .iter()
-        .filter(|e| element_info(e.kind).is_some_and(|(d, _)| d + 1 == dim) && !e.physicals.is_empty())
-        .collect();
+    // Elements one dimension below the cells must be facets of cells: anything else is a cell
+    // of another dimension mixed in (triangles beside a tetrahedron), which would be dropped.
+    // Those in physical groups become boundary regions, matched by vertices.
+    let facet_elements: Vec<&RawElement> =
+        raw.elements.iter().filter(|e| element_info(e.kind).is_some_and(|(d, _)| d + 1 == dim)).collect();
     if !facet_elements.is_empty() {
-        let mut facet_of: HashMap<[u32; 3], Facet> = HashMap::new();
-        for f in mesh.boundary_facets() {
-            let cell = mesh.cell(f.cell as usize);
-            let vs: Vec<u32> = kind.facets()[f.local as usize].iter().map(|&v| cell[v]).collect();
-            facet_of.insert(facet_key(&vs), f);
+        // Some(facet) on the boundary, None inside.
+        let mut facet_of: HashMap<[u32; 3], Option<Facet>> = HashMap::new();
+        for c in 0..mesh.num_cells() {
+            let cell = mesh.cell(c);
+            for (f, verts) in kind.info().facets.iter().enumerate() {
+                let vs: Vec<u32> = verts.iter().map(|&v| cell[v]).collect();
+                facet_of
+                    .entry(facet_key(&vs))
+                    .and_modify(|e| *e = None)
+                    .or_insert(Some(Facet { cell: c as u32, local: f as u8 }));
+            }
         }
+        let mixed = |e: &RawElement| {
+            err(
+                file,
+                e.at,
+                format!(
+                    "element {} (type {}, dimension {}) is neither a cell nor a facet of one: \
+                     the mesh mixes cells of dimensions {} and {dim}",
+                    e.tag,
+                    e.kind,
+                    dim - 1,
+                    dim - 1
+                ),
+            )
+        };
         let mut regions: BTreeMap<String, Vec<Facet>> = BTreeMap::new();
         let vertices = dim as usize; // a facet of a d-simplex has d vertices
         for e in facet_elements {
@@ -701,6 +731,9 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
                     err(file, e.at, format!("element {} refers to node {t}, which is not in `$Nodes`", e.tag))
                 })?;
                 if new_index[i] == u32::MAX {
+                    if e.physicals.is_empty() {
+                        return Err(mixed(e));
+                    }
                     return Err(err(
                         file,
                         e.at,
@@ -709,8 +742,16 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
                 }
                 vs.push(new_index[i]);
             }
-            let f = *facet_of
-                .get(&facet_key(&vs))
+            let found = facet_of.get(&facet_key(&vs));
+            if e.physicals.is_empty() {
+                if found.is_none() {
+                    return Err(mixed(e));
+                }
+                continue;
+            }
+            let f = found
+                .copied()
+                .flatten()
                 .ok_or_else(|| err(file, e.at, format!("element {} is not a boundary facet of any cell", e.tag)))?;
             for &p in &e.physicals {
                 regions.entry(name_of(dim - 1, p)).or_default().push(f);
@@ -722,11 +763,55 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
             mesh.regions.push(Region { name, facets });
         }
     }
-    mesh.validate().map_err(|e| match e {
+    Ok(mesh)
+}
+
+/// A validation error at the line (byte) of the element it names, with element tags (Gmsh
+/// numbers) beside our cell numbers.
+fn located(e: MeshError, cells: &[&RawElement], file: &str) -> MeshError {
+    let tags = |cs: &[usize]| -> Vec<String> { cs.iter().map(|&c| cells[c].tag.to_string()).collect() };
+    match e {
         MeshError::Degenerate { cell, .. } | MeshError::Inverted { cell } => {
             err(file, cells[cell].at, format!("element {}: {e}", cells[cell].tag))
         }
+        MeshError::DuplicateCell { first, second } | MeshError::SameSide { first, second } => {
+            let t = tags(&[first, second]);
+            err(file, cells[second].at, format!("elements {} and {}: {e}", t[0], t[1]))
+        }
+        MeshError::FacetSharedByMany { cells: ref cs } if !cs.is_empty() => {
+            let at = cells[cs[cs.len() - 1]].at;
+            err(file, at, format!("elements {}: {e}", tags(cs).join(", ")))
+        }
         other => MeshError::File { file: file.to_string(), reason: other.to_string() },
-    })?;
-    Ok(mesh)
+    }
+}
+
+/// Elements of types we do not use. Those of the cells' dimension or above are part of the
+/// body: dropping them would leave a hole, so they are an error. Lower ones (quadrangle faces
+/// beside tetrahedra) only lose their physical groups: a warning, by type and count.
+fn skipped_elements(raw: &Raw, dim: u32, file: &str) -> Result<Vec<String>, MeshError> {
+    let mut by_kind: BTreeMap<u32, (usize, u64, At)> = BTreeMap::new();
+    for &(kind, tag, at) in &raw.skipped {
+        by_kind.entry(kind).or_insert((0, tag, at)).0 += 1;
+    }
+    let mut warnings = Vec::new();
+    for (kind, (count, tag, at)) in by_kind {
+        let Some((d, _, name)) = other_element_info(kind) else { continue };
+        if d >= dim {
+            return Err(err(
+                file,
+                at,
+                format!(
+                    "element {tag} is a {name} (type {kind}, {count} in the file): cells must be \
+                     lines, triangles or tetrahedra (one kind per mesh), and dropping it would leave a hole"
+                ),
+            ));
+        }
+        let w = format!(
+            "{file}: skipped {count} {name} element(s) (type {kind}), which a {dim}D simplex mesh does not use"
+        );
+        tracing::warn!("{w}");
+        warnings.push(w);
+    }
+    Ok(warnings)
 }

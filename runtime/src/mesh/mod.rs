@@ -7,6 +7,7 @@ pub mod ball;
 mod boundary;
 pub mod disc;
 pub mod gmsh;
+mod integrity;
 pub mod structured;
 mod validate;
 
@@ -46,6 +47,8 @@ pub struct Mesh {
     pub regions: Vec<Region>,
     /// Named groups of cells (Gmsh physical groups of the cell dimension).
     pub cell_groups: Vec<(String, Vec<u32>)>,
+    /// What the reader skipped or doubted (e.g. element types it does not use), for the user.
+    pub warnings: Vec<String>,
     /// What `h`, the size of the cell carrying a facet, means in the forms (`set_cell_size`).
     cell_size: CellSize,
     /// Per cell, `h` when it is not the diameter (computed once: assembly reads it at every
@@ -86,6 +89,7 @@ impl Mesh {
             cells,
             regions: Vec::new(),
             cell_groups: Vec::new(),
+            warnings: Vec::new(),
             cell_size: CellSize::Diameter,
             sizes: Vec::new(),
         }
@@ -171,11 +175,56 @@ impl Mesh {
         boundary::boundary_facets(self)
     }
 
+    /// The region `name`, which must have facets of positive total measure (a contact zone
+    /// or Dirichlet side of measure zero would silently do nothing).
     pub fn region(&self, name: &str) -> Result<&Region, MeshError> {
-        self.regions.iter().find(|r| r.name == name).ok_or_else(|| MeshError::NoSuchRegion {
+        let region = self.regions.iter().find(|r| r.name == name).ok_or_else(|| MeshError::NoSuchRegion {
             name: name.to_string(),
             known: self.regions.iter().map(|r| r.name.clone()).collect(),
-        })
+        })?;
+        let empty = |reason: &str| MeshError::EmptyRegion { name: name.to_string(), reason: reason.to_string() };
+        if region.facets.is_empty() {
+            return Err(empty("has no facets"));
+        }
+        if let Some(f) = region
+            .facets
+            .iter()
+            .find(|f| f.cell as usize >= self.num_cells() || f.local as usize >= self.kind.vertices())
+        {
+            return Err(empty(&format!("names facet {} of cell {}, which the mesh does not have", f.local, f.cell)));
+        }
+        // Measure of the straight (vertex) facets, against the scale of their cells.
+        let (measure, scale) = region.facets.iter().fold((0.0, 0.0), |(m, s), f| {
+            let h = self.cell_diameter(f.cell as usize);
+            (m + self.straight_facet_measure(*f), s + h.powi(self.dim() as i32 - 1))
+        });
+        if measure.is_nan() || measure <= 1e-12 * scale {
+            return Err(empty(&format!("has measure {measure:e} over {} facets", region.facets.len())));
+        }
+        Ok(region)
+    }
+
+    /// Whether a region of that name exists (empty or not).
+    pub fn has_region(&self, name: &str) -> bool {
+        self.regions.iter().any(|r| r.name == name)
+    }
+
+    /// The measure of a facet's vertex simplex (a point counts 1).
+    fn straight_facet_measure(&self, f: Facet) -> f64 {
+        let cell = self.cell(f.cell as usize);
+        let verts = &self.kind.info().facets[f.local as usize];
+        let p = |i: usize| self.node(cell[verts[i]] as usize);
+        match self.dim() {
+            1 => 1.0,
+            2 => (0..2).map(|k| (p(1)[k] - p(0)[k]).powi(2)).sum::<f64>().sqrt(),
+            _ => {
+                let (a, b, o) = (p(1), p(2), p(0));
+                let u = [a[0] - o[0], a[1] - o[1], a[2] - o[2]];
+                let v = [b[0] - o[0], b[1] - o[1], b[2] - o[2]];
+                let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+                0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+            }
+        }
     }
 
     /// Adds (or replaces) a region made of the boundary facets whose outward unit normal and
@@ -324,6 +373,7 @@ impl Mesh {
             cells,
             regions: self.regions.clone(),
             cell_groups: self.cell_groups.clone(),
+            warnings: self.warnings.clone(),
             cell_size: CellSize::Diameter,
             sizes: Vec::new(),
         };

@@ -1,6 +1,7 @@
 //! Mesh errors and the geometric check every mesh passes before use: finite coordinates, node
 //! numbers in range, and cells that are neither degenerate nor inverted (the Jacobian of the
-//! isoparametric map keeps one sign, away from zero, at every node of the cell).
+//! isoparametric map keeps one sign, away from zero, at every node of the cell); then the
+//! topological checks of `integrity` (no repeated or overlapping cells).
 
 use super::Mesh;
 
@@ -27,10 +28,24 @@ pub enum MeshError {
     NoSuchRegion { name: String, known: Vec<String> },
     #[error("the mesh has no cells")]
     Empty,
+    #[error("cells {first} and {second} have the same vertices (a cell listed twice)")]
+    DuplicateCell { first: usize, second: usize },
+    #[error("cells {} share one facet, which bounds at most two cells: they overlap", list(cells))]
+    FacetSharedByMany { cells: Vec<usize> },
+    #[error("cells {first} and {second} share a facet and lie on the same side of it: they overlap (the mesh folds)")]
+    SameSide { first: usize, second: usize },
+    #[error("boundary region `{name}` {reason}")]
+    EmptyRegion { name: String, reason: String },
+}
+
+fn list(cells: &[usize]) -> String {
+    let s: Vec<String> = cells.iter().map(usize::to_string).collect();
+    s.join(", ")
 }
 
 impl Mesh {
-    /// Checks coordinates, connectivity and cell geometry.
+    /// Checks coordinates, connectivity, cell geometry, and that the cells neither repeat nor
+    /// overlap (`integrity`).
     pub fn validate(&self) -> Result<(), MeshError> {
         if self.num_cells() == 0 {
             return Err(MeshError::Empty);
@@ -71,6 +86,6 @@ impl Mesh {
                 }
             }
         }
-        Ok(())
+        super::integrity::check(self)
     }
 }

@@ -48,7 +48,7 @@ pub fn levels(dim: usize) -> usize {
 /// The built-in mesh of `level`, or the file `path`; with a name for the summary.
 pub fn load(dim: usize, level: usize, path: Option<&Path>) -> Result<(Mesh, String), CaseError> {
     let (mesh, name) = match path {
-        Some(p) => (gmsh::read(p)?, p.display().to_string()),
+        Some(p) => (crate::cases::read_mesh(p)?, p.display().to_string()),
         None => {
             let (set, stem) = match dim {
                 2 => (&CYLINDER[..], "hertz_cylinder"),
