@@ -77,7 +77,7 @@ pub(super) fn run_static(a: HertzStaticArgs) -> ExitCode {
             Ok(dir) => dir,
             Err(e) => return fail(e),
         },
-        newton: NewtonOptions { solver: a.solver, ..Default::default() },
+        newton: NewtonOptions { solver: a.solver, line_search: a.methods.line_search, ..Default::default() },
     };
     match statics::run(&opts) {
         Ok(s) => {
@@ -117,7 +117,7 @@ pub(super) fn run_impact(a: HertzImpactArgs) -> ExitCode {
         speed: a.speed,
         dt: a.dt,
         mass: a.mass,
-        newton: NewtonOptions { solver: a.solver, ..Default::default() },
+        newton: NewtonOptions { solver: a.solver, line_search: a.methods.line_search, ..Default::default() },
         out: match super::out_dir(a.out) {
             Ok(dir) => dir,
             Err(e) => return fail(e),

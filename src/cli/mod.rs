@@ -217,6 +217,9 @@ pub struct MethodArgs {
     /// (0: never).
     #[arg(long, default_value_t = 10.0)]
     max_energy_growth: f64,
+    /// Backtracking line search in Newton (halving the step while ‖R‖ does not decrease).
+    #[arg(long)]
+    line_search: bool,
 }
 
 impl MethodArgs {
@@ -320,9 +323,6 @@ pub struct StaticBlockArgs {
     /// Curvature c of the obstacle x_d = -c|x'|² (0: the plane).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     curvature: f64,
-    /// Backtracking line search in Newton.
-    #[arg(long)]
-    line_search: bool,
     /// Directory for summary.json.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -489,7 +489,7 @@ fn static_block(a: StaticBlockArgs) -> ExitCode {
         degree: a.degree as u32,
         h: a.h,
         curvature: a.curvature,
-        newton: crate::runtime::newton::NewtonOptions { line_search: a.line_search, ..Default::default() },
+        newton: crate::runtime::newton::NewtonOptions { line_search: a.methods.line_search, ..Default::default() },
         out: match out_dir(a.out) {
             Ok(dir) => dir,
             Err(e) => return fail(e),
@@ -611,7 +611,7 @@ fn run_bar(a: BarArgs) -> ExitCode {
         cell_size: a.methods.cell_size,
         out: a.out,
         progress: true,
-        ..Default::default()
+        newton: crate::runtime::newton::NewtonOptions { line_search: a.methods.line_search, ..Default::default() },
     };
     finish_bar(bar::run(&opts))
 }
@@ -706,7 +706,11 @@ fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
         },
         vtu_every: a.vtu_every,
         progress: true,
-        newton: crate::runtime::newton::NewtonOptions { solver: a.solver, ..Default::default() },
+        newton: crate::runtime::newton::NewtonOptions {
+            solver: a.solver,
+            line_search: a.methods.line_search,
+            ..Default::default()
+        },
     };
     finish_disc(crate::cases::disc::run(&opts))
 }
