@@ -264,3 +264,13 @@ fn an_interrupted_run_leaves_consistent_results_and_runs_never_mix() {
     assert!(summary.contains("\"case\": \"bar\""), "{summary}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// clap's own consistency checks over every subcommand (argument ids must be unique: a global
+/// `--force` and a command's `force` field once panicked at parse time).
+#[test]
+fn the_command_line_definition_is_consistent() {
+    use clap::CommandFactory;
+    signorini::cli::Cli::command().debug_assert();
+    let (code, _, err) = signorini(&["run", "hertz-static", "--level", "0", "--load", "0.5"]);
+    assert_eq!(code, 0, "{err}");
+}

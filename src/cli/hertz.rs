@@ -24,8 +24,8 @@ pub struct HertzStaticArgs {
     #[arg(long)]
     mesh: Option<PathBuf>,
     /// The force on the whole body (per unit length in 2D); default: Hertz's a = R/10.
-    #[arg(long = "load", allow_hyphen_values = true)]
-    force: Option<f64>,
+    #[arg(long, allow_hyphen_values = true)]
+    load: Option<f64>,
     /// Directory for summary.json and profile.png.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -72,7 +72,7 @@ pub(super) fn run_static(a: HertzStaticArgs) -> ExitCode {
         dim: a.dim as usize,
         level: a.level,
         mesh: a.mesh,
-        force: a.force,
+        force: a.load,
         out: match super::out_dir(a.out) {
             Ok(dir) => dir,
             Err(e) => return fail(e),
