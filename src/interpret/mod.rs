@@ -130,7 +130,7 @@ impl Library {
 
     /// Lowers every form declared in the root file of a checked program.
     pub fn new(prog: &Program) -> Library {
-        let irs: Vec<DimIr> = ir::DIMS.iter().map(|&d| ir::build(prog, d)).collect();
+        let irs = &prog.irs;
         let at = |span: Span| {
             let (line, _) = prog.sources.line_col(span.file, span.start);
             format!("{}:{line}", prog.sources.path(span.file).display())
@@ -153,7 +153,7 @@ impl Library {
         let forms = (0..prog.forms.len())
             .filter(|&fi| prog.forms[fi].span.file == prog.root)
             .map(|fi| FormEntry {
-                meta: meta(&irs, fi),
+                meta: meta(irs, fi),
                 dims: irs.iter().map(|ir| compile::dim_kernels(prog, ir, &ir.forms[fi])).collect(),
             })
             .collect();
