@@ -11,8 +11,12 @@ use crate::source::{SourceMap, Span};
 /// ui corpus (compiler/tests/ui) exercises each one, and docs/language.md lists them all.
 pub const CODES: &[(&str, &str)] = &[
     ("E0001", "syntax error"),
-    ("E0002", "nesting or length limit exceeded (expression nested too deeply, item too long)"),
+    (
+        "E0002",
+        "nesting or size limit exceeded (expression nested too deeply, item too long, functions expanding too far)",
+    ),
     ("E0003", "number out of range (not a finite double-precision number)"),
+    ("E0004", "constant arithmetic that is not finite (division by zero, overflow)"),
     ("E0101", "unknown name (with a suggestion when one is close)"),
     ("E0102", "name defined twice"),
     ("E0103", "duplicate argument, parameter or slot"),
@@ -33,6 +37,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0405", "form not linear in the test function (a term without it)"),
     ("E0501", "`n` or `h` in a volume integral"),
     ("E0502", "derivative of something that has none"),
+    ("E0503", "form needs a quadrature degree above the cap (20)"),
     ("E0601", "parameter default outside its range"),
     ("E0602", "empty parameter range"),
     ("E0603", "parameter default or bound not a finite constant"),
@@ -53,6 +58,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0814", "scheme: a relation that is not affine in the time levels"),
     ("E0816", "scheme: a call to a name that is not one of its slots (`uses`)"),
     ("E0817", "scheme: a slot that is never applied"),
+    ("E0818", "scheme: a stage time that is not finite for some parameter values"),
     ("W0001", "unused parameter (warning)"),
 ];
 
@@ -165,11 +171,28 @@ fn severity_word(s: Severity) -> &'static str {
     }
 }
 
-/// Renders all diagnostics, errors and warnings in source order, with a final count line.
+/// Most diagnostics rendered per file: a file of a million broken lines must not print
+/// hundreds of megabytes.
+pub const MAX_PER_FILE: usize = 100;
+
+/// Renders all diagnostics, errors and warnings in source order, with a final count line; past
+/// [`MAX_PER_FILE`] of one file, one line says how many more there are.
 pub fn render_all(diags: &[Diagnostic], sources: &SourceMap) -> String {
     let mut out = String::new();
+    let mut shown: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     for d in diags {
-        out.push_str(&d.render(sources));
+        let n = shown.entry(d.primary.span.file).or_default();
+        *n += 1;
+        if *n <= MAX_PER_FILE {
+            out.push_str(&d.render(sources));
+        }
+    }
+    let mut hidden: Vec<(usize, usize)> =
+        shown.into_iter().filter(|&(_, n)| n > MAX_PER_FILE).map(|(f, n)| (f, n - MAX_PER_FILE)).collect();
+    hidden.sort_unstable();
+    for (file, n) in hidden {
+        let name = if file < sources.len() { sources.path(file).display().to_string() } else { "?".into() };
+        out.push_str(&format!("note: {n} more diagnostics in {name} not shown\n"));
     }
     let errors = diags.iter().filter(|d| d.is_error()).count();
     let warnings = diags.len() - errors;

@@ -57,6 +57,13 @@ pub fn location(sources: &SourceMap, span: Span) -> String {
     format!("{}:{line}", file_name(sources, span))
 }
 
+/// `file.wf:line:col` of the region name in form `form`'s first `int(region)`.
+pub fn region_site(unit: &crate::check::Unit, form: &str, region: &str) -> String {
+    let f = unit.forms.iter().find(|f| f.name == form);
+    let i = f.and_then(|f| f.integrals.iter().find(|i| i.region.name == region));
+    i.map_or_else(|| "(source unknown)".to_string(), |i| location_col(&unit.sources, i.region.span))
+}
+
 /// `file.wf:line:col` of a span's start.
 pub fn location_col(sources: &SourceMap, span: Span) -> String {
     let (line, col) = sources.line_col(span.file, span.start);

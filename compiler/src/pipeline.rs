@@ -3,7 +3,6 @@
 //! `forms!` macro and the helpers below all go through [`compile`].
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 use crate::check::{self, load};
 use crate::codegen;
@@ -41,15 +40,13 @@ pub struct Compiled {
     pub ast: ast::File,
     /// The warnings, rendered (empty if none).
     pub warnings: String,
-    /// The IR for dimensions 1, 2, 3, built when first asked for.
-    irs: [OnceLock<DimIr>; 3],
 }
 
 impl Compiled {
     /// The IR of every form for dimension `d` (1, 2 or 3; panics otherwise).
     pub fn ir(&self, d: usize) -> &DimIr {
         assert!(ir::DIMS.contains(&d), "dimension {d} is not one of {:?}", ir::DIMS);
-        self.irs[d - 1].get_or_init(|| ir::build(&self.program, d))
+        &self.program.irs[d - 1]
     }
 
     /// The IR for every dimension of [`ir::DIMS`], in order.
@@ -154,6 +151,17 @@ fn front(loaded: load::Loaded, diags: Vec<Diagnostic>) -> Result<(Program, ast::
     let mut unit = check::check(sources, root, &files, diags)?;
     let mut diags = std::mem::take(&mut unit.warnings);
     let schemes = scheme::compile(&unit, &unit.scheme_defs, &mut diags);
+    let mut irs = Vec::new();
+    for &d in &ir::DIMS {
+        match ir::build(&unit, d) {
+            Ok(ir) => irs.push(ir),
+            // The first dimension's errors only: the others mostly repeat them.
+            Err(mut e) => {
+                diags.append(&mut e);
+                break;
+            }
+        }
+    }
     diagnostic::normalize(&mut diags);
     if diags.iter().any(Diagnostic::is_error) {
         return Err((diags, unit.sources));
@@ -163,7 +171,7 @@ fn front(loaded: load::Loaded, diags: Vec<Diagnostic>) -> Result<(Program, ast::
         Some(i) => files.swap_remove(i).1,
         None => ast::File::default(),
     };
-    Ok((Program { unit, schemes }, ast))
+    Ok((Program { unit, schemes, irs }, ast))
 }
 
 fn finish(front: Result<(Program, ast::File), (Vec<Diagnostic>, SourceMap)>) -> Result<Compiled, Failure> {
@@ -171,7 +179,7 @@ fn finish(front: Result<(Program, ast::File), (Vec<Diagnostic>, SourceMap)>) -> 
         Err((diags, sources)) => Err(Failure { rendered: render_all(&diags, &sources) }),
         Ok((program, ast)) => {
             let warnings = render_all(&program.warnings, &program.sources);
-            Ok(Compiled { program, ast, warnings, irs: Default::default() })
+            Ok(Compiled { program, ast, warnings })
         }
     }
 }

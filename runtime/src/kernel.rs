@@ -317,6 +317,9 @@ pub struct FormMeta {
     pub cell_degree: Option<[u32; 2]>,
     /// Boundary regions with suggested facet quadrature degrees for P1 and P2.
     pub facets: &'static [(&'static str, [u32; 2])],
+    /// Where each of `facets` is named in the source (`file.wf:line:col` of `int(NAME)`), for
+    /// errors when a case does not define the region.
+    pub facet_sites: &'static [&'static str],
 }
 
 /// Implemented by every generated form.

@@ -142,8 +142,8 @@ pub enum LibraryError {
     MissingCoef { name: &'static str, declared: &'static str },
     #[error("{0}")]
     Coef(String),
-    #[error("form `{form}` integrates over `{region}`, which the case does not define (it defines: {defined})")]
-    MissingRegion { form: &'static str, region: &'static str, defined: String },
+    #[error("{at}: form `{form}` integrates over `{region}`, which the case does not define (it defines: {defined}){hint}")]
+    MissingRegion { form: &'static str, region: &'static str, at: &'static str, defined: String, hint: String },
 }
 
 impl<'m> Binding<'m> {
@@ -151,16 +151,25 @@ impl<'m> Binding<'m> {
         &self,
         form: &'static str,
         names: &[(&'static str, [u32; 2])],
+        sites: &[&'static str],
     ) -> Result<Vec<(String, &'m [Facet])>, LibraryError> {
         names
             .iter()
-            .map(|(region, _)| {
+            .enumerate()
+            .map(|(k, (region, _))| {
                 self.regions.iter().find(|(n, _)| n == region).map(|(n, f)| (n.clone(), *f)).ok_or_else(|| {
                     let defined: Vec<&str> = self.regions.iter().map(|(n, _)| n.as_str()).collect();
+                    let close = defined
+                        .iter()
+                        .map(|d| (strsim::damerau_levenshtein(region, d), *d))
+                        .filter(|(dist, d)| *dist <= 1.max(region.len() / 3) && *dist < d.len())
+                        .min();
                     LibraryError::MissingRegion {
                         form,
                         region,
+                        at: sites.get(k).copied().unwrap_or("(source unknown)"),
                         defined: if defined.is_empty() { "none".into() } else { defined.join(", ") },
+                        hint: close.map_or_else(String::new, |(_, d)| format!("; did you mean `{d}`?")),
                     }
                 })
             })
@@ -170,14 +179,14 @@ impl<'m> Binding<'m> {
     /// A form kernel bound to this mesh.
     pub fn form<K: Kernel + 'm>(&self, kernel: K) -> Result<SlotForm<'m>, LibraryError> {
         let meta = *kernel.meta();
-        let regions = self.regions_of(meta.name, meta.facets)?;
+        let regions = self.regions_of(meta.name, meta.facets, meta.facet_sites)?;
         Ok(SlotForm::Form(Box::new(Bound { kernel, quadrature: self.quadrature, regions })))
     }
 
     /// A functional kernel bound to this mesh.
     pub fn functional<K: Functional + 'm>(&self, kernel: K) -> Result<SlotForm<'m>, LibraryError> {
         let meta = *kernel.meta();
-        let regions = self.regions_of(meta.name, meta.facets)?;
+        let regions = self.regions_of(meta.name, meta.facets, meta.facet_sites)?;
         Ok(SlotForm::Functional(Box::new(BoundValue { kernel, quadrature: self.quadrature, regions })))
     }
 }
@@ -233,5 +242,23 @@ impl<K: Functional> BoundFunctional for BoundValue<'_, K> {
             out.extend(asm.facet_point_values(&self.kernel, region, facets, rule, fields, t));
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_unknown_region_is_reported_at_its_source_with_a_suggestion() {
+        let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 2 };
+        let Err(e) = binding.regions_of("contact", &[("Gamma_c", [1, 2])], &["contact.wf:3:26"]) else {
+            panic!("bound an unknown region");
+        };
+        assert_eq!(
+            e.to_string(),
+            "contact.wf:3:26: form `contact` integrates over `Gamma_c`, which the case does not define (it defines: \
+             Gamma_C); did you mean `Gamma_C`?"
+        );
     }
 }

@@ -130,7 +130,7 @@ impl Library {
 
     /// Lowers every form declared in the root file of a checked program.
     pub fn new(prog: &Program) -> Library {
-        let irs: Vec<DimIr> = ir::DIMS.iter().map(|&d| ir::build(prog, d)).collect();
+        let irs = &prog.irs;
         let at = |span: Span| {
             let (line, _) = prog.sources.line_col(span.file, span.start);
             format!("{}:{line}", prog.sources.path(span.file).display())
@@ -153,7 +153,7 @@ impl Library {
         let forms = (0..prog.forms.len())
             .filter(|&fi| prog.forms[fi].span.file == prog.root)
             .map(|fi| FormEntry {
-                meta: meta(&irs, fi),
+                meta: meta(prog, irs, fi),
                 dims: irs.iter().map(|ir| compile::dim_kernels(prog, ir, &ir.forms[fi])).collect(),
             })
             .collect();
@@ -203,12 +203,18 @@ impl Library {
 /// `FormMeta` as codegen builds `META`: degrees from the 2D lowering, `linear` and
 /// `piecewise` over every dimension. Its strings are leaked, once per loaded form, because
 /// `FormMeta` holds `&'static` data (it is a constant in generated code).
-fn meta(irs: &[DimIr], fi: usize) -> FormMeta {
+fn meta(prog: &Program, irs: &[DimIr], fi: usize) -> FormMeta {
     let leak = |s: &str| -> &'static str { Box::leak(s.to_string().into_boxed_str()) };
     let f2 = &irs[1].forms[fi];
     let fields: Vec<&'static str> = f2.fields.iter().map(|f| leak(f)).collect();
     let facets: Vec<(&'static str, [u32; 2])> =
         f2.integrals.iter().filter(|i| !i.cell).map(|i| (leak(&i.region), i.degree)).collect();
+    let sites: Vec<&'static str> = f2
+        .integrals
+        .iter()
+        .filter(|i| !i.cell)
+        .map(|i| leak(&signorini_compiler::docs::region_site(prog, &f2.name, &i.region)))
+        .collect();
     FormMeta {
         name: leak(&f2.name),
         fields: Box::leak(fields.into_boxed_slice()),
@@ -217,5 +223,6 @@ fn meta(irs: &[DimIr], fi: usize) -> FormMeta {
         piecewise: irs.iter().all(|ir| ir.forms[fi].integrals.iter().all(|i| i.tangents.iter().all(|t| t.piecewise))),
         cell_degree: f2.integrals.iter().find(|i| i.cell).map(|i| i.degree),
         facets: Box::leak(facets.into_boxed_slice()),
+        facet_sites: Box::leak(sites.into_boxed_slice()),
     }
 }

@@ -21,11 +21,19 @@ pub struct Ty {
     pub smooth: bool,
     /// The value, when it is a compile-time constant.
     pub konst: Option<f64>,
+    /// Depth of the expression tree, `let`s and inlined `fn`s included: what the later
+    /// stages recurse through.
+    pub height: u32,
 }
 
 impl Ty {
+    /// What an inlined call's result depends on (the argument types of a memoised call).
+    fn key(&self) -> FnKey {
+        (self.shape, self.test, self.facet, self.smooth, self.konst.map(f64::to_bits), self.height)
+    }
+
     fn plain(shape: Shape) -> Ty {
-        Ty { shape, test: false, facet: None, smooth: true, konst: None }
+        Ty { shape, test: false, facet: None, smooth: true, konst: None, height: 0 }
     }
 
     fn constant(v: f64) -> Ty {
@@ -33,7 +41,14 @@ impl Ty {
     }
 
     fn join(a: &Ty, b: &Ty, shape: Shape) -> Ty {
-        Ty { shape, test: a.test || b.test, facet: a.facet.or(b.facet), smooth: a.smooth && b.smooth, konst: None }
+        Ty {
+            shape,
+            test: a.test || b.test,
+            facet: a.facet.or(b.facet),
+            smooth: a.smooth && b.smooth,
+            konst: None,
+            height: a.height.max(b.height),
+        }
     }
 }
 
@@ -52,9 +67,23 @@ pub(super) struct Checker<'p> {
     calls: Vec<(String, Span)>,
     /// Whether a global fn is being checked on its own (its parameters have unknown use).
     scope: Vec<(String, Ty)>,
+    /// Inlined calls already checked: (fn, argument types) → result and params used. A chain
+    /// of functions that each call the previous twice is then checked in linear time.
+    memo: HashMap<(String, Vec<FnKey>), (Option<Ty>, ParamSet)>,
+    /// Function bodies checked (memo misses), bounded by [`MAX_EXPANSIONS`].
+    expansions: usize,
+    /// Current recursion depth of [`Checker::ty`].
+    depth: u32,
 }
 
+type FnKey = (Shape, bool, Option<Span>, bool, Option<u64>, u32);
+
 const MAX_INLINE_DEPTH: usize = 32;
+/// Deepest expression accepted, through `let`s and inlined `fn`s: every later stage walks
+/// expressions recursively, and this bound keeps them within a thread's default stack.
+pub const MAX_DEPTH: u32 = 1024;
+/// Most function bodies checked with distinct argument types in one unit.
+const MAX_EXPANSIONS: usize = 100_000;
 
 impl<'p> Checker<'p> {
     pub fn new(prog: &'p Unit, broken: &'p HashSet<String>) -> Self {
@@ -66,6 +95,9 @@ impl<'p> Checker<'p> {
             lets: HashMap::new(),
             calls: Vec::new(),
             scope: Vec::new(),
+            memo: HashMap::new(),
+            expansions: 0,
+            depth: 0,
         }
     }
 
@@ -309,7 +341,45 @@ impl<'p> Checker<'p> {
         ty
     }
 
+    /// The type of `e`; also enforces [`MAX_DEPTH`] (going down, for this walk's own stack, and
+    /// coming up, for the heights of `let`s already checked) and that constants are finite.
     pub fn ty(&mut self, e: &Expr) -> Option<Ty> {
+        if self.depth >= MAX_DEPTH {
+            self.too_deep(e.span);
+            return None;
+        }
+        self.depth += 1;
+        let ty = self.ty_inner(e);
+        self.depth -= 1;
+        let mut ty = ty?;
+        ty.height += 1;
+        if ty.height > MAX_DEPTH {
+            self.too_deep(e.span);
+            return None;
+        }
+        if let Some(v) = ty.konst.filter(|v| !v.is_finite()) {
+            self.error(
+                Diagnostic::error("E0004", "constant arithmetic is not finite", e.span, format!("evaluates to {v}"))
+                    .with_note("a division by zero or an overflow of double precision"),
+            );
+            return None;
+        }
+        Some(ty)
+    }
+
+    fn too_deep(&mut self, span: Span) {
+        self.error(
+            Diagnostic::error(
+                "E0002",
+                format!("expression nests deeper than {MAX_DEPTH} levels"),
+                span,
+                format!("more than {MAX_DEPTH} levels deep, counting the `let`s and `fn`s it uses"),
+            )
+            .with_help("compute it in fewer nested steps: sum terms in balanced groups"),
+        );
+    }
+
+    fn ty_inner(&mut self, e: &Expr) -> Option<Ty> {
         match &e.kind {
             ExprKind::Number(v) => Some(Ty::constant(*v)),
             ExprKind::Name(id) => self.name_ty(id),
@@ -319,7 +389,9 @@ impl<'p> Checker<'p> {
             }
             ExprKind::Binary(op, a, b) => {
                 let (ta, tb) = (self.ty(a), self.ty(b));
-                self.binary_ty(*op, e, a, b, ta?, tb?)
+                let (ta, tb) = (ta?, tb?);
+                let height = ta.height.max(tb.height);
+                self.binary_ty(*op, e, a, b, ta, tb).map(|t| Ty { height, ..t })
             }
             ExprKind::Call(f, args) => self.call_ty(e, f, args),
         }
@@ -538,6 +610,11 @@ impl<'p> Checker<'p> {
                     return None;
                 }
                 let arg_tys: Vec<Ty> = arg_tys.into_iter().collect::<Option<_>>()?;
+                let key = (f.name.clone(), arg_tys.iter().map(Ty::key).collect::<Vec<_>>());
+                if let Some((ty, used)) = self.memo.get(&key) {
+                    self.used_params.extend(used.iter().copied());
+                    return *ty;
+                }
                 if self.calls.iter().any(|(n, _)| *n == f.name) {
                     self.error(
                         Diagnostic::error("E0105", format!("`{}` calls itself", f.name), f.span, "recursive call")
@@ -554,12 +631,31 @@ impl<'p> Checker<'p> {
                     ));
                     return None;
                 }
+                self.expansions += 1;
+                if self.expansions > MAX_EXPANSIONS {
+                    if self.expansions == MAX_EXPANSIONS + 1 {
+                        self.error(
+                            Diagnostic::error(
+                                "E0002",
+                                "functions expand too far",
+                                e.span,
+                                format!("more than {MAX_EXPANSIONS} inlined calls with distinct arguments"),
+                            )
+                            .with_help("functions are inlined at every call: compute shared values once with `let`"),
+                        );
+                    }
+                    return None;
+                }
                 let scope = params.iter().zip(arg_tys).map(|(p, t)| (p.name.clone(), t)).collect();
                 let saved = std::mem::replace(&mut self.scope, scope);
+                let saved_used = std::mem::take(&mut self.used_params);
                 self.calls.push((f.name.clone(), e.span));
                 let ty = self.ty(body);
                 self.calls.pop();
                 self.scope = saved;
+                let used = std::mem::replace(&mut self.used_params, saved_used);
+                self.used_params.extend(used.iter().copied());
+                self.memo.insert(key, (ty, used));
                 ty
             }
             Some(g) => {

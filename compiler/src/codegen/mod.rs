@@ -113,15 +113,22 @@ fn module_text(prog: &Program, irs: &[&DimIr], opts: &Options) -> String {
             .filter(|i| !i.cell)
             .map(|i| format!("({:?}, [{}, {}])", i.region, i.degree[0], i.degree[1]))
             .collect();
+        let sites: Vec<String> = ir2
+            .integrals
+            .iter()
+            .filter(|i| !i.cell)
+            .map(|i| format!("{:?}", crate::docs::region_site(prog, &form.name, &i.region)))
+            .collect();
         let _ = writeln!(
             s,
-            "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: &[{}] }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }}\n{} }}",
+            "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: &[{}], facet_sites: &[{}] }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }}\n{} }}",
             form.name,
             fields.join(", "),
             form.test.as_ref().map_or("", |t| t.name.as_str()),
             irs.iter().all(|ir| ir.forms[fi].linear),
             irs.iter().all(|ir| ir.forms[fi].integrals.iter().all(|i| i.tangents.iter().all(|t| t.piecewise))),
             facets.join(", "),
+            sites.join(", "),
             time_dependence(prog, irs, fi)
         );
         for ir in irs {

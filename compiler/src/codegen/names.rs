@@ -10,9 +10,15 @@ const RUST_KEYWORDS: &[&str] = &[
     "do", "final", "macro", "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen", "union", "_",
 ];
 
-/// A valid Rust identifier from a .wf name: `u'` → `u_p`, keywords get a trailing `_`.
+/// A valid Rust identifier from a .wf name or a file stem: `u'` → `u_p`, other characters
+/// outside `[A-Za-z0-9_]` → `_`, a leading digit gets a `_` before it (`9 bad-name` →
+/// `_9_bad_name`), keywords get a trailing `_`.
 pub fn ident(name: &str) -> String {
-    let mut s = name.replace('\'', "_p");
+    let mut s: String =
+        name.replace('\'', "_p").chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
+    if s.starts_with(|c: char| c.is_ascii_digit()) {
+        s.insert(0, '_');
+    }
     if RUST_KEYWORDS.contains(&s.as_str()) || s.is_empty() {
         s.push('_');
     }
@@ -56,5 +62,19 @@ impl Namer {
             return under;
         }
         (2..).map(|k| format!("{base}_{k}")).find(|c| self.taken.insert(c.clone())).expect("an unused name exists")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ident;
+
+    #[test]
+    fn file_stems_become_identifiers() {
+        assert_eq!(ident("9 bad-name"), "_9_bad_name");
+        assert_eq!(ident("u'"), "u_p");
+        assert_eq!(ident("type"), "type_");
+        assert_eq!(ident("é"), "__");
+        assert_eq!(ident(""), "_");
     }
 }

@@ -6,18 +6,26 @@ use std::collections::HashMap;
 
 use super::graph::{Graph, NodeId, Sym};
 use crate::check::{CELL_REGION, Global, Unit};
+use crate::diagnostic::Diagnostic;
+use crate::source::Span;
 use crate::syntax::ast::{BinOp, Expr, ExprKind, Shape};
+
+/// Most graph nodes one form's integrands may add in one dimension (before differentiation).
+/// Functions are inlined, and calls with distinct arguments can expand exponentially.
+pub const MAX_FORM_NODES: usize = 100_000;
+
+type Res<T> = Result<T, Box<Diagnostic>>;
 
 /// A scalar with its spatial gradient (`None` where no gradient exists: normal, case data,
 /// gradients themselves).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Jet {
     pub v: NodeId,
     pub g: Option<Vec<NodeId>>,
 }
 
 /// A lowered value: components in row-major order (1, d or d·d of them).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Val {
     pub shape: Shape,
     pub c: Vec<Jet>,
@@ -47,19 +55,37 @@ pub struct Lowerer<'p> {
     d: usize,
     scope: Vec<(String, Val)>,
     lets: HashMap<String, Val>,
+    /// Inlined calls by function and argument values: each distinct call is expanded once.
+    calls: HashMap<(String, Vec<Val>), Val>,
+    /// Graph size when the current form began, for [`MAX_FORM_NODES`], and its name.
+    form_start: usize,
+    form_name: String,
 }
 
 impl<'p> Lowerer<'p> {
     pub fn new(prog: &'p Unit, d: usize) -> Self {
-        Lowerer { g: Graph::default(), prog, d, scope: Vec::new(), lets: HashMap::new() }
+        Lowerer {
+            g: Graph::default(),
+            prog,
+            d,
+            scope: Vec::new(),
+            lets: HashMap::new(),
+            calls: HashMap::new(),
+            form_start: 0,
+            form_name: String::new(),
+        }
     }
 
     pub fn dim(&self) -> usize {
         self.d
     }
 
-    pub fn form(&mut self, index: usize) -> LoweredForm {
+    /// Lowers form `index`; refuses non-finite constant arithmetic and expansions past
+    /// [`MAX_FORM_NODES`], at the user's tokens.
+    pub fn form(&mut self, index: usize) -> Res<LoweredForm> {
         let form = &self.prog.forms[index];
+        self.form_start = self.g.len();
+        self.form_name.clone_from(&form.name);
         let d = self.d;
         let mut scope = Vec::new();
         for (a, f) in form.fields.iter().enumerate() {
@@ -87,7 +113,13 @@ impl<'p> Lowerer<'p> {
         self.scope = scope;
         let mut integrands: Vec<Integrand> = Vec::new();
         for integral in &form.integrals {
-            let v = self.expr(&integral.integrand).c[0].v;
+            let v = match self.expr(&integral.integrand) {
+                Ok(v) => v.c[0].v,
+                Err(d) => {
+                    self.scope.clear();
+                    return Err(d);
+                }
+            };
             let v = if integral.sign < 0.0 { self.g.neg(v) } else { v };
             match integrands.iter_mut().find(|i| i.region == integral.region.name) {
                 Some(i) => i.value = self.g.add(i.value, v),
@@ -97,12 +129,12 @@ impl<'p> Lowerer<'p> {
         // Volume integral first: kernels are emitted in this order.
         integrands.sort_by_key(|i| i.region != CELL_REGION);
         self.scope.clear();
-        LoweredForm {
+        Ok(LoweredForm {
             name: form.name.clone(),
             fields: form.fields.iter().map(|f| f.name.clone()).collect(),
             test: form.test.as_ref().map(|t| t.name.clone()),
             integrands,
-        }
+        })
     }
 
     fn zero_grad(&mut self) -> Option<Vec<NodeId>> {
@@ -119,31 +151,39 @@ impl<'p> Lowerer<'p> {
         Val { shape: Shape::Scalar, c: vec![j] }
     }
 
-    fn expr(&mut self, e: &Expr) -> Val {
-        match &e.kind {
+    fn expr(&mut self, e: &Expr) -> Res<Val> {
+        let v = match &e.kind {
             ExprKind::Number(v) => Self::scalar(self.constant(*v)),
-            ExprKind::Name(id) => self.name(&id.name),
+            ExprKind::Name(id) => self.name(&id.name)?,
             ExprKind::Neg(a) => {
-                let a = self.expr(a);
+                let a = self.expr(a)?;
                 self.map(&a, |s, j| s.jneg(j))
             }
             ExprKind::Binary(op, a, b) => {
-                let (a, b) = (self.expr(a), self.expr(b));
+                let (a, b) = (self.expr(a)?, self.expr(b)?);
+                if *op == BinOp::Div && self.g.is_zero(b.c[0].v) {
+                    return Err(Box::new(not_finite(e.span, "divides by zero")));
+                }
                 self.binary(*op, a, b, b_const(e))
             }
             ExprKind::Call(f, args) => {
-                let args: Vec<Val> = args.iter().map(|a| self.expr(a)).collect();
-                self.call(&f.name, args)
+                let args: Vec<Val> = args.iter().map(|a| self.expr(a)).collect::<Res<_>>()?;
+                self.call(&f.name, args, e.span)?
             }
+        };
+        // Operands are finite (checked below them), so a non-finite constant was made here.
+        if let Some(x) = v.c.iter().find_map(|j| self.g.as_const(j.v).filter(|x| !x.is_finite())) {
+            return Err(Box::new(not_finite(e.span, &format!("evaluates to {x}"))));
         }
+        Ok(v)
     }
 
-    fn name(&mut self, name: &str) -> Val {
+    fn name(&mut self, name: &str) -> Res<Val> {
         if let Some((_, v)) = self.scope.iter().rev().find(|(n, _)| n == name) {
-            return v.clone();
+            return Ok(v.clone());
         }
         let d = self.d;
-        match self.prog.globals.get(name) {
+        Ok(match self.prog.globals.get(name) {
             Some(Global::Param(i)) => {
                 let v = self.g.sym(Sym::Param(*i as u16));
                 Self::scalar(Jet { v, g: self.zero_grad() })
@@ -158,11 +198,12 @@ impl<'p> Lowerer<'p> {
             }
             Some(Global::Let { value, .. }) => {
                 if let Some(v) = self.lets.get(name) {
-                    return v.clone();
+                    return Ok(v.clone());
                 }
                 let saved = std::mem::take(&mut self.scope);
                 let v = self.expr(&value.clone());
                 self.scope = saved;
+                let v = v?;
                 self.name_val(&v, name);
                 self.lets.insert(name.to_string(), v.clone());
                 v
@@ -197,7 +238,7 @@ impl<'p> Lowerer<'p> {
                 "pi" => Self::scalar(self.constant(std::f64::consts::PI)),
                 _ => unreachable!("checked name `{name}`"),
             },
-        }
+        })
     }
 
     fn name_val(&mut self, v: &Val, name: &str) {
@@ -215,15 +256,37 @@ impl<'p> Lowerer<'p> {
         }
     }
 
-    fn call(&mut self, f: &str, args: Vec<Val>) -> Val {
+    fn call(&mut self, f: &str, args: Vec<Val>, span: Span) -> Res<Val> {
         if let Some(Global::Fn { params, body, .. }) = self.prog.globals.get(f) {
-            let scope = params.iter().map(|p| p.name.clone()).zip(args).collect();
+            let key = (f.to_string(), args);
+            if let Some(v) = self.calls.get(&key) {
+                return Ok(v.clone());
+            }
+            if self.g.len() - self.form_start > MAX_FORM_NODES {
+                return Err(Box::new(
+                    Diagnostic::error(
+                        "E0002",
+                        format!("`{f}` expands too far"),
+                        span,
+                        format!("the form grows past {MAX_FORM_NODES} operations by this call"),
+                    )
+                    .with_note(format!("while inlining the functions of form `{}`", self.form_name))
+                    .with_help("functions are inlined at every call with distinct arguments: compute shared values once with `let`"),
+                ));
+            }
+            let scope = params.iter().map(|p| p.name.clone()).zip(key.1.iter().cloned()).collect();
             let saved = std::mem::replace(&mut self.scope, scope);
             let v = self.expr(&body.clone());
             self.scope = saved;
+            let v = v?;
             self.name_val(&v, f);
-            return v;
+            self.calls.insert(key, v.clone());
+            return Ok(v);
         }
+        Ok(self.builtin(f, args))
+    }
+
+    fn builtin(&mut self, f: &str, args: Vec<Val>) -> Val {
         let d = self.d;
         let mut args = args.into_iter();
         let mut next = || args.next().expect("checked arity");
@@ -478,7 +541,8 @@ impl<'p> Lowerer<'p> {
         let g = a.g.as_ref().map(|ga| {
             let two = self.g.constant(2.0);
             let den = self.g.mul(two, v);
-            ga.iter().map(|&x| self.g.div(x, den)).collect()
+            // A constant's gradient is zero even where the root is (sqrt(0)), not 0/0.
+            ga.iter().map(|&x| if self.g.is_zero(x) { x } else { self.g.div(x, den) }).collect()
         });
         Jet { v, g }
     }
@@ -487,6 +551,11 @@ impl<'p> Lowerer<'p> {
         let v = self.g.heaviside(a.v);
         Jet { v, g: self.zero_grad() }
     }
+}
+
+fn not_finite(span: Span, label: &str) -> Diagnostic {
+    Diagnostic::error("E0004", "constant arithmetic is not finite", span, label)
+        .with_note("a division by zero or an overflow of double precision, after simplification")
 }
 
 /// Number of scalar components of a shape in dimension d.

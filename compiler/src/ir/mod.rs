@@ -16,6 +16,13 @@ use derive::Derivative;
 use graph::{Graph, Node, NodeId, Sym};
 
 use crate::check::{CELL_REGION, Unit};
+use crate::diagnostic::Diagnostic;
+
+/// Highest polynomial degree a form may need to be integrated exactly. The runtime has rules
+/// of every degree (runtime/src/quadrature.rs: collapsed Gauss products past its symmetric
+/// rules), but their point counts grow as degree^dim and only degrees up to 10 are tested
+/// there; an estimate past this is a mistake (`u^40`) rather than an integrand.
+pub const MAX_DEGREE: u32 = 20;
 
 /// Space dimensions the kernels are generated for.
 pub const DIMS: [usize; 3] = [1, 2, 3];
@@ -79,10 +86,21 @@ impl TangentIr {
     }
 }
 
-/// Lowers every form of the program for dimension `d`, with tangents.
-pub fn build(prog: &Unit, d: usize) -> DimIr {
+/// Lowers every form of the program for dimension `d`, with tangents. Refuses non-finite
+/// constant arithmetic, forms that expand too far and quadrature degrees past [`MAX_DEGREE`].
+pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
     let mut lowerer = lower::Lowerer::new(prog, d);
-    let lowered: Vec<_> = (0..prog.forms.len()).map(|i| lowerer.form(i)).collect();
+    let mut diags = Vec::new();
+    let mut lowered = Vec::new();
+    for i in 0..prog.forms.len() {
+        match lowerer.form(i) {
+            Ok(f) => lowered.push(f),
+            Err(e) => diags.push(*e),
+        }
+    }
+    if !diags.is_empty() {
+        return Err(diags);
+    }
     let mut g = lowerer.g;
     let mut forms = Vec::new();
     for lf in lowered {
@@ -127,9 +145,36 @@ pub fn build(prog: &Unit, d: usize) -> DimIr {
             .reachable(tangent_nodes)
             .into_iter()
             .any(|n| matches!(g.node(n), Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. })));
+        if let Some(e) = degree_error(prog, &lf.name, &integrals) {
+            diags.push(e);
+        }
         forms.push(FormIr { name: lf.name, fields: lf.fields, test: lf.test, integrals, linear });
     }
-    DimIr { dim: d, graph: g, forms }
+    if !diags.is_empty() {
+        return Err(diags);
+    }
+    Ok(DimIr { dim: d, graph: g, forms })
+}
+
+/// A form whose estimated quadrature degree (on P1 or P2 elements) passes [`MAX_DEGREE`].
+fn degree_error(prog: &Unit, name: &str, integrals: &[IntegralIr]) -> Option<Diagnostic> {
+    let (i, degree) =
+        integrals.iter().enumerate().map(|(i, x)| (i, x.degree[0].max(x.degree[1]))).max_by_key(|x| x.1)?;
+    if degree <= MAX_DEGREE {
+        return None;
+    }
+    let form = prog.forms.iter().find(|f| f.name == name)?;
+    let region = &integrals[i].region;
+    let integral = form.integrals.iter().find(|x| x.region.name == *region)?;
+    Some(
+        Diagnostic::error(
+            "E0503",
+            format!("form `{name}` needs quadrature of degree {degree}"),
+            integral.integrand.span,
+            format!("a polynomial of degree {degree} on P2 elements, above the cap of {MAX_DEGREE}"),
+        )
+        .with_help("lower the powers or the nesting of products; a high power of a field is rarely meant"),
+    )
 }
 
 fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> TangentIr {

@@ -488,6 +488,13 @@ impl<'a> Compiler<'a> {
                 self.g.add(t, dt)
             }
         };
+        if let (Some(e), Some(at)) = (&st.at, self.not_finite_at(time)) {
+            self.error(
+                Diagnostic::error("E0818", format!("the time of stage `{name}` is not finite"), e.span, at)
+                    .with_help("a stage time is t plus a finite multiple of dt for every parameter value in range"),
+            );
+            return None;
+        }
         // New quantities: the unknown, the relations' left-hand sides, and the names their
         // right-hand sides introduce.
         self.new = vec![unknown.name.clone()];
@@ -682,6 +689,26 @@ impl<'a> Compiler<'a> {
 
     /// Checks that a pivot coefficient keeps one sign, away from zero, over the parameter
     /// ranges and dt > 0.
+    /// Where (params, dt) a coefficient is not finite, among the pivot check's samples.
+    fn not_finite_at(&self, c: NodeId) -> Option<String> {
+        let samples: Vec<Vec<f64>> = self.params.iter().map(|p| p.samples()).collect();
+        let mut points: Vec<Vec<f64>> = vec![Vec::new()];
+        for s in &samples {
+            points = points.iter().flat_map(|p| s.iter().map(move |v| [p.as_slice(), &[*v]].concat())).collect();
+        }
+        for values in &points {
+            for dt in [1e-4, 1e-2, 1.0, 100.0] {
+                let v = affine::eval(&self.g, c, values, dt, 0.0);
+                if !v.is_finite() {
+                    let ps: Vec<String> =
+                        self.params.iter().zip(values).map(|(p, v)| format!("{} = {v}, ", p.name)).collect();
+                    return Some(format!("{v} at {}dt = {dt}, t = 0", ps.concat()));
+                }
+            }
+        }
+        None
+    }
+
     fn check_pivot(&self, c: NodeId) -> Result<(), String> {
         let samples: Vec<Vec<f64>> = self.params.iter().map(|p| p.samples()).collect();
         let mut index = vec![0usize; samples.len()];
@@ -864,8 +891,20 @@ impl<'a> Compiler<'a> {
         }
     }
 
-    /// A scalar, or an affine combination of time levels.
+    /// A scalar, or an affine combination of time levels; a division by zero or a non-finite
+    /// constant is refused where it is written.
     fn value(&mut self, e: &Expr) -> Option<Value> {
+        let v = self.value_inner(e)?;
+        if let Value::Scalar(n) = v
+            && let Some(x) = self.g.as_const(n).filter(|x| !x.is_finite())
+        {
+            self.error(not_finite(e.span, &format!("evaluates to {x}")));
+            return None;
+        }
+        Some(v)
+    }
+
+    fn value_inner(&mut self, e: &Expr) -> Option<Value> {
         match &e.kind {
             ExprKind::Number(v) => Some(Value::Scalar(self.g.constant(*v))),
             ExprKind::Name(id) => match self.scope.get(&id.name) {
@@ -897,6 +936,12 @@ impl<'a> Compiler<'a> {
             }),
             ExprKind::Binary(op, a, b) => {
                 let (x, y) = (self.value(a)?, self.value(b)?);
+                if let (BinOp::Div, Value::Scalar(q)) = (op, &y)
+                    && self.g.is_zero(*q)
+                {
+                    self.error(not_finite(e.span, "divides by zero"));
+                    return None;
+                }
                 match (op, x, y) {
                     (BinOp::Add, Value::Scalar(p), Value::Scalar(q)) => Some(Value::Scalar(self.g.add(p, q))),
                     (BinOp::Sub, Value::Scalar(p), Value::Scalar(q)) => Some(Value::Scalar(self.g.sub(p, q))),
@@ -994,4 +1039,9 @@ impl SchemeParamInfo {
         }
         s
     }
+}
+
+fn not_finite(span: Span, label: &str) -> Diagnostic {
+    Diagnostic::error("E0004", "constant arithmetic is not finite", span, label)
+        .with_note("a division by zero or an overflow of double precision, after simplification")
 }

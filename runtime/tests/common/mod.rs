@@ -17,6 +17,7 @@ const META: FormMeta = FormMeta {
     piecewise: false,
     cell_degree: Some([2, 4]),
     facets: &[],
+    facet_sites: &[],
 };
 
 impl Form for MassStiffness {
