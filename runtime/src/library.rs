@@ -142,7 +142,9 @@ pub enum LibraryError {
     MissingCoef { name: &'static str, declared: &'static str },
     #[error("{0}")]
     Coef(String),
-    #[error("{at}: form `{form}` integrates over `{region}`, which the case does not define (it defines: {defined}){hint}")]
+    #[error(
+        "{at}: form `{form}` integrates over `{region}`, which the case does not define (it defines: {defined}){hint}"
+    )]
     MissingRegion { form: &'static str, region: &'static str, at: &'static str, defined: String, hint: String },
 }
 

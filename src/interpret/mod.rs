@@ -27,7 +27,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use signorini_compiler::check::ParamRange;
-use signorini_compiler::ir::{self, DimIr};
+use signorini_compiler::ir::DimIr;
 use signorini_compiler::{FsLoader, Program, Span};
 use signorini_runtime::kernel::{Coef, FormMeta};
 
