@@ -249,10 +249,11 @@ pub fn node_degrees(
                 Sym::Param(_) | Sym::Normal(_) | Sym::CellDiameter | Sym::Time | Sym::Dt => 0,
             },
             Node::Add(a, b) => dg(a).max(dg(b)),
-            Node::Mul(a, b) | Node::Div(a, b) => dg(a) + dg(b),
+            // Saturating: deep products overflow u32; the cap on the degree reports them.
+            Node::Mul(a, b) | Node::Div(a, b) => dg(a).saturating_add(dg(b)),
             Node::Neg(a) => dg(a),
-            Node::Powi(a, k) if k >= 0 => dg(a) * k as u32,
-            Node::Powi(a, _) | Node::Sqrt(a) => dg(a) + 2,
+            Node::Powi(a, k) if k >= 0 => dg(a).saturating_mul(k as u32),
+            Node::Powi(a, _) | Node::Sqrt(a) => dg(a).saturating_add(2),
             Node::Heaviside(_) => 0,
         };
         deg.insert(id, v);
@@ -267,7 +268,7 @@ fn integral_degree(g: &Graph, p: u32, f0: &[NodeId], f1: &[NodeId], tangents: &[
     let mut best = 0;
     let mut take = |n: &NodeId, extra: u32| {
         if let Some(v) = d(n) {
-            best = best.max(v + extra);
+            best = best.max(v.saturating_add(extra));
         }
     };
     f0.iter().for_each(|n| take(n, p));
