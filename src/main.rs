@@ -1,5 +1,3 @@
-use clap::Parser;
-
 fn main() -> std::process::ExitCode {
     // Behave like other command-line tools when the reader of stdout goes away
     // (`signorini run bar --all | head`): end quietly instead of panicking in println!.
@@ -14,5 +12,5 @@ fn main() -> std::process::ExitCode {
         .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
         .with_writer(std::io::stderr)
         .init();
-    signorini::cli::run(signorini::cli::Cli::parse())
+    signorini::cli::run(signorini::cli::Cli::parse_args())
 }

@@ -30,10 +30,11 @@ fn check_against(case: &str, dofs: f64, dim: usize, h: Option<f64>, available: f
         return Ok(());
     }
     let gb = |b: f64| b / 1e9;
-    let fits =
-        h.map_or(String::new(), |h| format!("; h ≥ {:.3} fits", h * (need / (0.9 * available)).powf(1.0 / dim as f64)));
+    let fits = h.map_or(String::new(), |h| {
+        format!("; --h {:.3} or coarser fits", h * (need / (0.9 * available)).powf(1.0 / dim as f64))
+    });
     Err(CaseError::Option(format!(
-        "{case}: about {dofs:.2e} unknowns need about {:.1} GB, and {:.1} GB are available{fits}",
+        "{case}: about {dofs:.2e} unknowns need about {:.1} GB of memory, and {:.1} GB are available{fits}",
         gb(need),
         gb(available)
     )))
@@ -45,7 +46,10 @@ mod tests {
     fn the_message_says_which_size_fits() {
         // 1e9 unknowns in 3D against 24 GB: h must grow by (1e13 / 21.6e9)^(1/3) ≈ 7.7 (0.0077).
         let e = super::check_against("static-block", 1e9, 3, Some(0.001), 24e9).unwrap_err().to_string();
-        assert!(e.contains("1.00e9 unknowns need about 10000.0 GB") && e.contains("h ≥ 0.008"), "{e}");
+        assert!(
+            e.contains("1.00e9 unknowns need about 10000.0 GB of memory") && e.contains("--h 0.008 or coarser"),
+            "{e}"
+        );
         assert!(super::check_against("disc", 12_490.0, 2, Some(0.5), 24e9).is_ok());
     }
 }

@@ -81,7 +81,28 @@ pub struct FsLoader;
 
 impl Loader for FsLoader {
     fn load(&self, path: &Path) -> std::io::Result<String> {
-        std::fs::read_to_string(path)
+        decode(std::fs::read(path)?)
+    }
+}
+
+/// UTF-8 text without the byte-order mark some editors write; invalid UTF-8 is an error whose
+/// message starts with `line:column:` of the first bad byte.
+fn decode(bytes: Vec<u8>) -> std::io::Result<String> {
+    match String::from_utf8(bytes) {
+        Ok(text) => Ok(match text.strip_prefix('\u{feff}') {
+            Some(rest) => rest.to_string(),
+            None => text,
+        }),
+        Err(e) => {
+            let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let line = good.iter().filter(|&&b| b == b'\n').count() + 1;
+            let start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+            let col = String::from_utf8_lossy(&good[start..]).chars().count() + 1;
+            Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("{line}:{col}: not UTF-8 text (byte 0x{:02x})", e.as_bytes()[good.len()]),
+            ))
+        }
     }
 }
 

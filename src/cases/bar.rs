@@ -144,7 +144,12 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         return Err(CaseError::Option("--dt and --t-end must be positive".into()));
     }
     if opts.t_end / opts.dt > 1e7 {
-        return Err(CaseError::Option("more than 10⁷ steps".into()));
+        return Err(CaseError::Option(format!(
+            "--dt {} and --t-end {} make {:.1e} steps, more than 10⁷",
+            opts.dt,
+            opts.t_end,
+            opts.t_end / opts.dt
+        )));
     }
     let active = Active::resolve(&opts.setup, OVERRIDES)?;
     simulate(opts, &active)

@@ -37,6 +37,21 @@ pub struct Cli {
     pub force: bool,
 }
 
+impl Cli {
+    /// The command line, where every option's value may be negative: `--alpha -0.1` then gets
+    /// the option's own range error instead of clap's "unexpected argument '-0'".
+    pub fn parse_args() -> Self {
+        use clap::{CommandFactory, FromArgMatches};
+        let matches = negative_values(Self::command()).get_matches();
+        Self::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
+    }
+}
+
+fn negative_values(cmd: clap::Command) -> clap::Command {
+    cmd.mut_args(|a| if a.get_action().takes_values() { a.allow_negative_numbers(true) } else { a })
+        .mut_subcommands(negative_values)
+}
+
 /// `--force`, for the output directories of every command.
 static FORCE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 
@@ -100,7 +115,7 @@ pub enum Command {
         a: PathBuf,
         b: PathBuf,
         /// Fail (exit 1) when a column's relative difference exceeds this.
-        #[arg(long)]
+        #[arg(long, value_parser = energy_growth)]
         tol: Option<f64>,
     },
     /// Print a compilation stage of a .wf file.
@@ -211,15 +226,33 @@ pub struct MethodArgs {
     #[arg(long, value_parser = CellSize::parse, default_value = "diameter")]
     cell_size: CellSize,
     /// Halvings of Δt allowed when a step's Newton fails (Δt doubles back after two good steps).
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = 6, value_parser = step_cuts)]
     max_step_cuts: usize,
     /// Stop when ½uᵀKu + ½vᵀMv exceeds this many times its initial value plus the loads' work
     /// (0: never).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = energy_growth)]
     max_energy_growth: f64,
     /// Backtracking line search in Newton (halving the step while ‖R‖ does not decrease).
     #[arg(long)]
     line_search: bool,
+}
+
+/// `--max-step-cuts`: the range the case files accept too.
+fn step_cuts(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<i64>() {
+        Ok(n) if (0..=40).contains(&n) => Ok(n as usize),
+        Ok(n) => Err(format!("{n} is not in 0..=40")),
+        Err(_) => Err(format!("`{s}` is not a whole number")),
+    }
+}
+
+/// `--max-energy-growth` (0: off) and `--tol`: a number ≥ 0.
+fn energy_growth(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x >= 0.0 && x.is_finite() => Ok(x),
+        Ok(x) => Err(format!("{x} is not 0 or a positive number")),
+        Err(_) => Err(format!("`{s}` is not a number")),
+    }
 }
 
 impl MethodArgs {

@@ -170,7 +170,7 @@ pub struct LibraryLoader;
 
 impl crate::compiler::Loader for LibraryLoader {
     fn load(&self, path: &Path) -> std::io::Result<String> {
-        match std::fs::read_to_string(path) {
+        match crate::compiler::Loader::load(&crate::compiler::FsLoader, path) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
                 crate::forms::SOURCES.iter().find(|(n, _)| *n == name).map(|(_, text)| text.to_string()).ok_or(e)

@@ -17,7 +17,10 @@ pub struct Loaded {
 /// Reads and parses `root` and everything it imports. Syntax errors do not stop loading.
 pub fn load(root: &Path, loader: &dyn Loader, diags: &mut Vec<Diagnostic>) -> Result<Loaded, String> {
     let root = normalize(root);
-    let text = loader.load(&root).map_err(|e| format!("cannot read {}: {e}", root.display()))?;
+    let text = loader.load(&root).map_err(|e| match e.kind() {
+        std::io::ErrorKind::InvalidData => format!("{}:{e}", root.display()),
+        _ => format!("cannot read {}: {e}", root.display()),
+    })?;
     let mut l = Loader_ { loader, sources: SourceMap::default(), files: Vec::new(), stack: Vec::new() };
     let root_id = l.sources.add(root.clone(), text);
     l.visit(root_id, diags);

@@ -150,6 +150,17 @@ impl<'a> Compiler<'a> {
         let def = self.def;
         // Parameters.
         for (i, p) in def.params.iter().enumerate() {
+            if let Some(prev) = def.params[..i].iter().find(|q| q.name.name == p.name.name) {
+                self.error(
+                    Diagnostic::error(
+                        "E0103",
+                        format!("duplicate parameter `{}`", p.name.name),
+                        p.name.span,
+                        "repeated here",
+                    )
+                    .with_label(prev.name.span, "first here"),
+                );
+            }
             let default = match const_eval(&p.default) {
                 Ok(v) if v.is_finite() => v,
                 _ => {
@@ -242,15 +253,16 @@ impl<'a> Compiler<'a> {
                 match last.quantities.iter().position(|q| *q == primed) {
                     Some(index) => updates.push(Quantity::Stage { stage: stages.len() - 1, index }),
                     None => {
-                        let at =
+                        let last =
                             def.stages.last().and_then(|s| s.name.as_ref().map(|n| n.span)).unwrap_or(def.name.span);
                         self.error(
                             Diagnostic::error(
                                 "E0806",
                                 format!("state `{}` gets no new value", s.name),
-                                at,
-                                format!("no `{primed}` in the last stage"),
+                                s.span,
+                                format!("declared here, but there is no `{primed}` in the last stage"),
                             )
+                            .with_label(last, "the last stage")
                             .with_help(format!("relate `{primed}` to the other quantities, or make it the unknown")),
                         );
                     }

@@ -35,7 +35,19 @@ pub fn parse(file: FileId, text: &str) -> (File, Vec<Diagnostic>) {
     pest::set_error_detail(true);
     let mut out = File::default();
     let mut diags = Vec::new();
-    for (start, end) in chunks(text) {
+    let (chunks, open_comment) = chunks(text);
+    if let Some(at) = open_comment {
+        diags.push(
+            Diagnostic::error(
+                "E0001",
+                "unterminated comment",
+                Span::new(file, at, at + 2),
+                "this `/*` is never closed",
+            )
+            .with_help("close it with `*/`, or use `//` for a line comment"),
+        );
+    }
+    for (start, end) in chunks {
         let chunk = &text[start..end];
         if let Some(d) = nesting_error(file, chunk, start) {
             diags.push(d);
@@ -71,8 +83,8 @@ pub fn parse(file: FileId, text: &str) -> (File, Vec<Diagnostic>) {
 }
 
 /// Byte ranges of the chunks: boundaries at item keywords that start a line, outside comments,
-/// strings and braces.
-fn chunks(text: &str) -> Vec<(usize, usize)> {
+/// strings and braces; and where a `/*` comment that never ends starts (the chunks stop there).
+fn chunks(text: &str) -> (Vec<(usize, usize)>, Option<usize>) {
     let bytes = text.as_bytes();
     let mut starts = vec![0];
     let (mut i, mut depth, mut line_start) = (0, 0i64, true);
@@ -85,11 +97,16 @@ fn chunks(text: &str) -> Vec<(usize, usize)> {
             continue;
         }
         if bytes[i..].starts_with(b"/*") {
+            let open = i;
             i += 2;
             while i < bytes.len() && !bytes[i..].starts_with(b"*/") {
                 i += 1;
             }
-            i = (i + 2).min(bytes.len());
+            if i >= bytes.len() {
+                starts.push(open);
+                return (starts.windows(2).map(|w| (w[0], w[1])).collect(), Some(open));
+            }
+            i += 2;
             line_start = false;
             continue;
         }
@@ -111,7 +128,7 @@ fn chunks(text: &str) -> Vec<(usize, usize)> {
         i += 1;
     }
     starts.push(text.len());
-    starts.windows(2).map(|w| (w[0], w[1])).collect()
+    (starts.windows(2).map(|w| (w[0], w[1])).collect(), None)
 }
 
 fn starts_item(rest: &str) -> bool {
@@ -663,9 +680,20 @@ mod tests {
     #[test]
     fn chunks_split_at_item_keywords_only() {
         let text = "param a = 1\n// let b = 2\nlet c = a\n  + 1\nfn f(x) = x\n";
-        let c = chunks(text);
+        let (c, open) = chunks(text);
         assert_eq!(c.len(), 3);
         assert!(text[c[1].0..c[1].1].starts_with("let c"));
+        assert_eq!(open, None);
+    }
+
+    #[test]
+    fn an_unterminated_comment_is_reported_where_it_opens() {
+        let text = "param a = 1\n/* never closed\nlet c = a\n";
+        let (f, d) = parse(0, text);
+        assert_eq!(d.len(), 1, "{d:?}");
+        assert_eq!(d[0].code, "E0001");
+        assert_eq!(d[0].primary.span.start, text.find("/*").unwrap());
+        assert_eq!(f.items.len(), 1);
     }
 
     #[test]

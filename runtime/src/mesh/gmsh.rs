@@ -277,6 +277,7 @@ impl<'a> Parser<'a> {
         let mut raw = Raw::default();
         let mut seen_format = false;
         let mut entity_physicals: HashMap<(u32, i64), Vec<i64>> = HashMap::new();
+        let mut once: Vec<(String, usize)> = Vec::new();
         loop {
             let line_no = self.line;
             let Some(line) = self.next_line() else { break };
@@ -297,6 +298,18 @@ impl<'a> Parser<'a> {
                     At::Line(line_no),
                     "not a Gmsh mesh: the file must start with `$MeshFormat`",
                 ));
+            }
+            // Gmsh writes each of these once; a second one (two files concatenated, an edit
+            // gone wrong) would silently merge or replace the first.
+            if ["MeshFormat", "PhysicalNames", "Entities", "Nodes", "Elements"].contains(&section) {
+                if let Some((_, first)) = once.iter().find(|(s, _)| *s == section) {
+                    return Err(err(
+                        self.file,
+                        At::Line(line_no),
+                        format!("a second `${section}` section (the first is at line {first})"),
+                    ));
+                }
+                once.push((section.to_string(), line_no));
             }
             match section {
                 "MeshFormat" => {
@@ -761,6 +774,16 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
             facets.sort_unstable();
             facets.dedup();
             mesh.regions.push(Region { name, facets });
+        }
+    }
+    // A named boundary group without elements stays a region, empty: a case that asks for it
+    // then says so, instead of falling back to a default choice of facets.
+    let mut declared: Vec<&String> =
+        raw.names.iter().filter(|((d, _), _)| *d + 1 == dim).map(|(_, name)| name).collect();
+    declared.sort();
+    for name in declared {
+        if !mesh.has_region(name) {
+            mesh.regions.push(Region { name: name.clone(), facets: Vec::new() });
         }
     }
     Ok(mesh)
