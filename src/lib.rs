@@ -12,6 +12,7 @@ pub use signorini_runtime as runtime;
 
 pub mod bench;
 pub mod cases;
+pub mod checkpoint;
 pub mod cli;
 pub mod driver;
 pub mod forms;

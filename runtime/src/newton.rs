@@ -176,6 +176,18 @@ impl Newton {
         self.retire_previous();
     }
 
+    /// Drops every factorization and correction (their counters are kept): the next solve
+    /// runs exactly as a new `Newton`'s would. Checkpoints use it, so that a resumed run and an
+    /// uninterrupted one follow the same factorizations and agree bit for bit.
+    pub fn forget(&mut self) {
+        self.invalidate();
+        for f in [self.factorization.take(), self.spare.take()].into_iter().flatten() {
+            self.retired = self.retired + f.counters;
+        }
+        self.spd_failed = false;
+        self.jacobian = None;
+    }
+
     fn retire_previous(&mut self) {
         if let Some(f) = self.previous.take().and_then(|r| r.factorization) {
             self.retired = self.retired + f.counters;

@@ -365,6 +365,16 @@ impl<'a> Stepper<'a> {
     }
 
     /// Advances `states` from t to t + dt.
+    /// Drops the stages' factorizations, constant operators and loads: the next step runs as in
+    /// a new stepper (see [`crate::newton::Newton::forget`]).
+    pub fn forget(&mut self) {
+        for s in &mut self.stages {
+            s.newton.forget();
+            s.constant = None;
+        }
+        self.loads.clear();
+    }
+
     pub fn step(&mut self, states: &mut [Vec<f64>], t: f64, dt: f64) -> Result<StepReport, StepError> {
         self.step_observed(states, t, dt, &mut |_| {})
     }

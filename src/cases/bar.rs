@@ -227,23 +227,30 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let (mut half_err, mut half_norm) = (0.0, 0.0);
     let v_index = sim.v_index;
     let mut t = 0.0;
-    let outcome = sim.run(0.0, opts.dt, steps, opts.progress, &mut |_, _, _| {}, &mut |tools, step| {
-        t = step.t;
-        let mut row =
-            measure(tools, &step.states[0], v_index.map(|i| step.states[i].as_slice()), step.report.iterations(), t);
-        if redistributed {
-            // The massless contact node's velocity is not meaningful: report its mean velocity.
-            row.v_c = (step.states[0][0] - step.before[0]) / step.dt;
-        }
-        let half: Vec<f64> = step.before.iter().zip(&step.states[0]).map(|(a, b)| 0.5 * (a + b)).collect();
-        let s = exact::contact_stress(t - 0.5 * step.dt);
-        row.lambda_half = contact_stress(tools, &half).0;
-        half_err += (row.lambda_half - s).powi(2);
-        half_norm += s * s;
-        track(tools, &step.states[0], &row);
-        series.push(row);
-        Ok(())
-    })?;
+    let mut control = crate::checkpoint::Control::default();
+    let outcome =
+        sim.run(0.0, opts.dt, steps, opts.progress, &mut control, &mut |_, _, _| {}, &mut |tools, step, _| {
+            t = step.t;
+            let mut row = measure(
+                tools,
+                &step.states[0],
+                v_index.map(|i| step.states[i].as_slice()),
+                step.report.iterations(),
+                t,
+            );
+            if redistributed {
+                // The massless contact node's velocity is not meaningful: report its mean velocity.
+                row.v_c = (step.states[0][0] - step.before[0]) / step.dt;
+            }
+            let half: Vec<f64> = step.before.iter().zip(&step.states[0]).map(|(a, b)| 0.5 * (a + b)).collect();
+            let s = exact::contact_stress(t - 0.5 * step.dt);
+            row.lambda_half = contact_stress(tools, &half).0;
+            half_err += (row.lambda_half - s).powi(2);
+            half_norm += s * s;
+            track(tools, &step.states[0], &row);
+            series.push(row);
+            Ok(())
+        })?;
     let first = &series[0];
     let last = series.last().expect("at least the initial row");
     let e0 = first.energy_aug;

@@ -7,13 +7,15 @@
 //! hold the vertical component in both) are named after the axis (`uy_mean`, `fy_contact` for the disc;
 //! `uz_mean`, `fz_contact` for the sphere).
 
+use std::cell::RefCell;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::CaseError;
 use super::bar::MassChoice;
+use crate::checkpoint::{Control, Identity};
 use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::evaluate::facet_samples;
@@ -99,6 +101,10 @@ pub struct Options {
     pub vtu_every: usize,
     /// Show a progress bar on long runs (when stdout is a terminal).
     pub progress: bool,
+    /// Write `out`/checkpoint.bin after every this many steps (0: only on an interrupt).
+    pub checkpoint_every: usize,
+    /// Continue from `out`/checkpoint.bin.
+    pub resume: bool,
 }
 
 impl Default for Options {
@@ -117,12 +123,14 @@ impl Default for Options {
             out: None,
             vtu_every: 0,
             progress: false,
+            checkpoint_every: 0,
+            resume: false,
         }
     }
 }
 
 /// One row of `series.csv`.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Row {
     pub t: f64,
     pub energy: f64,
@@ -285,6 +293,16 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         mass: opts.mass,
         newton: opts.newton,
     };
+    let mut control = Control {
+        every: opts.checkpoint_every,
+        dir: opts.out.clone(),
+        identity: identity(opts, active, &mesh),
+        resume: None,
+    };
+    if opts.resume {
+        let dir = opts.out.as_ref().ok_or_else(|| CaseError::Option("resuming needs the run's directory".into()))?;
+        control.resume = Some(crate::checkpoint::read(dir, &control.identity)?);
+    }
     let mut sim = Simulation::new(&asm, problem, active)?;
     if sim.tools.probe.is_none() {
         return Err(CaseError::Option(
@@ -336,22 +354,44 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         }
     };
     let v_index = sim.v_index;
-    snapshots.write(&sim.tools, 0, t0, &sim.states[0], &velocity(&sim.states, v_index, &sim.states[0], opts.dt))?;
     // Multi-stage schemes: the state at each intermediate stage's time (stages.csv).
-    let mut stage_rows: Vec<StageRow> = Vec::new();
+    let stage_rows: RefCell<Vec<StageRow>> = RefCell::new(Vec::new());
+    match control.observer() {
+        Some(bytes) => {
+            let stages = sim.stepper.desc().stages;
+            let record: Record = postcard::from_bytes(bytes)
+                .map_err(|e| CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})")))?;
+            series = record.series.into_iter().map(Saved::into_row).collect();
+            for (name, row) in record.stages {
+                let stage = stages.iter().find(|s| s.name == name).ok_or_else(|| {
+                    CaseError::Option(format!("the checkpoint has a stage `{name}`, which this scheme has not"))
+                })?;
+                stage_rows.borrow_mut().push(StageRow { stage: stage.name, row: row.into_row() });
+            }
+            snapshots.resume(record.snapshots);
+        }
+        None => snapshots.write(
+            &sim.tools,
+            0,
+            t0,
+            &sim.states[0],
+            &velocity(&sim.states, v_index, &sim.states[0], opts.dt),
+        )?,
+    }
     let names = sim.stepper.desc().states;
     let outcome = sim.run(
         t0,
         opts.dt,
         steps,
         opts.progress,
+        &mut control,
         &mut |tools, stage, v_index| {
             if let Some(u) = stage.value_of(names[0]) {
                 let v = v_index.and_then(|i| stage.value_of(names[i]));
-                stage_rows.push(StageRow { stage: stage.name, row: measure(tools, u, v, 0, stage.time) });
+                stage_rows.borrow_mut().push(StageRow { stage: stage.name, row: measure(tools, u, v, 0, stage.time) });
             }
         },
-        &mut |tools, step| {
+        &mut |tools, step, record| {
             let v = v_index.map(|i| step.states[i].as_slice());
             series.push(measure(tools, &step.states[0], v, step.report.iterations(), step.t));
             snapshots.write(
@@ -360,9 +400,19 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
                 step.t,
                 &step.states[0],
                 &velocity(step.states, v_index, step.before, step.dt),
-            )
+            )?;
+            if let Some(record) = record {
+                *record = postcard::to_stdvec(&Record {
+                    series: series.iter().map(Saved::of).collect(),
+                    stages: stage_rows.borrow().iter().map(|s| (s.stage.to_string(), Saved::of(&s.row))).collect(),
+                    snapshots: snapshots.written().to_vec(),
+                })
+                .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
+            }
+            Ok(())
         },
     )?;
+    let stage_rows = stage_rows.into_inner();
     snapshots.finish()?;
     let wall = start.elapsed().as_secs_f64();
     let last = series.last().expect("initial row");
@@ -411,6 +461,53 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         return Err(e);
     }
     Ok(Run { summary, series, stages: stage_rows })
+}
+
+/// The disc's record of the run in a checkpoint.
+#[derive(Serialize, Deserialize)]
+struct Record {
+    series: Vec<Saved>,
+    stages: Vec<(String, Saved)>,
+    snapshots: Vec<(f64, String)>,
+}
+
+/// A row with its switches (which series.csv leaves out).
+#[derive(Serialize, Deserialize)]
+struct Saved(Row, Vec<bool>);
+
+impl Saved {
+    fn of(row: &Row) -> Saved {
+        Saved(row.clone(), row.switches.clone())
+    }
+
+    fn into_row(self) -> Row {
+        Row { switches: self.1, ..self.0 }
+    }
+}
+
+/// What a resumed run must share with its checkpoint.
+fn identity(opts: &Options, active: &Active, mesh: &Mesh) -> Identity {
+    let params =
+        active.forms.params.values().into_iter().map(|(name, p)| (format!("param {name}"), format!("{:?}", p.value)));
+    [
+        ("case", opts.body.name().to_string()),
+        ("scheme", active.scheme_name().to_string()),
+        ("contact law", active.forms.contact_name().to_string()),
+        ("files run interpreted", active.interpreted().join(", ")),
+        ("mass", format!("{:?}", opts.mass)),
+        ("cell size", format!("{:?}", opts.cell_size)),
+        ("mesh", crate::checkpoint::mesh_fingerprint(mesh)),
+        ("dt", format!("{:?}", opts.dt)),
+        ("t_start", format!("{:?}", opts.t_start)),
+        ("t_end", format!("{:?}", opts.t_end)),
+        ("Newton options", format!("{:?}", opts.newton)),
+        ("step guard", format!("{:?}", active.guard)),
+        ("checkpoint period", opts.checkpoint_every.to_string()),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .chain(params)
+    .collect()
 }
 
 fn write_outputs(

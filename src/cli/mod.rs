@@ -310,6 +310,14 @@ pub struct DiscArgs {
     /// Write a VTU snapshot every K steps into DIR/vtu, and DIR/disc.pvd (sphere.pvd) for ParaView.
     #[arg(long, default_value_t = 0)]
     vtu_every: usize,
+    /// Write DIR/checkpoint.bin after every N steps (0: only when interrupted); --resume DIR
+    /// then continues the run with the same bits as an uninterrupted one.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    checkpoint_every: usize,
+    /// Continue the run of output directory DIR from its checkpoint.bin, writing there. The
+    /// options must be the run's own (a checkpoint of other options is refused).
+    #[arg(long, value_name = "DIR", conflicts_with = "out")]
+    resume: Option<PathBuf>,
     /// Linear solver of each step: direct (sparse Cholesky/LU), iterative (Jacobi-preconditioned
     /// CG, or BiCGStab for unsymmetric tangents; memory of the matrix only), or auto (iterative
     /// above 10 000 unknowns in 3D, 100 000 in 2D).
@@ -733,12 +741,15 @@ fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
         dt: a.dt,
         t_start: a.t_start,
         t_end: a.t_end,
-        out: match out_dir(a.out) {
-            Ok(dir) => dir,
-            Err(e) => return fail(e),
+        out: match (a.resume.clone(), out_dir(a.out)) {
+            (Some(dir), _) => Some(dir),
+            (None, Ok(dir)) => dir,
+            (None, Err(e)) => return fail(e),
         },
         vtu_every: a.vtu_every,
         progress: true,
+        checkpoint_every: a.checkpoint_every,
+        resume: a.resume.is_some(),
         newton: crate::runtime::newton::NewtonOptions {
             solver: a.solver,
             line_search: a.methods.line_search,

@@ -9,6 +9,7 @@ use std::time::Instant;
 
 use crate::cases::CaseError;
 use crate::cases::bar::MassChoice;
+use crate::checkpoint::Control;
 use crate::driver::Active;
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
@@ -268,14 +269,21 @@ impl<'m> Simulation<'m> {
     /// that cannot go on ends with `Outcome::stopped` set, after the observer saw every good
     /// step, so that the case can write its results up to there; an observer's error ends it at
     /// once.
+    ///
+    /// Checkpoints (`control`, see [`crate::checkpoint`]): after a nominal step that ends a
+    /// checkpoint period or an interrupt, `on_step` gets a buffer for its own record of the run
+    /// so far (the case restores it from `control.observer()` before calling `run`). A run with
+    /// `control.resume` starts from that checkpoint's states and counters.
+    #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
         t0: f64,
         dt: f64,
         steps: usize,
         progress: bool,
+        control: &mut Control,
         on_stage: &mut dyn FnMut(&Tools, &StageView, Option<usize>),
-        on_step: &mut dyn FnMut(&Tools, &Step) -> Result<(), CaseError>,
+        on_step: &mut OnStep,
     ) -> Result<Outcome, CaseError> {
         let stages = self.stepper.desc().stages;
         let intermediate: Vec<&str> = stages.iter().rev().skip(1).map(|s| s.name).collect();
@@ -287,8 +295,20 @@ impl<'m> Simulation<'m> {
         // Progress through a nominal step in units of dt / 2^max_cuts.
         let max_cuts = guard.max_step_cuts.min(40);
         let full: u64 = 1 << max_cuts;
-        let (mut level, mut streak, mut accepted) = (0usize, 0usize, 0usize);
-        'steps: for k in 0..steps {
+        let (mut level, mut streak, mut accepted, mut first) = (0usize, 0usize, 0usize, 0usize);
+        if let Some((saved, _)) = &control.resume {
+            if saved.states.len() != states.len() || saved.states.iter().any(|s| s.len() != tools.asm.size()) {
+                return Err(CaseError::Option("the checkpoint's states do not fit this run's scheme and mesh".into()));
+            }
+            states.clone_from_slice(&saved.states);
+            (first, accepted, level, streak) = (saved.steps_done, saved.accepted, saved.level, saved.streak);
+            outcome.cuts = saved.cuts;
+            outcome.step_seconds.clone_from(&saved.step_seconds);
+            energy =
+                EnergyWatch { initial: saved.energy_initial, u0: saved.energy_u0.clone(), work: saved.energy_work };
+            stepper.forget();
+        }
+        'steps: for k in first..steps {
             bar.tick(k);
             let mut done: u64 = 0;
             while done < full {
@@ -330,7 +350,12 @@ impl<'m> Simulation<'m> {
                 done += units;
                 accepted += 1;
                 let t_end = if done == full { t0 + (k + 1) as f64 * dt } else { t + h };
-                on_step(tools, &Step { k: accepted, t: t_end, dt: h, states, before: &before, report: &report })?;
+                // A checkpoint after the last step would resume nothing.
+                let periodic = control.every > 0 && (k + 1).is_multiple_of(control.every) && k + 1 < steps;
+                let interrupted = crate::interrupt::requested();
+                let mut record = (done == full && (periodic || interrupted)).then(Vec::new);
+                let step = Step { k: accepted, t: t_end, dt: h, states, before: &before, report: &report };
+                on_step(tools, &step, record.as_mut())?;
                 streak += 1;
                 if level > 0 && streak >= 2 && done.is_multiple_of(2 * units) {
                     level -= 1;
@@ -350,7 +375,28 @@ impl<'m> Simulation<'m> {
                     });
                     break 'steps;
                 }
-                if crate::interrupt::requested() {
+                if let Some(record) = record {
+                    let driver = crate::checkpoint::DriverState {
+                        steps_done: k + 1,
+                        accepted,
+                        level,
+                        streak,
+                        cuts: outcome.cuts,
+                        step_seconds: outcome.step_seconds.clone(),
+                        energy_initial: energy.initial,
+                        energy_work: energy.work,
+                        energy_u0: energy.u0.clone(),
+                        states: states.to_vec(),
+                        periodic: !interrupted,
+                    };
+                    control.write(driver, record)?;
+                    if !interrupted {
+                        stepper.forget();
+                    }
+                }
+                // An interrupt lets the nominal step finish, so that its checkpoint is on the
+                // nominal time levels.
+                if interrupted && done == full {
                     outcome.stopped = Some(CaseError::Interrupted { t: t_end });
                     break 'steps;
                 }
@@ -360,6 +406,10 @@ impl<'m> Simulation<'m> {
         Ok(outcome)
     }
 }
+
+/// What a case does with each accepted step; when a checkpoint is due, it also writes its
+/// record of the run so far into the buffer.
+pub type OnStep<'a> = dyn FnMut(&Tools, &Step, Option<&mut Vec<u8>>) -> Result<(), CaseError> + 'a;
 
 /// How a run ended.
 pub struct Outcome {
@@ -504,6 +554,16 @@ impl Snapshots {
             .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
         self.written.push((t, format!("vtu/{file}")));
         Ok(())
+    }
+
+    /// The snapshots written so far: (time, file), for a checkpoint.
+    pub fn written(&self) -> &[(f64, String)] {
+        &self.written
+    }
+
+    /// Continues a run whose earlier snapshots are these.
+    pub fn resume(&mut self, written: Vec<(f64, String)>) {
+        self.written = written;
     }
 
     /// Writes the collection `dir`/NAME.pvd (if any snapshot was written).

@@ -177,7 +177,8 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     let steps = ((gap0 / opts.speed + 1.3 * hertz.contact_duration) / dt).ceil() as usize;
     let (mut peak, mut peak_state, mut newton) = (0.0, Vec::new(), 0);
     let v_index = sim.v_index;
-    let outcome = sim.run(0.0, dt, steps, opts.progress, &mut |_, _, _| {}, &mut |tools, step| {
+    let mut control = crate::checkpoint::Control::default();
+    let outcome = sim.run(0.0, dt, steps, opts.progress, &mut control, &mut |_, _, _| {}, &mut |tools, step, _| {
         let v = v_index.map(|i| step.states[i].as_slice());
         let r = row(tools, &step.states[0], v, step.t);
         newton += step.report.iterations();

@@ -1,0 +1,193 @@
+//! Checkpoints of a time-stepping run: every state of the scheme, the step-size controller, the
+//! energy check and the case's own record of the run so far (series rows, snapshots written),
+//! in one file written atomically, `DIR/checkpoint.bin`.
+//!
+//! `--checkpoint-every N` writes one after every N-th step and drops the stepper's
+//! factorizations there; `--resume DIR` starts from DIR's checkpoint with none, so a resumed run
+//! follows the same factorizations as the uninterrupted one and its results have the same bits.
+//! An interrupt (SIGINT, SIGTERM) writes one after the step it finishes; resuming from that one
+//! agrees to round-off only, as the uninterrupted run kept its factorizations there. A
+//! checkpoint is refused unless the version of signorini, the case, the scheme, the files, every
+//! param, the mesh and the time step are the ones of the run that resumes it.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::cases::CaseError;
+use crate::runtime::mesh::Mesh;
+
+/// The file in the output directory.
+pub const FILE: &str = "checkpoint.bin";
+const MAGIC: &[u8; 8] = b"SIGNCKPT";
+/// The layout of the file; a checkpoint of another layout is refused.
+const FORMAT: u32 = 1;
+
+/// What a run must share with the checkpoint it resumes: (what, value) pairs, compared one by
+/// one so that a refusal names what differs.
+pub type Identity = Vec<(String, String)>;
+
+/// The driver's part of a checkpoint (see `simulation::Simulation::run`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DriverState {
+    /// Nominal steps done.
+    pub steps_done: usize,
+    pub accepted: usize,
+    /// The step-size controller: halvings in force, good steps since the last change, and
+    /// halvings so far.
+    pub level: usize,
+    pub streak: usize,
+    pub cuts: usize,
+    pub step_seconds: Vec<f64>,
+    /// The energy check: E(0), the largest work of the loads so far, u(0).
+    pub energy_initial: f64,
+    pub energy_work: f64,
+    pub energy_u0: Vec<f64>,
+    pub states: Vec<Vec<f64>>,
+    /// Written every N steps (resumes bit for bit), or on an interrupt (to round-off).
+    pub periodic: bool,
+}
+
+#[derive(Serialize, Deserialize)]
+struct File {
+    program: String,
+    identity: Identity,
+    driver: DriverState,
+    /// The case's record of the run so far, in its own layout.
+    observer: Vec<u8>,
+}
+
+/// When and where a run writes checkpoints, and the one it resumes.
+#[derive(Default)]
+pub struct Control {
+    /// Steps between checkpoints (0: none, except on an interrupt).
+    pub every: usize,
+    /// The output directory (no checkpoints without one).
+    pub dir: Option<PathBuf>,
+    pub identity: Identity,
+    /// The checkpoint the run resumes: the driver's part (taken by the driver) and the case's.
+    pub resume: Option<(DriverState, Vec<u8>)>,
+}
+
+impl Control {
+    /// The case's record saved in the checkpoint being resumed, if any.
+    pub fn observer(&self) -> Option<&[u8]> {
+        self.resume.as_ref().map(|(_, o)| o.as_slice())
+    }
+
+    /// Writes `dir`/checkpoint.bin atomically (a no-op without an output directory).
+    pub fn write(&self, driver: DriverState, observer: Vec<u8>) -> Result<(), CaseError> {
+        let Some(dir) = &self.dir else { return Ok(()) };
+        let file = File { program: program(), identity: self.identity.clone(), driver, observer };
+        let mut bytes = MAGIC.to_vec();
+        bytes.extend_from_slice(&FORMAT.to_le_bytes());
+        bytes.extend(postcard::to_stdvec(&file).map_err(|e| write_error(dir, std::io::Error::other(e)))?);
+        let path = dir.join(FILE);
+        crate::output::write_atomic(&path, &bytes).map_err(|e| write_error(dir, e))
+    }
+}
+
+fn write_error(dir: &Path, source: std::io::Error) -> CaseError {
+    CaseError::Write { path: dir.join(FILE).display().to_string(), source }
+}
+
+fn program() -> String {
+    format!("signorini {}", env!("CARGO_PKG_VERSION"))
+}
+
+/// Reads `dir`/checkpoint.bin and checks it against the run's `identity`.
+pub fn read(dir: &Path, identity: &Identity) -> Result<(DriverState, Vec<u8>), CaseError> {
+    let path = dir.join(FILE);
+    let refuse = |why: String| CaseError::Option(format!("cannot resume from {}: {why}", path.display()));
+    let bytes = std::fs::read(&path).map_err(|e| refuse(e.to_string()))?;
+    if bytes.len() < 12 || &bytes[..8] != MAGIC {
+        return Err(refuse("not a signorini checkpoint".into()));
+    }
+    let format = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if format != FORMAT {
+        return Err(refuse(format!("its layout is version {format}; this signorini reads version {FORMAT}")));
+    }
+    let file: File =
+        postcard::from_bytes(&bytes[12..]).map_err(|e| refuse(format!("the file is damaged or truncated ({e})")))?;
+    if file.program != program() {
+        return Err(refuse(format!("it was written by {}; this is {}", file.program, program())));
+    }
+    for (what, value) in identity {
+        match file.identity.iter().find(|(w, _)| w == what) {
+            Some((_, old)) if old == value => {}
+            Some((_, old)) => {
+                return Err(refuse(format!("it was written with {what} {old}; this run has {what} {value}")));
+            }
+            None => return Err(refuse(format!("it does not record {what} (this run has {value})"))),
+        }
+    }
+    if let Some((what, _)) = file.identity.iter().find(|(w, _)| !identity.iter().any(|(v, _)| v == w)) {
+        return Err(refuse(format!("it records {what}, which this run does not have")));
+    }
+    Ok((file.driver, file.observer))
+}
+
+/// The mesh's size and a hash of its coordinates (their bits) and cells.
+pub fn mesh_fingerprint(mesh: &Mesh) -> String {
+    // FNV-1a: stable across builds and platforms, unlike std's hasher.
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |x: u64| {
+        for b in x.to_le_bytes() {
+            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for i in 0..mesh.num_nodes() {
+        mesh.node(i).iter().for_each(|x| eat(x.to_bits()));
+    }
+    for c in 0..mesh.num_cells() {
+        mesh.cell(c).iter().for_each(|&n| eat(n as u64));
+    }
+    format!("of {} nodes and {} cells (hash {h:016x})", mesh.num_nodes(), mesh.num_cells())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn driver() -> DriverState {
+        DriverState {
+            steps_done: 3,
+            accepted: 4,
+            level: 1,
+            streak: 0,
+            cuts: 1,
+            step_seconds: vec![0.1; 4],
+            energy_initial: 1.5,
+            energy_work: 0.0,
+            energy_u0: vec![0.0, 1.0],
+            states: vec![vec![f64::NAN, -0.0, 1e-300], vec![f64::INFINITY, 2.0, 3.0]],
+            periodic: true,
+        }
+    }
+
+    fn ident(dt: &str) -> Identity {
+        vec![("case".into(), "disc".into()), ("dt".into(), dt.into())]
+    }
+
+    #[test]
+    fn a_checkpoint_reads_back_bit_for_bit_and_refuses_another_run() {
+        let dir = std::env::temp_dir().join(format!("signorini-checkpoint-{}", std::process::id()));
+        let control = Control { every: 3, dir: Some(dir.clone()), identity: ident("0.02"), resume: None };
+        control.write(driver(), vec![7, 8, 9]).unwrap();
+        let (d, o) = read(&dir, &ident("0.02")).unwrap();
+        let bits = |s: &DriverState| s.states.iter().flatten().map(|x| x.to_bits()).collect::<Vec<u64>>();
+        assert_eq!(bits(&d), bits(&driver()));
+        assert_eq!((d.steps_done, d.accepted, d.level, d.cuts, o), (3, 4, 1, 1, vec![7, 8, 9]));
+        let e = read(&dir, &ident("0.01")).unwrap_err().to_string();
+        assert!(e.contains("written with dt 0.02; this run has dt 0.01"), "{e}");
+        // A truncated file is refused, not half read.
+        let path = dir.join(FILE);
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+        let e = read(&dir, &ident("0.02")).unwrap_err().to_string();
+        assert!(e.contains("damaged or truncated"), "{e}");
+        std::fs::write(&path, b"hello").unwrap();
+        assert!(read(&dir, &ident("0.02")).unwrap_err().to_string().contains("not a signorini checkpoint"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

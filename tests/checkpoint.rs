@@ -1,0 +1,156 @@
+//! Checkpoint and restart of the disc (issue 13): a run killed at arbitrary moments and resumed
+//! from its periodic checkpoints writes the same series.csv, bit for bit, as an uninterrupted
+//! run with the same checkpoint period; an interrupted run writes complete outputs and a
+//! checkpoint, exits with 130, and resumes to round-off; a checkpoint of other options is
+//! refused.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_signorini");
+/// The coarse disc through its first contact (t ≈ 6.3) and rebound: 150 steps.
+const RUN: [&str; 12] =
+    ["run", "disc", "--h", "2", "--t-start", "5.5", "--t-end", "8.5", "--dt", "0.02", "--checkpoint-every", "13"];
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("signorini-checkpoint-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn spawn(args: &[&str]) -> Child {
+    Command::new(BIN).args(args).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().expect("the binary starts")
+}
+
+fn finish(child: Child) -> (Option<i32>, String) {
+    let out = child.wait_with_output().unwrap();
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+fn series(dir: &Path) -> String {
+    std::fs::read_to_string(dir.join("series.csv")).expect("series.csv")
+}
+
+/// A deterministic sequence of delays (a linear congruential generator).
+struct Delays(u64);
+
+impl Delays {
+    fn next(&mut self, max_ms: u64) -> Duration {
+        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        Duration::from_millis(20 + (self.0 >> 33) % max_ms)
+    }
+}
+
+#[test]
+fn killed_and_resumed_runs_have_the_bits_of_an_uninterrupted_one() {
+    let root = scratch("kill");
+    let full = root.join("full");
+    let clock = Instant::now();
+    let (code, err) = finish(spawn(&[&RUN[..], &["--out", full.to_str().unwrap()]].concat()));
+    assert_eq!(code, Some(0), "{err}");
+    let reference = series(&full);
+    // Kill times spread over the run's length, whatever the machine's speed.
+    let length = clock.elapsed().as_millis() as u64;
+    let run = root.join("run");
+    let run_s = run.to_str().unwrap();
+    let mut delays = Delays(0x5eed);
+    let (mut kills, mut resumed) = (0, 0);
+    for attempt in 0.. {
+        assert!(attempt < 80, "no run was killed and resumed in 80 attempts ({kills} kills)");
+        let resume = run.join("checkpoint.bin").exists();
+        let args: Vec<&str> = if resume {
+            [&RUN[..], &["--resume", run_s]].concat()
+        } else {
+            [&["--force"], &RUN[..], &["--out", run_s]].concat()
+        };
+        let mut child = spawn(&args);
+        if kills >= 3 && resume {
+            // The last resumption runs to the end.
+            let (code, err) = finish(child);
+            assert_eq!(code, Some(0), "attempt {attempt} ({args:?}): {err}");
+            resumed += 1;
+            break;
+        }
+        std::thread::sleep(delays.next(length.max(40)));
+        if child.try_wait().unwrap().is_none() {
+            child.kill().unwrap();
+            let _ = child.wait();
+            kills += 1;
+            resumed += resume as usize;
+        } else {
+            // It ended before the kill: start over.
+            let _ = child.wait();
+            let _ = std::fs::remove_dir_all(&run);
+        }
+    }
+    assert!(series(&run) == reference, "series.csv after {kills} kills and {resumed} resumptions differs");
+    eprintln!("{kills} kills, {resumed} resumptions");
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn an_interrupted_run_writes_its_outputs_and_a_checkpoint_it_resumes_from() {
+    let root = scratch("interrupt");
+    let full = root.join("full");
+    let (code, err) = finish(spawn(&[&RUN[..], &["--out", full.to_str().unwrap()]].concat()));
+    assert_eq!(code, Some(0), "{err}");
+    let run = root.join("run");
+    let mut child = spawn(&[&RUN[..], &["--out", run.to_str().unwrap()]].concat());
+    // Interrupt once the run has started stepping (its first checkpoint is written).
+    let start = Instant::now();
+    while !run.join("checkpoint.bin").exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    // SAFETY: sending a signal to our own child.
+    unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) };
+    let status = child.wait().unwrap();
+    if status.code() == Some(0) {
+        eprintln!("the run ended before the interrupt arrived: nothing to check");
+        return;
+    }
+    assert_eq!(status.code(), Some(130));
+    let rows = series(&run).lines().count();
+    assert!(rows > 1 && rows < series(&full).lines().count(), "{rows} rows after the interrupt");
+    assert!(std::fs::read_to_string(run.join("summary.json")).unwrap().contains("interrupted"));
+    // Resuming completes the run; rows agree with the uninterrupted ones to round-off.
+    let (code, err) = finish(spawn(&[&RUN[..], &["--resume", run.to_str().unwrap()]].concat()));
+    assert_eq!(code, Some(0), "{err}");
+    let (a, b) = (series(&full), series(&run));
+    assert_eq!(a.lines().count(), b.lines().count());
+    for (x, y) in a.lines().zip(b.lines()).skip(1) {
+        for (p, q) in x.split(',').zip(y.split(',')) {
+            let (p, q): (f64, f64) = (p.parse().unwrap(), q.parse().unwrap());
+            assert!((p - q).abs() <= 1e-9 * (1.0 + p.abs()), "{x}\n{y}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_checkpoint_of_other_options_is_refused() {
+    let root = scratch("refuse");
+    let run = root.join("run");
+    let run_s = run.to_str().unwrap();
+    let (code, err) = finish(spawn(&[&RUN[..], &["--out", run_s]].concat()));
+    assert_eq!(code, Some(0), "{err}");
+    let cases: [(&[&str], &str); 3] = [
+        (&["--param", "gamma0=100"], "param gamma0 1000.0; this run has param gamma0 100.0"),
+        (&["--scheme", "hht"], "scheme newmark; this run has scheme hht"),
+        (&["--h", "1.5"], "mesh of"),
+    ];
+    for (extra, expected) in cases {
+        let mut args: Vec<&str> = RUN.to_vec();
+        if extra[0] == "--h" {
+            args[3] = extra[1];
+        } else {
+            args.extend_from_slice(extra);
+        }
+        args.extend_from_slice(&["--resume", run_s]);
+        let (code, err) = finish(spawn(&args));
+        assert_eq!(code, Some(1), "{args:?}: {err}");
+        assert!(err.contains("cannot resume") && err.contains(expected), "{args:?}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
