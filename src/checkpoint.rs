@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::cases::CaseError;
+use crate::driver::Active;
 use crate::runtime::mesh::Mesh;
 
 /// The file in the output directory.
@@ -125,6 +126,27 @@ pub fn read(dir: &Path, identity: &Identity) -> Result<(DriverState, Vec<u8>), C
         return Err(refuse(format!("it records {what}, which this run does not have")));
     }
     Ok((file.driver, file.observer))
+}
+
+/// What a resumed run must share with its checkpoint: the case, the scheme, the files and every
+/// param in use, the step guard, the mesh, and the case's own settings (`more`).
+pub fn identity(case: &str, active: &Active, mesh: &Mesh, more: &[(&str, String)]) -> Identity {
+    let common = [
+        ("case", case.to_string()),
+        ("scheme", active.scheme_name().to_string()),
+        ("contact law", active.forms.contact_name().to_string()),
+        ("files run interpreted", active.interpreted().join(", ")),
+        ("step guard", format!("{:?}", active.guard)),
+        ("mesh", mesh_fingerprint(mesh)),
+    ];
+    let params =
+        active.forms.params.values().into_iter().map(|(name, p)| (format!("param {name}"), format!("{:?}", p.value)));
+    common
+        .into_iter()
+        .chain(more.iter().map(|(k, v)| (*k, v.clone())))
+        .map(|(k, v)| (k.to_string(), v))
+        .chain(params)
+        .collect()
 }
 
 /// The mesh's size and a hash of its coordinates (their bits) and cells.

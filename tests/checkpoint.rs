@@ -44,11 +44,22 @@ impl Delays {
 }
 
 #[test]
-fn killed_and_resumed_runs_have_the_bits_of_an_uninterrupted_one() {
-    let root = scratch("kill");
+fn killed_and_resumed_discs_have_the_bits_of_an_uninterrupted_one() {
+    kill_and_resume("disc", &RUN);
+}
+
+#[test]
+fn killed_and_resumed_bars_have_the_bits_of_an_uninterrupted_one() {
+    kill_and_resume("bar", &["run", "bar", "--ne", "100", "--dt", "0.002", "--checkpoint-every", "37"]);
+}
+
+/// Runs `run` to the end; then again, killed at arbitrary moments and resumed from its
+/// checkpoints until a resumption ends it: both series.csv must have the same bytes.
+fn kill_and_resume(name: &str, run_args: &[&str]) {
+    let root = scratch(name);
     let full = root.join("full");
     let clock = Instant::now();
-    let (code, err) = finish(spawn(&[&RUN[..], &["--out", full.to_str().unwrap()]].concat()));
+    let (code, err) = finish(spawn(&[run_args, &["--out", full.to_str().unwrap()]].concat()));
     assert_eq!(code, Some(0), "{err}");
     let reference = series(&full);
     // Kill times spread over the run's length, whatever the machine's speed.
@@ -61,9 +72,9 @@ fn killed_and_resumed_runs_have_the_bits_of_an_uninterrupted_one() {
         assert!(attempt < 80, "no run was killed and resumed in 80 attempts ({kills} kills)");
         let resume = run.join("checkpoint.bin").exists();
         let args: Vec<&str> = if resume {
-            [&RUN[..], &["--resume", run_s]].concat()
+            [run_args, &["--resume", run_s]].concat()
         } else {
-            [&["--force"], &RUN[..], &["--out", run_s]].concat()
+            [&["--force"], run_args, &["--out", run_s]].concat()
         };
         let mut child = spawn(&args);
         if kills >= 3 && resume {

@@ -4,14 +4,15 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::CaseError;
 use super::exact;
+use crate::checkpoint::Control;
 use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
-use crate::runtime::mesh::{CellSize, structured};
+use crate::runtime::mesh::{CellSize, Mesh, structured};
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
 use crate::simulation::{Problem, Simulation, Tools};
@@ -41,6 +42,10 @@ pub struct Options {
     pub out: Option<PathBuf>,
     /// Show a progress bar on long runs (when stdout is a terminal).
     pub progress: bool,
+    /// Write `out`/checkpoint.bin after every this many steps (0: only on an interrupt).
+    pub checkpoint_every: usize,
+    /// Continue from `out`/checkpoint.bin.
+    pub resume: bool,
 }
 
 impl Default for Options {
@@ -54,13 +59,15 @@ impl Default for Options {
             cell_size: CellSize::Diameter,
             newton: NewtonOptions::default(),
             out: None,
+            checkpoint_every: 0,
+            resume: false,
             progress: false,
         }
     }
 }
 
 /// One row of `series.csv`.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Row {
     pub t: f64,
     pub u_c: f64,
@@ -182,6 +189,28 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         mass: opts.mass,
         newton: opts.newton,
     };
+    let mut control = Control {
+        every: opts.checkpoint_every,
+        dir: opts.out.clone(),
+        identity: crate::checkpoint::identity(
+            "bar",
+            active,
+            &mesh,
+            &[
+                ("mass", format!("{:?}", opts.mass)),
+                ("cell size", format!("{:?}", opts.cell_size)),
+                ("dt", format!("{:?}", opts.dt)),
+                ("t_end", format!("{:?}", opts.t_end)),
+                ("Newton options", format!("{:?}", opts.newton)),
+                ("checkpoint period", opts.checkpoint_every.to_string()),
+            ],
+        ),
+        resume: None,
+    };
+    if opts.resume {
+        let dir = opts.out.as_ref().ok_or_else(|| CaseError::Option("resuming needs the run's directory".into()))?;
+        control.resume = Some(crate::checkpoint::read(dir, &control.identity)?);
+    }
     let mut sim = Simulation::new(&asm, problem, active)?;
     let redistributed = opts.mass == MassChoice::Redistributed;
     // Initial state: u₀ = (1 − x)/2, v₀ = 0, a₀ from the scheme's initial problem.
@@ -211,25 +240,19 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         }
     };
     series.push(measure(&sim.tools, &sim.states[0], sim.velocity(), 0, 0.0));
-    let (mut err_max, mut exact_max) = (0.0f64, 0.0f64);
-    let (mut lam_err, mut lam_norm) = (0.0, 0.0);
-    // The error in the norm of the mass the scheme steps with.
-    let mut track = |tools: &Tools, u: &[f64], row: &Row| {
-        let interp: Vec<f64> = (0..n).map(|i| exact::displacement(mesh.node(i)[0], row.t)).collect();
-        let diff: Vec<f64> = u.iter().zip(&interp).map(|(a, b)| a - b).collect();
-        err_max = err_max.max(Tools::quad(&tools.scheme_mass, &diff, &diff).sqrt());
-        exact_max = exact_max.max(Tools::quad(&tools.scheme_mass, &interp, &interp).sqrt());
-        let s = exact::contact_stress(row.t);
-        lam_err += (row.lambda - s).powi(2);
-        lam_norm += s * s;
-    };
-    track(&sim.tools, &sim.states[0], &series[0]);
-    let (mut half_err, mut half_norm) = (0.0, 0.0);
-    let v_index = sim.v_index;
+    let mut errors = Errors::default();
+    errors.track(&sim.tools, &mesh, &sim.states[0], &series[0]);
     let mut t = 0.0;
-    let mut control = crate::checkpoint::Control::default();
+    if let Some(bytes) = control.observer() {
+        let record: Record = postcard::from_bytes(bytes)
+            .map_err(|e| CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})")))?;
+        series = record.series.into_iter().map(|(row, p1)| Row { p1, ..row }).collect();
+        errors = record.errors;
+        t = series.last().map_or(0.0, |r| r.t);
+    }
+    let v_index = sim.v_index;
     let outcome =
-        sim.run(0.0, opts.dt, steps, opts.progress, &mut control, &mut |_, _, _| {}, &mut |tools, step, _| {
+        sim.run(0.0, opts.dt, steps, opts.progress, &mut control, &mut |_, _, _| {}, &mut |tools, step, record| {
             t = step.t;
             let mut row = measure(
                 tools,
@@ -245,12 +268,20 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
             let half: Vec<f64> = step.before.iter().zip(&step.states[0]).map(|(a, b)| 0.5 * (a + b)).collect();
             let s = exact::contact_stress(t - 0.5 * step.dt);
             row.lambda_half = contact_stress(tools, &half).0;
-            half_err += (row.lambda_half - s).powi(2);
-            half_norm += s * s;
-            track(tools, &step.states[0], &row);
+            errors.half_err += (row.lambda_half - s).powi(2);
+            errors.half_norm += s * s;
+            errors.track(tools, &mesh, &step.states[0], &row);
             series.push(row);
+            if let Some(record) = record {
+                *record = postcard::to_stdvec(&Record {
+                    series: series.iter().map(|r| (r.clone(), r.p1)).collect(),
+                    errors: errors.clone(),
+                })
+                .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
+            }
             Ok(())
         })?;
+    let Errors { err_max, exact_max, lam_err, lam_norm, half_err, half_norm } = errors;
     let first = &series[0];
     let last = series.last().expect("at least the initial row");
     let e0 = first.energy_aug;
@@ -298,6 +329,38 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         return Err(e);
     }
     Ok(Run { summary, series })
+}
+
+/// The error sums over the steps.
+#[derive(Clone, Default, Serialize, Deserialize)]
+struct Errors {
+    err_max: f64,
+    exact_max: f64,
+    lam_err: f64,
+    lam_norm: f64,
+    half_err: f64,
+    half_norm: f64,
+}
+
+impl Errors {
+    /// The error in the norm of the mass the scheme steps with, and λ's against the exact one.
+    fn track(&mut self, tools: &Tools, mesh: &Mesh, u: &[f64], row: &Row) {
+        let interp: Vec<f64> = (0..u.len()).map(|i| exact::displacement(mesh.node(i)[0], row.t)).collect();
+        let diff: Vec<f64> = u.iter().zip(&interp).map(|(a, b)| a - b).collect();
+        self.err_max = self.err_max.max(Tools::quad(&tools.scheme_mass, &diff, &diff).sqrt());
+        self.exact_max = self.exact_max.max(Tools::quad(&tools.scheme_mass, &interp, &interp).sqrt());
+        let s = exact::contact_stress(row.t);
+        self.lam_err += (row.lambda - s).powi(2);
+        self.lam_norm += s * s;
+    }
+}
+
+/// The bar's record of the run in a checkpoint: the rows (with P, which series.csv leaves out)
+/// and the error sums.
+#[derive(Serialize, Deserialize)]
+struct Record {
+    series: Vec<(Row, f64)>,
+    errors: Errors,
 }
 
 /// (err/norm)^½, undefined when the exact quantity is zero.

@@ -487,27 +487,20 @@ impl Saved {
 
 /// What a resumed run must share with its checkpoint.
 fn identity(opts: &Options, active: &Active, mesh: &Mesh) -> Identity {
-    let params =
-        active.forms.params.values().into_iter().map(|(name, p)| (format!("param {name}"), format!("{:?}", p.value)));
-    [
-        ("case", opts.body.name().to_string()),
-        ("scheme", active.scheme_name().to_string()),
-        ("contact law", active.forms.contact_name().to_string()),
-        ("files run interpreted", active.interpreted().join(", ")),
-        ("mass", format!("{:?}", opts.mass)),
-        ("cell size", format!("{:?}", opts.cell_size)),
-        ("mesh", crate::checkpoint::mesh_fingerprint(mesh)),
-        ("dt", format!("{:?}", opts.dt)),
-        ("t_start", format!("{:?}", opts.t_start)),
-        ("t_end", format!("{:?}", opts.t_end)),
-        ("Newton options", format!("{:?}", opts.newton)),
-        ("step guard", format!("{:?}", active.guard)),
-        ("checkpoint period", opts.checkpoint_every.to_string()),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), v))
-    .chain(params)
-    .collect()
+    crate::checkpoint::identity(
+        opts.body.name(),
+        active,
+        mesh,
+        &[
+            ("mass", format!("{:?}", opts.mass)),
+            ("cell size", format!("{:?}", opts.cell_size)),
+            ("dt", format!("{:?}", opts.dt)),
+            ("t_start", format!("{:?}", opts.t_start)),
+            ("t_end", format!("{:?}", opts.t_end)),
+            ("Newton options", format!("{:?}", opts.newton)),
+            ("checkpoint period", opts.checkpoint_every.to_string()),
+        ],
+    )
 }
 
 fn write_outputs(

@@ -310,6 +310,18 @@ pub struct DiscArgs {
     /// Write a VTU snapshot every K steps into DIR/vtu, and DIR/disc.pvd (sphere.pvd) for ParaView.
     #[arg(long, default_value_t = 0)]
     vtu_every: usize,
+    #[command(flatten)]
+    checkpoint: CheckpointArgs,
+    /// Linear solver of each step: direct (sparse Cholesky/LU), iterative (Jacobi-preconditioned
+    /// CG, or BiCGStab for unsymmetric tangents; memory of the matrix only), or auto (iterative
+    /// above 10 000 unknowns in 3D, 100 000 in 2D).
+    #[arg(long, value_parser = Solver::parse, default_value = "auto")]
+    solver: Solver,
+}
+
+/// Checkpoint and restart of a time-stepping case.
+#[derive(clap::Args)]
+pub struct CheckpointArgs {
     /// Write DIR/checkpoint.bin after every N steps (0: only when interrupted); --resume DIR
     /// then continues the run with the same bits as an uninterrupted one.
     #[arg(long, default_value_t = 0, value_name = "N")]
@@ -318,11 +330,16 @@ pub struct DiscArgs {
     /// options must be the run's own (a checkpoint of other options is refused).
     #[arg(long, value_name = "DIR", conflicts_with = "out")]
     resume: Option<PathBuf>,
-    /// Linear solver of each step: direct (sparse Cholesky/LU), iterative (Jacobi-preconditioned
-    /// CG, or BiCGStab for unsymmetric tangents; memory of the matrix only), or auto (iterative
-    /// above 10 000 unknowns in 3D, 100 000 in 2D).
-    #[arg(long, value_parser = Solver::parse, default_value = "auto")]
-    solver: Solver,
+}
+
+impl CheckpointArgs {
+    /// The output directory: the resumed run's, or `--out` prepared (see `output::prepare`).
+    fn out(&self, out: Option<PathBuf>) -> Result<Option<PathBuf>, String> {
+        match &self.resume {
+            Some(dir) => Ok(Some(dir.clone())),
+            None => out_dir(out),
+        }
+    }
 }
 
 #[derive(clap::Args)]
@@ -345,6 +362,8 @@ pub struct BarArgs {
     /// settings that apply) and print one table.
     #[arg(long)]
     all: bool,
+    #[command(flatten)]
+    checkpoint: CheckpointArgs,
 }
 
 #[derive(clap::Args)]
@@ -636,7 +655,10 @@ fn run_bar(a: BarArgs) -> ExitCode {
         Err(e) => return fail(e),
     };
     let mut a = a;
-    a.out = match out_dir(a.out) {
+    if a.all && (a.checkpoint.checkpoint_every > 0 || a.checkpoint.resume.is_some()) {
+        return fail("--all runs many cases: it takes no --checkpoint-every or --resume");
+    }
+    a.out = match a.checkpoint.out(a.out.take()) {
         Ok(dir) => dir,
         Err(e) => return fail(e),
     };
@@ -653,6 +675,8 @@ fn run_bar(a: BarArgs) -> ExitCode {
         out: a.out,
         progress: true,
         newton: crate::runtime::newton::NewtonOptions { line_search: a.methods.line_search, ..Default::default() },
+        checkpoint_every: a.checkpoint.checkpoint_every,
+        resume: a.checkpoint.resume.is_some(),
     };
     finish_bar(bar::run(&opts))
 }
@@ -741,15 +765,14 @@ fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
         dt: a.dt,
         t_start: a.t_start,
         t_end: a.t_end,
-        out: match (a.resume.clone(), out_dir(a.out)) {
-            (Some(dir), _) => Some(dir),
-            (None, Ok(dir)) => dir,
-            (None, Err(e)) => return fail(e),
+        out: match a.checkpoint.out(a.out) {
+            Ok(dir) => dir,
+            Err(e) => return fail(e),
         },
         vtu_every: a.vtu_every,
         progress: true,
-        checkpoint_every: a.checkpoint_every,
-        resume: a.resume.is_some(),
+        checkpoint_every: a.checkpoint.checkpoint_every,
+        resume: a.checkpoint.resume.is_some(),
         newton: crate::runtime::newton::NewtonOptions {
             solver: a.solver,
             line_search: a.methods.line_search,
