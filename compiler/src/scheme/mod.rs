@@ -538,11 +538,24 @@ impl<'a> Compiler<'a> {
                 lhs_spans.push(r.name.span);
             }
         }
+        for n in &st.news {
+            if st.relates.iter().any(|r| r.name.name == n.name && r.name.name != unknown.name) {
+                // Declared and related: new either way.
+                continue;
+            }
+            if self.new.contains(&n.name) || self.scope.contains_key(&n.name) {
+                self.error(Diagnostic::error(
+                    "E0810",
+                    format!("`{}` is already a quantity of this stage or a name of the scheme", n.name),
+                    n.span,
+                    "declared again here",
+                ));
+            } else {
+                self.new.push(n.name.clone());
+            }
+        }
         for r in &st.relates {
             self.collect_new_names(&r.value, last);
-        }
-        if !last {
-            // Intermediate stages: primes belong to the last stage.
         }
         let n_new = self.new.len();
         for (i, q) in self.new.clone().iter().enumerate() {
@@ -670,13 +683,16 @@ impl<'a> Compiler<'a> {
         Some(StageIr { name, time, quantities, values, terms })
     }
 
-    /// Names on right-hand sides that are neither known nor new yet become new quantities
-    /// (auxiliary unknowns such as a mean acceleration).
+    /// The new level `s'` of a state `s` on a right-hand side is a new quantity (`a'` in
+    /// Newmark's relations). Every other name must be declared (a state, a param, a `let`, the
+    /// unknown, a relation's left-hand side or a `new` quantity): an unknown one is an error
+    /// with the closest names, reported when the relation is evaluated.
     fn collect_new_names(&mut self, e: &Expr, last: bool) {
         match &e.kind {
             ExprKind::Name(id) => {
                 if !self.scope.contains_key(&id.name)
                     && !self.new.contains(&id.name)
+                    && self.is_new_level(&id.name)
                     && self.is_vector_name(&id.name, last)
                 {
                     self.new.push(id.name.clone());
@@ -690,6 +706,22 @@ impl<'a> Compiler<'a> {
             }
             ExprKind::Number(_) => {}
         }
+    }
+
+    /// Whether `name` is `s'` for a state `s`.
+    fn is_new_level(&self, name: &str) -> bool {
+        name.strip_suffix('\'').is_some_and(|s| self.def.states.iter().any(|st| st.name == s))
+    }
+
+    /// The names a scheme's expression may use here, for "did you mean".
+    fn visible_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = self.scope.keys().cloned().collect();
+        names.extend(self.new.iter().cloned());
+        names.extend(self.def.states.iter().map(|s| format!("{}'", s.name)));
+        names.extend(self.def.uses.iter().map(|u| u.name.clone()));
+        names.sort();
+        names.dedup();
+        names
     }
 
     /// Whether an unknown name may be a new quantity: not a global or built-in name.
@@ -930,10 +962,25 @@ impl<'a> Compiler<'a> {
                     };
                     let mut d =
                         Diagnostic::error("E0101", format!("unknown name `{}` in scheme", id.name), id.span, what);
-                    if id.name.ends_with('\'') {
+                    let base = id.name.trim_end_matches('\'');
+                    let state = self.def.states.iter().any(|s| s.name == base);
+                    if id.name.ends_with("''") && state {
+                        d = d.with_help(format!(
+                            "a state has two levels in a step: `{base}` at its start and `{base}'` at its end"
+                        ));
+                    } else if let Some(close) =
+                        crate::check::suggest_name(&id.name, self.visible_names().iter().map(String::as_str))
+                    {
+                        d = d.with_help(format!("did you mean `{close}`?"));
+                    } else if id.name.ends_with('\'') {
                         d = d.with_help(
                             "primed quantities exist in the last stage: relate them, or make one the unknown",
                         );
+                    } else {
+                        d = d.with_help(format!(
+                            "a quantity that only the relations determine is declared: `new {}`",
+                            id.name
+                        ));
                     }
                     self.error(d);
                     None

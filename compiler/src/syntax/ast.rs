@@ -105,6 +105,8 @@ pub struct Stage {
     pub at: Option<Expr>,
     pub lets: Vec<(Ident, Expr)>,
     pub unknown: Option<Ident>,
+    /// Declared auxiliary quantities (`new abar`): determined by the relations.
+    pub news: Vec<Ident>,
     pub relates: Vec<Relate>,
     pub residual: Option<Residual>,
     pub span: Option<Span>,

@@ -353,11 +353,12 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::state_decl
         | Rule::uses_decl
         | Rule::unknown_decl
+        | Rule::new_decl
         | Rule::relate_decl
         | Rule::residual_decl
         | Rule::stage_block
         | Rule::initial_decl => {
-            "a scheme item (`uses`, `state`, `unknown`, `relate`, `residual`, `stage`, `initial`, `let`)"
+            "a scheme item (`uses`, `state`, `unknown`, `new`, `relate`, `residual`, `stage`, `initial`, `let`)"
         }
         Rule::scheme_params | Rule::scheme_param => "scheme parameters",
         _ => return None,
@@ -566,6 +567,10 @@ impl Builder {
                     return Err(Box::new(d));
                 }
                 stage.unknown = Some(name);
+            }
+            Rule::new_decl => {
+                let list = it.next().expect("new names");
+                stage.news.extend(list.into_inner().map(|i| self.ident(i)));
             }
             Rule::relate_decl => {
                 let name = self.ident(it.next().expect("relate name"));
