@@ -60,6 +60,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0817", "scheme: a slot that is never applied"),
     ("E0818", "scheme: a stage time that is not finite for some parameter values"),
     ("W0001", "unused parameter (warning)"),
+    ("W0002", "a scheme `let` hides another name (warning)"),
 ];
 
 /// The meaning of a diagnostic code, from [`CODES`].

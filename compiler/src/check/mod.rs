@@ -127,7 +127,7 @@ pub enum Global {
 }
 
 impl Global {
-    fn span(&self, prog_params: &[Param], coefs: &[Coef], forms: &[Form]) -> Span {
+    pub(crate) fn span(&self, prog_params: &[Param], coefs: &[Coef], forms: &[Form]) -> Span {
         match self {
             Global::Param(i) => prog_params[*i].span,
             Global::Coef(i) => coefs[*i].span,
@@ -137,7 +137,7 @@ impl Global {
         }
     }
 
-    fn kind(&self) -> &'static str {
+    pub(crate) fn kind(&self) -> &'static str {
         match self {
             Global::Param(_) => "param",
             Global::Coef(_) => "coef",

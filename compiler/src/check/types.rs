@@ -242,6 +242,12 @@ impl<'p> Checker<'p> {
                 };
                 let span = integral.integrand.span;
                 if ty.shape != Shape::Scalar {
+                    // The help names the form's own test function.
+                    let help = match (&form.test, ty.shape) {
+                        (Some(w), Shape::Tensor) => format!("take inner(..., grad({})) with the test function", w.name),
+                        (Some(w), _) => format!("take dot(..., {}) with the test function", w.name),
+                        (None, _) => "a functional integrates a scalar: take a dot or inner product".to_string(),
+                    };
                     self.error(
                         Diagnostic::error(
                             "E0304",
@@ -249,7 +255,7 @@ impl<'p> Checker<'p> {
                             span,
                             format!("this is a {}", ty.shape.name()),
                         )
-                        .with_help("take dot(..., v) or inner(..., grad(v)) with the test function"),
+                        .with_help(help),
                     );
                 } else if let Some(test) = form.test.as_ref().filter(|_| !ty.test) {
                     self.error(

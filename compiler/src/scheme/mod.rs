@@ -98,7 +98,17 @@ pub struct SchemeIr {
 
 /// Compiles every scheme; errors go to `diags`.
 pub fn compile(prog: &Unit, defs: &[SchemeDef], diags: &mut Vec<Diagnostic>) -> Vec<SchemeIr> {
-    defs.iter().filter_map(|d| Compiler::new(prog, d).run().map_err(|mut e| diags.append(&mut e)).ok()).collect()
+    let mut out = Vec::new();
+    for d in defs {
+        let mut warnings = Vec::new();
+        let result = Compiler::new(prog, d, &mut warnings).run();
+        diags.append(&mut warnings);
+        match result {
+            Ok(ir) => out.push(ir),
+            Err(mut e) => diags.append(&mut e),
+        }
+    }
+    out
 }
 
 /// What a name means inside a scheme.
@@ -114,6 +124,7 @@ struct Compiler<'a> {
     g: Graph,
     params: Vec<SchemeParamInfo>,
     diags: Vec<Diagnostic>,
+    warnings: &'a mut Vec<Diagnostic>,
     /// Names visible in the current stage: scalars and known or new vectors.
     scope: HashMap<String, Value>,
     /// Quantities of the stage being compiled: name → index.
@@ -128,13 +139,14 @@ const SCHEME_BUILTINS: &[&str] = &["dt", "t", "pi"];
 const SCHEME_FUNCTIONS: &[&str] = &["sqrt", "abs"];
 
 impl<'a> Compiler<'a> {
-    fn new(prog: &'a Unit, def: &'a SchemeDef) -> Self {
+    fn new(prog: &'a Unit, def: &'a SchemeDef, warnings: &'a mut Vec<Diagnostic>) -> Self {
         Compiler {
             prog,
             def,
             g: Graph::default(),
             params: Vec::new(),
             diags: Vec::new(),
+            warnings,
             scope: HashMap::new(),
             new: Vec::new(),
             stage_index: 0,
@@ -407,7 +419,39 @@ impl<'a> Compiler<'a> {
         out
     }
 
+    /// The declaration a `let` named `name` (declared at `at`) would hide: where, and what.
+    fn shadowed(&self, name: &str, at: Span) -> Option<(Option<Span>, String)> {
+        if let Some(p) = self.def.params.iter().find(|p| p.name.name == name) {
+            return Some((Some(p.name.span), "the scheme's parameter".into()));
+        }
+        if let Some(s) = self.def.states.iter().find(|s| s.name == name) {
+            return Some((Some(s.span), "the state".into()));
+        }
+        if let Some((n, _)) = self.def.lets.iter().find(|(n, _)| n.name == name && n.span.start < at.start) {
+            return Some((Some(n.span), "the scheme's `let`".into()));
+        }
+        if SCHEME_BUILTINS.contains(&name) {
+            return Some((None, "the built-in".into()));
+        }
+        let g = self.prog.globals.get(name)?;
+        let span = g.span(&self.prog.params, &self.prog.coefs, &self.prog.forms);
+        Some(((span.end > span.start).then_some(span), format!("the file's {}", g.kind())))
+    }
+
     fn bind_let(&mut self, name: &Ident, value: &Expr) {
+        if let Some((declared, what)) = self.shadowed(&name.name, name.span) {
+            let mut w = Diagnostic::warning(
+                "W0002",
+                format!("`{}` hides {what} `{}`", name.name, name.name),
+                name.span,
+                "this `let` hides it",
+            )
+            .with_help(format!("rename the `let` if `{}` should keep its meaning", name.name));
+            if let Some(at) = declared {
+                w = w.with_label(at, "declared here");
+            }
+            self.warnings.push(w);
+        }
         if let Some(v) = self.value(value) {
             match v {
                 Value::Scalar(n) => {
