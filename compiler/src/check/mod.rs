@@ -200,6 +200,13 @@ pub fn check(sources: SourceMap, root: FileId, files: &[(FileId, ast::File)], mu
             );
         }
     }
+    if diags.iter().any(Diagnostic::is_error) {
+        // The schemes need nothing the forms' errors break: their mistakes are shown in the
+        // same run (a clean unit compiles them in `pipeline`).
+        let defs: Vec<SchemeDef> =
+            prog.scheme_defs.iter().filter(|d| !broken.contains(&d.name.name)).cloned().collect();
+        crate::scheme::compile(&prog, &defs, &mut diags);
+    }
     diagnostic::normalize(&mut diags);
     if diags.iter().any(Diagnostic::is_error) {
         Err((diags, prog.sources))

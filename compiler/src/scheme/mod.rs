@@ -1022,8 +1022,9 @@ impl<'a> Compiler<'a> {
                         );
                     } else {
                         d = d.with_help(format!(
-                            "a quantity that only the relations determine is declared: `new {}`",
-                            id.name
+                            "declare it: a parameter in `scheme {}(...)`, a `let`, or `new {}` for a quantity \
+                             that only the relations determine",
+                            self.def.name.name, id.name
                         ));
                     }
                     self.error(d);
