@@ -56,6 +56,15 @@ fn main() {
         "/// The text of every form file of `forms/`, so that `import elasticity` in a file run by path\n/// finds the library's file wherever the binary runs.\npub static SOURCES: &[(&str, &str)] = &[{}];",
         texts.join(", ")
     );
+    let scheme_texts: Vec<String> = schemes
+        .iter()
+        .map(|s| format!("(\"{s}\", include_str!(concat!(env!(\"CARGO_MANIFEST_DIR\"), \"/forms/schemes/{s}.wf\")))"))
+        .collect();
+    let _ = writeln!(
+        out,
+        "/// The text of every scheme file of `forms/schemes/`, by file stem: `verify --scheme` reads\n/// the claims (`claim order = 2`) from it.\npub static SCHEME_SOURCES: &[(&str, &str)] = &[{}];",
+        scheme_texts.join(", ")
+    );
     let path = Path::new(&std::env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("library.rs");
     std::fs::write(&path, out).expect("OUT_DIR is writable");
 }

@@ -59,6 +59,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0816", "scheme: a call to a name that is not one of its slots (`uses`)"),
     ("E0817", "scheme: a slot that is never applied"),
     ("E0818", "scheme: a stage time that is not finite for some parameter values"),
+    ("E0819", "scheme: an unknown claim, or one that is not a function of the parameters"),
     ("W0001", "unused parameter (warning)"),
     ("W0002", "a scheme `let` hides another name (warning)"),
 ];

@@ -105,10 +105,15 @@ pub enum Command {
     /// Measure what the mathematics claims: every scheme's time orders and spectral radius,
     /// P1/P2 space orders in 1D/2D/3D, the energy laws with and without contact, and the
     /// disc's convergence under Δt and h refinement; writes DIR/verify.md, verify.json and
-    /// figures in DIR/verify/.
+    /// figures in DIR/verify/. With --scheme NAME|FILE.wf (and --param): that scheme alone, in
+    /// seconds: orders, spectral radius and period error over ωΔt, energy balance, the bar and
+    /// the disc beside the library's schemes, and its file's claims checked (exit 1 if one is
+    /// contradicted); writes DIR/verify_NAME.md, .json and .png.
     Verify {
         #[arg(long, default_value = "results")]
         out: PathBuf,
+        #[command(flatten)]
+        methods: MethodArgs,
     },
     /// Compare two runs' series.csv (or their output directories) column by column.
     Compare {
@@ -417,7 +422,8 @@ fn dispatch(cli: Cli) -> ExitCode {
             print!("{}", list::text());
             ExitCode::SUCCESS
         }
-        Command::Verify { out } => match crate::verify::run(&mut |what| eprintln!("running {what}")) {
+        Command::Verify { out, methods } if methods.scheme.is_some() => verify_scheme(&out, &methods),
+        Command::Verify { out, .. } => match crate::verify::run(&mut |what| eprintln!("running {what}")) {
             Ok(v) => match v.write(&out) {
                 Ok(()) => {
                     print!("{}", v.markdown());
@@ -745,6 +751,23 @@ fn run_bar_all(a: BarArgs, base: Setup) -> ExitCode {
         }
     }
     if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
+}
+
+fn verify_scheme(out: &Path, methods: &MethodArgs) -> ExitCode {
+    let setup = match methods.setup() {
+        Ok(s) => s,
+        Err(e) => return fail(e),
+    };
+    let v = match crate::verify::scheme::run(&setup, &mut |what| eprintln!("running {what}")) {
+        Ok(v) => v,
+        Err(e) => return fail(e),
+    };
+    if let Err(e) = v.write(out) {
+        return fail(e);
+    }
+    print!("{}", v.markdown());
+    println!("wrote {}", out.join(format!("verify_{}.md", v.scheme)).display());
+    if v.holds() { ExitCode::SUCCESS } else { fail("a claim of the scheme's file is contradicted by the measurements") }
 }
 
 fn run_disc(a: DiscArgs, body: Body) -> ExitCode {

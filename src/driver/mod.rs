@@ -256,6 +256,31 @@ impl Active {
         self.scheme.desc().name
     }
 
+    /// What the scheme's file claims (`claim order = 2`, `claim rho_inf = rho`), at the param
+    /// values in use.
+    pub fn scheme_claims(&self) -> Result<Vec<(String, f64)>, CaseError> {
+        use crate::compiler::{MemLoader, check_path};
+        let name = self.scheme_name();
+        let compiled = match &self.scheme {
+            SchemeSource::Compiled(_) => {
+                let (stem, text) = crate::forms::SCHEME_SOURCES
+                    .iter()
+                    .find(|(stem, _)| *stem == name)
+                    .ok_or_else(|| CaseError::Option(format!("no source of the library scheme `{name}`")))?;
+                let path = format!("forms/schemes/{stem}.wf");
+                check_path(Path::new(&path), &MemLoader::default().with(&path, *text))
+            }
+            SchemeSource::Interpreted(i) => check_path(Path::new(&i.file), &sources::LibraryLoader),
+        };
+        let (program, _) = compiled.map_err(|f| CaseError::Option(f.rendered))?;
+        let ir = program
+            .schemes
+            .iter()
+            .find(|s| s.name == name)
+            .ok_or_else(|| CaseError::Option(format!("the scheme `{name}` is not in its file")))?;
+        Ok(ir.claims_at(&self.forms.params.scheme_values(self.scheme.params())))
+    }
+
     /// The forms the scheme applies, bound; errors name the slot's declaration.
     pub fn scheme_forms<'m>(&self, inst: &mut Instance<'m>) -> Result<Vec<Slot<'m>>, CaseError> {
         let desc = self.scheme.desc();

@@ -7,6 +7,7 @@
 pub mod convergence;
 pub mod energy;
 mod oscillator;
+pub mod scheme;
 pub mod space;
 pub mod time;
 

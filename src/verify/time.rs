@@ -56,7 +56,7 @@ fn coarse_difference(a: &[bar::Row], b: &[bar::Row]) -> f64 {
 }
 
 /// The bar before impact: successive differences of the contact point's displacement.
-fn bar_differences(setup: &Setup) -> Result<Vec<(f64, f64)>, CaseError> {
+pub(crate) fn bar_differences(setup: &Setup) -> Result<Vec<(f64, f64)>, CaseError> {
     let runs: Vec<Vec<bar::Row>> = BAR_STEPS
         .iter()
         .map(|&dt| {

@@ -46,6 +46,7 @@ pub struct SchemeDef {
     pub states: Vec<Ident>,
     pub lets: Vec<(Ident, Expr)>,
     pub initial: Option<ast::Initial>,
+    pub claims: Vec<(Ident, Expr)>,
     pub stages: Vec<ast::Stage>,
     pub span: Span,
 }
@@ -282,7 +283,7 @@ fn declare(prog: &mut Unit, files: &[(FileId, ast::File)], diags: &mut Vec<Diagn
                     });
                     Global::Form(prog.forms.len() - 1)
                 }
-                ast::Item::Scheme { name, params, uses, states, lets, initial, stages, span } => {
+                ast::Item::Scheme { name, params, uses, states, lets, initial, claims, stages, span } => {
                     prog.scheme_defs.push(SchemeDef {
                         name: name.clone(),
                         params: params.clone(),
@@ -290,6 +291,7 @@ fn declare(prog: &mut Unit, files: &[(FileId, ast::File)], diags: &mut Vec<Diagn
                         states: states.clone(),
                         lets: lets.clone(),
                         initial: initial.clone(),
+                        claims: claims.clone(),
                         stages: stages.clone(),
                         span: *span,
                     });

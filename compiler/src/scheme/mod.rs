@@ -94,6 +94,22 @@ pub struct SchemeIr {
     pub stages: Vec<StageIr>,
     /// For each state, the quantity holding its value at the end of the step.
     pub updates: Vec<Quantity>,
+    /// The author's claims (`claim order = 2`): name and value, a function of the params.
+    pub claims: Vec<(String, NodeId)>,
+}
+
+/// The properties a scheme may claim, and what each means.
+pub const CLAIMS: &[(&str, &str)] =
+    &[("order", "the order of accuracy in time"), ("rho_inf", "the spectral radius of the one-step map as ωΔt → ∞")];
+
+impl SchemeIr {
+    /// The claims' values at these param values (in `params` order).
+    pub fn claims_at(&self, params: &[f64]) -> Vec<(String, f64)> {
+        self.claims
+            .iter()
+            .map(|(name, node)| (name.clone(), affine::eval(&self.graph, *node, params, 1.0, 0.0)))
+            .collect()
+    }
 }
 
 /// Compiles every scheme; errors go to `diags`.
@@ -294,6 +310,7 @@ impl<'a> Compiler<'a> {
                 ),
             }
         }
+        let claims = self.claims();
         if !self.diags.is_empty() {
             return Err(self.diags);
         }
@@ -307,8 +324,51 @@ impl<'a> Compiler<'a> {
             initial,
             stages,
             updates,
+            claims,
         };
         Ok(ir)
+    }
+
+    /// `claim NAME = EXPR`: a known property, a scalar of the params (not of t or dt).
+    fn claims(&mut self) -> Vec<(String, NodeId)> {
+        let mut out: Vec<(String, NodeId)> = Vec::new();
+        for (i, (name, e)) in self.def.claims.iter().enumerate() {
+            if !CLAIMS.iter().any(|(c, _)| *c == name.name) {
+                let known: Vec<&str> = CLAIMS.iter().map(|(c, _)| *c).collect();
+                let mut d = Diagnostic::error(
+                    "E0819",
+                    format!("`{}` is not a property a scheme can claim", name.name),
+                    name.span,
+                    "unknown claim",
+                )
+                .with_note(format!("claims: {}", known.join(", ")));
+                if let Some(s) = crate::check::suggest_name(&name.name, known.into_iter()) {
+                    d = d.with_help(format!("did you mean `{s}`?"));
+                }
+                self.error(d);
+                continue;
+            }
+            if let Some((prev, _)) = self.def.claims[..i].iter().find(|(p, _)| p.name == name.name) {
+                self.error(
+                    Diagnostic::error("E0102", format!("`{}` is claimed twice", name.name), name.span, "again here")
+                        .with_label(prev.span, "first here"),
+                );
+                continue;
+            }
+            match self.value(e) {
+                Some(Value::Scalar(n)) if !self.g.depends_on(n, |s| matches!(s, Sym::Time | Sym::Dt)) => {
+                    out.push((name.name.clone(), n))
+                }
+                Some(_) => self.error(Diagnostic::error(
+                    "E0819",
+                    "a claim is a number or a function of the scheme's parameters",
+                    e.span,
+                    "not a function of the parameters alone",
+                )),
+                None => {}
+            }
+        }
+        out
     }
 
     fn is_slot(&self, name: &str) -> bool {

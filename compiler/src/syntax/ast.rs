@@ -179,6 +179,8 @@ pub enum Item {
         /// Scalar lets shared by the stages.
         lets: Vec<(Ident, Expr)>,
         initial: Option<Initial>,
+        /// `claim NAME = EXPR`: properties the author states (`order`, `rho_inf`).
+        claims: Vec<(Ident, Expr)>,
         stages: Vec<Stage>,
         span: Span,
     },

@@ -354,11 +354,12 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         | Rule::uses_decl
         | Rule::unknown_decl
         | Rule::new_decl
+        | Rule::claim_decl
         | Rule::relate_decl
         | Rule::residual_decl
         | Rule::stage_block
         | Rule::initial_decl => {
-            "a scheme item (`uses`, `state`, `unknown`, `new`, `relate`, `residual`, `stage`, `initial`, `let`)"
+            "a scheme item (`uses`, `state`, `unknown`, `new`, `relate`, `residual`, `stage`, `initial`, `let`, `claim`)"
         }
         Rule::scheme_params | Rule::scheme_param => "scheme parameters",
         _ => return None,
@@ -475,6 +476,7 @@ impl Builder {
         let name = self.ident(name);
         let (mut params, mut states, mut initial, mut lets) = (Vec::new(), Vec::new(), None, Vec::new());
         let mut uses = Vec::new();
+        let mut claims = Vec::new();
         let mut stages: Vec<Stage> = Vec::new();
         // Items outside `stage` blocks form one implicit stage at t + dt.
         let mut implicit = Stage::default();
@@ -523,6 +525,11 @@ impl Builder {
                     let name = self.ident(it.next().expect("let name"));
                     lets.push((name, self.expr(it.next().expect("let value"))?));
                 }
+                Rule::claim_decl => {
+                    let mut it = p.into_inner();
+                    let name = self.ident(it.next().expect("claim name"));
+                    claims.push((name, self.expr(it.next().expect("claim value"))?));
+                }
                 _ => self.stage_item(&mut implicit, p)?,
             }
         }
@@ -547,7 +554,7 @@ impl Builder {
                 return Err(Box::new(d));
             }
         }
-        Ok(Item::Scheme { name, params, uses, states, lets, initial, stages, span })
+        Ok(Item::Scheme { name, params, uses, states, lets, initial, claims, stages, span })
     }
 
     fn stage_item(&self, stage: &mut Stage, p: Pair<Rule>) -> Result<(), Box<Diagnostic>> {

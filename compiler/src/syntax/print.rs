@@ -31,7 +31,7 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 let ps: Vec<_> = params.iter().map(|p| p.name.as_str()).collect();
                 out.push_str(&format!("{head}fn {}({}) = {}\n", name.name, ps.join(", "), expr(body)));
             }
-            Item::Scheme { name, params, uses, states, lets, initial, stages, .. } => {
+            Item::Scheme { name, params, uses, states, lets, initial, claims, stages, .. } => {
                 let ps: Vec<String> =
                     params.iter().map(|p| format!("{} = {}", p.name.name, expr(&p.default))).collect();
                 out.push_str(&format!("{head}scheme {}({})\n", name.name, ps.join(", ")));
@@ -41,6 +41,9 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 out.push_str(&format!("  state {}\n", ss.join(", ")));
                 for (n, v) in lets {
                     out.push_str(&format!("  let {} = {}\n", n.name, expr(v)));
+                }
+                for (n, v) in claims {
+                    out.push_str(&format!("  claim {} = {}\n", n.name, expr(v)));
                 }
                 if let Some(i) = initial {
                     out.push_str(&format!(
@@ -58,6 +61,10 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                     }
                     if let Some(u) = &st.unknown {
                         out.push_str(&format!("    unknown {}\n", u.name));
+                    }
+                    if !st.news.is_empty() {
+                        let ns: Vec<&str> = st.news.iter().map(|n| n.name.as_str()).collect();
+                        out.push_str(&format!("    new {}\n", ns.join(", ")));
                     }
                     for r in &st.relates {
                         out.push_str(&format!("    relate {} = {}\n", r.name.name, expr(&r.value)));

@@ -1,0 +1,355 @@
+//! `signorini verify --scheme NAME|FILE.wf [--param ...]`: one scheme, measured where the
+//! mathematics gives exact answers, in seconds. The oscillator ü + ω²u = 0 (ω = 1) gives the
+//! observed order against cos t, the one-step map's spectral radius and relative period error
+//! over ωΔt ∈ [1e-2, 1e6] (beside the library's Newmark, HHT and generalized-α), and the energy
+//! ½(u² + v²) step by step; the bar before impact gives the order on a system with every mode of
+//! the mesh excited and its energy balance; the bar's and the disc's summaries put the scheme
+//! beside the library's. What the file claims (`claim order = 2`, `claim rho_inf = ...`) is
+//! checked against the measurements: a contradiction fails the command.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::oscillator::{oscillator_energies, oscillator_error, spectral_radius, with_oscillator};
+use super::time::{BAR_STEPS, BarOrder, OSCILLATOR_STEPS, bar_differences, last_order};
+use crate::cases::{CaseError, bar, disc};
+use crate::driver::{Active, Setup};
+use crate::plot::Curve;
+
+/// The library's schemes every report compares with.
+const REFERENCES: [&str; 3] = ["newmark", "hht", "genalpha"];
+/// ωΔt of the spectrum: 10^(-2 + k/8), k = 0..=64 (1e-2 to 1e6).
+fn omega_dts() -> Vec<f64> {
+    (0..=64).map(|k| 10f64.powf(-2.0 + k as f64 / 8.0)).collect()
+}
+/// A measured order agrees with a claimed one within this.
+const ORDER_TOLERANCE: f64 = 0.25;
+/// A measured ρ∞ agrees with a claimed one within this.
+const RHO_TOLERANCE: f64 = 1e-3;
+
+/// The one-step map at one ωΔt.
+#[derive(Clone, Debug, Serialize)]
+pub struct SpectrumPoint {
+    pub omega_dt: f64,
+    pub rho: f64,
+    /// T̄/T − 1 of the principal roots ρ e^{±iΩΔt}; absent where the roots are real.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub period_error: Option<f64>,
+}
+
+/// A claim of the file and what was measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct Verdict {
+    pub claim: String,
+    pub claimed: f64,
+    pub measured: f64,
+    pub holds: bool,
+}
+
+/// One row of the bar's or the disc's comparison.
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseRow {
+    pub scheme: String,
+    pub values: Vec<(String, f64)>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SchemeVerification {
+    pub scheme: String,
+    /// The scheme's params with their values.
+    pub params: Vec<(String, f64)>,
+    pub claims: Vec<(String, f64)>,
+    /// (Δt, |u(10) − cos 10|).
+    pub oscillator: Vec<(f64, f64)>,
+    pub oscillator_order: f64,
+    pub bar_orders: Vec<BarOrder>,
+    pub rho_infinity: f64,
+    pub spectrum: Vec<SpectrumPoint>,
+    pub references: Vec<(String, Vec<SpectrumPoint>)>,
+    /// The oscillator at ωΔt = 0.1 over 1000 steps: max |E_{n+1} − E_n| / E_0 and (E_N − E_0)/E_0.
+    pub energy_step_max: Option<f64>,
+    pub energy_drift: Option<f64>,
+    /// The bar before impact (t ≤ 0.8, Δt = 0.01): max_n |E_n − E_0| / E_0.
+    pub bar_energy_drift: f64,
+    pub bar: Vec<CaseRow>,
+    pub disc: Vec<CaseRow>,
+    pub verdicts: Vec<Verdict>,
+}
+
+impl SchemeVerification {
+    pub fn holds(&self) -> bool {
+        self.verdicts.iter().all(|v| v.holds)
+    }
+}
+
+/// Measures the scheme of `setup` (its `scheme` and `params`).
+pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerification, CaseError> {
+    let active = Active::resolve(setup, &[])?;
+    let scheme = active.scheme_name().to_string();
+    let params: Vec<(String, f64)> = active
+        .scheme
+        .params()
+        .iter()
+        .zip(active.forms.params.scheme_values(active.scheme.params()))
+        .map(|(p, v)| (p.name.to_string(), v))
+        .collect();
+    let claims = active.scheme_claims()?;
+    progress(&format!("{scheme}: oscillator"));
+    let oscillator: Vec<(f64, f64)> = OSCILLATOR_STEPS
+        .iter()
+        .chain(&[0.005])
+        .map(|&dt| Ok((dt, oscillator_error(setup, dt, 10.0)?)))
+        .collect::<Result<_, CaseError>>()?;
+    let oscillator_order = last_order(&oscillator);
+    let rho_infinity = spectral_radius(setup, 1e12)?;
+    progress(&format!("{scheme}: spectrum"));
+    let own = spectrum(setup)?;
+    let references = REFERENCES
+        .iter()
+        .filter(|r| **r != scheme)
+        .map(|r| Ok((r.to_string(), spectrum(&Setup { scheme: r.to_string(), params: Vec::new(), ..setup.clone() })?)))
+        .collect::<Result<_, CaseError>>()?;
+    let (energy_step_max, energy_drift) = match oscillator_energies(setup, 0.1, 1000) {
+        Ok(e) => {
+            let step = e.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max) / e[0];
+            (Some(step), Some((e[e.len() - 1] - e[0]) / e[0]))
+        }
+        // A scheme without a velocity state has no ½v² to measure.
+        Err(_) => (None, None),
+    };
+    progress(&format!("{scheme}: bar before impact"));
+    let bar_orders = crate::settings::get()
+        .verify
+        .contacts
+        .iter()
+        .map(|contact| {
+            let differences = bar_differences(&Setup { contact: contact.clone(), ..setup.clone() })?;
+            Ok(BarOrder { contact: contact.clone(), order: last_order(&differences), differences })
+        })
+        .collect::<Result<_, CaseError>>()?;
+    let before = bar::run(&bar::Options { setup: setup.clone(), t_end: 0.8, ..bar::Options::default() })?;
+    let e0 = before.series[0].energy;
+    let bar_energy_drift = before.series.iter().map(|r| (r.energy - e0).abs()).fold(0.0, f64::max) / e0;
+    progress(&format!("{scheme}: bar and disc beside the library"));
+    let mut bar_rows = Vec::new();
+    let mut disc_rows = Vec::new();
+    let names = std::iter::once(None).chain(REFERENCES.iter().filter(|r| **r != scheme).map(Some));
+    for name in names {
+        let s = match name {
+            None => setup.clone(),
+            Some(r) => Setup { scheme: r.to_string(), params: Vec::new(), ..setup.clone() },
+        };
+        let label = name.map_or(scheme.clone(), |r| r.to_string());
+        let b = bar::run(&bar::Options { setup: s.clone(), ..bar::Options::default() })?.summary;
+        bar_rows.push(CaseRow {
+            scheme: label.clone(),
+            values: vec![
+                ("err_u".into(), b.err_linf_l2_u),
+                ("err_λ".into(), b.err_l2_lambda.unwrap_or(f64::NAN)),
+                ("E_aug drift".into(), b.energy_aug_drift_final),
+                ("penetration".into(), b.max_penetration),
+                ("Newton".into(), b.newton_total as f64),
+            ],
+        });
+        let d = disc::run(&disc::Options { setup: s, h: 2.0, ..disc::Options::default() })?.summary;
+        disc_rows.push(CaseRow {
+            scheme: label,
+            values: vec![
+                ("first contact".into(), d.first_contact.unwrap_or(f64::NAN)),
+                ("min ȳ".into(), d.min_uy_mean),
+                ("penetration".into(), d.max_penetration),
+                ("E_aug(T)".into(), d.energy_aug_final),
+                ("Newton".into(), d.newton_total as f64),
+            ],
+        });
+    }
+    let verdicts = claims
+        .iter()
+        .map(|(claim, claimed)| {
+            let (measured, holds) = match claim.as_str() {
+                "order" => (oscillator_order, (oscillator_order - claimed).abs() <= ORDER_TOLERANCE),
+                _ => (rho_infinity, (rho_infinity - claimed).abs() <= RHO_TOLERANCE),
+            };
+            Verdict { claim: claim.clone(), claimed: *claimed, measured, holds }
+        })
+        .collect();
+    Ok(SchemeVerification {
+        scheme,
+        params,
+        claims,
+        oscillator,
+        oscillator_order,
+        bar_orders,
+        rho_infinity,
+        spectrum: own,
+        references,
+        energy_step_max,
+        energy_drift,
+        bar_energy_drift,
+        bar: bar_rows,
+        disc: disc_rows,
+        verdicts,
+    })
+}
+
+/// The oscillator's one-step map over [`omega_dts`]: its spectral radius and the relative
+/// period error of its principal roots.
+fn spectrum(setup: &Setup) -> Result<Vec<SpectrumPoint>, CaseError> {
+    omega_dts()
+        .into_iter()
+        .map(|dt| {
+            let a = step_map(setup, dt)?;
+            let m = a.len();
+            let matrix = nalgebra::DMatrix::from_fn(m, m, |i, j| a[i][j]);
+            let roots = matrix.complex_eigenvalues();
+            let rho = roots.iter().map(|z| z.norm()).fold(0.0, f64::max);
+            // The principal pair: the complex root of largest modulus in the upper half plane.
+            let principal = roots
+                .iter()
+                .filter(|z| z.im > 1e-12 * z.norm().max(1e-300))
+                .max_by(|x, y| x.norm().total_cmp(&y.norm()));
+            let period_error = principal.map(|z| dt / z.im.atan2(z.re) - 1.0);
+            Ok(SpectrumPoint { omega_dt: dt, rho, period_error })
+        })
+        .collect()
+}
+
+/// The matrix of one step of the oscillator on the states (u, v, a, ...), column j the step of
+/// the j-th unit state.
+fn step_map(setup: &Setup, dt: f64) -> Result<Vec<Vec<f64>>, CaseError> {
+    with_oscillator(setup, |st| -> Result<Vec<Vec<f64>>, CaseError> {
+        let m = st.desc().states.len();
+        let mut a = vec![vec![0.0; m]; m];
+        for j in 0..m {
+            let mut states: Vec<Vec<f64>> = (0..m).map(|_| vec![0.0; 2]).collect();
+            states[j][0] = 1.0;
+            st.step(&mut states, 0.0, dt)?;
+            for (i, row) in a.iter_mut().enumerate() {
+                row[j] = states[i][0];
+            }
+        }
+        Ok(a)
+    })?
+}
+
+impl SchemeVerification {
+    /// Writes DIR/verify_NAME.md, .json and .png.
+    pub fn write(&self, dir: &Path) -> Result<(), CaseError> {
+        let stem = format!("verify_{}", self.scheme);
+        let png = dir.join(format!("{stem}.png"));
+        let labels: Vec<&str> =
+            std::iter::once(self.scheme.as_str()).chain(self.references.iter().map(|(n, _)| n.as_str())).collect();
+        let series: Vec<&[SpectrumPoint]> =
+            std::iter::once(&self.spectrum[..]).chain(self.references.iter().map(|(_, s)| &s[..])).collect();
+        // The scheme solid, the library's dashed.
+        let curves = |f: &dyn Fn(&SpectrumPoint) -> Option<f64>| -> Vec<Curve> {
+            labels
+                .iter()
+                .zip(&series)
+                .enumerate()
+                .map(|(i, (label, s))| Curve {
+                    label,
+                    points: s.iter().filter_map(|p| f(p).map(|y| (p.omega_dt.log10(), y))).collect(),
+                    dashed: i > 0,
+                })
+                .collect()
+        };
+        let rho = curves(&|p| Some(p.rho));
+        let period = curves(&|p| p.period_error.filter(|e| *e > 0.0).map(f64::log10));
+        crate::plot::panels(
+            &png,
+            "log10 ωΔt",
+            &[("spectral radius of the one-step map", "ρ", rho), ("relative period error", "log10 (T̄/T − 1)", period)],
+        )
+        .map_err(super::plot_error(&png))?;
+        let json = dir.join(format!("{stem}.json"));
+        crate::output::write_json(&json, self)
+            .map_err(|source| CaseError::Write { path: json.display().to_string(), source })?;
+        let md = dir.join(format!("{stem}.md"));
+        crate::output::write_atomic(&md, self.markdown().as_bytes())
+            .map_err(|source| CaseError::Write { path: md.display().to_string(), source })
+    }
+
+    pub fn markdown(&self) -> String {
+        let mut s = String::new();
+        let params: Vec<String> = self.params.iter().map(|(n, v)| format!("{n} = {v}")).collect();
+        let _ = writeln!(
+            s,
+            "# verify --scheme {}\n\nParams: {}.\n",
+            self.scheme,
+            if params.is_empty() { "none".into() } else { params.join(", ") }
+        );
+        if self.verdicts.is_empty() {
+            let _ =
+                writeln!(s, "The file claims nothing (`claim order = 2`, `claim rho_inf = ...` would be checked).\n");
+        } else {
+            let _ = writeln!(s, "| claim | claimed | measured | |\n|---|---|---|---|");
+            for v in &self.verdicts {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {:.4} | {} |",
+                    v.claim,
+                    v.claimed,
+                    v.measured,
+                    if v.holds { "holds" } else { "**contradicted**" }
+                );
+            }
+            s.push('\n');
+        }
+        let _ = writeln!(s, "## Oscillator ü + u = 0\n\n| Δt | \\|u(10) − cos 10\\| |\n|---|---|");
+        for (dt, e) in &self.oscillator {
+            let _ = writeln!(s, "| {dt} | {e:.3e} |");
+        }
+        let _ = writeln!(
+            s,
+            "\nObserved order {:.2}; spectral radius at ωΔt = 1e12: {:.4}.",
+            self.oscillator_order, self.rho_infinity
+        );
+        match (self.energy_step_max, self.energy_drift) {
+            (Some(step), Some(drift)) => {
+                let _ = writeln!(
+                    s,
+                    "Energy ½(u² + v²) at ωΔt = 0.1 over 1000 steps: largest change in one step {step:.3e} E₀, drift {drift:.3e} E₀."
+                );
+            }
+            _ => {
+                let _ = writeln!(s, "No velocity state: the oscillator's energy is not measured.");
+            }
+        }
+        let others: Vec<&str> = self.references.iter().map(|(n, _)| n.as_str()).collect();
+        let _ = writeln!(
+            s,
+            "\nSpectral radius and period error over ωΔt ∈ [1e-2, 1e6], beside {}: verify_{}.png.\n",
+            others.join(", "),
+            self.scheme
+        );
+        let _ = writeln!(
+            s,
+            "## Bar before impact (t ≤ 0.8)\n\n| contact law | order (successive differences) |\n|---|---|"
+        );
+        for b in &self.bar_orders {
+            let _ = writeln!(s, "| {} | {:.2} |", b.contact, b.order);
+        }
+        let _ = writeln!(
+            s,
+            "\nEnergy: max |E_n − E_0| / E_0 = {:.3e} at Δt = 0.01 (steps {:?} for the orders).\n",
+            self.bar_energy_drift, BAR_STEPS
+        );
+        for (title, rows) in [("Bar (Δt = 0.01, T = 12)", &self.bar), ("Disc (h = 2, Δt = 0.02, T = 20)", &self.disc)]
+        {
+            let _ = writeln!(s, "## {title}\n");
+            if let Some(first) = rows.first() {
+                let heads: Vec<&str> = first.values.iter().map(|(n, _)| n.as_str()).collect();
+                let _ = writeln!(s, "| scheme | {} |\n|---|{}", heads.join(" | "), "---|".repeat(heads.len()));
+                for r in rows.iter() {
+                    let vals: Vec<String> = r.values.iter().map(|(_, v)| format!("{v:.4e}")).collect();
+                    let _ = writeln!(s, "| {} | {} |", r.scheme, vals.join(" | "));
+                }
+            }
+            s.push('\n');
+        }
+        s
+    }
+}

@@ -1,0 +1,81 @@
+//! `verify --scheme` on schemes a user writes (issue 14): a generalized-α file is measured at
+//! order 2 with a spectral radius tending to its ρ∞, and its claims hold; a backward Euler that
+//! claims order 2 is measured at order 1 and the claim is contradicted.
+
+use signorini::driver::Setup;
+use signorini::verify::scheme;
+
+fn write(name: &str, text: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("signorini-verify-scheme-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+/// Chung and Hulbert's generalized-α, written from the paper by a user (not the library's file).
+const GENERALIZED_ALPHA: &str = "
+scheme my_genalpha(r = 0.6 in [0, 1]) {
+  uses mass, stiffness, contact, load
+  state u, v, a
+  claim order = 2
+  claim rho_inf = r
+  let am = (2*r - 1)/(r + 1)
+  let af = r/(r + 1)
+  let g = 1/2 - am + af
+  let b = (1 - am + af)^2/4
+  initial a: mass(a) + stiffness(u) + contact(u) == load(t)
+  unknown u'
+  relate u' = u + dt*v + dt^2*((1/2 - b)*a + b*a')
+  relate v' = v + dt*((1 - g)*a + g*a')
+  residual mass((1 - am)*a' + am*a) + stiffness((1 - af)*u' + af*u) + contact((1 - af)*u' + af*u)
+    == load(t + (1 - af)*dt)
+}
+";
+
+const BACKWARD_EULER: &str = "
+scheme euler {
+  uses mass, stiffness, contact, load
+  state u, v
+  claim order = 2
+  unknown u'
+  new a
+  relate u' = u + dt*v'
+  relate v' = v + dt*a
+  residual mass(a) + stiffness(u') + contact(u') == load(t + dt)
+}
+";
+
+#[test]
+fn a_users_generalized_alpha_has_order_two_and_its_rho_infinity() {
+    let path = write("my_genalpha.wf", GENERALIZED_ALPHA);
+    for r in [0.6, 0.3] {
+        let setup = Setup { scheme: path.clone(), ..Setup::default() }.set("r", r);
+        let v = scheme::run(&setup, &mut |_| {}).unwrap();
+        assert!((v.oscillator_order - 2.0).abs() < 0.05, "order {}", v.oscillator_order);
+        // Round-off of the step at ωΔt = 1e12 leaves about 1e-6.
+        assert!((v.rho_infinity - r).abs() < 1e-4, "ρ∞ {} for r = {r}", v.rho_infinity);
+        // The spectral radius falls from 1 at small ωΔt to ρ∞ at large.
+        let (first, last) = (v.spectrum.first().unwrap(), v.spectrum.last().unwrap());
+        assert!((first.rho - 1.0).abs() < 1e-3 && (last.rho - r).abs() < 1e-3, "{first:?} … {last:?}");
+        assert!(v.spectrum.windows(2).all(|w| w[1].rho <= w[0].rho + 1e-9), "ρ(ωΔt) is not monotone");
+        // Second order: the period error falls 100-fold per decade of ωΔt at small steps.
+        let e = |k: usize| v.spectrum[k].period_error.unwrap();
+        assert!((e(0) / e(8) - 1e-2).abs() < 2e-3, "period error {} → {}", e(0), e(8));
+        assert_eq!(v.verdicts.len(), 2);
+        assert!(v.holds(), "{:?}", v.verdicts);
+        assert!(v.bar_orders.iter().all(|b| (b.order - 2.0).abs() < 0.2), "{:?}", v.bar_orders);
+    }
+}
+
+#[test]
+fn a_first_order_scheme_that_claims_two_is_contradicted() {
+    let path = write("euler.wf", BACKWARD_EULER);
+    let v = scheme::run(&Setup { scheme: path, ..Setup::default() }, &mut |_| {}).unwrap();
+    assert!((v.oscillator_order - 1.0).abs() < 0.1, "order {}", v.oscillator_order);
+    assert!(!v.holds());
+    let order = &v.verdicts[0];
+    assert!(order.claim == "order" && !order.holds && (order.measured - 1.0).abs() < 0.1, "{order:?}");
+    // L-stable: the spectral radius tends to 0.
+    assert!(v.rho_infinity < 1e-6, "ρ∞ {}", v.rho_infinity);
+}
