@@ -10,5 +10,5 @@ export RUSTFLAGS="-Cpasses=sancov-module -Cllvm-args=-sanitizer-coverage-level=4
 target=$(rustc -vV | sed -n 's/^host: //p')
 cargo build --release --target "$target" --bin check
 mkdir -p corpus/check artifacts
-cp ../../forms/*.wf corpus/check/
+cp ../../forms/*.wf ../../forms/schemes/*.wf corpus/check/
 "./target/$target/release/check" corpus/check -artifact_prefix=artifacts/ -max_total_time="${1:-300}" -max_len=4096

@@ -767,7 +767,17 @@ fn verify_scheme(out: &Path, methods: &MethodArgs) -> ExitCode {
     }
     print!("{}", v.markdown());
     println!("wrote {}", out.join(format!("verify_{}.md", v.scheme)).display());
-    if v.holds() { ExitCode::SUCCESS } else { fail("a claim of the scheme's file is contradicted by the measurements") }
+    let contradicted: Vec<String> = v
+        .verdicts
+        .iter()
+        .filter(|c| !c.holds)
+        .map(|c| format!("{} = {} (measured {:.4})", c.claim, c.claimed, c.measured))
+        .collect();
+    if contradicted.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        fail(format!("the measurements contradict what {}'s file claims: {}", v.scheme, contradicted.join(", ")))
+    }
 }
 
 fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
