@@ -39,6 +39,11 @@ pub struct BarRuns {
 pub struct Verify {
     pub energy_conserving: Vec<String>,
     pub contacts: Vec<String>,
+    /// `verify --scheme`: the library's schemes every report compares with.
+    pub references: Vec<String>,
+    /// `verify --scheme`: the slot a scheme applies to the velocity for a damping term; a scheme
+    /// that uses it is also measured on the damped oscillator.
+    pub damping_slot: String,
 }
 
 /// The parsed file (compiled in; `tests/settings` checks that it parses and names library

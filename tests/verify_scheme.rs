@@ -1,6 +1,8 @@
 //! `verify --scheme` on schemes a user writes (issue 14): a generalized-α file is measured at
 //! order 2 with a spectral radius tending to its ρ∞, and its claims hold; a backward Euler that
-//! claims order 2 is measured at order 1 and the claim is contradicted.
+//! claims order 2 is measured at order 1 and the claim is contradicted; a damped Newmark has
+//! order 2 on the damped oscillator, and one with an explicit damping term order 1 there
+//! (though 2 without damping).
 
 use signorini::driver::Setup;
 use signorini::verify::scheme;
@@ -78,4 +80,44 @@ fn a_first_order_scheme_that_claims_two_is_contradicted() {
     assert!(order.claim == "order" && !order.holds && (order.measured - 1.0).abs() < 0.1, "{order:?}");
     // L-stable: the spectral radius tends to 0.
     assert!(v.rho_infinity < 1e-6, "ρ∞ {}", v.rho_infinity);
+}
+
+/// Newmark (trapezoidal) with a damping slot applied at `LEVEL`.
+const DAMPED_NEWMARK: &str = "
+scheme NAME {
+  uses mass, damping, stiffness, contact, load
+  state u, v, a
+  claim order = 2
+  initial a: mass(a) + damping(v) + stiffness(u) + contact(u) == load(t)
+  unknown u'
+  relate u' = u + dt*v + dt^2/4*(a + a')
+  relate v' = v + dt/2*(a + a')
+  residual mass(a') + damping(LEVEL) + stiffness(u') + contact(u') == load(t + dt)
+}
+";
+
+const DAMPING_FORM: &str = "param c = 0.05 in [0, inf)\nform damping(w; v) = int(Omega) c * dot(w, v)\n";
+
+#[test]
+fn damping_applied_explicitly_costs_an_order_on_the_damped_oscillator() {
+    let forms = write("damping.wf", DAMPING_FORM);
+    let run = |name: &str, level: &str| {
+        let path = write(&format!("{name}.wf"), &DAMPED_NEWMARK.replace("NAME", name).replace("LEVEL", level));
+        let setup = Setup { scheme: path, forms: vec![forms.clone().into()], ..Setup::default() };
+        scheme::run(&setup, &mut |_| {}).unwrap()
+    };
+    let implicit = run("newmark_damped", "v'");
+    let d = implicit.damped_order.expect("the damping slot is applied");
+    assert!(
+        (d - 2.0).abs() < 0.1 && (implicit.oscillator_order - 2.0).abs() < 0.1,
+        "{d} {}",
+        implicit.oscillator_order
+    );
+    assert!(implicit.holds(), "{:?}", implicit.verdicts);
+    let explicit = run("newmark_explicit_damping", "v");
+    let d = explicit.damped_order.unwrap();
+    assert!((d - 1.0).abs() < 0.15, "explicit damping: order {d}");
+    assert!((explicit.oscillator_order - 2.0).abs() < 0.1);
+    let damped = explicit.verdicts.iter().find(|v| v.claim == "order (damped)").unwrap();
+    assert!(!damped.holds && !explicit.holds(), "{:?}", explicit.verdicts);
 }

@@ -54,7 +54,7 @@ pub enum CaseError {
     Stopped { t: f64, cuts: usize, dt: f64, cause: String, history: String },
     /// The energy grew past what a stable scheme allows.
     #[error(
-        "stopped at t = {t}: the energy ½uᵀKu + ½vᵀMv = {energy:.3e} exceeds {growth} × {bound:.3e} (its initial value plus the work of the loads): the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt with an explicit contact treatment, Δt beyond a conditionally stable scheme's limit, or degenerate cells. Results up to here are written; --max-energy-growth 0 turns this check off"
+        "stopped at t = {t}: the energy ½uᵀKu + ½vᵀMv = {energy:.3e} exceeds {growth} × {bound:.3e} (its initial value plus the work of the loads): the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt with an explicit contact treatment, Δt beyond a conditionally stable scheme's limit, a contact parameter so large (γ0 or ε ≳ 1e12 × E) that the contact rows' round-off swamps the solve, or degenerate cells. Results up to here are written; --max-energy-growth 0 turns this check off"
     )]
     BlowUp { t: f64, energy: f64, bound: f64, growth: f64, params: String },
     /// SIGINT or SIGTERM.

@@ -283,9 +283,22 @@ impl Active {
 
     /// The forms the scheme applies, bound; errors name the slot's declaration.
     pub fn scheme_forms<'m>(&self, inst: &mut Instance<'m>) -> Result<Vec<Slot<'m>>, CaseError> {
+        self.scheme_forms_with(inst, Vec::new())
+    }
+
+    /// As [`Active::scheme_forms`], with some slots bound to the given forms instead.
+    pub fn scheme_forms_with<'m>(
+        &self,
+        inst: &mut Instance<'m>,
+        mut given: Vec<Slot<'m>>,
+    ) -> Result<Vec<Slot<'m>>, CaseError> {
         let desc = self.scheme.desc();
         let mut out = Vec::new();
         for slot in desc.uses {
+            if let Some(i) = given.iter().position(|(name, _)| *name == slot.name) {
+                out.push(given.swap_remove(i));
+                continue;
+            }
             let provided = || {
                 let list: Vec<String> = self
                     .forms

@@ -2,6 +2,7 @@
 //! error against cos t, and the spectral radius of a scheme's one-step map.
 
 use crate::cases::CaseError;
+use crate::driver::Slot;
 use crate::driver::{Active, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
@@ -10,7 +11,7 @@ use crate::runtime::linalg::Structure;
 use crate::runtime::mesh::structured;
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
-use crate::runtime::scheme::{Stepper, TimeScheme};
+use crate::runtime::scheme::{MatrixForm, Stepper, TimeScheme};
 
 /// Runs `f` with a stepper of `setup`'s scheme on the oscillator: one P1 element, E = 1,
 /// ρ = 3, so M = ρh/3 = 1 and K = E/h = 1 on the free dof; no contact facets.
@@ -25,6 +26,25 @@ pub fn with_oscillator_scheme<R>(
     scheme: Option<Box<dyn TimeScheme>>,
     f: impl FnOnce(&mut Stepper) -> R,
 ) -> Result<R, CaseError> {
+    oscillator(setup, scheme, None, f)
+}
+
+/// As [`with_oscillator`] on ü + 2ζu̇ + u = 0: the damping slot (forms/library.toml) is bound
+/// to 2ζM. (Without this, a scheme that applies it gets ζ = 0.)
+pub fn with_damped_oscillator<R>(
+    setup: &Setup,
+    damping: (&'static str, f64),
+    f: impl FnOnce(&mut Stepper) -> R,
+) -> Result<R, CaseError> {
+    oscillator(setup, None, Some(damping), f)
+}
+
+fn oscillator<R>(
+    setup: &Setup,
+    scheme: Option<Box<dyn TimeScheme>>,
+    damping: Option<(&'static str, f64)>,
+    f: impl FnOnce(&mut Stepper) -> R,
+) -> Result<R, CaseError> {
     let mesh = structured::interval(1, 0.0, 1.0);
     let asm = Assembler::new(&mesh);
     let active = Active::resolve(&setup.clone().set("elasticity.rho", 3.0), &[])?;
@@ -36,7 +56,22 @@ pub fn with_oscillator_scheme<R>(
     };
     let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
     let mut inst = active.forms.instantiate(&coefs, &binding)?;
-    let forms = active.scheme_forms(&mut inst)?;
+    // A scheme that applies the damping slot gets 2ζM there: ζ = 0 (undamped) unless asked.
+    let slot = crate::settings::get().verify.damping_slot.as_str();
+    let damping = damping.or_else(|| active.scheme.desc().uses.iter().any(|s| s.name == slot).then_some((slot, 0.0)));
+    let given: Vec<Slot> = match damping {
+        Some((slot, zeta)) => {
+            let mut mass = asm.zero_matrix();
+            let mut probe = active.forms.instantiate(&coefs, &binding)?;
+            let m = probe.take_form("mass").ok_or_else(|| CaseError::Option("the oscillator needs `mass`".into()))?;
+            m.tangent(&asm, &[&[0.0, 0.0]], 0, 0.0, &mut mass);
+            let mut c = asm.zero_matrix();
+            c.add_scaled(2.0 * zeta, &mass);
+            vec![(slot, Box::new(MatrixForm { name: slot.into(), matrix: c }))]
+        }
+        None => Vec::new(),
+    };
+    let forms = active.scheme_forms_with(&mut inst, given)?;
     let mut constraints = Constraints::none(asm.size());
     constraints.fix(1);
     let scheme = match scheme {
@@ -58,6 +93,29 @@ pub fn oscillator_error(setup: &Setup, dt: f64, t_end: f64) -> Result<f64, CaseE
             st.step(&mut states, k as f64 * dt, dt)?;
         }
         Ok((states[0][0] - t_end.cos()).abs())
+    })?
+}
+
+/// |u(T) − u_exact(T)| on ü + 2ζu̇ + u = 0 from u = 1, v = 0, with `slot` bound to 2ζM:
+/// u = e^{−ζt}(cos ω_d t + ζ/ω_d sin ω_d t), ω_d = √(1 − ζ²).
+pub fn damped_oscillator_error(
+    setup: &Setup,
+    slot: &'static str,
+    zeta: f64,
+    dt: f64,
+    t_end: f64,
+) -> Result<f64, CaseError> {
+    with_damped_oscillator(setup, (slot, zeta), |st| -> Result<f64, CaseError> {
+        let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
+        states[0][0] = 1.0;
+        st.initialize(&mut states, 0.0)?;
+        let steps = (t_end / dt).round() as usize;
+        for k in 0..steps {
+            st.step(&mut states, k as f64 * dt, dt)?;
+        }
+        let wd = (1.0 - zeta * zeta).sqrt();
+        let exact = (-zeta * t_end).exp() * ((wd * t_end).cos() + zeta / wd * (wd * t_end).sin());
+        Ok((states[0][0] - exact).abs())
     })?
 }
 
