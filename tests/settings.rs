@@ -1,5 +1,5 @@
 //! forms/library.toml parses, and every scheme, contact law, material and mass matrix it names
-//! exists in the library.
+//! exists in the library (verify's reference schemes too).
 
 use signorini::cases::bar::MassChoice;
 use signorini::driver::{self, Setup};
@@ -19,9 +19,11 @@ fn library_settings_name_library_files() {
         known(scheme, contact);
         <MassChoice as clap::ValueEnum>::from_str(mass, true).unwrap_or_else(|e| panic!("mass `{mass}`: {e}"));
     }
-    for scheme in &s.verify.energy_conserving {
+    for scheme in s.verify.energy_conserving.iter().chain(&s.verify.references) {
         for contact in &s.verify.contacts {
             known(scheme, contact);
         }
     }
+    // The damping slot is a name no library form takes (verify binds it itself).
+    assert!(!s.verify.damping_slot.is_empty());
 }
