@@ -24,6 +24,6 @@ fn library_settings_name_library_files() {
             known(scheme, contact);
         }
     }
-    // The damping slot is a name no library form takes (verify binds it itself).
+    // verify binds the damping slot itself: it must be named.
     assert!(!s.verify.damping_slot.is_empty());
 }

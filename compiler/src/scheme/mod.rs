@@ -568,7 +568,10 @@ impl<'a> Compiler<'a> {
         let Some(unknown) = &st.unknown else {
             self.error(
                 Diagnostic::error("E0805", format!("stage `{name}` has no unknown"), at_span, "no `unknown` line")
-                    .with_help("`unknown u'` names the quantity Newton solves for"),
+                    .with_help(format!(
+                        "`unknown {}'` names the quantity Newton solves for",
+                        self.def.states.first().map_or("u", |s| s.name.as_str())
+                    )),
             );
             return None;
         };
@@ -1011,10 +1014,29 @@ impl<'a> Compiler<'a> {
                         e.span,
                         "not a form application",
                     )
-                    .with_help("write e.g. `mass(a') + stiffness(u') == load(t + dt)`"),
+                    .with_help(self.residual_help(e)),
                 );
                 None
             }
+        }
+    }
+
+    /// What a residual side should look like, in this scheme's own names: its slots applied to
+    /// its states' new levels (and the closest slot to a misspelt name).
+    fn residual_help(&self, e: &Expr) -> String {
+        let slots: Vec<&str> = self.def.uses.iter().map(|u| u.name.as_str()).collect();
+        if let ExprKind::Name(id) = &e.kind
+            && let Some(close) = crate::check::suggest_name(&id.name, slots.iter().copied())
+        {
+            return format!("did you mean the slot `{close}`, applied to a time level: `{close}(...)`?");
+        }
+        let state = self.def.states.first().map_or("u", |s| s.name.as_str());
+        match slots.first() {
+            Some(first) => format!(
+                "apply the slots of the `uses` line ({}) to time levels, e.g. `{first}({state}')`",
+                slots.join(", ")
+            ),
+            None => "name the forms the scheme applies in a `uses` line, and apply them to time levels".into(),
         }
     }
 
