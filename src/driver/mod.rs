@@ -352,8 +352,13 @@ impl ActiveForms {
         let mut slots: Vec<(&'static str, SlotForm<'m>, &'static str)> = Vec::new();
         for unit in &self.units {
             let values = self.params.unit_values(unit.params());
-            let made =
-                unit.make(&values, coefs, binding).map_err(|e| CaseError::Option(format!("{}: {e}", unit.file())))?;
+            let made = unit.make(&values, coefs, binding).map_err(|e| {
+                let hint = match &e {
+                    crate::runtime::library::LibraryError::MissingCoef { name, .. } => provided_coefs(coefs, name),
+                    _ => String::new(),
+                };
+                CaseError::Option(format!("{}: {e}{hint}", unit.file()))
+            })?;
             for (name, form) in made {
                 if let Some((_, _, other)) = slots.iter().find(|(n, _, _)| *n == name) {
                     return Err(CaseError::Option(format!(
@@ -366,6 +371,22 @@ impl ActiveForms {
         }
         Ok(Instance { slots })
     }
+}
+
+/// The coefs a case provides, among those the library's files declare, with the closest to
+/// `missing`: "; the case provides f, g, nc; did you mean `g`?".
+fn provided_coefs(coefs: &dyn Fn(&str) -> Option<Coef>, missing: &str) -> String {
+    let mut names: Vec<&str> =
+        LIBRARY.iter().filter_map(|u| u.forms).flat_map(|f| f.coefs.iter().map(|c| c.name)).collect();
+    names.sort_unstable();
+    names.dedup();
+    names.retain(|n| coefs(n).is_some());
+    if names.is_empty() {
+        return String::new();
+    }
+    let hint = crate::compiler::check::suggest_name(missing, names.iter().copied())
+        .map_or(String::new(), |s| format!("; did you mean `{s}`?"));
+    format!("; the case provides {}{hint}", names.join(", "))
 }
 
 /// The bound forms of a run, taken by slot name.

@@ -100,7 +100,8 @@ impl Interpreted {
         let params: Vec<(&str, f64)> = self.params.iter().map(|p| p.name).zip(values.iter().copied()).collect();
         let mut data = Vec::new();
         for name in self.lib.coefs() {
-            let c = coefs(name).ok_or_else(|| LibraryError::Coef(format!("the case provides no `{name}`")))?;
+            let c = coefs(name)
+                .ok_or_else(|| LibraryError::MissingCoef { name: leak(name.to_string()), declared: self.file })?;
             data.push((name, c));
         }
         let mut made = Vec::new();
