@@ -62,6 +62,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0819", "scheme: an unknown claim, or one that is not a function of the parameters"),
     ("W0001", "unused parameter (warning)"),
     ("W0002", "a scheme `let` hides another name (warning)"),
+    ("W0003", "a `fn` or `form` argument hides a name of the file (warning)"),
 ];
 
 /// The meaning of a diagnostic code, from [`CODES`].

@@ -172,6 +172,7 @@ pub fn check(sources: SourceMap, root: FileId, files: &[(FileId, ast::File)], mu
     };
     let broken: HashSet<String> = files.iter().flat_map(|(_, f)| f.broken_names.iter().cloned()).collect();
     declare(&mut prog, files, &mut diags);
+    shadowing(&prog, files, &mut diags);
     let used = {
         let mut c = types::Checker::new(&prog, &broken);
         let values = c.check_params();
@@ -214,6 +215,38 @@ pub fn check(sources: SourceMap, root: FileId, files: &[(FileId, ast::File)], mu
     } else {
         prog.warnings = diags;
         Ok(prog)
+    }
+}
+
+/// Arguments of a `fn` or a `form` named like a global of the unit (a param, a let, ...):
+/// inside, the argument wins, which is rarely what was meant. A warning at both.
+fn shadowing(prog: &Unit, files: &[(FileId, ast::File)], diags: &mut Vec<Diagnostic>) {
+    for (file, ast) in files {
+        if *file != prog.root {
+            continue;
+        }
+        for item in &ast.items {
+            let (what, args): (&str, Vec<&Ident>) = match item {
+                ast::Item::Fn { params, .. } => ("fn", params.iter().collect()),
+                ast::Item::Form { fields, test, .. } => ("form", fields.iter().chain(test).collect()),
+                _ => continue,
+            };
+            for a in args {
+                let Some(g) = prog.globals.get(&a.name) else { continue };
+                let at = g.span(&prog.params, &prog.coefs, &prog.forms);
+                let mut w = Diagnostic::warning(
+                    "W0003",
+                    format!("the {what} argument `{}` hides the {} `{}`", a.name, g.kind(), a.name),
+                    a.span,
+                    "this argument hides it",
+                )
+                .with_help(format!("rename the argument if `{}` should keep its meaning inside", a.name));
+                if at.end > at.start {
+                    w = w.with_label(at, "declared here");
+                }
+                diags.push(w);
+            }
+        }
     }
 }
 
