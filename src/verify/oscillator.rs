@@ -84,16 +84,7 @@ fn oscillator<R>(
 
 /// |u(T) − cos T| from u = 1, v = 0.
 pub fn oscillator_error(setup: &Setup, dt: f64, t_end: f64) -> Result<f64, CaseError> {
-    with_oscillator(setup, |st| -> Result<f64, CaseError> {
-        let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
-        states[0][0] = 1.0;
-        st.initialize(&mut states, 0.0)?;
-        let steps = (t_end / dt).round() as usize;
-        for k in 0..steps {
-            st.step(&mut states, k as f64 * dt, dt)?;
-        }
-        Ok((states[0][0] - t_end.cos()).abs())
-    })?
+    with_oscillator(setup, |st| final_displacement(st, dt, t_end))?.map(|u| (u - t_end.cos()).abs())
 }
 
 /// |u(T) − u_exact(T)| on ü + 2ζu̇ + u = 0 from u = 1, v = 0, with `slot` bound to 2ζM:
@@ -105,34 +96,43 @@ pub fn damped_oscillator_error(
     dt: f64,
     t_end: f64,
 ) -> Result<f64, CaseError> {
-    with_damped_oscillator(setup, (slot, zeta), |st| -> Result<f64, CaseError> {
-        let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
-        states[0][0] = 1.0;
-        st.initialize(&mut states, 0.0)?;
-        let steps = (t_end / dt).round() as usize;
-        for k in 0..steps {
-            st.step(&mut states, k as f64 * dt, dt)?;
-        }
-        let wd = (1.0 - zeta * zeta).sqrt();
-        let exact = (-zeta * t_end).exp() * ((wd * t_end).cos() + zeta / wd * (wd * t_end).sin());
-        Ok((states[0][0] - exact).abs())
-    })?
+    let wd = (1.0 - zeta * zeta).sqrt();
+    let exact = (-zeta * t_end).exp() * ((wd * t_end).cos() + zeta / wd * (wd * t_end).sin());
+    with_damped_oscillator(setup, (slot, zeta), |st| final_displacement(st, dt, t_end))?.map(|u| (u - exact).abs())
+}
+
+/// u(T) after steps of `dt` from u = 1, v = 0 and the scheme's initial problem.
+fn final_displacement(st: &mut Stepper, dt: f64, t_end: f64) -> Result<f64, CaseError> {
+    let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
+    states[0][0] = 1.0;
+    st.initialize(&mut states, 0.0)?;
+    let steps = (t_end / dt).round() as usize;
+    for k in 0..steps {
+        st.step(&mut states, k as f64 * dt, dt)?;
+    }
+    Ok(states[0][0])
 }
 
 /// Spectral radius of the one-step map of the oscillator's states at step `dt` (ω = 1).
 pub fn spectral_radius(setup: &Setup, dt: f64) -> Result<f64, CaseError> {
-    with_oscillator(setup, |st| -> Result<f64, CaseError> {
+    Ok(spectral_radius_of(&step_map(setup, dt)?))
+}
+
+/// The matrix of one step of the oscillator on the states (u, v, a, ...): column j is the step
+/// of the j-th unit state.
+pub fn step_map(setup: &Setup, dt: f64) -> Result<Vec<Vec<f64>>, CaseError> {
+    with_oscillator(setup, |st| -> Result<Vec<Vec<f64>>, CaseError> {
         let m = st.desc().states.len();
         let mut a = vec![vec![0.0; m]; m];
         for j in 0..m {
             let mut states: Vec<Vec<f64>> = (0..m).map(|_| vec![0.0; 2]).collect();
             states[j][0] = 1.0;
             st.step(&mut states, 0.0, dt)?;
-            for i in 0..m {
-                a[i][j] = states[i][0];
+            for (i, row) in a.iter_mut().enumerate() {
+                row[j] = states[i][0];
             }
         }
-        Ok(spectral_radius_of(&a))
+        Ok(a)
     })?
 }
 

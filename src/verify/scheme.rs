@@ -12,10 +12,8 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::oscillator::{
-    damped_oscillator_error, oscillator_energies, oscillator_error, spectral_radius, with_oscillator,
-};
-use super::time::{BAR_STEPS, BarOrder, OSCILLATOR_STEPS, bar_differences, last_order};
+use super::oscillator::{damped_oscillator_error, oscillator_energies, oscillator_error, spectral_radius, step_map};
+use super::time::{BAR_STEPS, BarOrder, OSCILLATOR_STEPS, bar_orders, last_order};
 use crate::cases::{CaseError, bar, disc};
 use crate::driver::{Active, Setup};
 use crate::plot::Curve;
@@ -140,15 +138,7 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
         Err(_) => (None, None),
     };
     progress(&format!("{scheme}: bar before impact"));
-    let bar_orders = crate::settings::get()
-        .verify
-        .contacts
-        .iter()
-        .map(|contact| {
-            let differences = bar_differences(&Setup { contact: contact.clone(), ..setup.clone() })?;
-            Ok(BarOrder { contact: contact.clone(), order: last_order(&differences), differences })
-        })
-        .collect::<Result<_, CaseError>>()?;
+    let bar_orders = bar_orders(setup)?;
     let before = bar::run(&bar::Options { setup: setup.clone(), t_end: 0.8, ..bar::Options::default() })?;
     let e0 = before.series[0].energy;
     let bar_energy_drift = before.series.iter().map(|r| (r.energy - e0).abs()).fold(0.0, f64::max) / e0;
@@ -241,24 +231,6 @@ fn spectrum(setup: &Setup) -> Result<Vec<SpectrumPoint>, CaseError> {
             Ok(SpectrumPoint { omega_dt: dt, rho, period_error })
         })
         .collect()
-}
-
-/// The matrix of one step of the oscillator on the states (u, v, a, ...), column j the step of
-/// the j-th unit state.
-fn step_map(setup: &Setup, dt: f64) -> Result<Vec<Vec<f64>>, CaseError> {
-    with_oscillator(setup, |st| -> Result<Vec<Vec<f64>>, CaseError> {
-        let m = st.desc().states.len();
-        let mut a = vec![vec![0.0; m]; m];
-        for j in 0..m {
-            let mut states: Vec<Vec<f64>> = (0..m).map(|_| vec![0.0; 2]).collect();
-            states[j][0] = 1.0;
-            st.step(&mut states, 0.0, dt)?;
-            for (i, row) in a.iter_mut().enumerate() {
-                row[j] = states[i][0];
-            }
-        }
-        Ok(a)
-    })?
 }
 
 impl SchemeVerification {

@@ -56,7 +56,7 @@ fn coarse_difference(a: &[bar::Row], b: &[bar::Row]) -> f64 {
 }
 
 /// The bar before impact: successive differences of the contact point's displacement.
-pub(crate) fn bar_differences(setup: &Setup) -> Result<Vec<(f64, f64)>, CaseError> {
+fn bar_differences(setup: &Setup) -> Result<Vec<(f64, f64)>, CaseError> {
     let runs: Vec<Vec<bar::Row>> = BAR_STEPS
         .iter()
         .map(|&dt| {
@@ -65,6 +65,19 @@ pub(crate) fn bar_differences(setup: &Setup) -> Result<Vec<(f64, f64)>, CaseErro
         })
         .collect::<Result<_, CaseError>>()?;
     Ok(runs.windows(2).zip(BAR_STEPS).map(|(w, dt)| (dt, coarse_difference(&w[0], &w[1]))).collect())
+}
+
+/// The bar's order before impact with each contact law of verify's list (forms/library.toml).
+pub fn bar_orders(setup: &Setup) -> Result<Vec<BarOrder>, CaseError> {
+    crate::settings::get()
+        .verify
+        .contacts
+        .iter()
+        .map(|contact| {
+            let differences = bar_differences(&Setup { contact: contact.clone(), ..setup.clone() })?;
+            Ok(BarOrder { contact: contact.clone(), order: last_order(&differences), differences })
+        })
+        .collect()
 }
 
 /// Orders and ρ∞ of every scheme of the library, with its default params.
@@ -78,15 +91,7 @@ pub fn orders(progress: &mut dyn FnMut(&str)) -> Result<Vec<TimeRow>, CaseError>
                 .iter()
                 .map(|&dt| Ok((dt, oscillator_error(&setup, dt, 10.0)?)))
                 .collect::<Result<_, CaseError>>()?;
-            let bar = crate::settings::get()
-                .verify
-                .contacts
-                .iter()
-                .map(|contact| {
-                    let differences = bar_differences(&Setup { contact: contact.clone(), ..setup.clone() })?;
-                    Ok(BarOrder { contact: contact.clone(), order: last_order(&differences), differences })
-                })
-                .collect::<Result<_, CaseError>>()?;
+            let bar = bar_orders(&setup)?;
             Ok(TimeRow {
                 scheme: scheme.into(),
                 oscillator_order: last_order(&oscillator),
