@@ -141,30 +141,39 @@ pub fn identity(case: &str, active: &Active, mesh: &Mesh, more: &[(&str, String)
     ];
     let params =
         active.forms.params.values().into_iter().map(|(name, p)| (format!("param {name}"), format!("{:?}", p.value)));
+    // A file run by path may be edited between the stop and the resume: its text counts.
+    let texts = active.interpreted().into_iter().map(|file| {
+        let text = std::fs::read(&file).map_or_else(|e| format!("unreadable ({e})"), |b| format!("{:016x}", fnv(&b)));
+        (format!("text of {file}"), text)
+    });
     common
         .into_iter()
         .chain(more.iter().map(|(k, v)| (*k, v.clone())))
         .map(|(k, v)| (k.to_string(), v))
         .chain(params)
+        .chain(texts)
         .collect()
 }
 
-/// The mesh's size and a hash of its coordinates (their bits) and cells.
+/// The mesh's size and a hash of its coordinates (their bits), cells and named regions.
 pub fn mesh_fingerprint(mesh: &Mesh) -> String {
-    // FNV-1a: stable across builds and platforms, unlike std's hasher.
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut eat = |x: u64| {
-        for b in x.to_le_bytes() {
-            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
-        }
-    };
+    let mut bytes = Vec::new();
     for i in 0..mesh.num_nodes() {
-        mesh.node(i).iter().for_each(|x| eat(x.to_bits()));
+        mesh.node(i).iter().for_each(|x| bytes.extend(x.to_bits().to_le_bytes()));
     }
     for c in 0..mesh.num_cells() {
-        mesh.cell(c).iter().for_each(|&n| eat(n as u64));
+        mesh.cell(c).iter().for_each(|&n| bytes.extend(n.to_le_bytes()));
     }
-    format!("of {} nodes and {} cells (hash {h:016x})", mesh.num_nodes(), mesh.num_cells())
+    for r in &mesh.regions {
+        bytes.extend(r.name.as_bytes());
+        r.facets.iter().for_each(|f| bytes.extend(f.cell.to_le_bytes().into_iter().chain([f.local])));
+    }
+    format!("of {} nodes and {} cells (hash {:016x})", mesh.num_nodes(), mesh.num_cells(), fnv(&bytes))
+}
+
+/// FNV-1a: stable across builds and platforms, unlike std's hasher.
+fn fnv(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
 }
 
 #[cfg(test)]

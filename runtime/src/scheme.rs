@@ -364,7 +364,6 @@ impl<'a> Stepper<'a> {
         Ok(Some(report))
     }
 
-    /// Advances `states` from t to t + dt.
     /// Drops the stages' factorizations, constant operators and loads: the next step runs as in
     /// a new stepper (see [`crate::newton::Newton::forget`]).
     pub fn forget(&mut self) {
@@ -375,6 +374,7 @@ impl<'a> Stepper<'a> {
         self.loads.clear();
     }
 
+    /// Advances `states` from t to t + dt.
     pub fn step(&mut self, states: &mut [Vec<f64>], t: f64, dt: f64) -> Result<StepReport, StepError> {
         self.step_observed(states, t, dt, &mut |_| {})
     }

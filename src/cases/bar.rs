@@ -131,6 +131,9 @@ pub struct Summary {
     /// Why the run ended before t_end, if it did (the series stops at the last good step).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stopped: Option<String>,
+    /// The checkpoint this run resumed from (its counters and wall time cover the rest only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub resumed: Option<crate::simulation::Resumed>,
     /// Why a metric is absent.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
@@ -313,6 +316,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         wall_seconds: start.elapsed().as_secs_f64(),
         step_cuts: outcome.cuts,
         stopped: outcome.stopped.as_ref().map(ToString::to_string),
+        resumed: outcome.resumed,
         notes: Vec::new(),
     };
     let mut summary = summary;

@@ -209,6 +209,9 @@ pub struct Summary {
     /// Why the run ended before t_end, if it did (the series stops at the last good step).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stopped: Option<String>,
+    /// The checkpoint this run resumed from (its counters and wall time cover the rest only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resumed: Option<crate::simulation::Resumed>,
 }
 
 pub struct Run {
@@ -453,6 +456,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         peak_memory_bytes: crate::bench::peak_memory(),
         step_cuts: outcome.cuts,
         stopped: outcome.stopped.as_ref().map(ToString::to_string),
+        resumed: outcome.resumed,
     };
     if let Some(dir) = &opts.out {
         write_outputs(dir, opts.body, &summary, &series, &stage_rows)?;

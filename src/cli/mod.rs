@@ -261,6 +261,19 @@ fn energy_growth(s: &str) -> Result<f64, String> {
 }
 
 impl MethodArgs {
+    /// Whether any choice of files or params was given.
+    fn given(&self) -> bool {
+        self.scheme.is_some()
+            || self.contact.is_some()
+            || self.material.is_some()
+            || !self.forms.is_empty()
+            || !self.params.is_empty()
+            || self.alpha.is_some()
+            || self.theta.is_some()
+            || self.gamma0.is_some()
+            || self.line_search
+    }
+
     fn setup(&self) -> Result<Setup, String> {
         let mut params = Vec::new();
         for (name, v) in [("alpha", self.alpha), ("theta", self.theta), ("gamma0", self.gamma0)] {
@@ -342,6 +355,9 @@ impl CheckpointArgs {
     fn out(&self, out: Option<PathBuf>) -> Result<Option<PathBuf>, String> {
         match &self.resume {
             Some(dir) => Ok(Some(dir.clone())),
+            None if self.checkpoint_every > 0 && out.is_none() => {
+                Err("--checkpoint-every needs --out DIR: the checkpoints go there".into())
+            }
             None => out_dir(out),
         }
     }
@@ -423,6 +439,9 @@ fn dispatch(cli: Cli) -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Verify { out, methods } if methods.scheme.is_some() => verify_scheme(&out, &methods),
+        Command::Verify { methods, .. } if methods.given() => fail(
+            "--contact, --material, --forms, --param, --alpha, --theta, --gamma0 and --line-search apply to `verify --scheme` only",
+        ),
         Command::Verify { out, .. } => match crate::verify::run(&mut |what| eprintln!("running {what}")) {
             Ok(v) => match v.write(&out) {
                 Ok(()) => {

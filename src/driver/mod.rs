@@ -261,24 +261,26 @@ impl Active {
     pub fn scheme_claims(&self) -> Result<Vec<(String, f64)>, CaseError> {
         use crate::compiler::{MemLoader, check_path};
         let name = self.scheme_name();
-        let compiled = match &self.scheme {
-            SchemeSource::Compiled(_) => {
-                let (stem, text) = crate::forms::SCHEME_SOURCES
-                    .iter()
-                    .find(|(stem, _)| *stem == name)
-                    .ok_or_else(|| CaseError::Option(format!("no source of the library scheme `{name}`")))?;
-                let path = format!("forms/schemes/{stem}.wf");
-                check_path(Path::new(&path), &MemLoader::default().with(&path, *text))
-            }
-            SchemeSource::Interpreted(i) => check_path(Path::new(&i.file), &sources::LibraryLoader),
+        let programs = match &self.scheme {
+            // The library file that declares it (a scheme compiled by a crate of its own has
+            // no source here: it claims nothing).
+            SchemeSource::Compiled(_) => crate::forms::SCHEME_SOURCES
+                .iter()
+                .filter(|(_, text)| text.contains(&format!("scheme {name}")))
+                .map(|(stem, text)| {
+                    let path = format!("forms/schemes/{stem}.wf");
+                    check_path(Path::new(&path), &MemLoader::default().with(&path, *text))
+                })
+                .collect::<Vec<_>>(),
+            SchemeSource::Interpreted(i) => vec![check_path(Path::new(&i.file), &sources::LibraryLoader)],
         };
-        let (program, _) = compiled.map_err(|f| CaseError::Option(f.rendered))?;
-        let ir = program
-            .schemes
-            .iter()
-            .find(|s| s.name == name)
-            .ok_or_else(|| CaseError::Option(format!("the scheme `{name}` is not in its file")))?;
-        Ok(ir.claims_at(&self.forms.params.scheme_values(self.scheme.params())))
+        for compiled in programs {
+            let (program, _) = compiled.map_err(|f| CaseError::Option(f.rendered))?;
+            if let Some(ir) = program.schemes.iter().find(|s| s.name == name) {
+                return Ok(ir.claims_at(&self.forms.params.scheme_values(self.scheme.params())));
+            }
+        }
+        Ok(Vec::new())
     }
 
     /// The forms the scheme applies, bound; errors name the slot's declaration.

@@ -287,7 +287,7 @@ impl<'m> Simulation<'m> {
     ) -> Result<Outcome, CaseError> {
         let stages = self.stepper.desc().stages;
         let intermediate: Vec<&str> = stages.iter().rev().skip(1).map(|s| s.name).collect();
-        let mut outcome = Outcome { step_seconds: Vec::with_capacity(steps), cuts: 0, stopped: None };
+        let mut outcome = Outcome { step_seconds: Vec::with_capacity(steps), cuts: 0, stopped: None, resumed: None };
         let mut bar = crate::progress::Progress::new(steps, progress);
         let guard = self.guard;
         let mut energy = EnergyWatch::new(&self.tools, &self.states, self.v_index);
@@ -306,8 +306,12 @@ impl<'m> Simulation<'m> {
             outcome.step_seconds.clone_from(&saved.step_seconds);
             energy =
                 EnergyWatch { initial: saved.energy_initial, u0: saved.energy_u0.clone(), work: saved.energy_work };
+            outcome.resumed = Some(Resumed { step: saved.steps_done, bit_for_bit: saved.periodic });
             stepper.forget();
         }
+        // Fault injection for the restart tests: the process aborts, as if killed, right after
+        // this accepted step (and its checkpoint, if one is due).
+        let crash_at: Option<usize> = std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok());
         'steps: for k in first..steps {
             bar.tick(k);
             let mut done: u64 = 0;
@@ -353,7 +357,10 @@ impl<'m> Simulation<'m> {
                 // A checkpoint after the last step would resume nothing.
                 let periodic = control.every > 0 && (k + 1).is_multiple_of(control.every) && k + 1 < steps;
                 let interrupted = crate::interrupt::requested();
-                let mut record = (done == full && (periodic || interrupted)).then(Vec::new);
+                // With periodic checkpoints an interrupt keeps the last one, which resumes bit
+                // for bit; without, it writes one of its own (which resumes to round-off).
+                let on_interrupt = interrupted && control.every == 0;
+                let mut record = (done == full && (periodic || on_interrupt)).then(Vec::new);
                 let step = Step { k: accepted, t: t_end, dt: h, states, before: &before, report: &report };
                 on_step(tools, &step, record.as_mut())?;
                 streak += 1;
@@ -389,10 +396,17 @@ impl<'m> Simulation<'m> {
                         states: states.to_vec(),
                         periodic: !interrupted,
                     };
-                    control.write(driver, record)?;
+                    if let Err(e) = control.write(driver, record) {
+                        // The outputs up to here are still written.
+                        outcome.stopped = Some(e);
+                        break 'steps;
+                    }
                     if !interrupted {
                         stepper.forget();
                     }
+                }
+                if crash_at == Some(accepted) {
+                    std::process::abort();
                 }
                 // An interrupt lets the nominal step finish, so that its checkpoint is on the
                 // nominal time levels.
@@ -419,6 +433,18 @@ pub struct Outcome {
     pub cuts: usize,
     /// Why the run stopped early, if it did (the observer has seen every step before).
     pub stopped: Option<CaseError>,
+    /// The checkpoint the run resumed from, if it did.
+    pub resumed: Option<Resumed>,
+}
+
+/// Where a resumed run started.
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
+pub struct Resumed {
+    /// Nominal steps done before.
+    pub step: usize,
+    /// From a periodic checkpoint (the bits of an uninterrupted run), or from one written on an
+    /// interrupt without periodic ones (agrees to round-off).
+    pub bit_for_bit: bool,
 }
 
 /// When a step may fail and how much energy a run may gain (`--max-step-cuts`,

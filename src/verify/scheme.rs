@@ -127,7 +127,7 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
     let others: Vec<&String> = settings.references.iter().filter(|r| **r != scheme).collect();
     let references = others
         .iter()
-        .map(|r| Ok((r.to_string(), spectrum(&Setup { scheme: r.to_string(), params: Vec::new(), ..setup.clone() })?)))
+        .map(|r| Ok((r.to_string(), spectrum(&reference(setup, r))?)))
         .collect::<Result<_, CaseError>>()?;
     let (energy_step_max, energy_drift) = match oscillator_energies(setup, 0.1, 1000) {
         Ok(e) => {
@@ -149,7 +149,7 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
     for name in names {
         let s = match name {
             None => setup.clone(),
-            Some(r) => Setup { scheme: r.to_string(), params: Vec::new(), ..setup.clone() },
+            Some(r) => reference(setup, r),
         };
         let label = name.map_or(scheme.clone(), |r| r.to_string());
         let b = bar::run(&bar::Options { setup: s.clone(), ..bar::Options::default() })?.summary;
@@ -183,7 +183,8 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
                 .chain(damped_order.map(|o| ("order (damped)".to_string(), o)))
                 .map(|(c, m)| (c, m, ORDER_TOLERANCE))
                 .collect(),
-            _ => vec![(claim.clone(), rho_infinity, RHO_TOLERANCE)],
+            "rho_inf" => vec![(claim.clone(), rho_infinity, RHO_TOLERANCE)],
+            other => return Err(CaseError::Option(format!("verify cannot measure the claim `{other}` yet"))),
         };
         for (name, m, tolerance) in measured {
             let holds = (m - claimed).abs() <= tolerance;
@@ -209,6 +210,21 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
         disc: disc_rows,
         verdicts,
     })
+}
+
+/// The setup with a reference scheme instead: the settings that apply to it (the form files'
+/// params, and scheme params of the same name) are kept.
+fn reference(setup: &Setup, scheme: &str) -> Setup {
+    let params = setup
+        .params
+        .iter()
+        .filter(|p| {
+            let probe = Setup { scheme: scheme.into(), params: vec![(*p).clone()], ..setup.clone() };
+            Active::resolve(&probe, &[]).is_ok()
+        })
+        .cloned()
+        .collect();
+    Setup { scheme: scheme.into(), params, ..setup.clone() }
 }
 
 /// The oscillator's one-step map over [`omega_dts`]: its spectral radius and the relative

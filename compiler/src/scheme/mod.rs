@@ -493,6 +493,7 @@ impl<'a> Compiler<'a> {
         if SCHEME_BUILTINS.contains(&name) {
             return Some((None, "the built-in".into()));
         }
+        // Schemes do not see the file's names, but a reader of the file may think so.
         let g = self.prog.globals.get(name)?;
         let span = g.span(&self.prog.params, &self.prog.coefs, &self.prog.forms);
         Some(((span.end > span.start).then_some(span), format!("the file's {}", g.kind())))
@@ -509,6 +510,12 @@ impl<'a> Compiler<'a> {
             .with_help(format!("rename the `let` if `{}` should keep its meaning", name.name));
             if let Some(at) = declared {
                 w = w.with_label(at, "declared here");
+            }
+            if what.starts_with("the file's") {
+                w = w.with_note(format!(
+                    "a scheme sees only its own names: inside it `{}` is this `let`, though a reader may take it for the file's",
+                    name.name
+                ));
             }
             self.warnings.push(w);
         }
