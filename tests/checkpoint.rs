@@ -1,7 +1,8 @@
-//! Checkpoint and restart of the disc (issue 13): a run killed at arbitrary moments and resumed
-//! from its periodic checkpoints writes the same series.csv, bit for bit, as an uninterrupted
-//! run with the same checkpoint period; an interrupted run writes complete outputs and a
-//! checkpoint, exits with 130, and resumes to round-off; a checkpoint of other options is
+//! Checkpoint and restart (issue 13): a run killed at arbitrary moments (or crashed around its
+//! step cuts) and resumed from its periodic checkpoints writes the same series.csv, bit for bit,
+//! as an uninterrupted run with the same checkpoint period; an interrupted run writes complete
+//! outputs and exits with 130, keeping its last periodic checkpoint (bit for bit) or, without
+//! periodic ones, writing one that resumes to round-off; a checkpoint of other options is
 //! refused.
 
 use std::path::{Path, PathBuf};
@@ -105,33 +106,54 @@ fn kill_and_resume(name: &str, run_args: &[&str]) {
 }
 
 #[test]
-fn an_interrupted_run_writes_its_outputs_and_a_checkpoint_it_resumes_from() {
-    let root = scratch("interrupt");
+fn an_interrupted_run_keeps_its_last_periodic_checkpoint_and_resumes_bit_for_bit() {
+    interrupt_and_resume("interrupt-periodic", "13", true);
+}
+
+#[test]
+fn an_interrupted_run_without_periodic_checkpoints_writes_one_that_resumes_to_round_off() {
+    interrupt_and_resume("interrupt-once", "0", false);
+}
+
+/// SIGINT once the run is stepping: exit 130 with complete outputs; then `--resume` completes
+/// the run, with the bits of the uninterrupted one (`exact`) or to round-off.
+fn interrupt_and_resume(name: &str, period: &str, exact: bool) {
+    let root = scratch(name);
+    let mut args: Vec<&str> = RUN.to_vec();
+    args[11] = period;
     let full = root.join("full");
-    let (code, err) = finish(spawn(&[&RUN[..], &["--out", full.to_str().unwrap()]].concat()));
+    let clock = Instant::now();
+    let (code, err) = finish(spawn(&[&args[..], &["--out", full.to_str().unwrap()]].concat()));
     assert_eq!(code, Some(0), "{err}");
+    let length = clock.elapsed();
     let run = root.join("run");
-    let mut child = spawn(&[&RUN[..], &["--out", run.to_str().unwrap()]].concat());
-    // Interrupt once the run has started stepping (its first checkpoint is written).
+    let mut child = spawn(&[&args[..], &["--out", run.to_str().unwrap()]].concat());
+    // Interrupt once the run is stepping: its first periodic checkpoint is written, or a third
+    // of the uninterrupted run's time has passed.
     let start = Instant::now();
-    while !run.join("checkpoint.bin").exists() && start.elapsed() < Duration::from_secs(60) {
+    while !(run.join("checkpoint.bin").exists() || (!exact && start.elapsed() > length / 3))
+        && start.elapsed() < Duration::from_secs(60)
+    {
         std::thread::sleep(Duration::from_millis(5));
     }
     // SAFETY: sending a signal to our own child.
     unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) };
     let status = child.wait().unwrap();
-    if status.code() == Some(0) {
-        eprintln!("the run ended before the interrupt arrived: nothing to check");
+    if status.code() == Some(0) || !run.join("checkpoint.bin").exists() {
+        eprintln!("the interrupt arrived before the first step or after the last: nothing to check");
         return;
     }
     assert_eq!(status.code(), Some(130));
     let rows = series(&run).lines().count();
     assert!(rows > 1 && rows <= series(&full).lines().count(), "{rows} rows after the interrupt");
     assert!(std::fs::read_to_string(run.join("summary.json")).unwrap().contains("interrupted"));
-    // Resuming completes the run; rows agree with the uninterrupted ones to round-off.
-    let (code, err) = finish(spawn(&[&RUN[..], &["--resume", run.to_str().unwrap()]].concat()));
+    let (code, err) = finish(spawn(&[&args[..], &["--resume", run.to_str().unwrap()]].concat()));
     assert_eq!(code, Some(0), "{err}");
     let (a, b) = (series(&full), series(&run));
+    if exact {
+        assert!(a == b, "series.csv differs after an interrupt and a resume from the periodic checkpoint");
+        return;
+    }
     assert_eq!(a.lines().count(), b.lines().count());
     for (x, y) in a.lines().zip(b.lines()).skip(1) {
         for (p, q) in x.split(',').zip(y.split(',')) {
