@@ -1,6 +1,9 @@
-//! Checkpoints of a time-stepping run: every state of the scheme, the step-size controller, the
-//! energy check and the case's own record of the run so far (series rows, snapshots written),
-//! in one file written atomically, `DIR/checkpoint.bin`.
+//! Checkpoints of a time-stepping run: every state of the scheme, the step-size controller and
+//! the energy check in `DIR/checkpoint.bin`, written atomically; the case's record of the run
+//! (series rows, snapshots written) in `DIR/checkpoint.log`, to which each checkpoint appends
+//! what is new since the last, so that a checkpoint costs the same at every step of a long run.
+//! checkpoint.bin says how much of the log it covers: a crash between the two writes leaves a
+//! longer log, cut back on resume.
 //!
 //! `--checkpoint-every N` writes one after every N-th step and drops the stepper's
 //! factorizations there; `--resume DIR` starts from DIR's checkpoint with none, so a resumed run
@@ -18,11 +21,12 @@ use crate::cases::CaseError;
 use crate::driver::Active;
 use crate::runtime::mesh::Mesh;
 
-/// The file in the output directory.
+/// The files in the output directory.
 pub const FILE: &str = "checkpoint.bin";
+pub const LOG: &str = "checkpoint.log";
 const MAGIC: &[u8; 8] = b"SIGNCKPT";
 /// The layout of the file; a checkpoint of another layout is refused.
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
 
 /// What a run must share with the checkpoint it resumes: (what, value) pairs, compared one by
 /// one so that a refusal names what differs.
@@ -39,7 +43,6 @@ pub struct DriverState {
     pub level: usize,
     pub streak: usize,
     pub cuts: usize,
-    pub step_seconds: Vec<f64>,
     /// The energy check: E(0), the largest work of the loads so far, u(0).
     pub energy_initial: f64,
     pub energy_work: f64,
@@ -54,8 +57,8 @@ struct File {
     program: String,
     identity: Identity,
     driver: DriverState,
-    /// The case's record of the run so far, in its own layout.
-    observer: Vec<u8>,
+    /// Bytes of checkpoint.log this checkpoint covers.
+    log_len: u64,
 }
 
 /// When and where a run writes checkpoints, and the one it resumes.
@@ -66,20 +69,37 @@ pub struct Control {
     /// The output directory (no checkpoints without one).
     pub dir: Option<PathBuf>,
     pub identity: Identity,
-    /// The checkpoint the run resumes: the driver's part (taken by the driver) and the case's.
-    pub resume: Option<(DriverState, Vec<u8>)>,
+    /// The checkpoint the run resumes: the driver's part (taken by the driver) and the case's
+    /// records, one per checkpoint so far, in order.
+    pub resume: Option<(DriverState, Vec<Vec<u8>>)>,
+    /// Whether this run has started its log (a new run empties an old one at its first write).
+    pub log_started: bool,
 }
 
 impl Control {
-    /// The case's record saved in the checkpoint being resumed, if any.
-    pub fn observer(&self) -> Option<&[u8]> {
+    /// The case's records in the checkpoint being resumed (one per checkpoint), if any.
+    pub fn observer(&self) -> Option<&[Vec<u8>]> {
         self.resume.as_ref().map(|(_, o)| o.as_slice())
     }
 
-    /// Writes `dir`/checkpoint.bin atomically (a no-op without an output directory).
-    pub fn write(&self, driver: DriverState, observer: Vec<u8>) -> Result<(), CaseError> {
+    /// Appends the case's `record` (what is new since the last checkpoint) to checkpoint.log,
+    /// then writes checkpoint.bin atomically (a no-op without an output directory).
+    pub fn write(&mut self, driver: DriverState, record: Vec<u8>) -> Result<(), CaseError> {
+        use std::io::Write;
         let Some(dir) = &self.dir else { return Ok(()) };
-        let file = File { program: program(), identity: self.identity.clone(), driver, observer };
+        let log = dir.join(LOG);
+        let log_error = |source| CaseError::Write { path: log.display().to_string(), source };
+        std::fs::create_dir_all(dir).map_err(log_error)?;
+        let mut f = std::fs::OpenOptions::new().create(true).append(true).open(&log).map_err(log_error)?;
+        if !self.log_started {
+            f.set_len(0).map_err(log_error)?;
+            self.log_started = true;
+        }
+        f.write_all(&(record.len() as u64).to_le_bytes()).map_err(log_error)?;
+        f.write_all(&record).map_err(log_error)?;
+        f.sync_data().map_err(log_error)?;
+        let log_len = f.metadata().map_err(log_error)?.len();
+        let file = File { program: program(), identity: self.identity.clone(), driver, log_len };
         let mut bytes = MAGIC.to_vec();
         bytes.extend_from_slice(&FORMAT.to_le_bytes());
         bytes.extend(postcard::to_stdvec(&file).map_err(|e| write_error(dir, std::io::Error::other(e)))?);
@@ -96,8 +116,9 @@ fn program() -> String {
     format!("signorini {}", env!("CARGO_PKG_VERSION"))
 }
 
-/// Reads `dir`/checkpoint.bin and checks it against the run's `identity`.
-pub fn read(dir: &Path, identity: &Identity) -> Result<(DriverState, Vec<u8>), CaseError> {
+/// Reads `dir`/checkpoint.bin and the part of checkpoint.log it covers (cutting the log back to
+/// it), and checks it against the run's `identity`.
+pub fn read(dir: &Path, identity: &Identity) -> Result<(DriverState, Vec<Vec<u8>>), CaseError> {
     let path = dir.join(FILE);
     let refuse = |why: String| CaseError::Option(format!("cannot resume from {}: {why}", path.display()));
     let bytes = std::fs::read(&path).map_err(|e| refuse(e.to_string()))?;
@@ -125,7 +146,29 @@ pub fn read(dir: &Path, identity: &Identity) -> Result<(DriverState, Vec<u8>), C
     if let Some((what, _)) = file.identity.iter().find(|(w, _)| !identity.iter().any(|(v, _)| v == w)) {
         return Err(refuse(format!("it records {what}, which this run does not have")));
     }
-    Ok((file.driver, file.observer))
+    let log = dir.join(LOG);
+    let bytes = std::fs::read(&log).map_err(|e| refuse(format!("{}: {e}", log.display())))?;
+    let covered = usize::try_from(file.log_len).ok().filter(|&n| n <= bytes.len());
+    let Some(covered) = covered else {
+        return Err(refuse(format!("{} is shorter than the checkpoint says", log.display())));
+    };
+    let mut records = Vec::new();
+    let mut at = 0;
+    while at < covered {
+        let len = bytes.get(at..at + 8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")) as usize);
+        let Some(record) = len.and_then(|n| bytes.get(at + 8..at + 8 + n)).filter(|_| at + 8 <= covered) else {
+            return Err(refuse(format!("{} is damaged", log.display())));
+        };
+        records.push(record.to_vec());
+        at += 8 + record.len();
+    }
+    // What a crash appended after the checkpoint is dropped: the resumed run redoes it.
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&log)
+        .and_then(|f| f.set_len(covered as u64))
+        .map_err(|e| refuse(format!("{}: {e}", log.display())))?;
+    Ok((file.driver, records))
 }
 
 /// What a resumed run must share with its checkpoint: the case, the scheme, the files and every
@@ -187,7 +230,6 @@ mod tests {
             level: 1,
             streak: 0,
             cuts: 1,
-            step_seconds: vec![0.1; 4],
             energy_initial: 1.5,
             energy_work: 0.0,
             energy_u0: vec![0.0, 1.0],
@@ -203,12 +245,21 @@ mod tests {
     #[test]
     fn a_checkpoint_reads_back_bit_for_bit_and_refuses_another_run() {
         let dir = std::env::temp_dir().join(format!("signorini-checkpoint-{}", std::process::id()));
-        let control = Control { every: 3, dir: Some(dir.clone()), identity: ident("0.02"), resume: None };
+        let mut control =
+            Control { every: 3, dir: Some(dir.clone()), identity: ident("0.02"), resume: None, log_started: false };
         control.write(driver(), vec![7, 8, 9]).unwrap();
+        control.write(driver(), vec![10]).unwrap();
+        // A record appended by a run that crashed before its checkpoint.bin: cut on resume.
+        std::fs::OpenOptions::new()
+            .append(true)
+            .open(dir.join(LOG))
+            .and_then(|mut f| std::io::Write::write_all(&mut f, &[1, 0, 0, 0, 0, 0, 0, 0, 11]))
+            .unwrap();
         let (d, o) = read(&dir, &ident("0.02")).unwrap();
+        assert_eq!(std::fs::metadata(dir.join(LOG)).unwrap().len(), 8 + 3 + 8 + 1);
         let bits = |s: &DriverState| s.states.iter().flatten().map(|x| x.to_bits()).collect::<Vec<u64>>();
         assert_eq!(bits(&d), bits(&driver()));
-        assert_eq!((d.steps_done, d.accepted, d.level, d.cuts, o), (3, 4, 1, 1, vec![7, 8, 9]));
+        assert_eq!((d.steps_done, d.accepted, d.level, d.cuts, o), (3, 4, 1, 1, vec![vec![7, 8, 9], vec![10]]));
         let e = read(&dir, &ident("0.01")).unwrap_err().to_string();
         assert!(e.contains("written with dt 0.02; this run has dt 0.01"), "{e}");
         // A truncated file is refused, not half read.

@@ -209,10 +209,12 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
             ],
         ),
         resume: None,
+        log_started: false,
     };
     if opts.resume {
         let dir = opts.out.as_ref().ok_or_else(|| CaseError::Option("resuming needs the run's directory".into()))?;
         control.resume = Some(crate::checkpoint::read(dir, &control.identity)?);
+        control.log_started = true;
     }
     let mut sim = Simulation::new(&asm, problem, active)?;
     let redistributed = opts.mass == MassChoice::Redistributed;
@@ -246,12 +248,18 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let mut errors = Errors::default();
     errors.track(&sim.tools, &mesh, &sim.states[0], &series[0]);
     let mut t = 0.0;
-    if let Some(bytes) = control.observer() {
-        let record: Record = postcard::from_bytes(bytes)
-            .map_err(|e| CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})")))?;
-        series = record.series.into_iter().map(|(row, p1)| Row { p1, ..row }).collect();
-        errors = record.errors;
+    // Rows the checkpoints so far hold (each records the rows new since the one before).
+    let mut saved_rows = 0;
+    if let Some(records) = control.observer() {
+        series.clear();
+        for bytes in records {
+            let record: Record = postcard::from_bytes(bytes)
+                .map_err(|e| CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})")))?;
+            series.extend(record.series.into_iter().map(|(row, p1)| Row { p1, ..row }));
+            errors = record.errors;
+        }
         t = series.last().map_or(0.0, |r| r.t);
+        saved_rows = series.len();
     }
     let v_index = sim.v_index;
     let outcome =
@@ -277,10 +285,11 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
             series.push(row);
             if let Some(record) = record {
                 *record = postcard::to_stdvec(&Record {
-                    series: series.iter().map(|r| (r.clone(), r.p1)).collect(),
+                    series: series[saved_rows..].iter().map(|r| (r.clone(), r.p1)).collect(),
                     errors: errors.clone(),
                 })
                 .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
+                saved_rows = series.len();
             }
             Ok(())
         })?;
@@ -359,8 +368,8 @@ impl Errors {
     }
 }
 
-/// The bar's record of the run in a checkpoint: the rows (with P, which series.csv leaves out)
-/// and the error sums.
+/// The bar's record in a checkpoint: the rows new since the checkpoint before (with P, which
+/// series.csv leaves out) and the error sums so far.
 #[derive(Serialize, Deserialize)]
 struct Record {
     series: Vec<(Row, f64)>,

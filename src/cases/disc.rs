@@ -301,10 +301,12 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         dir: opts.out.clone(),
         identity: identity(opts, active, &mesh),
         resume: None,
+        log_started: false,
     };
     if opts.resume {
         let dir = opts.out.as_ref().ok_or_else(|| CaseError::Option("resuming needs the run's directory".into()))?;
         control.resume = Some(crate::checkpoint::read(dir, &control.identity)?);
+        control.log_started = true;
     }
     let mut sim = Simulation::new(&asm, problem, active)?;
     if sim.tools.probe.is_none() {
@@ -359,19 +361,26 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     let v_index = sim.v_index;
     // Multi-stage schemes: the state at each intermediate stage's time (stages.csv).
     let stage_rows: RefCell<Vec<StageRow>> = RefCell::new(Vec::new());
+    // What the checkpoints so far hold (each records what is new since the one before).
+    let (mut saved_rows, mut saved_stages, mut saved_snapshots) = (0, 0, 0);
     match control.observer() {
-        Some(bytes) => {
+        Some(records) => {
             let stages = sim.stepper.desc().stages;
-            let record: Record = postcard::from_bytes(bytes)
-                .map_err(|e| CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})")))?;
-            series = record.series.into_iter().map(Saved::into_row).collect();
-            for (name, row) in record.stages {
-                let stage = stages.iter().find(|s| s.name == name).ok_or_else(|| {
-                    CaseError::Option(format!("the checkpoint has a stage `{name}`, which this scheme has not"))
-                })?;
-                stage_rows.borrow_mut().push(StageRow { stage: stage.name, row: row.into_row() });
+            series.clear();
+            for bytes in records {
+                let record: Record = postcard::from_bytes(bytes)
+                    .map_err(|e| CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})")))?;
+                series.extend(record.series.into_iter().map(Saved::into_row));
+                for (name, row) in record.stages {
+                    let stage = stages.iter().find(|s| s.name == name).ok_or_else(|| {
+                        CaseError::Option(format!("the checkpoint has a stage `{name}`, which this scheme has not"))
+                    })?;
+                    stage_rows.borrow_mut().push(StageRow { stage: stage.name, row: row.into_row() });
+                }
+                snapshots.extend_written(record.snapshots);
             }
-            snapshots.resume(record.snapshots);
+            (saved_rows, saved_stages, saved_snapshots) =
+                (series.len(), stage_rows.borrow().len(), snapshots.written().len());
         }
         None => snapshots.write(
             &sim.tools,
@@ -405,12 +414,14 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
                 &velocity(step.states, v_index, step.before, step.dt),
             )?;
             if let Some(record) = record {
+                let stages = stage_rows.borrow();
                 *record = postcard::to_stdvec(&Record {
-                    series: series.iter().map(Saved::of).collect(),
-                    stages: stage_rows.borrow().iter().map(|s| (s.stage.to_string(), Saved::of(&s.row))).collect(),
-                    snapshots: snapshots.written().to_vec(),
+                    series: series[saved_rows..].iter().map(Saved::of).collect(),
+                    stages: stages[saved_stages..].iter().map(|s| (s.stage.to_string(), Saved::of(&s.row))).collect(),
+                    snapshots: snapshots.written()[saved_snapshots..].to_vec(),
                 })
                 .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
+                (saved_rows, saved_stages, saved_snapshots) = (series.len(), stages.len(), snapshots.written().len());
             }
             Ok(())
         },
@@ -467,7 +478,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
     Ok(Run { summary, series, stages: stage_rows })
 }
 
-/// The disc's record of the run in a checkpoint.
+/// The disc's record in a checkpoint: what is new since the checkpoint before.
 #[derive(Serialize, Deserialize)]
 struct Record {
     series: Vec<Saved>,

@@ -303,7 +303,6 @@ impl<'m> Simulation<'m> {
             states.clone_from_slice(&saved.states);
             (first, accepted, level, streak) = (saved.steps_done, saved.accepted, saved.level, saved.streak);
             outcome.cuts = saved.cuts;
-            outcome.step_seconds.clone_from(&saved.step_seconds);
             energy =
                 EnergyWatch { initial: saved.energy_initial, u0: saved.energy_u0.clone(), work: saved.energy_work };
             outcome.resumed = Some(Resumed { step: saved.steps_done, bit_for_bit: saved.periodic });
@@ -389,7 +388,6 @@ impl<'m> Simulation<'m> {
                         level,
                         streak,
                         cuts: outcome.cuts,
-                        step_seconds: outcome.step_seconds.clone(),
                         energy_initial: energy.initial,
                         energy_work: energy.work,
                         energy_u0: energy.u0.clone(),
@@ -427,7 +425,7 @@ pub type OnStep<'a> = dyn FnMut(&Tools, &Step, Option<&mut Vec<u8>>) -> Result<(
 
 /// How a run ended.
 pub struct Outcome {
-    /// Wall time of each accepted step.
+    /// Wall time of each accepted step (of this process: not those before a resume).
     pub step_seconds: Vec<f64>,
     /// Step halvings after a failed Newton.
     pub cuts: usize,
@@ -587,9 +585,9 @@ impl Snapshots {
         &self.written
     }
 
-    /// Continues a run whose earlier snapshots are these.
-    pub fn resume(&mut self, written: Vec<(f64, String)>) {
-        self.written = written;
+    /// Adds snapshots an earlier part of the run wrote.
+    pub fn extend_written(&mut self, written: Vec<(f64, String)>) {
+        self.written.extend(written);
     }
 
     /// Writes the collection `dir`/NAME.pvd (if any snapshot was written).
