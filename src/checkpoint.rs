@@ -73,10 +73,23 @@ pub struct Control {
     /// records, one per checkpoint so far, in order.
     pub resume: Option<(DriverState, Vec<Vec<u8>>)>,
     /// Whether this run has started its log (a new run empties an old one at its first write).
-    pub log_started: bool,
+    log_started: bool,
 }
 
 impl Control {
+    /// Checkpoints every `every` steps into `dir` for a run of this `identity`; with `resume`,
+    /// the run continues from `dir`'s checkpoint (read and checked here).
+    pub fn new(every: usize, dir: Option<PathBuf>, identity: Identity, resume: bool) -> Result<Control, CaseError> {
+        let mut control = Control { every, dir, identity, resume: None, log_started: false };
+        if resume {
+            let dir =
+                control.dir.as_ref().ok_or_else(|| CaseError::Option("resuming needs the run's directory".into()))?;
+            control.resume = Some(read(dir, &control.identity)?);
+            control.log_started = true;
+        }
+        Ok(control)
+    }
+
     /// The case's records in the checkpoint being resumed (one per checkpoint), if any.
     pub fn observer(&self) -> Option<&[Vec<u8>]> {
         self.resume.as_ref().map(|(_, o)| o.as_slice())
@@ -245,8 +258,7 @@ mod tests {
     #[test]
     fn a_checkpoint_reads_back_bit_for_bit_and_refuses_another_run() {
         let dir = std::env::temp_dir().join(format!("signorini-checkpoint-{}", std::process::id()));
-        let mut control =
-            Control { every: 3, dir: Some(dir.clone()), identity: ident("0.02"), resume: None, log_started: false };
+        let mut control = Control::new(3, Some(dir.clone()), ident("0.02"), false).unwrap();
         control.write(driver(), vec![7, 8, 9]).unwrap();
         control.write(driver(), vec![10]).unwrap();
         // A record appended by a run that crashed before its checkpoint.bin: cut on resume.

@@ -192,30 +192,20 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         mass: opts.mass,
         newton: opts.newton,
     };
-    let mut control = Control {
-        every: opts.checkpoint_every,
-        dir: opts.out.clone(),
-        identity: crate::checkpoint::identity(
-            "bar",
-            active,
-            &mesh,
-            &[
-                ("mass", format!("{:?}", opts.mass)),
-                ("cell size", format!("{:?}", opts.cell_size)),
-                ("dt", format!("{:?}", opts.dt)),
-                ("t_end", format!("{:?}", opts.t_end)),
-                ("Newton options", format!("{:?}", opts.newton)),
-                ("checkpoint period", opts.checkpoint_every.to_string()),
-            ],
-        ),
-        resume: None,
-        log_started: false,
-    };
-    if opts.resume {
-        let dir = opts.out.as_ref().ok_or_else(|| CaseError::Option("resuming needs the run's directory".into()))?;
-        control.resume = Some(crate::checkpoint::read(dir, &control.identity)?);
-        control.log_started = true;
-    }
+    let identity = crate::checkpoint::identity(
+        "bar",
+        active,
+        &mesh,
+        &[
+            ("mass", format!("{:?}", opts.mass)),
+            ("cell size", format!("{:?}", opts.cell_size)),
+            ("dt", format!("{:?}", opts.dt)),
+            ("t_end", format!("{:?}", opts.t_end)),
+            ("Newton options", format!("{:?}", opts.newton)),
+            ("checkpoint period", opts.checkpoint_every.to_string()),
+        ],
+    );
+    let mut control = Control::new(opts.checkpoint_every, opts.out.clone(), identity, opts.resume)?;
     let mut sim = Simulation::new(&asm, problem, active)?;
     let redistributed = opts.mass == MassChoice::Redistributed;
     // Initial state: u₀ = (1 − x)/2, v₀ = 0, a₀ from the scheme's initial problem.

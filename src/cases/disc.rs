@@ -296,18 +296,8 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         mass: opts.mass,
         newton: opts.newton,
     };
-    let mut control = Control {
-        every: opts.checkpoint_every,
-        dir: opts.out.clone(),
-        identity: identity(opts, active, &mesh),
-        resume: None,
-        log_started: false,
-    };
-    if opts.resume {
-        let dir = opts.out.as_ref().ok_or_else(|| CaseError::Option("resuming needs the run's directory".into()))?;
-        control.resume = Some(crate::checkpoint::read(dir, &control.identity)?);
-        control.log_started = true;
-    }
+    let mut control =
+        Control::new(opts.checkpoint_every, opts.out.clone(), identity(opts, active, &mesh), opts.resume)?;
     let mut sim = Simulation::new(&asm, problem, active)?;
     if sim.tools.probe.is_none() {
         return Err(CaseError::Option(

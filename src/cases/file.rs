@@ -14,6 +14,7 @@ use super::bar::{self, MassChoice};
 use super::disc;
 use crate::driver::{self, Setting, Setup};
 use crate::runtime::mesh::CellSize;
+use crate::simulation::MAX_STEP_CUTS;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -187,8 +188,10 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
         guard: crate::simulation::Guard {
             max_step_cuts: match &parsed.max_step_cuts {
                 None => d.guard.max_step_cuts,
-                Some(s) if (0..=40).contains(s.get_ref()) => *s.get_ref() as usize,
-                Some(s) => return Err(r.error(s, "max_step_cuts", format!("{} is not in 0..=40", s.get_ref()))),
+                Some(s) if (0..=MAX_STEP_CUTS as i64).contains(s.get_ref()) => *s.get_ref() as usize,
+                Some(s) => {
+                    return Err(r.error(s, "max_step_cuts", format!("{} is not in 0..={MAX_STEP_CUTS}", s.get_ref())));
+                }
             },
             max_energy_growth: r.number(
                 &parsed.max_energy_growth,

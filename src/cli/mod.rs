@@ -120,7 +120,7 @@ pub enum Command {
         a: PathBuf,
         b: PathBuf,
         /// Fail (exit 1) when a column's relative difference exceeds this.
-        #[arg(long, value_parser = energy_growth)]
+        #[arg(long, value_parser = non_negative)]
         tol: Option<f64>,
     },
     /// Print a compilation stage of a .wf file.
@@ -235,7 +235,7 @@ pub struct MethodArgs {
     max_step_cuts: usize,
     /// Stop when ½uᵀKu + ½vᵀMv exceeds this many times its initial value plus the loads' work
     /// (0: never).
-    #[arg(long, default_value_t = 10.0, value_parser = energy_growth)]
+    #[arg(long, default_value_t = 10.0, value_parser = non_negative)]
     max_energy_growth: f64,
     /// Backtracking line search in Newton (halving the step while ‖R‖ does not decrease).
     #[arg(long)]
@@ -244,15 +244,16 @@ pub struct MethodArgs {
 
 /// `--max-step-cuts`: the range the case files accept too.
 fn step_cuts(s: &str) -> Result<usize, String> {
+    use crate::simulation::MAX_STEP_CUTS;
     match s.trim().parse::<i64>() {
-        Ok(n) if (0..=40).contains(&n) => Ok(n as usize),
-        Ok(n) => Err(format!("{n} is not in 0..=40")),
+        Ok(n) if (0..=MAX_STEP_CUTS as i64).contains(&n) => Ok(n as usize),
+        Ok(n) => Err(format!("{n} is not in 0..={MAX_STEP_CUTS}")),
         Err(_) => Err(format!("`{s}` is not a whole number")),
     }
 }
 
 /// `--max-energy-growth` (0: off) and `--tol`: a number ≥ 0.
-fn energy_growth(s: &str) -> Result<f64, String> {
+fn non_negative(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(x) if x >= 0.0 && x.is_finite() => Ok(x),
         Ok(x) => Err(format!("{x} is not 0 or a positive number")),

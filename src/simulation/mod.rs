@@ -293,7 +293,7 @@ impl<'m> Simulation<'m> {
         let mut energy = EnergyWatch::new(&self.tools, &self.states, self.v_index);
         let Simulation { stepper, tools, states, v_index, params, .. } = self;
         // Progress through a nominal step in units of dt / 2^max_cuts.
-        let max_cuts = guard.max_step_cuts.min(40);
+        let max_cuts = guard.max_step_cuts.min(MAX_STEP_CUTS);
         let full: u64 = 1 << max_cuts;
         let (mut level, mut streak, mut accepted, mut first) = (0usize, 0usize, 0usize, 0usize);
         if let Some((saved, _)) = &control.resume {
@@ -444,6 +444,10 @@ pub struct Resumed {
     /// interrupt without periodic ones (agrees to round-off).
     pub bit_for_bit: bool,
 }
+
+/// Most halvings of a step (`--max-step-cuts`, `max_step_cuts`): Δt/2⁴⁰ is below any use, and
+/// the step's progress is counted in units of Δt/2^cuts.
+pub const MAX_STEP_CUTS: usize = 40;
 
 /// When a step may fail and how much energy a run may gain (`--max-step-cuts`,
 /// `--max-energy-growth`).

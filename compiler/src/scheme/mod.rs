@@ -98,6 +98,14 @@ pub struct SchemeIr {
     pub claims: Vec<(String, NodeId)>,
 }
 
+/// A declaration a scheme `let` hides (W0002).
+struct Hidden {
+    span: Option<Span>,
+    what: String,
+    /// A name of the file, which the scheme does not see.
+    of_the_file: bool,
+}
+
 /// The properties a scheme may claim, and what each means.
 pub const CLAIMS: &[(&str, &str)] =
     &[("order", "the order of accuracy in time"), ("rho_inf", "the spectral radius of the one-step map as ωΔt → ∞")];
@@ -479,39 +487,44 @@ impl<'a> Compiler<'a> {
         out
     }
 
-    /// The declaration a `let` named `name` (declared at `at`) would hide: where, and what.
-    fn shadowed(&self, name: &str, at: Span) -> Option<(Option<Span>, String)> {
+    /// The declaration a `let` named `name` (declared at `at`) would hide, if any.
+    fn shadowed(&self, name: &str, at: Span) -> Option<Hidden> {
+        let mine = |span: Option<Span>, what: &str| Some(Hidden { span, what: what.into(), of_the_file: false });
         if let Some(p) = self.def.params.iter().find(|p| p.name.name == name) {
-            return Some((Some(p.name.span), "the scheme's parameter".into()));
+            return mine(Some(p.name.span), "the scheme's parameter");
         }
         if let Some(s) = self.def.states.iter().find(|s| s.name == name) {
-            return Some((Some(s.span), "the state".into()));
+            return mine(Some(s.span), "the state");
         }
         if let Some((n, _)) = self.def.lets.iter().find(|(n, _)| n.name == name && n.span.start < at.start) {
-            return Some((Some(n.span), "the scheme's `let`".into()));
+            return mine(Some(n.span), "the scheme's `let`");
         }
         if SCHEME_BUILTINS.contains(&name) {
-            return Some((None, "the built-in".into()));
+            return mine(None, "the built-in");
         }
         // Schemes do not see the file's names, but a reader of the file may think so.
         let g = self.prog.globals.get(name)?;
         let span = g.span(&self.prog.params, &self.prog.coefs, &self.prog.forms);
-        Some(((span.end > span.start).then_some(span), format!("the file's {}", g.kind())))
+        Some(Hidden {
+            span: (span.end > span.start).then_some(span),
+            what: format!("the file's {}", g.kind()),
+            of_the_file: true,
+        })
     }
 
     fn bind_let(&mut self, name: &Ident, value: &Expr) {
-        if let Some((declared, what)) = self.shadowed(&name.name, name.span) {
+        if let Some(hidden) = self.shadowed(&name.name, name.span) {
             let mut w = Diagnostic::warning(
                 "W0002",
-                format!("`{}` hides {what} `{}`", name.name, name.name),
+                format!("`{}` hides {} `{}`", name.name, hidden.what, name.name),
                 name.span,
                 "this `let` hides it",
             )
             .with_help(format!("rename the `let` if `{}` should keep its meaning", name.name));
-            if let Some(at) = declared {
+            if let Some(at) = hidden.span {
                 w = w.with_label(at, "declared here");
             }
-            if what.starts_with("the file's") {
+            if hidden.of_the_file {
                 w = w.with_note(format!(
                     "a scheme sees only its own names: inside it `{}` is this `let`, though a reader may take it for the file's",
                     name.name
