@@ -18,6 +18,7 @@ macro_rules! dispatch {
 }
 
 pub mod assembly;
+pub mod block_factor;
 pub mod element;
 pub mod evaluate;
 pub mod geometry;

@@ -13,6 +13,7 @@ use faer::sparse::linalg::lu::{self, LuRef, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
+use crate::block_factor::BlockFactor;
 use crate::pattern::Pattern;
 
 /// Supernodal Cholesky only when the factorization does more than 3·40 flops per entry of L
@@ -23,6 +24,32 @@ const SUPERNODAL_THRESHOLD: faer::sparse::linalg::SupernodalThreshold = faer::sp
 
 /// Stored entries from which a matrix–vector product is split over threads.
 const PARALLEL_NNZ: usize = 1 << 20;
+
+/// The approximate-minimum-degree ordering of the pattern's node graph, each node's dofs kept
+/// together and in order (so that the Cholesky factor is made of node blocks): the dof at each
+/// position of the elimination, and the inverse permutation.
+pub(crate) fn node_ordering(pattern: &Pattern) -> Result<(Vec<usize>, Vec<usize>), LinalgError> {
+    use faer::sparse::linalg::amd;
+    let nodes = pattern.num_nodes();
+    let mut col_ptr = Vec::with_capacity(nodes + 1);
+    col_ptr.push(0);
+    let mut row_idx = Vec::new();
+    for j in 0..nodes {
+        row_idx.extend(pattern.neighbours(j).iter().map(|&i| i as usize));
+        col_ptr.push(row_idx.len());
+    }
+    let graph = SymbolicSparseColMatRef::new_checked(nodes, nodes, &col_ptr, None, &row_idx);
+    let (mut perm, mut inverse) = (vec![0usize; nodes], vec![0usize; nodes]);
+    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(nodes, row_idx.len()))
+        .map_err(|_| LinalgError::Other("out of memory".into()))?;
+    amd::order(&mut perm, &mut inverse, graph, Default::default(), MemStack::new(&mut mem))
+        .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
+    let d = pattern.dim();
+    let order: Vec<usize> = perm.iter().flat_map(|&node| (0..d).map(move |m| node * d + m)).collect();
+    let mut inverse = vec![0; order.len()];
+    order.iter().enumerate().for_each(|(k, &i)| inverse[i] = k);
+    Ok((order, inverse))
+}
 
 /// A square sparse matrix in compressed-column form over a shared pattern.
 #[derive(Clone, Debug)]
@@ -238,8 +265,19 @@ impl Solver {
 enum Factors {
     None,
     Krylov(Box<crate::krylov::Krylov>),
-    Llt { symbolic: Arc<SymbolicCholesky<usize>>, values: Vec<f64>, factored: bool },
-    Lu { symbolic: Arc<SymbolicLu<usize>>, numeric: Box<NumericLu<usize, f64>>, factored: bool },
+    /// faer's factor, and its copy in node blocks that the solves use (faer's values are then
+    /// dropped until the next factorization).
+    Llt {
+        symbolic: Arc<SymbolicCholesky<usize>>,
+        values: Vec<f64>,
+        block: Option<BlockFactor>,
+        factored: bool,
+    },
+    Lu {
+        symbolic: Arc<SymbolicLu<usize>>,
+        numeric: Box<NumericLu<usize, f64>>,
+        factored: bool,
+    },
 }
 
 /// A reusable sparse factorization.
@@ -306,21 +344,18 @@ impl Factorization {
         if !same_pattern {
             self.factors = match self.structure {
                 Structure::SymmetricPositiveDefinite => {
+                    let (order, inverse) = node_ordering(&a.pattern)?;
                     let symbolic = cholesky::factorize_symbolic_cholesky(
                         sym,
                         Side::Lower,
-                        Default::default(),
+                        cholesky::SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(&order, &inverse, n)),
                         cholesky::CholeskySymbolicParams {
                             supernodal_flop_ratio_threshold: SUPERNODAL_THRESHOLD,
                             ..Default::default()
                         },
                     )
                     .map_err(|e| LinalgError::Other(format!("{e:?}")))?;
-                    Factors::Llt {
-                        values: vec![0.0; symbolic.len_val()],
-                        symbolic: Arc::new(symbolic),
-                        factored: false,
-                    }
+                    Factors::Llt { values: Vec::new(), symbolic: Arc::new(symbolic), block: None, factored: false }
                 }
                 Structure::General | Structure::Auto => {
                     let symbolic = lu::factorize_symbolic_lu(sym, Default::default())
@@ -335,8 +370,10 @@ impl Factorization {
         let par = self.par;
         self.counters.numeric += 1;
         match &mut self.factors {
-            Factors::Llt { symbolic, values, factored } => {
+            Factors::Llt { symbolic, values, block, factored } => {
                 *factored = false;
+                *block = None;
+                values.resize(symbolic.len_val(), 0.0);
                 let req = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
                 let mut mem = MemBuffer::try_new(req).map_err(|_| LinalgError::Other("out of memory".into()))?;
                 symbolic
@@ -354,6 +391,10 @@ impl Factorization {
                             LinalgError::NotPositiveDefinite { index }
                         }
                     })?;
+                *block = BlockFactor::new(symbolic, values, a.pattern.dim());
+                if block.is_some() {
+                    *values = Vec::new();
+                }
                 *factored = true;
             }
             Factors::Lu { symbolic, numeric, factored } => {
@@ -380,7 +421,7 @@ impl Factorization {
     pub fn fork(&self) -> Factorization {
         let factors = match &self.factors {
             Factors::Llt { symbolic, .. } => {
-                Factors::Llt { symbolic: symbolic.clone(), values: vec![0.0; symbolic.len_val()], factored: false }
+                Factors::Llt { symbolic: symbolic.clone(), values: Vec::new(), block: None, factored: false }
             }
             Factors::Lu { symbolic, .. } => {
                 Factors::Lu { symbolic: symbolic.clone(), numeric: Box::new(NumericLu::new()), factored: false }
@@ -401,7 +442,16 @@ impl Factorization {
     /// Stored values of the Cholesky factor L, if that is what was computed.
     pub fn factor_nnz(&self) -> Option<usize> {
         match &self.factors {
+            Factors::Llt { block: Some(b), factored: true, .. } => Some(b.nnz()),
             Factors::Llt { symbolic, factored: true, .. } => Some(symbolic.len_val()),
+            _ => None,
+        }
+    }
+
+    /// The Cholesky factor in node blocks, if that is what the last factorization computed.
+    pub fn block(&self) -> Option<&BlockFactor> {
+        match &self.factors {
+            Factors::Llt { block: Some(b), factored: true, .. } => Some(b),
             _ => None,
         }
     }
@@ -418,7 +468,13 @@ impl Factorization {
         let par = self.par;
         let rhs = MatMut::from_column_major_slice_mut(b, n, ncols);
         match &self.factors {
-            Factors::Llt { symbolic, values, factored: true } => {
+            Factors::Llt { block: Some(block), factored: true, .. } => {
+                let mut work = Vec::with_capacity(n);
+                for x in b.chunks_exact_mut(n.max(1)) {
+                    block.solve_in_place(x, &mut work);
+                }
+            }
+            Factors::Llt { symbolic, values, factored: true, .. } => {
                 let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(ncols, par));
                 LltRef::new(symbolic, values).solve_in_place_with_conj(Conj::No, rhs, par, MemStack::new(&mut mem));
             }
