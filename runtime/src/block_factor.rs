@@ -115,6 +115,11 @@ impl BlockFactor {
         self.order.len()
     }
 
+    /// Dofs per node (the block size).
+    pub fn dim(&self) -> usize {
+        self.d
+    }
+
     /// Stored entries of L (the diagonal blocks' lower triangles and the blocks below).
     pub fn nnz(&self) -> usize {
         let nodes = self.ptr.len() - 1;

@@ -141,7 +141,15 @@ impl Matrix {
         rows.binary_search(&i).map_or(0.0, |k| self.values[p.col_ptr[j] + k])
     }
 
-    /// Frobenius norm.
+    /// ‖A‖∞, the largest row sum of |a_ij|.
+    pub fn norm_inf(&self) -> f64 {
+        let mut rows = vec![0.0f64; self.size()];
+        for (&i, v) in self.pattern.row_idx.iter().zip(&self.values) {
+            rows[i] += v.abs();
+        }
+        rows.into_iter().fold(0.0, f64::max)
+    }
+
     /// Whether |a_ij − a_ji| ≤ tol·max|a| for every stored entry.
     pub fn is_symmetric(&self, tol: f64) -> bool {
         let scale = self.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -154,6 +162,7 @@ impl Matrix {
         })
     }
 
+    /// Frobenius norm.
     pub fn frobenius(&self) -> f64 {
         self.values.iter().map(|v| v * v).sum::<f64>().sqrt()
     }
@@ -490,6 +499,17 @@ impl Factorization {
             _ => return Err(LinalgError::NotFactored),
         }
         self.counters.solves += ncols;
+        if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(LinalgError::Singular { index: None }) }
+    }
+
+    /// Solves `A x = b` in place with the Cholesky factor in node blocks, applying `between` to
+    /// L⁻¹ b (in elimination order) before the backward pass (see `lowrank`).
+    pub fn solve_split_in_place(&mut self, b: &mut [f64], between: impl FnOnce(&mut [f64])) -> Result<(), LinalgError> {
+        let Factors::Llt { block: Some(block), factored: true, .. } = &self.factors else {
+            return Err(LinalgError::NotFactored);
+        };
+        block.solve_with(b, &mut Vec::with_capacity(b.len()), between);
+        self.counters.solves += 1;
         if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(LinalgError::Singular { index: None }) }
     }
 

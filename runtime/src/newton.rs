@@ -140,6 +140,10 @@ pub struct Newton {
     previous: Option<Reference>,
     /// Counters of factorizations no longer kept.
     retired: crate::linalg::Counters,
+    /// ‖J‖∞ of the current operator, for the round-off of its solves, and their relative
+    /// accuracy once known (0 for Cholesky without correction: backward stable).
+    jacobian_norm: f64,
+    solve_accuracy: Option<f64>,
 }
 
 /// A factored Jacobian, its correction towards the current one, and the correction's cost so far.
@@ -164,12 +168,15 @@ impl Newton {
             force_refactor: false,
             previous: None,
             retired: Default::default(),
+            jacobian_norm: f64::INFINITY,
+            solve_accuracy: None,
         }
     }
 
     /// Forgets the factorization's validity (the linear part of the problem changed).
     pub fn invalidate(&mut self) {
         self.factored_for = None;
+        self.solve_accuracy = None;
         self.low_rank = None;
         self.overhead = 0;
         self.force_refactor = false;
@@ -203,12 +210,13 @@ impl Newton {
         }
     }
 
-    /// The factor's mean column count c = nnz(L)/n. A solve pair reads 16·n·c bytes, a
-    /// factorization does about n·c² flops (c/2 solve pairs' worth), and a correction of size k
-    /// reads 8·n·k bytes per solve (k/2c solve pairs): so a correction is worth it while
-    /// k ≲ c, and until the corrections since the factorization have cost c/2 solve pairs
-    /// (Σ k ≈ c²). Measured with `bench disc` (c = 79 on its 12 490-unknown mesh, where 64 beat
-    /// 256 as a fixed limit) and `bench sphere` (c = 740 at 14 739 unknowns).
+    /// The factor's mean column count c = nnz(L)/n. A solve pair reads 2·n·c values and a
+    /// factorization does about n·c² flops (c/2 solve pairs' worth). A correction reads
+    /// `LowRank::entries` more values per solve (k·n for k dense columns; with the factor in node
+    /// blocks, the columns of W = L⁻¹U are sparse, about 0.07·n each on the disc): it is
+    /// accepted while it reads at most what the factor does (k ≲ c for dense columns), while its
+    /// k×k system costs no more than a factorization (k³ ≲ n·c²), and until the corrections
+    /// since the factorization have read c/2 solve pairs' worth (Σ entries ≈ n·c²).
     fn mean_column_count(&self, n: usize) -> Option<usize> {
         let nnz = self.factorization.as_ref().and_then(Factorization::factor_nnz)?;
         Some(nnz / n.max(1))
@@ -216,8 +224,15 @@ impl Newton {
 
     /// Largest correction size accepted instead of a refactorization.
     fn rank_limit(&self, n: usize) -> usize {
-        let c = self.mean_column_count(n).unwrap_or(0);
-        self.options.max_rank.min(c.max(32)).min(self.column_limit(n))
+        let c = self.mean_column_count(n).unwrap_or(0).max(32);
+        let sparse = self.factorization.as_ref().is_some_and(|f| f.block().is_some());
+        let k = if sparse { ((n * c * c) as f64).cbrt() as usize } else { c };
+        self.options.max_rank.min(k).min(self.column_limit(n))
+    }
+
+    /// Values a correction may read per solve.
+    fn entries_limit(&self, n: usize) -> usize {
+        self.mean_column_count(n).unwrap_or(0).max(32) * n
     }
 
     /// Columns the corrections may cache in all (current and previous reference).
@@ -231,9 +246,15 @@ impl Newton {
         current + self.previous.as_ref().and_then(|r| r.low_rank.as_ref()).map_or(0, LowRank::cached)
     }
 
-    /// Σ of correction sizes over solves that costs as much as a refactorization.
+    /// Σ of values read by corrections over solves after which the reference is refactored:
+    /// with dense columns, what a refactorization costs. Sparse columns are never refactored
+    /// away: their cost per solve is bounded by `entries_limit` and `rank_limit`, and a
+    /// reference refactored at one contact state is as far from the next (bench disc).
     fn overhead_budget(&self, n: usize) -> usize {
-        self.mean_column_count(n).unwrap_or(0).max(32).pow(2)
+        if self.factorization.as_ref().is_some_and(|f| f.block().is_some()) {
+            return usize::MAX;
+        }
+        self.mean_column_count(n).unwrap_or(0).max(32).pow(2) * n
     }
 
     /// Stored values of the current Cholesky factor, if there is one.
@@ -292,39 +313,56 @@ impl Newton {
                     Err(source) => return Err(NewtonError::Linear { source, report }),
                 }
                 self.factored_for = piecewise.then(|| set.clone());
+                self.jacobian_norm = self.jacobian.as_ref().map_or(f64::INFINITY, Matrix::norm_inf);
+                self.solve_accuracy = self.exact_solves().then_some(0.0);
             }
             delta.iter_mut().zip(&r).for_each(|(d, ri)| *d = -ri);
             let f = self.factorization.as_mut().expect("factored above");
-            if let Err(source) = f.solve_in_place(&mut delta) {
+            let solved = match &self.low_rank {
+                Some(lr) => lr.solve(f, &mut delta),
+                None => f.solve_in_place(&mut delta),
+            };
+            if let Err(source) = solved {
                 return Err(NewtonError::Linear { source, report });
             }
             if let Some(lr) = &self.low_rank {
-                lr.correct(&mut delta);
-                self.overhead += lr.rank();
+                self.overhead = self.overhead.saturating_add(lr.entries());
                 self.force_refactor = self.overhead > self.overhead_budget(n);
             }
-            // A (numerically) singular Jacobian still yields numbers: check that the step
-            // solves the linear system. J δ + R is small for any usable factorization.
+            // A Cholesky solve without correction is backward stable: J δ = −R + e with e at
+            // round-off, so the product J δ is not needed. Any other solve may be inaccurate (a
+            // correction of an ill-conditioned size, an LU of a numerically singular Jacobian, an
+            // iterative solve): the first solve with a new direct operator is checked, and its
+            // relative error (times 10) taken for the operator's; iterative solves always are.
+            let trusted = if piecewise && !self.options.line_search { self.solve_accuracy } else { None };
             let j = self.jacobian.as_ref().expect("assembled above");
-            // Aᵀ δ reads half the bytes, but only a problem declared symmetric is sure to stay so
-            // (under Structure::Auto a corrected Cholesky reference may meet a nonsymmetric J).
-            if p.structure() == Structure::SymmetricPositiveDefinite {
-                j.mul_vec_transposed(&delta, &mut jd);
+            let linear = if trusted.is_some() {
+                0.0
             } else {
-                j.mul_vec(&delta, &mut jd);
-            }
-            let linear = jd.iter().zip(&r).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(&r);
+                // Aᵀ δ reads half the bytes, but only a problem declared symmetric is sure to stay
+                // so (under Structure::Auto a corrected Cholesky reference may meet a nonsymmetric J).
+                if p.structure() == Structure::SymmetricPositiveDefinite {
+                    j.mul_vec_transposed(&delta, &mut jd);
+                } else {
+                    j.mul_vec(&delta, &mut jd);
+                }
+                jd.iter().zip(&r).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(&r)
+            };
             if linear.is_nan() || linear > LINEAR_TOLERANCE {
                 if self.low_rank.as_ref().is_some_and(|lr| lr.rank() > 0) {
                     // An ill-conditioned correction: refactor at this iterate and retry.
                     debug!(linear_residual = linear, "low-rank correction inaccurate: refactoring");
                     self.force_refactor = true;
                     self.factored_for = None;
+                    self.solve_accuracy = None;
                     continue;
                 }
                 let source = LinalgError::Singular { index: None };
                 debug!(linear_residual = linear, "the Jacobian is singular to working precision");
                 return Err(NewtonError::Linear { source, report });
+            }
+            if trusted.is_none() && self.factorization.as_ref().is_some_and(Factorization::is_direct) {
+                self.solve_accuracy = Some(10.0 * linear);
             }
             let step = if piecewise && !self.options.line_search {
                 // R is affine wherever the active set is the one J was built for: if it still
@@ -333,10 +371,19 @@ impl Newton {
                 let mut after = Vec::with_capacity(set.len());
                 p.active_set(w, &mut after);
                 let kept = after == set;
-                if kept {
+                // After a trusted solve R there is the solve's error: its relative accuracy
+                // times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
+                let bound = trusted.map(|a| a * norm_inf(&r) + ROUNDOFF * self.jacobian_norm * norm_inf(&delta));
+                let estimated = kept && bound.is_some_and(|b| b <= threshold);
+                if estimated {
+                    res = bound.expect("trusted");
+                } else if kept && trusted.is_none() {
                     r.iter_mut().zip(&jd).for_each(|(ri, x)| *ri += x);
                 } else {
                     p.residual(w, &mut r);
+                }
+                if !estimated {
+                    res = norm_inf(&r);
                 }
                 small_step = kept && norm_inf(&delta) <= self.options.tol * norm_inf(w);
                 next = Some(after);
@@ -346,9 +393,9 @@ impl Newton {
                 let mut after = Vec::with_capacity(set.len());
                 p.active_set(w, &mut after);
                 small_step = after == set && step * norm_inf(&delta) <= self.options.tol * norm_inf(w);
+                res = norm_inf(&r);
                 step
             };
-            res = norm_inf(&r);
             debug!(iteration = report.history.len() + 1, residual = res, active, refactor, updated, step, "newton");
             report.history.push(Iteration { residual: res, active, refactored: refactor, updated, step });
             if !res.is_finite() || w.iter().any(|x| !x.is_finite()) {
@@ -356,6 +403,16 @@ impl Newton {
             }
         }
         Ok(report)
+    }
+
+    /// Whether a solve with the current operator is a Cholesky solve without correction
+    /// (backward stable: its residual is round-off of ‖J‖‖δ‖).
+    fn exact_solves(&self) -> bool {
+        self.low_rank.as_ref().is_none_or(|lr| lr.rank() == 0)
+            && self
+                .factorization
+                .as_ref()
+                .is_some_and(|f| f.is_direct() && f.structure() == Structure::SymmetricPositiveDefinite)
     }
 
     /// Makes the operator the Jacobian at w: a low-rank correction of the factored reference
@@ -386,11 +443,15 @@ impl Newton {
             let updated = dofs.len() <= self.rank_limit(j.size())
                 && self.cached_columns() + new_columns <= self.column_limit(j.size())
                 && match (self.low_rank.as_mut(), self.factorization.as_mut()) {
-                    (Some(lr), Some(f)) => lr.update(&j, dofs, f).is_ok(),
+                    (Some(lr), Some(f)) => {
+                        lr.update(&j, dofs, f).is_ok() && lr.entries() <= self.entries_limit(j.size())
+                    }
                     _ => false,
                 };
             self.jacobian = Some(j);
             if updated {
+                let lr = self.low_rank.as_ref().expect("updated");
+                debug!(rank = lr.rank(), entries = lr.entries(), cached = lr.cached(), "low-rank update");
                 self.updates += 1;
                 return Ok(false);
             }
