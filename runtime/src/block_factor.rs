@@ -55,7 +55,7 @@ impl BlockFactor {
         // Each node's dofs consecutive, in order.
         if order
             .chunks_exact(d)
-            .any(|c| c[0] as usize % d != 0 || c.iter().enumerate().any(|(m, &i)| i != c[0] + m as u32))
+            .any(|c| !(c[0] as usize).is_multiple_of(d) || c.iter().enumerate().any(|(m, &i)| i != c[0] + m as u32))
         {
             return None;
         }

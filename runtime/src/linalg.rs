@@ -169,17 +169,20 @@ impl Matrix {
 
     /// Imposes `x_i = given` on the listed dofs: zeroes their rows and columns and puts `diag`
     /// on the diagonal, keeping the matrix symmetric (the right-hand side is the caller's).
-    pub fn constrain(&mut self, dofs: &[usize], is_fixed: &[bool], diag: f64) {
+    /// Touches only the listed dofs' columns and rows (the pattern is symmetric).
+    pub fn constrain(&mut self, dofs: &[usize], diag: f64) {
         let p = self.pattern.clone();
-        for j in 0..p.size() {
-            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
-                let i = p.row_idx[k];
-                if is_fixed[i] || is_fixed[j] {
-                    self.values[k] = if i == j { diag } else { 0.0 };
+        for &i in dofs {
+            for k in p.col_ptr[i]..p.col_ptr[i + 1] {
+                let j = p.row_idx[k];
+                self.values[k] = if i == j { diag } else { 0.0 };
+                if i != j {
+                    let rows = &p.row_idx[p.col_ptr[j]..p.col_ptr[j + 1]];
+                    let at = rows.binary_search(&i).expect("symmetric pattern");
+                    self.values[p.col_ptr[j] + at] = 0.0;
                 }
             }
         }
-        debug_assert!(dofs.iter().all(|&d| is_fixed[d]));
     }
 }
 
@@ -298,6 +301,8 @@ pub struct Factorization {
     pattern: Option<Arc<Pattern>>,
     par: Par,
     pub counters: Counters,
+    /// The solves' vector in elimination order (kept between solves).
+    work: Vec<f64>,
 }
 
 impl Factorization {
@@ -310,6 +315,7 @@ impl Factorization {
             pattern: None,
             par: Par::Seq,
             counters: Counters::default(),
+            work: Vec::new(),
         }
     }
 
@@ -445,6 +451,7 @@ impl Factorization {
             pattern,
             par: self.par,
             counters: Counters::default(),
+            work: Vec::new(),
         }
     }
 
@@ -478,9 +485,8 @@ impl Factorization {
         let rhs = MatMut::from_column_major_slice_mut(b, n, ncols);
         match &self.factors {
             Factors::Llt { block: Some(block), factored: true, .. } => {
-                let mut work = Vec::with_capacity(n);
                 for x in b.chunks_exact_mut(n.max(1)) {
-                    block.solve_in_place(x, &mut work);
+                    block.solve_in_place(x, &mut self.work);
                 }
             }
             Factors::Llt { symbolic, values, factored: true, .. } => {
@@ -508,7 +514,7 @@ impl Factorization {
         let Factors::Llt { block: Some(block), factored: true, .. } = &self.factors else {
             return Err(LinalgError::NotFactored);
         };
-        block.solve_with(b, &mut Vec::with_capacity(b.len()), between);
+        block.solve_with(b, &mut self.work, between);
         self.counters.solves += 1;
         if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(LinalgError::Singular { index: None }) }
     }

@@ -85,6 +85,12 @@ impl LowRank {
         self.dofs.len()
     }
 
+    /// ‖E‖∞ of the current correction: ‖J‖∞ ≤ ‖J₀‖∞ + ‖E‖∞.
+    pub fn change_norm(&self) -> f64 {
+        let k = self.dofs.len();
+        self.e.chunks_exact(k.max(1)).map(|row| row.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max)
+    }
+
     /// Values a solve reads beyond the factor's: the current correction's columns.
     pub fn entries(&self) -> usize {
         self.column_entries
@@ -173,7 +179,8 @@ impl LowRank {
         let lu = m.partial_piv_lu();
         let u = lu.U();
         let scale = (0..k).map(|i| u[(i, i)].abs()).fold(0.0f64, f64::max);
-        if (0..k).any(|i| !(u[(i, i)].abs() > 1e-14 * scale)) {
+        // A vanishing or NaN pivot.
+        if (0..k).any(|i| u[(i, i)].abs().partial_cmp(&(1e-14 * scale)) != Some(std::cmp::Ordering::Greater)) {
             return Err(LinalgError::Singular { index: None });
         }
         self.column_entries = match &self.columns {

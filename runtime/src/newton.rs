@@ -144,6 +144,20 @@ pub struct Newton {
     /// accuracy once known (0 for Cholesky without correction: backward stable).
     jacobian_norm: f64,
     solve_accuracy: Option<f64>,
+    /// ‖J₀‖∞ of the factored reference (a bound on ‖J‖∞ is this plus the correction's).
+    reference_norm: f64,
+    scratch: Scratch,
+}
+
+/// Newton's vectors, kept between solves.
+#[derive(Default)]
+struct Scratch {
+    r: Vec<f64>,
+    delta: Vec<f64>,
+    jd: Vec<f64>,
+    /// The active set the step starts from, and the one at its end.
+    set: Vec<bool>,
+    after: Vec<bool>,
 }
 
 /// A factored Jacobian, its correction towards the current one, and the correction's cost so far.
@@ -151,6 +165,8 @@ struct Reference {
     factorization: Option<Factorization>,
     low_rank: Option<LowRank>,
     overhead: usize,
+    /// ‖J₀‖∞.
+    norm: f64,
 }
 
 impl Newton {
@@ -170,6 +186,8 @@ impl Newton {
             retired: Default::default(),
             jacobian_norm: f64::INFINITY,
             solve_accuracy: None,
+            reference_norm: f64::INFINITY,
+            scratch: Scratch::default(),
         }
     }
 
@@ -207,6 +225,7 @@ impl Newton {
             std::mem::swap(&mut self.factorization, &mut prev.factorization);
             std::mem::swap(&mut self.low_rank, &mut prev.low_rank);
             std::mem::swap(&mut self.overhead, &mut prev.overhead);
+            std::mem::swap(&mut self.reference_norm, &mut prev.norm);
         }
     }
 
@@ -273,13 +292,28 @@ impl Newton {
 
     /// Solves R(w) = 0 starting from `w`, which holds the solution on success.
     pub fn solve(&mut self, p: &mut impl NonlinearProblem, w: &mut [f64]) -> Result<NewtonReport, NewtonError> {
+        // The vectors live from one solve (time step) to the next.
+        let mut scratch = std::mem::take(&mut self.scratch);
         let n = w.len();
-        let mut r = vec![0.0; n];
-        let mut delta = vec![0.0; n];
-        let mut jd = vec![0.0; n];
-        let mut set = Vec::new();
-        p.residual(w, &mut r);
-        let r0 = norm_inf(&r);
+        for v in [&mut scratch.r, &mut scratch.delta, &mut scratch.jd] {
+            v.resize(n, 0.0);
+        }
+        let result = self.solve_with(p, w, &mut scratch);
+        self.scratch = scratch;
+        result
+    }
+
+    fn solve_with(
+        &mut self,
+        p: &mut impl NonlinearProblem,
+        w: &mut [f64],
+        scratch: &mut Scratch,
+    ) -> Result<NewtonReport, NewtonError> {
+        let n = w.len();
+        let Scratch { r, delta, jd, set, after } = scratch;
+        let (r, delta, jd) = (r.as_mut_slice(), delta.as_mut_slice(), jd.as_mut_slice());
+        p.residual(w, r);
+        let r0 = norm_inf(r);
         let mut report = NewtonReport { initial_residual: r0, history: Vec::new() };
         if !r0.is_finite() {
             return Err(NewtonError::NonFinite { report });
@@ -290,21 +324,22 @@ impl Newton {
         let threshold = (self.options.tol * r0).max(floor);
         let mut res = r0;
         let mut piecewise = false;
-        let mut next: Option<Vec<bool>> = None;
+        // The active set at the iterate, when the last step found it.
+        let mut known = false;
         let mut small_step = false;
         while !converged(res, floor, threshold, !report.history.is_empty(), small_step) {
             if report.history.len() >= self.options.max_iterations {
                 return Err(NewtonError::IterationLimit { report, threshold });
             }
-            match next.take() {
-                Some(known) => set = known,
-                None => {
-                    set.clear();
-                    piecewise = p.active_set(w, &mut set);
-                }
+            if known {
+                std::mem::swap(set, after);
+            } else {
+                set.clear();
+                piecewise = p.active_set(w, set);
             }
+            known = false;
             let active = set.iter().filter(|b| **b).count();
-            let changed = !piecewise || self.force_refactor || self.factored_for.as_deref() != Some(&set);
+            let changed = !piecewise || self.force_refactor || self.factored_for.as_deref() != Some(set.as_slice());
             let (mut refactor, mut updated) = (false, false);
             if changed {
                 self.factored_for = None;
@@ -313,14 +348,20 @@ impl Newton {
                     Err(source) => return Err(NewtonError::Linear { source, report }),
                 }
                 self.factored_for = piecewise.then(|| set.clone());
-                self.jacobian_norm = self.jacobian.as_ref().map_or(f64::INFINITY, Matrix::norm_inf);
+                self.jacobian_norm = match (updated, &self.low_rank) {
+                    (true, Some(lr)) => self.reference_norm + lr.change_norm(),
+                    _ => {
+                        self.reference_norm = self.jacobian.as_ref().map_or(f64::INFINITY, Matrix::norm_inf);
+                        self.reference_norm
+                    }
+                };
                 self.solve_accuracy = self.exact_solves().then_some(0.0);
             }
-            delta.iter_mut().zip(&r).for_each(|(d, ri)| *d = -ri);
+            delta.iter_mut().zip(r.iter()).for_each(|(d, ri)| *d = -ri);
             let f = self.factorization.as_mut().expect("factored above");
             let solved = match &self.low_rank {
-                Some(lr) => lr.solve(f, &mut delta),
-                None => f.solve_in_place(&mut delta),
+                Some(lr) => lr.solve(f, delta),
+                None => f.solve_in_place(delta),
             };
             if let Err(source) = solved {
                 return Err(NewtonError::Linear { source, report });
@@ -342,11 +383,11 @@ impl Newton {
                 // Aᵀ δ reads half the bytes, but only a problem declared symmetric is sure to stay
                 // so (under Structure::Auto a corrected Cholesky reference may meet a nonsymmetric J).
                 if p.structure() == Structure::SymmetricPositiveDefinite {
-                    j.mul_vec_transposed(&delta, &mut jd);
+                    j.mul_vec_transposed(delta, jd);
                 } else {
-                    j.mul_vec(&delta, &mut jd);
+                    j.mul_vec(delta, jd);
                 }
-                jd.iter().zip(&r).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(&r)
+                jd.iter().zip(r.iter()).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(r)
             };
             if linear.is_nan() || linear > LINEAR_TOLERANCE {
                 if self.low_rank.as_ref().is_some_and(|lr| lr.rank() > 0) {
@@ -367,33 +408,33 @@ impl Newton {
             let step = if piecewise && !self.options.line_search {
                 // R is affine wherever the active set is the one J was built for: if it still
                 // is at the new iterate, R there is R + J δ, and no assembly is needed.
-                w.iter_mut().zip(&delta).for_each(|(x, d)| *x += d);
-                let mut after = Vec::with_capacity(set.len());
-                p.active_set(w, &mut after);
+                w.iter_mut().zip(delta.iter()).for_each(|(x, d)| *x += d);
+                after.clear();
+                p.active_set(w, after);
                 let kept = after == set;
                 // After a trusted solve R there is the solve's error: its relative accuracy
                 // times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
-                let bound = trusted.map(|a| a * norm_inf(&r) + ROUNDOFF * self.jacobian_norm * norm_inf(&delta));
+                let bound = trusted.map(|a| a * norm_inf(r) + ROUNDOFF * self.jacobian_norm * norm_inf(delta));
                 let estimated = kept && bound.is_some_and(|b| b <= threshold);
                 if estimated {
                     res = bound.expect("trusted");
                 } else if kept && trusted.is_none() {
-                    r.iter_mut().zip(&jd).for_each(|(ri, x)| *ri += x);
+                    r.iter_mut().zip(jd.iter()).for_each(|(ri, x)| *ri += x);
                 } else {
-                    p.residual(w, &mut r);
+                    p.residual(w, r);
                 }
                 if !estimated {
-                    res = norm_inf(&r);
+                    res = norm_inf(r);
                 }
-                small_step = kept && norm_inf(&delta) <= self.options.tol * norm_inf(w);
-                next = Some(after);
+                small_step = kept && norm_inf(delta) <= self.options.tol * norm_inf(w);
+                known = true;
                 1.0
             } else {
-                let step = self.step(p, w, &delta, &mut r);
-                let mut after = Vec::with_capacity(set.len());
-                p.active_set(w, &mut after);
-                small_step = after == set && step * norm_inf(&delta) <= self.options.tol * norm_inf(w);
-                res = norm_inf(&r);
+                let step = self.step(p, w, delta, r);
+                after.clear();
+                p.active_set(w, after);
+                small_step = after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w);
+                res = norm_inf(r);
                 step
             };
             debug!(iteration = report.history.len() + 1, residual = res, active, refactor, updated, step, "newton");
@@ -466,8 +507,12 @@ impl Newton {
             let fork = f.fork();
             self.retire_previous();
             let old = self.factorization.replace(fork);
-            self.previous =
-                Some(Reference { factorization: old, low_rank: self.low_rank.take(), overhead: self.overhead });
+            self.previous = Some(Reference {
+                factorization: old,
+                low_rank: self.low_rank.take(),
+                overhead: self.overhead,
+                norm: self.reference_norm,
+            });
         }
         self.low_rank = None;
         self.overhead = 0;

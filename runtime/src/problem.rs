@@ -69,7 +69,7 @@ impl Constraints {
 
     /// Replaces constrained rows and columns by the identity.
     pub fn apply(&self, m: &mut Matrix) {
-        m.constrain(&self.dofs(), &self.fixed, 1.0);
+        m.constrain(&self.dofs(), 1.0);
     }
 }
 

@@ -127,9 +127,8 @@ pub fn redistribute(mesh: &Mesh, mass: &Matrix, contact_nodes: &[u32]) -> Result
         .fold(0.0, f64::max);
     // Positive definite on the non-contact dofs: factor with the identity on contact dofs.
     let mut check = out.clone();
-    let fixed: Vec<bool> = (0..nodes * d).map(|r| is_contact[r / d]).collect();
-    let dofs: Vec<usize> = (0..nodes * d).filter(|&r| fixed[r]).collect();
-    check.constrain(&dofs, &fixed, 1.0);
+    let dofs: Vec<usize> = (0..nodes * d).filter(|&r| is_contact[r / d]).collect();
+    check.constrain(&dofs, 1.0);
     Factorization::new(Structure::SymmetricPositiveDefinite)
         .factor(&check)
         .map_err(RedistributionError::NotPositiveDefinite)?;
