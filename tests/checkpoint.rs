@@ -192,8 +192,8 @@ fn a_checkpoint_of_other_options_is_refused() {
 }
 
 /// The disc through its first contact with γ0 = 1e13: Newton fails on some steps, which are
-/// retried with Δt halved (8 cuts, from t = 6.51 on). Crashes right after chosen accepted steps
-/// among the cut ones, then
+/// retried with Δt halved (where exactly depends on round-off, so the test finds them in an
+/// uninterrupted run). Crashes right after accepted steps among the cut ones, then
 /// resumptions: the step controller's state (halvings in force, streak) and the energy check
 /// come back from the checkpoint, and the series has the bits of the uninterrupted run.
 #[test]
@@ -209,14 +209,28 @@ fn restarts_through_step_cuts_have_the_bits_of_an_uninterrupted_run() {
         let at = summary.find("\"step_cuts\": ").expect("step_cuts") + 13;
         summary[at..].split(|c: char| !c.is_ascii_digit()).next().unwrap().parse().unwrap()
     };
-    assert!(cuts(&full) >= 4, "the run should cut steps: {}", cuts(&full));
+    assert!(cuts(&full) >= 2, "the run should cut steps: {}", cuts(&full));
+    // The accepted steps shorter than Δt = 0.02, and the one after each of them.
+    let times: Vec<f64> =
+        series(&full).lines().skip(1).map(|l| l.split(',').next().unwrap().parse().unwrap()).collect();
+    let mut crashes: Vec<String> = Vec::new();
+    for k in 1..times.len() {
+        if (times[k] - times[k - 1] - 0.02).abs() > 1e-9 {
+            for step in [k, k + 1] {
+                if crashes.last().is_none_or(|c| c.parse::<usize>().unwrap() < step) && step < times.len() - 1 {
+                    crashes.push(step.to_string());
+                }
+            }
+        }
+    }
+    assert!(crashes.len() >= 2, "cut steps to crash at: {crashes:?}");
     let run = root.join("run");
     let run_s = run.to_str().unwrap();
-    for (i, crash) in ["27", "36", "42", "45"].iter().enumerate() {
+    for (i, crash) in crashes.iter().take(4).enumerate() {
         let more: Vec<&str> = if i == 0 { vec!["--out", run_s] } else { vec!["--resume", run_s] };
         let status = Command::new(BIN)
             .args([&args[..], &more].concat())
-            .env("SIGNORINI_CRASH_AFTER_STEP", crash)
+            .env("SIGNORINI_CRASH_AFTER_STEP", crash.as_str())
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .status()

@@ -8,9 +8,11 @@
 //! on the state only through the active set, so the problem reports its active set at each
 //! iterate; while it is the one the current operator was built for, the Jacobian is neither
 //! reassembled nor refactored. When it changes, the new Jacobian is assembled and, if it
-//! differs from the factored one on at most `max_rank` dofs, the factorization is corrected
+//! differs from the factored one on few enough dofs, the factorization is corrected
 //! (`lowrank`) instead of recomputed. The factorization survives between solves (time steps)
-//! until `invalidate` is called.
+//! until `invalidate` is called. Where a step keeps the active set, R is affine and the new
+//! residual is the solve's error: after a backward-stable solve (Cholesky, no correction) it is
+//! bounded by round-off and not evaluated; other operators' solves are checked once.
 
 use tracing::debug;
 
@@ -23,6 +25,10 @@ pub const ROUNDOFF: f64 = 512.0 * f64::EPSILON;
 /// Largest accepted ‖J δ + R‖∞ / ‖R‖∞ of a Newton step; above it the Jacobian is treated as
 /// singular (round-off in a sound solve stays orders of magnitude below).
 const LINEAR_TOLERANCE: f64 = 1e-6;
+
+/// Largest relative error ‖J δ + R‖∞ / ‖R‖∞ of a new operator's first solve for its later
+/// solves to go unchecked (ten times it bounds theirs).
+const TRUSTED_ACCURACY: f64 = 1e-12;
 
 /// At round-off, or after at least one iteration below the relative threshold or with a step
 /// too small to matter.
@@ -373,8 +379,9 @@ impl Newton {
             // A Cholesky solve without correction is backward stable: J δ = −R + e with e at
             // round-off, so the product J δ is not needed. Any other solve may be inaccurate (a
             // correction of an ill-conditioned size, an LU of a numerically singular Jacobian, an
-            // iterative solve): the first solve with a new direct operator is checked, and its
-            // relative error (times 10) taken for the operator's; iterative solves always are.
+            // iterative solve): the first solve with a new direct operator is checked, and if it
+            // is accurate, ten times its relative error is taken for the operator's; iterative
+            // solves always are.
             let trusted = if piecewise && !self.options.line_search { self.solve_accuracy } else { None };
             let j = self.jacobian.as_ref().expect("assembled above");
             let linear = if trusted.is_some() {
@@ -402,7 +409,12 @@ impl Newton {
                 debug!(linear_residual = linear, "the Jacobian is singular to working precision");
                 return Err(NewtonError::Linear { source, report });
             }
-            if trusted.is_none() && self.factorization.as_ref().is_some_and(Factorization::is_direct) {
+            // Only an operator whose first solve was accurate to near round-off is trusted; an
+            // ill-conditioned one (a huge penalty or Nitsche parameter) is checked at every solve.
+            if trusted.is_none()
+                && linear <= TRUSTED_ACCURACY
+                && self.factorization.as_ref().is_some_and(Factorization::is_direct)
+            {
                 self.solve_accuracy = Some(10.0 * linear);
             }
             let step = if piecewise && !self.options.line_search {

@@ -313,7 +313,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         (0..mesh.num_nodes()).min_by(|&a, &b| mesh.node(a)[vert].total_cmp(&mesh.node(b)[vert])).expect("nodes");
     let measure = |tools: &Tools, u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
         let kinetic = tools.kinetic(v);
-        let energy = tools.energy(u, v);
+        let energy = tools.energy_with_kinetic(u, kinetic);
         let switches = tools.contact_switches(u, t);
         let samples = facet_samples(&mesh, tools.contact_facets, quadrature.facet.unwrap_or(7), u);
         // The gap u_N − g at each point: −u_d − x_d.

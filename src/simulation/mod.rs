@@ -72,8 +72,12 @@ impl Tools<'_> {
 
     /// E = ½uᵀKu + ½vᵀMv − Fᵀu.
     pub fn energy(&self, u: &[f64], v: Option<&[f64]>) -> f64 {
-        0.5 * Self::quad(&self.stiffness, u, u) + self.kinetic(v)
-            - self.load.iter().zip(u).map(|(l, x)| l * x).sum::<f64>()
+        self.energy_with_kinetic(u, self.kinetic(v))
+    }
+
+    /// E = ½uᵀKu + `kinetic` − Fᵀu, with ½vᵀMv already computed.
+    pub fn energy_with_kinetic(&self, u: &[f64], kinetic: f64) -> f64 {
+        0.5 * Self::quad(&self.stiffness, u, u) + kinetic - self.load.iter().zip(u).map(|(l, x)| l * x).sum::<f64>()
     }
 
     /// The resultant of the contact term on the body along each axis (zeros without a
