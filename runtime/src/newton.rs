@@ -11,8 +11,8 @@
 //! differs from the factored one on few enough dofs, the factorization is corrected
 //! (`lowrank`) instead of recomputed. The factorization survives between solves (time steps)
 //! until `invalidate` is called. Where a step keeps the active set, R is affine and the new
-//! residual is the solve's error: after a backward-stable solve (Cholesky, no correction) it is
-//! bounded by round-off and not evaluated; other operators' solves are checked once.
+//! residual is the solve's error: each new operator's first solve is checked, and the later
+//! ones, when that one was accurate, are bounded by its accuracy and round-off, not evaluated.
 
 use tracing::debug;
 
@@ -147,7 +147,7 @@ pub struct Newton {
     /// Counters of factorizations no longer kept.
     retired: crate::linalg::Counters,
     /// ‖J‖∞ of the current operator, for the round-off of its solves, and their relative
-    /// accuracy once known (0 for Cholesky without correction: backward stable).
+    /// accuracy once its first solve has been checked.
     jacobian_norm: f64,
     solve_accuracy: Option<f64>,
     /// ‖J₀‖∞ of the factored reference (a bound on ‖J‖∞ is this plus the correction's).
@@ -361,7 +361,7 @@ impl Newton {
                         self.reference_norm
                     }
                 };
-                self.solve_accuracy = self.exact_solves().then_some(0.0);
+                self.solve_accuracy = None;
             }
             delta.iter_mut().zip(r.iter()).for_each(|(d, ri)| *d = -ri);
             let f = self.factorization.as_mut().expect("factored above");
@@ -376,12 +376,10 @@ impl Newton {
                 self.overhead = self.overhead.saturating_add(lr.entries());
                 self.force_refactor = self.overhead > self.overhead_budget(n);
             }
-            // A Cholesky solve without correction is backward stable: J δ = −R + e with e at
-            // round-off, so the product J δ is not needed. Any other solve may be inaccurate (a
-            // correction of an ill-conditioned size, an LU of a numerically singular Jacobian, an
-            // iterative solve): the first solve with a new direct operator is checked, and if it
-            // is accurate, ten times its relative error is taken for the operator's; iterative
-            // solves always are.
+            // A direct solve is backward stable unless the operator is numerically singular or
+            // its correction ill-conditioned: the first solve with a new operator is checked
+            // (J δ + R), and if it is accurate, ten times its relative error bounds the later
+            // solves' (no product J δ for them). Iterative solves are always checked.
             let trusted = if piecewise && !self.options.line_search { self.solve_accuracy } else { None };
             let j = self.jacobian.as_ref().expect("assembled above");
             let linear = if trusted.is_some() {
@@ -456,16 +454,6 @@ impl Newton {
             }
         }
         Ok(report)
-    }
-
-    /// Whether a solve with the current operator is a Cholesky solve without correction
-    /// (backward stable: its residual is round-off of ‖J‖‖δ‖).
-    fn exact_solves(&self) -> bool {
-        self.low_rank.as_ref().is_none_or(|lr| lr.rank() == 0)
-            && self
-                .factorization
-                .as_ref()
-                .is_some_and(|f| f.is_direct() && f.structure() == Structure::SymmetricPositiveDefinite)
     }
 
     /// Makes the operator the Jacobian at w: a low-rank correction of the factored reference
