@@ -237,20 +237,52 @@ impl LowRank {
 
 /// Σ w·x over the column's nodes.
 fn gather(w: &SparseColumn, d: usize, x: &[f64]) -> f64 {
-    w.nodes
-        .iter()
-        .zip(w.values.chunks_exact(d))
-        .map(|(&node, v)| {
-            let xs = &x[node as usize * d..][..d];
-            v.iter().zip(xs).map(|(a, b)| a * b).sum::<f64>()
-        })
-        .sum()
+    match d {
+        1 => gather_d::<1>(w, x),
+        2 => gather_d::<2>(w, x),
+        _ => gather_d::<3>(w, x),
+    }
+}
+
+/// Four independent sums per block entry (nodes taken four at a time): one dependent chain of
+/// additions would hold each load back by the latency of the previous addition.
+fn gather_d<const D: usize>(w: &SparseColumn, x: &[f64]) -> f64 {
+    let mut acc = [[0.0f64; D]; 4];
+    let (nodes, values) = (&w.nodes, &w.values[..w.nodes.len() * D]);
+    let quads = nodes.len() / 4;
+    for q in 0..quads {
+        for (l, a) in acc.iter_mut().enumerate() {
+            let node = nodes[4 * q + l] as usize;
+            let (v, xs) = (&values[(4 * q + l) * D..][..D], &x[node * D..][..D]);
+            for m in 0..D {
+                a[m] += v[m] * xs[m];
+            }
+        }
+    }
+    for i in 4 * quads..nodes.len() {
+        let node = nodes[i] as usize;
+        for m in 0..D {
+            acc[0][m] += values[i * D + m] * x[node * D + m];
+        }
+    }
+    acc.iter().flatten().sum()
 }
 
 /// x += a·w.
 fn axpy(w: &SparseColumn, d: usize, a: f64, x: &mut [f64]) {
-    for (&node, v) in w.nodes.iter().zip(w.values.chunks_exact(d)) {
-        x[node as usize * d..][..d].iter_mut().zip(v).for_each(|(xi, vi)| *xi += a * vi);
+    match d {
+        1 => axpy_d::<1>(w, a, x),
+        2 => axpy_d::<2>(w, a, x),
+        _ => axpy_d::<3>(w, a, x),
+    }
+}
+
+fn axpy_d<const D: usize>(w: &SparseColumn, a: f64, x: &mut [f64]) {
+    for (&node, v) in w.nodes.iter().zip(w.values.chunks_exact(D)) {
+        let xs = &mut x[node as usize * D..][..D];
+        for m in 0..D {
+            xs[m] += a * v[m];
+        }
     }
 }
 
