@@ -1,11 +1,15 @@
 //! The two operations a contact time step spends its time in, once the factorization is
-//! reused: a symmetric matrix–vector product and a pair of triangular solves, on P2
+//! reused: a symmetric matrix–vector product (from the whole matrix and from its lower half)
+//! and a pair of triangular solves, on P2
 //! plane-strain patterns the size of the disc's meshes (3 362 and 12 482 unknowns).
 //! `cargo bench -p signorini-runtime --bench linalg`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use signorini_runtime::assembly::Assembler;
+use std::sync::Arc;
+
 use signorini_runtime::linalg::{Factorization, Matrix, Structure};
+use signorini_runtime::lower_half::{HalfPattern, LowerHalf};
 use signorini_runtime::mesh::structured::{Diagonal, rectangle};
 
 /// A symmetric, strictly diagonally dominant matrix on the mesh's pattern.
@@ -36,6 +40,8 @@ fn products_and_solves(c: &mut Criterion) {
         let x: Vec<f64> = (0..n).map(|i| ((i * 31) % 101) as f64 / 101.0).collect();
         let mut y = vec![0.0; n];
         c.bench_function(&format!("symmetric product, {n} unknowns"), |b| b.iter(|| a.mul_vec_transposed(&x, &mut y)));
+        let lower = LowerHalf::new(&a, &Arc::new(HalfPattern::new(&a.pattern)));
+        c.bench_function(&format!("lower-half product, {n} unknowns"), |b| b.iter(|| lower.mul_vec(&x, &mut y)));
         let mut f = Factorization::new(Structure::SymmetricPositiveDefinite);
         f.factor(&a).unwrap();
         c.bench_function(&format!("solve pair, {n} unknowns"), |b| {

@@ -26,6 +26,7 @@ pub mod kernel;
 pub mod krylov;
 pub mod library;
 pub mod linalg;
+pub mod lower_half;
 pub mod lowrank;
 pub mod mesh;
 pub mod newton;

@@ -16,9 +16,11 @@
 //! and cancels the large terms before scaling them (see `zero_sum_groups`).
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use crate::assembly::{Assembler, Kernel, Quadrature};
 use crate::linalg::{Matrix, Structure};
+use crate::lower_half::{HalfPattern, LowerHalf};
 use crate::mesh::Facet;
 use crate::newton::{Newton, NewtonError, NewtonOptions, NewtonReport, NonlinearProblem};
 use crate::problem::Constraints;
@@ -247,7 +249,9 @@ pub struct Stepper<'a> {
     /// Per stage: its Newton (keeps its factorization) and the constant operator for `dt`.
     stages: Vec<StageCache>,
     /// Linear forms' matrices (assembled once).
-    matrices: HashMap<String, Matrix>,
+    matrices: HashMap<String, Linear>,
+    /// The pattern's lower half, when the stage matrices are symmetric.
+    half_pattern: Option<Arc<HalfPattern>>,
     /// Recently assembled loads, by (form, time).
     loads: Vec<((&'static str, u64), Vec<f64>)>,
     coefs: Vec<f64>,
@@ -256,7 +260,7 @@ pub struct Stepper<'a> {
 struct StageCache {
     newton: Newton,
     dt: f64,
-    constant: Option<Matrix>,
+    constant: Option<Linear>,
 }
 
 impl<'a> Stepper<'a> {
@@ -303,6 +307,9 @@ impl<'a> Stepper<'a> {
             Structure::Auto => probe_structure(asm, &forms, &matrices),
             s => s,
         };
+        let half_pattern =
+            (structure == Structure::SymmetricPositiveDefinite).then(|| Arc::new(HalfPattern::new(asm.pattern())));
+        let matrices = matrices.into_iter().map(|(name, m)| (name, Linear::new(m, half_pattern.as_ref()))).collect();
         let stages = (0..desc.stages.len() + 1)
             .map(|_| StageCache { newton: Newton::new(newton_options), dt: f64::NAN, constant: None })
             .collect();
@@ -317,6 +324,7 @@ impl<'a> Stepper<'a> {
             newton_options,
             stages,
             matrices,
+            half_pattern,
             loads: Vec::new(),
             coefs: vec![0.0; desc.coefficients],
         })
@@ -339,7 +347,7 @@ impl<'a> Stepper<'a> {
 
     /// The matrix of a linear one-field form (e.g. `mass`, for energies).
     pub fn matrix(&self, form: &str) -> Option<&Matrix> {
-        self.matrices.get(form)
+        self.matrices.get(form).map(|l| &l.matrix)
     }
 
     /// Solves the initial problem (e.g. M a⁰ = L⁰ − B(u⁰)) for its state, if the scheme has one.
@@ -522,10 +530,10 @@ impl<'a> Stepper<'a> {
                 Some(k) if alphas.len() == 1 => {
                     // Linear: coef·K·(α w + base).
                     let mut kb = vec![0.0; n];
-                    mul(k, self.structure, &bases[0], &mut kb);
+                    k.mul(&bases[0], &mut kb);
                     constant_rhs.iter_mut().zip(&kb).for_each(|(r, x)| *r += coef * x);
                     if let Some(c) = constant.as_mut() {
-                        c.add_scaled(coef * alphas[0], k);
+                        c.add_scaled(coef * alphas[0], &k.matrix);
                     }
                 }
                 _ if alphas.iter().all(|a| *a == 0.0) => {
@@ -539,7 +547,7 @@ impl<'a> Stepper<'a> {
         }
         if let Some(c) = constant {
             let entry = &mut self.stages[cache];
-            entry.constant = Some(c);
+            entry.constant = Some(Linear::new(c, self.half_pattern.as_ref()));
             entry.dt = dt;
             entry.newton.invalidate();
         }
@@ -653,10 +661,26 @@ fn probe_structure(
     Structure::SymmetricPositiveDefinite
 }
 
-/// `y = A x`; as `Aᵀ x` (threaded, reading half the bytes) when the stage matrices are
-/// symmetric.
-fn mul(a: &Matrix, structure: Structure, x: &[f64], y: &mut [f64]) {
-    if structure == Structure::SymmetricPositiveDefinite { a.mul_vec_transposed(x, y) } else { a.mul_vec(x, y) }
+/// A stage matrix; a symmetric one (under Cholesky) also as its lower half, whose products
+/// read half the values.
+struct Linear {
+    matrix: Matrix,
+    half: Option<LowerHalf>,
+}
+
+impl Linear {
+    fn new(matrix: Matrix, half_pattern: Option<&Arc<HalfPattern>>) -> Linear {
+        let half = half_pattern.map(|h| LowerHalf::new(&matrix, h));
+        Linear { matrix, half }
+    }
+
+    /// `y = A x`.
+    fn mul(&self, x: &[f64], y: &mut [f64]) {
+        match &self.half {
+            Some(h) => h.mul_vec(x, y),
+            None => self.matrix.mul_vec(x, y),
+        }
+    }
 }
 
 /// A nonlinear term of a stage: coef·form(α₁w + b₁, ...).
@@ -682,7 +706,7 @@ impl ActiveTerm {
 struct StageProblem<'p, 'a> {
     asm: &'p Assembler<'a>,
     forms: &'p HashMap<String, Box<dyn BoundForm + 'a>>,
-    constant: &'p Matrix,
+    constant: &'p Linear,
     rhs: Vec<f64>,
     terms: Vec<ActiveTerm>,
     constraints: &'p Constraints,
@@ -704,7 +728,7 @@ impl NonlinearProblem for StageProblem<'_, '_> {
         if w.iter().all(|x| *x == 0.0) {
             r.copy_from_slice(&self.rhs);
         } else {
-            mul(self.constant, self.structure, w, r);
+            self.constant.mul(w, r);
             self.magnitude = self.magnitude.max(norm_inf(r));
             r.iter_mut().zip(&self.rhs).for_each(|(ri, c)| *ri += c);
         }
@@ -738,7 +762,7 @@ impl NonlinearProblem for StageProblem<'_, '_> {
     }
 
     fn jacobian(&mut self, w: &[f64], j: &mut Matrix) {
-        j.values.copy_from_slice(&self.constant.values);
+        j.values.copy_from_slice(&self.constant.matrix.values);
         for term in &self.terms {
             term.args_into(w, &mut self.args);
             let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();

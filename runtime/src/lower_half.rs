@@ -1,0 +1,345 @@
+//! Products with a symmetric matrix read from its lower half: half the values the full
+//! product reads, and the product is memory-bound (`benches/linalg.rs`).
+//!
+//! The node blocks below the diagonal are stored by column, in a reverse Cuthill–McKee order
+//! of the nodes, so column p's blocks lie in a band of rows just after p, and the products
+//! y_i += A_ip x_p that a column sends to other rows land near it. The columns are cut into
+//! tasks of a fixed number of nodes; each task sums into its own buffer, which covers its rows
+//! and the band after them, and the buffers are added in task order: the same bits for any
+//! number of threads.
+
+use std::sync::{Arc, Mutex};
+
+use rayon::prelude::*;
+
+use crate::linalg::Matrix;
+use crate::pattern::Pattern;
+
+/// Columns (nodes) per task: fixed, so the sums do not depend on the number of threads.
+const NODES_PER_TASK: usize = 512;
+
+/// Below this many stored values one thread does it all.
+const PARALLEL_VALUES: usize = 200_000;
+
+/// The lower half of a pattern in node blocks, in reverse Cuthill–McKee order; shared by the
+/// matrices on that pattern.
+#[derive(Debug)]
+pub struct HalfPattern {
+    d: usize,
+    /// `order[p]` is the node at position p.
+    order: Vec<u32>,
+    /// Column p's blocks below the diagonal: rows (positions > p, increasing) `rows[ptr[p]..ptr[p + 1]]`.
+    ptr: Vec<usize>,
+    rows: Vec<u32>,
+    /// Where each block is in the full pattern: the offset of its first value in column
+    /// `order[p]·d` of the full matrix (the other columns follow at the same offset).
+    source: Vec<usize>,
+    tasks: Vec<Task>,
+}
+
+/// Columns `start..end`; the task's buffer covers positions `start..reach`.
+#[derive(Debug, Clone, Copy)]
+struct Task {
+    start: usize,
+    end: usize,
+    reach: usize,
+}
+
+impl HalfPattern {
+    pub fn new(p: &Pattern) -> HalfPattern {
+        let d = p.dim();
+        let order = reverse_cuthill_mckee(p);
+        let mut position = vec![0u32; order.len()];
+        order.iter().enumerate().for_each(|(q, &node)| position[node as usize] = q as u32);
+        let (mut ptr, mut rows, mut source) = (vec![0usize], Vec::new(), Vec::new());
+        let mut column: Vec<(u32, usize)> = Vec::new();
+        for &node in &order {
+            let j = node as usize;
+            let here = position[j];
+            column.clear();
+            for (k, &i) in p.neighbours(j).iter().enumerate() {
+                if position[i as usize] > here {
+                    column.push((position[i as usize], p.col_ptr[j * d] + k * d));
+                }
+            }
+            column.sort_unstable();
+            rows.extend(column.iter().map(|c| c.0));
+            source.extend(column.iter().map(|c| c.1));
+            ptr.push(rows.len());
+        }
+        let nodes = order.len();
+        let tasks = (0..nodes.div_ceil(NODES_PER_TASK))
+            .map(|t| {
+                let (start, end) = (t * NODES_PER_TASK, ((t + 1) * NODES_PER_TASK).min(nodes));
+                let reach = rows[ptr[start]..ptr[end]].iter().map(|&r| r as usize + 1).fold(end, usize::max);
+                Task { start, end, reach }
+            })
+            .collect();
+        HalfPattern { d, order, ptr, rows, source, tasks }
+    }
+
+    fn nodes(&self) -> usize {
+        self.order.len()
+    }
+
+    /// Doubles of work space a product needs: x and y in position order, and the task buffers.
+    fn work_len(&self) -> usize {
+        self.d * (2 * self.nodes() + self.tasks.iter().map(|t| t.reach - t.start).sum::<usize>())
+    }
+}
+
+/// A symmetric matrix's lower half (diagonal blocks whole), for products.
+#[derive(Debug)]
+pub struct LowerHalf {
+    pattern: Arc<HalfPattern>,
+    /// Per position, the diagonal block, d×d row-major.
+    diag: Vec<f64>,
+    /// Per block below the diagonal, d×d row-major: `values[(k·d + r)·d + c]` is
+    /// A[rows[k]·d + r, p·d + c] (in position order).
+    values: Vec<f64>,
+    work: Mutex<Vec<f64>>,
+}
+
+impl LowerHalf {
+    /// The lower half of `a`, which must be symmetric on `half`'s pattern (only the lower half
+    /// is read).
+    pub fn new(a: &Matrix, half: &Arc<HalfPattern>) -> LowerHalf {
+        let h = half.as_ref();
+        let d = h.d;
+        let p = &a.pattern;
+        let column = |node: usize, c: usize| &a.values[p.col_ptr[node * d + c]..p.col_ptr[node * d + c + 1]];
+        let mut diag = vec![0.0; h.nodes() * d * d];
+        for (q, &node) in h.order.iter().enumerate() {
+            let node = node as usize;
+            let own = p.neighbours(node).binary_search(&(node as u32)).expect("a node neighbours itself");
+            for c in 0..d {
+                for r in 0..d {
+                    diag[(q * d + r) * d + c] = column(node, c)[own * d + r];
+                }
+            }
+        }
+        let mut values = vec![0.0; h.rows.len() * d * d];
+        for (q, &node) in h.order.iter().enumerate() {
+            for k in h.ptr[q]..h.ptr[q + 1] {
+                let offset = h.source[k] - p.col_ptr[node as usize * d];
+                for c in 0..d {
+                    for r in 0..d {
+                        values[(k * d + r) * d + c] = column(node as usize, c)[offset + r];
+                    }
+                }
+            }
+        }
+        LowerHalf { pattern: half.clone(), diag, values, work: Mutex::new(vec![0.0; h.work_len()]) }
+    }
+
+    /// `y = A x`.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        match self.pattern.d {
+            1 => self.mul_vec_d::<1>(x, y),
+            2 => self.mul_vec_d::<2>(x, y),
+            _ => self.mul_vec_d::<3>(x, y),
+        }
+    }
+
+    fn mul_vec_d<const D: usize>(&self, x: &[f64], y: &mut [f64]) {
+        let h = self.pattern.as_ref();
+        let n = h.nodes() * D;
+        // A poisoned lock only means another product panicked; the buffer is overwritten anyway.
+        let mut work = self.work.lock().unwrap_or_else(|e| e.into_inner());
+        let (xp, rest) = work.split_at_mut(n);
+        let (yp, mut bufs) = rest.split_at_mut(n);
+        for (q, &node) in h.order.iter().enumerate() {
+            xp[q * D..][..D].copy_from_slice(&x[node as usize * D..][..D]);
+        }
+        let mut slices = Vec::with_capacity(h.tasks.len());
+        for t in &h.tasks {
+            let (buf, tail) = std::mem::take(&mut bufs).split_at_mut((t.reach - t.start) * D);
+            slices.push((t, buf));
+            bufs = tail;
+        }
+        let xp = &*xp;
+        let run = |(t, buf): &mut (&Task, &mut [f64])| self.task::<D>(t, xp, buf);
+        if self.values.len() < PARALLEL_VALUES || rayon::current_num_threads() == 1 {
+            slices.iter_mut().for_each(run);
+        } else {
+            slices.par_iter_mut().for_each(run);
+        }
+        yp.iter_mut().for_each(|v| *v = 0.0);
+        for (t, buf) in &slices {
+            yp[t.start * D..t.reach * D].iter_mut().zip(buf.iter()).for_each(|(a, b)| *a += b);
+        }
+        for (q, &node) in h.order.iter().enumerate() {
+            y[node as usize * D..][..D].copy_from_slice(&yp[q * D..][..D]);
+        }
+    }
+
+    /// The task's columns' products, into `buf` (positions `t.start..t.reach`).
+    fn task<const D: usize>(&self, t: &Task, x: &[f64], buf: &mut [f64]) {
+        let h = self.pattern.as_ref();
+        buf.iter_mut().for_each(|v| *v = 0.0);
+        for p in t.start..t.end {
+            let xj: [f64; D] = std::array::from_fn(|c| x[p * D + c]);
+            // (A_ip)ᵀ x_i summed over the column: D² independent sums.
+            let mut acc = [[0.0f64; D]; D];
+            let range = h.ptr[p]..h.ptr[p + 1];
+            let values = &self.values[range.start * D * D..range.end * D * D];
+            for (&i, a) in h.rows[range].iter().zip(values.chunks_exact(D * D)) {
+                let i = i as usize;
+                let xi = &x[i * D..][..D];
+                let yi = &mut buf[(i - t.start) * D..][..D];
+                for r in 0..D {
+                    let mut s = 0.0;
+                    for c in 0..D {
+                        acc[c][r] += a[r * D + c] * xi[r];
+                        s += a[r * D + c] * xj[c];
+                    }
+                    yi[r] += s;
+                }
+            }
+            let dg = &self.diag[p * D * D..][..D * D];
+            let yj = &mut buf[(p - t.start) * D..][..D];
+            for c in 0..D {
+                let own: f64 = (0..D).map(|m| dg[c * D + m] * xj[m]).sum();
+                yj[c] += own + acc[c].iter().sum::<f64>();
+            }
+        }
+    }
+}
+
+/// Reverse Cuthill–McKee order of the pattern's nodes: breadth-first from a pseudo-peripheral
+/// node of each connected component, neighbours by increasing degree, reversed.
+fn reverse_cuthill_mckee(p: &Pattern) -> Vec<u32> {
+    let nodes = p.num_nodes();
+    let degree = |i: usize| p.neighbours(i).len();
+    let mut order = Vec::with_capacity(nodes);
+    let mut visited = vec![false; nodes];
+    let mut level = vec![usize::MAX; nodes];
+    let mut queue: Vec<u32> = Vec::new();
+    // Breadth-first levels from `root` (within its component); returns the visited nodes.
+    let bfs = |root: usize, level: &mut Vec<usize>, queue: &mut Vec<u32>| {
+        queue.clear();
+        queue.push(root as u32);
+        level[root] = 0;
+        let mut head = 0;
+        while head < queue.len() {
+            let j = queue[head] as usize;
+            head += 1;
+            for &i in p.neighbours(j) {
+                if level[i as usize] == usize::MAX {
+                    level[i as usize] = level[j] + 1;
+                    queue.push(i);
+                }
+            }
+        }
+    };
+    for seed in 0..nodes {
+        if visited[seed] {
+            continue;
+        }
+        // Pseudo-peripheral root: repeat from the lowest-degree node of the last level while
+        // the eccentricity grows.
+        let mut root = seed;
+        let mut depth = 0;
+        for _ in 0..8 {
+            bfs(root, &mut level, &mut queue);
+            let last = queue.iter().map(|&i| level[i as usize]).max().unwrap_or(0);
+            let far = queue
+                .iter()
+                .filter(|&&i| level[i as usize] == last)
+                .min_by_key(|&&i| (degree(i as usize), i))
+                .map_or(root, |&i| i as usize);
+            queue.iter().for_each(|&i| level[i as usize] = usize::MAX);
+            if last <= depth && depth > 0 {
+                break;
+            }
+            depth = last;
+            root = far;
+        }
+        // Cuthill–McKee from the root.
+        let start = order.len();
+        order.push(root as u32);
+        visited[root] = true;
+        let mut head = start;
+        let mut next: Vec<u32> = Vec::new();
+        while head < order.len() {
+            let j = order[head] as usize;
+            head += 1;
+            next.clear();
+            next.extend(p.neighbours(j).iter().copied().filter(|&i| !visited[i as usize]));
+            next.sort_unstable_by_key(|&i| (degree(i as usize), i));
+            for &i in &next {
+                visited[i as usize] = true;
+                order.push(i);
+            }
+        }
+    }
+    order.reverse();
+    order
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::Assembler;
+    use crate::mesh::Mesh;
+    use crate::mesh::structured::{Diagonal, cuboid, interval, rectangle};
+
+    /// A symmetric matrix on the mesh's pattern with values that differ entry by entry.
+    fn symmetric(mesh: &Mesh) -> Matrix {
+        let mut a = Assembler::new(mesh).zero_matrix();
+        let p = a.pattern.clone();
+        for j in 0..a.size() {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let (lo, hi) = (p.row_idx[k].min(j), p.row_idx[k].max(j));
+                a.values[k] = 1.0 / (1.0 + ((lo * 7 + hi * 13) % 17) as f64) - 0.3;
+            }
+        }
+        a
+    }
+
+    #[test]
+    fn the_lower_half_product_is_the_full_product_for_any_number_of_threads() {
+        let unit = [0.0, 1.0];
+        // The large mesh has several tasks and takes the threaded path.
+        let meshes = [
+            interval(700, 0.0, 1.0),
+            rectangle(9, 7, unit, unit, Diagonal::Right, 2),
+            rectangle(60, 60, unit, unit, Diagonal::Right, 2),
+            cuboid([3, 4, 2], unit, unit, unit, 2),
+        ];
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap();
+        for mesh in &meshes {
+            let a = symmetric(mesh);
+            let half = Arc::new(HalfPattern::new(&a.pattern));
+            let lower = LowerHalf::new(&a, &half);
+            let n = a.size();
+            let x: Vec<f64> = (0..n).map(|i| ((i * 31) % 101) as f64 / 101.0 - 0.5).collect();
+            let (mut full, mut y) = (vec![0.0; n], vec![0.0; n]);
+            a.mul_vec(&x, &mut full);
+            lower.mul_vec(&x, &mut y);
+            let scale = full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (i, (f, h)) in full.iter().zip(&y).enumerate() {
+                assert!((f - h).abs() <= 1e-13 * scale, "{n} unknowns, row {i}: {f} against {h}");
+            }
+            let mut threaded = vec![0.0; n];
+            pool.install(|| lower.mul_vec(&x, &mut threaded));
+            assert_eq!(y, threaded, "{n} unknowns");
+        }
+    }
+
+    #[test]
+    fn reverse_cuthill_mckee_narrows_the_band_of_a_scrambled_mesh() {
+        // A strip of 41 × 4 nodes, numbered along it: neighbours across it are 41 apart.
+        let mesh = rectangle(40, 3, [0.0, 40.0], [0.0, 3.0], Diagonal::Right, 1);
+        let a = symmetric(&mesh);
+        let half = HalfPattern::new(&a.pattern);
+        let mut seen = half.order.clone();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..mesh.num_nodes() as u32).collect::<Vec<_>>(), "a permutation");
+        // A 41×4-node strip: RCM levels run across the strip, each a few nodes wide.
+        let band = (0..half.nodes())
+            .flat_map(|p| half.rows[half.ptr[p]..half.ptr[p + 1]].iter().map(move |&r| r as usize - p))
+            .max();
+        assert!(band.unwrap() <= 8, "band {band:?}");
+    }
+}
