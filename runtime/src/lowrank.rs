@@ -25,6 +25,7 @@ use faer::linalg::solvers::{PartialPivLu, Solve};
 
 use crate::block_factor::SparseColumn;
 use crate::linalg::{Factorization, LinalgError, Matrix};
+use crate::pattern::Entries;
 
 /// The correction of a factored reference J₀ towards the current matrix.
 pub struct LowRank {
@@ -96,17 +97,20 @@ impl LowRank {
         self.column_entries
     }
 
-    /// The dofs on which `j` differs from the reference (rows and columns), sorted.
-    pub fn changed_dofs(&self, j: &Matrix) -> Vec<usize> {
+    /// The dofs on which `j` differs from the reference (rows and columns), sorted; only
+    /// `entries` are compared if given (the only ones that can differ).
+    pub fn changed_dofs(&self, j: &Matrix, entries: Option<&Entries>) -> Vec<usize> {
         let p = &j.pattern;
         let mut changed = vec![false; j.size()];
-        for col in 0..j.size() {
-            for k in p.col_ptr[col]..p.col_ptr[col + 1] {
-                if j.values[k] != self.reference[k] {
-                    changed[col] = true;
-                    changed[p.row_idx[k]] = true;
-                }
+        let mut compare = |k: usize, col: usize| {
+            if j.values[k] != self.reference[k] {
+                changed[col] = true;
+                changed[p.row_idx[k]] = true;
             }
+        };
+        match entries {
+            Some(e) => e.indices.iter().zip(&e.columns).for_each(|(&k, &col)| compare(k, col as usize)),
+            None => (0..j.size()).for_each(|col| (p.col_ptr[col]..p.col_ptr[col + 1]).for_each(|k| compare(k, col))),
         }
         (0..j.size()).filter(|&i| changed[i]).collect()
     }

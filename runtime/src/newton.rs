@@ -18,6 +18,7 @@ use tracing::debug;
 
 use crate::linalg::{Factorization, LinalgError, Matrix, Solver, Structure};
 use crate::lowrank::LowRank;
+use crate::pattern::Entries;
 
 /// A residual at most this times its terms' magnitude is round-off (a few hundred roundings).
 pub const ROUNDOFF: f64 = 512.0 * f64::EPSILON;
@@ -52,6 +53,11 @@ pub trait NonlinearProblem {
     fn jacobian_matrix(&self) -> Matrix;
     /// Cholesky for symmetric positive definite Jacobians, LU otherwise.
     fn structure(&self) -> Structure;
+    /// The entries outside which the Jacobian is the same at every w, if the problem knows
+    /// them: corrections then compare Jacobians there only.
+    fn varying_entries(&self) -> Option<&Entries> {
+        None
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -466,7 +472,8 @@ impl Newton {
             let mut j = self.jacobian.take().expect("assembled with the reference");
             j.values.iter_mut().for_each(|v| *v = 0.0);
             p.jacobian(w, &mut j);
-            let mut dofs = self.low_rank.as_ref().map(|lr| lr.changed_dofs(&j)).unwrap_or_default();
+            let entries = p.varying_entries();
+            let mut dofs = self.low_rank.as_ref().map(|lr| lr.changed_dofs(&j, entries)).unwrap_or_default();
             // The previous reference, if the active set has come back near it.
             let budget = self.overhead_budget(j.size());
             if let Some(other) = self
@@ -474,7 +481,7 @@ impl Newton {
                 .as_ref()
                 .filter(|r| r.overhead <= budget)
                 .and_then(|r| r.low_rank.as_ref())
-                .map(|lr| lr.changed_dofs(&j))
+                .map(|lr| lr.changed_dofs(&j, entries))
                 && other.len() < dofs.len()
             {
                 self.swap_references();

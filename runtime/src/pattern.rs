@@ -21,6 +21,13 @@ pub struct Pattern {
     cell_offsets: Vec<u32>,
 }
 
+/// Some entries of a pattern: their indices among the stored values, and their columns.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Entries {
+    pub indices: Vec<usize>,
+    pub columns: Vec<u32>,
+}
+
 /// The cells of each node: node i's are `cells[ptr[i]..ptr[i + 1]]`, in increasing order.
 pub(crate) fn cells_of_nodes(mesh: &Mesh) -> (Vec<usize>, Vec<u32>) {
     let nodes = mesh.num_nodes();
@@ -115,6 +122,25 @@ impl Pattern {
     /// The nodes coupled to node `j`, sorted (`j` among them).
     pub fn neighbours(&self, j: usize) -> &[u32] {
         &self.node_adj[self.node_ptr[j]..self.node_ptr[j + 1]]
+    }
+
+    /// The entries whose row and column are both dofs of flagged nodes, column by column.
+    pub fn entries_among(&self, nodes: &[bool]) -> Entries {
+        let d = self.dim;
+        let mut out = Entries::default();
+        for j in (0..self.num_nodes()).filter(|&j| nodes[j]) {
+            for m in 0..d {
+                let col = j * d + m;
+                for (t, &i) in self.neighbours(j).iter().enumerate() {
+                    if nodes[i as usize] {
+                        let start = self.col_ptr[col] + t * d;
+                        out.indices.extend(start..start + d);
+                        out.columns.extend(std::iter::repeat_n(col as u32, d));
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// Adds an element matrix of cell `c` with nodes `cell` into `values`.

@@ -23,6 +23,7 @@ use crate::linalg::{Matrix, Structure};
 use crate::lower_half::{HalfPattern, LowerHalf};
 use crate::mesh::Facet;
 use crate::newton::{Newton, NewtonError, NewtonOptions, NewtonReport, NonlinearProblem};
+use crate::pattern::Entries;
 use crate::problem::Constraints;
 
 /// A vector known when a stage starts.
@@ -118,6 +119,11 @@ pub trait BoundForm {
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]);
     fn tangent(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix);
     fn switches(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, out: &mut Vec<bool>);
+    /// The cells whose element matrices the tangent adds to, if not all of them (a form that
+    /// integrates over boundary facets only): the Jacobian changes nowhere else.
+    fn support(&self) -> Option<Vec<u32>> {
+        None
+    }
     /// Whether the form changes with time other than through its fields.
     fn time_dependent(&self) -> bool {
         true
@@ -165,6 +171,12 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
         for (region, facets) in &self.regions {
             asm.facet_switches(&self.kernel, region, facets, self.quadrature, fields, wrt, t, out);
         }
+    }
+    fn support(&self) -> Option<Vec<u32>> {
+        if self.kernel.meta().cell_degree.is_some() {
+            return None;
+        }
+        Some(self.regions.iter().flat_map(|(_, facets)| facets.iter().map(|f| f.cell)).collect())
     }
     fn time_dependent(&self) -> bool {
         self.kernel.time_dependent()
@@ -261,6 +273,10 @@ struct StageCache {
     newton: Newton,
     dt: f64,
     constant: Option<Linear>,
+    /// The entries the nonlinear terms' tangents add to (None: anywhere), once known.
+    support: Option<Option<Entries>>,
+    /// Scratch for the nonlinear terms' tangents: zero outside `support`.
+    scratch: Option<Matrix>,
 }
 
 impl<'a> Stepper<'a> {
@@ -311,7 +327,13 @@ impl<'a> Stepper<'a> {
             (structure == Structure::SymmetricPositiveDefinite).then(|| Arc::new(HalfPattern::new(asm.pattern())));
         let matrices = matrices.into_iter().map(|(name, m)| (name, Linear::new(m, half_pattern.as_ref()))).collect();
         let stages = (0..desc.stages.len() + 1)
-            .map(|_| StageCache { newton: Newton::new(newton_options), dt: f64::NAN, constant: None })
+            .map(|_| StageCache {
+                newton: Newton::new(newton_options),
+                dt: f64::NAN,
+                constant: None,
+                support: None,
+                scratch: None,
+            })
             .collect();
         Ok(Stepper {
             scheme,
@@ -552,17 +574,19 @@ impl<'a> Stepper<'a> {
             entry.newton.invalidate();
         }
         let piecewise = nonlinear.iter().all(|a| self.forms[a.form].piecewise());
-        let stage_cache = &mut self.stages[cache];
+        let StageCache { newton, constant, support, scratch, .. } = &mut self.stages[cache];
+        let support = support.get_or_insert_with(|| tangent_support(self.asm, &self.forms, &nonlinear)).as_ref();
         let mut problem = StageProblem {
             asm: self.asm,
             forms: &self.forms,
-            constant: stage_cache.constant.as_ref().expect("built above"),
+            constant: constant.as_ref().expect("built above"),
             rhs: constant_rhs,
             terms: nonlinear,
             constraints: &self.constraints,
             structure: self.structure,
             piecewise,
-            scratch: None,
+            support,
+            scratch,
             args: Vec::new(),
             term: Vec::new(),
             magnitude: 0.0,
@@ -575,7 +599,7 @@ impl<'a> Stepper<'a> {
         let mut delta = w0.clone();
         self.constraints.impose(&mut delta);
         delta.iter_mut().zip(w0).for_each(|(d, r)| *d -= r);
-        let report = stage_cache.newton.solve(&mut problem, &mut delta).map_err(|source| StepError::Newton {
+        let report = newton.solve(&mut problem, &mut delta).map_err(|source| StepError::Newton {
             stage: stage.name,
             t: stage_t,
             source,
@@ -712,8 +736,10 @@ struct StageProblem<'p, 'a> {
     constraints: &'p Constraints,
     structure: Structure,
     piecewise: bool,
+    /// Where the nonlinear terms' tangents add to J, if known.
+    support: Option<&'p Entries>,
     /// Reused for the nonlinear terms' tangents, arguments and residuals.
-    scratch: Option<Matrix>,
+    scratch: &'p mut Option<Matrix>,
     args: Vec<Vec<f64>>,
     term: Vec<f64>,
     /// The largest term of the last residual.
@@ -768,11 +794,19 @@ impl NonlinearProblem for StageProblem<'_, '_> {
             let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
-                    // Kernels add unscaled: assemble into the scratch matrix, then scale in.
+                    // Kernels add unscaled: assemble into the scratch matrix, then scale in
+                    // (only where the tangent can be nonzero, when that is known).
                     let m = self.scratch.get_or_insert_with(|| self.asm.zero_matrix());
-                    m.values.iter_mut().for_each(|v| *v = 0.0);
+                    match self.support {
+                        Some(s) => s.indices.iter().for_each(|&i| m.values[i] = 0.0),
+                        None => m.values.iter_mut().for_each(|v| *v = 0.0),
+                    }
                     self.forms[term.form].tangent(self.asm, &refs, k, term.t, m);
-                    j.add_scaled(term.coef * a, m);
+                    let c = term.coef * a;
+                    match self.support {
+                        Some(s) => s.indices.iter().for_each(|&i| j.values[i] += c * m.values[i]),
+                        None => j.add_scaled(c, m),
+                    }
                 }
             }
         }
@@ -786,6 +820,26 @@ impl NonlinearProblem for StageProblem<'_, '_> {
     fn structure(&self) -> Structure {
         self.structure
     }
+
+    fn varying_entries(&self) -> Option<&Entries> {
+        self.support
+    }
+}
+
+/// The entries the stage's nonlinear terms' tangents add to: those coupling the nodes of the
+/// cells of their supports (None if one of them has none).
+fn tangent_support(
+    asm: &Assembler,
+    forms: &HashMap<String, Box<dyn BoundForm + '_>>,
+    terms: &[ActiveTerm],
+) -> Option<Entries> {
+    let mut nodes = vec![false; asm.mesh().num_nodes()];
+    for term in terms {
+        for cell in forms[term.form].support()? {
+            asm.mesh().cell(cell as usize).iter().for_each(|&n| nodes[n as usize] = true);
+        }
+    }
+    Some(asm.pattern().entries_among(&nodes))
 }
 
 #[cfg(test)]

@@ -166,7 +166,11 @@ fn a_low_rank_correction_solves_the_changed_matrix() {
                 changed.values[a] += c;
                 changed.values[b2] += c * (1.0 - round as f64);
             }
-            let dofs = lr.changed_dofs(&changed);
+            let dofs = lr.changed_dofs(&changed, None);
+            // Told where J can differ (the entries among the changed nodes), the same dofs.
+            let mut flags = vec![false; changed.pattern.num_nodes()];
+            nodes.iter().for_each(|&n| flags[n] = true);
+            assert_eq!(lr.changed_dofs(&changed, Some(&changed.pattern.entries_among(&flags))), dofs);
             assert!(dofs.len() <= nodes.len() * d && !dofs.is_empty(), "changed dofs {dofs:?}");
             lr.update(&changed, dofs, &mut f).expect("updates");
             let mut x = b.clone();
