@@ -11,26 +11,12 @@ use std::sync::Arc;
 use signorini_runtime::linalg::{Factorization, Matrix, Structure};
 use signorini_runtime::lower_half::{HalfPattern, LowerHalf};
 use signorini_runtime::mesh::structured::{Diagonal, rectangle};
+use signorini_runtime::test_matrices::diagonally_dominant;
 
-/// A symmetric, strictly diagonally dominant matrix on the mesh's pattern.
+/// A symmetric, strictly diagonally dominant matrix on a P2 plane-strain pattern.
 fn spd_matrix(cells: usize) -> Matrix {
     let mesh = rectangle(cells, cells, [0.0, 1.0], [0.0, 1.0], Diagonal::Right, 2);
-    let mut a = Assembler::new(&mesh).zero_matrix();
-    let p = a.pattern.clone();
-    for j in 0..a.size() {
-        let mut off = 0.0;
-        for k in p.col_ptr[j]..p.col_ptr[j + 1] {
-            let i = p.row_idx[k];
-            if i != j {
-                let (lo, hi) = (i.min(j), i.max(j));
-                a.values[k] = -1.0 / (1.0 + ((lo * 7 + hi * 13) % 17) as f64);
-                off += a.values[k].abs();
-            }
-        }
-        let diag = p.col_ptr[j] + p.row_idx[p.col_ptr[j]..p.col_ptr[j + 1]].binary_search(&j).unwrap();
-        a.values[diag] = 1.0 + 2.0 * off;
-    }
-    a
+    diagonally_dominant(&Assembler::new(&mesh))
 }
 
 fn products_and_solves(c: &mut Criterion) {

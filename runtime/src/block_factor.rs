@@ -335,33 +335,14 @@ impl<'a> Columns<'a> {
 mod tests {
     use super::*;
     use crate::assembly::Assembler;
-    use crate::linalg::{Matrix, node_ordering};
+    use crate::linalg::node_ordering;
     use crate::mesh::structured::{Diagonal, cuboid, interval, rectangle};
+    use crate::test_matrices::diagonally_dominant;
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::sparse::linalg::SupernodalThreshold;
     use faer::sparse::linalg::cholesky::{self, LltRef, SymmetricOrdering};
     use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
     use faer::{Conj, MatMut, Par, Side};
-
-    /// A symmetric, diagonally dominant matrix on the mesh's pattern.
-    fn spd(asm: &Assembler) -> Matrix {
-        let mut a = asm.zero_matrix();
-        let p = a.pattern.clone();
-        for j in 0..a.size() {
-            let mut off = 0.0;
-            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
-                let i = p.row_idx[k];
-                if i != j {
-                    let (lo, hi) = (i.min(j), i.max(j));
-                    a.values[k] = -1.0 / (1.0 + ((lo * 7 + hi * 13) % 17) as f64);
-                    off += a.values[k].abs();
-                }
-            }
-            let diag = p.col_ptr[j] + p.row_idx[p.col_ptr[j]..p.col_ptr[j + 1]].binary_search(&j).unwrap();
-            a.values[diag] = 1.0 + 2.0 * off;
-        }
-        a
-    }
 
     #[test]
     fn block_solves_match_faers_for_simplicial_and_supernodal_factors() {
@@ -373,7 +354,7 @@ mod tests {
         ];
         for mesh in &meshes {
             let asm = Assembler::new(mesh);
-            let a = spd(&asm);
+            let a = diagonally_dominant(&asm);
             let n = a.size();
             let p = &a.pattern;
             let sym = SymbolicSparseColMatRef::new_checked(n, n, &p.col_ptr, None, &p.row_idx);

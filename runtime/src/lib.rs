@@ -35,3 +35,4 @@ pub mod problem;
 pub mod quadrature;
 pub mod redistribute;
 pub mod scheme;
+pub mod test_matrices;

@@ -31,8 +31,8 @@ pub struct HalfPattern {
     /// Column p's blocks below the diagonal: rows (positions > p, increasing) `rows[ptr[p]..ptr[p + 1]]`.
     ptr: Vec<usize>,
     rows: Vec<u32>,
-    /// Where each block is in the full pattern: the offset of its first value in column
-    /// `order[p]·d` of the full matrix (the other columns follow at the same offset).
+    /// Where each block is in the full pattern: the offset of its first value within each of
+    /// node `order[p]`'s columns.
     source: Vec<usize>,
     tasks: Vec<Task>,
 }
@@ -59,7 +59,7 @@ impl HalfPattern {
             column.clear();
             for (k, &i) in p.neighbours(j).iter().enumerate() {
                 if position[i as usize] > here {
-                    column.push((position[i as usize], p.col_ptr[j * d] + k * d));
+                    column.push((position[i as usize], k * d));
                 }
             }
             column.sort_unstable();
@@ -121,7 +121,7 @@ impl LowerHalf {
         let mut values = vec![0.0; h.rows.len() * d * d];
         for (q, &node) in h.order.iter().enumerate() {
             for k in h.ptr[q]..h.ptr[q + 1] {
-                let offset = h.source[k] - p.col_ptr[node as usize * d];
+                let offset = h.source[k];
                 for c in 0..d {
                     for r in 0..d {
                         values[(k * d + r) * d + c] = column(node as usize, c)[offset + r];
@@ -281,21 +281,8 @@ fn reverse_cuthill_mckee(p: &Pattern) -> Vec<u32> {
 mod tests {
     use super::*;
     use crate::assembly::Assembler;
-    use crate::mesh::Mesh;
     use crate::mesh::structured::{Diagonal, cuboid, interval, rectangle};
-
-    /// A symmetric matrix on the mesh's pattern with values that differ entry by entry.
-    fn symmetric(mesh: &Mesh) -> Matrix {
-        let mut a = Assembler::new(mesh).zero_matrix();
-        let p = a.pattern.clone();
-        for j in 0..a.size() {
-            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
-                let (lo, hi) = (p.row_idx[k].min(j), p.row_idx[k].max(j));
-                a.values[k] = 1.0 / (1.0 + ((lo * 7 + hi * 13) % 17) as f64) - 0.3;
-            }
-        }
-        a
-    }
+    use crate::test_matrices::diagonally_dominant;
 
     #[test]
     fn the_lower_half_product_is_the_full_product_for_any_number_of_threads() {
@@ -309,7 +296,7 @@ mod tests {
         ];
         let pool = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap();
         for mesh in &meshes {
-            let a = symmetric(mesh);
+            let a = diagonally_dominant(&Assembler::new(mesh));
             let half = Arc::new(HalfPattern::new(&a.pattern));
             let lower = LowerHalf::new(&a, &half);
             let n = a.size();
@@ -331,7 +318,7 @@ mod tests {
     fn reverse_cuthill_mckee_narrows_the_band_of_a_scrambled_mesh() {
         // A strip of 41 × 4 nodes, numbered along it: neighbours across it are 41 apart.
         let mesh = rectangle(40, 3, [0.0, 40.0], [0.0, 3.0], Diagonal::Right, 1);
-        let a = symmetric(&mesh);
+        let a = diagonally_dominant(&Assembler::new(&mesh));
         let half = HalfPattern::new(&a.pattern);
         let mut seen = half.order.clone();
         seen.sort_unstable();

@@ -273,8 +273,8 @@ struct StageCache {
     newton: Newton,
     dt: f64,
     constant: Option<Linear>,
-    /// The entries the nonlinear terms' tangents add to (None: anywhere), once known.
-    support: Option<Option<Entries>>,
+    /// The nonlinear terms' forms, and the entries their tangents add to (None: anywhere).
+    support: Option<(Vec<&'static str>, Option<Entries>)>,
     /// Scratch for the nonlinear terms' tangents: zero outside `support`.
     scratch: Option<Matrix>,
 }
@@ -575,7 +575,15 @@ impl<'a> Stepper<'a> {
         }
         let piecewise = nonlinear.iter().all(|a| self.forms[a.form].piecewise());
         let StageCache { newton, constant, support, scratch, .. } = &mut self.stages[cache];
-        let support = support.get_or_insert_with(|| tangent_support(self.asm, &self.forms, &nonlinear)).as_ref();
+        // The same forms at every step in practice; should they change, so may the entries where
+        // J varies, and the references compared there only are dropped.
+        if support.as_ref().is_none_or(|(forms, _)| !forms.iter().eq(nonlinear.iter().map(|a| &a.form))) {
+            let forms = nonlinear.iter().map(|a| a.form).collect();
+            *support = Some((forms, tangent_support(self.asm, &self.forms, &nonlinear)));
+            *scratch = None;
+            newton.invalidate();
+        }
+        let support = support.as_ref().and_then(|(_, entries)| entries.as_ref());
         let mut problem = StageProblem {
             asm: self.asm,
             forms: &self.forms,
