@@ -1,6 +1,6 @@
 //! The two operations a contact time step spends its time in, once the factorization is
 //! reused: a symmetric matrix–vector product (from the whole matrix and from its lower half)
-//! and a pair of triangular solves, on P2
+//! and a pair of triangular solves; and the numeric refactorization they avoid. On P2
 //! plane-strain patterns the size of the disc's meshes (3 362 and 12 482 unknowns).
 //! `cargo bench -p signorini-runtime --bench linalg`.
 
@@ -30,6 +30,8 @@ fn products_and_solves(c: &mut Criterion) {
         c.bench_function(&format!("lower-half product, {n} unknowns"), |b| b.iter(|| lower.mul_vec(&x, &mut y)));
         let mut f = Factorization::new(Structure::SymmetricPositiveDefinite);
         f.factor(&a).unwrap();
+        // The symbolic analysis is kept: this is the refactorization a time step may need.
+        c.bench_function(&format!("numeric factorization, {n} unknowns"), |b| b.iter(|| f.factor(&a).unwrap()));
         c.bench_function(&format!("solve pair, {n} unknowns"), |b| {
             b.iter(|| {
                 y.copy_from_slice(&x);

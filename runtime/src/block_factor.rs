@@ -61,54 +61,40 @@ impl BlockFactor {
         }
         let mut position = vec![0u32; n];
         order.iter().enumerate().for_each(|(k, &i)| position[i as usize] = k as u32);
-        // Column j of L as (rows, values), rows increasing, the diagonal first.
-        let columns = Columns::of(symbolic, values)?;
-        let nodes = n / d;
-        let mut diag = vec![0.0; nodes * d * d];
-        let mut ptr = Vec::with_capacity(nodes + 1);
-        ptr.push(0);
-        let (mut rows, mut blocks) = (Vec::new(), Vec::new());
-        for node in 0..nodes {
-            // The first column of the node has every row of the node's later columns.
-            let (first_rows, _) = columns.get(node * d);
-            if first_rows.len() < d || (0..d).any(|m| first_rows[m] != node * d + m) {
-                return None;
-            }
-            let below = &first_rows[d..];
-            if below.len() % d != 0 {
-                return None;
-            }
-            let start = blocks.len();
-            blocks.resize(start + below.len() * d, 0.0);
-            let mut last = node;
-            for group in below.chunks_exact(d) {
-                // Whole nodes, in increasing order (the first is the parent in the elimination tree).
-                if group[0] % d != 0
-                    || group[0] / d <= last
-                    || group.iter().enumerate().any(|(m, &r)| r != group[0] + m)
-                {
-                    return None;
-                }
-                last = group[0] / d;
-                rows.push(last as u32);
-            }
-            for c in 0..d {
-                let (col_rows, col_values) = columns.get(node * d + c);
-                // Rows node·d + c.. of the diagonal block, then exactly the node's rows below.
-                if col_rows.len() != (d - c) + below.len() || col_rows[d - c..] != *below {
-                    return None;
-                }
-                for r in c..d {
-                    diag[(node * d + r) * d + c] = col_values[r - c];
-                }
-                for (k, v) in col_values[d - c..].iter().enumerate() {
-                    let (block, r) = (k / d, k % d);
-                    blocks[start + (block * d + r) * d + c] = *v;
+        let mut blocks = Blocks { d, diag: vec![0.0; n * d], ptr: vec![0], rows: Vec::new(), values: Vec::new() };
+        match symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let (col_ptr, row_idx) = (s.col_ptr(), s.row_idx());
+                for node in 0..n / d {
+                    let column = |j: usize| (&row_idx[col_ptr[j]..col_ptr[j + 1]], &values[col_ptr[j]..col_ptr[j + 1]]);
+                    blocks.push(node, column)?;
                 }
             }
-            ptr.push(rows.len());
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                // A supernode's columns b..e share their rows: b..e, then its pattern; each is
+                // stored whole (column-major, nrows × (e − b)), the part above the diagonal unused.
+                let mut rows = Vec::new();
+                for sn in 0..s.n_supernodes() {
+                    let (b, e) = (s.supernode_begin()[sn], s.supernode_end()[sn]);
+                    if b % d != 0 || e % d != 0 {
+                        return None;
+                    }
+                    rows.clear();
+                    rows.extend(b..e);
+                    rows.extend_from_slice(s.supernode(sn).pattern());
+                    let nrows = rows.len();
+                    let block = &values[s.col_ptr_for_val()[sn]..][..nrows * (e - b)];
+                    for node in b / d..e / d {
+                        // Column j from its diagonal down.
+                        let column =
+                            |j: usize| (&rows[j - b..], &block[(j - b) * nrows + (j - b)..(j - b + 1) * nrows]);
+                        blocks.push(node, column)?;
+                    }
+                }
+            }
         }
-        Some(BlockFactor { d, order, position, diag, ptr, rows, values: blocks })
+        let Blocks { diag, ptr, rows, values, .. } = blocks;
+        Some(BlockFactor { d, order, position, diag, ptr, rows, values })
     }
 
     pub fn size(&self) -> usize {
@@ -269,65 +255,59 @@ fn diag_solve<const D: usize>(dg: &[f64], b: &[f64]) -> [f64; D] {
     x
 }
 
-/// Read access to the columns of faer's factor, simplicial or supernodal.
-enum Columns<'a> {
-    Simplicial {
-        col_ptr: &'a [usize],
-        row_idx: &'a [usize],
-        values: &'a [f64],
-    },
-    /// Columns copied out of the supernodes (rows of the diagonal part and the pattern).
-    Copied {
-        col_ptr: Vec<usize>,
-        row_idx: Vec<usize>,
-        values: Vec<f64>,
-    },
+/// The node blocks of L as they are copied in, node column by node column.
+struct Blocks {
+    d: usize,
+    diag: Vec<f64>,
+    ptr: Vec<usize>,
+    rows: Vec<u32>,
+    values: Vec<f64>,
 }
 
-impl<'a> Columns<'a> {
-    fn of(symbolic: &'a SymbolicCholesky<usize>, values: &'a [f64]) -> Option<Columns<'a>> {
-        match symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(s) => {
-                Some(Columns::Simplicial { col_ptr: s.col_ptr(), row_idx: s.row_idx(), values })
+impl Blocks {
+    /// Copies node column `node`, given its d dof columns from their diagonal down (rows
+    /// increasing, and the values at those rows). None unless they are made of whole node
+    /// blocks: the first column's rows below the node are those of every later column.
+    fn push<'c>(&mut self, node: usize, column: impl Fn(usize) -> (&'c [usize], &'c [f64])) -> Option<()> {
+        let d = self.d;
+        let (first_rows, _) = column(node * d);
+        if first_rows.len() < d || (0..d).any(|m| first_rows[m] != node * d + m) {
+            return None;
+        }
+        let below = &first_rows[d..];
+        if below.len() % d != 0 {
+            return None;
+        }
+        let start = self.values.len();
+        self.values.resize(start + below.len() * d, 0.0);
+        let mut last = node;
+        for group in below.chunks_exact(d) {
+            // Whole nodes, in increasing order (the first is the parent in the elimination tree).
+            if group[0] % d != 0 || group[0] / d <= last || group.iter().enumerate().any(|(m, &r)| r != group[0] + m) {
+                return None;
             }
-            SymbolicCholeskyRaw::Supernodal(s) => {
-                let n = s.nrows();
-                let mut col_ptr = Vec::with_capacity(n + 1);
-                col_ptr.push(0);
-                let (mut row_idx, mut vals) = (Vec::new(), Vec::new());
-                let begin = s.supernode_begin();
-                let end = s.supernode_end();
-                for sn in 0..s.n_supernodes() {
-                    let (b, e) = (begin[sn], end[sn]);
-                    let pattern = s.supernode(sn).pattern();
-                    let offset = s.col_ptr_for_val()[sn];
-                    let nrows = (e - b) + pattern.len();
-                    let block = &values[offset..offset + nrows * (e - b)];
-                    for j in 0..e - b {
-                        let column = &block[j * nrows..(j + 1) * nrows];
-                        for i in j..e - b {
-                            row_idx.push(b + i);
-                            vals.push(column[i]);
-                        }
-                        for (p, &r) in pattern.iter().enumerate() {
-                            row_idx.push(r);
-                            vals.push(column[e - b + p]);
-                        }
-                        col_ptr.push(row_idx.len());
-                    }
-                }
-                Some(Columns::Copied { col_ptr, row_idx, values: vals })
+            last = group[0] / d;
+            self.rows.push(last as u32);
+        }
+        for c in 0..d {
+            let (col_rows, col_values) = column(node * d + c);
+            // Rows node·d + c.. of the diagonal block, then exactly the node's rows below.
+            if col_rows.len() != (d - c) + below.len()
+                || col_rows[d - c..] != *below
+                || col_values.len() != col_rows.len()
+            {
+                return None;
+            }
+            for r in c..d {
+                self.diag[(node * d + r) * d + c] = col_values[r - c];
+            }
+            for (k, v) in col_values[d - c..].iter().enumerate() {
+                let (block, r) = (k / d, k % d);
+                self.values[start + (block * d + r) * d + c] = *v;
             }
         }
-    }
-
-    fn get(&self, j: usize) -> (&[usize], &[f64]) {
-        let (col_ptr, row_idx, values): (&[usize], &[usize], &[f64]) = match self {
-            Columns::Simplicial { col_ptr, row_idx, values } => (col_ptr, row_idx, values),
-            Columns::Copied { col_ptr, row_idx, values } => (col_ptr, row_idx, values),
-        };
-        let r = col_ptr[j]..col_ptr[j + 1];
-        (&row_idx[r.clone()], &values[r])
+        self.ptr.push(self.rows.len());
+        Some(())
     }
 }
 

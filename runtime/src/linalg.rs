@@ -10,17 +10,12 @@ use std::sync::Arc;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{self, LltRef, SymbolicCholesky};
 use faer::sparse::linalg::lu::{self, LuRef, NumericLu, SymbolicLu};
+use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
 use crate::block_factor::BlockFactor;
 use crate::pattern::Pattern;
-
-/// Supernodal Cholesky only when the factorization does more than 3·40 flops per entry of L
-/// (faer's default: 40). Below, on 2D meshes such as the disc's, the simplicial factor solves
-/// faster (bench disc, 12 490 unknowns: 5.6 against 6.5 ms/step), and with low-rank updates
-/// the solves, not the factorizations, are what a step costs; 3D factors stay supernodal.
-const SUPERNODAL_THRESHOLD: faer::sparse::linalg::SupernodalThreshold = faer::sparse::linalg::SupernodalThreshold(3.0);
 
 /// Stored entries from which a matrix–vector product is split over threads.
 const PARALLEL_NNZ: usize = 1 << 20;
@@ -360,12 +355,17 @@ impl Factorization {
             self.factors = match self.structure {
                 Structure::SymmetricPositiveDefinite => {
                     let (order, inverse) = node_ordering(&a.pattern)?;
+                    // The solves read a copy in node blocks (`block_factor`), so faer's layout
+                    // only decides how fast it factors: supernodal (half the time of simplicial on
+                    // the disc's 12 490 unknowns), with no relaxed supernodes, whose explicit
+                    // zeros the solves would read.
                     let symbolic = cholesky::factorize_symbolic_cholesky(
                         sym,
                         Side::Lower,
                         cholesky::SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(&order, &inverse, n)),
                         cholesky::CholeskySymbolicParams {
-                            supernodal_flop_ratio_threshold: SUPERNODAL_THRESHOLD,
+                            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                            supernodal_params: SymbolicSupernodalParams { relax: None },
                             ..Default::default()
                         },
                     )
