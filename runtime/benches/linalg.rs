@@ -28,6 +28,12 @@ fn products_and_solves(c: &mut Criterion) {
         c.bench_function(&format!("symmetric product, {n} unknowns"), |b| b.iter(|| a.mul_vec_transposed(&x, &mut y)));
         let lower = LowerHalf::new(&a, &Arc::new(HalfPattern::new(&a.pattern)));
         c.bench_function(&format!("lower-half product, {n} unknowns"), |b| b.iter(|| lower.mul_vec(&x, &mut y)));
+        // Two matrices in one pass (a Newmark stage's M a + K u) against two products above.
+        let pair = LowerHalf::fused(&[&a, &a], &Arc::new(HalfPattern::new(&a.pattern)));
+        let terms = [(1.0, x.as_slice()), (0.5, x.as_slice())];
+        c.bench_function(&format!("fused lower-half product of two, {n} unknowns"), |b| {
+            b.iter(|| pair.mul_sum(&terms, &mut y))
+        });
         let mut f = Factorization::new(Structure::SymmetricPositiveDefinite);
         f.factor(&a).unwrap();
         // The symbolic analysis is kept: this is the refactorization a time step may need.

@@ -82,74 +82,113 @@ impl HalfPattern {
         self.order.len()
     }
 
-    /// Doubles of work space a product needs: x and y in position order, and the task buffers.
-    fn work_len(&self) -> usize {
-        self.d * (2 * self.nodes() + self.tasks.iter().map(|t| t.reach - t.start).sum::<usize>())
+    /// Doubles of work space a product of `m` matrices needs: the m vectors and y in position
+    /// order, and the task buffers.
+    fn work_len(&self, m: usize) -> usize {
+        self.d * ((m + 1) * self.nodes() + self.tasks.iter().map(|t| t.reach - t.start).sum::<usize>())
     }
 }
 
-/// A symmetric matrix's lower half (diagonal blocks whole), for products.
+/// The lower halves (diagonal blocks whole) of a few symmetric matrices on one pattern, their
+/// blocks interleaved, for products Σ c_m A_m x_m in one pass: the pattern, the buffers and the
+/// sums into y are shared (a stage's linear terms, M a + K u for Newmark, cost one product).
 #[derive(Debug)]
 pub struct LowerHalf {
     pattern: Arc<HalfPattern>,
-    /// Per position, the diagonal block, d×d row-major.
+    /// How many matrices.
+    m: usize,
+    /// Per position, the matrices' diagonal blocks, d×d row-major each.
     diag: Vec<f64>,
-    /// Per block below the diagonal, d×d row-major: `values[(k·d + r)·d + c]` is
-    /// A[rows[k]·d + r, p·d + c] (in position order).
+    /// Per block below the diagonal, the matrices' d×d blocks, row-major: `values[((k·m + l)·d
+    /// + r)·d + c]` is A_l[rows[k]·d + r, p·d + c] (in position order).
     values: Vec<f64>,
     work: Mutex<Vec<f64>>,
 }
+
+/// Matrices a product fuses at most: the kernels are compiled for each count.
+pub const MAX_FUSED: usize = 4;
 
 impl LowerHalf {
     /// The lower half of `a`, which must be symmetric on `half`'s pattern (only the lower half
     /// is read).
     pub fn new(a: &Matrix, half: &Arc<HalfPattern>) -> LowerHalf {
+        LowerHalf::fused(&[a], half)
+    }
+
+    /// The lower halves of `matrices` (1 to [`MAX_FUSED`], symmetric, on `half`'s pattern).
+    pub fn fused(matrices: &[&Matrix], half: &Arc<HalfPattern>) -> LowerHalf {
+        assert!((1..=MAX_FUSED).contains(&matrices.len()), "1 to {MAX_FUSED} matrices");
         let h = half.as_ref();
-        let d = h.d;
-        let p = &a.pattern;
-        let column = |node: usize, c: usize| &a.values[p.col_ptr[node * d + c]..p.col_ptr[node * d + c + 1]];
-        let mut diag = vec![0.0; h.nodes() * d * d];
-        for (q, &node) in h.order.iter().enumerate() {
-            let node = node as usize;
-            let own = p.neighbours(node).binary_search(&(node as u32)).expect("a node neighbours itself");
-            for c in 0..d {
-                for r in 0..d {
-                    diag[(q * d + r) * d + c] = column(node, c)[own * d + r];
-                }
-            }
-        }
-        let mut values = vec![0.0; h.rows.len() * d * d];
-        for (q, &node) in h.order.iter().enumerate() {
-            for k in h.ptr[q]..h.ptr[q + 1] {
-                let offset = h.source[k];
+        let (d, m) = (h.d, matrices.len());
+        let mut diag = vec![0.0; h.nodes() * m * d * d];
+        let mut values = vec![0.0; h.rows.len() * m * d * d];
+        for (l, a) in matrices.iter().enumerate() {
+            let p = &a.pattern;
+            let column = |node: usize, c: usize| &a.values[p.col_ptr[node * d + c]..p.col_ptr[node * d + c + 1]];
+            for (q, &node) in h.order.iter().enumerate() {
+                let node = node as usize;
+                let own = p.neighbours(node).binary_search(&(node as u32)).expect("a node neighbours itself");
                 for c in 0..d {
                     for r in 0..d {
-                        values[(k * d + r) * d + c] = column(node as usize, c)[offset + r];
+                        diag[((q * m + l) * d + r) * d + c] = column(node, c)[own * d + r];
+                    }
+                }
+                for k in h.ptr[q]..h.ptr[q + 1] {
+                    let offset = h.source[k];
+                    for c in 0..d {
+                        for r in 0..d {
+                            values[((k * m + l) * d + r) * d + c] = column(node, c)[offset + r];
+                        }
                     }
                 }
             }
         }
-        LowerHalf { pattern: half.clone(), diag, values, work: Mutex::new(vec![0.0; h.work_len()]) }
+        let work = Mutex::new(vec![0.0; h.work_len(m)]);
+        LowerHalf { pattern: half.clone(), m, diag, values, work }
     }
 
-    /// `y = A x`.
+    /// How many matrices.
+    pub fn count(&self) -> usize {
+        self.m
+    }
+
+    /// `y = A x` (one matrix).
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
-        match self.pattern.d {
-            1 => self.mul_vec_d::<1>(x, y),
-            2 => self.mul_vec_d::<2>(x, y),
-            _ => self.mul_vec_d::<3>(x, y),
+        self.mul_sum(&[(1.0, x)], y);
+    }
+
+    /// `y = Σ c_l A_l x_l`, one (c_l, x_l) per matrix.
+    pub fn mul_sum(&self, terms: &[(f64, &[f64])], y: &mut [f64]) {
+        assert_eq!(terms.len(), self.m, "one vector per matrix");
+        match (self.pattern.d, self.m) {
+            (1, 1) => self.mul_sum_d::<1, 1>(terms, y),
+            (1, 2) => self.mul_sum_d::<1, 2>(terms, y),
+            (1, 3) => self.mul_sum_d::<1, 3>(terms, y),
+            (1, _) => self.mul_sum_d::<1, 4>(terms, y),
+            (2, 1) => self.mul_sum_d::<2, 1>(terms, y),
+            (2, 2) => self.mul_sum_d::<2, 2>(terms, y),
+            (2, 3) => self.mul_sum_d::<2, 3>(terms, y),
+            (2, _) => self.mul_sum_d::<2, 4>(terms, y),
+            (_, 1) => self.mul_sum_d::<3, 1>(terms, y),
+            (_, 2) => self.mul_sum_d::<3, 2>(terms, y),
+            (_, 3) => self.mul_sum_d::<3, 3>(terms, y),
+            (_, _) => self.mul_sum_d::<3, 4>(terms, y),
         }
     }
 
-    fn mul_vec_d<const D: usize>(&self, x: &[f64], y: &mut [f64]) {
+    fn mul_sum_d<const D: usize, const M: usize>(&self, terms: &[(f64, &[f64])], y: &mut [f64]) {
         let h = self.pattern.as_ref();
         let n = h.nodes() * D;
         // A poisoned lock only means another product panicked; the buffer is overwritten anyway.
         let mut work = self.work.lock().unwrap_or_else(|e| e.into_inner());
-        let (xp, rest) = work.split_at_mut(n);
+        let (xp, rest) = work.split_at_mut(n * M);
         let (yp, mut bufs) = rest.split_at_mut(n);
+        // The scaled vectors in position order, interleaved per node.
         for (q, &node) in h.order.iter().enumerate() {
-            xp[q * D..][..D].copy_from_slice(&x[node as usize * D..][..D]);
+            for (l, (c, x)) in terms.iter().enumerate() {
+                let (to, from) = (&mut xp[(q * M + l) * D..][..D], &x[node as usize * D..][..D]);
+                to.iter_mut().zip(from).for_each(|(t, f)| *t = c * f);
+            }
         }
         let mut slices = Vec::with_capacity(h.tasks.len());
         for t in &h.tasks {
@@ -158,7 +197,7 @@ impl LowerHalf {
             bufs = tail;
         }
         let xp = &*xp;
-        let run = |(t, buf): &mut (&Task, &mut [f64])| self.task::<D>(t, xp, buf);
+        let run = |(t, buf): &mut (&Task, &mut [f64])| self.task::<D, M>(t, xp, buf);
         if self.values.len() < PARALLEL_VALUES || rayon::current_num_threads() == 1 {
             slices.iter_mut().for_each(run);
         } else {
@@ -173,33 +212,36 @@ impl LowerHalf {
         }
     }
 
-    /// The task's columns' products, into `buf` (positions `t.start..t.reach`).
-    fn task<const D: usize>(&self, t: &Task, x: &[f64], buf: &mut [f64]) {
+    /// The task's columns' products, into `buf` (positions `t.start..t.reach`); `x` holds the
+    /// M vectors interleaved per node.
+    fn task<const D: usize, const M: usize>(&self, t: &Task, x: &[f64], buf: &mut [f64]) {
         let h = self.pattern.as_ref();
         buf.iter_mut().for_each(|v| *v = 0.0);
         for p in t.start..t.end {
-            let xj: [f64; D] = std::array::from_fn(|c| x[p * D + c]);
-            // (A_ip)ᵀ x_i summed over the column: D² independent sums.
+            let xj: [[f64; D]; M] = std::array::from_fn(|l| std::array::from_fn(|c| x[(p * M + l) * D + c]));
+            // Σ_l (A_l,ip)ᵀ x_l,i summed over the column: D² independent sums.
             let mut acc = [[0.0f64; D]; D];
             let range = h.ptr[p]..h.ptr[p + 1];
-            let values = &self.values[range.start * D * D..range.end * D * D];
-            for (&i, a) in h.rows[range].iter().zip(values.chunks_exact(D * D)) {
+            let values = &self.values[range.start * M * D * D..range.end * M * D * D];
+            for (&i, blocks) in h.rows[range].iter().zip(values.chunks_exact(M * D * D)) {
                 let i = i as usize;
-                let xi = &x[i * D..][..D];
                 let yi = &mut buf[(i - t.start) * D..][..D];
-                for r in 0..D {
-                    let mut s = 0.0;
-                    for c in 0..D {
-                        acc[c][r] += a[r * D + c] * xi[r];
-                        s += a[r * D + c] * xj[c];
+                for (l, a) in blocks.chunks_exact(D * D).enumerate() {
+                    let xi = &x[(i * M + l) * D..][..D];
+                    for r in 0..D {
+                        let mut s = 0.0;
+                        for c in 0..D {
+                            acc[c][r] += a[r * D + c] * xi[r];
+                            s += a[r * D + c] * xj[l][c];
+                        }
+                        yi[r] += s;
                     }
-                    yi[r] += s;
                 }
             }
-            let dg = &self.diag[p * D * D..][..D * D];
+            let dg = &self.diag[p * M * D * D..][..M * D * D];
             let yj = &mut buf[(p - t.start) * D..][..D];
             for c in 0..D {
-                let own: f64 = (0..D).map(|m| dg[c * D + m] * xj[m]).sum();
+                let own: f64 = (0..M).map(|l| (0..D).map(|k| dg[(l * D + c) * D + k] * xj[l][k]).sum::<f64>()).sum();
                 yj[c] += own + acc[c].iter().sum::<f64>();
             }
         }
@@ -311,6 +353,47 @@ mod tests {
             let mut threaded = vec![0.0; n];
             pool.install(|| lower.mul_vec(&x, &mut threaded));
             assert_eq!(y, threaded, "{n} unknowns");
+        }
+    }
+
+    #[test]
+    fn a_fused_product_is_the_sum_of_the_full_products() {
+        let unit = [0.0, 1.0];
+        for mesh in [
+            interval(50, 0.0, 1.0),
+            rectangle(9, 7, unit, unit, Diagonal::Right, 2),
+            cuboid([3, 2, 2], unit, unit, unit, 1),
+        ] {
+            let a = diagonally_dominant(&Assembler::new(&mesh));
+            let n = a.size();
+            let half = Arc::new(HalfPattern::new(&a.pattern));
+            // Symmetric matrices with different values: entrywise functions of a symmetric one.
+            let mut others = vec![a.clone()];
+            for k in 1..MAX_FUSED {
+                let mut b = a.clone();
+                b.values.iter_mut().for_each(|v| *v = (*v * k as f64).sin());
+                others.push(b);
+            }
+            let xs: Vec<Vec<f64>> = (0..MAX_FUSED)
+                .map(|k| (0..n).map(|i| (((i + 7 * k) * 31) % 101) as f64 / 101.0 - 0.5).collect())
+                .collect();
+            let coefs = [1.0, -2.5, 0.75, 3.0];
+            for m in 1..=MAX_FUSED {
+                let matrices: Vec<&Matrix> = others[..m].iter().collect();
+                let fused = LowerHalf::fused(&matrices, &half);
+                let mut expected = vec![0.0; n];
+                let mut product = vec![0.0; n];
+                for l in 0..m {
+                    others[l].mul_vec(&xs[l], &mut product);
+                    expected.iter_mut().zip(&product).for_each(|(e, p)| *e += coefs[l] * p);
+                }
+                let terms: Vec<(f64, &[f64])> = (0..m).map(|l| (coefs[l], xs[l].as_slice())).collect();
+                let mut y = vec![0.0; n];
+                fused.mul_sum(&terms, &mut y);
+                let scale = expected.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+                let err = y.iter().zip(&expected).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
+                assert!(err <= 1e-13 * scale, "{n} unknowns, {m} matrices: differs by {err:.1e} of {scale:.1e}");
+            }
         }
     }
 

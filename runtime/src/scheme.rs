@@ -20,7 +20,7 @@ use std::sync::Arc;
 
 use crate::assembly::{Assembler, Kernel, Quadrature};
 use crate::linalg::{Matrix, Structure};
-use crate::lower_half::{HalfPattern, LowerHalf};
+use crate::lower_half::{HalfPattern, LowerHalf, MAX_FUSED};
 use crate::mesh::Facet;
 use crate::newton::{Newton, NewtonError, NewtonOptions, NewtonReport, NonlinearProblem};
 use crate::pattern::Entries;
@@ -261,7 +261,7 @@ pub struct Stepper<'a> {
     /// Per stage: its Newton (keeps its factorization) and the constant operator for `dt`.
     stages: Vec<StageCache>,
     /// Linear forms' matrices (assembled once).
-    matrices: HashMap<String, Linear>,
+    matrices: HashMap<String, Matrix>,
     /// The pattern's lower half, when the stage matrices are symmetric.
     half_pattern: Option<Arc<HalfPattern>>,
     /// Recently assembled loads, by (form, time).
@@ -277,6 +277,9 @@ struct StageCache {
     support: Option<(Vec<&'static str>, Option<Entries>)>,
     /// Scratch for the nonlinear terms' tangents: zero outside `support`.
     scratch: Option<Matrix>,
+    /// The linear terms' forms, and their matrices' lower halves fused for one product (in
+    /// groups of at most [`MAX_FUSED`]), when the matrices are symmetric.
+    linear: Option<(Vec<&'static str>, Vec<LowerHalf>)>,
 }
 
 impl<'a> Stepper<'a> {
@@ -325,7 +328,6 @@ impl<'a> Stepper<'a> {
         };
         let half_pattern =
             (structure == Structure::SymmetricPositiveDefinite).then(|| Arc::new(HalfPattern::new(asm.pattern())));
-        let matrices = matrices.into_iter().map(|(name, m)| (name, Linear::new(m, half_pattern.as_ref()))).collect();
         let stages = (0..desc.stages.len() + 1)
             .map(|_| StageCache {
                 newton: Newton::new(newton_options),
@@ -333,6 +335,7 @@ impl<'a> Stepper<'a> {
                 constant: None,
                 support: None,
                 scratch: None,
+                linear: None,
             })
             .collect();
         Ok(Stepper {
@@ -369,7 +372,7 @@ impl<'a> Stepper<'a> {
 
     /// The matrix of a linear one-field form (e.g. `mass`, for energies).
     pub fn matrix(&self, form: &str) -> Option<&Matrix> {
-        self.matrices.get(form).map(|l| &l.matrix)
+        self.matrices.get(form)
     }
 
     /// Solves the initial problem (e.g. M a⁰ = L⁰ − B(u⁰)) for its state, if the scheme has one.
@@ -504,6 +507,39 @@ impl<'a> Stepper<'a> {
         out
     }
 
+    /// Adds Σ coef·K·base over a stage's linear terms (forms, coefficients, bases) to `rhs`:
+    /// one pass over the matrices' fused lower halves when they are symmetric.
+    fn add_linear(
+        &mut self,
+        cache: usize,
+        (forms, coefs, bases): &(Vec<&'static str>, Vec<f64>, Vec<Vec<f64>>),
+        rhs: &mut [f64],
+    ) {
+        if forms.is_empty() {
+            return;
+        }
+        let mut product = vec![0.0; rhs.len()];
+        let Some(half) = self.half_pattern.as_ref() else {
+            for ((form, coef), base) in forms.iter().zip(coefs).zip(bases) {
+                self.matrices[*form].mul_vec(base, &mut product);
+                rhs.iter_mut().zip(&product).for_each(|(r, x)| *r += coef * x);
+            }
+            return;
+        };
+        let entry = &mut self.stages[cache];
+        if entry.linear.as_ref().is_none_or(|(cached, _)| cached != forms) {
+            let matrices: Vec<&Matrix> = forms.iter().map(|f| &self.matrices[*f]).collect();
+            let groups = matrices.chunks(MAX_FUSED).map(|g| LowerHalf::fused(g, half)).collect();
+            entry.linear = Some((forms.clone(), groups));
+        }
+        let (_, groups) = entry.linear.as_ref().expect("built above");
+        let terms: Vec<(f64, &[f64])> = coefs.iter().zip(bases).map(|(c, b)| (*c, b.as_slice())).collect();
+        for (group, terms) in groups.iter().zip(terms.chunks(MAX_FUSED)) {
+            group.mul_sum(terms, &mut product);
+            rhs.iter_mut().zip(&product).for_each(|(r, x)| *r += x);
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn solve_stage(
         &mut self,
@@ -520,6 +556,8 @@ impl<'a> Stepper<'a> {
         // Known parts of every argument, and the constant part of the residual.
         let mut constant_rhs = vec![0.0; n];
         let mut nonlinear: Vec<ActiveTerm> = Vec::new();
+        // Linear terms coef·K·(α w + base): their forms, coefficients and bases.
+        let mut linear: (Vec<&'static str>, Vec<f64>, Vec<Vec<f64>>) = Default::default();
         let rebuild = self.stages[cache].dt != dt || self.stages[cache].constant.is_none();
         let mut constant = if rebuild { Some(self.asm.zero_matrix()) } else { None };
         for term in stage.terms {
@@ -550,13 +588,12 @@ impl<'a> Stepper<'a> {
             let alphas: Vec<f64> = term.args.iter().map(|c| c.unknown.map_or(0.0, |k| self.coefs[k])).collect();
             match self.matrices.get(term.form) {
                 Some(k) if alphas.len() == 1 => {
-                    // Linear: coef·K·(α w + base).
-                    let mut kb = vec![0.0; n];
-                    k.mul(&bases[0], &mut kb);
-                    constant_rhs.iter_mut().zip(&kb).for_each(|(r, x)| *r += coef * x);
                     if let Some(c) = constant.as_mut() {
-                        c.add_scaled(coef * alphas[0], &k.matrix);
+                        c.add_scaled(coef * alphas[0], k);
                     }
+                    linear.0.push(term.form);
+                    linear.1.push(coef);
+                    linear.2.extend(bases);
                 }
                 _ if alphas.iter().all(|a| *a == 0.0) => {
                     let refs: Vec<&[f64]> = bases.iter().map(Vec::as_slice).collect();
@@ -567,6 +604,7 @@ impl<'a> Stepper<'a> {
                 _ => nonlinear.push(ActiveTerm { form: term.form, coef, alphas, bases, t: term_t }),
             }
         }
+        self.add_linear(cache, &linear, &mut constant_rhs);
         if let Some(c) = constant {
             let entry = &mut self.stages[cache];
             entry.constant = Some(Linear::new(c, self.half_pattern.as_ref()));
