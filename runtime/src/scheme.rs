@@ -274,7 +274,7 @@ struct StageCache {
     dt: f64,
     constant: Option<Linear>,
     /// The nonlinear terms' forms, and the entries their tangents add to (None: anywhere).
-    support: Option<(Vec<&'static str>, Option<Entries>)>,
+    support: Option<(Vec<&'static str>, Option<Support>)>,
     /// Scratch for the nonlinear terms' tangents: zero outside `support`.
     scratch: Option<Matrix>,
     /// The linear terms' forms, and their matrices' lower halves fused for one product (in
@@ -437,11 +437,14 @@ impl<'a> Stepper<'a> {
             observe(&StageView { name: stage.name, time, quantities: stage.quantities, values: &values });
             quantities.push(values);
         }
+        // A stage quantity that becomes one state only is moved there, not copied.
+        let uses = |level: &Level| desc.updates.iter().filter(|l| *l == level).count();
         let new_states: Vec<Vec<f64>> = desc
             .updates
             .iter()
             .map(|l| match *l {
                 Level::State(i) => states[i].clone(),
+                Level::Stage(s, q) if uses(l) == 1 => std::mem::take(&mut quantities[s][q]),
                 Level::Stage(s, q) => quantities[s][q].clone(),
             })
             .collect();
@@ -621,7 +624,7 @@ impl<'a> Stepper<'a> {
             *scratch = None;
             newton.invalidate();
         }
-        let support = support.as_ref().and_then(|(_, entries)| entries.as_ref());
+        let support = support.as_ref().and_then(|(_, s)| s.as_ref());
         let mut problem = StageProblem {
             asm: self.asm,
             forms: &self.forms,
@@ -763,12 +766,21 @@ struct ActiveTerm {
 }
 
 impl ActiveTerm {
-    /// Writes the arguments α w + b into `out` (resized, reused across calls).
-    fn args_into(&self, w: &[f64], out: &mut Vec<Vec<f64>>) {
+    /// Writes the arguments α w + b into `out` (resized, reused across calls): at `dofs` only,
+    /// if given (the rest is never read).
+    fn args_into(&self, w: &[f64], out: &mut Vec<Vec<f64>>, dofs: Option<&[usize]>) {
         out.resize_with(self.alphas.len(), Vec::new);
         for ((o, a), b) in out.iter_mut().zip(&self.alphas).zip(&self.bases) {
-            o.clear();
-            o.extend(b.iter().zip(w).map(|(bi, wi)| bi + a * wi));
+            match dofs {
+                Some(dofs) => {
+                    o.resize(w.len(), 0.0);
+                    dofs.iter().for_each(|&i| o[i] = b[i] + a * w[i]);
+                }
+                None => {
+                    o.clear();
+                    o.extend(b.iter().zip(w).map(|(bi, wi)| bi + a * wi));
+                }
+            }
         }
     }
 }
@@ -782,8 +794,8 @@ struct StageProblem<'p, 'a> {
     constraints: &'p Constraints,
     structure: Structure,
     piecewise: bool,
-    /// Where the nonlinear terms' tangents add to J, if known.
-    support: Option<&'p Entries>,
+    /// Where the nonlinear terms' residuals and tangents can be nonzero, if known.
+    support: Option<&'p Support>,
     /// Reused for the nonlinear terms' tangents, arguments and residuals.
     scratch: &'p mut Option<Matrix>,
     args: Vec<Vec<f64>>,
@@ -804,14 +816,32 @@ impl NonlinearProblem for StageProblem<'_, '_> {
             self.magnitude = self.magnitude.max(norm_inf(r));
             r.iter_mut().zip(&self.rhs).for_each(|(ri, c)| *ri += c);
         }
+        let dofs = self.support.map(|s| s.dofs.as_slice());
         for term in &self.terms {
-            term.args_into(w, &mut self.args);
+            term.args_into(w, &mut self.args, dofs);
             let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
-            self.term.clear();
-            self.term.resize(r.len(), 0.0);
+            // The term is nonzero at the support's dofs only, if there is one.
+            match dofs {
+                Some(dofs) => {
+                    self.term.resize(r.len(), 0.0);
+                    dofs.iter().for_each(|&i| self.term[i] = 0.0);
+                }
+                None => {
+                    self.term.clear();
+                    self.term.resize(r.len(), 0.0);
+                }
+            }
             self.forms[term.form].residual(self.asm, &refs, term.t, &mut self.term);
-            self.magnitude = self.magnitude.max(term.coef.abs() * norm_inf(&self.term));
-            r.iter_mut().zip(&self.term).for_each(|(ri, x)| *ri += term.coef * x);
+            let largest = match dofs {
+                // A NaN reaches r, where Newton sees it; the magnitude only sets a floor.
+                Some(dofs) => dofs.iter().map(|&i| self.term[i].abs()).fold(0.0, f64::max),
+                None => norm_inf(&self.term),
+            };
+            self.magnitude = self.magnitude.max(term.coef.abs() * largest);
+            match dofs {
+                Some(dofs) => dofs.iter().for_each(|&i| r[i] += term.coef * self.term[i]),
+                None => r.iter_mut().zip(&self.term).for_each(|(ri, x)| *ri += term.coef * x),
+            }
         }
         self.constraints.zero(r);
     }
@@ -822,7 +852,7 @@ impl NonlinearProblem for StageProblem<'_, '_> {
 
     fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool {
         for term in &self.terms {
-            term.args_into(w, &mut self.args);
+            term.args_into(w, &mut self.args, self.support.map(|s| s.dofs.as_slice()));
             let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
@@ -836,7 +866,7 @@ impl NonlinearProblem for StageProblem<'_, '_> {
     fn jacobian(&mut self, w: &[f64], j: &mut Matrix) {
         j.values.copy_from_slice(&self.constant.matrix.values);
         for term in &self.terms {
-            term.args_into(w, &mut self.args);
+            term.args_into(w, &mut self.args, self.support.map(|s| s.dofs.as_slice()));
             let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
@@ -844,13 +874,13 @@ impl NonlinearProblem for StageProblem<'_, '_> {
                     // (only where the tangent can be nonzero, when that is known).
                     let m = self.scratch.get_or_insert_with(|| self.asm.zero_matrix());
                     match self.support {
-                        Some(s) => s.indices.iter().for_each(|&i| m.values[i] = 0.0),
+                        Some(s) => s.entries.indices.iter().for_each(|&i| m.values[i] = 0.0),
                         None => m.values.iter_mut().for_each(|v| *v = 0.0),
                     }
                     self.forms[term.form].tangent(self.asm, &refs, k, term.t, m);
                     let c = term.coef * a;
                     match self.support {
-                        Some(s) => s.indices.iter().for_each(|&i| j.values[i] += c * m.values[i]),
+                        Some(s) => s.entries.indices.iter().for_each(|&i| j.values[i] += c * m.values[i]),
                         None => j.add_scaled(c, m),
                     }
                 }
@@ -868,7 +898,7 @@ impl NonlinearProblem for StageProblem<'_, '_> {
     }
 
     fn varying_entries(&self) -> Option<&Entries> {
-        self.support
+        self.support.map(|s| &s.entries)
     }
 }
 
@@ -878,14 +908,24 @@ fn tangent_support(
     asm: &Assembler,
     forms: &HashMap<String, Box<dyn BoundForm + '_>>,
     terms: &[ActiveTerm],
-) -> Option<Entries> {
+) -> Option<Support> {
     let mut nodes = vec![false; asm.mesh().num_nodes()];
     for term in terms {
         for cell in forms[term.form].support()? {
             asm.mesh().cell(cell as usize).iter().for_each(|&n| nodes[n as usize] = true);
         }
     }
-    Some(asm.pattern().entries_among(&nodes))
+    let d = asm.pattern().dim();
+    let dofs = (0..nodes.len()).filter(|&j| nodes[j]).flat_map(|j| j * d..(j + 1) * d).collect();
+    Some(Support { entries: asm.pattern().entries_among(&nodes), dofs })
+}
+
+/// Where a stage's nonlinear terms live when they integrate over facets only: the dofs of
+/// their cells (the only ones their residuals touch and their arguments are read at) and the
+/// entries coupling them (the only ones their tangents add to).
+struct Support {
+    entries: Entries,
+    dofs: Vec<usize>,
 }
 
 #[cfg(test)]
