@@ -15,6 +15,7 @@ use std::sync::{Arc, OnceLock};
 use rayon::prelude::*;
 
 use crate::element::ElementKind;
+use crate::elements::ElementMatrices;
 use crate::kernel::{
     CellCtx, FacetCtx, FacetTabulation, Form, FormKernel, FormMeta, FunctionalKernel, LocalMatrix, LocalVector,
     Tabulation,
@@ -169,6 +170,25 @@ impl<'m> Assembler<'m> {
             self.mesh.kind,
             facet_tangent::<K>(self.mesh, &self.pattern, k, r, facets, degree, fields, wrt, t, &mut m.values)
         )
+    }
+
+    /// Appends the element matrices of the tangent of `k`'s integral over `region`, one per
+    /// facet of `facets` (over its cell's dofs), to `out`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn facet_tangent_elements<K: Kernel>(
+        &self,
+        k: &K,
+        region: &str,
+        facets: &[Facet],
+        q: Quadrature,
+        fields: &[&[f64]],
+        wrt: usize,
+        t: f64,
+        out: &mut ElementMatrices,
+    ) {
+        let Some(r) = region_index(k.meta(), region) else { return };
+        let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
+        dispatch!(self.mesh.kind, facet_tangent_elements::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, out))
     }
 
     /// Appends the active-set switches of `k`'s integral over `region` on `facets`.
@@ -478,6 +498,35 @@ fn facet_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
         *ke = [[[[0.0; D]; N]; D]; N];
         with_refs(&local, |refs| k.facet_tangent(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, &mut ke));
         pattern.scatter(c, cell, &ke, values);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn facet_tangent_elements<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    mesh: &Mesh,
+    k: &K,
+    region: usize,
+    facets: &[Facet],
+    degree: u32,
+    fields: &[&[f64]],
+    wrt: usize,
+    t: f64,
+    out: &mut ElementMatrices,
+) {
+    let tabs = FacetTabulation::<D, N>::shared(mesh.kind, degree).expect("kind matches D and N");
+    let mut local = locals::<D, N>(fields.len());
+    let mut ke: Box<LocalMatrix<D, N>> = Box::new([[[[0.0; D]; N]; D]; N]);
+    out.size = N * D;
+    for &f in facets {
+        let c = f.cell as usize;
+        let cell = mesh.cell(c);
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(cell, fields, &mut local);
+        *ke = [[[[0.0; D]; N]; D]; N];
+        with_refs(&local, |refs| k.facet_tangent(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, &mut ke));
+        out.dofs.extend(cell.iter().flat_map(|&node| (0..D).map(move |m| node as usize * D + m)));
+        // [test node][test component][trial node][trial component]: row-major (N·D)².
+        out.values.extend(ke.iter().flatten().flatten().flatten());
     }
 }
 

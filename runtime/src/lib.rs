@@ -20,6 +20,7 @@ macro_rules! dispatch {
 pub mod assembly;
 pub mod block_factor;
 pub mod element;
+pub mod elements;
 pub mod evaluate;
 pub mod geometry;
 pub mod kernel;

@@ -24,6 +24,7 @@ use faer::Mat;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 
 use crate::block_factor::SparseColumn;
+use crate::elements::{ChangeSplitter, ElementMatrices, RankOneTerms};
 use crate::linalg::{Factorization, LinalgError, Matrix};
 use crate::pattern::Entries;
 
@@ -39,8 +40,15 @@ pub struct LowRank {
     /// Stored values of the current correction's columns (the extra reads of a solve).
     column_entries: usize,
     /// The current correction's columns of W, dense over the union of their nodes, when that
-    /// is not much larger than their sparse entries.
+    /// is not much larger than their sparse entries; or, for a correction by rank-one terms,
+    /// W times their vectors.
     dense: Option<DenseColumns>,
+    /// ‖E‖∞ of the current correction.
+    change_norm: f64,
+    /// Columns of the current correction: the changed dofs, or the rank-one terms.
+    terms: usize,
+    /// The varying part of J₀ as element matrices, if the problem gives them.
+    elements: Option<ChangeSplitter>,
 }
 
 /// Columns of W over a common set of nodes (the union of their supports: the ancestors of the
@@ -80,6 +88,9 @@ impl LowRank {
             lu: None,
             column_entries: 0,
             dense: None,
+            change_norm: 0.0,
+            terms: 0,
+            elements: None,
         }
     }
 
@@ -101,15 +112,31 @@ impl LowRank {
         }
     }
 
-    /// Size of the current correction.
+    /// Dofs of the current correction.
     pub fn rank(&self) -> usize {
         self.dofs.len()
     }
 
+    /// Columns of the current correction: its rank-one terms if it is made of them, else its
+    /// dofs.
+    pub fn terms(&self) -> usize {
+        self.terms
+    }
+
     /// ‖E‖∞ of the current correction: ‖J‖∞ ≤ ‖J₀‖∞ + ‖E‖∞.
     pub fn change_norm(&self) -> f64 {
-        let k = self.dofs.len();
-        self.e.chunks_exact(k.max(1)).map(|row| row.iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max)
+        self.change_norm
+    }
+
+    /// Gives the varying part of J₀ as element matrices: later updates given the current ones
+    /// correct by the rank-one terms of the elements' changes.
+    pub fn set_elements(&mut self, elements: Option<ElementMatrices>) {
+        self.elements = elements.map(ChangeSplitter::new);
+    }
+
+    /// Whether J₀'s element matrices are known.
+    pub fn has_elements(&self) -> bool {
+        self.elements.is_some()
     }
 
     /// Values a solve reads beyond the factor's: the current correction's columns.
@@ -136,8 +163,16 @@ impl LowRank {
     }
 
     /// Makes the correction the one from the reference to `j`, whose differing dofs are `dofs`
-    /// (from [`LowRank::changed_dofs`]); `reference` is J₀'s factorization.
-    pub fn update(&mut self, j: &Matrix, dofs: Vec<usize>, reference: &mut Factorization) -> Result<(), LinalgError> {
+    /// (from [`LowRank::changed_dofs`]); `reference` is J₀'s factorization. Given `elements`,
+    /// the varying part of `j` as element matrices (see [`LowRank::set_elements`]), a Cholesky
+    /// reference is corrected by the rank-one terms of their change, if those make up J − J₀.
+    pub fn update(
+        &mut self,
+        j: &Matrix,
+        dofs: Vec<usize>,
+        reference: &mut Factorization,
+        elements: Option<&ElementMatrices>,
+    ) -> Result<(), LinalgError> {
         let n = j.size();
         if matches!(self.columns, Columns::Unknown) {
             self.columns = match reference.block() {
@@ -199,6 +234,20 @@ impl LowRank {
                 Mat::from_fn(k, k, |a, c| columns[dofs[c]].as_ref().expect("computed above")[dofs[a]])
             }
         };
+        self.change_norm = (0..k).map(|a| (0..k).map(|b| e[(a, b)].abs()).sum::<f64>()).fold(0.0, f64::max);
+        let terms = match (elements, &mut self.elements) {
+            (Some(now), Some(splitter)) if k > 0 => splitter.split(now),
+            _ => None,
+        };
+        if let Some(terms) = terms
+            && let Some(factored) = self.factored(&dofs, &e, &g, &terms, n)
+        {
+            (self.dense, self.e, self.lu) = (Some(factored.dense), factored.s, Some(factored.lu));
+            self.column_entries = factored.entries;
+            self.terms = terms.len();
+            self.dofs = dofs;
+            return Ok(());
+        }
         let m = Mat::<f64>::identity(k, k) + &g * &e;
         let lu = m.partial_piv_lu();
         let u = lu.U();
@@ -223,8 +272,68 @@ impl LowRank {
         };
         self.lu = (k > 0).then_some(lu);
         self.e = (0..k * k).map(|i| e[(i / k, i % k)]).collect();
+        self.terms = k;
         self.dofs = dofs;
         Ok(())
+    }
+
+    /// The correction by rank-one terms λ v vᵀ that make up E on `dofs` (with G = Wᵀ W there):
+    /// with X the terms' vectors (k×r, a few dofs each) and S = diag(λ), J = Pᵀ L (I + Ŵ S Ŵᵀ)
+    /// Lᵀ P for Ŵ = W X, and the solve's correction is Ŵ S M̃⁻¹ Ŵᵀ with M̃ = I + Xᵀ G X S,
+    /// r×r. Returns Ŵ (dense), S, M̃'s factors and Ŵ's size; None if the terms do not make up
+    /// E to round-off, or Ŵ would be too large (the correction by E is used then).
+    fn factored(&self, dofs: &[usize], e: &Mat<f64>, g: &Mat<f64>, terms: &RankOneTerms, n: usize) -> Option<Factored> {
+        let Columns::Sparse { of_dof, columns, d, .. } = &self.columns else { return None };
+        let (k, r, s) = (dofs.len(), terms.len(), terms.size);
+        let mut position = vec![usize::MAX; n];
+        dofs.iter().enumerate().for_each(|(a, &dof)| position[dof] = a);
+        // X as (position in D, value) per term; a term reaching outside D does not make up E.
+        let mut x: Vec<(usize, f64)> = Vec::with_capacity(r * s);
+        for (&dof, &v) in terms.dofs.iter().zip(&terms.vectors) {
+            match position[dof] {
+                usize::MAX if v != 0.0 => return None,
+                usize::MAX => x.push((0, 0.0)),
+                a => x.push((a, v)),
+            }
+        }
+        let term = |t: usize| &x[t * s..(t + 1) * s];
+        // Σ λ v vᵀ against E.
+        let mut sum = Mat::<f64>::zeros(k, k);
+        for t in 0..r {
+            for &(a, va) in term(t) {
+                for &(b, vb) in term(t) {
+                    sum[(a, b)] += terms.lambdas[t] * va * vb;
+                }
+            }
+        }
+        let scale = (0..k * k).map(|i| e[(i / k, i % k)].abs()).fold(0.0f64, f64::max);
+        let error = (0..k * k).map(|i| (e[(i / k, i % k)] - sum[(i / k, i % k)]).abs()).fold(0.0f64, f64::max);
+        if error.is_nan() || error > TERMS_ACCURACY * scale {
+            return None;
+        }
+        // Xᵀ G X through H = G X (k×r, column-major: a few columns of G per column).
+        let mut h = vec![0.0; k * r];
+        for (t, ht) in h.chunks_exact_mut(k).enumerate() {
+            for &(b, v) in term(t).iter().filter(|(_, v)| *v != 0.0) {
+                ht.iter_mut().zip(g.col(b).iter()).for_each(|(x, gb)| *x += v * gb);
+            }
+        }
+        let m = Mat::from_fn(r, r, |p, q| {
+            let gpq: f64 = term(p).iter().map(|&(a, v)| v * h[q * k + a]).sum();
+            f64::from(u8::from(p == q)) + gpq * terms.lambdas[q]
+        });
+        let lu = m.partial_piv_lu();
+        let u = lu.U();
+        let largest = (0..r).map(|i| u[(i, i)].abs()).fold(0.0f64, f64::max);
+        if (0..r).any(|i| u[(i, i)].abs().partial_cmp(&(1e-14 * largest)) != Some(std::cmp::Ordering::Greater)) {
+            return None;
+        }
+        let cols: Vec<&SparseColumn> =
+            dofs.iter().map(|&dof| &columns[of_dof[dof].expect("computed") as usize]).collect();
+        let dense = DenseColumns::new(&cols, *d, n / *d, usize::MAX)?.combined(*d, &x, s)?;
+        let entries = dense.values.len();
+        let sd = (0..r * r).map(|i| if i / r == i % r { terms.lambdas[i / r] } else { 0.0 }).collect();
+        Some(Factored { dense, s: sd, lu, entries })
     }
 
     /// Solves J x = b in place (b on entry) with the reference factorization `f` and this
@@ -260,7 +369,35 @@ impl LowRank {
     }
 }
 
+/// A correction by rank-one terms: Ŵ (dense), S (r×r, row-major), M̃'s factors, Ŵ's size.
+struct Factored {
+    dense: DenseColumns,
+    s: Vec<f64>,
+    lu: PartialPivLu<f64>,
+    entries: usize,
+}
+
+/// Rank-one terms must make up the change of J to this fraction of its largest entry.
+const TERMS_ACCURACY: f64 = 1e-12;
+
 impl DenseColumns {
+    /// The combinations Σ x·w of these columns given by `x` (per combination, `s` pairs
+    /// (column, weight)), over the same nodes; None beyond [`DENSE_BYTES`].
+    fn combined(&self, d: usize, x: &[(usize, f64)], s: usize) -> Option<DenseColumns> {
+        let m = self.nodes.len() * d;
+        let r = x.len() / s.max(1);
+        if 8 * m * r > DENSE_BYTES {
+            return None;
+        }
+        let mut values = vec![0.0; m * r];
+        for (t, out) in values.chunks_exact_mut(m.max(1)).enumerate() {
+            for &(a, v) in x[t * s..(t + 1) * s].iter().filter(|(_, v)| *v != 0.0) {
+                out.iter_mut().zip(&self.values[a * m..(a + 1) * m]).for_each(|(o, w)| *o += v * w);
+            }
+        }
+        Some(DenseColumns { nodes: self.nodes.clone(), values })
+    }
+
     /// The columns over the union of their nodes (sorted), if that holds at most
     /// [`DENSE_FILL`] times their `entries` and [`DENSE_BYTES`].
     fn new(columns: &[&SparseColumn], d: usize, nodes: usize, entries: usize) -> Option<DenseColumns> {
@@ -275,7 +412,7 @@ impl DenseColumns {
             }
         }
         let (m, k) = (union.len() * d, columns.len());
-        if m * k > DENSE_FILL * entries || 8 * m * k > DENSE_BYTES {
+        if m * k > DENSE_FILL.saturating_mul(entries) || 8 * m * k > DENSE_BYTES {
             return None;
         }
         union.sort_unstable();
@@ -418,6 +555,70 @@ mod tests {
     use crate::linalg::Structure;
     use crate::mesh::structured::{Diagonal, cuboid, rectangle};
     use crate::test_matrices::diagonally_dominant;
+
+    #[test]
+    fn rank_one_terms_of_element_changes_correct_the_factor() {
+        let unit = [0.0, 1.0];
+        let mesh = rectangle(10, 8, unit, unit, Diagonal::Right, 2);
+        let asm = Assembler::new(&mesh);
+        let a = diagonally_dominant(&asm);
+        let (n, d) = (a.size(), 2);
+        // Elements on five cells, zero at the reference; two change, by a rank-one and a
+        // rank-two symmetric matrix (one term negative).
+        let cells = [3usize, 17, 40, 41, 77];
+        let s = 6 * d;
+        let dofs: Vec<usize> = cells
+            .iter()
+            .flat_map(|&c| mesh.cell(c).iter().flat_map(|&node| (0..d).map(move |m| node as usize * d + m)))
+            .collect();
+        let reference = ElementMatrices { size: s, dofs: dofs.clone(), values: vec![0.0; cells.len() * s * s] };
+        let mut current = reference.clone();
+        let v = |k: usize| (0..s).map(|i| ((i * 7 + k * 3) % 11) as f64 / 11.0 - 0.3).collect::<Vec<f64>>();
+        for (e, terms) in [(1usize, vec![(2.0, v(0))]), (3, vec![(1.5, v(1)), (-0.25, v(2))])] {
+            for (lambda, x) in terms {
+                for i in 0..s {
+                    for j in 0..s {
+                        current.values[(e * s + i) * s + j] += lambda * x[i] * x[j];
+                    }
+                }
+            }
+        }
+        // J = J₀ + the elements' assembly.
+        let mut j = a.clone();
+        for (e, block) in current.values.chunks_exact(s * s).enumerate() {
+            for (r, &row) in dofs[e * s..(e + 1) * s].iter().enumerate() {
+                for (c, &col) in dofs[e * s..(e + 1) * s].iter().enumerate() {
+                    let p = &j.pattern;
+                    let k = p.col_ptr[col] + p.row_idx[p.col_ptr[col]..p.col_ptr[col + 1]].binary_search(&row).unwrap();
+                    j.values[k] += block[r * s + c];
+                }
+            }
+        }
+        let mut f = Factorization::new(Structure::SymmetricPositiveDefinite);
+        f.factor(&a).unwrap();
+        let mut lr = LowRank::new(&a);
+        lr.set_elements(Some(reference));
+        let changed = lr.changed_dofs(&j, None);
+        lr.update(&j, changed.clone(), &mut f, Some(&current)).unwrap();
+        assert_eq!(lr.terms(), 3, "three rank-one terms for {} changed dofs", changed.len());
+        assert!(changed.len() > 3);
+        let b: Vec<f64> = (0..n).map(|i| ((i * 13) % 23) as f64 / 23.0 - 0.5).collect();
+        let mut x = b.clone();
+        lr.solve(&mut f, &mut x).unwrap();
+        // J x = b.
+        let mut jx = vec![0.0; n];
+        j.mul_vec(&x, &mut jx);
+        let err = jx.iter().zip(&b).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+        assert!(err < 1e-12, "residual {err:.1e}");
+        // Without the elements, the correction by E on the changed dofs solves alike.
+        let mut by_dofs = LowRank::new(&a);
+        by_dofs.update(&j, changed.clone(), &mut f, None).unwrap();
+        assert_eq!(by_dofs.terms(), changed.len());
+        let mut y = b.clone();
+        by_dofs.solve(&mut f, &mut y).unwrap();
+        let diff = x.iter().zip(&y).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+        assert!(diff < 1e-12, "the two corrections differ by {diff:.1e}");
+    }
 
     #[test]
     fn dense_and_sparse_columns_correct_alike() {

@@ -16,6 +16,7 @@
 
 use tracing::debug;
 
+use crate::elements::ElementMatrices;
 use crate::linalg::{Factorization, LinalgError, Matrix, Solver, Structure};
 use crate::lowrank::LowRank;
 use crate::pattern::Entries;
@@ -56,6 +57,12 @@ pub trait NonlinearProblem {
     /// The entries outside which the Jacobian is the same at every w, if the problem knows
     /// them: corrections then compare Jacobians there only.
     fn varying_entries(&self) -> Option<&Entries> {
+        None
+    }
+    /// The part of the Jacobian at w that varies with w, as element matrices (always the same
+    /// elements), if the problem can give it: corrections then have the rank of the elements'
+    /// changes rather than of the dofs they touch.
+    fn tangent_elements(&mut self, _w: &[f64]) -> Option<ElementMatrices> {
         None
     }
 }
@@ -488,11 +495,14 @@ impl Newton {
                 dofs = other;
             }
             let new_columns = self.low_rank.as_ref().map_or(0, |lr| lr.missing(&dofs));
+            let elements =
+                if self.low_rank.as_ref().is_some_and(LowRank::has_elements) { p.tangent_elements(w) } else { None };
             let updated = dofs.len() <= self.rank_limit(j.size())
                 && self.cached_columns() + new_columns <= self.column_limit(j.size())
                 && match (self.low_rank.as_mut(), self.factorization.as_mut()) {
                     (Some(lr), Some(f)) => {
-                        lr.update(&j, dofs, f).is_ok() && lr.entries() <= self.entries_limit(j.size())
+                        lr.update(&j, dofs, f, elements.as_ref()).is_ok()
+                            && lr.entries() <= self.entries_limit(j.size())
                     }
                     _ => false,
                 };
@@ -526,7 +536,9 @@ impl Newton {
         self.refactor(p, w, assembled)?;
         let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
         if piecewise && direct && self.options.max_rank > 0 {
-            self.low_rank = Some(LowRank::new(self.jacobian.as_ref().expect("assembled by refactor")));
+            let mut lr = LowRank::new(self.jacobian.as_ref().expect("assembled by refactor"));
+            lr.set_elements(p.tangent_elements(w));
+            self.low_rank = Some(lr);
         }
         Ok(true)
     }

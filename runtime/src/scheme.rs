@@ -19,6 +19,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use crate::assembly::{Assembler, Kernel, Quadrature};
+use crate::elements::ElementMatrices;
 use crate::linalg::{Matrix, Structure};
 use crate::lower_half::{HalfPattern, LowerHalf, MAX_FUSED};
 use crate::mesh::Facet;
@@ -124,6 +125,18 @@ pub trait BoundForm {
     fn support(&self) -> Option<Vec<u32>> {
         None
     }
+    /// Appends the tangent's element matrices (unscaled, as `tangent` adds them) if the form
+    /// integrates over facets only; false if it cannot.
+    fn tangent_elements(
+        &self,
+        _asm: &Assembler,
+        _fields: &[&[f64]],
+        _wrt: usize,
+        _t: f64,
+        _out: &mut ElementMatrices,
+    ) -> bool {
+        false
+    }
     /// Whether the form changes with time other than through its fields.
     fn time_dependent(&self) -> bool {
         true
@@ -177,6 +190,22 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
             return None;
         }
         Some(self.regions.iter().flat_map(|(_, facets)| facets.iter().map(|f| f.cell)).collect())
+    }
+    fn tangent_elements(
+        &self,
+        asm: &Assembler,
+        fields: &[&[f64]],
+        wrt: usize,
+        t: f64,
+        out: &mut ElementMatrices,
+    ) -> bool {
+        if self.kernel.meta().cell_degree.is_some() {
+            return false;
+        }
+        for (region, facets) in &self.regions {
+            asm.facet_tangent_elements(&self.kernel, region, facets, self.quadrature, fields, wrt, t, out);
+        }
+        true
     }
     fn time_dependent(&self) -> bool {
         self.kernel.time_dependent()
@@ -899,6 +928,26 @@ impl NonlinearProblem for StageProblem<'_, '_> {
 
     fn varying_entries(&self) -> Option<&Entries> {
         self.support.map(|s| &s.entries)
+    }
+
+    fn tangent_elements(&mut self, w: &[f64]) -> Option<ElementMatrices> {
+        let mut out = ElementMatrices::default();
+        let dofs = self.support.map(|s| s.dofs.as_slice());
+        for term in &self.terms {
+            term.args_into(w, &mut self.args, dofs);
+            let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
+            for (k, a) in term.alphas.iter().enumerate() {
+                if *a != 0.0 {
+                    let from = out.len();
+                    if !self.forms[term.form].tangent_elements(self.asm, &refs, k, term.t, &mut out) {
+                        return None;
+                    }
+                    out.scale_from(from, term.coef * a);
+                }
+            }
+        }
+        out.zero_fixed(&self.constraints.fixed);
+        Some(out)
     }
 }
 
