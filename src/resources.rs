@@ -5,7 +5,7 @@ use crate::cases::CaseError;
 
 /// Peak bytes per unknown, measured: the 3D P2 ball with the iterative solver needs 9.6–9.8 kB
 /// per unknown from 108k to 986k unknowns (bench sphere); 2D P2 (about 25 stored entries per
-/// row, five matrices, a simplicial factor of about 60 entries per column) about 2.5 kB; the
+/// row, five matrices, a Cholesky factor of about 60 entries per column) about 2.5 kB; the
 /// 1D bar far less.
 const BYTES_PER_DOF: [f64; 3] = [500.0, 2_500.0, 10_000.0];
 

@@ -356,9 +356,9 @@ impl Factorization {
                 Structure::SymmetricPositiveDefinite => {
                     let (order, inverse) = node_ordering(&a.pattern)?;
                     // The solves read a copy in node blocks (`block_factor`), so faer's layout
-                    // only decides how fast it factors: supernodal (half the time of simplicial on
-                    // the disc's 12 490 unknowns), with no relaxed supernodes, whose explicit
-                    // zeros the solves would read.
+                    // only decides how fast it factors: supernodal (criterion: 13.3 against
+                    // 46.4 ms simplicial at 12 482 unknowns), with no relaxed supernodes, whose
+                    // explicit zeros the solves would read.
                     let symbolic = cholesky::factorize_symbolic_cholesky(
                         sym,
                         Side::Lower,
