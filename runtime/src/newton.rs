@@ -48,8 +48,15 @@ pub trait NonlinearProblem {
     /// Writes the active set at w. Returns false if the Jacobian depends on w otherwise (then
     /// it is rebuilt at every iteration).
     fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool;
-    /// Writes the Jacobian at w (constrained rows and columns replaced by the identity).
+    /// Writes the Jacobian at w (constrained rows and columns replaced by the identity) into
+    /// a zeroed `j`.
     fn jacobian(&mut self, w: &[f64], j: &mut Matrix);
+    /// Makes `j`, which holds what this problem's last `jacobian` or `update_jacobian` wrote
+    /// (the problem unchanged since), the Jacobian at w by rewriting only what can differ;
+    /// false if it cannot (Newton then zeroes j and calls `jacobian`).
+    fn update_jacobian(&mut self, _w: &[f64], _j: &mut Matrix) -> bool {
+        false
+    }
     /// An empty matrix with the Jacobian's pattern.
     fn jacobian_matrix(&self) -> Matrix;
     /// Cholesky for symmetric positive definite Jacobians, LU otherwise.
@@ -145,6 +152,8 @@ pub struct Newton {
     spare: Option<Factorization>,
     spd_failed: bool,
     jacobian: Option<Matrix>,
+    /// `jacobian` was last written by the problem, which has not changed since.
+    jacobian_current: bool,
     /// The active set the current operator (factorization and correction) was built for.
     factored_for: Option<Vec<bool>>,
     /// The correction of the factorization towards the current Jacobian (direct solver,
@@ -196,6 +205,7 @@ impl Newton {
             spare: None,
             spd_failed: false,
             jacobian: None,
+            jacobian_current: false,
             factored_for: None,
             low_rank: None,
             updates: 0,
@@ -213,6 +223,7 @@ impl Newton {
     /// Forgets the factorization's validity (the linear part of the problem changed).
     pub fn invalidate(&mut self) {
         self.factored_for = None;
+        self.jacobian_current = false;
         self.solve_accuracy = None;
         self.low_rank = None;
         self.overhead = 0;
@@ -477,8 +488,8 @@ impl Newton {
         if piecewise && !self.force_refactor && self.low_rank.is_some() {
             assembled = true;
             let mut j = self.jacobian.take().expect("assembled with the reference");
-            j.values.iter_mut().for_each(|v| *v = 0.0);
-            p.jacobian(w, &mut j);
+            Self::assemble(p, w, &mut j, self.jacobian_current);
+            self.jacobian_current = true;
             let entries = p.varying_entries();
             let mut dofs = self.low_rank.as_ref().map(|lr| lr.changed_dofs(&j, entries)).unwrap_or_default();
             // The previous reference, if the active set has come back near it.
@@ -546,11 +557,12 @@ impl Newton {
     /// Assembles and factors the Jacobian at w; a failed Cholesky falls back to LU.
     /// `assembled`: the Jacobian at w is already in place (from a low-rank attempt).
     fn refactor(&mut self, p: &mut impl NonlinearProblem, w: &[f64], assembled: bool) -> Result<(), LinalgError> {
+        let current = self.jacobian.is_some() && self.jacobian_current;
         let j = self.jacobian.get_or_insert_with(|| p.jacobian_matrix());
         if !assembled {
-            j.values.iter_mut().for_each(|v| *v = 0.0);
-            p.jacobian(w, j);
+            Self::assemble(p, w, j, current);
         }
+        self.jacobian_current = true;
         let want = match p.structure() {
             Structure::Auto if self.spd_failed || !j.is_symmetric(1e-12) => Structure::General,
             Structure::Auto => Structure::SymmetricPositiveDefinite,
@@ -584,6 +596,23 @@ impl Newton {
             }
             other => other,
         }
+    }
+
+    /// Writes the Jacobian at w into `j`: only what can differ if `current` (j holds the
+    /// problem's last Jacobian) and the problem can, else from zero.
+    fn assemble(p: &mut impl NonlinearProblem, w: &[f64], j: &mut Matrix, current: bool) {
+        if current && p.update_jacobian(w, j) {
+            // Test builds check the update against the whole assembly, bit for bit.
+            if cfg!(debug_assertions) {
+                let mut whole = p.jacobian_matrix();
+                p.jacobian(w, &mut whole);
+                let same = whole.values.iter().zip(&j.values).all(|(a, b)| a.to_bits() == b.to_bits());
+                assert!(same, "update_jacobian differs from jacobian");
+            }
+            return;
+        }
+        j.values.iter_mut().for_each(|v| *v = 0.0);
+        p.jacobian(w, j);
     }
 
     /// Takes the step (with backtracking if enabled); leaves R at the new iterate in `r`.

@@ -833,6 +833,33 @@ struct StageProblem<'p, 'a> {
     magnitude: f64,
 }
 
+impl StageProblem<'_, '_> {
+    /// Adds the nonlinear terms' tangents at w to `j` (on the support only, if known).
+    fn add_tangents(&mut self, w: &[f64], j: &mut Matrix) {
+        for term in &self.terms {
+            term.args_into(w, &mut self.args, self.support.map(|s| s.dofs.as_slice()));
+            let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
+            for (k, a) in term.alphas.iter().enumerate() {
+                if *a != 0.0 {
+                    // Kernels add unscaled: assemble into the scratch matrix, then scale in
+                    // (only where the tangent can be nonzero, when that is known).
+                    let m = self.scratch.get_or_insert_with(|| self.asm.zero_matrix());
+                    match self.support {
+                        Some(s) => s.entries.indices.iter().for_each(|&i| m.values[i] = 0.0),
+                        None => m.values.iter_mut().for_each(|v| *v = 0.0),
+                    }
+                    self.forms[term.form].tangent(self.asm, &refs, k, term.t, m);
+                    let c = term.coef * a;
+                    match self.support {
+                        Some(s) => s.entries.indices.iter().for_each(|&i| j.values[i] += c * m.values[i]),
+                        None => j.add_scaled(c, m),
+                    }
+                }
+            }
+        }
+    }
+}
+
 impl NonlinearProblem for StageProblem<'_, '_> {
     fn residual(&mut self, w: &[f64], r: &mut [f64]) {
         use crate::newton::norm_inf;
@@ -894,28 +921,17 @@ impl NonlinearProblem for StageProblem<'_, '_> {
 
     fn jacobian(&mut self, w: &[f64], j: &mut Matrix) {
         j.values.copy_from_slice(&self.constant.matrix.values);
-        for term in &self.terms {
-            term.args_into(w, &mut self.args, self.support.map(|s| s.dofs.as_slice()));
-            let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
-            for (k, a) in term.alphas.iter().enumerate() {
-                if *a != 0.0 {
-                    // Kernels add unscaled: assemble into the scratch matrix, then scale in
-                    // (only where the tangent can be nonzero, when that is known).
-                    let m = self.scratch.get_or_insert_with(|| self.asm.zero_matrix());
-                    match self.support {
-                        Some(s) => s.entries.indices.iter().for_each(|&i| m.values[i] = 0.0),
-                        None => m.values.iter_mut().for_each(|v| *v = 0.0),
-                    }
-                    self.forms[term.form].tangent(self.asm, &refs, k, term.t, m);
-                    let c = term.coef * a;
-                    match self.support {
-                        Some(s) => s.entries.indices.iter().for_each(|&i| j.values[i] += c * m.values[i]),
-                        None => j.add_scaled(c, m),
-                    }
-                }
-            }
-        }
+        self.add_tangents(w, j);
         self.constraints.apply(j);
+    }
+
+    fn update_jacobian(&mut self, w: &[f64], j: &mut Matrix) -> bool {
+        // Outside the support, J is the constant part (with the constraints) at every w.
+        let Some(s) = self.support else { return false };
+        s.entries.indices.iter().for_each(|&i| j.values[i] = self.constant.matrix.values[i]);
+        self.add_tangents(w, j);
+        self.constraints.apply(j);
+        true
     }
 
     fn jacobian_matrix(&self) -> Matrix {
