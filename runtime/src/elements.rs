@@ -16,13 +16,15 @@ pub struct ElementMatrices {
     pub values: Vec<f64>,
 }
 
-/// Symmetric rank-one terms λ v vᵀ, each v over `size` dofs: `dofs[t·size..]`, `vectors[t·size..]`.
+/// Symmetric rank-one terms λ v vᵀ, each v over `size` dofs: `dofs[t·size..]`, `vectors[t·size..]`;
+/// `ids` tell the same term (the same vector on the same dofs) at two updates.
 #[derive(Clone, Debug, Default)]
 pub struct RankOneTerms {
     pub size: usize,
     pub dofs: Vec<usize>,
     pub vectors: Vec<f64>,
     pub lambdas: Vec<f64>,
+    pub ids: Vec<u32>,
 }
 
 impl ElementMatrices {
@@ -72,6 +74,8 @@ pub struct ChangeSplitter {
     reference: ElementMatrices,
     /// Per element: the matrix last split and its terms (eigenvalues, eigenvectors).
     splits: Vec<Option<Split>>,
+    /// The id of the next split's first term.
+    next_id: u32,
 }
 
 #[derive(Clone, Debug)]
@@ -79,12 +83,14 @@ struct Split {
     matrix: Vec<f64>,
     lambdas: Vec<f64>,
     vectors: Vec<f64>,
+    /// Its first term's id (the others follow).
+    id: u32,
 }
 
 impl ChangeSplitter {
     pub fn new(reference: ElementMatrices) -> ChangeSplitter {
         let splits = vec![None; reference.len()];
-        ChangeSplitter { reference, splits }
+        ChangeSplitter { reference, splits, next_id: 0 }
     }
 
     /// The change from the reference to `current` (the same elements, at other arguments) as
@@ -102,13 +108,17 @@ impl ChangeSplitter {
                 continue;
             }
             if self.splits[e].as_ref().is_none_or(|split| split.matrix != after) {
-                self.splits[e] = Some(split_change(before, after, s)?);
+                let mut split = split_change(before, after, s)?;
+                split.id = self.next_id;
+                self.next_id += split.lambdas.len() as u32;
+                self.splits[e] = Some(split);
             }
             let split = self.splits[e].as_ref().expect("split above");
             for (i, &lambda) in split.lambdas.iter().enumerate() {
                 terms.dofs.extend_from_slice(&current.dofs[e * s..(e + 1) * s]);
                 terms.vectors.extend_from_slice(&split.vectors[i * s..(i + 1) * s]);
                 terms.lambdas.push(lambda);
+                terms.ids.push(split.id + i as u32);
             }
         }
         Some(terms)
@@ -129,6 +139,7 @@ fn split_change(before: &[f64], after: &[f64], s: usize) -> Option<Split> {
     Some(Split {
         matrix: after.to_vec(),
         lambdas: kept.iter().map(|&i| values[i]).collect(),
+        id: 0,
         vectors: kept.iter().flat_map(|&i| (0..s).map(move |a| vectors[(a, i)])).collect(),
     })
 }
@@ -175,8 +186,9 @@ mod tests {
                 assert!((sum - change).abs() < 1e-14, "({i}, {j}): {sum} against {change}");
             }
         }
-        // The same change again: the remembered split.
-        assert_eq!(splitter.split(&current).expect("symmetric").lambdas, terms.lambdas);
+        // The same change again: the remembered split, the same ids.
+        let again = splitter.split(&current).expect("symmetric");
+        assert_eq!((again.lambdas, again.ids), (terms.lambdas.clone(), terms.ids.clone()));
         // A nonsymmetric change is not split.
         current.values[9 + 1] += 1.0;
         assert!(splitter.split(&current).is_none());

@@ -49,6 +49,16 @@ pub struct LowRank {
     terms: usize,
     /// The varying part of J₀ as element matrices, if the problem gives them.
     elements: Option<ChangeSplitter>,
+    /// Columns W v of the rank-one terms seen so far, by term id, and their Gram matrix.
+    term_columns: TermColumns,
+}
+
+/// Columns kept per rank-one term until the reference changes: a term that persists from one
+/// update to the next (an element that stays switched) is not combined again.
+#[derive(Default)]
+struct TermColumns {
+    of_id: std::collections::HashMap<u32, u32>,
+    columns: Vec<SparseColumn>,
 }
 
 /// Columns of W over a common set of nodes (the union of their supports: the ancestors of the
@@ -91,6 +101,7 @@ impl LowRank {
             change_norm: 0.0,
             terms: 0,
             elements: None,
+            term_columns: TermColumns::default(),
         }
     }
 
@@ -98,7 +109,7 @@ impl LowRank {
     pub fn cached(&self) -> usize {
         match &self.columns {
             Columns::Unknown => 0,
-            Columns::Sparse { columns, .. } => columns.len(),
+            Columns::Sparse { columns, .. } => columns.len() + self.term_columns.columns.len(),
             Columns::Dense(c) => c.iter().filter(|c| c.is_some()).count(),
         }
     }
@@ -193,8 +204,8 @@ impl LowRank {
                 }
             }
         }
-        // G, k×k: Wᵀ W or Uᵀ Z.
-        let g = match &mut self.columns {
+        // W's or Z's columns for the dofs that have none yet.
+        match &mut self.columns {
             Columns::Unknown => unreachable!("decided above"),
             Columns::Sparse { of_dof, columns, gram, .. } => {
                 let block = reference.block().ok_or(LinalgError::NotFactored)?;
@@ -213,11 +224,6 @@ impl LowRank {
                         gram.push(row);
                     }
                 }
-                let slot = |dof: usize| of_dof[dof].expect("computed above") as usize;
-                Mat::from_fn(k, k, |a, c| {
-                    let (x, y) = (slot(dofs[a]), slot(dofs[c]));
-                    gram[x.max(y)][x.min(y)]
-                })
             }
             Columns::Dense(columns) => {
                 let missing: Vec<usize> = dofs.iter().copied().filter(|&d| columns[d].is_none()).collect();
@@ -231,16 +237,15 @@ impl LowRank {
                         columns[d] = Some(block[c * n..(c + 1) * n].into());
                     }
                 }
-                Mat::from_fn(k, k, |a, c| columns[dofs[c]].as_ref().expect("computed above")[dofs[a]])
             }
-        };
+        }
         self.change_norm = (0..k).map(|a| (0..k).map(|b| e[(a, b)].abs()).sum::<f64>()).fold(0.0, f64::max);
         let terms = match (elements, &mut self.elements) {
             (Some(now), Some(splitter)) if k > 0 => splitter.split(now),
             _ => None,
         };
         if let Some(terms) = terms
-            && let Some(factored) = self.factored(&dofs, &e, &g, &terms, n)
+            && let Some(factored) = self.factored(&dofs, &e, &terms, n)
         {
             (self.dense, self.e, self.lu) = (Some(factored.dense), factored.s, Some(factored.lu));
             self.column_entries = factored.entries;
@@ -248,6 +253,20 @@ impl LowRank {
             self.dofs = dofs;
             return Ok(());
         }
+        // G, k×k: Wᵀ W or Uᵀ Z.
+        let g = match &self.columns {
+            Columns::Unknown => unreachable!("decided above"),
+            Columns::Sparse { of_dof, gram, .. } => {
+                let slot = |dof: usize| of_dof[dof].expect("computed above") as usize;
+                Mat::from_fn(k, k, |a, c| {
+                    let (x, y) = (slot(dofs[a]), slot(dofs[c]));
+                    gram[x.max(y)][x.min(y)]
+                })
+            }
+            Columns::Dense(columns) => {
+                Mat::from_fn(k, k, |a, c| columns[dofs[c]].as_ref().expect("computed above")[dofs[a]])
+            }
+        };
         let m = Mat::<f64>::identity(k, k) + &g * &e;
         let lu = m.partial_piv_lu();
         let u = lu.U();
@@ -282,8 +301,9 @@ impl LowRank {
     /// Lᵀ P for Ŵ = W X, and the solve's correction is Ŵ S M̃⁻¹ Ŵᵀ with M̃ = I + Xᵀ G X S,
     /// r×r. Returns Ŵ (dense), S, M̃'s factors and Ŵ's size; None if the terms do not make up
     /// E to round-off, or Ŵ would be too large (the correction by E is used then).
-    fn factored(&self, dofs: &[usize], e: &Mat<f64>, g: &Mat<f64>, terms: &RankOneTerms, n: usize) -> Option<Factored> {
-        let Columns::Sparse { of_dof, columns, d, .. } = &self.columns else { return None };
+    fn factored(&mut self, dofs: &[usize], e: &Mat<f64>, terms: &RankOneTerms, n: usize) -> Option<Factored> {
+        let Columns::Sparse { of_dof, columns, gram, d } = &self.columns else { return None };
+        let d = *d;
         let (k, r, s) = (dofs.len(), terms.len(), terms.size);
         let mut position = vec![usize::MAX; n];
         dofs.iter().enumerate().for_each(|(a, &dof)| position[dof] = a);
@@ -311,26 +331,60 @@ impl LowRank {
         if error.is_nan() || error > TERMS_ACCURACY * scale {
             return None;
         }
-        // Xᵀ G X through H = G X (k×r, column-major: a few columns of G per column).
+        // Xᵀ G X through H = G X (k×r, column-major), G from the dofs' Gram matrix.
+        let slots: Vec<usize> = dofs.iter().map(|&dof| of_dof[dof].expect("computed") as usize).collect();
+        let mut g = vec![0.0; k * k];
+        for (b, gb) in g.chunks_exact_mut(k).enumerate() {
+            let y = slots[b];
+            gb.iter_mut().zip(&slots).for_each(|(x, &z)| *x = gram[y.max(z)][y.min(z)]);
+        }
         let mut h = vec![0.0; k * r];
         for (t, ht) in h.chunks_exact_mut(k).enumerate() {
             for &(b, v) in term(t).iter().filter(|(_, v)| *v != 0.0) {
-                ht.iter_mut().zip(g.col(b).iter()).for_each(|(x, gb)| *x += v * gb);
+                ht.iter_mut().zip(&g[b * k..(b + 1) * k]).for_each(|(x, gb)| *x += v * gb);
             }
         }
         let m = Mat::from_fn(r, r, |p, q| {
             let gpq: f64 = term(p).iter().map(|&(a, v)| v * h[q * k + a]).sum();
             f64::from(u8::from(p == q)) + gpq * terms.lambdas[q]
         });
+        // Each new term's column W v = Σ v_i W e_i, over the union of its dofs' columns' nodes.
+        let cache = &mut self.term_columns;
+        let (mut work, mut seen) = (vec![0.0; n], vec![false; n / d]);
+        for (t, &id) in terms.ids.iter().enumerate() {
+            if cache.of_id.contains_key(&id) {
+                continue;
+            }
+            let mut nodes: Vec<u32> = Vec::new();
+            for &(a, v) in term(t).iter().filter(|(_, v)| *v != 0.0) {
+                let col = &columns[of_dof[dofs[a]].expect("computed") as usize];
+                for (&node, w) in col.nodes.iter().zip(col.values.chunks_exact(d)) {
+                    if !seen[node as usize] {
+                        seen[node as usize] = true;
+                        nodes.push(node);
+                    }
+                    work[node as usize * d..][..d].iter_mut().zip(w).for_each(|(x, wi)| *x += v * wi);
+                }
+            }
+            nodes.sort_unstable();
+            let mut values = Vec::with_capacity(nodes.len() * d);
+            for &node in &nodes {
+                seen[node as usize] = false;
+                let at = &mut work[node as usize * d..][..d];
+                values.extend_from_slice(at);
+                at.iter_mut().for_each(|x| *x = 0.0);
+            }
+            cache.of_id.insert(id, cache.columns.len() as u32);
+            cache.columns.push(SparseColumn { nodes, values });
+        }
         let lu = m.partial_piv_lu();
         let u = lu.U();
         let largest = (0..r).map(|i| u[(i, i)].abs()).fold(0.0f64, f64::max);
         if (0..r).any(|i| u[(i, i)].abs().partial_cmp(&(1e-14 * largest)) != Some(std::cmp::Ordering::Greater)) {
             return None;
         }
-        let cols: Vec<&SparseColumn> =
-            dofs.iter().map(|&dof| &columns[of_dof[dof].expect("computed") as usize]).collect();
-        let dense = DenseColumns::new(&cols, *d, n / *d, usize::MAX)?.combined(*d, &x, s)?;
+        let cols: Vec<&SparseColumn> = terms.ids.iter().map(|id| &cache.columns[cache.of_id[id] as usize]).collect();
+        let dense = DenseColumns::new(&cols, d, n / d, usize::MAX)?;
         let entries = dense.values.len();
         let sd = (0..r * r).map(|i| if i / r == i % r { terms.lambdas[i / r] } else { 0.0 }).collect();
         Some(Factored { dense, s: sd, lu, entries })
@@ -381,23 +435,6 @@ struct Factored {
 const TERMS_ACCURACY: f64 = 1e-12;
 
 impl DenseColumns {
-    /// The combinations Σ x·w of these columns given by `x` (per combination, `s` pairs
-    /// (column, weight)), over the same nodes; None beyond [`DENSE_BYTES`].
-    fn combined(&self, d: usize, x: &[(usize, f64)], s: usize) -> Option<DenseColumns> {
-        let m = self.nodes.len() * d;
-        let r = x.len() / s.max(1);
-        if 8 * m * r > DENSE_BYTES {
-            return None;
-        }
-        let mut values = vec![0.0; m * r];
-        for (t, out) in values.chunks_exact_mut(m.max(1)).enumerate() {
-            for &(a, v) in x[t * s..(t + 1) * s].iter().filter(|(_, v)| *v != 0.0) {
-                out.iter_mut().zip(&self.values[a * m..(a + 1) * m]).for_each(|(o, w)| *o += v * w);
-            }
-        }
-        Some(DenseColumns { nodes: self.nodes.clone(), values })
-    }
-
     /// The columns over the union of their nodes (sorted), if that holds at most
     /// [`DENSE_FILL`] times their `entries` and [`DENSE_BYTES`].
     fn new(columns: &[&SparseColumn], d: usize, nodes: usize, entries: usize) -> Option<DenseColumns> {
