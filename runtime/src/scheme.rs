@@ -499,7 +499,6 @@ impl<'a> Stepper<'a> {
         quantities: &[Vec<Vec<f64>>],
     ) -> Vec<f64> {
         let n = self.asm.size();
-        let mut out = vec![0.0; n];
         let level = |l: Level| -> &[f64] {
             match l {
                 Level::State(i) => &states[i],
@@ -511,10 +510,12 @@ impl<'a> Stepper<'a> {
             Some((_, b)) => *b += a,
             None => terms.push((l, a)),
         };
+        // The sum's parts in order: out += a·x, or out += a·(x − y).
+        let mut parts: Vec<Part> = Vec::new();
         if let Some(k) = c.unknown {
             let a = self.coefs[k];
             if let Some(d) = delta {
-                out.iter_mut().zip(d).for_each(|(o, x)| *o += a * x);
+                parts.push((a, d, None));
             }
             add(reference, a);
         }
@@ -526,14 +527,30 @@ impl<'a> Stepper<'a> {
         for group in zero_sum_groups(&coefs) {
             if group.len() == 1 {
                 let (l, a) = terms[group[0]];
-                out.iter_mut().zip(level(l)).for_each(|(o, x)| *o += a * x);
+                parts.push((a, level(l), None));
                 continue;
             }
             let r = group.iter().copied().find(|&i| terms[i].0 == reference).unwrap_or(group[0]);
             let x0 = level(terms[r].0);
             for &i in group.iter().filter(|&&i| i != r) {
                 let (l, a) = terms[i];
-                out.iter_mut().zip(level(l)).zip(x0).for_each(|((o, x), y)| *o += a * (x - y));
+                parts.push((a, level(l), Some(x0)));
+            }
+        }
+        // Strip by strip, each part in turn: one pass over memory, the same sums as part by part.
+        const STRIP: usize = 512;
+        let mut out = vec![0.0; n];
+        for (k, o) in out.chunks_mut(STRIP).enumerate() {
+            let range = k * STRIP..k * STRIP + o.len();
+            for &(a, x, y) in &parts {
+                match y {
+                    None => o.iter_mut().zip(&x[range.clone()]).for_each(|(o, x)| *o += a * x),
+                    Some(y) => o
+                        .iter_mut()
+                        .zip(&x[range.clone()])
+                        .zip(&y[range.clone()])
+                        .for_each(|((o, x), y)| *o += a * (x - y)),
+                }
             }
         }
         out
@@ -784,6 +801,9 @@ impl Linear {
         }
     }
 }
+
+/// A part of a combination: a·x, or a·(x − y).
+type Part<'v> = (f64, &'v [f64], Option<&'v [f64]>);
 
 /// A nonlinear term of a stage: coef·form(α₁w + b₁, ...).
 struct ActiveTerm {
