@@ -155,23 +155,3 @@ fn the_reference_meshes_pass_every_check() {
     m.region("contact").unwrap();
     m.region("free").unwrap();
 }
-
-/// The cost of the checks on the largest built-in ball of `bench sphere` (985k unknowns),
-/// against one quadrature pass over its cells (`measure`, a lower bound for an assembly):
-/// `cargo test --release -p signorini-runtime --test mesh_integrity -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn validate_cost_on_a_large_ball() {
-    let m = signorini_runtime::mesh::ball::ball(10.0, [0.0, 0.0, 12.0], 10.0 / 17.0);
-    let t = std::time::Instant::now();
-    m.validate().unwrap();
-    let validate = t.elapsed().as_secs_f64();
-    let t = std::time::Instant::now();
-    let measure = m.measure();
-    let pass = t.elapsed().as_secs_f64();
-    println!(
-        "ball: {} cells, {} unknowns: validate {validate:.3} s, one quadrature pass (measure {measure:.1}) {pass:.3} s",
-        m.num_cells(),
-        3 * m.num_nodes(),
-    );
-}
