@@ -474,6 +474,34 @@ fn facet_residual<const D: usize, const N: usize, K: FormKernel<D, N>>(
     }
 }
 
+/// Calls `each(cell index, cell nodes, element matrix)` with the tangent of `k`'s integral over
+/// `region` on each of `facets`.
+#[allow(clippy::too_many_arguments)]
+fn for_facet_tangents<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    mesh: &Mesh,
+    k: &K,
+    region: usize,
+    facets: &[Facet],
+    degree: u32,
+    fields: &[&[f64]],
+    wrt: usize,
+    t: f64,
+    mut each: impl FnMut(usize, &[u32], &LocalMatrix<D, N>),
+) {
+    let tabs = FacetTabulation::<D, N>::shared(mesh.kind, degree).expect("kind matches D and N");
+    let mut local = locals::<D, N>(fields.len());
+    let mut ke: Box<LocalMatrix<D, N>> = Box::new([[[[0.0; D]; N]; D]; N]);
+    for &f in facets {
+        let c = f.cell as usize;
+        let cell = mesh.cell(c);
+        let coords = mesh.cell_coords::<D, N>(c);
+        gather(cell, fields, &mut local);
+        *ke = [[[[0.0; D]; N]; D]; N];
+        with_refs(&local, |refs| k.facet_tangent(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, &mut ke));
+        each(c, cell, &ke);
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn facet_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
     mesh: &Mesh,
@@ -487,18 +515,9 @@ fn facet_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
     t: f64,
     values: &mut [f64],
 ) {
-    let tabs = FacetTabulation::<D, N>::shared(mesh.kind, degree).expect("kind matches D and N");
-    let mut local = locals::<D, N>(fields.len());
-    let mut ke: Box<LocalMatrix<D, N>> = Box::new([[[[0.0; D]; N]; D]; N]);
-    for &f in facets {
-        let c = f.cell as usize;
-        let cell = mesh.cell(c);
-        let coords = mesh.cell_coords::<D, N>(c);
-        gather(cell, fields, &mut local);
-        *ke = [[[[0.0; D]; N]; D]; N];
-        with_refs(&local, |refs| k.facet_tangent(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, &mut ke));
-        pattern.scatter(c, cell, &ke, values);
-    }
+    for_facet_tangents(mesh, k, region, facets, degree, fields, wrt, t, |c, cell, ke| {
+        pattern.scatter(c, cell, ke, values)
+    });
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -513,21 +532,12 @@ fn facet_tangent_elements<const D: usize, const N: usize, K: FormKernel<D, N>>(
     t: f64,
     out: &mut ElementMatrices,
 ) {
-    let tabs = FacetTabulation::<D, N>::shared(mesh.kind, degree).expect("kind matches D and N");
-    let mut local = locals::<D, N>(fields.len());
-    let mut ke: Box<LocalMatrix<D, N>> = Box::new([[[[0.0; D]; N]; D]; N]);
     out.size = N * D;
-    for &f in facets {
-        let c = f.cell as usize;
-        let cell = mesh.cell(c);
-        let coords = mesh.cell_coords::<D, N>(c);
-        gather(cell, fields, &mut local);
-        *ke = [[[[0.0; D]; N]; D]; N];
-        with_refs(&local, |refs| k.facet_tangent(region, &facet_ctx(mesh, &tabs, f, &coords, t), refs, wrt, &mut ke));
+    for_facet_tangents(mesh, k, region, facets, degree, fields, wrt, t, |_, cell, ke| {
         out.dofs.extend(cell.iter().flat_map(|&node| (0..D).map(move |m| node as usize * D + m)));
         // [test node][test component][trial node][trial component]: row-major (N·D)².
         out.values.extend(ke.iter().flatten().flatten().flatten());
-    }
+    });
 }
 
 #[allow(clippy::too_many_arguments)]

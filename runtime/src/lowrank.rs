@@ -15,10 +15,15 @@
 //!
 //!   x₀ = J₀⁻¹ b,  (I + G E) y = x₀[D],  x = x₀ − Z E y.
 //!
+//! * Cholesky reference whose change is given as rank-one terms (`elements`): with E = X S Xᵀ,
+//!   X k×r (each column on one element's dofs) and S = diag(λ), the same correction with
+//!   Ŵ = W X in place of W, S in place of E and the r×r matrix I + XᵀGX S in place of M; r is
+//!   the number of switched quadrature points, about k/2.7 on the disc.
+//!
 //! A contact tangent changes only on the cells of facets whose active set changed, so D stays
 //! small while the reference is the operator at an active set near the current one. Columns
-//! (and, for W, their Gram matrix) are kept per dof until the reference changes: a dof that
-//! switches again costs nothing.
+//! (and, for W, their Gram matrix) are kept per dof, and the terms' columns Ŵ per term, until
+//! the reference changes: a dof that switches again costs nothing.
 
 use faer::Mat;
 use faer::linalg::solvers::{PartialPivLu, Solve};
@@ -49,7 +54,7 @@ pub struct LowRank {
     terms: usize,
     /// The varying part of J₀ as element matrices, if the problem gives them.
     elements: Option<ChangeSplitter>,
-    /// Columns W v of the rank-one terms seen so far, by term id, and their Gram matrix.
+    /// Columns W v of the rank-one terms seen so far, by term id.
     term_columns: TermColumns,
 }
 
@@ -240,19 +245,6 @@ impl LowRank {
             }
         }
         self.change_norm = (0..k).map(|a| (0..k).map(|b| e[(a, b)].abs()).sum::<f64>()).fold(0.0, f64::max);
-        let terms = match (elements, &mut self.elements) {
-            (Some(now), Some(splitter)) if k > 0 => splitter.split(now),
-            _ => None,
-        };
-        if let Some(terms) = terms
-            && let Some(factored) = self.factored(&dofs, &e, &terms, n)
-        {
-            (self.dense, self.e, self.lu) = (Some(factored.dense), factored.s, Some(factored.lu));
-            self.column_entries = factored.entries;
-            self.terms = terms.len();
-            self.dofs = dofs;
-            return Ok(());
-        }
         // G, k×k: Wᵀ W or Uᵀ Z.
         let g = match &self.columns {
             Columns::Unknown => unreachable!("decided above"),
@@ -267,6 +259,19 @@ impl LowRank {
                 Mat::from_fn(k, k, |a, c| columns[dofs[c]].as_ref().expect("computed above")[dofs[a]])
             }
         };
+        let terms = match (elements, &mut self.elements) {
+            (Some(now), Some(splitter)) if k > 0 => splitter.split(now),
+            _ => None,
+        };
+        if let Some(terms) = terms
+            && let Some(factored) = self.factored(&dofs, &position, &e, &g, &terms, n)
+        {
+            self.column_entries = factored.dense.values.len();
+            (self.dense, self.e, self.lu) = (Some(factored.dense), factored.s, Some(factored.lu));
+            self.terms = terms.len();
+            self.dofs = dofs;
+            return Ok(());
+        }
         let m = Mat::<f64>::identity(k, k) + &g * &e;
         let lu = m.partial_piv_lu();
         let u = lu.U();
@@ -299,14 +304,21 @@ impl LowRank {
     /// The correction by rank-one terms λ v vᵀ that make up E on `dofs` (with G = Wᵀ W there):
     /// with X the terms' vectors (k×r, a few dofs each) and S = diag(λ), J = Pᵀ L (I + Ŵ S Ŵᵀ)
     /// Lᵀ P for Ŵ = W X, and the solve's correction is Ŵ S M̃⁻¹ Ŵᵀ with M̃ = I + Xᵀ G X S,
-    /// r×r. Returns Ŵ (dense), S, M̃'s factors and Ŵ's size; None if the terms do not make up
+    /// r×r. Returns Ŵ (dense), S and M̃'s factors; None if the terms do not make up
     /// E to round-off, or Ŵ would be too large (the correction by E is used then).
-    fn factored(&mut self, dofs: &[usize], e: &Mat<f64>, terms: &RankOneTerms, n: usize) -> Option<Factored> {
-        let Columns::Sparse { of_dof, columns, gram, d } = &self.columns else { return None };
+    /// `position[dof]` is the dof's index in `dofs` (usize::MAX if it is not one of them).
+    fn factored(
+        &mut self,
+        dofs: &[usize],
+        position: &[usize],
+        e: &Mat<f64>,
+        g: &Mat<f64>,
+        terms: &RankOneTerms,
+        n: usize,
+    ) -> Option<Factored> {
+        let Columns::Sparse { of_dof, columns, d, .. } = &self.columns else { return None };
         let d = *d;
         let (k, r, s) = (dofs.len(), terms.len(), terms.size);
-        let mut position = vec![usize::MAX; n];
-        dofs.iter().enumerate().for_each(|(a, &dof)| position[dof] = a);
         // X as (position in D, value) per term; a term reaching outside D does not make up E.
         let mut x: Vec<(usize, f64)> = Vec::with_capacity(r * s);
         for (&dof, &v) in terms.dofs.iter().zip(&terms.vectors) {
@@ -331,17 +343,11 @@ impl LowRank {
         if error.is_nan() || error > TERMS_ACCURACY * scale {
             return None;
         }
-        // Xᵀ G X through H = G X (k×r, column-major), G from the dofs' Gram matrix.
-        let slots: Vec<usize> = dofs.iter().map(|&dof| of_dof[dof].expect("computed") as usize).collect();
-        let mut g = vec![0.0; k * k];
-        for (b, gb) in g.chunks_exact_mut(k).enumerate() {
-            let y = slots[b];
-            gb.iter_mut().zip(&slots).for_each(|(x, &z)| *x = gram[y.max(z)][y.min(z)]);
-        }
+        // Xᵀ G X through H = G X (k×r, column-major).
         let mut h = vec![0.0; k * r];
         for (t, ht) in h.chunks_exact_mut(k).enumerate() {
             for &(b, v) in term(t).iter().filter(|(_, v)| *v != 0.0) {
-                ht.iter_mut().zip(&g[b * k..(b + 1) * k]).for_each(|(x, gb)| *x += v * gb);
+                ht.iter_mut().zip(g.col(b).iter()).for_each(|(x, gb)| *x += v * gb);
             }
         }
         let m = Mat::from_fn(r, r, |p, q| {
@@ -385,9 +391,8 @@ impl LowRank {
         }
         let cols: Vec<&SparseColumn> = terms.ids.iter().map(|id| &cache.columns[cache.of_id[id] as usize]).collect();
         let dense = DenseColumns::new(&cols, d, n / d, usize::MAX)?;
-        let entries = dense.values.len();
         let sd = (0..r * r).map(|i| if i / r == i % r { terms.lambdas[i / r] } else { 0.0 }).collect();
-        Some(Factored { dense, s: sd, lu, entries })
+        Some(Factored { dense, s: sd, lu })
     }
 
     /// Solves J x = b in place (b on entry) with the reference factorization `f` and this
@@ -423,12 +428,11 @@ impl LowRank {
     }
 }
 
-/// A correction by rank-one terms: Ŵ (dense), S (r×r, row-major), M̃'s factors, Ŵ's size.
+/// A correction by rank-one terms: Ŵ (dense), S (r×r, row-major) and M̃'s factors.
 struct Factored {
     dense: DenseColumns,
     s: Vec<f64>,
     lu: PartialPivLu<f64>,
-    entries: usize,
 }
 
 /// Rank-one terms must make up the change of J to this fraction of its largest entry.

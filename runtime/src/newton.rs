@@ -506,12 +506,11 @@ impl Newton {
                 dofs = other;
             }
             let new_columns = self.low_rank.as_ref().map_or(0, |lr| lr.missing(&dofs));
-            let elements =
-                if self.low_rank.as_ref().is_some_and(LowRank::has_elements) { p.tangent_elements(w) } else { None };
             let updated = dofs.len() <= self.rank_limit(j.size())
                 && self.cached_columns() + new_columns <= self.column_limit(j.size())
                 && match (self.low_rank.as_mut(), self.factorization.as_mut()) {
                     (Some(lr), Some(f)) => {
+                        let elements = if lr.has_elements() { p.tangent_elements(w) } else { None };
                         lr.update(&j, dofs, f, elements.as_ref()).is_ok()
                             && lr.entries() <= self.entries_limit(j.size())
                     }
