@@ -296,6 +296,36 @@ pub struct Stepper<'a> {
     /// Recently assembled loads, by (form, time).
     loads: Vec<((&'static str, u64), Vec<f64>)>,
     coefs: Vec<f64>,
+    /// Vectors of the problem's size no longer in use (states replaced, bases, products), for
+    /// the next step: a step allocates none once the first has run.
+    pool: Pool,
+}
+
+/// Spare vectors, reused.
+#[derive(Default)]
+struct Pool(Vec<Vec<f64>>);
+
+impl Pool {
+    /// A vector of length `n`, contents unspecified.
+    fn take(&mut self, n: usize) -> Vec<f64> {
+        let mut v = self.0.pop().unwrap_or_default();
+        v.resize(n, 0.0);
+        v
+    }
+
+    /// A copy of `x`.
+    fn copy(&mut self, x: &[f64]) -> Vec<f64> {
+        let mut v = self.take(x.len());
+        v.copy_from_slice(x);
+        v
+    }
+
+    fn give(&mut self, v: Vec<f64>) {
+        // Bounded, should a scheme give back more than it takes.
+        if v.capacity() > 0 && self.0.len() < 64 {
+            self.0.push(v);
+        }
+    }
 }
 
 struct StageCache {
@@ -309,6 +339,9 @@ struct StageCache {
     /// The linear terms' forms, and their matrices' lower halves fused for one product (in
     /// groups of at most [`MAX_FUSED`]), when the matrices are symmetric.
     linear: Option<(Vec<&'static str>, Vec<LowerHalf>)>,
+    /// The nonlinear terms' arguments and residual, kept from one step to the next.
+    args: Vec<Vec<f64>>,
+    term: Vec<f64>,
 }
 
 impl<'a> Stepper<'a> {
@@ -365,6 +398,8 @@ impl<'a> Stepper<'a> {
                 support: None,
                 scratch: None,
                 linear: None,
+                args: Vec::new(),
+                term: Vec::new(),
             })
             .collect();
         Ok(Stepper {
@@ -381,6 +416,7 @@ impl<'a> Stepper<'a> {
             half_pattern,
             loads: Vec::new(),
             coefs: vec![0.0; desc.coefficients],
+            pool: Pool::default(),
         })
     }
 
@@ -450,6 +486,7 @@ impl<'a> Stepper<'a> {
         observe: &mut dyn FnMut(&StageView),
     ) -> Result<StepReport, StepError> {
         let desc = self.desc;
+        let n = self.asm.size();
         self.scheme.coefficients(dt, t, &mut self.coefs);
         let mut quantities: Vec<Vec<Vec<f64>>> = Vec::with_capacity(desc.stages.len());
         let mut report = StepReport::default();
@@ -460,8 +497,13 @@ impl<'a> Stepper<'a> {
                 Level::State(desc.states.iter().position(|st| name.trim_end_matches('\'') == *st).unwrap_or(0));
             let (delta, r) = self.solve_stage(stage, s, states, &quantities, reference, dt, t)?;
             report.stages.push(r);
-            let values: Vec<Vec<f64>> =
-                stage.values.iter().map(|c| self.combine(c, reference, Some(&delta), states, &quantities)).collect();
+            let mut values: Vec<Vec<f64>> = Vec::with_capacity(stage.values.len());
+            for c in stage.values {
+                let mut v = self.pool.take(n);
+                self.combine(c, reference, Some(&delta), states, &quantities, &mut v);
+                values.push(v);
+            }
+            self.pool.give(delta);
             let time = self.coefs.get(stage.time).copied().unwrap_or(t + dt);
             observe(&StageView { name: stage.name, time, quantities: stage.quantities, values: &values });
             quantities.push(values);
@@ -472,17 +514,18 @@ impl<'a> Stepper<'a> {
             .updates
             .iter()
             .map(|l| match *l {
-                Level::State(i) => states[i].clone(),
+                Level::State(i) => self.pool.copy(&states[i]),
                 Level::Stage(s, q) if uses(l) == 1 => std::mem::take(&mut quantities[s][q]),
-                Level::Stage(s, q) => quantities[s][q].clone(),
+                Level::Stage(s, q) => self.pool.copy(&quantities[s][q]),
             })
             .collect();
         if new_states.iter().flatten().any(|x| !x.is_finite()) {
             return Err(StepError::NonFinite { t: t + dt });
         }
         for (st, v) in states.iter_mut().zip(new_states) {
-            *st = v;
+            self.pool.give(std::mem::replace(st, v));
         }
+        quantities.into_iter().flatten().for_each(|v| self.pool.give(v));
         Ok(report)
     }
 
@@ -497,8 +540,8 @@ impl<'a> Stepper<'a> {
         delta: Option<&[f64]>,
         states: &[Vec<f64>],
         quantities: &[Vec<Vec<f64>>],
-    ) -> Vec<f64> {
-        let n = self.asm.size();
+        out: &mut [f64],
+    ) {
         let level = |l: Level| -> &[f64] {
             match l {
                 Level::State(i) => &states[i],
@@ -539,9 +582,9 @@ impl<'a> Stepper<'a> {
         }
         // Strip by strip, each part in turn: one pass over memory, the same sums as part by part.
         const STRIP: usize = 512;
-        let mut out = vec![0.0; n];
         for (k, o) in out.chunks_mut(STRIP).enumerate() {
             let range = k * STRIP..k * STRIP + o.len();
+            o.fill(0.0);
             for &(a, x, y) in &parts {
                 match y {
                     None => o.iter_mut().zip(&x[range.clone()]).for_each(|(o, x)| *o += a * x),
@@ -553,7 +596,6 @@ impl<'a> Stepper<'a> {
                 }
             }
         }
-        out
     }
 
     /// Adds Σ coef·K·base over a stage's linear terms (forms, coefficients, bases) to `rhs`:
@@ -567,12 +609,13 @@ impl<'a> Stepper<'a> {
         if forms.is_empty() {
             return;
         }
-        let mut product = vec![0.0; rhs.len()];
+        let mut product = self.pool.take(rhs.len());
         let Some(half) = self.half_pattern.as_ref() else {
             for ((form, coef), base) in forms.iter().zip(coefs).zip(bases) {
                 self.matrices[*form].mul_vec(base, &mut product);
                 rhs.iter_mut().zip(&product).for_each(|(r, x)| *r += coef * x);
             }
+            self.pool.give(product);
             return;
         };
         let entry = &mut self.stages[cache];
@@ -587,6 +630,7 @@ impl<'a> Stepper<'a> {
             group.mul_sum(terms, &mut product);
             rhs.iter_mut().zip(&product).for_each(|(r, x)| *r += x);
         }
+        self.pool.give(product);
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -603,7 +647,8 @@ impl<'a> Stepper<'a> {
         let n = self.asm.size();
         let stage_t = self.coefs.get(stage.time).copied().filter(|_| !stage.quantities.is_empty()).unwrap_or(t);
         // Known parts of every argument, and the constant part of the residual.
-        let mut constant_rhs = vec![0.0; n];
+        let mut constant_rhs = self.pool.take(n);
+        constant_rhs.fill(0.0);
         let mut nonlinear: Vec<ActiveTerm> = Vec::new();
         // Linear terms coef·K·(α w + base): their forms, coefficients and bases.
         let mut linear: (Vec<&'static str>, Vec<f64>, Vec<Vec<f64>>) = Default::default();
@@ -632,8 +677,12 @@ impl<'a> Stepper<'a> {
                 constant_rhs.iter_mut().zip(b).for_each(|(r, x)| *r += coef * x);
                 continue;
             }
-            let bases: Vec<Vec<f64>> =
-                term.args.iter().map(|c| self.combine(c, reference, None, states, quantities)).collect();
+            let mut bases: Vec<Vec<f64>> = Vec::with_capacity(term.args.len());
+            for c in term.args {
+                let mut b = self.pool.take(n);
+                self.combine(c, reference, None, states, quantities, &mut b);
+                bases.push(b);
+            }
             let alphas: Vec<f64> = term.args.iter().map(|c| c.unknown.map_or(0.0, |k| self.coefs[k])).collect();
             match self.matrices.get(term.form) {
                 Some(k) if alphas.len() == 1 => {
@@ -646,14 +695,18 @@ impl<'a> Stepper<'a> {
                 }
                 _ if alphas.iter().all(|a| *a == 0.0) => {
                     let refs: Vec<&[f64]> = bases.iter().map(Vec::as_slice).collect();
-                    let mut b = vec![0.0; n];
+                    let mut b = self.pool.take(n);
+                    b.fill(0.0);
                     form.residual(self.asm, &refs, term_t, &mut b);
                     constant_rhs.iter_mut().zip(&b).for_each(|(r, x)| *r += coef * x);
+                    self.pool.give(b);
+                    bases.into_iter().for_each(|b| self.pool.give(b));
                 }
                 _ => nonlinear.push(ActiveTerm { form: term.form, coef, alphas, bases, t: term_t }),
             }
         }
         self.add_linear(cache, &linear, &mut constant_rhs);
+        linear.2.into_iter().for_each(|b| self.pool.give(b));
         if let Some(c) = constant {
             let entry = &mut self.stages[cache];
             entry.constant = Some(Linear::new(c, self.half_pattern.as_ref()));
@@ -661,7 +714,7 @@ impl<'a> Stepper<'a> {
             entry.newton.invalidate();
         }
         let piecewise = nonlinear.iter().all(|a| self.forms[a.form].piecewise());
-        let StageCache { newton, constant, support, scratch, .. } = &mut self.stages[cache];
+        let StageCache { newton, constant, support, scratch, args, term, .. } = &mut self.stages[cache];
         // The same forms at every step in practice; should they change, so may the entries where
         // J varies, and the references compared there only are dropped.
         if support.as_ref().is_none_or(|(forms, _)| !forms.iter().eq(nonlinear.iter().map(|a| &a.form))) {
@@ -682,8 +735,8 @@ impl<'a> Stepper<'a> {
             piecewise,
             support,
             scratch,
-            args: Vec::new(),
-            term: Vec::new(),
+            args: std::mem::take(args),
+            term: std::mem::take(term),
             magnitude: 0.0,
         };
         // δ = w − reference, with the constrained values of w imposed.
@@ -691,14 +744,15 @@ impl<'a> Stepper<'a> {
             Level::State(i) => &states[i],
             Level::Stage(s, q) => &quantities[s][q],
         };
-        let mut delta = w0.clone();
+        let mut delta = self.pool.take(n);
+        delta.copy_from_slice(w0);
         self.constraints.impose(&mut delta);
         delta.iter_mut().zip(w0).for_each(|(d, r)| *d -= r);
-        let report = newton.solve(&mut problem, &mut delta).map_err(|source| StepError::Newton {
-            stage: stage.name,
-            t: stage_t,
-            source,
-        })?;
+        let report = newton.solve(&mut problem, &mut delta);
+        (*args, *term) = (problem.args, problem.term);
+        self.pool.give(problem.rhs);
+        problem.terms.into_iter().flat_map(|t| t.bases).for_each(|b| self.pool.give(b));
+        let report = report.map_err(|source| StepError::Newton { stage: stage.name, t: stage_t, source })?;
         Ok((delta, report))
     }
 }

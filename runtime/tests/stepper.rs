@@ -2,9 +2,14 @@
 //! data a compiled scheme provides (its description and coefficients, transcribed from
 //! `signorini emit forms/schemes/newmark.wf`), stepping the oscillator ü + u = 0 built from a
 //! hand-written form (one P1 element, ρ = 3, k = 1: M = K = 1 on the free dof). The scheme
-//! conserves ½(v² + u²) to round-off and is second order against cos t.
+//! conserves ½(v² + u²) to round-off and is second order against cos t. On 400 cells, the
+//! steps after the first allocate no vector of the problem's size (issue 12), counted by an
+//! allocator that records, per thread, allocations of at least a given size.
 
 mod common;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 
 use common::MassStiffness;
 use signorini_runtime::assembly::{Assembler, Quadrature};
@@ -16,6 +21,43 @@ use signorini_runtime::problem::Constraints;
 use signorini_runtime::scheme::{
     Bound, BoundForm, Combination, InitialDesc, Level, SchemeDesc, StageDesc, Stepper, TermDesc, TimeScheme,
 };
+
+thread_local! {
+    /// Allocations of at least `THRESHOLD` bytes on this thread since it was last reset.
+    static LARGE: Cell<usize> = const { Cell::new(0) };
+    static THRESHOLD: Cell<usize> = const { Cell::new(usize::MAX) };
+}
+
+struct Counting;
+
+impl Counting {
+    fn record(size: usize) {
+        if size >= THRESHOLD.with(Cell::get) {
+            LARGE.with(|c| c.set(c.get() + 1));
+        }
+    }
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        Self::record(layout.size());
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        Self::record(layout.size());
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        Self::record(new_size);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
 
 struct CrankNicolson;
 
@@ -114,4 +156,44 @@ fn crank_nicolson_from_data_conserves_energy_and_is_second_order() {
     assert!(drift < 1e-13, "energy drift {drift:e}");
     let order = (coarse / fine).log2();
     assert!((order - 2.0).abs() < 0.05, "order {order} ({coarse:e}, {fine:e})");
+}
+
+#[test]
+fn steps_after_the_first_allocate_no_vector_of_the_problems_size() {
+    let cells = 400;
+    let mesh = interval(cells, 0.0, 1.0);
+    let asm = Assembler::new(&mesh);
+    let bound = |rho, k| -> Box<dyn BoundForm> {
+        Box::new(Bound { kernel: MassStiffness { rho, k }, quadrature: Quadrature::default(), regions: Vec::new() })
+    };
+    let forms = vec![("mass", bound(3.0, 0.0)), ("stiffness", bound(0.0, 1.0))];
+    let n = cells + 1;
+    let mut constraints = Constraints::none(n);
+    constraints.fix(cells);
+    let mut stepper = Stepper::new(
+        Box::new(CrankNicolson),
+        &asm,
+        forms,
+        constraints,
+        Structure::SymmetricPositiveDefinite,
+        NewtonOptions::default(),
+    )
+    .unwrap();
+    let u0: Vec<f64> = (0..n).map(|i| (std::f64::consts::FRAC_PI_2 * i as f64 / cells as f64).cos()).collect();
+    let mut states = vec![u0, vec![0.0; n], vec![0.0; n]];
+    stepper.initialize(&mut states, 0.0).unwrap();
+    let dt = 1e-3;
+    // The first steps factor the operator and fill the stepper's reusable vectors.
+    for k in 0..3 {
+        stepper.step(&mut states, k as f64 * dt, dt).unwrap();
+    }
+    THRESHOLD.with(|t| t.set(8 * n));
+    LARGE.with(|c| c.set(0));
+    for k in 3..23 {
+        stepper.step(&mut states, k as f64 * dt, dt).unwrap();
+    }
+    THRESHOLD.with(|t| t.set(usize::MAX));
+    let large = LARGE.with(Cell::get);
+    assert_eq!(large, 0, "{large} allocations of at least {} bytes in 20 steps", 8 * n);
+    assert!(states[0].iter().all(|x| x.is_finite()));
 }
