@@ -44,8 +44,20 @@ impl BlockFactor {
     /// the ordering does not keep each node's dofs together in order (then faer's own solves
     /// are used).
     pub fn new(symbolic: &SymbolicCholesky<usize>, values: &[f64], d: usize) -> Option<BlockFactor> {
+        Self::reusing(symbolic, values, d, None)
+    }
+
+    /// As [`BlockFactor::new`], storing into `old`'s buffers (a refactorization then allocates
+    /// nothing).
+    pub fn reusing(
+        symbolic: &SymbolicCholesky<usize>,
+        values: &[f64],
+        d: usize,
+        old: Option<BlockFactor>,
+    ) -> Option<BlockFactor> {
         let n = symbolic.nrows();
-        if d == 0 || !n.is_multiple_of(d) {
+        // Node blocks of 1 to 3 dofs (the solves are compiled for those).
+        if !(1..=3).contains(&d) || !n.is_multiple_of(d) {
             return None;
         }
         let order: Vec<u32> = match symbolic.perm() {
@@ -61,7 +73,26 @@ impl BlockFactor {
         }
         let mut position = vec![0u32; n];
         order.iter().enumerate().for_each(|(k, &i)| position[i as usize] = k as u32);
-        let mut blocks = Blocks { d, diag: vec![0.0; n * d], ptr: vec![0], rows: Vec::new(), values: Vec::new() };
+        let mut blocks = match old {
+            Some(BlockFactor { mut diag, mut ptr, mut rows, mut values, .. }) => {
+                diag.clear();
+                diag.resize(n * d, 0.0);
+                ptr.clear();
+                rows.clear();
+                values.clear();
+                Blocks { d, diag, ptr, rows, values }
+            }
+            // faer's values bound the blocks' (its supernodes are stored whole, upper parts
+            // included): reserved at once, the copy never reallocates.
+            None => Blocks {
+                d,
+                diag: vec![0.0; n * d],
+                ptr: Vec::with_capacity(n / d + 1),
+                rows: Vec::with_capacity(values.len() / (d * d)),
+                values: Vec::with_capacity(values.len()),
+            },
+        };
+        blocks.ptr.push(0);
         match symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(s) => {
                 let (col_ptr, row_idx) = (s.col_ptr(), s.row_idx());

@@ -387,7 +387,7 @@ impl Factorization {
         match &mut self.factors {
             Factors::Llt { symbolic, values, block, factored } => {
                 *factored = false;
-                *block = None;
+                let old = block.take();
                 values.resize(symbolic.len_val(), 0.0);
                 let req = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
                 let mut mem = MemBuffer::try_new(req).map_err(|_| LinalgError::Other("out of memory".into()))?;
@@ -406,7 +406,7 @@ impl Factorization {
                             LinalgError::NotPositiveDefinite { index }
                         }
                     })?;
-                *block = BlockFactor::new(symbolic, values, a.pattern.dim());
+                *block = BlockFactor::reusing(symbolic, values, a.pattern.dim(), old);
                 if block.is_some() {
                     *values = Vec::new();
                 }

@@ -220,6 +220,14 @@ impl Newton {
         }
     }
 
+    /// Starts from `other`'s symbolic analysis, if this Newton has none and the other has one
+    /// (a problem with the same Jacobian pattern: a scheme's initial problem and its stages).
+    pub fn share_analysis(&mut self, other: &Newton) {
+        if self.factorization.is_none() {
+            self.factorization = other.factorization.as_ref().map(Factorization::fork);
+        }
+    }
+
     /// Forgets the factorization's validity (the linear part of the problem changed).
     pub fn invalidate(&mut self) {
         self.factored_for = None;

@@ -459,6 +459,11 @@ impl<'a> Stepper<'a> {
         }
         let (w, report) = result?;
         states[init.state] = w;
+        // The stages' Jacobians have the initial problem's pattern: one ordering and symbolic
+        // analysis serves all.
+        if let Some((initial, stages)) = self.stages.split_last_mut() {
+            stages.iter_mut().for_each(|s| s.newton.share_analysis(&initial.newton));
+        }
         Ok(Some(report))
     }
 

@@ -187,6 +187,9 @@ fn steps_after_the_first_allocate_no_vector_of_the_problems_size() {
     for k in 0..3 {
         stepper.step(&mut states, k as f64 * dt, dt).unwrap();
     }
+    // The initial problem and the stage share one symbolic analysis; each has its factor.
+    let counters = stepper.counters();
+    assert_eq!((counters.symbolic, counters.numeric), (1, 2));
     THRESHOLD.with(|t| t.set(8 * n));
     LARGE.with(|c| c.set(0));
     for k in 3..23 {
