@@ -313,6 +313,13 @@ impl Pool {
         v
     }
 
+    /// A vector of `n` zeros.
+    fn zeros(&mut self, n: usize) -> Vec<f64> {
+        let mut v = self.take(n);
+        v.fill(0.0);
+        v
+    }
+
     /// A copy of `x`.
     fn copy(&mut self, x: &[f64]) -> Vec<f64> {
         let mut v = self.take(x.len());
@@ -652,8 +659,7 @@ impl<'a> Stepper<'a> {
         let n = self.asm.size();
         let stage_t = self.coefs.get(stage.time).copied().filter(|_| !stage.quantities.is_empty()).unwrap_or(t);
         // Known parts of every argument, and the constant part of the residual.
-        let mut constant_rhs = self.pool.take(n);
-        constant_rhs.fill(0.0);
+        let mut constant_rhs = self.pool.zeros(n);
         let mut nonlinear: Vec<ActiveTerm> = Vec::new();
         // Linear terms coef·K·(α w + base): their forms, coefficients and bases.
         let mut linear: (Vec<&'static str>, Vec<f64>, Vec<Vec<f64>>) = Default::default();
@@ -700,8 +706,7 @@ impl<'a> Stepper<'a> {
                 }
                 _ if alphas.iter().all(|a| *a == 0.0) => {
                     let refs: Vec<&[f64]> = bases.iter().map(Vec::as_slice).collect();
-                    let mut b = self.pool.take(n);
-                    b.fill(0.0);
+                    let mut b = self.pool.zeros(n);
                     form.residual(self.asm, &refs, term_t, &mut b);
                     constant_rhs.iter_mut().zip(&b).for_each(|(r, x)| *r += coef * x);
                     self.pool.give(b);
@@ -749,8 +754,7 @@ impl<'a> Stepper<'a> {
             Level::State(i) => &states[i],
             Level::Stage(s, q) => &quantities[s][q],
         };
-        let mut delta = self.pool.take(n);
-        delta.copy_from_slice(w0);
+        let mut delta = self.pool.copy(w0);
         self.constraints.impose(&mut delta);
         delta.iter_mut().zip(w0).for_each(|(d, r)| *d -= r);
         let report = newton.solve(&mut problem, &mut delta);

@@ -118,24 +118,30 @@ impl TimeScheme for CrankNicolson {
     }
 }
 
-fn run(dt: f64, t_end: f64) -> (f64, f64) {
-    let mesh = interval(1, 0.0, 1.0);
-    let asm = Assembler::new(&mesh);
+/// Crank–Nicolson on the oscillator's forms over `asm`'s mesh, its last dof fixed.
+fn stepper<'a>(asm: &'a Assembler<'a>) -> Stepper<'a> {
     let bound = |rho, k| -> Box<dyn BoundForm> {
         Box::new(Bound { kernel: MassStiffness { rho, k }, quadrature: Quadrature::default(), regions: Vec::new() })
     };
     let forms = vec![("mass", bound(3.0, 0.0)), ("stiffness", bound(0.0, 1.0))];
-    let mut constraints = Constraints::none(2);
-    constraints.fix(1);
-    let mut stepper = Stepper::new(
+    let n = asm.size();
+    let mut constraints = Constraints::none(n);
+    constraints.fix(n - 1);
+    Stepper::new(
         Box::new(CrankNicolson),
-        &asm,
+        asm,
         forms,
         constraints,
         Structure::SymmetricPositiveDefinite,
         NewtonOptions::default(),
     )
-    .unwrap();
+    .unwrap()
+}
+
+fn run(dt: f64, t_end: f64) -> (f64, f64) {
+    let mesh = interval(1, 0.0, 1.0);
+    let asm = Assembler::new(&mesh);
+    let mut stepper = stepper(&asm);
     let mut states = vec![vec![1.0, 0.0], vec![0.0; 2], vec![0.0; 2]];
     stepper.initialize(&mut states, 0.0).unwrap();
     assert!((states[2][0] + 1.0).abs() < 1e-14, "a(0) = −u(0)");
@@ -163,22 +169,8 @@ fn steps_after_the_first_allocate_no_vector_of_the_problems_size() {
     let cells = 400;
     let mesh = interval(cells, 0.0, 1.0);
     let asm = Assembler::new(&mesh);
-    let bound = |rho, k| -> Box<dyn BoundForm> {
-        Box::new(Bound { kernel: MassStiffness { rho, k }, quadrature: Quadrature::default(), regions: Vec::new() })
-    };
-    let forms = vec![("mass", bound(3.0, 0.0)), ("stiffness", bound(0.0, 1.0))];
+    let mut stepper = stepper(&asm);
     let n = cells + 1;
-    let mut constraints = Constraints::none(n);
-    constraints.fix(cells);
-    let mut stepper = Stepper::new(
-        Box::new(CrankNicolson),
-        &asm,
-        forms,
-        constraints,
-        Structure::SymmetricPositiveDefinite,
-        NewtonOptions::default(),
-    )
-    .unwrap();
     let u0: Vec<f64> = (0..n).map(|i| (std::f64::consts::FRAC_PI_2 * i as f64 / cells as f64).cos()).collect();
     let mut states = vec![u0, vec![0.0; n], vec![0.0; n]];
     stepper.initialize(&mut states, 0.0).unwrap();
