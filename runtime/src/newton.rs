@@ -57,6 +57,13 @@ pub trait NonlinearProblem {
     fn update_jacobian(&mut self, _w: &[f64], _j: &mut Matrix) -> bool {
         false
     }
+    /// Writes y = J x for `j`, which holds what this problem's last `jacobian` or
+    /// `update_jacobian` wrote (the problem unchanged since), by a route that reads less than j
+    /// (its constant part's lower half and the entries that vary); false if the problem has
+    /// none (Newton then multiplies by j).
+    fn jacobian_product(&mut self, _j: &Matrix, _x: &[f64], _y: &mut [f64]) -> bool {
+        false
+    }
     /// An empty matrix with the Jacobian's pattern.
     fn jacobian_matrix(&self) -> Matrix;
     /// Cholesky for symmetric positive definite Jacobians, LU otherwise.
@@ -419,7 +426,16 @@ impl Newton {
             } else {
                 // Aᵀ δ reads half the bytes, but only a problem declared symmetric is sure to stay
                 // so (under Structure::Auto a corrected Cholesky reference may meet a nonsymmetric J).
-                if p.structure() == Structure::SymmetricPositiveDefinite {
+                if p.jacobian_product(j, delta, jd) {
+                    // Test builds check the problem's product against j's, to round-off.
+                    if cfg!(debug_assertions) {
+                        let mut full = vec![0.0; n];
+                        j.mul_vec(delta, &mut full);
+                        let scale = j.norm_inf() * norm_inf(delta);
+                        let err = full.iter().zip(jd.iter()).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                        assert!(err <= 64.0 * f64::EPSILON * scale, "jacobian_product differs by {err:e}");
+                    }
+                } else if p.structure() == Structure::SymmetricPositiveDefinite {
                     j.mul_vec_transposed(delta, jd);
                 } else {
                     j.mul_vec(delta, jd);

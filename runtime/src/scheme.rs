@@ -1017,6 +1017,30 @@ impl NonlinearProblem for StageProblem<'_, '_> {
         true
     }
 
+    fn jacobian_product(&mut self, j: &Matrix, x: &[f64], y: &mut [f64]) -> bool {
+        // J = P (A + T) P + I_c: A the constant part (its lower half), T the tangents on the
+        // support's entries (J − A there), P zeroing the constrained dofs.
+        let (Some(s), Some(_)) = (self.support, self.constant.half.as_ref()) else { return false };
+        let constrained = self.constraints.fixed.iter().any(|f| *f);
+        let x_free = if constrained {
+            self.term.clear();
+            self.term.extend_from_slice(x);
+            self.constraints.zero(&mut self.term);
+            self.term.as_slice()
+        } else {
+            x
+        };
+        self.constant.mul(x_free, y);
+        let (a, rows) = (&self.constant.matrix.values, &j.pattern.row_idx);
+        for (&k, &col) in s.entries.indices.iter().zip(&s.entries.columns) {
+            y[rows[k]] += (j.values[k] - a[k]) * x_free[col as usize];
+        }
+        if constrained {
+            y.iter_mut().zip(x).zip(&self.constraints.fixed).filter(|(_, f)| **f).for_each(|((y, x), _)| *y = *x);
+        }
+        true
+    }
+
     fn jacobian_matrix(&self) -> Matrix {
         self.asm.zero_matrix()
     }
