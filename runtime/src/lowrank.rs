@@ -86,7 +86,8 @@ const DENSE_BYTES: usize = 64 << 20;
 enum Columns {
     /// Not decided until the first update sees the factorization.
     Unknown,
-    /// W's columns (factor in node blocks) and their Gram matrix over the cached dofs.
+    /// W's columns (factor in node blocks) and their Gram matrix over the cached dofs
+    /// (`gram[x][y]` for y ≤ x, NaN until columns x and y are in one correction).
     Sparse { of_dof: Vec<Option<u32>>, columns: Vec<SparseColumn>, gram: Vec<Vec<f64>>, d: usize },
     /// Z's columns (J₀⁻¹ e_d).
     Dense(Vec<Option<Box<[f64]>>>),
@@ -212,22 +213,33 @@ impl LowRank {
         // W's or Z's columns for the dofs that have none yet.
         match &mut self.columns {
             Columns::Unknown => unreachable!("decided above"),
-            Columns::Sparse { of_dof, columns, gram, .. } => {
+            Columns::Sparse { of_dof, columns, gram, d } => {
                 let block = reference.block().ok_or(LinalgError::NotFactored)?;
                 let mut work = vec![0.0; n];
                 for &dof in &dofs {
                     if of_dof[dof].is_none() {
                         let w = block.forward_unit(block.position(dof), &mut work);
-                        // Its products with every cached column (and itself).
-                        let d = block.dim();
-                        scatter(&w, d, &mut work);
-                        let row: Vec<f64> =
-                            columns.iter().chain(std::iter::once(&w)).map(|c| gather(c, d, &work)).collect();
-                        unscatter(&w, d, &mut work);
                         of_dof[dof] = Some(columns.len() as u32);
                         columns.push(w);
-                        gram.push(row);
+                        gram.push(vec![f64::NAN; columns.len()]);
                     }
+                }
+                // The products among this correction's columns not computed yet (NaN): a
+                // column's products with columns of other corrections wait until they meet.
+                let mut slots: Vec<usize> = dofs.iter().map(|&dof| of_dof[dof].expect("computed above") as usize).collect();
+                slots.sort_unstable();
+                let mut missing = Vec::new();
+                for (i, &x) in slots.iter().enumerate() {
+                    missing.clear();
+                    missing.extend(slots[..=i].iter().copied().filter(|&y| gram[x][y].is_nan()));
+                    if missing.is_empty() {
+                        continue;
+                    }
+                    scatter(&columns[x], *d, &mut work);
+                    for &y in &missing {
+                        gram[x][y] = gather(&columns[y], *d, &work);
+                    }
+                    unscatter(&columns[x], *d, &mut work);
                 }
             }
             Columns::Dense(columns) => {
