@@ -226,7 +226,8 @@ impl LowRank {
                 }
                 // The products among this correction's columns not computed yet (NaN): a
                 // column's products with columns of other corrections wait until they meet.
-                let mut slots: Vec<usize> = dofs.iter().map(|&dof| of_dof[dof].expect("computed above") as usize).collect();
+                let mut slots: Vec<usize> =
+                    dofs.iter().map(|&dof| of_dof[dof].expect("computed above") as usize).collect();
                 slots.sort_unstable();
                 let mut missing = Vec::new();
                 for (i, &x) in slots.iter().enumerate() {
