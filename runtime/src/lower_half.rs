@@ -124,22 +124,24 @@ impl LowerHalf {
         let mut values = vec![0.0; h.rows.len() * m * d * d];
         for (l, a) in matrices.iter().enumerate() {
             let p = &a.pattern;
-            let column = |node: usize, c: usize| &a.values[p.col_ptr[node * d + c]..p.col_ptr[node * d + c + 1]];
             for (q, &node) in h.order.iter().enumerate() {
                 let node = node as usize;
                 let own = p.neighbours(node).binary_search(&(node as u32)).expect("a node neighbours itself");
-                for c in 0..d {
-                    for r in 0..d {
-                        diag[((q * m + l) * d + r) * d + c] = column(node, c)[own * d + r];
-                    }
+                // The node's d columns, sliced once.
+                let mut columns: [&[f64]; 3] = [&[]; 3];
+                for (c, column) in columns.iter_mut().enumerate().take(d) {
+                    *column = &a.values[p.col_ptr[node * d + c]..p.col_ptr[node * d + c + 1]];
                 }
-                for k in h.ptr[q]..h.ptr[q + 1] {
-                    let offset = h.source[k];
-                    for c in 0..d {
-                        for r in 0..d {
-                            values[((k * m + l) * d + r) * d + c] = column(node, c)[offset + r];
+                let copy = |out: &mut [f64], offset: usize| {
+                    for (c, column) in columns[..d].iter().enumerate() {
+                        for (r, v) in column[offset..offset + d].iter().enumerate() {
+                            out[r * d + c] = *v;
                         }
                     }
+                };
+                copy(&mut diag[(q * m + l) * d * d..][..d * d], own * d);
+                for k in h.ptr[q]..h.ptr[q + 1] {
+                    copy(&mut values[(k * m + l) * d * d..][..d * d], h.source[k]);
                 }
             }
         }
