@@ -1022,6 +1022,9 @@ impl NonlinearProblem for StageProblem<'_, '_> {
         // support's entries (J − A there), P zeroing the constrained dofs.
         let (Some(s), Some(_)) = (self.support, self.constant.half.as_ref()) else { return false };
         let constrained = self.constraints.fixed.iter().any(|f| *f);
+        // x with its constrained entries zeroed, in the terms' residual buffer: with a support,
+        // `residual` zeroes and reads that buffer at the support's dofs only, so what this
+        // leaves elsewhere is never read (and no vector is allocated per check).
         let x_free = if constrained {
             self.term.clear();
             self.term.extend_from_slice(x);
