@@ -198,6 +198,8 @@ impl LowRank {
             };
         }
         let k = dofs.len();
+        // The previous correction's dense columns' memory, reused for the new ones.
+        let mut spare = self.dense.take().map(|d| d.values).unwrap_or_default();
         let mut e = Mat::<f64>::zeros(k, k);
         let mut position = vec![usize::MAX; n];
         dofs.iter().enumerate().for_each(|(a, &d)| position[d] = a);
@@ -277,7 +279,7 @@ impl LowRank {
             _ => None,
         };
         if let Some(terms) = terms
-            && let Some(factored) = self.factored(&dofs, &position, &e, &g, &terms, n)
+            && let Some(factored) = self.factored(&dofs, &position, &e, &g, &terms, n, &mut spare)
         {
             self.column_entries = factored.dense.values.len();
             (self.dense, self.e, self.lu) = (Some(factored.dense), factored.s, Some(factored.lu));
@@ -303,7 +305,7 @@ impl LowRank {
             Columns::Sparse { of_dof, columns, d, .. } if k > 0 => {
                 let cols: Vec<&SparseColumn> =
                     dofs.iter().map(|&dof| &columns[of_dof[dof].expect("computed") as usize]).collect();
-                DenseColumns::new(&cols, *d, n / *d, self.column_entries)
+                DenseColumns::new(&cols, *d, n / *d, self.column_entries, &mut spare)
             }
             _ => None,
         };
@@ -328,6 +330,7 @@ impl LowRank {
         g: &Mat<f64>,
         terms: &RankOneTerms,
         n: usize,
+        spare: &mut Vec<f64>,
     ) -> Option<Factored> {
         let Columns::Sparse { of_dof, columns, d, .. } = &self.columns else { return None };
         let d = *d;
@@ -342,18 +345,25 @@ impl LowRank {
             }
         }
         let term = |t: usize| &x[t * s..(t + 1) * s];
-        // Σ λ v vᵀ against E.
-        let mut sum = Mat::<f64>::zeros(k, k);
+        // Σ λ v vᵀ (column-major) against E, column by column.
+        let mut sum = vec![0.0; k * k];
         for t in 0..r {
             for &(a, va) in term(t) {
                 for &(b, vb) in term(t) {
-                    sum[(a, b)] += terms.lambdas[t] * va * vb;
+                    sum[b * k + a] += terms.lambdas[t] * va * vb;
                 }
             }
         }
-        let scale = (0..k * k).map(|i| e[(i / k, i % k)].abs()).fold(0.0f64, f64::max);
-        let error = (0..k * k).map(|i| (e[(i / k, i % k)] - sum[(i / k, i % k)]).abs()).fold(0.0f64, f64::max);
-        if error.is_nan() || error > TERMS_ACCURACY * scale {
+        let (mut scale, mut error, mut nan) = (0.0f64, 0.0f64, false);
+        for (b, column) in sum.chunks_exact(k).enumerate() {
+            for (a, &v) in column.iter().enumerate() {
+                let x = e[(a, b)];
+                scale = scale.max(x.abs());
+                error = error.max((x - v).abs());
+                nan |= x.is_nan() || v.is_nan();
+            }
+        }
+        if nan || error > TERMS_ACCURACY * scale {
             return None;
         }
         // Xᵀ G X through H = G X (k×r, column-major).
@@ -403,7 +413,7 @@ impl LowRank {
             return None;
         }
         let cols: Vec<&SparseColumn> = terms.ids.iter().map(|id| &cache.columns[cache.of_id[id] as usize]).collect();
-        let dense = DenseColumns::new(&cols, d, n / d, usize::MAX)?;
+        let dense = DenseColumns::new(&cols, d, n / d, usize::MAX, spare)?;
         let sd = (0..r * r).map(|i| if i / r == i % r { terms.lambdas[i / r] } else { 0.0 }).collect();
         Some(Factored { dense, s: sd, lu })
     }
@@ -453,8 +463,15 @@ const TERMS_ACCURACY: f64 = 1e-12;
 
 impl DenseColumns {
     /// The columns over the union of their nodes (sorted), if that holds at most
-    /// [`DENSE_FILL`] times their `entries` and [`DENSE_BYTES`].
-    fn new(columns: &[&SparseColumn], d: usize, nodes: usize, entries: usize) -> Option<DenseColumns> {
+    /// [`DENSE_FILL`] times their `entries` and [`DENSE_BYTES`]; stored in `spare`'s memory (the
+    /// previous correction's, so an update allocates none).
+    fn new(
+        columns: &[&SparseColumn],
+        d: usize,
+        nodes: usize,
+        entries: usize,
+        spare: &mut Vec<f64>,
+    ) -> Option<DenseColumns> {
         let mut slot = vec![u32::MAX; nodes];
         let mut union: Vec<u32> = Vec::new();
         for c in columns {
@@ -471,7 +488,9 @@ impl DenseColumns {
         }
         union.sort_unstable();
         union.iter().enumerate().for_each(|(i, &node)| slot[node as usize] = i as u32);
-        let mut values = vec![0.0; m * k];
+        let mut values = std::mem::take(spare);
+        values.clear();
+        values.resize(m * k, 0.0);
         for (c, col) in columns.iter().enumerate() {
             let out = &mut values[c * m..(c + 1) * m];
             for (&node, v) in col.nodes.iter().zip(col.values.chunks_exact(d)) {
@@ -702,7 +721,9 @@ mod tests {
             let m = Mat::<f64>::identity(k, k) + &g * Mat::from_fn(k, k, |x, y| e[x * k + y]);
             let lu = m.partial_piv_lu();
             let entries = columns.iter().map(|c| c.values.len()).sum();
-            let dense = DenseColumns::new(&cols, d, n / d, entries).expect("few columns: dense");
+            // Stored in memory holding other values (a previous correction's): overwritten whole.
+            let mut spare = vec![7.0; 5 * n];
+            let dense = DenseColumns::new(&cols, d, n / d, entries, &mut spare).expect("few columns: dense");
             let z: Vec<f64> = (0..n).map(|i| ((i * 29) % 97) as f64 / 97.0 - 0.5).collect();
             let (mut sparse_z, mut dense_z) = (z.clone(), z.clone());
             correct_sparse(&cols, d, &lu, &e, &mut sparse_z);
