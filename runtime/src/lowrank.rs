@@ -56,6 +56,10 @@ pub struct LowRank {
     elements: Option<ChangeSplitter>,
     /// Columns W v of the rank-one terms seen so far, by term id.
     term_columns: TermColumns,
+    /// The current correction's rank-one terms' vectors X, `term_size` (position in D, value)
+    /// pairs per term (empty for a correction by E).
+    term_vectors: Vec<(usize, f64)>,
+    term_size: usize,
 }
 
 /// Columns kept per rank-one term until the reference changes: a term that persists from one
@@ -108,6 +112,8 @@ impl LowRank {
             terms: 0,
             elements: None,
             term_columns: TermColumns::default(),
+            term_vectors: Vec::new(),
+            term_size: 0,
         }
     }
 
@@ -279,10 +285,11 @@ impl LowRank {
             _ => None,
         };
         if let Some(terms) = terms
-            && let Some(factored) = self.factored(&dofs, &position, &e, &g, &terms, n, &mut spare)
+            && let Some(factored) = self.factored(&dofs, &position, &e, &g, &terms, &mut spare)
         {
             self.column_entries = factored.dense.values.len();
             (self.dense, self.e, self.lu) = (Some(factored.dense), factored.s, Some(factored.lu));
+            (self.term_vectors, self.term_size) = (factored.x, terms.size);
             self.terms = terms.len();
             self.dofs = dofs;
             return Ok(());
@@ -311,6 +318,7 @@ impl LowRank {
         };
         self.lu = (k > 0).then_some(lu);
         self.e = (0..k * k).map(|i| e[(i / k, i % k)]).collect();
+        (self.term_vectors, self.term_size) = (Vec::new(), 0);
         self.terms = k;
         self.dofs = dofs;
         Ok(())
@@ -321,7 +329,8 @@ impl LowRank {
     /// Lᵀ P for Ŵ = W X, and the solve's correction is Ŵ S M̃⁻¹ Ŵᵀ with M̃ = I + Xᵀ G X S,
     /// r×r. Returns Ŵ (dense), S and M̃'s factors; None if the terms do not make up
     /// E to round-off, or Ŵ would be too large (the correction by E is used then).
-    /// `position[dof]` is the dof's index in `dofs` (usize::MAX if it is not one of them).
+    /// `position[dof]` is the dof's index in `dofs` (usize::MAX if it is not one of them), for
+    /// each of the n dofs; `spare` is memory for Ŵ.
     fn factored(
         &mut self,
         dofs: &[usize],
@@ -329,9 +338,9 @@ impl LowRank {
         e: &Mat<f64>,
         g: &Mat<f64>,
         terms: &RankOneTerms,
-        n: usize,
         spare: &mut Vec<f64>,
     ) -> Option<Factored> {
+        let n = position.len();
         let Columns::Sparse { of_dof, columns, d, .. } = &self.columns else { return None };
         let d = *d;
         let (k, r, s) = (dofs.len(), terms.len(), terms.size);
@@ -415,22 +424,32 @@ impl LowRank {
         let cols: Vec<&SparseColumn> = terms.ids.iter().map(|id| &cache.columns[cache.of_id[id] as usize]).collect();
         let dense = DenseColumns::new(&cols, d, n / d, usize::MAX, spare)?;
         let sd = (0..r * r).map(|i| if i / r == i % r { terms.lambdas[i / r] } else { 0.0 }).collect();
-        Some(Factored { dense, s: sd, lu })
+        Some(Factored { dense, s: sd, lu, x })
     }
 
     /// Solves J x = b in place (b on entry) with the reference factorization `f` and this
-    /// correction.
-    pub fn solve(&self, f: &mut Factorization, b: &mut [f64]) -> Result<(), LinalgError> {
-        let Some(lu) = self.lu.as_ref() else { return f.solve_in_place(b) };
+    /// correction. With `defect`, also returns ‖J x − b‖∞ as the correction leaves it (the
+    /// residual were the triangular passes exact): with the correction's small system solved
+    /// to y, ρ = Wᵀz' − y for the corrected z' = L⁻¹Pb − W E y, and J x − b = U E ρ (U X S ρ
+    /// for rank-one terms), on the dofs D only. None if not asked or not known (columns of
+    /// J₀⁻¹, for a reference other than a Cholesky factor in node blocks).
+    pub fn solve(&self, f: &mut Factorization, b: &mut [f64], defect: bool) -> Result<Option<f64>, LinalgError> {
+        let Some(lu) = self.lu.as_ref() else {
+            f.solve_in_place(b)?;
+            return Ok(defect.then_some(0.0));
+        };
         let k = self.dofs.len();
+        let mut rho = defect.then(Vec::new);
         match &self.columns {
             Columns::Sparse { of_dof, columns, d, .. } => {
                 if let Some(dense) = &self.dense {
-                    return f.solve_split_in_place(b, |z| dense.correct(z, *d, lu, &self.e));
+                    f.solve_split_in_place(b, |z| dense.correct(z, *d, lu, &self.e, rho.as_mut()))?;
+                } else {
+                    let cols: Vec<&SparseColumn> =
+                        self.dofs.iter().map(|&dof| &columns[of_dof[dof].expect("computed") as usize]).collect();
+                    f.solve_split_in_place(b, |z| correct_sparse(&cols, *d, lu, &self.e, z, rho.as_mut()))?;
                 }
-                let cols: Vec<&SparseColumn> =
-                    self.dofs.iter().map(|&dof| &columns[of_dof[dof].expect("computed") as usize]).collect();
-                f.solve_split_in_place(b, |z| correct_sparse(&cols, *d, lu, &self.e, z))
+                Ok(rho.map(|rho| self.defect(&rho)))
             }
             Columns::Dense(columns) => {
                 f.solve_in_place(b)?;
@@ -444,10 +463,32 @@ impl LowRank {
                         b.iter_mut().zip(z.iter()).for_each(|(xi, zi)| *xi -= ey * zi);
                     }
                 }
-                Ok(())
+                Ok(None)
             }
-            Columns::Unknown => f.solve_in_place(b),
+            Columns::Unknown => {
+                f.solve_in_place(b)?;
+                Ok(defect.then_some(0.0))
+            }
         }
+    }
+
+    /// ‖U E ρ‖∞, or ‖U X S ρ‖∞ for a correction by rank-one terms (see [`LowRank::solve`]);
+    /// NaN if any entry is.
+    fn defect(&self, rho: &[f64]) -> f64 {
+        let k = self.dofs.len();
+        let mut v = vec![0.0; k];
+        if self.term_size > 0 {
+            let (r, s) = (rho.len(), self.term_size);
+            for (t, x) in self.term_vectors.chunks_exact(s).enumerate() {
+                let c = self.e[t * r + t] * rho[t];
+                x.iter().for_each(|&(a, xa)| v[a] += xa * c);
+            }
+        } else {
+            for (c, vc) in v.iter_mut().enumerate() {
+                *vc = (0..k).map(|x| self.e[c * k + x] * rho[x]).sum();
+            }
+        }
+        crate::newton::norm_inf(&v)
     }
 }
 
@@ -456,6 +497,7 @@ struct Factored {
     dense: DenseColumns,
     s: Vec<f64>,
     lu: PartialPivLu<f64>,
+    x: Vec<(usize, f64)>,
 }
 
 /// Rank-one terms must make up the change of J to this fraction of its largest entry.
@@ -500,8 +542,9 @@ impl DenseColumns {
         Some(DenseColumns { nodes: union, values })
     }
 
-    /// z ← z − W E M⁻¹ Wᵀ z, with M's LU factors and E (row-major).
-    fn correct(&self, z: &mut [f64], d: usize, lu: &PartialPivLu<f64>, e: &[f64]) {
+    /// z ← z − W E M⁻¹ Wᵀ z, with M's LU factors and E (row-major); given `rho`, writes
+    /// Wᵀz − y there for the new z and the small system's solution y.
+    fn correct(&self, z: &mut [f64], d: usize, lu: &PartialPivLu<f64>, e: &[f64], rho: Option<&mut Vec<f64>>) {
         let m = self.nodes.len() * d;
         let k = self.values.len() / m;
         let mut zu = vec![0.0; m];
@@ -529,11 +572,26 @@ impl DenseColumns {
         for (i, &node) in self.nodes.iter().enumerate() {
             z[node as usize * d..][..d].iter_mut().zip(&zu[i * d..][..d]).for_each(|(a, b)| *a -= b);
         }
+        if let Some(rho) = rho {
+            for (i, &node) in self.nodes.iter().enumerate() {
+                zu[i * d..][..d].copy_from_slice(&z[node as usize * d..][..d]);
+            }
+            rho.clear();
+            rho.extend((0..k).map(|c| dot(&self.values[c * m..(c + 1) * m], &zu) - y[(c, 0)]));
+        }
     }
 }
 
-/// z ← z − W E M⁻¹ Wᵀ z, with W's columns node by node.
-fn correct_sparse(cols: &[&SparseColumn], d: usize, lu: &PartialPivLu<f64>, e: &[f64], z: &mut [f64]) {
+/// z ← z − W E M⁻¹ Wᵀ z, with W's columns node by node; given `rho`, writes Wᵀz − y there
+/// (as [`DenseColumns::correct`]).
+fn correct_sparse(
+    cols: &[&SparseColumn],
+    d: usize,
+    lu: &PartialPivLu<f64>,
+    e: &[f64],
+    z: &mut [f64],
+    rho: Option<&mut Vec<f64>>,
+) {
     let k = cols.len();
     let mut y = Mat::from_fn(k, 1, |a, _| gather(cols[a], d, z));
     lu.solve_in_place(y.as_mut());
@@ -542,6 +600,10 @@ fn correct_sparse(cols: &[&SparseColumn], d: usize, lu: &PartialPivLu<f64>, e: &
         if ey != 0.0 {
             axpy(col, d, -ey, z);
         }
+    }
+    if let Some(rho) = rho {
+        rho.clear();
+        rho.extend(cols.iter().enumerate().map(|(a, col)| gather(col, d, z) - y[(a, 0)]));
     }
 }
 
@@ -677,18 +739,19 @@ mod tests {
         assert!(changed.len() > 3);
         let b: Vec<f64> = (0..n).map(|i| ((i * 13) % 23) as f64 / 23.0 - 0.5).collect();
         let mut x = b.clone();
-        lr.solve(&mut f, &mut x).unwrap();
-        // J x = b.
+        let defect = lr.solve(&mut f, &mut x, true).unwrap().expect("a Cholesky reference in node blocks");
+        // J x = b, and the residual the terms' correction reports is as small.
         let mut jx = vec![0.0; n];
         j.mul_vec(&x, &mut jx);
         let err = jx.iter().zip(&b).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
         assert!(err < 1e-12, "residual {err:.1e}");
+        assert!(defect < 1e-12, "defect {defect:.1e}");
         // Without the elements, the correction by E on the changed dofs solves alike.
         let mut by_dofs = LowRank::new(&a);
         by_dofs.update(&j, changed.clone(), &mut f, None).unwrap();
         assert_eq!(by_dofs.terms(), changed.len());
         let mut y = b.clone();
-        by_dofs.solve(&mut f, &mut y).unwrap();
+        by_dofs.solve(&mut f, &mut y, false).unwrap();
         let diff = x.iter().zip(&y).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
         assert!(diff < 1e-12, "the two corrections differ by {diff:.1e}");
     }
@@ -726,12 +789,47 @@ mod tests {
             let dense = DenseColumns::new(&cols, d, n / d, entries, &mut spare).expect("few columns: dense");
             let z: Vec<f64> = (0..n).map(|i| ((i * 29) % 97) as f64 / 97.0 - 0.5).collect();
             let (mut sparse_z, mut dense_z) = (z.clone(), z.clone());
-            correct_sparse(&cols, d, &lu, &e, &mut sparse_z);
-            dense.correct(&mut dense_z, d, &lu, &e);
+            correct_sparse(&cols, d, &lu, &e, &mut sparse_z, None);
+            dense.correct(&mut dense_z, d, &lu, &e, None);
             let scale = sparse_z.iter().fold(0.0f64, |s, v| s.max(v.abs()));
             let err = sparse_z.iter().zip(&dense_z).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
             assert!(err <= 1e-14 * scale, "{n} unknowns: differ by {err:.1e}");
             assert!(sparse_z != z, "the correction changes z");
+
+            // Whatever y the small system is solved to (here a perturbed M's), the corrected
+            // solve's residual is U E ρ with ρ = Wᵀz' − y: exact on the dofs D, zero elsewhere,
+            // to the triangular passes' round-off.
+            let perturbed = (&m + Mat::from_fn(k, k, |x, y| 1e-3 * (1.0 + ((x + 2 * y) % 5) as f64))).partial_piv_lu();
+            let j_times = |x: &[f64]| {
+                let mut jx = vec![0.0; n];
+                a.mul_vec(x, &mut jx);
+                for c in 0..k {
+                    jx[dofs[c]] += (0..k).map(|y| e[c * k + y] * x[dofs[y]]).sum::<f64>();
+                }
+                jx
+            };
+            let b: Vec<f64> = (0..n).map(|i| ((i * 13) % 31) as f64 / 31.0 - 0.5).collect();
+            for sparse in [true, false] {
+                let (mut x, mut rho, mut work) = (b.clone(), Vec::new(), Vec::new());
+                block.solve_with(&mut x, &mut work, |z| match sparse {
+                    true => correct_sparse(&cols, d, &perturbed, &e, z, Some(&mut rho)),
+                    false => dense.correct(z, d, &perturbed, &e, Some(&mut rho)),
+                });
+                let mut expected = vec![0.0; n];
+                for c in 0..k {
+                    expected[dofs[c]] = (0..k).map(|y| e[c * k + y] * rho[y]).sum();
+                }
+                let jx = j_times(&x);
+                let residual: Vec<f64> = jx.iter().zip(&b).map(|(p, q)| p - q).collect();
+                let size = crate::newton::norm_inf(&residual);
+                let err = residual.iter().zip(&expected).fold(0.0f64, |s, (p, q)| s.max((p - q).abs()));
+                let roundoff = 64.0 * f64::EPSILON * a.norm_inf() * crate::newton::norm_inf(&x);
+                assert!(size > 1e3 * roundoff, "{n} unknowns: the perturbation shows ({size:.1e})");
+                assert!(
+                    err <= roundoff,
+                    "{n} unknowns, sparse {sparse}: U E ρ misses J x − b by {err:.1e} of {size:.1e}"
+                );
+            }
         }
     }
 }

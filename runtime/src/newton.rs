@@ -11,8 +11,11 @@
 //! differs from the factored one on few enough dofs, the factorization is corrected
 //! (`lowrank`) instead of recomputed. The factorization survives between solves (time steps)
 //! until `invalidate` is called. Where a step keeps the active set, R is affine and the new
-//! residual is the solve's error: each new operator's first solve is checked, and the later
-//! ones, when that one was accurate, are bounded by its accuracy and round-off, not evaluated.
+//! residual is the solve's error: each new factorization's first solve is checked (J δ + R),
+//! and the later ones, when that one was accurate, are bounded by its accuracy and round-off,
+//! not evaluated. A corrected operator's first solve is bounded the same way by the
+//! reference's accuracy plus the residual the correction reports it leaves (`LowRank::solve`),
+//! and checked only when that bound is not small.
 
 use tracing::debug;
 
@@ -179,8 +182,10 @@ pub struct Newton {
     /// accuracy once its first solve has been checked.
     jacobian_norm: f64,
     solve_accuracy: Option<f64>,
-    /// ‖J₀‖∞ of the factored reference (a bound on ‖J‖∞ is this plus the correction's).
+    /// ‖J₀‖∞ of the factored reference (a bound on ‖J‖∞ is this plus the correction's), and
+    /// the relative accuracy its solves are trusted to, once its first solve was checked.
     reference_norm: f64,
+    reference_accuracy: Option<f64>,
     scratch: Scratch,
 }
 
@@ -200,8 +205,9 @@ struct Reference {
     factorization: Option<Factorization>,
     low_rank: Option<LowRank>,
     overhead: usize,
-    /// ‖J₀‖∞.
+    /// ‖J₀‖∞ and its solves' trusted accuracy.
     norm: f64,
+    accuracy: Option<f64>,
 }
 
 impl Newton {
@@ -223,6 +229,7 @@ impl Newton {
             jacobian_norm: f64::INFINITY,
             solve_accuracy: None,
             reference_norm: f64::INFINITY,
+            reference_accuracy: None,
             scratch: Scratch::default(),
         }
     }
@@ -240,6 +247,7 @@ impl Newton {
         self.factored_for = None;
         self.jacobian_current = false;
         self.solve_accuracy = None;
+        self.reference_accuracy = None;
         self.low_rank = None;
         self.overhead = 0;
         self.force_refactor = false;
@@ -271,6 +279,7 @@ impl Newton {
             std::mem::swap(&mut self.low_rank, &mut prev.low_rank);
             std::mem::swap(&mut self.overhead, &mut prev.overhead);
             std::mem::swap(&mut self.reference_norm, &mut prev.norm);
+            std::mem::swap(&mut self.reference_accuracy, &mut prev.accuracy);
         }
     }
 
@@ -403,14 +412,20 @@ impl Newton {
                 self.solve_accuracy = None;
             }
             delta.iter_mut().zip(r.iter()).for_each(|(d, ri)| *d = -ri);
+            let trusted = if piecewise && !self.options.line_search { self.solve_accuracy } else { None };
+            // A correction of a reference whose solves are trusted reports the residual it
+            // leaves itself (`LowRank::solve`): its first solve needs no product J δ then.
+            let defect =
+                trusted.is_none() && piecewise && !self.options.line_search && self.reference_accuracy.is_some();
             let f = self.factorization.as_mut().expect("factored above");
             let solved = match &self.low_rank {
-                Some(lr) => lr.solve(f, delta),
-                None => f.solve_in_place(delta),
+                Some(lr) => lr.solve(f, delta, defect),
+                None => f.solve_in_place(delta).map(|()| None),
             };
-            if let Err(source) = solved {
-                return Err(NewtonError::Linear { source, report });
-            }
+            let defect = match solved {
+                Ok(defect) => defect,
+                Err(source) => return Err(NewtonError::Linear { source, report }),
+            };
             if let Some(lr) = &self.low_rank {
                 self.overhead = self.overhead.saturating_add(lr.entries());
                 self.force_refactor = self.overhead > self.overhead_budget(n);
@@ -418,10 +433,17 @@ impl Newton {
             // A direct solve is backward stable unless the operator is numerically singular or
             // its correction ill-conditioned: the first solve with a new operator is checked
             // (J δ + R), and if it is accurate, ten times its relative error bounds the later
-            // solves' (no product J δ for them). Iterative solves are always checked.
-            let trusted = if piecewise && !self.options.line_search { self.solve_accuracy } else { None };
+            // solves' (no product J δ for them). Iterative solves are always checked. A
+            // corrected operator's first solve is estimated instead, when its reference's solves
+            // are trusted: their accuracy plus the correction's own residual, if that is small.
+            let norm_r = norm_inf(r);
+            let estimate =
+                defect.zip(self.reference_accuracy).map(|(d, a)| a + d / norm_r).filter(|e| *e <= TRUSTED_ACCURACY);
+            let checked = trusted.is_none() && estimate.is_none();
             let j = self.jacobian.as_ref().expect("assembled above");
-            let linear = if trusted.is_some() {
+            let linear = if let Some(e) = estimate {
+                e
+            } else if !checked {
                 0.0
             } else {
                 // Aᵀ δ reads half the bytes, but only a problem declared symmetric is sure to stay
@@ -440,7 +462,7 @@ impl Newton {
                 } else {
                     j.mul_vec(delta, jd);
                 }
-                jd.iter().zip(r.iter()).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_inf(r)
+                jd.iter().zip(r.iter()).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_r
             };
             if linear.is_nan() || linear > LINEAR_TOLERANCE {
                 if self.low_rank.as_ref().is_some_and(|lr| lr.rank() > 0) {
@@ -462,7 +484,14 @@ impl Newton {
                 && self.factorization.as_ref().is_some_and(Factorization::is_direct)
             {
                 self.solve_accuracy = Some(10.0 * linear);
+                // A new factorization's first solve, checked: the reference its corrections
+                // are estimated from.
+                if refactor && checked {
+                    self.reference_accuracy = self.solve_accuracy;
+                }
             }
+            // The relative accuracy of this solve, where it is not measured by a product.
+            let accuracy = trusted.or(estimate);
             let step = if piecewise && !self.options.line_search {
                 // R is affine wherever the active set is the one J was built for: if it still
                 // is at the new iterate, R there is R + J δ, and no assembly is needed.
@@ -470,13 +499,13 @@ impl Newton {
                 after.clear();
                 p.active_set(w, after);
                 let kept = after == set;
-                // After a trusted solve R there is the solve's error: its relative accuracy
-                // times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
-                let bound = trusted.map(|a| a * norm_inf(r) + ROUNDOFF * self.jacobian_norm * norm_inf(delta));
+                // After a trusted or estimated solve R there is the solve's error: its relative
+                // accuracy times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
+                let bound = accuracy.map(|a| a * norm_r + ROUNDOFF * self.jacobian_norm * norm_inf(delta));
                 let estimated = kept && bound.is_some_and(|b| b <= threshold);
                 if estimated {
                     res = bound.expect("trusted");
-                } else if kept && trusted.is_none() {
+                } else if kept && checked {
                     r.iter_mut().zip(jd.iter()).for_each(|(ri, x)| *ri += x);
                 } else {
                     p.residual(w, r);
@@ -563,10 +592,12 @@ impl Newton {
                 low_rank: self.low_rank.take(),
                 overhead: self.overhead,
                 norm: self.reference_norm,
+                accuracy: self.reference_accuracy,
             });
         }
         self.low_rank = None;
         self.overhead = 0;
+        self.reference_accuracy = None;
         self.refactor(p, w, assembled)?;
         let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
         if piecewise && direct && self.options.max_rank > 0 {
