@@ -455,6 +455,21 @@ impl Factorization {
         }
     }
 
+    /// As [`Factorization::fork`], taking this one's numeric storage along (this one is left
+    /// unfactored, its analysis kept): the fork's first factorization then writes into memory
+    /// already in use, where fresh storage costs zeroing and page faults.
+    pub fn fork_with_storage(&mut self) -> Factorization {
+        let mut fork = self.fork();
+        if let (Factors::Llt { values, block, factored, .. }, Factors::Llt { values: to, block: to_block, .. }) =
+            (&mut self.factors, &mut fork.factors)
+        {
+            *to = std::mem::take(values);
+            *to_block = block.take();
+            *factored = false;
+        }
+        fork
+    }
+
     /// Stored values of the Cholesky factor L, if that is what was computed.
     pub fn factor_nnz(&self) -> Option<usize> {
         match &self.factors {

@@ -234,6 +234,18 @@ impl Newton {
         }
     }
 
+    /// Starts from `other`'s symbolic analysis and takes its factor's storage, if this Newton
+    /// has no factorization and the other has one (a scheme's initial problem, solved once, and
+    /// its first stage); `other` is left to refactor at its next solve.
+    pub fn inherit(&mut self, other: &mut Newton) {
+        if self.factorization.is_none()
+            && let Some(f) = other.factorization.as_mut()
+        {
+            self.factorization = Some(f.fork_with_storage());
+            other.invalidate();
+        }
+    }
+
     /// Starts from `other`'s symbolic analysis, if this Newton has none and the other has one
     /// (a problem with the same Jacobian pattern: a scheme's initial problem and its stages).
     pub fn share_analysis(&mut self, other: &Newton) {

@@ -467,9 +467,12 @@ impl<'a> Stepper<'a> {
         let (w, report) = result?;
         states[init.state] = w;
         // The stages' Jacobians have the initial problem's pattern: one ordering and symbolic
-        // analysis serves all.
-        if let Some((initial, stages)) = self.stages.split_last_mut() {
-            stages.iter_mut().for_each(|s| s.newton.share_analysis(&initial.newton));
+        // analysis serves all, and the first stage factors into the initial problem's storage.
+        if let Some((initial, stages)) = self.stages.split_last_mut()
+            && let Some((first, rest)) = stages.split_first_mut()
+        {
+            rest.iter_mut().for_each(|s| s.newton.share_analysis(&initial.newton));
+            first.newton.inherit(&mut initial.newton);
         }
         Ok(Some(report))
     }
