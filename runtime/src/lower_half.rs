@@ -219,20 +219,26 @@ impl LowerHalf {
     fn task<const D: usize, const M: usize>(&self, t: &Task, x: &[f64], buf: &mut [f64]) {
         let h = self.pattern.as_ref();
         buf.iter_mut().for_each(|v| *v = 0.0);
+        // Vectors by node: one bounds check per block rather than two.
+        let (x, _) = x.as_chunks::<D>();
+        let (buf, _) = buf.as_chunks_mut::<D>();
         for p in t.start..t.end {
-            let xj: [[f64; D]; M] = std::array::from_fn(|l| std::array::from_fn(|c| x[(p * M + l) * D + c]));
+            let xj: [[f64; D]; M] = std::array::from_fn(|l| x[p * M + l]);
             // Σ_l (A_l,ip)ᵀ x_l,i summed over the column: D² independent sums.
             let mut acc = [[0.0f64; D]; D];
             let range = h.ptr[p]..h.ptr[p + 1];
             let values = &self.values[range.start * M * D * D..range.end * M * D * D];
             for (&i, blocks) in h.rows[range].iter().zip(values.chunks_exact(M * D * D)) {
                 let i = i as usize;
-                let yi = &mut buf[(i - t.start) * D..][..D];
+                let yi = &mut buf[i - t.start];
                 for (l, a) in blocks.chunks_exact(D * D).enumerate() {
-                    let xi = &x[(i * M + l) * D..][..D];
+                    let xi = &x[i * M + l];
                     for r in 0..D {
-                        let mut s = 0.0;
-                        for c in 0..D {
+                        // Started from the first product, not from 0.0 (an addition the
+                        // compiler must keep, for the sign of zero).
+                        acc[0][r] += a[r * D] * xi[r];
+                        let mut s = a[r * D] * xj[l][0];
+                        for c in 1..D {
                             acc[c][r] += a[r * D + c] * xi[r];
                             s += a[r * D + c] * xj[l][c];
                         }
@@ -241,7 +247,7 @@ impl LowerHalf {
                 }
             }
             let dg = &self.diag[p * M * D * D..][..M * D * D];
-            let yj = &mut buf[(p - t.start) * D..][..D];
+            let yj = &mut buf[p - t.start];
             for c in 0..D {
                 let own: f64 = (0..M).map(|l| (0..D).map(|k| dg[(l * D + c) * D + k] * xj[l][k]).sum::<f64>()).sum();
                 yj[c] += own + acc[c].iter().sum::<f64>();
