@@ -349,6 +349,22 @@ struct StageCache {
     /// The nonlinear terms' arguments and residual, kept from one step to the next.
     args: Vec<Vec<f64>>,
     term: Vec<f64>,
+    switches: SwitchMemo,
+}
+
+/// The last active set a stage's terms gave, and what it is a function of: the terms' forms,
+/// times (for forms that change with time) and arguments at the support's dofs. A stage whose Newton starts where the last one
+/// ended (Newmark's u' = u + δ at δ = 0 is the last iterate, bit for bit) finds its active set
+/// here instead of evaluating the contact facets again.
+#[derive(Default)]
+struct SwitchMemo {
+    /// The forms, then per term its time, the arguments it is differentiated by, and its
+    /// arguments at the support's dofs, as bits.
+    forms: Vec<&'static str>,
+    key: Vec<u64>,
+    set: Vec<bool>,
+    /// Scratch for the key being compared.
+    next: Vec<u64>,
 }
 
 impl<'a> Stepper<'a> {
@@ -407,6 +423,7 @@ impl<'a> Stepper<'a> {
                 linear: None,
                 args: Vec::new(),
                 term: Vec::new(),
+                switches: SwitchMemo::default(),
             })
             .collect();
         Ok(Stepper {
@@ -483,6 +500,7 @@ impl<'a> Stepper<'a> {
         for s in &mut self.stages {
             s.newton.forget();
             s.constant = None;
+            s.switches = SwitchMemo::default();
         }
         self.loads.clear();
     }
@@ -727,7 +745,7 @@ impl<'a> Stepper<'a> {
             entry.newton.invalidate();
         }
         let piecewise = nonlinear.iter().all(|a| self.forms[a.form].piecewise());
-        let StageCache { newton, constant, support, scratch, args, term, .. } = &mut self.stages[cache];
+        let StageCache { newton, constant, support, scratch, args, term, switches, .. } = &mut self.stages[cache];
         // The same forms at every step in practice; should they change, so may the entries where
         // J varies, and the references compared there only are dropped.
         if support.as_ref().is_none_or(|(forms, _)| !forms.iter().eq(nonlinear.iter().map(|a| &a.form))) {
@@ -750,6 +768,7 @@ impl<'a> Stepper<'a> {
             scratch,
             args: std::mem::take(args),
             term: std::mem::take(term),
+            switches,
             magnitude: 0.0,
         };
         // δ = w − reference, with the constrained values of w imposed.
@@ -915,6 +934,7 @@ struct StageProblem<'p, 'a> {
     scratch: &'p mut Option<Matrix>,
     args: Vec<Vec<f64>>,
     term: Vec<f64>,
+    switches: &'p mut SwitchMemo,
     /// The largest term of the last residual.
     magnitude: f64,
 }
@@ -993,14 +1013,43 @@ impl NonlinearProblem for StageProblem<'_, '_> {
     }
 
     fn active_set(&mut self, w: &[f64], out: &mut Vec<bool>) -> bool {
+        let dofs = self.support.map(|s| s.dofs.as_slice());
+        // The set is a function of the forms, times and arguments at the support's dofs: the
+        // last one evaluated is reused if those are the same bits.
+        let memo = &mut *self.switches;
+        if let Some(dofs) = dofs {
+            memo.next.clear();
+            for term in &self.terms {
+                term.args_into(w, &mut self.args, Some(dofs));
+                // A steady form's set does not depend on the time.
+                let steady = !self.forms[term.form].time_dependent();
+                memo.next.push(if steady { u64::MAX } else { term.t.to_bits() });
+                memo.next.extend(term.alphas.iter().map(|a| u64::from(*a != 0.0)));
+                for arg in &self.args {
+                    memo.next.extend(dofs.iter().map(|&i| arg[i].to_bits()));
+                }
+            }
+            if memo.key == memo.next && memo.forms.iter().eq(self.terms.iter().map(|t| &t.form)) {
+                out.extend_from_slice(&memo.set);
+                return self.piecewise;
+            }
+        }
+        let start = out.len();
         for term in &self.terms {
-            term.args_into(w, &mut self.args, self.support.map(|s| s.dofs.as_slice()));
+            term.args_into(w, &mut self.args, dofs);
             let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
                     self.forms[term.form].switches(self.asm, &refs, k, term.t, out);
                 }
             }
+        }
+        if dofs.is_some() {
+            std::mem::swap(&mut memo.key, &mut memo.next);
+            memo.forms.clear();
+            memo.forms.extend(self.terms.iter().map(|t| t.form));
+            memo.set.clear();
+            memo.set.extend_from_slice(&out[start..]);
         }
         self.piecewise
     }
