@@ -448,7 +448,8 @@ impl Newton {
             // solves' (no product J δ for them). Iterative solves are always checked. A
             // corrected operator's first solve is estimated instead, when its reference's solves
             // are trusted: their accuracy plus the correction's own residual, if that is small.
-            let norm_r = norm_inf(r);
+            // (`res` is ‖r‖∞ here: the loop goes on only after a step that evaluated r.)
+            let norm_r = res;
             let estimate =
                 defect.zip(self.reference_accuracy).map(|(d, a)| a + d / norm_r).filter(|e| *e <= TRUSTED_ACCURACY);
             let checked = trusted.is_none() && estimate.is_none();
@@ -513,7 +514,8 @@ impl Newton {
                 let kept = after == set;
                 // After a trusted or estimated solve R there is the solve's error: its relative
                 // accuracy times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
-                let bound = accuracy.map(|a| a * norm_r + ROUNDOFF * self.jacobian_norm * norm_inf(delta));
+                let norm_delta = norm_inf(delta);
+                let bound = accuracy.map(|a| a * norm_r + ROUNDOFF * self.jacobian_norm * norm_delta);
                 let estimated = kept && bound.is_some_and(|b| b <= threshold);
                 if estimated {
                     res = bound.expect("trusted");
@@ -525,7 +527,7 @@ impl Newton {
                 if !estimated {
                     res = norm_inf(r);
                 }
-                small_step = kept && norm_inf(delta) <= self.options.tol * norm_inf(w);
+                small_step = kept && norm_delta <= self.options.tol * norm_inf(w);
                 known = true;
                 1.0
             } else {

@@ -771,14 +771,16 @@ impl<'a> Stepper<'a> {
             switches,
             magnitude: 0.0,
         };
-        // δ = w − reference, with the constrained values of w imposed.
+        // δ = w − reference, with the constrained values of w imposed: zero but on those.
         let w0 = match reference {
             Level::State(i) => &states[i],
             Level::Stage(s, q) => &quantities[s][q],
         };
-        let mut delta = self.pool.copy(w0);
-        self.constraints.impose(&mut delta);
-        delta.iter_mut().zip(w0).for_each(|(d, r)| *d -= r);
+        let mut delta = self.pool.zeros(n);
+        let Constraints { fixed, values } = &self.constraints;
+        for (i, _) in fixed.iter().enumerate().filter(|(_, f)| **f) {
+            delta[i] = values[i] - w0[i];
+        }
         let report = newton.solve(&mut problem, &mut delta);
         (*args, *term) = (problem.args, problem.term);
         self.pool.give(problem.rhs);
