@@ -237,24 +237,36 @@ impl BlockFactor {
     /// L⁻¹ e_k for the unit vector at elimination position `k`: only the ancestors of k's node
     /// are visited. `work` must be zero on entry (length `size()`); it is zero again on exit.
     pub fn forward_unit(&self, k: usize, work: &mut [f64]) -> SparseColumn {
-        let d = self.d;
-        let mut out = SparseColumn::default();
-        work[k] = 1.0;
-        let mut node = k / d;
+        self.forward_units(&[k], work).pop().expect("one column")
+    }
+
+    /// L⁻¹ e_k for each of `ks`, elimination positions of one node's dofs (at most d): the
+    /// ancestors of that node are visited once, each block read once for all the columns,
+    /// which are the same bits as one by one. `work` must be zero on entry (length
+    /// `ks.len() · size()`, one vector per column); it is zero again on exit.
+    pub fn forward_units(&self, ks: &[usize], work: &mut [f64]) -> Vec<SparseColumn> {
+        let (d, n, m) = (self.d, self.size(), ks.len());
+        assert!((1..=d).contains(&m) && ks.iter().all(|k| k / d == ks[0] / d), "dofs of one node");
+        let mut out: Vec<SparseColumn> = (0..m).map(|_| SparseColumn::default()).collect();
+        let (work, _) = work.split_at_mut(m * n);
+        ks.iter().zip(work.chunks_exact_mut(n)).for_each(|(&k, w)| w[k] = 1.0);
+        let mut node = ks[0] / d;
         loop {
-            out.nodes.push(node as u32);
             let dg = &self.diag[node * d * d..][..d * d];
-            let mut xj = [0.0f64; 3];
-            for r in 0..d {
-                let mut s = work[node * d + r];
-                for c in 0..r {
-                    s -= dg[r * d + c] * xj[c];
+            let mut xj = [[0.0f64; 3]; 3];
+            for ((x, column), w) in xj.iter_mut().zip(out.iter_mut()).zip(work.chunks_exact_mut(n)) {
+                column.nodes.push(node as u32);
+                for r in 0..d {
+                    let mut s = w[node * d + r];
+                    for c in 0..r {
+                        s -= dg[r * d + c] * x[c];
+                    }
+                    x[r] = s / dg[r * d + r];
                 }
-                xj[r] = s / dg[r * d + r];
-            }
-            for r in 0..d {
-                out.values.push(xj[r]);
-                work[node * d + r] = 0.0;
+                for r in 0..d {
+                    column.values.push(x[r]);
+                    w[node * d + r] = 0.0;
+                }
             }
             let range = self.ptr[node]..self.ptr[node + 1];
             if range.is_empty() {
@@ -262,12 +274,14 @@ impl BlockFactor {
             }
             for (i, &row) in self.rows[range.clone()].iter().enumerate() {
                 let block = &self.values[(range.start + i) * d * d..][..d * d];
-                for r in 0..d {
-                    let mut s = 0.0;
-                    for c in 0..d {
-                        s += block[r * d + c] * xj[c];
+                for (x, w) in xj.iter().zip(work.chunks_exact_mut(n)) {
+                    for r in 0..d {
+                        let mut s = 0.0;
+                        for c in 0..d {
+                            s += block[r * d + c] * x[c];
+                        }
+                        w[row as usize * d + r] -= s;
                     }
-                    work[row as usize * d + r] -= s;
                 }
             }
             // The parent in the elimination tree: the first row below the diagonal block.
@@ -429,6 +443,16 @@ mod tests {
                         sparse[node as usize * d..][..d].copy_from_slice(&column.values[i * d..][..d]);
                     }
                     assert_eq!(sparse, dense, "forward_unit({k}) is the forward solve of e_k");
+                    // With the node's other dofs, in one visit: the same columns.
+                    let d = p.dim();
+                    let node: Vec<usize> = (k / d * d..(k / d + 1) * d).collect();
+                    let mut works = vec![0.0; d * n];
+                    let together = block.forward_units(&node, &mut works);
+                    assert!(works.iter().all(|w| *w == 0.0), "work left zero");
+                    for (&j, c) in node.iter().zip(&together) {
+                        let alone = block.forward_unit(j, &mut work);
+                        assert_eq!((&c.nodes, &c.values), (&alone.nodes, &alone.values), "forward_units at {j}");
+                    }
                 }
             }
         }
