@@ -4,7 +4,9 @@
 //! hand-written form (one P1 element, ρ = 3, k = 1: M = K = 1 on the free dof). The scheme
 //! conserves ½(v² + u²) to round-off and is second order against cos t. On 400 cells, the
 //! steps after the first allocate no vector of the problem's size (issue 12), counted by an
-//! allocator that records, per thread, allocations of at least a given size.
+//! allocator that records, per thread, allocations of at least a given size. With a penalty
+//! obstacle that counts its evaluations: a steady form's active set is evaluated once a step,
+//! a moving one's twice (the stage reuses the last set for the same arguments).
 
 mod common;
 
@@ -14,7 +16,7 @@ use std::cell::Cell;
 use common::MassStiffness;
 use signorini_runtime::assembly::{Assembler, Quadrature};
 use signorini_runtime::library::SlotUse;
-use signorini_runtime::linalg::Structure;
+use signorini_runtime::linalg::{Matrix, Structure};
 use signorini_runtime::mesh::structured::interval;
 use signorini_runtime::newton::NewtonOptions;
 use signorini_runtime::problem::Constraints;
@@ -222,4 +224,130 @@ fn the_initial_problem_solves_again_after_the_stage_took_its_factor_storage() {
     }
     assert_eq!(a, b);
     assert!(a[0] != start[0], "the states moved");
+}
+
+/// A penalty obstacle at dof 0, k·min(u₀ − g(t), 0), g(t) = −1 − t (far below the state, so
+/// never active), counting its active-set evaluations; `moving` says whether it changes with
+/// time (it does, through g, either way: a steady form's set must not depend on t).
+struct Obstacle {
+    k: f64,
+    moving: bool,
+    calls: std::rc::Rc<Cell<usize>>,
+}
+
+impl Obstacle {
+    fn gap(&self, u: &[f64], t: f64) -> f64 {
+        let g = if self.moving { -1.0 - t } else { -1.0 };
+        u[0] - g
+    }
+}
+
+impl BoundForm for Obstacle {
+    fn name(&self) -> &str {
+        "obstacle"
+    }
+    fn fields(&self) -> usize {
+        1
+    }
+    fn linear(&self) -> bool {
+        false
+    }
+    fn piecewise(&self) -> bool {
+        true
+    }
+    fn residual(&self, _asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {
+        out[0] += self.k * self.gap(fields[0], t).min(0.0);
+    }
+    fn tangent(&self, _asm: &Assembler, fields: &[&[f64]], _wrt: usize, t: f64, m: &mut Matrix) {
+        if self.gap(fields[0], t) < 0.0 {
+            let p = &m.pattern;
+            let at = p.col_ptr[0] + p.row_idx[p.col_ptr[0]..p.col_ptr[1]].binary_search(&0).unwrap();
+            m.values[at] += self.k;
+        }
+    }
+    fn switches(&self, _asm: &Assembler, fields: &[&[f64]], _wrt: usize, t: f64, out: &mut Vec<bool>) {
+        self.calls.set(self.calls.get() + 1);
+        out.push(self.gap(fields[0], t) < 0.0);
+    }
+    fn support(&self) -> Option<Vec<u32>> {
+        Some(vec![0])
+    }
+    fn time_dependent(&self) -> bool {
+        self.moving
+    }
+}
+
+const U_NEW: Combination = Combination { unknown: Some(0), known: &[] };
+
+const OBSTACLE_DESC: SchemeDesc = SchemeDesc {
+    name: "crank_nicolson_obstacle",
+    uses: &[
+        SlotUse { name: "mass", fields: 1, declared: "test:1:1" },
+        SlotUse { name: "stiffness", fields: 1, declared: "test:1:6" },
+        SlotUse { name: "obstacle", fields: 1, declared: "test:1:17" },
+    ],
+    stages: &[StageDesc {
+        terms: &[
+            TermDesc { coef: 0, form: "mass", args: &[A_NEW], time: 3 },
+            TermDesc { coef: 0, form: "stiffness", args: &[U_NEW], time: 3 },
+            TermDesc { coef: 0, form: "obstacle", args: &[U_NEW], time: 3 },
+        ],
+        ..DESC.stages[0]
+    }],
+    ..DESC
+};
+
+struct WithObstacle;
+
+impl TimeScheme for WithObstacle {
+    fn desc(&self) -> &SchemeDesc {
+        &OBSTACLE_DESC
+    }
+    fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]) {
+        CrankNicolson.coefficients(dt, t, out);
+    }
+}
+
+#[test]
+fn a_steady_forms_active_set_is_evaluated_once_a_step_and_a_moving_ones_twice() {
+    let cells = 20;
+    let mesh = interval(cells, 0.0, 1.0);
+    let asm = Assembler::new(&mesh);
+    let n = cells + 1;
+    for moving in [false, true] {
+        let calls = std::rc::Rc::new(Cell::new(0));
+        let bound = |rho, k| -> Box<dyn BoundForm> {
+            Box::new(Bound { kernel: MassStiffness { rho, k }, quadrature: Quadrature::default(), regions: Vec::new() })
+        };
+        let obstacle = Obstacle { k: 1e3, moving, calls: calls.clone() };
+        let forms =
+            vec![("mass", bound(3.0, 0.0)), ("stiffness", bound(0.0, 1.0)), ("obstacle", Box::new(obstacle) as _)];
+        let mut constraints = Constraints::none(n);
+        constraints.fix(n - 1);
+        let options = NewtonOptions::default();
+        let mut stepper = Stepper::new(
+            Box::new(WithObstacle),
+            &asm,
+            forms,
+            constraints,
+            Structure::SymmetricPositiveDefinite,
+            options,
+        )
+        .unwrap();
+        let u0: Vec<f64> = (0..n).map(|i| (std::f64::consts::FRAC_PI_2 * i as f64 / cells as f64).cos()).collect();
+        let mut states = vec![u0, vec![0.0; n], vec![0.0; n]];
+        stepper.initialize(&mut states, 0.0).unwrap();
+        let dt = 1e-2;
+        stepper.step(&mut states, 0.0, dt).unwrap();
+        let before = calls.get();
+        let mut iterations = 0;
+        for k in 1..11 {
+            iterations += stepper.step(&mut states, k as f64 * dt, dt).unwrap().iterations();
+        }
+        assert_eq!(iterations, 10, "one Newton iteration a step (the obstacle is never reached)");
+        // After each step's solve; and at its start only if the set may have moved with time
+        // (the step starts at the last iterate, the same arguments).
+        let per_step = if moving { 2 } else { 1 };
+        assert_eq!(calls.get() - before, 10 * per_step, "moving {moving}");
+    }
 }
