@@ -122,22 +122,32 @@ impl TimeScheme for CrankNicolson {
 
 /// Crank–Nicolson on the oscillator's forms over `asm`'s mesh, its last dof fixed.
 fn stepper<'a>(asm: &'a Assembler<'a>) -> Stepper<'a> {
+    stepper_with(asm, Box::new(CrankNicolson), Vec::new())
+}
+
+/// `scheme` on the oscillator's forms and `more` over `asm`'s mesh, its last dof fixed.
+fn stepper_with<'a>(
+    asm: &'a Assembler<'a>,
+    scheme: Box<dyn TimeScheme>,
+    more: Vec<(&'static str, Box<dyn BoundForm>)>,
+) -> Stepper<'a> {
     let bound = |rho, k| -> Box<dyn BoundForm> {
         Box::new(Bound { kernel: MassStiffness { rho, k }, quadrature: Quadrature::default(), regions: Vec::new() })
     };
-    let forms = vec![("mass", bound(3.0, 0.0)), ("stiffness", bound(0.0, 1.0))];
+    let mut forms = vec![("mass", bound(3.0, 0.0)), ("stiffness", bound(0.0, 1.0))];
+    forms.extend(more);
     let n = asm.size();
     let mut constraints = Constraints::none(n);
     constraints.fix(n - 1);
-    Stepper::new(
-        Box::new(CrankNicolson),
-        asm,
-        forms,
-        constraints,
-        Structure::SymmetricPositiveDefinite,
-        NewtonOptions::default(),
-    )
-    .unwrap()
+    Stepper::new(scheme, asm, forms, constraints, Structure::SymmetricPositiveDefinite, NewtonOptions::default())
+        .unwrap()
+}
+
+/// A quarter cosine at rest on `cells` cells: u, v and a.
+fn at_rest(cells: usize) -> Vec<Vec<f64>> {
+    let n = cells + 1;
+    let u0 = (0..n).map(|i| (std::f64::consts::FRAC_PI_2 * i as f64 / cells as f64).cos()).collect();
+    vec![u0, vec![0.0; n], vec![0.0; n]]
 }
 
 fn run(dt: f64, t_end: f64) -> (f64, f64) {
@@ -173,8 +183,7 @@ fn steps_after_the_first_allocate_no_vector_of_the_problems_size() {
     let asm = Assembler::new(&mesh);
     let mut stepper = stepper(&asm);
     let n = cells + 1;
-    let u0: Vec<f64> = (0..n).map(|i| (std::f64::consts::FRAC_PI_2 * i as f64 / cells as f64).cos()).collect();
-    let mut states = vec![u0, vec![0.0; n], vec![0.0; n]];
+    let mut states = at_rest(cells);
     stepper.initialize(&mut states, 0.0).unwrap();
     let dt = 1e-3;
     // The first steps factor the operator and fill the stepper's reusable vectors.
@@ -200,9 +209,7 @@ fn the_initial_problem_solves_again_after_the_stage_took_its_factor_storage() {
     let cells = 60;
     let mesh = interval(cells, 0.0, 1.0);
     let asm = Assembler::new(&mesh);
-    let n = cells + 1;
-    let u0: Vec<f64> = (0..n).map(|i| (std::f64::consts::FRAC_PI_2 * i as f64 / cells as f64).cos()).collect();
-    let start = vec![u0, vec![0.0; n], vec![0.0; n]];
+    let start = at_rest(cells);
     let dt = 1e-2;
     // A stepper initialized once and one initialized again after its steps (its initial problem
     // refactors, the stage keeps its factor) step alike, bit for bit.
@@ -313,29 +320,11 @@ fn a_steady_forms_active_set_is_evaluated_once_a_step_and_a_moving_ones_twice() 
     let cells = 20;
     let mesh = interval(cells, 0.0, 1.0);
     let asm = Assembler::new(&mesh);
-    let n = cells + 1;
     for moving in [false, true] {
         let calls = std::rc::Rc::new(Cell::new(0));
-        let bound = |rho, k| -> Box<dyn BoundForm> {
-            Box::new(Bound { kernel: MassStiffness { rho, k }, quadrature: Quadrature::default(), regions: Vec::new() })
-        };
         let obstacle = Obstacle { k: 1e3, moving, calls: calls.clone() };
-        let forms =
-            vec![("mass", bound(3.0, 0.0)), ("stiffness", bound(0.0, 1.0)), ("obstacle", Box::new(obstacle) as _)];
-        let mut constraints = Constraints::none(n);
-        constraints.fix(n - 1);
-        let options = NewtonOptions::default();
-        let mut stepper = Stepper::new(
-            Box::new(WithObstacle),
-            &asm,
-            forms,
-            constraints,
-            Structure::SymmetricPositiveDefinite,
-            options,
-        )
-        .unwrap();
-        let u0: Vec<f64> = (0..n).map(|i| (std::f64::consts::FRAC_PI_2 * i as f64 / cells as f64).cos()).collect();
-        let mut states = vec![u0, vec![0.0; n], vec![0.0; n]];
+        let mut stepper = stepper_with(&asm, Box::new(WithObstacle), vec![("obstacle", Box::new(obstacle))]);
+        let mut states = at_rest(cells);
         stepper.initialize(&mut states, 0.0).unwrap();
         let dt = 1e-2;
         stepper.step(&mut states, 0.0, dt).unwrap();
