@@ -4,7 +4,12 @@
 //! faer computes the factorization; this keeps a copy of L laid out for the solves: the
 //! unknowns are ordered node by node (the fill-reducing ordering is computed on the node graph
 //! and each node's d dofs kept together), so L is made of d×d blocks, stored per node column
-//! with one u32 row index per block. A solve pair then reads 8 bytes per entry of L plus one
+//! with one u32 row index per block, rows decreasing: the forward pass reads the factor upwards
+//! in memory (each column's parent block first, then the rest), the backward pass, which visits
+//! the columns from the last, reads it downwards, summing each column's rows in increasing
+//! order all the same (a steady downward stream: solve pair 561–589 against 623–645 µs at
+//! 12 482 unknowns, criterion, three alternating rounds; unchanged at 3 362, where the factor
+//! fits the cache). A solve pair then reads 8 bytes per entry of L plus one
 //! index per d² entries, where faer's simplicial solve reads 16 bytes per entry (an index per
 //! value); measured on the disc's factors, it is 1.5 times faster (`bench disc`).
 //!
@@ -23,7 +28,7 @@ pub struct BlockFactor {
     order: Vec<u32>,
     position: Vec<u32>,
     /// Per node column: its diagonal block (d×d, row-major, upper part zero) and its blocks
-    /// below, `rows[ptr[J]..ptr[J + 1]]` (node rows, increasing) with `values` d×d each,
+    /// below, `rows[ptr[J]..ptr[J + 1]]` (node rows, decreasing) with `values` d×d each,
     /// row-major: `values[(k·d + r)·d + c] = L[rows[k]·d + r, J·d + c]`.
     diag: Vec<f64>,
     ptr: Vec<usize>,
@@ -192,16 +197,14 @@ impl BlockFactor {
             x[node] = xj;
             let range = self.ptr[node]..self.ptr[node + 1];
             let values = &self.values[range.start * D * D..range.end * D * D];
-            for (&row, block) in self.rows[range].iter().zip(values.chunks_exact(D * D)) {
-                let xi = &mut x[row as usize];
-                for r in 0..D {
-                    // Started from the first product, not from 0.0 (an addition the compiler
-                    // must keep, for the sign of zero).
-                    let mut s = block[r * D] * xj[0];
-                    for c in 1..D {
-                        s += block[r * D + c] * xj[c];
-                    }
-                    xi[r] -= s;
+            // The parent (stored last) first: the next column's diagonal solve waits on it.
+            // Each block updates its own row, so the order leaves the bits alone.
+            let rows = &self.rows[range];
+            if let Some((&parent, rest)) = rows.split_last() {
+                let (others, last) = values.split_at(rest.len() * D * D);
+                update::<D>(&mut x[parent as usize], last, &xj);
+                for (&row, block) in rest.iter().zip(others.chunks_exact(D * D)) {
+                    update::<D>(&mut x[row as usize], block, &xj);
                 }
             }
         }
@@ -214,7 +217,8 @@ impl BlockFactor {
             let values = &self.values[range.start * D * D..range.end * D * D];
             // D² independent sums rather than D dependent chains.
             let mut acc = [[0.0f64; D]; D];
-            for (&row, block) in self.rows[range].iter().zip(values.chunks_exact(D * D)) {
+            // Rows increasing (the sums' order), the memory read downwards.
+            for (&row, block) in self.rows[range].iter().rev().zip(values.rchunks_exact(D * D)) {
                 let xi = &x[row as usize];
                 for r in 0..D {
                     for c in 0..D {
@@ -284,10 +288,25 @@ impl BlockFactor {
                     }
                 }
             }
-            // The parent in the elimination tree: the first row below the diagonal block.
-            node = self.rows[range.start] as usize;
+            // The parent in the elimination tree: the first row below the diagonal block (stored
+            // last).
+            node = self.rows[range.end - 1] as usize;
         }
         out
+    }
+}
+
+/// xi −= block · xj (a block below the diagonal in the forward pass).
+#[inline(always)]
+fn update<const D: usize>(xi: &mut [f64; D], block: &[f64], xj: &[f64; D]) {
+    for r in 0..D {
+        // Started from the first product, not from 0.0 (an addition the compiler must keep,
+        // for the sign of zero).
+        let mut s = block[r * D] * xj[0];
+        for c in 1..D {
+            s += block[r * D + c] * xj[c];
+        }
+        xi[r] -= s;
     }
 }
 
@@ -339,6 +358,11 @@ impl Blocks {
             last = group[0] / d;
             self.rows.push(last as u32);
         }
+        // Stored in decreasing order: the backward pass, which visits the columns from the
+        // last, then reads the whole factor downwards in memory.
+        let blocks = below.len() / d;
+        let len = self.rows.len();
+        self.rows[len - blocks..].reverse();
         for c in 0..d {
             let (col_rows, col_values) = column(node * d + c);
             // Rows node·d + c.. of the diagonal block, then exactly the node's rows below.
@@ -352,7 +376,7 @@ impl Blocks {
                 self.diag[(node * d + r) * d + c] = col_values[r - c];
             }
             for (k, v) in col_values[d - c..].iter().enumerate() {
-                let (block, r) = (k / d, k % d);
+                let (block, r) = (blocks - 1 - k / d, k % d);
                 self.values[start + (block * d + r) * d + c] = *v;
             }
         }
