@@ -4,14 +4,15 @@
 //! faer computes the factorization; this keeps a copy of L laid out for the solves: the
 //! unknowns are ordered node by node (the fill-reducing ordering is computed on the node graph
 //! and each node's d dofs kept together), so L is made of d×d blocks, stored per node column
-//! with one u32 row index per block, rows decreasing: the forward pass reads the factor upwards
-//! in memory (each column's parent block first, then the rest), the backward pass, which visits
-//! the columns from the last, reads it downwards, summing each column's rows in increasing
-//! order all the same (a steady downward stream: solve pair 561–589 against 623–645 µs at
-//! 12 482 unknowns, criterion, three alternating rounds; unchanged at 3 362, where the factor
-//! fits the cache). A solve pair then reads 8 bytes per entry of L plus one
+//! with one u32 row index per block. A solve pair then reads 8 bytes per entry of L plus one
 //! index per d² entries, where faer's simplicial solve reads 16 bytes per entry (an index per
 //! value); measured on the disc's factors, it is 1.5 times faster (`bench disc`).
+//!
+//! Each column's blocks are stored with rows decreasing: the backward pass, which visits the
+//! columns from the last, then reads the whole factor downwards in memory while still summing
+//! each column's rows in increasing order (criterion solve pair 561–589 against 623–645 µs at
+//! 12 482 unknowns; unchanged at 3 362, where the factor fits the cache). The forward pass
+//! reads upwards, each column's parent block (stored last) first.
 //!
 //! It also solves L w = e_k for a unit vector, touching only the columns where w is nonzero:
 //! the ancestors of k's node in the elimination tree (a few percent of the columns on a 2D

@@ -225,8 +225,8 @@ impl LowRank {
                 let block = reference.block().ok_or(LinalgError::NotFactored)?;
                 // A node's new dofs together: their columns share the node's ancestors.
                 let mut work = vec![0.0; *d * n];
-                let missing: Vec<usize> = dofs.iter().copied().filter(|&dof| of_dof[dof].is_none()).collect();
-                for group in missing.chunk_by(|&a, &b| block.position(a) / *d == block.position(b) / *d) {
+                let new_dofs: Vec<usize> = dofs.iter().copied().filter(|&dof| of_dof[dof].is_none()).collect();
+                for group in new_dofs.chunk_by(|&a, &b| block.position(a) / *d == block.position(b) / *d) {
                     let positions: Vec<usize> = group.iter().map(|&dof| block.position(dof)).collect();
                     for (&dof, w) in group.iter().zip(block.forward_units(&positions, &mut work)) {
                         of_dof[dof] = Some(columns.len() as u32);

@@ -353,9 +353,9 @@ struct StageCache {
 }
 
 /// The last active set a stage's terms gave, and what it is a function of: the terms' forms,
-/// times (for forms that change with time) and arguments at the support's dofs. A stage whose Newton starts where the last one
-/// ended (Newmark's u' = u + δ at δ = 0 is the last iterate, bit for bit) finds its active set
-/// here instead of evaluating the contact facets again.
+/// times (for forms that change with time) and arguments at the support's dofs. A stage whose
+/// Newton starts where the last one ended (Newmark's u' = u + δ at δ = 0 is the last iterate,
+/// bit for bit) finds its active set here instead of evaluating the contact facets again.
 #[derive(Default)]
 struct SwitchMemo {
     /// The forms, then per term its time, the arguments it is differentiated by, and its
