@@ -44,6 +44,21 @@ fn products_and_solves(c: &mut Criterion) {
                 f.solve_in_place(&mut y).unwrap()
             })
         });
+        // The two passes apart: the forward pass waits on each column's diagonal solve, the
+        // backward pass on each column's sum.
+        let bf = f.block().expect("a Cholesky factor in node blocks");
+        c.bench_function(&format!("forward pass, {n} unknowns"), |b| {
+            b.iter(|| {
+                y.copy_from_slice(&x);
+                bf.forward(&mut y)
+            })
+        });
+        c.bench_function(&format!("backward pass, {n} unknowns"), |b| {
+            b.iter(|| {
+                y.copy_from_slice(&x);
+                bf.backward(&mut y)
+            })
+        });
     }
 }
 

@@ -277,7 +277,7 @@ enum Factors {
     Llt {
         symbolic: Arc<SymbolicCholesky<usize>>,
         values: Vec<f64>,
-        block: Option<BlockFactor>,
+        block: Option<Box<BlockFactor>>,
         factored: bool,
     },
     Lu {
@@ -387,7 +387,7 @@ impl Factorization {
         match &mut self.factors {
             Factors::Llt { symbolic, values, block, factored } => {
                 *factored = false;
-                let old = block.take();
+                let old = block.take().map(|b| *b);
                 values.resize(symbolic.len_val(), 0.0);
                 let req = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
                 let mut mem = MemBuffer::try_new(req).map_err(|_| LinalgError::Other("out of memory".into()))?;
@@ -406,7 +406,7 @@ impl Factorization {
                             LinalgError::NotPositiveDefinite { index }
                         }
                     })?;
-                *block = BlockFactor::reusing(symbolic, values, a.pattern.dim(), old);
+                *block = BlockFactor::reusing(symbolic, values, a.pattern.dim(), old).map(Box::new);
                 if block.is_some() {
                     *values = Vec::new();
                 }
