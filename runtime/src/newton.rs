@@ -45,6 +45,15 @@ fn converged(res: f64, floor: f64, threshold: f64, iterated: bool, small_step: b
 pub trait NonlinearProblem {
     /// Writes R(w) (zero on constrained dofs).
     fn residual(&mut self, w: &[f64], r: &mut [f64]);
+    /// Writes R(w) on the dofs where the nonlinear terms can be nonzero, and zero elsewhere;
+    /// false (r unspecified) if the problem does not know those dofs. Newton calls it when w
+    /// = w₀ + δ for a δ that solved J δ = −R(w₀) to a known accuracy and the active set
+    /// changed: elsewhere R(w) = R(w₀) + J δ is then that solve's error, which Newton carries
+    /// in its bounds, and the next solve's forward pass visits the ancestors of these dofs
+    /// only.
+    fn residual_on_support(&mut self, _w: &[f64], _r: &mut [f64]) -> bool {
+        false
+    }
     /// The largest ∞-norm among the terms summed in the last `residual` (stiffness, inertia,
     /// contact, loads): the residual's round-off is about ε times this.
     fn magnitude(&self) -> f64;
@@ -393,6 +402,11 @@ impl Newton {
         // The active set at the iterate, when the last step found it.
         let mut known = false;
         let mut small_step = false;
+        // A bound on what R(w) holds beyond r: the errors of solves whose residual was then
+        // evaluated on the nonlinear terms' dofs only (`residual_on_support`).
+        let mut carried = 0.0;
+        // ‖r‖∞ of the r the next solve is given.
+        let mut norm_r = r0;
         while !converged(res, floor, threshold, !report.history.is_empty(), small_step) {
             if report.history.len() >= self.options.max_iterations {
                 return Err(NewtonError::IterationLimit { report, threshold });
@@ -448,8 +462,7 @@ impl Newton {
             // solves' (no product J δ for them). Iterative solves are always checked. A
             // corrected operator's first solve is estimated instead, when its reference's solves
             // are trusted: their accuracy plus the correction's own residual, if that is small.
-            // (`res` is ‖r‖∞ here: the loop goes on only after a step that evaluated r.)
-            let norm_r = res;
+            // (`norm_r` is ‖r‖∞ here: the loop goes on only after a step that evaluated r.)
             let estimate =
                 defect.zip(self.reference_accuracy).map(|(d, a)| a + d / norm_r).filter(|e| *e <= TRUSTED_ACCURACY);
             let checked = trusted.is_none() && estimate.is_none();
@@ -515,17 +528,25 @@ impl Newton {
                 // After a trusted or estimated solve R there is the solve's error: its relative
                 // accuracy times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
                 let norm_delta = norm_inf(delta);
-                let bound = accuracy.map(|a| a * norm_r + ROUNDOFF * self.jacobian_norm * norm_delta);
+                let bound = accuracy.map(|a| a * norm_r + ROUNDOFF * self.jacobian_norm * norm_delta + carried);
                 let estimated = kept && bound.is_some_and(|b| b <= threshold);
                 if estimated {
                     res = bound.expect("trusted");
                 } else if kept && checked {
                     r.iter_mut().zip(jd.iter()).for_each(|(ri, x)| *ri += x);
+                } else if let Some(b) = bound.filter(|_| !kept)
+                    && p.residual_on_support(w, r)
+                {
+                    // The set changed where the nonlinear terms are: elsewhere R is this
+                    // solve's error, bounded by b.
+                    carried = b;
                 } else {
                     p.residual(w, r);
+                    carried = 0.0;
                 }
                 if !estimated {
-                    res = norm_inf(r);
+                    norm_r = norm_inf(r);
+                    res = norm_r + carried;
                 }
                 small_step = kept && norm_delta <= self.options.tol * norm_inf(w);
                 known = true;
@@ -536,6 +557,7 @@ impl Newton {
                 p.active_set(w, after);
                 small_step = after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w);
                 res = norm_inf(r);
+                norm_r = res;
                 step
             };
             debug!(iteration = report.history.len() + 1, residual = res, active, refactor, updated, step, "newton");

@@ -942,6 +942,38 @@ struct StageProblem<'p, 'a> {
 }
 
 impl StageProblem<'_, '_> {
+    /// Adds the nonlinear terms at w to `r` (on the support only, if known).
+    fn add_terms(&mut self, w: &[f64], r: &mut [f64]) {
+        use crate::newton::norm_inf;
+        let dofs = self.support.map(|s| s.dofs.as_slice());
+        for term in &self.terms {
+            term.args_into(w, &mut self.args, dofs);
+            let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
+            // The term is nonzero at the support's dofs only, if there is one.
+            match dofs {
+                Some(dofs) => {
+                    self.term.resize(r.len(), 0.0);
+                    dofs.iter().for_each(|&i| self.term[i] = 0.0);
+                }
+                None => {
+                    self.term.clear();
+                    self.term.resize(r.len(), 0.0);
+                }
+            }
+            self.forms[term.form].residual(self.asm, &refs, term.t, &mut self.term);
+            let largest = match dofs {
+                // A NaN reaches r, where Newton sees it; the magnitude only sets a floor.
+                Some(dofs) => dofs.iter().map(|&i| self.term[i].abs()).fold(0.0, f64::max),
+                None => norm_inf(&self.term),
+            };
+            self.magnitude = self.magnitude.max(term.coef.abs() * largest);
+            match dofs {
+                Some(dofs) => dofs.iter().for_each(|&i| r[i] += term.coef * self.term[i]),
+                None => r.iter_mut().zip(&self.term).for_each(|(ri, x)| *ri += term.coef * x),
+            }
+        }
+    }
+
     /// Adds the nonlinear terms' tangents at w to `j` (on the support only, if known).
     fn add_tangents(&mut self, w: &[f64], j: &mut Matrix) {
         for term in &self.terms {
@@ -980,34 +1012,27 @@ impl NonlinearProblem for StageProblem<'_, '_> {
             self.magnitude = self.magnitude.max(norm_inf(r));
             r.iter_mut().zip(&self.rhs).for_each(|(ri, c)| *ri += c);
         }
-        let dofs = self.support.map(|s| s.dofs.as_slice());
-        for term in &self.terms {
-            term.args_into(w, &mut self.args, dofs);
-            let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
-            // The term is nonzero at the support's dofs only, if there is one.
-            match dofs {
-                Some(dofs) => {
-                    self.term.resize(r.len(), 0.0);
-                    dofs.iter().for_each(|&i| self.term[i] = 0.0);
-                }
-                None => {
-                    self.term.clear();
-                    self.term.resize(r.len(), 0.0);
-                }
-            }
-            self.forms[term.form].residual(self.asm, &refs, term.t, &mut self.term);
-            let largest = match dofs {
-                // A NaN reaches r, where Newton sees it; the magnitude only sets a floor.
-                Some(dofs) => dofs.iter().map(|&i| self.term[i].abs()).fold(0.0, f64::max),
-                None => norm_inf(&self.term),
-            };
-            self.magnitude = self.magnitude.max(term.coef.abs() * largest);
-            match dofs {
-                Some(dofs) => dofs.iter().for_each(|&i| r[i] += term.coef * self.term[i]),
-                None => r.iter_mut().zip(&self.term).for_each(|(ri, x)| *ri += term.coef * x),
-            }
-        }
+        self.add_terms(w, r);
         self.constraints.zero(r);
+    }
+
+    fn residual_on_support(&mut self, w: &[f64], r: &mut [f64]) -> bool {
+        // (A w)ᵢ = Σⱼ Aⱼᵢ wⱼ down column i: A is symmetric where it has a lower half.
+        let Some(support) = self.support.filter(|_| self.constant.half.is_some()) else { return false };
+        let a = &self.constant.matrix;
+        let p = &a.pattern;
+        r.fill(0.0);
+        let mut largest = 0.0f64;
+        for &i in &support.dofs {
+            let range = p.col_ptr[i]..p.col_ptr[i + 1];
+            let aw: f64 = a.values[range.clone()].iter().zip(&p.row_idx[range]).map(|(v, &j)| v * w[j]).sum();
+            largest = largest.max(aw.abs());
+            r[i] = aw + self.rhs[i];
+        }
+        self.magnitude = self.magnitude.max(largest);
+        self.add_terms(w, r);
+        self.constraints.zero(r);
+        true
     }
 
     fn magnitude(&self) -> f64 {
