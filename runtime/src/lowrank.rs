@@ -60,6 +60,18 @@ pub struct LowRank {
     /// pairs per term (empty for a correction by E).
     term_vectors: Vec<(usize, f64)>,
     term_size: usize,
+    /// An update's work vectors, kept between updates in their resting state (`Scratch`).
+    scratch: Scratch,
+}
+
+/// Work vectors of an update, kept at rest between updates: `work` zero (d·n), `position`
+/// usize::MAX (n), `seen` false (nodes). An update that ends in an error leaves them reset
+/// whole.
+#[derive(Default)]
+struct Scratch {
+    work: Vec<f64>,
+    position: Vec<usize>,
+    seen: Vec<bool>,
 }
 
 /// Columns kept per rank-one term until the reference changes: a term that persists from one
@@ -114,6 +126,7 @@ impl LowRank {
             term_columns: TermColumns::default(),
             term_vectors: Vec::new(),
             term_size: 0,
+            scratch: Scratch::default(),
         }
     }
 
@@ -197,6 +210,33 @@ impl LowRank {
         elements: Option<&ElementMatrices>,
     ) -> Result<(), LinalgError> {
         let n = j.size();
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let d = reference.block().map_or(1, |b| b.dim());
+        if scratch.position.len() != n || scratch.work.len() < d * n || scratch.seen.len() < n / d {
+            scratch = Scratch { work: vec![0.0; d * n], position: vec![usize::MAX; n], seen: vec![false; n / d] };
+        }
+        let result = self.update_with(j, dofs, reference, elements, &mut scratch);
+        match result {
+            Ok(()) => self.dofs.iter().for_each(|&i| scratch.position[i] = usize::MAX),
+            Err(_) => {
+                scratch.work.fill(0.0);
+                scratch.position.fill(usize::MAX);
+                scratch.seen.fill(false);
+            }
+        }
+        self.scratch = scratch;
+        result
+    }
+
+    fn update_with(
+        &mut self,
+        j: &Matrix,
+        dofs: Vec<usize>,
+        reference: &mut Factorization,
+        elements: Option<&ElementMatrices>,
+        scratch: &mut Scratch,
+    ) -> Result<(), LinalgError> {
+        let n = j.size();
         if matches!(self.columns, Columns::Unknown) {
             self.columns = match reference.block() {
                 Some(b) => Columns::Sparse { of_dof: vec![None; n], columns: Vec::new(), gram: Vec::new(), d: b.dim() },
@@ -207,7 +247,7 @@ impl LowRank {
         // The previous correction's dense columns' memory, reused for the new ones.
         let mut spare = self.dense.take().map(|d| d.values).unwrap_or_default();
         let mut e = Mat::<f64>::zeros(k, k);
-        let mut position = vec![usize::MAX; n];
+        let position = &mut scratch.position;
         dofs.iter().enumerate().for_each(|(a, &d)| position[d] = a);
         let p = &j.pattern;
         for (b, &col) in dofs.iter().enumerate() {
@@ -224,11 +264,11 @@ impl LowRank {
             Columns::Sparse { of_dof, columns, gram, d } => {
                 let block = reference.block().ok_or(LinalgError::NotFactored)?;
                 // A node's new dofs together: their columns share the node's ancestors.
-                let mut work = vec![0.0; *d * n];
+                let work = &mut scratch.work;
                 let new_dofs: Vec<usize> = dofs.iter().copied().filter(|&dof| of_dof[dof].is_none()).collect();
                 for group in new_dofs.chunk_by(|&a, &b| block.position(a) / *d == block.position(b) / *d) {
                     let positions: Vec<usize> = group.iter().map(|&dof| block.position(dof)).collect();
-                    for (&dof, w) in group.iter().zip(block.forward_units(&positions, &mut work)) {
+                    for (&dof, w) in group.iter().zip(block.forward_units(&positions, work)) {
                         of_dof[dof] = Some(columns.len() as u32);
                         columns.push(w);
                         gram.push(vec![f64::NAN; columns.len()]);
@@ -246,11 +286,11 @@ impl LowRank {
                     if missing.is_empty() {
                         continue;
                     }
-                    scatter(&columns[x], *d, &mut work);
+                    scatter(&columns[x], *d, work);
                     for &y in &missing {
-                        gram[x][y] = gather(&columns[y], *d, &work);
+                        gram[x][y] = gather(&columns[y], *d, work);
                     }
-                    unscatter(&columns[x], *d, &mut work);
+                    unscatter(&columns[x], *d, work);
                 }
             }
             Columns::Dense(columns) => {
@@ -287,7 +327,7 @@ impl LowRank {
             _ => None,
         };
         if let Some(terms) = terms
-            && let Some(factored) = self.factored(&dofs, &position, &e, &g, &terms, &mut spare)
+            && let Some(factored) = self.factored(&dofs, scratch, &e, &g, &terms, &mut spare)
         {
             self.column_entries = factored.dense.values.len();
             (self.dense, self.e, self.lu) = (Some(factored.dense), factored.s, Some(factored.lu));
@@ -331,17 +371,18 @@ impl LowRank {
     /// Lᵀ P for Ŵ = W X, and the solve's correction is Ŵ S M̃⁻¹ Ŵᵀ with M̃ = I + Xᵀ G X S,
     /// r×r. Returns Ŵ (dense), S and M̃'s factors; None if the terms do not make up
     /// E to round-off, or Ŵ would be too large (the correction by E is used then).
-    /// `position[dof]` is the dof's index in `dofs` (usize::MAX if it is not one of them), for
-    /// each of the n dofs; `spare` is memory for Ŵ.
+    /// `scratch.position[dof]` is the dof's index in `dofs` (usize::MAX if it is not one of
+    /// them), for each of the n dofs; `spare` is memory for Ŵ.
     fn factored(
         &mut self,
         dofs: &[usize],
-        position: &[usize],
+        scratch: &mut Scratch,
         e: &Mat<f64>,
         g: &Mat<f64>,
         terms: &RankOneTerms,
         spare: &mut Vec<f64>,
     ) -> Option<Factored> {
+        let Scratch { work, position, seen } = scratch;
         let n = position.len();
         let Columns::Sparse { of_dof, columns, d, .. } = &self.columns else { return None };
         let d = *d;
@@ -390,7 +431,6 @@ impl LowRank {
         });
         // Each new term's column W v = Σ v_i W e_i, over the union of its dofs' columns' nodes.
         let cache = &mut self.term_columns;
-        let (mut work, mut seen) = (vec![0.0; n], vec![false; n / d]);
         for (t, &id) in terms.ids.iter().enumerate() {
             if cache.of_id.contains_key(&id) {
                 continue;
