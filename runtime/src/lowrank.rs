@@ -312,9 +312,9 @@ impl LowRank {
         let g = match &self.columns {
             Columns::Unknown => unreachable!("decided above"),
             Columns::Sparse { of_dof, gram, .. } => {
-                let slot = |dof: usize| of_dof[dof].expect("computed above") as usize;
+                let slots: Vec<usize> = dofs.iter().map(|&dof| of_dof[dof].expect("computed above") as usize).collect();
                 Mat::from_fn(k, k, |a, c| {
-                    let (x, y) = (slot(dofs[a]), slot(dofs[c]));
+                    let (x, y) = (slots[a], slots[c]);
                     gram[x.max(y)][x.min(y)]
                 })
             }
@@ -574,11 +574,25 @@ impl DenseColumns {
         union.iter().enumerate().for_each(|(i, &node)| slot[node as usize] = i as u32);
         let mut values = std::mem::take(spare);
         values.clear();
-        values.resize(m * k, 0.0);
-        for (c, col) in columns.iter().enumerate() {
-            let out = &mut values[c * m..(c + 1) * m];
-            for (&node, v) in col.nodes.iter().zip(col.values.chunks_exact(d)) {
-                out[slot[node as usize] as usize * d..][..d].copy_from_slice(v);
+        values.reserve(m * k);
+        for col in columns {
+            let pairs = col.nodes.iter().zip(col.values.chunks_exact(d));
+            if col.nodes.is_sorted() {
+                // Merged with the union (sorted, and holding the column's nodes): written once,
+                // zeros and values in turn.
+                let mut pairs = pairs.peekable();
+                for &node in &union {
+                    match pairs.next_if(|(n, _)| **n == node) {
+                        Some((_, v)) => values.extend_from_slice(v),
+                        None => values.extend(std::iter::repeat_n(0.0, d)),
+                    }
+                }
+            } else {
+                let start = values.len();
+                values.resize(start + m, 0.0);
+                for (&node, v) in pairs {
+                    values[start + slot[node as usize] as usize * d..][..d].copy_from_slice(v);
+                }
             }
         }
         Some(DenseColumns { nodes: union, values })
@@ -732,6 +746,26 @@ mod tests {
     use crate::linalg::Structure;
     use crate::mesh::structured::{Diagonal, cuboid, rectangle};
     use crate::test_matrices::diagonally_dominant;
+
+    #[test]
+    fn dense_columns_hold_each_column_over_the_union_of_their_nodes() {
+        // d = 2; the second column's nodes unsorted (the scattered path), the others sorted
+        // (merged with the union).
+        let columns = [
+            SparseColumn { nodes: vec![1, 4], values: vec![1.0, 2.0, 3.0, 4.0] },
+            SparseColumn { nodes: vec![7, 0], values: vec![5.0, 6.0, 7.0, 8.0] },
+            SparseColumn { nodes: vec![4, 7], values: vec![9.0, 10.0, 11.0, 12.0] },
+        ];
+        let refs: Vec<&SparseColumn> = columns.iter().collect();
+        let dense = DenseColumns::new(&refs, 2, 8, usize::MAX, &mut vec![f64::NAN; 3]).expect("small");
+        assert_eq!(dense.nodes, [0, 1, 4, 7]);
+        let expected = [
+            [0.0, 0.0, 1.0, 2.0, 3.0, 4.0, 0.0, 0.0],
+            [7.0, 8.0, 0.0, 0.0, 0.0, 0.0, 5.0, 6.0],
+            [0.0, 0.0, 0.0, 0.0, 9.0, 10.0, 11.0, 12.0],
+        ];
+        assert_eq!(dense.values, expected.concat());
+    }
 
     #[test]
     fn rank_one_terms_of_element_changes_correct_the_factor() {

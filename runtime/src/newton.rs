@@ -49,8 +49,9 @@ pub trait NonlinearProblem {
     /// false (r unspecified) if the problem does not know those dofs. Newton calls it when w
     /// = w₀ + δ for a δ that solved J δ = −R(w₀) to a known accuracy and the active set
     /// changed: elsewhere R(w) = R(w₀) + J δ is then that solve's error, which Newton carries
-    /// in its bounds, and the next solve's forward pass visits the ancestors of these dofs
-    /// only.
+    /// in its bounds (and evaluates the whole residual when that bound alone keeps it from
+    /// converging). With a factor in node blocks, the next solve's forward pass then visits
+    /// the ancestors of these dofs only.
     fn residual_on_support(&mut self, _w: &[f64], _r: &mut [f64]) -> bool {
         false
     }
@@ -546,6 +547,13 @@ impl Newton {
                 }
                 if !estimated {
                     norm_r = norm_inf(r);
+                    if carried > 0.0 && norm_r <= threshold && norm_r + carried > threshold {
+                        // Only the carried bound stands between r and convergence: the whole
+                        // residual decides (and the next solve is never given an r of zero).
+                        p.residual(w, r);
+                        carried = 0.0;
+                        norm_r = norm_inf(r);
+                    }
                     res = norm_r + carried;
                 }
                 small_step = kept && norm_delta <= self.options.tol * norm_inf(w);
@@ -558,6 +566,7 @@ impl Newton {
                 small_step = after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w);
                 res = norm_inf(r);
                 norm_r = res;
+                carried = 0.0;
                 step
             };
             debug!(iteration = report.history.len() + 1, residual = res, active, refactor, updated, step, "newton");

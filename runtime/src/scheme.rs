@@ -1017,21 +1017,40 @@ impl NonlinearProblem for StageProblem<'_, '_> {
     }
 
     fn residual_on_support(&mut self, w: &[f64], r: &mut [f64]) -> bool {
-        // (A w)ᵢ = Σⱼ Aⱼᵢ wⱼ down column i: A is symmetric where it has a lower half.
+        // (A w)ᵢ from A's lower triangle, as `residual`'s lower-half product reads it (A is
+        // symmetric where it has one, to round-off: its two triangles may differ in their
+        // last bits).
         let Some(support) = self.support.filter(|_| self.constant.half.is_some()) else { return false };
         let a = &self.constant.matrix;
         let p = &a.pattern;
         r.fill(0.0);
         let mut largest = 0.0f64;
-        for &i in &support.dofs {
-            let range = p.col_ptr[i]..p.col_ptr[i + 1];
-            let aw: f64 = a.values[range.clone()].iter().zip(&p.row_idx[range]).map(|(v, &j)| v * w[j]).sum();
+        for (&i, left) in support.dofs.iter().zip(&support.lower_rows) {
+            let below = p.col_ptr[i]..p.col_ptr[i + 1];
+            let mut aw: f64 = left.iter().map(|&(k, j)| a.values[k] * w[j]).sum();
+            for (v, &j) in a.values[below.clone()].iter().zip(&p.row_idx[below]) {
+                if j > i {
+                    aw += v * w[j];
+                }
+            }
             largest = largest.max(aw.abs());
             r[i] = aw + self.rhs[i];
         }
         self.magnitude = self.magnitude.max(largest);
         self.add_terms(w, r);
         self.constraints.zero(r);
+        // Test builds check it against the whole residual there, to round-off.
+        if cfg!(debug_assertions) {
+            let magnitude = self.magnitude;
+            let mut full = vec![0.0; r.len()];
+            self.residual(w, &mut full);
+            self.magnitude = magnitude;
+            let scale = a.norm_inf() * crate::newton::norm_inf(w) + magnitude;
+            for &i in &support.dofs {
+                let err = (full[i] - r[i]).abs();
+                assert!(err <= 64.0 * f64::EPSILON * scale, "residual_on_support differs at {i} by {err:e}");
+            }
+        }
         true
     }
 
@@ -1170,8 +1189,25 @@ fn tangent_support(
         }
     }
     let d = asm.pattern().dim();
-    let dofs = (0..nodes.len()).filter(|&j| nodes[j]).flat_map(|j| j * d..(j + 1) * d).collect();
-    Some(Support { entries: asm.pattern().entries_among(&nodes), dofs })
+    let dofs: Vec<usize> = (0..nodes.len()).filter(|&j| nodes[j]).flat_map(|j| j * d..(j + 1) * d).collect();
+    let p = asm.pattern();
+    let lower_rows = dofs
+        .iter()
+        .map(|&i| {
+            // The pattern is symmetric: row i's columns are column i's rows.
+            let columns = &p.row_idx[p.col_ptr[i]..p.col_ptr[i + 1]];
+            columns
+                .iter()
+                .filter(|&&j| j <= i)
+                .map(|&j| {
+                    let rows = &p.row_idx[p.col_ptr[j]..p.col_ptr[j + 1]];
+                    let k = rows.binary_search(&i).expect("a symmetric pattern");
+                    (p.col_ptr[j] + k, j)
+                })
+                .collect()
+        })
+        .collect();
+    Some(Support { entries: asm.pattern().entries_among(&nodes), dofs, lower_rows })
 }
 
 /// Where a stage's nonlinear terms live when they integrate over facets only: the dofs of
@@ -1180,6 +1216,11 @@ fn tangent_support(
 struct Support {
     entries: Entries,
     dofs: Vec<usize>,
+    /// For each of `dofs` (row i), where the pattern's lower triangle holds row i left of and
+    /// on the diagonal: (entry index, column j ≤ i). With column i below the diagonal, these
+    /// read row i of a symmetric matrix from its lower triangle alone, as its lower-half
+    /// products do (`residual_on_support`).
+    lower_rows: Vec<Vec<(usize, usize)>>,
 }
 
 #[cfg(test)]
