@@ -52,8 +52,8 @@ pub struct BlockFactor {
     groups: Vec<u32>,
 }
 
-/// A sparse vector over the factor's node positions (d values per listed node), such as
-/// L⁻¹ e_k: nonzero only on the ancestors of k's node.
+/// A sparse vector over the factor's node positions (d values per listed node, the nodes
+/// increasing), such as L⁻¹ e_k: nonzero only on the ancestors of k's node, listed from k's up.
 #[derive(Clone, Debug, Default)]
 pub struct SparseColumn {
     pub nodes: Vec<u32>,

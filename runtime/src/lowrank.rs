@@ -556,12 +556,12 @@ impl DenseColumns {
         entries: usize,
         spare: &mut Vec<f64>,
     ) -> Option<DenseColumns> {
-        let mut slot = vec![u32::MAX; nodes];
+        let mut seen = vec![false; nodes];
         let mut union: Vec<u32> = Vec::new();
         for c in columns {
             for &node in &c.nodes {
-                if slot[node as usize] == u32::MAX {
-                    slot[node as usize] = 0;
+                if !seen[node as usize] {
+                    seen[node as usize] = true;
                     union.push(node);
                 }
             }
@@ -571,27 +571,18 @@ impl DenseColumns {
             return None;
         }
         union.sort_unstable();
-        union.iter().enumerate().for_each(|(i, &node)| slot[node as usize] = i as u32);
         let mut values = std::mem::take(spare);
         values.clear();
         values.reserve(m * k);
         for col in columns {
-            let pairs = col.nodes.iter().zip(col.values.chunks_exact(d));
-            if col.nodes.is_sorted() {
-                // Merged with the union (sorted, and holding the column's nodes): written once,
-                // zeros and values in turn.
-                let mut pairs = pairs.peekable();
-                for &node in &union {
-                    match pairs.next_if(|(n, _)| **n == node) {
-                        Some((_, v)) => values.extend_from_slice(v),
-                        None => values.extend(std::iter::repeat_n(0.0, d)),
-                    }
-                }
-            } else {
-                let start = values.len();
-                values.resize(start + m, 0.0);
-                for (&node, v) in pairs {
-                    values[start + slot[node as usize] as usize * d..][..d].copy_from_slice(v);
+            // Merged with the union (both increasing, the union holding the column's nodes):
+            // written once, zeros and values in turn.
+            debug_assert!(col.nodes.is_sorted(), "a sparse column's nodes increase");
+            let mut pairs = col.nodes.iter().zip(col.values.chunks_exact(d)).peekable();
+            for &node in &union {
+                match pairs.next_if(|(n, _)| **n == node) {
+                    Some((_, v)) => values.extend_from_slice(v),
+                    None => values.extend(std::iter::repeat_n(0.0, d)),
                 }
             }
         }
@@ -749,11 +740,10 @@ mod tests {
 
     #[test]
     fn dense_columns_hold_each_column_over_the_union_of_their_nodes() {
-        // d = 2; the second column's nodes unsorted (the scattered path), the others sorted
-        // (merged with the union).
+        // d = 2, nodes increasing in each column.
         let columns = [
             SparseColumn { nodes: vec![1, 4], values: vec![1.0, 2.0, 3.0, 4.0] },
-            SparseColumn { nodes: vec![7, 0], values: vec![5.0, 6.0, 7.0, 8.0] },
+            SparseColumn { nodes: vec![0, 7], values: vec![7.0, 8.0, 5.0, 6.0] },
             SparseColumn { nodes: vec![4, 7], values: vec![9.0, 10.0, 11.0, 12.0] },
         ];
         let refs: Vec<&SparseColumn> = columns.iter().collect();
