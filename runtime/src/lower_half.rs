@@ -92,15 +92,25 @@ impl HalfPattern {
 /// The lower halves (diagonal blocks whole) of a few symmetric matrices on one pattern, their
 /// blocks interleaved, for products Σ c_m A_m x_m in one pass: the pattern, the buffers and the
 /// sums into y are shared (a stage's linear terms, M a + K u for Newmark, cost one product).
+///
+/// A matrix whose every block is a multiple of the identity (a vector field's mass matrix) is
+/// stored with one value per block, a quarter of the bytes in 2D: such matrices come first in
+/// the storage (`order`), the others after them, each group in the caller's order.
 #[derive(Debug)]
 pub struct LowerHalf {
     pattern: Arc<HalfPattern>,
-    /// How many matrices.
+    /// How many matrices, and how many of them are stored by one value per block.
     m: usize,
-    /// Per position, the matrices' diagonal blocks, d×d row-major each.
+    scalars: usize,
+    /// `order[s]` is the caller's index of the matrix in storage slot s.
+    order: Vec<usize>,
+    /// Per position, the matrices' diagonal blocks: one value for each of the first `scalars`
+    /// slots, then d×d row-major for each other.
     diag: Vec<f64>,
-    /// Per block below the diagonal, the matrices' d×d blocks, row-major: `values[((k·m + l)·d
-    /// + r)·d + c]` is A_l[rows[k]·d + r, p·d + c] (in position order).
+    /// Per block below the diagonal, the matrices' blocks laid out as `diag`'s: with `stride`
+    /// = scalars + (m − scalars)·d², block k's values for full slot s start at
+    /// `k·stride + scalars + (s − scalars)·d²`, where `[r·d + c]` is A[rows[k]·d + r, p·d + c]
+    /// (in position order).
     values: Vec<f64>,
     work: Mutex<Vec<f64>>,
 }
@@ -120,33 +130,33 @@ impl LowerHalf {
         assert!((1..=MAX_FUSED).contains(&matrices.len()), "1 to {MAX_FUSED} matrices");
         let h = half.as_ref();
         let (d, m) = (h.d, matrices.len());
-        let mut diag = vec![0.0; h.nodes() * m * d * d];
-        let mut values = vec![0.0; h.rows.len() * m * d * d];
-        for (l, a) in matrices.iter().enumerate() {
-            let p = &a.pattern;
-            for (q, &node) in h.order.iter().enumerate() {
-                let node = node as usize;
-                let own = p.neighbours(node).binary_search(&(node as u32)).expect("a node neighbours itself");
-                // The node's d columns, sliced once.
-                let mut columns: [&[f64]; 3] = [&[]; 3];
-                for (c, column) in columns.iter_mut().enumerate().take(d) {
-                    *column = &a.values[p.col_ptr[node * d + c]..p.col_ptr[node * d + c + 1]];
-                }
-                let copy = |out: &mut [f64], offset: usize| {
+        let scalar: Vec<bool> = matrices.iter().map(|a| d > 1 && identity_multiples(a, h)).collect();
+        let order: Vec<usize> = (0..m).filter(|&l| scalar[l]).chain((0..m).filter(|&l| !scalar[l])).collect();
+        let scalars = scalar.iter().filter(|s| **s).count();
+        let stride = scalars + (m - scalars) * d * d;
+        let mut diag = vec![0.0; h.nodes() * stride];
+        let mut values = vec![0.0; h.rows.len() * stride];
+        for (slot, &l) in order.iter().enumerate() {
+            let (a, offset) = (matrices[l], if slot < scalars { slot } else { scalars + (slot - scalars) * d * d });
+            for (q, block) in blocks(a, h) {
+                let out = match block {
+                    Block::Diagonal(_) => &mut diag[q * stride + offset..],
+                    Block::Below(k, _) => &mut values[k * stride + offset..],
+                };
+                let (Block::Diagonal(columns) | Block::Below(_, columns)) = block;
+                if slot < scalars {
+                    out[0] = columns[0][0];
+                } else {
                     for (c, column) in columns[..d].iter().enumerate() {
-                        for (r, v) in column[offset..offset + d].iter().enumerate() {
+                        for (r, v) in column.iter().enumerate() {
                             out[r * d + c] = *v;
                         }
                     }
-                };
-                copy(&mut diag[(q * m + l) * d * d..][..d * d], own * d);
-                for k in h.ptr[q]..h.ptr[q + 1] {
-                    copy(&mut values[(k * m + l) * d * d..][..d * d], h.source[k]);
                 }
             }
         }
         let work = Mutex::new(vec![0.0; h.work_len(m)]);
-        LowerHalf { pattern: half.clone(), m, diag, values, work }
+        LowerHalf { pattern: half.clone(), m, scalars, order, diag, values, work }
     }
 
     /// How many matrices.
@@ -162,34 +172,42 @@ impl LowerHalf {
     /// `y = Σ c_l A_l x_l`, one (c_l, x_l) per matrix.
     pub fn mul_sum(&self, terms: &[(f64, &[f64])], y: &mut [f64]) {
         assert_eq!(terms.len(), self.m, "one vector per matrix");
-        match (self.pattern.d, self.m) {
-            (1, 1) => self.mul_sum_d::<1, 1>(terms, y),
-            (1, 2) => self.mul_sum_d::<1, 2>(terms, y),
-            (1, 3) => self.mul_sum_d::<1, 3>(terms, y),
-            (1, _) => self.mul_sum_d::<1, 4>(terms, y),
-            (2, 1) => self.mul_sum_d::<2, 1>(terms, y),
-            (2, 2) => self.mul_sum_d::<2, 2>(terms, y),
-            (2, 3) => self.mul_sum_d::<2, 3>(terms, y),
-            (2, _) => self.mul_sum_d::<2, 4>(terms, y),
-            (_, 1) => self.mul_sum_d::<3, 1>(terms, y),
-            (_, 2) => self.mul_sum_d::<3, 2>(terms, y),
-            (_, 3) => self.mul_sum_d::<3, 3>(terms, y),
-            (_, _) => self.mul_sum_d::<3, 4>(terms, y),
+        macro_rules! kernels {
+            ($(($d:literal, $m:literal, $s:literal)),*) => {
+                match (self.pattern.d.min(3), self.m, self.scalars) {
+                    $(($d, $m, $s) => self.mul_sum_d::<$d, $m, $s>(terms, y),)*
+                    _ => unreachable!("1 to {MAX_FUSED} matrices, scalar ones only for d > 1"),
+                }
+            };
         }
+        // (d, matrices, scalar ones): d = 1 stores every matrix whole.
+        #[rustfmt::skip]
+        kernels!(
+            (1, 1, 0), (1, 2, 0), (1, 3, 0), (1, 4, 0),
+            (2, 1, 0), (2, 2, 0), (2, 3, 0), (2, 4, 0), (2, 1, 1), (2, 2, 1), (2, 3, 1), (2, 4, 1),
+            (2, 2, 2), (2, 3, 2), (2, 4, 2), (2, 3, 3), (2, 4, 3), (2, 4, 4),
+            (3, 1, 0), (3, 2, 0), (3, 3, 0), (3, 4, 0), (3, 1, 1), (3, 2, 1), (3, 3, 1), (3, 4, 1),
+            (3, 2, 2), (3, 3, 2), (3, 4, 2), (3, 3, 3), (3, 4, 3), (3, 4, 4)
+        );
     }
 
-    fn mul_sum_d<const D: usize, const M: usize>(&self, terms: &[(f64, &[f64])], y: &mut [f64]) {
+    /// The product for d = D, M matrices of which the first S (in storage order) are scalar.
+    fn mul_sum_d<const D: usize, const M: usize, const S: usize>(&self, terms: &[(f64, &[f64])], y: &mut [f64]) {
         let h = self.pattern.as_ref();
         let n = h.nodes() * D;
         // A poisoned lock only means another product panicked; the buffer is overwritten anyway.
         let mut work = self.work.lock().unwrap_or_else(|e| e.into_inner());
         let (xp, rest) = work.split_at_mut(n * M);
         let (yp, mut bufs) = rest.split_at_mut(n);
-        // The scaled vectors in position order, interleaved per node.
-        for (q, &node) in h.order.iter().enumerate() {
-            for (l, (c, x)) in terms.iter().enumerate() {
-                let (to, from) = (&mut xp[(q * M + l) * D..][..D], &x[node as usize * D..][..D]);
-                to.iter_mut().zip(from).for_each(|(t, f)| *t = c * f);
+        // The scaled vectors in position order, interleaved per node in storage order.
+        let xs: [(f64, &[[f64; D]]); M] = std::array::from_fn(|l| {
+            let (c, x) = terms[self.order[l]];
+            (c, x.as_chunks::<D>().0)
+        });
+        let (to, _) = xp.as_chunks_mut::<D>();
+        for (to, &node) in to.chunks_exact_mut(M).zip(&h.order) {
+            for (to, (c, x)) in to.iter_mut().zip(xs) {
+                *to = x[node as usize].map(|v| c * v);
             }
         }
         let mut slices = Vec::with_capacity(h.tasks.len());
@@ -199,7 +217,7 @@ impl LowerHalf {
             bufs = tail;
         }
         let xp = &*xp;
-        let run = |(t, buf): &mut (&Task, &mut [f64])| self.task::<D, M>(t, xp, buf);
+        let run = |(t, buf): &mut (&Task, &mut [f64])| self.task::<D, M, S>(t, xp, buf);
         if self.values.len() < PARALLEL_VALUES || rayon::current_num_threads() == 1 {
             slices.iter_mut().for_each(run);
         } else {
@@ -209,15 +227,17 @@ impl LowerHalf {
         for (t, buf) in &slices {
             yp[t.start * D..t.reach * D].iter_mut().zip(buf.iter()).for_each(|(a, b)| *a += b);
         }
-        for (q, &node) in h.order.iter().enumerate() {
-            y[node as usize * D..][..D].copy_from_slice(&yp[q * D..][..D]);
+        let ((y, _), (yp, _)) = (y.as_chunks_mut::<D>(), yp.as_chunks::<D>());
+        for (v, &node) in yp.iter().zip(&h.order) {
+            y[node as usize] = *v;
         }
     }
 
     /// The task's columns' products, into `buf` (positions `t.start..t.reach`); `x` holds the
-    /// M vectors interleaved per node.
-    fn task<const D: usize, const M: usize>(&self, t: &Task, x: &[f64], buf: &mut [f64]) {
+    /// M vectors interleaved per node, in storage order (the S scalar matrices first).
+    fn task<const D: usize, const M: usize, const S: usize>(&self, t: &Task, x: &[f64], buf: &mut [f64]) {
         let h = self.pattern.as_ref();
+        let stride = S + (M - S) * D * D;
         buf.iter_mut().for_each(|v| *v = 0.0);
         // Vectors by node: one bounds check per block rather than two.
         let (x, _) = x.as_chunks::<D>();
@@ -227,11 +247,21 @@ impl LowerHalf {
             // Σ_l (A_l,ip)ᵀ x_l,i summed over the column: D² independent sums.
             let mut acc = [[0.0f64; D]; D];
             let range = h.ptr[p]..h.ptr[p + 1];
-            let values = &self.values[range.start * M * D * D..range.end * M * D * D];
-            for (&i, blocks) in h.rows[range].iter().zip(values.chunks_exact(M * D * D)) {
+            let values = &self.values[range.start * stride..range.end * stride];
+            for (&i, blocks) in h.rows[range].iter().zip(values.chunks_exact(stride)) {
                 let i = i as usize;
                 let yi = &mut buf[i - t.start];
-                for (l, a) in blocks.chunks_exact(D * D).enumerate() {
+                let (scalars, full) = blocks.split_at(S);
+                // a·I: the full product's sums without its products by zero.
+                for (l, &a) in scalars.iter().enumerate() {
+                    let xi = &x[i * M + l];
+                    for r in 0..D {
+                        acc[r][r] += a * xi[r];
+                        yi[r] += a * xj[l][r];
+                    }
+                }
+                for (f, a) in full.chunks_exact(D * D).enumerate() {
+                    let l = S + f;
                     let xi = &x[i * M + l];
                     for r in 0..D {
                         // Started from the first product, not from 0.0 (an addition the
@@ -246,14 +276,60 @@ impl LowerHalf {
                     }
                 }
             }
-            let dg = &self.diag[p * M * D * D..][..M * D * D];
+            let dg = &self.diag[p * stride..][..stride];
             let yj = &mut buf[p - t.start];
             for c in 0..D {
-                let own: f64 = (0..M).map(|l| (0..D).map(|k| dg[(l * D + c) * D + k] * xj[l][k]).sum::<f64>()).sum();
-                yj[c] += own + acc[c].iter().sum::<f64>();
+                // Σ_l (A_l,pp x_l,p)_c in storage order, then the column's sums.
+                let mut own = -0.0;
+                for l in 0..S {
+                    own += dg[l] * xj[l][c];
+                }
+                for l in S..M {
+                    let b = &dg[S + (l - S) * D * D..][..D * D];
+                    let mut row = b[c * D] * xj[l][0];
+                    for k in 1..D {
+                        row += b[c * D + k] * xj[l][k];
+                    }
+                    own += row;
+                }
+                let mut column = acc[c][0];
+                for v in &acc[c][1..] {
+                    column += v;
+                }
+                yj[c] += own + column;
             }
         }
     }
+}
+
+/// A symmetric matrix's lower-half blocks with their position: the diagonal block of position
+/// q, or block k below it (in `HalfPattern::rows`); each as its d columns, d values each.
+enum Block<'a> {
+    Diagonal([&'a [f64]; 3]),
+    Below(usize, [&'a [f64]; 3]),
+}
+
+/// `a`'s lower-half blocks, position by position: (q, block).
+fn blocks<'a>(a: &'a Matrix, h: &'a HalfPattern) -> impl Iterator<Item = (usize, Block<'a>)> + 'a {
+    let (p, d) = (&a.pattern, h.d);
+    h.order.iter().enumerate().flat_map(move |(q, &node)| {
+        let node = node as usize;
+        let own = p.neighbours(node).binary_search(&(node as u32)).expect("a node neighbours itself");
+        let columns = move |offset: usize| -> [&'a [f64]; 3] {
+            std::array::from_fn(|c| if c < d { &a.values[p.col_ptr[node * d + c]..][offset..offset + d] } else { &[] })
+        };
+        std::iter::once((q, Block::Diagonal(columns(own * d))))
+            .chain((h.ptr[q]..h.ptr[q + 1]).map(move |k| (q, Block::Below(k, columns(h.source[k])))))
+    })
+}
+
+/// Whether every lower-half block of `a` is a multiple of the identity (zero off its diagonal,
+/// the same value along it), exactly.
+fn identity_multiples(a: &Matrix, h: &HalfPattern) -> bool {
+    blocks(a, h).all(|(_, block)| {
+        let (Block::Diagonal(columns) | Block::Below(_, columns)) = block;
+        (0..h.d).all(|c| (0..h.d).all(|r| columns[c][r] == if r == c { columns[0][0] } else { 0.0 }))
+    })
 }
 
 /// Reverse Cuthill–McKee order of the pattern's nodes: breadth-first from a pseudo-peripheral
@@ -375,32 +451,49 @@ mod tests {
             let a = diagonally_dominant(&Assembler::new(&mesh));
             let n = a.size();
             let half = Arc::new(HalfPattern::new(&a.pattern));
-            // Symmetric matrices with different values: entrywise functions of a symmetric one.
+            let d = a.pattern.dim();
+            // Symmetric matrices with different values: entrywise functions of a symmetric one,
+            // and (odd k) ones whose blocks are multiples of the identity, stored by one value
+            // per block wherever they stand among the others.
             let mut others = vec![a.clone()];
-            for k in 1..MAX_FUSED {
+            for k in 1..2 * MAX_FUSED {
                 let mut b = a.clone();
-                b.values.iter_mut().for_each(|v| *v = (*v * k as f64).sin());
+                let p = &a.pattern;
+                for j in 0..n {
+                    for e in p.col_ptr[j]..p.col_ptr[j + 1] {
+                        let i = p.row_idx[e];
+                        b.values[e] = match k % 2 {
+                            0 => (b.values[e] * k as f64).sin(),
+                            _ if i % d != j % d => 0.0,
+                            _ => (((i / d).min(j / d) * 7 + (i / d).max(j / d) * 13 + k) as f64).cos(),
+                        };
+                    }
+                }
                 others.push(b);
             }
-            let xs: Vec<Vec<f64>> = (0..MAX_FUSED)
+            let xs: Vec<Vec<f64>> = (0..2 * MAX_FUSED)
                 .map(|k| (0..n).map(|i| (((i + 7 * k) * 31) % 101) as f64 / 101.0 - 0.5).collect())
                 .collect();
-            let coefs = [1.0, -2.5, 0.75, 3.0];
-            for m in 1..=MAX_FUSED {
-                let matrices: Vec<&Matrix> = others[..m].iter().collect();
+            let coefs = [1.0, -2.5, 0.75, 3.0, 0.5, -1.25, 2.0, -0.375];
+            // Every subset of up to MAX_FUSED of the matrices, in increasing order.
+            for subset in (1..1usize << others.len()).filter(|s| s.count_ones() as usize <= MAX_FUSED) {
+                let chosen: Vec<usize> = (0..others.len()).filter(|l| subset >> l & 1 == 1).collect();
+                let matrices: Vec<&Matrix> = chosen.iter().map(|&l| &others[l]).collect();
                 let fused = LowerHalf::fused(&matrices, &half);
+                let scalars = chosen.iter().filter(|&&l| d > 1 && l % 2 == 1).count();
+                assert_eq!(fused.scalars, scalars, "{chosen:?}: matrices stored by one value per block");
                 let mut expected = vec![0.0; n];
                 let mut product = vec![0.0; n];
-                for l in 0..m {
+                for &l in &chosen {
                     others[l].mul_vec(&xs[l], &mut product);
                     expected.iter_mut().zip(&product).for_each(|(e, p)| *e += coefs[l] * p);
                 }
-                let terms: Vec<(f64, &[f64])> = (0..m).map(|l| (coefs[l], xs[l].as_slice())).collect();
+                let terms: Vec<(f64, &[f64])> = chosen.iter().map(|&l| (coefs[l], xs[l].as_slice())).collect();
                 let mut y = vec![0.0; n];
                 fused.mul_sum(&terms, &mut y);
                 let scale = expected.iter().fold(0.0f64, |s, v| s.max(v.abs()));
                 let err = y.iter().zip(&expected).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
-                assert!(err <= 1e-13 * scale, "{n} unknowns, {m} matrices: differs by {err:.1e} of {scale:.1e}");
+                assert!(err <= 1e-13 * scale, "{n} unknowns, matrices {chosen:?}: differs by {err:.1e} of {scale:.1e}");
             }
         }
     }
