@@ -191,6 +191,41 @@ impl<'m> Assembler<'m> {
         dispatch!(self.mesh.kind, facet_tangent_elements::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, out))
     }
 
+    /// As [`Assembler::facet_tangent`] into `m`, also appending the element matrices as
+    /// [`Assembler::facet_tangent_elements`] does: each computed once for both.
+    #[allow(clippy::too_many_arguments)]
+    pub fn facet_tangent_recording<K: Kernel>(
+        &self,
+        k: &K,
+        region: &str,
+        facets: &[Facet],
+        q: Quadrature,
+        fields: &[&[f64]],
+        wrt: usize,
+        t: f64,
+        m: &mut Matrix,
+        out: &mut ElementMatrices,
+    ) {
+        let Some(r) = region_index(k.meta(), region) else { return };
+        let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
+        dispatch!(
+            self.mesh.kind,
+            facet_tangent_recording::<K>(
+                self.mesh,
+                &self.pattern,
+                k,
+                r,
+                facets,
+                degree,
+                fields,
+                wrt,
+                t,
+                &mut m.values,
+                out
+            )
+        )
+    }
+
     /// Appends the active-set switches of `k`'s integral over `region` on `facets`.
     #[allow(clippy::too_many_arguments)]
     pub fn facet_switches<K: Kernel>(
@@ -536,6 +571,28 @@ fn facet_tangent_elements<const D: usize, const N: usize, K: FormKernel<D, N>>(
     for_facet_tangents(mesh, k, region, facets, degree, fields, wrt, t, |_, cell, ke| {
         out.dofs.extend(cell.iter().flat_map(|&node| (0..D).map(move |m| node as usize * D + m)));
         // [test node][test component][trial node][trial component]: row-major (N·D)².
+        out.values.extend(ke.iter().flatten().flatten().flatten());
+    });
+}
+
+#[allow(clippy::too_many_arguments)]
+fn facet_tangent_recording<const D: usize, const N: usize, K: FormKernel<D, N>>(
+    mesh: &Mesh,
+    pattern: &Pattern,
+    k: &K,
+    region: usize,
+    facets: &[Facet],
+    degree: u32,
+    fields: &[&[f64]],
+    wrt: usize,
+    t: f64,
+    values: &mut [f64],
+    out: &mut ElementMatrices,
+) {
+    out.size = N * D;
+    for_facet_tangents(mesh, k, region, facets, degree, fields, wrt, t, |c, cell, ke| {
+        pattern.scatter(c, cell, ke, values);
+        out.dofs.extend(cell.iter().flat_map(|&node| (0..D).map(move |m| node as usize * D + m)));
         out.values.extend(ke.iter().flatten().flatten().flatten());
     });
 }

@@ -137,6 +137,20 @@ pub trait BoundForm {
     ) -> bool {
         false
     }
+    /// As `tangent`, appending the element matrices it adds (as `tangent_elements` does) to
+    /// `elements` too: one evaluation for both. False, with nothing done, if the form cannot
+    /// give its elements.
+    fn tangent_recording(
+        &self,
+        _asm: &Assembler,
+        _fields: &[&[f64]],
+        _wrt: usize,
+        _t: f64,
+        _m: &mut Matrix,
+        _elements: &mut ElementMatrices,
+    ) -> bool {
+        false
+    }
     /// Whether the form changes with time other than through its fields.
     fn time_dependent(&self) -> bool {
         true
@@ -204,6 +218,23 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
         }
         for (region, facets) in &self.regions {
             asm.facet_tangent_elements(&self.kernel, region, facets, self.quadrature, fields, wrt, t, out);
+        }
+        true
+    }
+    fn tangent_recording(
+        &self,
+        asm: &Assembler,
+        fields: &[&[f64]],
+        wrt: usize,
+        t: f64,
+        m: &mut Matrix,
+        elements: &mut ElementMatrices,
+    ) -> bool {
+        if self.kernel.meta().cell_degree.is_some() {
+            return false;
+        }
+        for (region, facets) in &self.regions {
+            asm.facet_tangent_recording(&self.kernel, region, facets, self.quadrature, fields, wrt, t, m, elements);
         }
         true
     }
@@ -770,6 +801,7 @@ impl<'a> Stepper<'a> {
             term: std::mem::take(term),
             switches,
             magnitude: 0.0,
+            recorded: RecordedTangent::default(),
         };
         // δ = w − reference, with the constrained values of w imposed: zero but on those.
         let w0 = match reference {
@@ -939,6 +971,19 @@ struct StageProblem<'p, 'a> {
     switches: &'p mut SwitchMemo,
     /// The largest term of the last residual.
     magnitude: f64,
+    recorded: RecordedTangent,
+}
+
+/// The nonlinear terms' tangent as element matrices, recorded by the last Jacobian assembly
+/// (unscaled, with each term's first element and scale) at the arguments it had (`key`, their
+/// bits at the support's dofs): `tangent_elements` at the same arguments reads them rather
+/// than evaluating the kernels a second time.
+#[derive(Default)]
+struct RecordedTangent {
+    valid: bool,
+    key: Vec<u64>,
+    parts: Vec<(usize, f64)>,
+    elements: ElementMatrices,
 }
 
 impl StageProblem<'_, '_> {
@@ -976,8 +1021,16 @@ impl StageProblem<'_, '_> {
 
     /// Adds the nonlinear terms' tangents at w to `j` (on the support only, if known).
     fn add_tangents(&mut self, w: &[f64], j: &mut Matrix) {
+        let dofs = self.support.map(|s| s.dofs.as_slice());
+        let rec = &mut self.recorded;
+        rec.valid = true;
+        rec.key.clear();
+        rec.parts.clear();
+        rec.elements.dofs.clear();
+        rec.elements.values.clear();
         for term in &self.terms {
-            term.args_into(w, &mut self.args, self.support.map(|s| s.dofs.as_slice()));
+            term.args_into(w, &mut self.args, dofs);
+            push_key(&self.args, dofs, &mut rec.key);
             let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
@@ -988,8 +1041,13 @@ impl StageProblem<'_, '_> {
                         Some(s) => s.entries.indices.iter().for_each(|&i| m.values[i] = 0.0),
                         None => m.values.iter_mut().for_each(|v| *v = 0.0),
                     }
-                    self.forms[term.form].tangent(self.asm, &refs, k, term.t, m);
                     let c = term.coef * a;
+                    let form = &self.forms[term.form];
+                    rec.parts.push((rec.elements.len(), c));
+                    rec.valid = rec.valid && form.tangent_recording(self.asm, &refs, k, term.t, m, &mut rec.elements);
+                    if !rec.valid {
+                        form.tangent(self.asm, &refs, k, term.t, m);
+                    }
                     match self.support {
                         Some(s) => s.entries.indices.iter().for_each(|&i| j.values[i] += c * m.values[i]),
                         None => j.add_scaled(c, m),
@@ -1155,8 +1213,47 @@ impl NonlinearProblem for StageProblem<'_, '_> {
     }
 
     fn tangent_elements(&mut self, w: &[f64]) -> Option<ElementMatrices> {
-        let mut out = ElementMatrices::default();
+        let Some(recorded) = self.recorded_elements(w) else { return self.evaluate_elements(w) };
+        // Test builds check the recording against an evaluation, bit for bit.
+        if cfg!(debug_assertions) {
+            assert_eq!(self.evaluate_elements(w).as_ref(), Some(&recorded), "recorded tangent elements");
+        }
+        Some(recorded)
+    }
+}
+
+impl StageProblem<'_, '_> {
+    /// The elements the last Jacobian assembly recorded, scaled as `evaluate_elements` scales
+    /// them, if it was at w's arguments.
+    fn recorded_elements(&mut self, w: &[f64]) -> Option<ElementMatrices> {
+        if !self.recorded.valid {
+            return None;
+        }
         let dofs = self.support.map(|s| s.dofs.as_slice());
+        let mut key = Vec::with_capacity(self.recorded.key.len());
+        for term in &self.terms {
+            term.args_into(w, &mut self.args, dofs);
+            push_key(&self.args, dofs, &mut key);
+        }
+        let rec = &self.recorded;
+        if key != rec.key {
+            return None;
+        }
+        let mut out = rec.elements.clone();
+        let size = out.size * out.size;
+        for (p, &(from, c)) in rec.parts.iter().enumerate() {
+            let to = rec.parts.get(p + 1).map_or(out.len(), |next| next.0);
+            out.values[from * size..to * size].iter_mut().for_each(|v| *v *= c);
+        }
+        out.zero_fixed(&self.constraints.fixed);
+        Some(out)
+    }
+
+    /// The nonlinear terms' tangent at w as element matrices, each term's scaled by its
+    /// coefficient; None if a form cannot give them.
+    fn evaluate_elements(&mut self, w: &[f64]) -> Option<ElementMatrices> {
+        let dofs = self.support.map(|s| s.dofs.as_slice());
+        let mut out = ElementMatrices::default();
         for term in &self.terms {
             term.args_into(w, &mut self.args, dofs);
             let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
@@ -1172,6 +1269,16 @@ impl NonlinearProblem for StageProblem<'_, '_> {
         }
         out.zero_fixed(&self.constraints.fixed);
         Some(out)
+    }
+}
+
+/// Appends the bits of `args` at `dofs` (everywhere if None).
+fn push_key(args: &[Vec<f64>], dofs: Option<&[usize]>, key: &mut Vec<u64>) {
+    for arg in args {
+        match dofs {
+            Some(dofs) => key.extend(dofs.iter().map(|&i| arg[i].to_bits())),
+            None => key.extend(arg.iter().map(|x| x.to_bits())),
+        }
     }
 }
 
