@@ -188,7 +188,10 @@ impl<'m> Assembler<'m> {
     ) {
         let Some(r) = region_index(k.meta(), region) else { return };
         let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
-        dispatch!(self.mesh.kind, facet_tangent_elements::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, out))
+        dispatch!(
+            self.mesh.kind,
+            facet_tangent_elements::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, None, out)
+        )
     }
 
     /// As [`Assembler::facet_tangent`] into `m`, also appending the element matrices as
@@ -210,9 +213,8 @@ impl<'m> Assembler<'m> {
         let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
         dispatch!(
             self.mesh.kind,
-            facet_tangent_recording::<K>(
+            facet_tangent_elements::<K>(
                 self.mesh,
-                &self.pattern,
                 k,
                 r,
                 facets,
@@ -220,7 +222,7 @@ impl<'m> Assembler<'m> {
                 fields,
                 wrt,
                 t,
-                &mut m.values,
+                Some((&self.pattern, &mut m.values)),
                 out
             )
         )
@@ -555,6 +557,9 @@ fn facet_tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
     });
 }
 
+/// Appends the element matrices of the tangent of `k`'s integral over `region` on `facets` to
+/// `out`, and with `scatter` also adds each into those values of the pattern (one evaluation
+/// for both).
 #[allow(clippy::too_many_arguments)]
 fn facet_tangent_elements<const D: usize, const N: usize, K: FormKernel<D, N>>(
     mesh: &Mesh,
@@ -565,34 +570,16 @@ fn facet_tangent_elements<const D: usize, const N: usize, K: FormKernel<D, N>>(
     fields: &[&[f64]],
     wrt: usize,
     t: f64,
-    out: &mut ElementMatrices,
-) {
-    out.size = N * D;
-    for_facet_tangents(mesh, k, region, facets, degree, fields, wrt, t, |_, cell, ke| {
-        out.dofs.extend(cell.iter().flat_map(|&node| (0..D).map(move |m| node as usize * D + m)));
-        // [test node][test component][trial node][trial component]: row-major (N·D)².
-        out.values.extend(ke.iter().flatten().flatten().flatten());
-    });
-}
-
-#[allow(clippy::too_many_arguments)]
-fn facet_tangent_recording<const D: usize, const N: usize, K: FormKernel<D, N>>(
-    mesh: &Mesh,
-    pattern: &Pattern,
-    k: &K,
-    region: usize,
-    facets: &[Facet],
-    degree: u32,
-    fields: &[&[f64]],
-    wrt: usize,
-    t: f64,
-    values: &mut [f64],
+    mut scatter: Option<(&Pattern, &mut [f64])>,
     out: &mut ElementMatrices,
 ) {
     out.size = N * D;
     for_facet_tangents(mesh, k, region, facets, degree, fields, wrt, t, |c, cell, ke| {
-        pattern.scatter(c, cell, ke, values);
+        if let Some((pattern, values)) = scatter.as_mut() {
+            pattern.scatter(c, cell, ke, values);
+        }
         out.dofs.extend(cell.iter().flat_map(|&node| (0..D).map(move |m| node as usize * D + m)));
+        // [test node][test component][trial node][trial component]: row-major (N·D)².
         out.values.extend(ke.iter().flatten().flatten().flatten());
     });
 }
