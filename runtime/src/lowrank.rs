@@ -408,8 +408,7 @@ impl LowRank {
         }
         let (mut scale, mut error, mut nan) = (0.0f64, 0.0f64, false);
         for (b, column) in sum.chunks_exact(k).enumerate() {
-            for (a, &v) in column.iter().enumerate() {
-                let x = e[(a, b)];
+            for (&x, &v) in e.col_as_slice(b).iter().zip(column) {
                 scale = scale.max(x.abs());
                 error = error.max((x - v).abs());
                 nan |= x.is_nan() || v.is_nan();
