@@ -173,7 +173,8 @@ impl<'m> Assembler<'m> {
     }
 
     /// Appends the element matrices of the tangent of `k`'s integral over `region`, one per
-    /// facet of `facets` (over its cell's dofs), to `out`.
+    /// facet of `facets` (over its cell's dofs), to `out`; with `m`, also adds them into `m` as
+    /// [`Assembler::facet_tangent`] does (one evaluation for both).
     #[allow(clippy::too_many_arguments)]
     pub fn facet_tangent_elements<K: Kernel>(
         &self,
@@ -184,47 +185,15 @@ impl<'m> Assembler<'m> {
         fields: &[&[f64]],
         wrt: usize,
         t: f64,
+        m: Option<&mut Matrix>,
         out: &mut ElementMatrices,
     ) {
         let Some(r) = region_index(k.meta(), region) else { return };
         let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
+        let scatter = m.map(|m| (self.pattern.as_ref(), m.values.as_mut_slice()));
         dispatch!(
             self.mesh.kind,
-            facet_tangent_elements::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, None, out)
-        )
-    }
-
-    /// As [`Assembler::facet_tangent`] into `m`, also appending the element matrices as
-    /// [`Assembler::facet_tangent_elements`] does: each computed once for both.
-    #[allow(clippy::too_many_arguments)]
-    pub fn facet_tangent_recording<K: Kernel>(
-        &self,
-        k: &K,
-        region: &str,
-        facets: &[Facet],
-        q: Quadrature,
-        fields: &[&[f64]],
-        wrt: usize,
-        t: f64,
-        m: &mut Matrix,
-        out: &mut ElementMatrices,
-    ) {
-        let Some(r) = region_index(k.meta(), region) else { return };
-        let degree = q.facet_degree(k.meta(), self.mesh.kind, r);
-        dispatch!(
-            self.mesh.kind,
-            facet_tangent_elements::<K>(
-                self.mesh,
-                k,
-                r,
-                facets,
-                degree,
-                fields,
-                wrt,
-                t,
-                Some((&self.pattern, &mut m.values)),
-                out
-            )
+            facet_tangent_elements::<K>(self.mesh, k, r, facets, degree, fields, wrt, t, scatter, out)
         )
     }
 

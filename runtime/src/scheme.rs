@@ -217,7 +217,7 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
             return false;
         }
         for (region, facets) in &self.regions {
-            asm.facet_tangent_elements(&self.kernel, region, facets, self.quadrature, fields, wrt, t, out);
+            asm.facet_tangent_elements(&self.kernel, region, facets, self.quadrature, fields, wrt, t, None, out);
         }
         true
     }
@@ -234,7 +234,8 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
             return false;
         }
         for (region, facets) in &self.regions {
-            asm.facet_tangent_recording(&self.kernel, region, facets, self.quadrature, fields, wrt, t, m, elements);
+            let q = self.quadrature;
+            asm.facet_tangent_elements(&self.kernel, region, facets, q, fields, wrt, t, Some(&mut *m), elements);
         }
         true
     }
@@ -1129,9 +1130,7 @@ impl NonlinearProblem for StageProblem<'_, '_> {
                 let steady = !self.forms[term.form].time_dependent();
                 memo.next.push(if steady { u64::MAX } else { term.t.to_bits() });
                 memo.next.extend(term.alphas.iter().map(|a| u64::from(*a != 0.0)));
-                for arg in &self.args {
-                    memo.next.extend(dofs.iter().map(|&i| arg[i].to_bits()));
-                }
+                push_key(&self.args, Some(dofs), &mut memo.next);
             }
             if memo.key == memo.next && memo.forms.iter().eq(self.terms.iter().map(|t| &t.form)) {
                 out.extend_from_slice(&memo.set);
