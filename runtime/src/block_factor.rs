@@ -35,8 +35,9 @@ pub struct BlockFactor {
     order: Vec<u32>,
     position: Vec<u32>,
     /// Per node column J: its diagonal block (d×d, row-major, upper part zero) and its
-    /// `ptr[J + 1] − ptr[J]` blocks below, `values[ptr[J]·d²..]` d×d each, row-major, at the
-    /// node rows `rows[row_start[J]..]` (decreasing): `values[(ptr[J] + k)·d² + r·d + c] =
+    /// `ptr[J + 1] − ptr[J]` blocks below, `values[ptr[J]·d²..]` d×d each, column-major (both
+    /// passes then work on a block's rows side by side), at the node rows
+    /// `rows[row_start[J]..]` (decreasing): `values[(ptr[J] + k)·d² + c·d + r] =
     /// L[rows[row_start[J] + k]·d + r, J·d + c]`. A column whose rows are the previous
     /// column's but its last (the next column of a supernode) reads them there: the rows of
     /// a supernode are stored once, an index per block of its first column only.
@@ -287,10 +288,13 @@ impl BlockFactor {
                 update::<D>(xi, &columns[c][(m - 1) * D * D..], &solved[c]);
             }
             for (k, &row) in rest.iter().enumerate() {
-                let xi = &mut x[row as usize];
+                // Updated in registers, stored once (through the reference, each update would
+                // be stored before the next one's bounds check, and loaded back).
+                let mut xi = x[row as usize];
                 for c in 0..G {
-                    update::<D>(xi, &columns[c][k * D * D..(k + 1) * D * D], &solved[c]);
+                    update::<D>(&mut xi, &columns[c][k * D * D..(k + 1) * D * D], &solved[c]);
                 }
+                x[row as usize] = xi;
             }
         }
     }
@@ -305,9 +309,9 @@ impl BlockFactor {
             // Rows increasing (the sums' order), the memory read downwards.
             for (&row, block) in self.rows_of(node).iter().rev().zip(values.rchunks_exact(D * D)) {
                 let xi = &x[row as usize];
-                for r in 0..D {
-                    for c in 0..D {
-                        acc[c][r] += block[r * D + c] * xi[r];
+                for c in 0..D {
+                    for r in 0..D {
+                        acc[c][r] += block[c * D + r] * xi[r];
                     }
                 }
             }
@@ -367,7 +371,7 @@ impl BlockFactor {
                     for r in 0..d {
                         let mut s = 0.0;
                         for c in 0..d {
-                            s += block[r * d + c] * x[c];
+                            s += block[c * d + r] * x[c];
                         }
                         w[row as usize * d + r] -= s;
                     }
@@ -387,14 +391,17 @@ const GROUP: usize = 8;
 /// xi −= block · xj (a block below the diagonal in the forward pass).
 #[inline(always)]
 fn update<const D: usize>(xi: &mut [f64; D], block: &[f64], xj: &[f64; D]) {
-    for r in 0..D {
-        // Started from the first product, not from 0.0 (an addition the compiler must keep,
-        // for the sign of zero).
-        let mut s = block[r * D] * xj[0];
-        for c in 1..D {
-            s += block[r * D + c] * xj[c];
+    // Started from the first product, not from 0.0 (an addition the compiler must keep, for
+    // the sign of zero). Column by column, the rows side by side: one vector operation per
+    // column rather than a scalar one per entry.
+    let mut s: [f64; D] = std::array::from_fn(|r| block[r] * xj[0]);
+    for c in 1..D {
+        for r in 0..D {
+            s[r] += block[c * D + r] * xj[c];
         }
-        xi[r] -= s;
+    }
+    for r in 0..D {
+        xi[r] -= s[r];
     }
 }
 
@@ -485,7 +492,7 @@ impl Blocks {
             }
             for (k, v) in col_values[d - c..].iter().enumerate() {
                 let (block, r) = (blocks - 1 - k / d, k % d);
-                self.values[start + (block * d + r) * d + c] = *v;
+                self.values[start + (block * d + c) * d + r] = *v;
             }
         }
         self.ptr.push(self.values.len() / (d * d));
