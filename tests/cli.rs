@@ -196,7 +196,7 @@ fn bench_disc_times_the_stepper_and_reports_missing_meshes() {
     for key in ["\"dofs\": 3250", "\"steps\": 1000", "\"ms_per_step\"", "\"median_step_ms\""] {
         assert!(json.contains(key), "{key} missing from {json}");
     }
-    // Both ratios are the timings over the one model.
+    // The ratios are the timings over the models.
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     let m = &v["meshes"][0];
     let num = |k: &str| m[k].as_f64().unwrap_or_else(|| panic!("{k} missing from {json}"));
@@ -204,6 +204,12 @@ fn bench_disc_times_the_stepper_and_reports_missing_meshes() {
     assert!(model > 0.0);
     assert!((num("measured_over_model") - num("ms_per_step") / model).abs() <= 1e-12 * num("measured_over_model"));
     assert!((num("median_over_model") - num("median_step_ms") / model).abs() <= 1e-12 * num("median_over_model"));
+    // The same bytes at two bandwidths: out of cache (STREAM's) and in cache.
+    let cache = num("cache_model_ms");
+    assert!((model * num("stream_gb_s") - cache * num("cache_gb_s")).abs() <= 1e-12 * model * num("stream_gb_s"));
+    assert!(
+        (num("measured_over_cache_model") - num("ms_per_step") / cache).abs() <= 1e-12 * num("ms_per_step") / cache
+    );
 }
 
 #[test]
