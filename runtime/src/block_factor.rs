@@ -34,7 +34,9 @@ pub struct BlockFactor {
     /// `order[k]` is the dof at position k of the elimination; `position` its inverse.
     order: Vec<u32>,
     position: Vec<u32>,
-    /// Per node column J: its diagonal block (d×d, row-major, upper part zero) and its
+    /// Per node column J: its diagonal block (d×d, row-major, upper part zero; the pivots
+    /// stored as their reciprocals, so that the chain of dependent operations from one column
+    /// to the next multiplies instead of dividing) and its
     /// `ptr[J + 1] − ptr[J]` blocks below, `values[ptr[J]·d²..]` d×d each, column-major (both
     /// passes then work on a block's rows side by side), at the node rows
     /// `rows[row_start[J]..]` (decreasing): `values[(ptr[J] + k)·d² + c·d + r] =
@@ -322,7 +324,7 @@ impl BlockFactor {
                 for r in c + 1..D {
                     s -= dg[r * D + c] * xj[r];
                 }
-                xj[c] = s / dg[c * D + c];
+                xj[c] = s * dg[c * D + c];
             }
         }
     }
@@ -354,7 +356,7 @@ impl BlockFactor {
                     for c in 0..r {
                         s -= dg[r * d + c] * x[c];
                     }
-                    x[r] = s / dg[r * d + r];
+                    x[r] = s * dg[r * d + r];
                 }
                 for r in 0..d {
                     column.values.push(x[r]);
@@ -414,7 +416,7 @@ fn diag_solve<const D: usize>(dg: &[f64], b: &[f64]) -> [f64; D] {
         for c in 0..r {
             s -= dg[r * D + c] * x[c];
         }
-        x[r] = s / dg[r * D + r];
+        x[r] = s * dg[r * D + r];
     }
     x
 }
@@ -488,7 +490,7 @@ impl Blocks {
                 return None;
             }
             for r in c..d {
-                self.diag[(node * d + r) * d + c] = col_values[r - c];
+                self.diag[(node * d + r) * d + c] = if r == c { 1.0 / col_values[0] } else { col_values[r - c] };
             }
             for (k, v) in col_values[d - c..].iter().enumerate() {
                 let (block, r) = (blocks - 1 - k / d, k % d);
