@@ -308,12 +308,24 @@ impl BlockFactor {
             let values = &self.values[range.start * D * D..range.end * D * D];
             // D² independent sums rather than D dependent chains.
             let mut acc = [[0.0f64; D]; D];
-            // Rows increasing (the sums' order), the memory read downwards.
-            for (&row, block) in self.rows_of(node).iter().rev().zip(values.rchunks_exact(D * D)) {
-                let xi = &x[row as usize];
+            // The parent (the smallest row, stored last) last: the sum over the other rows,
+            // increasing (the memory read downwards), need not wait on the column solved just
+            // before, which is the parent more often than not.
+            let rows = self.rows_of(node);
+            if let Some((&parent, rest)) = rows.split_last() {
+                let (others, last) = values.split_at(rest.len() * D * D);
+                for (&row, block) in rest.iter().rev().zip(others.rchunks_exact(D * D)) {
+                    let xi = &x[row as usize];
+                    for c in 0..D {
+                        for r in 0..D {
+                            acc[c][r] += block[c * D + r] * xi[r];
+                        }
+                    }
+                }
+                let xi = &x[parent as usize];
                 for c in 0..D {
                     for r in 0..D {
-                        acc[c][r] += block[c * D + r] * xi[r];
+                        acc[c][r] += last[c * D + r] * xi[r];
                     }
                 }
             }
