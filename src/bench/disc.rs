@@ -176,9 +176,7 @@ fn last_level_cache_bytes() -> Option<usize> {
 }
 
 /// Bytes per second of the triad a = b + s·c over three arrays of `bytes` in all (at least
-/// 64 KiB): the best of 15 timings, each repeating the triad for at least a millisecond. The
-/// best, as STREAM reports it: on a shared machine it is the steadiest (at 384 MB, three
-/// measurements read 25.9–27.6 GB/s at best where their medians read 20.6–26.9).
+/// 64 KiB): the median of 15 timings, each repeating the triad for at least a millisecond.
 pub fn triad_bandwidth(bytes: usize) -> f64 {
     let n = (bytes / 24).max(8192);
     let (b, c) = (vec![1.0f64; n], vec![2.0f64; n]);
@@ -192,7 +190,7 @@ pub fn triad_bandwidth(bytes: usize) -> f64 {
     triad(0.5);
     let once = clock.elapsed().as_secs_f64().max(1e-9);
     let reps = ((1e-3 / once).ceil() as usize).max(1);
-    (0..15)
+    let timings: Vec<f64> = (0..15)
         .map(|k| {
             let clock = Instant::now();
             for r in 0..reps {
@@ -200,5 +198,6 @@ pub fn triad_bandwidth(bytes: usize) -> f64 {
             }
             (24 * n * reps) as f64 / clock.elapsed().as_secs_f64()
         })
-        .fold(0.0, f64::max)
+        .collect();
+    median(timings)
 }
