@@ -176,7 +176,10 @@ fn last_level_cache_bytes() -> Option<usize> {
 }
 
 /// Bytes per second of the triad a = b + s·c over three arrays of `bytes` in all (at least
-/// 64 KiB): the median of 15 timings, each repeating the triad for at least a millisecond.
+/// 64 KiB): the median of 15 timings, each repeating the triad for at least a millisecond. The
+/// median, not STREAM's best: the step times it is compared with are medians, and on a shared
+/// machine the best is an instant the steps do not see (at 384 MB, three measurements read
+/// 25.9–27.6 GB/s at best and 20.6–26.9 at the median).
 pub fn triad_bandwidth(bytes: usize) -> f64 {
     let n = (bytes / 24).max(8192);
     let (b, c) = (vec![1.0f64; n], vec![2.0f64; n]);
