@@ -204,6 +204,7 @@ fn bench_disc_times_the_stepper_and_reports_missing_meshes() {
     assert!(model > 0.0);
     assert!((num("measured_over_model") - num("ms_per_step") / model).abs() <= 1e-12 * num("measured_over_model"));
     assert!((num("median_over_model") - num("median_step_ms") / model).abs() <= 1e-12 * num("median_over_model"));
+    assert!(num("ms_per_step_fastest") <= num("ms_per_step") && num("ms_per_step") <= num("ms_per_step_slowest"));
     // The same bytes at two bandwidths: out of cache (STREAM's) and in cache.
     let cache = num("cache_model_ms");
     assert!((model * num("stream_gb_s") - cache * num("cache_gb_s")).abs() <= 1e-12 * model * num("stream_gb_s"));

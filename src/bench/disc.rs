@@ -33,8 +33,11 @@ pub struct DiscTiming {
     pub steps: usize,
     pub newton_total: usize,
     pub factorizations: usize,
-    /// Median over runs of (stepping time / steps).
+    /// Median over runs of (stepping time / steps), and the fastest and slowest run's: their
+    /// spread tells how busy the machine was.
     pub ms_per_step: f64,
+    pub ms_per_step_fastest: f64,
+    pub ms_per_step_slowest: f64,
     /// Median over runs of the median step time.
     pub median_step_ms: f64,
     /// Median over runs of the whole run (setup and measurements included) / steps.
@@ -93,6 +96,8 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
         let model_ms = 1e3 * model_bytes / stream;
         let cache = triad_bandwidth(model_bytes as usize);
         let cache_model_ms = 1e3 * model_bytes / cache;
+        let fastest = mean.iter().copied().fold(f64::INFINITY, f64::min);
+        let slowest = mean.iter().copied().fold(0.0, f64::max);
         let ms_per_step = median(mean);
         let t = DiscTiming {
             mesh: path.display().to_string(),
@@ -101,6 +106,8 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             newton_total: s.newton_total,
             factorizations: s.factorizations,
             ms_per_step,
+            ms_per_step_fastest: fastest,
+            ms_per_step_slowest: slowest,
             median_step_ms,
             ms_per_step_with_setup: median(whole),
             factorizations_per_1000: per_1000(s.factorizations),
@@ -117,7 +124,7 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             measured_over_cache_model: ms_per_step / cache_model_ms,
         };
         progress(&format!(
-            "{}: {} dofs, {} steps, {} Newton iterations, {} factorizations, {} low-rank updates; {:.3} ms/step stepping (median step {:.3} ms), {:.3} ms/step whole run; model {:.3} ms ({:.2} MB at STREAM's {:.1} GB/s), measured/model {:.2} (median step/model {:.2}); in cache {:.3} ms (at {:.1} GB/s), measured/model {:.2}",
+            "{}: {} dofs, {} steps, {} Newton iterations, {} factorizations, {} low-rank updates; {:.3} ms/step stepping (runs {:.3}–{:.3}; median step {:.3} ms), {:.3} ms/step whole run; model {:.3} ms ({:.2} MB at STREAM's {:.1} GB/s), measured/model {:.2} (median step/model {:.2}); in cache {:.3} ms (at {:.1} GB/s), measured/model {:.2}",
             t.mesh,
             t.dofs,
             t.steps,
@@ -125,6 +132,8 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             t.factorizations,
             s.low_rank_updates,
             t.ms_per_step,
+            t.ms_per_step_fastest,
+            t.ms_per_step_slowest,
             t.median_step_ms,
             t.ms_per_step_with_setup,
             t.model_ms,
