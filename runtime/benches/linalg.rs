@@ -6,6 +6,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use signorini_runtime::assembly::Assembler;
+use signorini_runtime::block_factor::BlockFactor;
 use std::sync::Arc;
 
 use signorini_runtime::linalg::{Factorization, Matrix, Structure};
@@ -76,32 +77,23 @@ fn products_and_solves(c: &mut Criterion) {
         // The passes with the factor out of the caches (64 MB written in between, untimed), as
         // the forward pass meets it in a step when the step's other data has pushed it out.
         let mut flush = vec![0.0f64; 8 << 20];
-        c.bench_function(&format!("forward pass from memory, {n} unknowns"), |b| {
-            b.iter_batched(
-                || {
-                    flush.iter_mut().for_each(|v| *v += 1.0);
-                    std::hint::black_box(&flush);
-                },
-                |_| {
-                    y.copy_from_slice(&x);
-                    bf.forward(&mut y)
-                },
-                criterion::BatchSize::PerIteration,
-            )
-        });
-        c.bench_function(&format!("backward pass from memory, {n} unknowns"), |b| {
-            b.iter_batched(
-                || {
-                    flush.iter_mut().for_each(|v| *v += 1.0);
-                    std::hint::black_box(&flush);
-                },
-                |_| {
-                    y.copy_from_slice(&x);
-                    bf.backward(&mut y)
-                },
-                criterion::BatchSize::PerIteration,
-            )
-        });
+        let passes: [(&str, fn(&BlockFactor, &mut [f64])); 2] =
+            [("forward", BlockFactor::forward), ("backward", BlockFactor::backward)];
+        for (name, pass) in passes {
+            c.bench_function(&format!("{name} pass from memory, {n} unknowns"), |b| {
+                b.iter_batched(
+                    || {
+                        flush.iter_mut().for_each(|v| *v += 1.0);
+                        std::hint::black_box(&flush);
+                    },
+                    |_| {
+                        y.copy_from_slice(&x);
+                        pass(bf, &mut y)
+                    },
+                    criterion::BatchSize::PerIteration,
+                )
+            });
+        }
         c.bench_function(&format!("backward pass, {n} unknowns"), |b| {
             b.iter(|| {
                 y.copy_from_slice(&x);
