@@ -34,6 +34,9 @@ fn identity_blocks(a: &Matrix) -> Matrix {
     m
 }
 
+/// A triangular pass of the factor, in place.
+type Pass = fn(&BlockFactor, &mut [f64]);
+
 fn products_and_solves(c: &mut Criterion) {
     for cells in [20, 39] {
         let a = spd_matrix(cells);
@@ -77,8 +80,7 @@ fn products_and_solves(c: &mut Criterion) {
         // The passes with the factor out of the caches (64 MB written in between, untimed), as
         // the forward pass meets it in a step when the step's other data has pushed it out.
         let mut flush = vec![0.0f64; 8 << 20];
-        let passes: [(&str, fn(&BlockFactor, &mut [f64])); 2] =
-            [("forward", BlockFactor::forward), ("backward", BlockFactor::backward)];
+        let passes: [(&str, Pass); 2] = [("forward", BlockFactor::forward), ("backward", BlockFactor::backward)];
         for (name, pass) in passes {
             c.bench_function(&format!("{name} pass from memory, {n} unknowns"), |b| {
                 b.iter_batched(
