@@ -259,19 +259,9 @@ impl BlockFactor {
             if let Some((&parent, rest)) = rows.split_last() {
                 let (others, last) = values.split_at(rest.len() * D * D);
                 for (&row, block) in rest.iter().rev().zip(others.rchunks_exact(D * D)) {
-                    let xi = &x[row as usize];
-                    for c in 0..D {
-                        for r in 0..D {
-                            acc[c][r] += block[c * D + r] * xi[r];
-                        }
-                    }
+                    accumulate::<D>(&mut acc, block, &x[row as usize]);
                 }
-                let xi = &x[parent as usize];
-                for c in 0..D {
-                    for r in 0..D {
-                        acc[c][r] += last[c * D + r] * xi[r];
-                    }
-                }
+                accumulate::<D>(&mut acc, last, &x[parent as usize]);
             }
             let dg = &self.diag[node * D * D..][..D * D];
             let xj = &mut x[node];
@@ -360,6 +350,17 @@ fn update<const D: usize>(xi: &mut [f64; D], block: &[f64], xj: &[f64; D]) {
     }
 }
 
+/// acc[c] += block[:, c] ⊙ xi (a block below the diagonal in the backward pass: D² sums,
+/// added up per column at the end).
+#[inline(always)]
+fn accumulate<const D: usize>(acc: &mut [[f64; D]; D], block: &[f64], xi: &[f64; D]) {
+    for c in 0..D {
+        for r in 0..D {
+            acc[c][r] += block[c * D + r] * xi[r];
+        }
+    }
+}
+
 /// The solve of a lower-triangular diagonal block.
 #[inline(always)]
 fn diag_solve<const D: usize>(dg: &[f64], b: &[f64]) -> [f64; D] {
@@ -437,7 +438,7 @@ impl Blocks {
                 return None;
             }
             for r in c..d {
-                self.diag[(node * d + r) * d + c] = if r == c { 1.0 / col_values[0] } else { col_values[r - c] };
+                self.diag[(node * d + r) * d + c] = if r == c { 1.0 / col_values[r - c] } else { col_values[r - c] };
             }
             for (k, v) in col_values[d - c..].iter().enumerate() {
                 let (block, r) = (blocks - 1 - k / d, k % d);

@@ -126,28 +126,16 @@ pub trait BoundForm {
         None
     }
     /// Appends the tangent's element matrices (unscaled, as `tangent` adds them) if the form
-    /// integrates over facets only; false if it cannot.
+    /// integrates over facets only, and with `m` also adds them into `m` as `tangent` does (one
+    /// evaluation for both); false, with nothing done, if it cannot.
     fn tangent_elements(
         &self,
         _asm: &Assembler,
         _fields: &[&[f64]],
         _wrt: usize,
         _t: f64,
+        _m: Option<&mut Matrix>,
         _out: &mut ElementMatrices,
-    ) -> bool {
-        false
-    }
-    /// As `tangent`, appending the element matrices it adds (as `tangent_elements` does) to
-    /// `elements` too: one evaluation for both. False, with nothing done, if the form cannot
-    /// give its elements.
-    fn tangent_recording(
-        &self,
-        _asm: &Assembler,
-        _fields: &[&[f64]],
-        _wrt: usize,
-        _t: f64,
-        _m: &mut Matrix,
-        _elements: &mut ElementMatrices,
     ) -> bool {
         false
     }
@@ -211,31 +199,15 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
         fields: &[&[f64]],
         wrt: usize,
         t: f64,
+        mut m: Option<&mut Matrix>,
         out: &mut ElementMatrices,
     ) -> bool {
         if self.kernel.meta().cell_degree.is_some() {
             return false;
         }
         for (region, facets) in &self.regions {
-            asm.facet_tangent_elements(&self.kernel, region, facets, self.quadrature, fields, wrt, t, None, out);
-        }
-        true
-    }
-    fn tangent_recording(
-        &self,
-        asm: &Assembler,
-        fields: &[&[f64]],
-        wrt: usize,
-        t: f64,
-        m: &mut Matrix,
-        elements: &mut ElementMatrices,
-    ) -> bool {
-        if self.kernel.meta().cell_degree.is_some() {
-            return false;
-        }
-        for (region, facets) in &self.regions {
-            let q = self.quadrature;
-            asm.facet_tangent_elements(&self.kernel, region, facets, q, fields, wrt, t, Some(&mut *m), elements);
+            let (q, m) = (self.quadrature, m.as_deref_mut());
+            asm.facet_tangent_elements(&self.kernel, region, facets, q, fields, wrt, t, m, out);
         }
         true
     }
@@ -382,6 +354,9 @@ struct StageCache {
     args: Vec<Vec<f64>>,
     term: Vec<f64>,
     switches: SwitchMemo,
+    /// The last Jacobian assembly's recorded tangent, its storage kept from one step to the
+    /// next (a new stage problem starts it invalid: its coefficients and times may differ).
+    recorded: RecordedTangent,
 }
 
 /// The last active set a stage's terms gave, and what it is a function of: the terms' forms,
@@ -456,6 +431,7 @@ impl<'a> Stepper<'a> {
                 args: Vec::new(),
                 term: Vec::new(),
                 switches: SwitchMemo::default(),
+                recorded: RecordedTangent::default(),
             })
             .collect();
         Ok(Stepper {
@@ -477,6 +453,13 @@ impl<'a> Stepper<'a> {
     }
 
     /// The scheme's description (states, stages, slots).
+    /// The lower half of the mesh's pattern (in reverse Cuthill–McKee order) that the stages'
+    /// symmetric matrices are stored on, when they are: for other symmetric products on the
+    /// same pattern.
+    pub fn half_pattern(&self) -> Option<&Arc<HalfPattern>> {
+        self.half_pattern.as_ref()
+    }
+
     pub fn desc(&self) -> &SchemeDesc {
         &self.desc
     }
@@ -777,7 +760,8 @@ impl<'a> Stepper<'a> {
             entry.newton.invalidate();
         }
         let piecewise = nonlinear.iter().all(|a| self.forms[a.form].piecewise());
-        let StageCache { newton, constant, support, scratch, args, term, switches, .. } = &mut self.stages[cache];
+        let StageCache { newton, constant, support, scratch, args, term, switches, recorded, .. } =
+            &mut self.stages[cache];
         // The same forms at every step in practice; should they change, so may the entries where
         // J varies, and the references compared there only are dropped.
         if support.as_ref().is_none_or(|(forms, _)| !forms.iter().eq(nonlinear.iter().map(|a| &a.form))) {
@@ -802,7 +786,7 @@ impl<'a> Stepper<'a> {
             term: std::mem::take(term),
             switches,
             magnitude: 0.0,
-            recorded: RecordedTangent::default(),
+            recorded: RecordedTangent { valid: false, ..std::mem::take(recorded) },
         };
         // δ = w − reference, with the constrained values of w imposed: zero but on those.
         let w0 = match reference {
@@ -815,7 +799,7 @@ impl<'a> Stepper<'a> {
             delta[i] = values[i] - w0[i];
         }
         let report = newton.solve(&mut problem, &mut delta);
-        (*args, *term) = (problem.args, problem.term);
+        (*args, *term, *recorded) = (problem.args, problem.term, problem.recorded);
         self.pool.give(problem.rhs);
         problem.terms.into_iter().flat_map(|t| t.bases).for_each(|b| self.pool.give(b));
         let report = report.map_err(|source| StepError::Newton { stage: stage.name, t: stage_t, source })?;
@@ -1045,7 +1029,8 @@ impl StageProblem<'_, '_> {
                     let c = term.coef * a;
                     let form = &self.forms[term.form];
                     rec.parts.push((rec.elements.len(), c));
-                    rec.valid = rec.valid && form.tangent_recording(self.asm, &refs, k, term.t, m, &mut rec.elements);
+                    rec.valid = rec.valid
+                        && form.tangent_elements(self.asm, &refs, k, term.t, Some(&mut *m), &mut rec.elements);
                     if !rec.valid {
                         form.tangent(self.asm, &refs, k, term.t, m);
                     }
@@ -1259,7 +1244,7 @@ impl StageProblem<'_, '_> {
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
                     let from = out.len();
-                    if !self.forms[term.form].tangent_elements(self.asm, &refs, k, term.t, &mut out) {
+                    if !self.forms[term.form].tangent_elements(self.asm, &refs, k, term.t, None, &mut out) {
                         return None;
                     }
                     out.scale_from(from, term.coef * a);

@@ -13,8 +13,8 @@
 //!   memory's bandwidth. This is the model the goal is stated against.
 //! - In cache: arrays of the working set's total size. The small meshes' working set lives in
 //!   the cache, and this is the speed it could be read at there: the stricter model. How far
-//!   it is from main memory's depends on the machine (from 1.2 to 3.4 times here), so both
-//!   are reported.
+//!   it is from main memory's depends on the machine (3 to 4.5 times on the one of
+//!   2026-11-26, docs/mathematics.md), so both are reported.
 
 use std::path::PathBuf;
 

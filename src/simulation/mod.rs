@@ -20,6 +20,7 @@ use crate::runtime::mesh::{Facet, Mesh};
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
 use crate::runtime::scheme::{BoundForm, MatrixForm, StageView, StepReport, Stepper};
+use std::sync::Arc;
 
 pub mod statics;
 
@@ -73,8 +74,9 @@ pub struct Energies {
 }
 
 impl Energies {
-    pub fn new(asm: &Assembler, stiffness: &Matrix, mass: &Matrix) -> Energies {
-        let half = std::sync::Arc::new(HalfPattern::new(asm.pattern()));
+    /// With the stepper's lower-half pattern when it has one (the same pattern).
+    pub fn new(asm: &Assembler, half: Option<&Arc<HalfPattern>>, stiffness: &Matrix, mass: &Matrix) -> Energies {
+        let half = half.cloned().unwrap_or_else(|| Arc::new(HalfPattern::new(asm.pattern())));
         let lower = |a: &Matrix| a.is_symmetric(1e-12).then(|| LowerHalf::new(a, &half));
         Energies { stiffness: lower(stiffness), mass: lower(mass), work: Default::default() }
     }
@@ -256,7 +258,7 @@ impl<'m> Simulation<'m> {
             contact_trial: inst.take_functional("contact_trial"),
             von_mises: inst.take_functional("von_mises"),
             cell_measure: inst.take_functional("measure"),
-            energies: Energies::new(asm, &stiffness, &scheme_mass),
+            energies: Energies::new(asm, stepper.half_pattern(), &stiffness, &scheme_mass),
             mass,
             scheme_mass,
             stiffness,
