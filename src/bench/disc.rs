@@ -158,10 +158,11 @@ pub fn read(dir: &std::path::Path) -> Option<Result<Report, String>> {
 }
 
 /// STREAM's bandwidth, one thread: the triad over arrays of four times the last-level cache
-/// each (STREAM's rule for measuring main memory), 64 MiB each at least, 128 MiB where the
-/// cache's size cannot be read.
+/// each (STREAM's rule for measuring main memory), 64 MiB each at least and 512 MiB at most
+/// (three such arrays still exceed a 384 MB cache four times), 128 MiB where the cache's size
+/// cannot be read.
 pub fn stream_bandwidth() -> f64 {
-    let array = last_level_cache_bytes().map_or(128 << 20, |c| (4 * c).max(64 << 20));
+    let array = last_level_cache_bytes().map_or(128 << 20, |c| (4 * c).clamp(64 << 20, 512 << 20));
     triad_bandwidth(3 * array)
 }
 
