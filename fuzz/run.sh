@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Runs a libFuzzer target on the stable toolchain (cargo-fuzz itself needs nightly), built with
 # the SanitizerCoverage passes cargo-fuzz would add. Usage: fuzz/run.sh TARGET [seconds]
-# (TARGET: gmsh or case_file; default 300 s). Seeds are copied in at run time (the reference
-# meshes beside the repository are too large to commit); crashes land in ./artifacts/TARGET.
+# (TARGET: gmsh or case_file; default 300 s). Seeds are copied in at run time from the repository's
+# meshes; crashes land in ./artifacts/TARGET.
 set -euo pipefail
 cd "$(dirname "$0")"
 name=${1:?usage: run.sh gmsh|case_file [seconds]}
@@ -14,7 +14,7 @@ cargo build --release --target "$target" --bin "$name"
 mkdir -p "corpus/$name" "artifacts/$name"
 case $name in
   gmsh)
-    cp ../../shared/meshes/*.msh ../runtime/tests/*.msh ../runtime/tests/gmsh_bad/*.msh "corpus/$name/" 2>/dev/null || true
+    cp ../assets/meshes/*.msh ../runtime/tests/*.msh ../runtime/tests/gmsh_bad/*.msh "corpus/$name/" 2>/dev/null || true
     max_len=131072 ;;
   case_file)
     cp ../examples/*.toml "corpus/$name/"

@@ -187,7 +187,7 @@ fn bench_disc_times_the_stepper_and_reports_missing_meshes() {
     let (code, _, err) = signorini(&["bench", "disc", "--mesh", "/nonexistent/disc.msh", "--repeats", "1"]);
     assert_eq!(code, 1);
     assert!(err.contains("/nonexistent/disc.msh"), "{err}");
-    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/disc_r10_h1_v22.msh");
+    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/meshes/disc_r10_h1_v22.msh");
     let dir = std::env::temp_dir().join(format!("signorini-bench-disc-{}", std::process::id()));
     let (code, _, err) =
         signorini(&["bench", "disc", "--mesh", mesh, "--repeats", "1", "--out", dir.to_str().unwrap()]);

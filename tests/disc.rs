@@ -102,8 +102,8 @@ fn penetration_decreases_with_the_contact_parameter() {
 /// impact, deepest descent and rebound of the centre of mass, release time.
 #[test]
 fn gmsh_mesh_and_built_in_generator_agree() {
-    let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/disc_r10_h1_v22.msh");
-    assert!(shared.exists(), "{} is missing: the reference meshes live in ../shared/meshes", shared.display());
+    let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/disc_r10_h1_v22.msh");
+    assert!(shared.exists(), "{} is missing: the reference meshes live in assets/meshes", shared.display());
     let summary = |mesh: Option<std::path::PathBuf>| {
         let r = disc::run(&Options { setup: scheme("hybrid"), mesh, t_end: 26.0, ..Options::default() }).unwrap();
         let release = r.series.iter().filter(|row| row.active_points > 0).map(|row| row.t).fold(0.0, f64::max);

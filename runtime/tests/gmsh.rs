@@ -1,4 +1,4 @@
-//! The Gmsh reader on the reference meshes of `../shared/meshes` (the same mesh in MSH 2.2
+//! The Gmsh reader on the reference meshes of `assets/meshes` (the same mesh in MSH 2.2
 //! ASCII, 4.1 ASCII and 4.1 binary) and on a corpus of malformed files.
 
 use std::path::{Path, PathBuf};
@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 use signorini_runtime::element::ElementKind;
 use signorini_runtime::mesh::{Mesh, MeshError, gmsh};
 
-/// A reference mesh of `../shared/meshes` (beside the clone, in CI too).
+/// A reference mesh of `assets/meshes`.
 fn shared(name: &str) -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes").join(name);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/meshes").join(name);
     assert!(
         p.exists(),
-        "{} is missing: the reference meshes live in ../shared/meshes beside the repository",
+        "{} is missing: the reference meshes live in assets/meshes",
         p.display()
     );
     Some(p)

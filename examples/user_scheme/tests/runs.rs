@@ -17,7 +17,7 @@ fn compiled() -> Setup {
 
 #[test]
 fn the_binary_runs_the_bar_and_a_gmsh_disc() {
-    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/meshes/disc_r10_h1_groups_v41.msh");
+    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes/disc_r10_h1_groups_v41.msh");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_user-scheme")).arg(mesh).output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
