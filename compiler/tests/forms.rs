@@ -68,3 +68,25 @@ fn ast_ir_and_scheme_snapshots() {
         });
     }
 }
+
+/// The library's problems (`forms/problems/`): each checks clean, and its AST as printed (what
+/// the binding of a run reads) is a snapshot a reviewer reads.
+#[test]
+fn library_problems_check_clean_and_print() {
+    let Ok(entries) = std::fs::read_dir("../forms/problems") else { panic!("forms/problems is missing") };
+    let mut files: Vec<PathBuf> = entries
+        .map(|e| e.expect("readable entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "wf"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty());
+    for f in &files {
+        let compiled = compile(f, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", f.display()));
+        assert!(compiled.warnings.is_empty(), "{}:\n{}", f.display(), compiled.warnings);
+        assert!(compiled.program.unit.problems.len() == 1, "{}: one problem per file", f.display());
+        let ast = syntax::print::print_file(&compiled.ast, &compiled.program.unit.sources);
+        insta::with_settings!({ snapshot_path => "snapshots/problems", prepend_module_to_snapshot => false }, {
+            insta::assert_snapshot!(format!("{}.ast", stem(f)), ast);
+        });
+    }
+}

@@ -7,6 +7,7 @@
 
 mod builtins;
 pub mod load;
+pub mod problem;
 mod types;
 
 use crate::diagnostic::{self, Diagnostic};
@@ -32,6 +33,8 @@ pub struct Unit {
     pub forms: Vec<Form>,
     /// Time schemes as written (`Global::Scheme` indexes them).
     pub scheme_defs: Vec<SchemeDef>,
+    /// Problems as written (`Global::Problem` indexes them).
+    pub problems: Vec<ast::Problem>,
     pub globals: HashMap<String, Global>,
     /// Warnings (errors make `check` return `Err`).
     pub warnings: Vec<Diagnostic>,
@@ -125,6 +128,7 @@ pub enum Global {
     Fn { params: Vec<Ident>, body: Expr, span: Span },
     Form(usize),
     Scheme(usize),
+    Problem(usize),
 }
 
 impl Global {
@@ -134,7 +138,7 @@ impl Global {
             Global::Coef(i) => coefs[*i].span,
             Global::Let { span, .. } | Global::Fn { span, .. } => *span,
             Global::Form(i) => forms[*i].span,
-            Global::Scheme(_) => Span::new(0, 0, 0),
+            Global::Scheme(_) | Global::Problem(_) => Span::new(0, 0, 0),
         }
     }
 
@@ -146,8 +150,20 @@ impl Global {
             Global::Fn { .. } => "fn",
             Global::Form(_) => "form",
             Global::Scheme(_) => "scheme",
+            Global::Problem(_) => "problem",
         }
     }
+}
+
+/// E0207: a vector literal or a component outside a problem.
+pub fn problem_only(span: Span) -> Diagnostic {
+    Diagnostic::error(
+        "E0207",
+        "vector literals and components need a known dimension",
+        span,
+        "only a problem's expressions may write `[a, b]` or `x[1]`",
+    )
+    .with_help("a form serves every dimension: use `dot(a, b)`, `outer`, or a `coef: vector` the problem sets")
 }
 
 /// The region name of volume integrals.
@@ -167,6 +183,7 @@ pub fn check(sources: SourceMap, root: FileId, files: &[(FileId, ast::File)], mu
         coefs: Vec::new(),
         forms: Vec::new(),
         scheme_defs: Vec::new(),
+        problems: Vec::new(),
         globals: HashMap::new(),
         warnings: Vec::new(),
     };
@@ -179,6 +196,9 @@ pub fn check(sources: SourceMap, root: FileId, files: &[(FileId, ast::File)], mu
         c.check_lets_and_fns();
         c.check_forms();
         let used = c.used_params.clone();
+        for p in &prog.problems {
+            problem::check(&mut c, p, &mut diags);
+        }
         diags.append(&mut c.diags);
         for (p, (default, range)) in prog.params.iter_mut().zip(values) {
             p.default = default.unwrap_or(f64::NAN);
@@ -329,6 +349,10 @@ fn declare(prog: &mut Unit, files: &[(FileId, ast::File)], diags: &mut Vec<Diagn
                         span: *span,
                     });
                     Global::Scheme(prog.scheme_defs.len() - 1)
+                }
+                ast::Item::Problem(p) => {
+                    prog.problems.push((**p).clone());
+                    Global::Problem(prog.problems.len() - 1)
                 }
                 ast::Item::Import { .. } => continue,
             };

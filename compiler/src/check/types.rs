@@ -74,6 +74,13 @@ pub(super) struct Checker<'p> {
     expansions: usize,
     /// Current recursion depth of [`Checker::ty`].
     depth: u32,
+    /// Inside a problem, whose dimension is known: vector literals and components allowed.
+    pub vectors_allowed: bool,
+}
+
+/// E0301 at `span`: `what`, found `shape`.
+fn shape_error(span: Span, what: &str, shape: Shape) -> Diagnostic {
+    Diagnostic::error("E0301", "shape mismatch", span, format!("{what}, not a {}", shape.name()))
 }
 
 type FnKey = (Shape, bool, Option<Span>, bool, Option<u64>, u32);
@@ -98,6 +105,7 @@ impl<'p> Checker<'p> {
             memo: HashMap::new(),
             expansions: 0,
             depth: 0,
+            vectors_allowed: false,
         }
     }
 
@@ -200,6 +208,18 @@ impl<'p> Checker<'p> {
         }
     }
 
+    /// The type of a problem's expression, with `names` (the problem's params and lets, and
+    /// the fields of the context) visible and vectors allowed.
+    pub(super) fn problem_ty(&mut self, e: &Expr, names: &[(String, Shape)]) -> Option<Ty> {
+        let old = std::mem::take(&mut self.scope);
+        self.scope = names.iter().map(|(n, s)| (n.clone(), Ty::plain(*s))).collect();
+        self.vectors_allowed = true;
+        let ty = self.ty(e);
+        self.vectors_allowed = false;
+        self.scope = old;
+        ty
+    }
+
     /// Reports unknown names in an expression whose argument shapes are not known.
     fn names_only(&mut self, e: &Expr, params: &[Ident]) {
         match &e.kind {
@@ -221,10 +241,11 @@ impl<'p> Checker<'p> {
                 }
             }
             ExprKind::Neg(a) => self.names_only(a, params),
-            ExprKind::Binary(_, a, b) => {
+            ExprKind::Binary(_, a, b) | ExprKind::Index(a, b) => {
                 self.names_only(a, params);
                 self.names_only(b, params);
             }
+            ExprKind::Vector(items) => items.iter().for_each(|a| self.names_only(a, params)),
         }
     }
 
@@ -400,6 +421,45 @@ impl<'p> Checker<'p> {
                 self.binary_ty(*op, e, a, b, ta, tb).map(|t| Ty { height, ..t })
             }
             ExprKind::Call(f, args) => self.call_ty(e, f, args),
+            ExprKind::Vector(items) => {
+                let tys: Vec<Option<Ty>> = items.iter().map(|a| self.ty(a)).collect();
+                let mut out = Ty { shape: Shape::Vector, ..Ty::plain(Shape::Vector) };
+                for (a, t) in items.iter().zip(tys) {
+                    let t = t?;
+                    if t.shape != Shape::Scalar {
+                        self.error(shape_error(a.span, "a component of a vector must be a scalar", t.shape));
+                        return None;
+                    }
+                    out = Ty::join(&out, &t, Shape::Vector);
+                }
+                if !self.vectors_allowed {
+                    self.error(super::problem_only(e.span));
+                    return None;
+                }
+                Some(Ty { height: out.height + 1, ..out })
+            }
+            ExprKind::Index(a, i) => {
+                let ta = self.ty(a)?;
+                if !self.vectors_allowed {
+                    self.error(super::problem_only(e.span));
+                    return None;
+                }
+                if ta.shape != Shape::Vector {
+                    self.error(shape_error(a.span, "only a vector has components", ta.shape));
+                    return None;
+                }
+                match const_eval(i) {
+                    Ok(k) if k >= 0.0 && k.fract() == 0.0 && k < 3.0 => {}
+                    _ => {
+                        self.error(
+                            Diagnostic::error("E0302", "a component index must be 0, 1 or 2", i.span, "not one")
+                                .with_help("components count from 0: `x[0]`, `x[1]`, `x[2]`"),
+                        );
+                        return None;
+                    }
+                }
+                Some(Ty { shape: Shape::Scalar, konst: None, height: ta.height + 1, ..ta })
+            }
         }
     }
 
@@ -414,7 +474,7 @@ impl<'p> Checker<'p> {
             }
             Some(Global::Coef(i)) => Some(Ty { smooth: false, ..Ty::plain(self.prog.coefs[*i].shape) }),
             Some(Global::Let { .. }) => self.let_ty(&id.name, id.span),
-            Some(g @ (Global::Fn { .. } | Global::Form(_) | Global::Scheme(_))) => {
+            Some(g @ (Global::Fn { .. } | Global::Form(_) | Global::Scheme(_) | Global::Problem(_))) => {
                 let kind = g.kind();
                 self.error(
                     Diagnostic::error(
@@ -802,6 +862,7 @@ pub fn const_eval(e: &Expr) -> Result<f64, Span> {
                 BinOp::Pow => x.powf(y),
             }
         }
+        ExprKind::Vector(_) | ExprKind::Index(..) => return Err(e.span),
         ExprKind::Call(f, args) => match (f.name.as_str(), args.as_slice()) {
             ("sqrt", [a]) => const_eval(a)?.sqrt(),
             ("abs", [a]) => const_eval(a)?.abs(),

@@ -80,6 +80,21 @@ impl<'p> Lowerer<'p> {
         self.d
     }
 
+    /// Lowers an expression of a problem, with `scope` (its params as constants, its fields)
+    /// visible before the unit's names.
+    pub fn problem_expr(&mut self, e: &Expr, scope: Vec<(String, Val)>) -> Res<Val> {
+        self.form_start = self.g.len();
+        self.scope = scope;
+        let v = self.expr(e);
+        self.scope.clear();
+        v
+    }
+
+    /// A constant value with a zero gradient.
+    pub fn constant_val(&mut self, v: f64) -> Val {
+        Self::scalar(self.constant(v))
+    }
+
     /// Lowers form `index`; refuses non-finite constant arithmetic and expansions past
     /// [`MAX_FORM_NODES`], at the user's tokens.
     pub fn form(&mut self, index: usize) -> Res<LoweredForm> {
@@ -169,6 +184,33 @@ impl<'p> Lowerer<'p> {
             ExprKind::Call(f, args) => {
                 let args: Vec<Val> = args.iter().map(|a| self.expr(a)).collect::<Res<_>>()?;
                 self.call(&f.name, args, e.span)?
+            }
+            ExprKind::Vector(items) => {
+                if items.len() != self.d {
+                    let d = Diagnostic::error(
+                        "E0302",
+                        "wrong dimension",
+                        e.span,
+                        format!("a vector of {} components in a {}D problem", items.len(), self.d),
+                    );
+                    return Err(Box::new(d));
+                }
+                let c = items.iter().map(|a| Ok(self.expr(a)?.c[0].clone())).collect::<Res<Vec<Jet>>>()?;
+                Val { shape: Shape::Vector, c }
+            }
+            ExprKind::Index(a, i) => {
+                let a = self.expr(a)?;
+                let k = crate::check::const_value(i).unwrap_or(-1.0);
+                if !(k >= 0.0 && (k as usize) < self.d) {
+                    let d = Diagnostic::error(
+                        "E0302",
+                        "wrong dimension",
+                        i.span,
+                        format!("component {k} of a vector in a {}D problem (components count from 0)", self.d),
+                    );
+                    return Err(Box::new(d));
+                }
+                Self::scalar(a.c[k as usize].clone())
             }
         };
         // Operands are finite (checked below them), so a non-finite constant was made here.

@@ -827,10 +827,11 @@ impl<'a> Compiler<'a> {
             }
             ExprKind::Call(_, args) => args.iter().for_each(|a| self.collect_new_names(a, last)),
             ExprKind::Neg(a) => self.collect_new_names(a, last),
-            ExprKind::Binary(_, a, b) => {
+            ExprKind::Binary(_, a, b) | ExprKind::Index(a, b) => {
                 self.collect_new_names(a, last);
                 self.collect_new_names(b, last);
             }
+            ExprKind::Vector(items) => items.iter().for_each(|a| self.collect_new_names(a, last)),
             ExprKind::Number(_) => {}
         }
     }
@@ -1096,6 +1097,10 @@ impl<'a> Compiler<'a> {
 
     fn value_inner(&mut self, e: &Expr) -> Option<Value> {
         match &e.kind {
+            ExprKind::Vector(_) | ExprKind::Index(..) => {
+                self.error(crate::check::problem_only(e.span));
+                None
+            }
             ExprKind::Number(v) => Some(Value::Scalar(self.g.constant(*v))),
             ExprKind::Name(id) => match self.scope.get(&id.name) {
                 Some(v) => Some(v.clone()),

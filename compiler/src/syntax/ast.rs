@@ -36,6 +36,10 @@ pub enum ExprKind {
     Call(Ident, Vec<Expr>),
     Neg(Box<Expr>),
     Binary(BinOp, Box<Expr>, Box<Expr>),
+    /// `[a, b, c]`: a vector of components (problems only, where the dimension is known).
+    Vector(Vec<Expr>),
+    /// `a[i]`: component `i` (from 0) of a vector (problems only).
+    Index(Box<Expr>, Box<Expr>),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -170,6 +174,7 @@ pub enum Item {
         integrals: Vec<Integral>,
         span: Span,
     },
+    Problem(Box<Problem>),
     Scheme {
         name: Ident,
         params: Vec<SchemeParam>,
@@ -197,6 +202,7 @@ impl Item {
             | Item::Fn { name, .. }
             | Item::Form { name, .. }
             | Item::Scheme { name, .. } => Some(name),
+            Item::Problem(p) => Some(&p.name),
         }
     }
 
@@ -209,6 +215,7 @@ impl Item {
             | Item::Fn { span, .. }
             | Item::Form { span, .. }
             | Item::Scheme { span, .. } => *span,
+            Item::Problem(p) => p.span,
         }
     }
 }
@@ -219,4 +226,157 @@ impl Item {
 pub struct File {
     pub items: Vec<Item>,
     pub broken_names: Vec<String>,
+}
+
+/// `name = value`, in a call with named arguments or a list of settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedArg {
+    pub name: Ident,
+    pub value: Expr,
+}
+
+/// `name(a = 1, b = [0, 2])`: a mesh generator or an obstacle helper.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedCall {
+    pub name: Ident,
+    pub args: Vec<NamedArg>,
+    pub span: Span,
+}
+
+/// Where a problem's mesh comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshSource {
+    /// A Gmsh file, relative to the problem file.
+    File { path: String, span: Span },
+    /// A built-in generator.
+    Generator(NamedCall),
+}
+
+/// `lhs < rhs` and the like, in a region predicate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    pub lhs: Expr,
+    pub op: Compare,
+    pub rhs: Expr,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compare {
+    Less,
+    LessEqual,
+    Greater,
+    GreaterEqual,
+}
+
+impl Compare {
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Compare::Less => "<",
+            Compare::LessEqual => "<=",
+            Compare::Greater => ">",
+            Compare::GreaterEqual => ">=",
+        }
+    }
+
+    /// Whether `a op b` holds.
+    pub fn holds(self, a: f64, b: f64) -> bool {
+        match self {
+            Compare::Less => a < b,
+            Compare::LessEqual => a <= b,
+            Compare::Greater => a > b,
+            Compare::GreaterEqual => a >= b,
+        }
+    }
+}
+
+/// One way to find a region's facets.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RegionSource {
+    /// A Gmsh physical group, by name.
+    Group { name: String, span: Span },
+    /// The boundary facets whose outward normal `n` and centroid `x` satisfy every comparison
+    /// (all of the boundary without one).
+    Boundary { conditions: Vec<Comparison>, span: Span },
+}
+
+/// `region NAME = SOURCE else SOURCE ...`: the first source that names anything.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RegionDecl {
+    pub name: Ident,
+    pub sources: Vec<RegionSource>,
+    pub span: Span,
+}
+
+/// A file bound to a role of the run: `scheme = hybrid`, `contact = "my_law.wf"`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bind {
+    pub role: Ident,
+    /// A library name, or a path (relative to the problem file) when written as a string.
+    pub target: String,
+    pub is_path: bool,
+    pub span: Span,
+}
+
+/// `name = expr` with its span, for the problem's field-like declarations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Defined {
+    pub name: Ident,
+    pub value: Expr,
+    pub span: Span,
+}
+
+/// `dirichlet REGION: FIELD = EXPR`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dirichlet {
+    pub region: Ident,
+    pub field: Ident,
+    pub value: Expr,
+    pub span: Span,
+}
+
+/// `obstacle plane(point = [0, 0], normal = [0, 1]) on Gamma_C`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Obstacle {
+    pub shape: NamedCall,
+    /// The contact region it faces (`Gamma_C` when omitted).
+    pub region: Option<Ident>,
+    pub span: Span,
+}
+
+/// `plot "title": col, col`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plot {
+    pub title: String,
+    pub columns: Vec<Ident>,
+    pub span: Span,
+}
+
+/// A problem: the body, its mesh and regions, the files bound to the run's roles, every coef,
+/// obstacles, Dirichlet data, initial fields, what is measured, and the run's defaults.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Problem {
+    pub name: Ident,
+    pub params: Vec<SchemeParam>,
+    pub mesh: Vec<MeshSource>,
+    pub regions: Vec<RegionDecl>,
+    pub binds: Vec<Bind>,
+    /// Param values of the scheme and form files (`set E = 50`).
+    pub sets: Vec<Defined>,
+    pub coefs: Vec<Defined>,
+    pub obstacles: Vec<Obstacle>,
+    pub initial: Vec<Defined>,
+    pub dirichlet: Vec<Dirichlet>,
+    /// Series columns (written) and observed values (not written), in order.
+    pub series: Vec<(Defined, bool)>,
+    pub summary: Vec<Defined>,
+    pub plots: Vec<Plot>,
+    /// Run settings: `dt`, `t_end`, `t_start`.
+    pub run: Vec<Defined>,
+    /// Quadrature degrees: `cell`, `facet`.
+    pub quadrature: Vec<Defined>,
+    /// An analytic reference solution provided by the runtime, by name.
+    pub reference: Option<Ident>,
+    pub lets: Vec<Defined>,
+    pub span: Span,
 }

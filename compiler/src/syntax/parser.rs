@@ -14,7 +14,7 @@ use crate::source::{FileId, Span};
 #[grammar = "syntax/grammar.pest"]
 struct WfParser;
 
-const ITEM_KEYWORDS: &[&str] = &["import", "param", "coef", "let", "fn", "form", "functional", "scheme"];
+const ITEM_KEYWORDS: &[&str] = &["import", "param", "coef", "let", "fn", "form", "functional", "scheme", "problem"];
 
 /// Deepest nesting of parentheses accepted; deeper input is refused before parsing, so that
 /// neither the parser nor the recursive checks can exhaust the stack.
@@ -28,6 +28,7 @@ static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
         .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
         .op(Op::prefix(Rule::neg))
         .op(Op::infix(Rule::pow, Assoc::Right))
+        .op(Op::postfix(Rule::index))
 });
 
 /// Parses one file. Returns the items that parsed and one diagnostic per broken chunk.
@@ -218,8 +219,8 @@ fn syntax_error(file: FileId, chunk: &str, offset: usize, e: &pest::error::Error
     let operator = has("an operator", &expected);
     for t in tokens {
         let punctuation = t.chars().all(|c| c.is_ascii_punctuation());
-        let part_of_expression = expression && matches!(t.as_str(), "(" | "-" | "_" | ".");
-        let part_of_operator = operator && matches!(t.as_str(), "+" | "-" | "*" | "/" | "^");
+        let part_of_expression = expression && matches!(t.as_str(), "(" | "[" | "-" | "_" | ".");
+        let part_of_operator = operator && matches!(t.as_str(), "+" | "-" | "*" | "/" | "^" | "[");
         if punctuation
             && !part_of_expression
             && !part_of_operator
@@ -303,6 +304,11 @@ fn content_end(chunk: &str) -> usize {
     end
 }
 
+/// A string literal's content.
+fn unquote(s: &str) -> String {
+    s[1..s.len() - 1].to_string()
+}
+
 fn join_or(items: &[String]) -> String {
     match items {
         [] => String::new(),
@@ -361,7 +367,28 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         | Rule::initial_decl => {
             "a scheme item (`uses`, `state`, `unknown`, `new`, `relate`, `residual`, `stage`, `initial`, `let`, `claim`)"
         }
-        Rule::scheme_params | Rule::scheme_param => "scheme parameters",
+        Rule::scheme_params | Rule::scheme_param => "parameters",
+        Rule::mesh_decl
+        | Rule::region_decl
+        | Rule::bind_decl
+        | Rule::set_decl
+        | Rule::coef_def
+        | Rule::obstacle_decl
+        | Rule::initial_field
+        | Rule::dirichlet_decl
+        | Rule::series_decl
+        | Rule::observe_decl
+        | Rule::summary_decl
+        | Rule::plot_decl
+        | Rule::run_decl
+        | Rule::quadrature_decl
+        | Rule::reference_decl => {
+            "a problem item (`mesh`, `region`, `bind`, `set`, `coef`, `obstacle`, `initial`, `dirichlet`, `series`, `observe`, `summary`, `plot`, `run`, `quadrature`, `reference`, `let`)"
+        }
+        Rule::named_arg | Rule::assignments => "`NAME = VALUE`",
+        Rule::region_source | Rule::group_source | Rule::boundary_source => "`group \"NAME\"` or `boundary where ...`",
+        Rule::compare => "a comparison (`<`, `<=`, `>`, `>=`)",
+        Rule::vector => "an expression",
         _ => return None,
     })
 }
@@ -451,6 +478,7 @@ impl Builder {
                 Item::Form { name, fields, test: Some(test.expect("form has a test function")), integrals, span }
             }
             Rule::scheme_decl => self.scheme(span, next(), it)?,
+            Rule::problem_decl => Item::Problem(Box::new(self.problem(span, next(), it)?)),
             Rule::functional_decl => {
                 let name = self.ident(next());
                 let mut fields = Vec::new();
@@ -557,6 +585,172 @@ impl Builder {
         Ok(Item::Scheme { name, params, uses, states, lets, initial, claims, stages, span })
     }
 
+    fn problem(
+        &self,
+        span: Span,
+        name: Pair<Rule>,
+        rest: pest::iterators::Pairs<Rule>,
+    ) -> Result<Problem, Box<Diagnostic>> {
+        let mut pb = Problem {
+            name: self.ident(name),
+            params: Vec::new(),
+            mesh: Vec::new(),
+            regions: Vec::new(),
+            binds: Vec::new(),
+            sets: Vec::new(),
+            coefs: Vec::new(),
+            obstacles: Vec::new(),
+            initial: Vec::new(),
+            dirichlet: Vec::new(),
+            series: Vec::new(),
+            summary: Vec::new(),
+            plots: Vec::new(),
+            run: Vec::new(),
+            quadrature: Vec::new(),
+            reference: None,
+            lets: Vec::new(),
+            span,
+        };
+        for p in rest {
+            let span = self.span(&p);
+            let rule = p.as_rule();
+            let mut it = p.into_inner();
+            let mut next = || it.next().expect("grammar guarantees the child");
+            match rule {
+                Rule::scheme_params => {
+                    for q in it {
+                        let span = self.span(&q);
+                        let mut it = q.into_inner();
+                        let name = self.ident(it.next().expect("param name"));
+                        let default = self.expr(it.next().expect("param default"))?;
+                        let range = it.next().map(|r| self.range(r)).transpose()?;
+                        pb.params.push(SchemeParam { name, default, range, span });
+                    }
+                }
+                Rule::mesh_decl => {
+                    let q = next();
+                    pb.mesh.push(match q.as_rule() {
+                        Rule::string => MeshSource::File { path: unquote(q.as_str()), span: self.span(&q) },
+                        _ => MeshSource::Generator(self.named_call(q)?),
+                    });
+                }
+                Rule::region_decl => {
+                    let name = self.ident(next());
+                    let mut sources = Vec::new();
+                    for q in it {
+                        let q = q.into_inner().next().expect("region source");
+                        let qspan = self.span(&q);
+                        sources.push(match q.as_rule() {
+                            Rule::group_source => {
+                                let s = q.into_inner().next().expect("group name");
+                                RegionSource::Group { name: unquote(s.as_str()), span: qspan }
+                            }
+                            _ => {
+                                let conditions =
+                                    q.into_inner().map(|c| self.comparison(c)).collect::<Result<Vec<_>, _>>()?;
+                                RegionSource::Boundary { conditions, span: qspan }
+                            }
+                        });
+                    }
+                    pb.regions.push(RegionDecl { name, sources, span });
+                }
+                Rule::bind_decl => {
+                    for q in it {
+                        let span = self.span(&q);
+                        let mut parts = q.into_inner();
+                        let role = self.ident(parts.next().expect("role"));
+                        let target = parts.next().expect("target");
+                        let is_path = target.as_rule() == Rule::string;
+                        let target = if is_path { unquote(target.as_str()) } else { target.as_str().to_string() };
+                        pb.binds.push(Bind { role, target, is_path, span });
+                    }
+                }
+                Rule::set_decl => pb.sets.extend(self.assignments(next())?),
+                Rule::run_decl => pb.run.extend(self.assignments(next())?),
+                Rule::quadrature_decl => pb.quadrature.extend(self.assignments(next())?),
+                Rule::coef_def => pb.coefs.push(self.defined(span, next(), it.next())?),
+                Rule::initial_field => pb.initial.push(self.defined(span, next(), it.next())?),
+                Rule::series_decl => pb.series.push((self.defined(span, next(), it.next())?, true)),
+                Rule::observe_decl => pb.series.push((self.defined(span, next(), it.next())?, false)),
+                Rule::summary_decl => pb.summary.push(self.defined(span, next(), it.next())?),
+                Rule::let_decl => pb.lets.push(self.defined(span, next(), it.next())?),
+                Rule::obstacle_decl => {
+                    let shape = self.named_call(next())?;
+                    let region = it.next().map(|q| self.ident(q));
+                    pb.obstacles.push(Obstacle { shape, region, span });
+                }
+                Rule::dirichlet_decl => {
+                    let region = self.ident(next());
+                    let field = self.ident(next());
+                    let value = self.expr(next())?;
+                    pb.dirichlet.push(Dirichlet { region, field, value, span });
+                }
+                Rule::plot_decl => {
+                    let title = unquote(next().as_str());
+                    let columns = next().into_inner().map(|i| self.ident(i)).collect();
+                    pb.plots.push(Plot { title, columns, span });
+                }
+                Rule::reference_decl => {
+                    let name = self.ident(next());
+                    if let Some(prev) = &pb.reference {
+                        let d = Diagnostic::error("E0102", "a problem names one reference", name.span, "second one")
+                            .with_label(prev.span, "first one");
+                        return Err(Box::new(d));
+                    }
+                    pb.reference = Some(name);
+                }
+                r => unreachable!("not a problem item: {r:?}"),
+            }
+        }
+        Ok(pb)
+    }
+
+    /// `name = expr` from its two pairs.
+    fn defined(&self, span: Span, name: Pair<Rule>, value: Option<Pair<Rule>>) -> Result<Defined, Box<Diagnostic>> {
+        let name = self.ident(name);
+        let value = self.expr(value.expect("grammar guarantees the value"))?;
+        Ok(Defined { name, value, span })
+    }
+
+    fn assignments(&self, p: Pair<Rule>) -> Result<Vec<Defined>, Box<Diagnostic>> {
+        p.into_inner()
+            .map(|q| {
+                let span = self.span(&q);
+                let mut it = q.into_inner();
+                let name = it.next().expect("name");
+                self.defined(span, name, it.next())
+            })
+            .collect()
+    }
+
+    fn named_call(&self, p: Pair<Rule>) -> Result<NamedCall, Box<Diagnostic>> {
+        let span = self.span(&p);
+        let mut it = p.into_inner();
+        let name = self.ident(it.next().expect("callee"));
+        let args = it
+            .map(|q| {
+                let mut parts = q.into_inner();
+                let name = self.ident(parts.next().expect("argument name"));
+                Ok(NamedArg { name, value: self.expr(parts.next().expect("argument value"))? })
+            })
+            .collect::<Result<Vec<_>, Box<Diagnostic>>>()?;
+        Ok(NamedCall { name, args, span })
+    }
+
+    fn comparison(&self, p: Pair<Rule>) -> Result<Comparison, Box<Diagnostic>> {
+        let span = self.span(&p);
+        let mut it = p.into_inner();
+        let lhs = self.expr(it.next().expect("lhs"))?;
+        let op = match it.next().expect("comparison").as_str() {
+            "<" => Compare::Less,
+            "<=" => Compare::LessEqual,
+            ">" => Compare::Greater,
+            _ => Compare::GreaterEqual,
+        };
+        let rhs = self.expr(it.next().expect("rhs"))?;
+        Ok(Comparison { lhs, op, rhs, span })
+    }
+
     fn stage_item(&self, stage: &mut Stage, p: Pair<Rule>) -> Result<(), Box<Diagnostic>> {
         let span = self.span(&p);
         let rule = p.as_rule();
@@ -655,6 +849,12 @@ impl Builder {
                 let span = lhs.span.to(rhs.span);
                 Ok(Expr { kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)), span })
             })
+            .map_postfix(|lhs, op| {
+                let lhs = lhs?;
+                let span = lhs.span.to(self.span(&op));
+                let index = self.expr(op.into_inner().next().expect("index expression"))?;
+                Ok(Expr { kind: ExprKind::Index(Box::new(lhs), Box::new(index)), span })
+            })
             .parse(p.into_inner())
     }
 
@@ -675,6 +875,10 @@ impl Builder {
                 let name = self.ident(it.next().expect("callee"));
                 let args = it.map(|a| self.expr(a)).collect::<Result<Vec<_>, _>>()?;
                 Expr { kind: ExprKind::Call(name, args), span }
+            }
+            Rule::vector => {
+                let items = p.into_inner().map(|a| self.expr(a)).collect::<Result<Vec<_>, _>>()?;
+                Expr { kind: ExprKind::Vector(items), span }
             }
             Rule::expr => {
                 // Parenthesised: keep the span of the parentheses' content.

@@ -74,6 +74,12 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                     }
                 }
             }
+            Item::Problem(p) => {
+                let ps: Vec<String> =
+                    p.params.iter().map(|q| format!("{} = {}", q.name.name, expr(&q.default))).collect();
+                out.push_str(&format!("{head}problem {}({})\n", p.name.name, ps.join(", ")));
+                problem(p, &mut out);
+            }
             Item::Form { name, fields, test, integrals, .. } => {
                 let fs: Vec<_> = fields.iter().map(|p| p.name.as_str()).collect();
                 match test {
@@ -102,5 +108,81 @@ pub fn expr(e: &Expr) -> String {
         }
         ExprKind::Neg(a) => format!("(neg {})", expr(a)),
         ExprKind::Binary(op, a, b) => format!("({} {} {})", op.symbol(), expr(a), expr(b)),
+        ExprKind::Vector(items) => {
+            let a: Vec<_> = items.iter().map(expr).collect();
+            format!("[{}]", a.join(", "))
+        }
+        ExprKind::Index(a, i) => format!("(index {} {})", expr(a), expr(i)),
+    }
+}
+
+fn named_call(c: &NamedCall) -> String {
+    let a: Vec<_> = c.args.iter().map(|a| format!("{} = {}", a.name.name, expr(&a.value))).collect();
+    format!("{}({})", c.name.name, a.join(", "))
+}
+
+fn problem(p: &Problem, out: &mut String) {
+    let line = |out: &mut String, what: &str, d: &Defined| {
+        out.push_str(&format!("  {what} {} = {}\n", d.name.name, expr(&d.value)));
+    };
+    for m in &p.mesh {
+        match m {
+            MeshSource::File { path, .. } => out.push_str(&format!("  mesh {path:?}\n")),
+            MeshSource::Generator(c) => out.push_str(&format!("  mesh {}\n", named_call(c))),
+        }
+    }
+    for r in &p.regions {
+        let sources: Vec<String> = r
+            .sources
+            .iter()
+            .map(|s| match s {
+                RegionSource::Group { name, .. } => format!("group {name:?}"),
+                RegionSource::Boundary { conditions, .. } => {
+                    let c: Vec<String> = conditions
+                        .iter()
+                        .map(|c| format!("{} {} {}", expr(&c.lhs), c.op.symbol(), expr(&c.rhs)))
+                        .collect();
+                    if c.is_empty() { "boundary".into() } else { format!("boundary where {}", c.join(" and ")) }
+                }
+            })
+            .collect();
+        out.push_str(&format!("  region {} = {}\n", r.name.name, sources.join(" else ")));
+    }
+    for b in &p.binds {
+        let target = if b.is_path { format!("{:?}", b.target) } else { b.target.clone() };
+        out.push_str(&format!("  bind {} = {target}\n", b.role.name));
+    }
+    let groups: [(&str, &Vec<Defined>); 6] = [
+        ("run", &p.run),
+        ("quadrature", &p.quadrature),
+        ("set", &p.sets),
+        ("let", &p.lets),
+        ("coef", &p.coefs),
+        ("initial", &p.initial),
+    ];
+    for (what, list) in groups {
+        for d in list {
+            line(out, what, d);
+        }
+    }
+    for o in &p.obstacles {
+        let on = o.region.as_ref().map_or(String::new(), |r| format!(" on {}", r.name));
+        out.push_str(&format!("  obstacle {}{on}\n", named_call(&o.shape)));
+    }
+    for d in &p.dirichlet {
+        out.push_str(&format!("  dirichlet {}: {} = {}\n", d.region.name, d.field.name, expr(&d.value)));
+    }
+    for (d, written) in &p.series {
+        line(out, if *written { "series" } else { "observe" }, d);
+    }
+    for d in &p.summary {
+        line(out, "summary", d);
+    }
+    for pl in &p.plots {
+        let c: Vec<&str> = pl.columns.iter().map(|c| c.name.as_str()).collect();
+        out.push_str(&format!("  plot {:?}: {}\n", pl.title, c.join(", ")));
+    }
+    if let Some(r) = &p.reference {
+        out.push_str(&format!("  reference {}\n", r.name));
     }
 }

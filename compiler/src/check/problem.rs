@@ -1,0 +1,301 @@
+//! Checks of a `problem` item that need no mesh and no bound files: its params, one mesh, a
+//! known generator or obstacle helper with its arguments, distinct names, the run and
+//! quadrature settings, and the shape of every expression with the names its place allows
+//! (`x` and `t` in coefs and fields, `n` in region predicates). What depends on the mesh (its
+//! groups, empty regions, the dimension) or on the files bound to the slots (unset coefs,
+//! observables) is checked when the problem is bound (`signorini check` does both).
+
+use std::collections::HashMap;
+
+use super::types::Checker;
+use crate::diagnostic::Diagnostic;
+use crate::source::Span;
+use crate::syntax::ast::{Defined, Expr, Ident, MeshSource, NamedCall, Problem, RegionSource, Shape};
+
+/// A built-in mesh generator or obstacle helper: its name, its dimension (0: any) and its
+/// arguments with their shapes (`true`: optional).
+pub struct Builtin {
+    pub name: &'static str,
+    pub dim: usize,
+    pub args: &'static [(&'static str, Shape, bool)],
+    pub doc: &'static str,
+}
+
+use Shape::{Scalar, Vector};
+
+/// The mesh generators a problem may name.
+pub const GENERATORS: &[Builtin] = &[
+    Builtin {
+        name: "interval",
+        dim: 1,
+        args: &[("length", Scalar, false), ("cells", Scalar, false), ("start", Scalar, true)],
+        doc: "P1 segments of [start, start + length]",
+    },
+    Builtin {
+        name: "rectangle",
+        dim: 2,
+        args: &[
+            ("width", Scalar, false),
+            ("height", Scalar, false),
+            ("nx", Scalar, false),
+            ("ny", Scalar, false),
+            ("degree", Scalar, true),
+        ],
+        doc: "triangles of [0, width] × [0, height], P1 or P2",
+    },
+    Builtin {
+        name: "box",
+        dim: 3,
+        args: &[
+            ("size", Vector, false),
+            ("nx", Scalar, false),
+            ("ny", Scalar, false),
+            ("nz", Scalar, false),
+            ("degree", Scalar, true),
+        ],
+        doc: "tetrahedra of [0, size[0]] × [0, size[1]] × [0, size[2]], P1 or P2",
+    },
+    Builtin {
+        name: "disc",
+        dim: 2,
+        args: &[("radius", Scalar, false), ("centre", Vector, false), ("h", Scalar, false)],
+        doc: "curved P2 triangles of a disc, edge length about h",
+    },
+    Builtin {
+        name: "ball",
+        dim: 3,
+        args: &[("radius", Scalar, false), ("centre", Vector, false), ("h", Scalar, false)],
+        doc: "curved P2 tetrahedra of a ball, edge length about h",
+    },
+];
+
+/// The obstacle helpers: each sets the gap `g` and the obstacle normal `nc` on its region.
+pub const OBSTACLES: &[Builtin] = &[
+    Builtin {
+        name: "plane",
+        dim: 0,
+        args: &[("point", Vector, false), ("normal", Vector, false)],
+        doc: "the half-space below the plane through `point` with unit outward `normal`: g = (x − point)·normal, nc = −normal",
+    },
+    Builtin {
+        name: "sphere",
+        dim: 0,
+        args: &[("centre", Vector, false), ("radius", Scalar, false)],
+        doc: "a rigid disc (2D) or ball (3D), possibly moving with t: g = |x − centre| − radius, nc = (centre − x)/|x − centre|",
+    },
+];
+
+/// Run settings a problem may give defaults for (each overridable from the command line).
+pub const RUN_SETTINGS: &[(&str, &str)] = &[
+    ("dt", "the time step"),
+    ("t_end", "the end time"),
+    ("t_start", "the start time (initial fields are evaluated there)"),
+];
+
+/// Quadrature settings: degrees of the cell and contact-facet rules.
+pub const QUADRATURE_SETTINGS: &[&str] = &["cell", "facet"];
+
+/// Fields whose initial value a problem may give.
+pub const INITIAL_FIELDS: &[&str] = &["u", "v"];
+
+pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
+    let mut names: Vec<(String, Shape)> = p.params.iter().map(|q| (q.name.name.clone(), Scalar)).collect();
+    distinct(p.params.iter().map(|q| &q.name), "parameter", diags);
+    // Params are constants with a default in their range (as a scheme's).
+    for q in &p.params {
+        c.problem_ty(&q.default, &[]);
+    }
+    // Lets in order, each seeing the ones before.
+    distinct(p.lets.iter().map(|d| &d.name), "let", diags);
+    for d in &p.lets {
+        let shape = expression(c, &d.value, &names.clone(), diags, false).unwrap_or(Scalar);
+        names.push((d.name.name.clone(), shape));
+    }
+    let constants = names.clone();
+    match p.mesh.as_slice() {
+        [] => diags.push(
+            Diagnostic::error("E0901", format!("problem `{}` has no mesh", p.name.name), p.name.span, "no `mesh` line")
+                .with_help("add `mesh \"body.msh\"` (a Gmsh file beside the problem) or a generator such as `mesh disc(radius = 10, centre = [0, 12], h = 1)`"),
+        ),
+        [MeshSource::Generator(call)] => builtin_call(c, call, GENERATORS, "mesh generator", &constants, diags),
+        [_] => {}
+        [_, second, ..] => {
+            let span = match second {
+                MeshSource::File { span, .. } => *span,
+                MeshSource::Generator(call) => call.span,
+            };
+            diags.push(Diagnostic::error("E0102", "a problem has one mesh", span, "second `mesh`"));
+        }
+    }
+    distinct(p.regions.iter().map(|r| &r.name), "region", diags);
+    // `x` and `t` are built-in names; `n` too, but it means something only on a facet.
+    let facet = constants.clone();
+    for r in &p.regions {
+        for s in &r.sources {
+            if let RegionSource::Boundary { conditions, .. } = s {
+                for cmp in conditions {
+                    for side in [&cmp.lhs, &cmp.rhs] {
+                        scalar(c, side, &facet, diags, true);
+                    }
+                }
+            }
+        }
+    }
+    settings(&p.run, RUN_SETTINGS.iter().map(|(n, _)| *n), "run setting", c, &constants, diags);
+    settings(&p.quadrature, QUADRATURE_SETTINGS.iter().copied(), "quadrature setting", c, &constants, diags);
+    let fields = &constants;
+    distinct(p.coefs.iter().map(|d| &d.name), "coef", diags);
+    for d in &p.coefs {
+        expression(c, &d.value, fields, diags, false);
+    }
+    distinct(p.initial.iter().map(|d| &d.name), "initial field", diags);
+    for d in &p.initial {
+        if !INITIAL_FIELDS.contains(&d.name.name.as_str()) {
+            diags.push(unknown_among(&d.name, INITIAL_FIELDS.iter().copied(), "initial field"));
+        }
+        vector(c, &d.value, fields, diags);
+    }
+    for d in &p.dirichlet {
+        if d.field.name != "u" {
+            diags.push(unknown_among(&d.field, ["u"].into_iter(), "Dirichlet field"));
+        }
+        vector(c, &d.value, fields, diags);
+    }
+    for o in &p.obstacles {
+        builtin_call(c, &o.shape, OBSTACLES, "obstacle", fields, diags);
+    }
+    let mut columns: HashMap<&str, Span> = HashMap::new();
+    for d in p.series.iter().map(|(d, _)| d).chain(&p.summary) {
+        if let Some(prev) = columns.insert(&d.name.name, d.name.span) {
+            diags.push(
+                Diagnostic::error("E0102", format!("`{}` is measured twice", d.name.name), d.name.span, "again here")
+                    .with_label(prev, "first here"),
+            );
+        }
+    }
+    for pl in &p.plots {
+        for col in &pl.columns {
+            if !p.series.iter().any(|(d, _)| d.name.name == col.name) {
+                diags.push(unknown_among(col, p.series.iter().map(|(d, _)| d.name.name.as_str()), "series column"));
+            }
+        }
+    }
+}
+
+fn settings<'a>(
+    list: &[Defined],
+    known: impl Iterator<Item = &'a str> + Clone,
+    what: &str,
+    c: &mut Checker,
+    names: &[(String, Shape)],
+    diags: &mut Vec<Diagnostic>,
+) {
+    distinct(list.iter().map(|d| &d.name), what, diags);
+    for d in list {
+        if !known.clone().any(|k| k == d.name.name) {
+            diags.push(unknown_among(&d.name, known.clone(), what));
+        }
+        scalar(c, &d.value, names, diags, false);
+    }
+}
+
+fn builtin_call(
+    c: &mut Checker,
+    call: &NamedCall,
+    catalogue: &[Builtin],
+    what: &str,
+    names: &[(String, Shape)],
+    diags: &mut Vec<Diagnostic>,
+) {
+    let Some(b) = catalogue.iter().find(|b| b.name == call.name.name) else {
+        diags.push(unknown_among(&call.name, catalogue.iter().map(|b| b.name), what));
+        return;
+    };
+    distinct(call.args.iter().map(|a| &a.name), "argument", diags);
+    for a in &call.args {
+        match b.args.iter().find(|(n, _, _)| *n == a.name.name) {
+            Some((_, Scalar, _)) => scalar(c, &a.value, names, diags, false),
+            Some(_) => vector(c, &a.value, names, diags),
+            None => diags.push(unknown_among(
+                &a.name,
+                b.args.iter().map(|(n, _, _)| *n),
+                &format!("argument of `{}`", b.name),
+            )),
+        }
+    }
+    for (n, _, optional) in b.args {
+        if !optional && !call.args.iter().any(|a| a.name.name == *n) {
+            diags.push(
+                Diagnostic::error("E0201", format!("`{}` needs `{n}`", b.name), call.span, format!("no `{n} = ...`"))
+                    .with_note(format!("{}: {}", b.name, b.doc)),
+            );
+        }
+    }
+}
+
+fn expression(
+    c: &mut Checker,
+    e: &Expr,
+    names: &[(String, Shape)],
+    diags: &mut Vec<Diagnostic>,
+    facet: bool,
+) -> Option<Shape> {
+    let ty = c.problem_ty(e, names)?;
+    if !facet && let Some(at) = ty.facet {
+        diags.push(Diagnostic::error("E0501", "`n` or `h` outside a region predicate", at, "no facet here").with_help(
+            "a problem's coefs and fields are functions of `x` and `t`; the normal is known in `boundary where ...`",
+        ));
+    }
+    Some(ty.shape)
+}
+
+fn scalar(c: &mut Checker, e: &Expr, names: &[(String, Shape)], diags: &mut Vec<Diagnostic>, facet: bool) {
+    if let Some(s) = expression(c, e, names, diags, facet)
+        && s != Scalar
+    {
+        diags.push(Diagnostic::error(
+            "E0301",
+            "shape mismatch",
+            e.span,
+            format!("a scalar is needed here, not a {}", s.name()),
+        ));
+    }
+}
+
+fn vector(c: &mut Checker, e: &Expr, names: &[(String, Shape)], diags: &mut Vec<Diagnostic>) {
+    if let Some(s) = expression(c, e, names, diags, false)
+        && s != Vector
+    {
+        diags.push(Diagnostic::error(
+            "E0301",
+            "shape mismatch",
+            e.span,
+            format!("a vector is needed here, not a {}", s.name()),
+        ));
+    }
+}
+
+fn distinct<'a>(names: impl Iterator<Item = &'a Ident>, what: &str, diags: &mut Vec<Diagnostic>) {
+    let mut seen: HashMap<&str, Span> = HashMap::new();
+    for n in names {
+        if let Some(prev) = seen.insert(&n.name, n.span) {
+            diags.push(
+                Diagnostic::error("E0103", format!("duplicate {what} `{}`", n.name), n.span, "repeated here")
+                    .with_label(prev, "first here"),
+            );
+        }
+    }
+}
+
+/// E0101 for `id`, which is none of `known`, with the closest and the list.
+pub fn unknown_among<'a>(id: &Ident, known: impl Iterator<Item = &'a str> + Clone, what: &str) -> Diagnostic {
+    let mut d = Diagnostic::error("E0101", format!("unknown {what} `{}`", id.name), id.span, "not one of them");
+    if let Some(s) = super::suggest_name(&id.name, known.clone()) {
+        d = d.with_help(format!("did you mean `{s}`?"));
+    }
+    let list: Vec<&str> = known.collect();
+    if list.is_empty() {
+        return d.with_note(format!("there is no {what}"));
+    }
+    d.with_note(format!("the {what}s: {}", list.join(", ")))
+}
