@@ -9,11 +9,7 @@ use signorini_runtime::mesh::{Mesh, MeshError, gmsh};
 /// A reference mesh of `assets/meshes`.
 fn shared(name: &str) -> Option<PathBuf> {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/meshes").join(name);
-    assert!(
-        p.exists(),
-        "{} is missing: the reference meshes live in assets/meshes",
-        p.display()
-    );
+    assert!(p.exists(), "{} is missing: the reference meshes live in assets/meshes", p.display());
     Some(p)
 }
 
