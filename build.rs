@@ -65,6 +65,16 @@ fn main() {
         "/// The text of every scheme file of `forms/schemes/`, by file stem: `verify --scheme` reads\n/// the claims (`claim order = 2`) from it.\npub static SCHEME_SOURCES: &[(&str, &str)] = &[{}];",
         scheme_texts.join(", ")
     );
+    let problems = wf_files(Path::new("forms/problems"));
+    let problem_texts: Vec<String> = problems
+        .iter()
+        .map(|s| format!("(\"{s}\", include_str!(concat!(env!(\"CARGO_MANIFEST_DIR\"), \"/forms/problems/{s}.wf\")))"))
+        .collect();
+    let _ = writeln!(
+        out,
+        "/// The text of every problem file of `forms/problems/`, by file stem: `run NAME` compiles it at\n/// run time (a problem's expressions are evaluated at points, not generated).\npub static PROBLEM_SOURCES: &[(&str, &str)] = &[{}];",
+        problem_texts.join(", ")
+    );
     let path = Path::new(&std::env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("library.rs");
     std::fs::write(&path, out).expect("OUT_DIR is writable");
 }

@@ -228,7 +228,7 @@ pub fn mesh_fingerprint(mesh: &Mesh) -> String {
 }
 
 /// FNV-1a: stable across builds and platforms, unlike std's hasher.
-fn fnv(bytes: &[u8]) -> u64 {
+pub fn fnv(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
 }
 

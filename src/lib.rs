@@ -20,6 +20,7 @@ pub mod interpret;
 pub mod interrupt;
 pub mod output;
 pub mod plot;
+pub mod problem;
 pub mod progress;
 pub mod report;
 pub mod resources;

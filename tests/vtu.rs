@@ -9,7 +9,8 @@ fn snapshots_read_back_with_vtkio() {
     let out = std::env::temp_dir().join(format!("signorini-vtu-{}", std::process::id()));
     let opts = Options { h: 2.0, t_end: 1.0, vtu_every: 25, out: Some(out.clone()), ..Options::default() };
     let run = disc::run(&opts).unwrap();
-    let mesh = disc::mesh(&opts).unwrap();
+    // The problem's mesh at h = 2: the built-in curved disc of radius 10 about (0, 12).
+    let mesh = signorini::runtime::mesh::disc::disc(10.0, [0.0, 12.0], 2.0);
     // The collection: one entry per snapshot, with the physical times.
     let pvd = std::fs::read_to_string(out.join("disc.pvd")).unwrap();
     let times: Vec<f64> =

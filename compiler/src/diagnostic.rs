@@ -66,7 +66,12 @@ pub const CODES: &[(&str, &str)] = &[
     ("W0001", "unused parameter (warning)"),
     ("W0002", "a scheme `let` hides another name (warning)"),
     ("W0003", "a `fn` or `form` argument hides a name of the file (warning)"),
+    ("W0004", "problem: a coef set that no file in use reads (warning)"),
 ];
+
+/// Codes reported when a problem is bound to the files of a run (the facade's bad-input corpus
+/// exercises them; the compiler's own corpus cannot, as the files in use are not known there).
+pub const BINDING_CODES: &[&str] = &["W0004"];
 
 /// The meaning of a diagnostic code, from [`CODES`].
 pub fn describe(code: &str) -> Option<&'static str> {

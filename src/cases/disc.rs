@@ -1,30 +1,21 @@
-//! `signorini run disc` and `run sphere`: an elastic body bouncing on a rigid plane
-//! (docs/mathematics.md §6). The disc of radius 10 centred at (0, 12) falls from rest under
-//! f = (0, −0.1) onto {y = 0}: plane strain with λ = μ = 20 (E = 50, ν = 1/4), ρ = 1, curved P2
-//! triangles, no Dirichlet condition. The sphere is the same in 3D: the ball of radius 10
-//! centred at (0, 0, 12), f = (0, 0, −0.1), the plane {z = 0}, curved P2 tetrahedra. The
-//! series' vertical columns (the fields `uy_*`, `vy_mean`, `fy_contact` of [`Row`], which
-//! hold the vertical component in both) are named after the axis (`uy_mean`, `fy_contact` for the disc;
-//! `uz_mean`, `fz_contact` for the sphere).
+//! The bouncing disc and sphere as the report, `verify` and the benchmarks read them: the
+//! problems themselves are data (`forms/problems/disc.wf`, `sphere.wf`, run by the one driver,
+//! [`crate::problem::run`]); this module gives their rows and summary typed fields. The series'
+//! vertical columns (the fields `uy_*`, `vy_mean`, `fy_contact` of [`Row`], which hold the
+//! vertical component in both) are named after the axis in the files (`uy_mean`, `fy_contact`
+//! for the disc; `uz_mean`, `fz_contact` for the sphere).
 
-use std::cell::RefCell;
 use std::path::PathBuf;
-use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
 use super::CaseError;
 use super::bar::MassChoice;
-use crate::checkpoint::{Control, Identity};
-use crate::driver::{Active, ParamValue, Setup};
-use crate::runtime::assembly::{Assembler, Quadrature};
-use crate::runtime::evaluate::facet_samples;
-use crate::runtime::mesh::{CellSize, Mesh, ball::ball, disc::disc};
+use crate::driver::{ParamValue, Setup};
+use crate::runtime::mesh::CellSize;
 use crate::runtime::newton::NewtonOptions;
-use crate::runtime::problem::Constraints;
-use crate::simulation::{Problem, Simulation, Snapshots, Tools};
 
-/// Gravity of the benchmark.
+/// Gravity of the benchmark (the free fall before the first contact is exact: u = −g t²/2).
 pub const GRAVITY: f64 = 0.1;
 /// The body: the 2D disc or the 3D sphere.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -42,21 +33,6 @@ impl Body {
         }
     }
 
-    pub fn dim(self) -> usize {
-        match self {
-            Body::Disc => 2,
-            Body::Sphere => 3,
-        }
-    }
-
-    /// What the built-in mesh is called.
-    pub fn mesh_name(self) -> &'static str {
-        match self {
-            Body::Disc => "disc",
-            Body::Sphere => "ball",
-        }
-    }
-
     /// The vertical axis's letter, for column names.
     pub fn axis(self) -> char {
         match self {
@@ -64,19 +40,7 @@ impl Body {
             Body::Sphere => 'z',
         }
     }
-
-    /// Cell and contact-facet quadrature degrees. Disc: the 12-point triangle rule and 4 Gauss
-    /// points per edge (GetFEM's IM_TRIANGLE(6)). Sphere: degree 4 in the cells (the P2 mass on
-    /// straight cells), 5 on the contact faces.
-    fn quadrature(self) -> Quadrature {
-        match self {
-            Body::Disc => Quadrature { cell: Some(6), facet: Some(7) },
-            Body::Sphere => Quadrature { cell: Some(4), facet: Some(5) },
-        }
-    }
 }
-/// The disc's material (λ = μ = 20) and its Nitsche/penalty parameter, over the files' defaults.
-pub const OVERRIDES: &[(&str, f64)] = &[("E", 50.0), ("nu", 0.25), ("rho", 1.0), ("gamma0", 1000.0)];
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
@@ -226,364 +190,128 @@ pub struct Run {
 #[derive(Clone, Debug)]
 pub struct StageRow {
     /// The stage's name in the scheme's file.
-    pub stage: &'static str,
+    pub stage: String,
     pub row: Row,
 }
 
-/// The mesh: read or generated, validated, with its `contact` region (the Gmsh group of that
-/// name, else the facets whose outward normal points down).
-pub fn mesh(opts: &Options) -> Result<Mesh, CaseError> {
-    let d = opts.body.dim();
-    let mut mesh = match &opts.mesh {
-        Some(path) => super::read_mesh(path)?,
-        None => {
-            // The sphere's P2 dofs grow like (20/h)³: h = 0.3 is about 3 million.
-            let smallest = if d == 2 { 0.05 } else { 0.3 };
-            if !(opts.h >= smallest && opts.h <= 10.0) {
-                return Err(CaseError::Option(format!("--h must be in [{smallest}, 10], not {}", opts.h)));
-            }
-            // P2 nodes: the disc's rings (3m² vertices), the ball's (2n+1)³ lattice.
-            let dofs = match opts.body {
-                Body::Disc => 2.0 * 4.0 * 3.0 * (10.0 / opts.h).ceil().powi(2),
-                Body::Sphere => 3.0 * (4.0 * (10.0 / opts.h).round() + 1.0).powi(3),
-            };
-            crate::resources::check(opts.body.name(), dofs, d, Some(opts.h))?;
-            match opts.body {
-                Body::Disc => disc(10.0, [0.0, 12.0], opts.h),
-                Body::Sphere => ball(10.0, [0.0, 0.0, 12.0], opts.h),
-            }
-        }
-    };
-    if opts.mesh.is_some() {
-        crate::resources::check(opts.body.name(), (mesh.num_nodes() * mesh.dim()) as f64, mesh.dim(), None)?;
-    }
-    if mesh.dim() != d {
-        return Err(CaseError::Option(format!("the {} case needs a {d}D mesh, not {}D", opts.body.name(), mesh.dim())));
-    }
-    if !mesh.has_region("contact") {
-        mesh.add_region_where("contact", |n, _| n[d - 1] < 0.0);
-    }
-    mesh.set_cell_size(opts.cell_size);
-    mesh.validate()?;
-    Ok(mesh)
-}
-
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    let positive = |x: f64| x > 0.0 && x.is_finite();
-    if !positive(opts.dt) || !positive(opts.t_end) || opts.t_end / opts.dt > 1e7 {
-        return Err(CaseError::Option("--dt and --t-end must be positive, with at most 10⁷ steps".into()));
-    }
-    if !(opts.t_start >= 0.0 && opts.t_start < opts.t_end) {
-        return Err(CaseError::Option(format!("--t-start must be in [0, t_end), not {}", opts.t_start)));
-    }
-    let active = Active::resolve(&opts.setup, OVERRIDES)?;
-    simulate(opts, &active)
-}
-
-fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
-    let start = Instant::now();
-    let mesh = mesh(opts)?;
-    let asm = Assembler::new(&mesh);
-    let n = asm.size();
-    let (d, vert) = (opts.body.dim(), opts.body.dim() - 1);
-    let quadrature = opts.body.quadrature();
-    let coefs = super::above_plane(d, 0.0, GRAVITY);
-    let problem = Problem {
-        coefs: &coefs,
-        quadrature,
-        contact: "contact",
-        constraints: Constraints::none(n),
-        mass: opts.mass,
-        newton: opts.newton,
-    };
-    let mut control =
-        Control::new(opts.checkpoint_every, opts.out.clone(), identity(opts, active, &mesh), opts.resume)?;
-    let mut sim = Simulation::new(&asm, problem, active)?;
-    if sim.tools.probe.is_none() {
-        return Err(CaseError::Option(
-            "the disc measures `contact`, which the form files in use do not provide".into(),
-        ));
-    }
-    // At rest at t = 0, or in exact free fall at t_start.
-    let t0 = opts.t_start;
-    let fall = |size: f64| (0..n).map(|i| if i % d == d - 1 && size != 0.0 { size } else { 0.0 }).collect::<Vec<f64>>();
-    sim.initialize_at(t0, fall(-0.5 * GRAVITY * t0 * t0), fall(-GRAVITY * t0))?;
-    let vertical_mean = sim.tools.axis_mean(vert);
-    let lowest =
-        (0..mesh.num_nodes()).min_by(|&a, &b| mesh.node(a)[vert].total_cmp(&mesh.node(b)[vert])).expect("nodes");
-    let measure = |tools: &Tools, u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| -> Row {
-        let kinetic = tools.kinetic(v);
-        let energy = tools.energy_with_kinetic(u, kinetic);
-        let switches = tools.contact_switches(u, t);
-        let samples = facet_samples(&mesh, tools.contact_facets, quadrature.facet.unwrap_or(7), u);
-        // The gap u_N − g at each point: −u_d − x_d.
-        let gaps: Vec<f64> = samples.iter().map(|s| -s.value[vert] - s.x[vert]).collect();
-        let penetration = gaps.iter().fold(0.0f64, |m, g| m.max(*g));
-        Row {
-            t,
-            energy,
-            kinetic,
-            energy_aug: energy + tools.value(&tools.contact_energy, u),
-            // Area-weighted mean of u_y: e_yᵀ M u / e_yᵀ M e_y.
-            uy_mean: vertical_mean.of(u),
-            uy_mean_nodal: u.iter().skip(vert).step_by(d).sum::<f64>() / (n / d) as f64,
-            vy_mean: v.map_or(f64::NAN, |v| vertical_mean.of(v)),
-            uy_lowest: u[d * lowest + vert],
-            // Where the body touches or penetrates the plane: the gap closed.
-            contact_area: samples.iter().zip(&gaps).filter(|(_, g)| **g >= 0.0).map(|(s, _)| s.weight).sum(),
-            fy_contact: tools.contact_force(u, t)[vert],
-            active_points: switches.iter().filter(|b| **b).count(),
-            switches,
-            penetration,
-            newton,
-        }
-    };
-    let mut series = vec![measure(&sim.tools, &sim.states[0], sim.velocity(), 0, t0)];
-    let steps = ((opts.t_end - t0) / opts.dt).round() as usize;
-    let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, opts.body.name());
-    // A scheme without a velocity state: the step's mean velocity.
-    let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64], dt: f64| -> Vec<f64> {
-        match v_index {
-            Some(i) => states[i].clone(),
-            None => states[0].iter().zip(before).map(|(a, b)| (a - b) / dt).collect(),
-        }
-    };
-    let v_index = sim.v_index;
-    // Multi-stage schemes: the state at each intermediate stage's time (stages.csv).
-    let stage_rows: RefCell<Vec<StageRow>> = RefCell::new(Vec::new());
-    // What the checkpoints so far hold (each records what is new since the one before).
-    let (mut saved_rows, mut saved_stages, mut saved_snapshots) = (0, 0, 0);
-    match control.observer() {
-        Some(records) => {
-            let stages = sim.stepper.desc().stages;
-            series.clear();
-            for bytes in records {
-                let record: Record = postcard::from_bytes(bytes)
-                    .map_err(|e| CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})")))?;
-                series.extend(record.series.into_iter().map(Saved::into_row));
-                for (name, row) in record.stages {
-                    let stage = stages.iter().find(|s| s.name == name).ok_or_else(|| {
-                        CaseError::Option(format!("the checkpoint has a stage `{name}`, which this scheme has not"))
-                    })?;
-                    stage_rows.borrow_mut().push(StageRow { stage: stage.name, row: row.into_row() });
-                }
-                snapshots.extend_written(record.snapshots);
-            }
-            (saved_rows, saved_stages, saved_snapshots) =
-                (series.len(), stage_rows.borrow().len(), snapshots.written().len());
-        }
-        None => snapshots.write(
-            &sim.tools,
-            0,
-            t0,
-            &sim.states[0],
-            &velocity(&sim.states, v_index, &sim.states[0], opts.dt),
-        )?,
-    }
-    let names = sim.stepper.desc().states;
-    let outcome = sim.run(
-        t0,
-        opts.dt,
-        steps,
-        opts.progress,
-        &mut control,
-        &mut |tools, stage, v_index| {
-            if let Some(u) = stage.value_of(names[0]) {
-                let v = v_index.and_then(|i| stage.value_of(names[i]));
-                stage_rows.borrow_mut().push(StageRow { stage: stage.name, row: measure(tools, u, v, 0, stage.time) });
-            }
-        },
-        &mut |tools, step, record| {
-            let v = v_index.map(|i| step.states[i].as_slice());
-            series.push(measure(tools, &step.states[0], v, step.report.iterations(), step.t));
-            snapshots.write(
-                tools,
-                step.k,
-                step.t,
-                &step.states[0],
-                &velocity(step.states, v_index, step.before, step.dt),
-            )?;
-            if let Some(record) = record {
-                let stages = stage_rows.borrow();
-                *record = postcard::to_stdvec(&Record {
-                    series: series[saved_rows..].iter().map(Saved::of).collect(),
-                    stages: stages[saved_stages..].iter().map(|s| (s.stage.to_string(), Saved::of(&s.row))).collect(),
-                    snapshots: snapshots.written()[saved_snapshots..].to_vec(),
-                })
-                .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
-                (saved_rows, saved_stages, saved_snapshots) = (series.len(), stages.len(), snapshots.written().len());
-            }
-            Ok(())
-        },
-    )?;
-    let stage_rows = stage_rows.into_inner();
-    snapshots.finish()?;
-    let wall = start.elapsed().as_secs_f64();
-    let last = series.last().expect("initial row");
-    let summary = Summary {
-        case: opts.body.name(),
-        scheme: active.scheme_name().to_string(),
-        contact: active.forms.contact_name().to_string(),
-        interpreted: active.interpreted(),
-        params: active.forms.params.values(),
+    let mut setup = opts.setup.clone();
+    // The problem's mesh-size param, as the user's setting (before theirs: theirs wins).
+    setup.params.insert(0, crate::driver::Setting { name: "h".into(), value: opts.h, origin: "--h".into() });
+    let problem = crate::problem::run::Options {
+        problem: opts.body.name().to_string(),
+        setup,
         mass: opts.mass,
         cell_size: opts.cell_size,
-        mesh: opts
-            .mesh
-            .as_ref()
-            .map_or_else(|| format!("built-in {}, h = {}", opts.body.mesh_name(), opts.h), |p| p.display().to_string()),
-        cells: mesh.num_cells(),
-        dofs: n,
-        dt: opts.dt,
-        steps,
-        first_contact: series.iter().find(|r| r.active_points > 0).map(|r| r.t),
-        max_penetration: series.iter().map(|r| r.penetration).fold(0.0, f64::max),
-        min_uy_mean: series.iter().map(|r| r.uy_mean).fold(f64::INFINITY, f64::min),
-        energy_aug_initial: series[0].energy_aug,
-        energy_aug_final: last.energy_aug,
-        kinetic_energy_max: series.iter().map(|r| r.kinetic).fold(0.0, f64::max),
-        newton_total: series.iter().map(|r| r.newton).sum(),
-        newton_max: series.iter().map(|r| r.newton).max().unwrap_or(0),
-        wall_seconds: wall,
-        seconds_per_step: wall / steps.max(1) as f64,
-        stepping_seconds: outcome.step_seconds.iter().sum(),
-        step_median_seconds: crate::bench::median(outcome.step_seconds),
-        factorizations: sim.stepper.counters().numeric,
-        low_rank_updates: sim.stepper.counters().updates,
-        matrix_nnz: sim.tools.asm.pattern().nnz(),
-        factor_nnz: sim.stepper.factor_nnz(),
+        mesh: opts.mesh.clone(),
+        dt: Some(opts.dt),
+        t_start: Some(opts.t_start),
+        t_end: Some(opts.t_end),
+        newton: opts.newton,
+        out: opts.out.clone(),
+        vtu_every: opts.vtu_every,
+        progress: opts.progress,
+        checkpoint_every: opts.checkpoint_every,
+        resume: opts.resume,
+    };
+    let run = crate::problem::run::run(&problem)?;
+    from_problem(opts, &run)
+}
+
+/// The problem file's run as the disc's rows and summary (its columns by name).
+fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, CaseError> {
+    let a = opts.body.axis();
+    let names = [
+        "energy".to_string(),
+        "kinetic".to_string(),
+        "energy_aug".to_string(),
+        format!("u{a}_mean"),
+        format!("u{a}_mean_nodal"),
+        format!("v{a}_mean"),
+        format!("u{a}_lowest"),
+        format!("f{a}_contact"),
+        "contact_area".to_string(),
+        "active_points".to_string(),
+        "penetration".to_string(),
+        "newton".to_string(),
+    ];
+    let index: Vec<usize> = names
+        .iter()
+        .map(|n| {
+            run.columns
+                .iter()
+                .position(|c| c == n)
+                .ok_or_else(|| CaseError::Option(format!("the {} problem file has no column `{n}`", opts.body.name())))
+        })
+        .collect::<Result<_, _>>()?;
+    let row = |t: f64, v: &[f64], switches: Vec<bool>| Row {
+        t,
+        energy: v[index[0]],
+        kinetic: v[index[1]],
+        energy_aug: v[index[2]],
+        uy_mean: v[index[3]],
+        uy_mean_nodal: v[index[4]],
+        vy_mean: v[index[5]],
+        uy_lowest: v[index[6]],
+        fy_contact: v[index[7]],
+        contact_area: v[index[8]],
+        active_points: v[index[9]] as usize,
+        switches,
+        penetration: v[index[10]],
+        newton: v[index[11]] as usize,
+    };
+    let series: Vec<Row> = run.rows.iter().zip(&run.switches).map(|((t, v), s)| row(*t, v, s.clone())).collect();
+    let stages =
+        run.stages.iter().map(|(name, t, v)| StageRow { stage: name.clone(), row: row(*t, v, Vec::new()) }).collect();
+    let s = &run.summary;
+    let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
+    let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
+    let mut params: std::collections::BTreeMap<String, ParamValue> = field(s, "params")?;
+    params.retain(|k, _| !k.starts_with(&format!("{}.", opts.body.name())));
+    let summary = Summary {
+        case: opts.body.name(),
+        scheme: field(s, "scheme")?,
+        contact: field(s, "contact")?,
+        interpreted: field(s, "interpreted")?,
+        params,
+        mass: opts.mass,
+        cell_size: opts.cell_size,
+        mesh: field(s, "mesh")?,
+        cells: count("cells"),
+        dofs: count("dofs"),
+        dt: number("dt"),
+        steps: count("steps"),
+        first_contact: s.number("first_contact"),
+        max_penetration: number("max_penetration"),
+        min_uy_mean: number("min_uy_mean"),
+        energy_aug_initial: number("energy_aug_initial"),
+        energy_aug_final: number("energy_aug_final"),
+        kinetic_energy_max: number("kinetic_energy_max"),
+        newton_total: count("newton_total"),
+        newton_max: count("newton_max"),
+        wall_seconds: number("wall_seconds"),
+        seconds_per_step: number("seconds_per_step"),
+        stepping_seconds: number("stepping_seconds"),
+        step_median_seconds: number("step_median_seconds"),
+        factorizations: count("factorizations"),
+        low_rank_updates: count("low_rank_updates"),
+        matrix_nnz: count("matrix_nnz"),
+        factor_nnz: s.get("factor_nnz").and_then(|v| v.as_u64()).map(|v| v as usize),
         solver: opts.newton.solver,
-        krylov_iterations: sim.stepper.counters().iterations,
-        peak_memory_bytes: crate::bench::peak_memory(),
-        step_cuts: outcome.cuts,
-        stopped: outcome.stopped.as_ref().map(ToString::to_string),
-        resumed: outcome.resumed,
+        krylov_iterations: count("krylov_iterations"),
+        peak_memory_bytes: s.get("peak_memory_bytes").and_then(|v| v.as_u64()),
+        step_cuts: count("step_cuts"),
+        stopped: s.get("stopped").and_then(|v| v.as_str()).map(str::to_string),
+        resumed: match s.get("resumed") {
+            Some(v) => Some(serde_json::from_value(v.clone()).map_err(|e| CaseError::Option(e.to_string()))?),
+            None => None,
+        },
     };
-    if let Some(dir) = &opts.out {
-        write_outputs(dir, opts.body, &summary, &series, &stage_rows)?;
-    }
-    if let Some(e) = outcome.stopped {
-        return Err(e);
-    }
-    Ok(Run { summary, series, stages: stage_rows })
+    Ok(Run { summary, series, stages })
 }
 
-/// The disc's record in a checkpoint: what is new since the checkpoint before.
-#[derive(Serialize, Deserialize)]
-struct Record {
-    series: Vec<Saved>,
-    stages: Vec<(String, Saved)>,
-    snapshots: Vec<(f64, String)>,
-}
-
-/// A row with its switches (which series.csv leaves out).
-#[derive(Serialize, Deserialize)]
-struct Saved(Row, Vec<bool>);
-
-impl Saved {
-    fn of(row: &Row) -> Saved {
-        Saved(row.clone(), row.switches.clone())
-    }
-
-    fn into_row(self) -> Row {
-        Row { switches: self.1, ..self.0 }
-    }
-}
-
-/// What a resumed run must share with its checkpoint.
-fn identity(opts: &Options, active: &Active, mesh: &Mesh) -> Identity {
-    crate::checkpoint::identity(
-        opts.body.name(),
-        active,
-        mesh,
-        &[
-            ("mass", format!("{:?}", opts.mass)),
-            ("cell size", format!("{:?}", opts.cell_size)),
-            ("dt", format!("{:?}", opts.dt)),
-            ("t_start", format!("{:?}", opts.t_start)),
-            ("t_end", format!("{:?}", opts.t_end)),
-            ("Newton options", format!("{:?}", opts.newton)),
-            ("checkpoint period", opts.checkpoint_every.to_string()),
-        ],
-    )
-}
-
-fn write_outputs(
-    dir: &std::path::Path,
-    body: Body,
-    summary: &Summary,
-    series: &[Row],
-    stages: &[StageRow],
-) -> Result<(), CaseError> {
-    let a = body.axis();
-    let header = format!(
-        "t,energy,energy_aug,u{a}_mean,u{a}_mean_nodal,v{a}_mean,u{a}_lowest,f{a}_contact,contact_area,active_points,penetration,newton"
-    );
-    let line = |r: &Row| {
-        format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            r.t,
-            r.energy,
-            r.energy_aug,
-            r.uy_mean,
-            r.uy_mean_nodal,
-            r.vy_mean,
-            r.uy_lowest,
-            r.fy_contact,
-            r.contact_area,
-            r.active_points,
-            r.penetration,
-            r.newton
-        )
-    };
-    let mut csv = format!("{header}\n");
-    series.iter().for_each(|r| csv.push_str(&line(r)));
-    let err = |path: std::path::PathBuf| move |source| CaseError::Write { path: path.display().to_string(), source };
-    crate::output::write_atomic(&dir.join("series.csv"), csv.as_bytes()).map_err(err(dir.join("series.csv")))?;
-    crate::output::write_json(&dir.join("summary.json"), summary).map_err(err(dir.join("summary.json")))?;
-    if !stages.is_empty() {
-        // The series' columns, after the stage's name (Newton: 0, counted per step).
-        let mut csv = format!("stage,{header}\n");
-        for StageRow { stage, row } in stages {
-            csv.push_str(&format!("{stage},{}", line(row)));
-        }
-        crate::output::write_atomic(&dir.join("stages.csv"), csv.as_bytes()).map_err(err(dir.join("stages.csv")))?;
-    }
-    use crate::plot::Curve;
-    let pts = |f: &dyn Fn(&Row) -> f64| series.iter().map(|r| (r.t, f(r))).collect::<Vec<_>>();
-    let plot_err = |e: String| CaseError::Write { path: dir.display().to_string(), source: std::io::Error::other(e) };
-    let aug = "E + contact energy";
-    crate::plot::panels(
-        &dir.join(format!("{}.png", body.name())),
-        "t",
-        &[
-            (
-                "energies",
-                "energy",
-                vec![
-                    Curve { label: "E", points: pts(&|r| r.energy), dashed: false },
-                    Curve { label: aug, points: pts(&|r| r.energy_aug), dashed: false },
-                ],
-            ),
-            (
-                "vertical displacement",
-                &format!("u_{a}"),
-                vec![
-                    Curve { label: "mean", points: pts(&|r| r.uy_mean), dashed: false },
-                    Curve { label: "lowest point", points: pts(&|r| r.uy_lowest), dashed: false },
-                ],
-            ),
-            (
-                "contact force",
-                &format!("F_{a}"),
-                vec![Curve { label: "vertical", points: pts(&|r| r.fy_contact), dashed: false }],
-            ),
-            (
-                "Newton iterations",
-                "iterations",
-                vec![Curve { label: "per step", points: pts(&|r| r.newton as f64), dashed: false }],
-            ),
-        ],
-    )
-    .map_err(plot_err)
+/// A key of the summary, as its type.
+fn field<T: serde::de::DeserializeOwned>(s: &crate::problem::run::Summary, k: &str) -> Result<T, CaseError> {
+    let v = s.get(k).cloned().unwrap_or(serde_json::Value::Null);
+    serde_json::from_value(v).map_err(|e| CaseError::Option(format!("the summary's `{k}`: {e}")))
 }

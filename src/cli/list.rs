@@ -39,8 +39,36 @@ pub fn text() -> String {
         let _ = writeln!(out, "  {:<16} {}", u.name, first_sentence(u.doc));
         print_forms(&mut out, u, false);
     }
+    out.push_str("\nProblems (signorini run NAME, or a problem .wf file):\n");
+    problems(&mut out);
     out.push_str("\nSet a param with --param NAME=VALUE (OWNER.NAME when two files declare NAME).\n");
     out
+}
+
+/// The library's problems, with their params and the run's defaults, from their files.
+fn problems(out: &mut String) {
+    use crate::compiler::docs::{declaration, file, location, written};
+    for name in crate::problem::library_names() {
+        let pf = match crate::problem::load(name) {
+            Ok(pf) => pf,
+            Err(e) => {
+                let _ = writeln!(out, "  {name:<16} (does not check: {e})");
+                continue;
+            }
+        };
+        let sources = &pf.program.unit.sources;
+        let text = sources.text(pf.problem().span.file);
+        let _ = writeln!(out, "  {:<16} {}", pf.name(), first_sentence(&file(text)));
+        let run: Vec<String> =
+            pf.problem().run.iter().map(|d| format!("{} = {}", d.name.name, sources.slice(d.value.span))).collect();
+        let _ = writeln!(out, "    run {}   ({})", run.join(", "), pf.file);
+        for q in &pf.problem().params {
+            let doc = declaration(sources, q.span);
+            let doc = if doc.is_empty() { String::new() } else { format!("  {}", first_sentence(&doc)) };
+            let at = location(sources, q.span);
+            let _ = writeln!(out, "    {:<8} = {:<22} {:<22}{doc}", q.name.name, written(sources, q.span), at);
+        }
+    }
 }
 
 fn print_forms(out: &mut String, u: &Unit, own_params_only: bool) {

@@ -10,7 +10,6 @@ mod hertz;
 mod list;
 
 use crate::cases::bar::{self, MassChoice};
-use crate::cases::disc::Body;
 use crate::cases::static_block;
 use crate::compiler;
 use crate::driver::{Setting, Setup};
@@ -91,13 +90,17 @@ pub enum Command {
         #[command(subcommand)]
         command: MeshCommand,
     },
-    /// Run a built-in case, or a case file (`signorini run case.toml`).
+    /// Run a problem of the library by name (`disc`, `sphere`; `signorini list` shows them), a
+    /// problem file (`my_problem.wf`), a built-in case, or a case file (`case.toml`).
     #[command(args_conflicts_with_subcommands = true)]
     Run {
         #[command(subcommand)]
         case: Option<Box<Case>>,
-        /// A TOML case file (`case = "bar"` or `"disc"`, and the options as keys).
+        /// A problem by name or .wf file, or a TOML case file (`case = "bar"` or `"disc"`, and
+        /// the options as keys).
         file: Option<PathBuf>,
+        #[command(flatten)]
+        args: Box<ProblemArgs>,
     },
     /// Print every scheme and contact law of the library with its params (defaults, ranges,
     /// docs), and the other form files with their slots.
@@ -189,10 +192,6 @@ pub enum Case {
     StaticBlock(StaticBlockArgs),
     /// The compressed 1D bar against its exact solution (docs/mathematics.md §6).
     Bar(BarArgs),
-    /// The elastic disc bouncing on a rigid plane (docs/mathematics.md §6).
-    Disc(DiscArgs),
-    /// The elastic ball bouncing on a rigid plane: the disc in 3D (curved P2 tetrahedra).
-    Sphere(DiscArgs),
     /// A cylinder (2D) or ball (3D) pressed onto the plane by its weight, against Hertz.
     HertzStatic(HertzStaticArgs),
     /// A ball hitting the plane at low speed, against Hertz's impact formulas.
@@ -304,29 +303,34 @@ impl MethodArgs {
     }
 }
 
+/// The options of a problem's run; the problem's file gives the defaults of `--dt`, `--t-end`,
+/// `--t-start` and of its params (`--param NAME=VALUE`).
 #[derive(clap::Args)]
-pub struct DiscArgs {
+pub struct ProblemArgs {
     #[command(flatten)]
     methods: MethodArgs,
     #[arg(long, value_enum, default_value_t = MassChoice::Consistent)]
     mass: MassChoice,
-    /// A Gmsh mesh (MSH 2.2 or 4.1); default: the built-in curved P2 disc.
+    /// A Gmsh mesh (MSH 2.2 or 4.1) instead of the problem's.
     #[arg(long)]
     mesh: Option<PathBuf>,
-    /// Mesh size of the built-in mesh (default: 1 for the disc, 2.5 for the sphere).
+    /// Shorthand for --param h=VALUE (the mesh size of the disc's and the sphere's built-in mesh).
     #[arg(long, allow_hyphen_values = true)]
     h: Option<f64>,
-    #[arg(long, default_value_t = 0.02, allow_hyphen_values = true)]
-    dt: f64,
-    #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
-    t_end: f64,
-    /// Start in exact free fall at this time instead of at rest at t = 0 (first contact: √40).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    t_start: f64,
-    /// Directory for series.csv, summary.json and disc.png (sphere.png).
+    /// The time step (default: the problem's `run dt = ...`).
+    #[arg(long, allow_hyphen_values = true)]
+    dt: Option<f64>,
+    /// The end time (default: the problem's).
+    #[arg(long, allow_hyphen_values = true)]
+    t_end: Option<f64>,
+    /// The start time, where the initial fields are evaluated (default: the problem's; the
+    /// disc and the sphere start in exact free fall there).
+    #[arg(long, allow_hyphen_values = true)]
+    t_start: Option<f64>,
+    /// Directory for series.csv, summary.json and the problem's figure (NAME.png).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Write a VTU snapshot every K steps into DIR/vtu, and DIR/disc.pvd (sphere.pvd) for ParaView.
+    /// Write a VTU snapshot every K steps into DIR/vtu, and DIR/NAME.pvd for ParaView.
     #[arg(long, default_value_t = 0)]
     vtu_every: usize,
     #[command(flatten)]
@@ -483,14 +487,18 @@ fn dispatch(cli: Cli) -> ExitCode {
         Command::Run { case: Some(case), .. } => match *case {
             Case::StaticBlock(a) => static_block(a),
             Case::Bar(a) => run_bar(a),
-            Case::Disc(a) => run_disc(a, Body::Disc),
-            Case::Sphere(a) => run_disc(a, Body::Sphere),
             Case::HertzStatic(a) => hertz::run_static(a),
             Case::HertzImpact(a) => hertz::run_impact(a),
         },
-        Command::Run { case: None, file: Some(file) } => run_file(&file),
-        Command::Run { case: None, file: None } => {
-            eprintln!("error: name a case (static-block, bar, disc) or a case file");
+        Command::Run { case: None, file: Some(file), .. } if file.extension().is_some_and(|e| e == "toml") => {
+            run_file(&file)
+        }
+        Command::Run { case: None, file: Some(problem), args } => run_problem(&problem.to_string_lossy(), *args),
+        Command::Run { case: None, file: None, .. } => {
+            let names = crate::problem::library_names().join(", ");
+            eprintln!(
+                "error: name a problem ({names}), a problem file, a case (static-block, bar, hertz-static, hertz-impact) or a case file"
+            );
             ExitCode::FAILURE
         }
         Command::Mesh { command: MeshCommand::Info { file } } => mesh_info(&file),
@@ -506,7 +514,16 @@ fn check(files: &[PathBuf]) -> ExitCode {
     let mut failed = false;
     for f in files {
         match compiler::compile(f, &crate::driver::sources::LibraryLoader) {
-            Ok(compiled) => eprint!("{}", compiled.warnings),
+            Ok(compiled) => {
+                eprint!("{}", compiled.warnings);
+                // A problem is also bound: its mesh and regions, the coefs of the files in use.
+                if !compiled.program.unit.problems.is_empty()
+                    && let Err(e) = crate::problem::run::check(&f.to_string_lossy())
+                {
+                    eprintln!("{e}");
+                    failed = true;
+                }
+            }
             Err(e) => {
                 eprint!("{e}");
                 failed = true;
@@ -800,24 +817,28 @@ fn verify_scheme(out: &Path, methods: &MethodArgs) -> ExitCode {
     }
 }
 
-fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
-    let setup = match a.methods.setup() {
+fn run_problem(problem: &str, a: ProblemArgs) -> ExitCode {
+    let mut setup = match a.methods.setup() {
         Ok(s) => s,
         Err(e) => return fail(e),
     };
-    let opts = crate::cases::disc::Options {
-        body,
+    if let Some(h) = a.h {
+        setup.params.push(Setting { name: "h".into(), value: h, origin: "--h".into() });
+    }
+    let opts = crate::problem::run::Options {
+        problem: problem.to_string(),
         setup,
         mass: a.mass,
         cell_size: a.methods.cell_size,
         mesh: a.mesh,
-        h: a.h.unwrap_or(match body {
-            Body::Disc => 1.0,
-            Body::Sphere => 2.5,
-        }),
         dt: a.dt,
         t_start: a.t_start,
         t_end: a.t_end,
+        newton: crate::runtime::newton::NewtonOptions {
+            solver: a.solver,
+            line_search: a.methods.line_search,
+            ..Default::default()
+        },
         out: match a.checkpoint.out(a.out) {
             Ok(dir) => dir,
             Err(e) => return fail(e),
@@ -826,13 +847,58 @@ fn run_disc(a: DiscArgs, body: Body) -> ExitCode {
         progress: true,
         checkpoint_every: a.checkpoint.checkpoint_every,
         resume: a.checkpoint.resume.is_some(),
-        newton: crate::runtime::newton::NewtonOptions {
-            solver: a.solver,
-            line_search: a.methods.line_search,
-            ..Default::default()
-        },
     };
-    finish_disc(crate::cases::disc::run(&opts))
+    finish_problem(crate::problem::run::run(&opts))
+}
+
+fn finish_problem(result: Result<crate::problem::run::Run, crate::cases::CaseError>) -> ExitCode {
+    match result {
+        Ok(r) => {
+            let s = &r.summary;
+            if let Some(files) = s.get("interpreted").and_then(|v| v.as_array()) {
+                let files: Vec<String> = files.iter().filter_map(|f| f.as_str().map(str::to_string)).collect();
+                interpreted_note(&files);
+            }
+            let text =
+                |k: &str| s.get(k).map_or(String::new(), |v| v.as_str().map_or_else(|| v.to_string(), str::to_string));
+            // The problem's own summary keys; null where a reducer found nothing.
+            let own: Vec<String> = s
+                .own
+                .iter()
+                .map(|k| format!("{k} {}", s.number(k).map_or("none".to_string(), |x| format!("{x:.6}"))))
+                .collect();
+            let set: Vec<String> = s
+                .get("params")
+                .and_then(|p| p.as_object())
+                .map(|p| {
+                    p.iter()
+                        .filter(|(_, v)| v.get("source").and_then(|x| x.as_str()) != Some("file"))
+                        .map(|(n, v)| format!("{n} = {}", v.get("value").map_or(String::new(), ToString::to_string)))
+                        .collect()
+                })
+                .unwrap_or_default();
+            let set = if set.is_empty() { String::new() } else { format!(" ({})", set.join(", ")) };
+            println!(
+                "{}: {} {}{set}, {} dofs, {} steps: {}; Newton {} (max {}), {:.2} s ({:.3} ms/step){}",
+                text("case"),
+                text("scheme"),
+                text("contact"),
+                text("dofs"),
+                text("steps"),
+                own.join(", "),
+                text("newton_total"),
+                text("newton_max"),
+                s.number("wall_seconds").unwrap_or(f64::NAN),
+                1e3 * s.number("seconds_per_step").unwrap_or(f64::NAN),
+                s.number("peak_memory_bytes").map_or(String::new(), |b| format!(", peak memory {:.0} MB", b / 1e6))
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }
 
 fn run_file(file: &Path) -> ExitCode {

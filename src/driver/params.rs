@@ -21,7 +21,7 @@ pub struct Setting {
 }
 
 /// Where a param's value comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Source {
     /// The default in its .wf file.
@@ -33,7 +33,7 @@ pub enum Source {
 }
 
 /// A param in effect.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct ParamValue {
     pub value: f64,
     pub source: Source,

@@ -148,6 +148,16 @@ impl FormSource {
         matches!(self, FormSource::Interpreted(_))
     }
 
+    /// The coefs the file's forms read (its own and its imports'): name and tensor rank.
+    pub fn coefs(&self) -> Vec<(String, u32)> {
+        match self {
+            FormSource::Compiled(u) => {
+                u.forms.map_or(Vec::new(), |f| f.coefs.iter().map(|c| (c.name.to_string(), c.rank)).collect())
+            }
+            FormSource::Interpreted(i) => i.lib.coef_ranks(),
+        }
+    }
+
     /// Instantiates every form of the file: param values in `params()` order.
     pub fn make<'m>(
         &self,

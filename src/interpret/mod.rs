@@ -186,6 +186,11 @@ impl Library {
         self.unit.coefs.iter().map(|c| c.name.as_str()).collect()
     }
 
+    /// The coefs with their tensor ranks (0 scalar, 1 vector, 2 tensor).
+    pub fn coef_ranks(&self) -> Vec<(String, u32)> {
+        self.unit.coefs.iter().map(|c| (c.name.clone(), c.rank)).collect()
+    }
+
     /// Binds form `name` for cells of dimension `dim`: parameters not in `params` take their
     /// defaults; `coefs` gives a value for every coef of the unit (as a generated
     /// `Coefficients` does), with the components its shape needs in `dim`.

@@ -589,14 +589,14 @@ impl EnergyWatch {
 pub struct Snapshots {
     dir: Option<PathBuf>,
     every: usize,
-    name: &'static str,
+    name: String,
     written: Vec<(f64, String)>,
 }
 
 impl Snapshots {
     /// Writes nothing unless `out` is given and `every` > 0.
-    pub fn new(out: Option<&PathBuf>, every: usize, name: &'static str) -> Snapshots {
-        Snapshots { dir: out.filter(|_| every > 0).cloned(), every, name, written: Vec::new() }
+    pub fn new(out: Option<&PathBuf>, every: usize, name: &str) -> Snapshots {
+        Snapshots { dir: out.filter(|_| every > 0).cloned(), every, name: name.to_string(), written: Vec::new() }
     }
 
     /// The displacement and velocity at step `k`, and the cell-mean von Mises stress when the

@@ -95,6 +95,42 @@ pub const RUN_SETTINGS: &[(&str, &str)] = &[
 /// Quadrature settings: degrees of the cell and contact-facet rules.
 pub const QUADRATURE_SETTINGS: &[&str] = &["cell", "facet"];
 
+/// What a series column may read at every row besides other columns: a name and its meaning.
+pub const ROW_VALUES: &[(&str, &str)] = &[
+    ("t", "the row's time"),
+    ("energy", "½uᵀKu + ½vᵀMv − Fᵀu, with the mass the scheme steps with"),
+    ("kinetic", "½vᵀMv, with the mass the scheme steps with (0 without a velocity)"),
+    ("newton", "Newton iterations of the step (0 at the initial row and at stages)"),
+    ("active_points", "contact quadrature points whose switch is on (the active set)"),
+];
+
+/// The reducers of a series column: name, arguments as written, meaning.
+pub const ROW_REDUCERS: &[(&str, &str, &str)] = &[
+    ("mean", "mean(u[k])", "mass-weighted mean of a component of u or v over the body (the centre of mass's)"),
+    ("nodal_mean", "nodal_mean(u[k])", "plain mean of a component of u or v over the nodes"),
+    ("at_min", "at_min(u[k], EXPR)", "a component of u or v at the node where EXPR (of x) is least"),
+    ("force", "force(SLOT)", "the resultant of a slot's residual on the body (a vector): force(contact)"),
+    ("measure", "measure(REGION, EXPR)", "the measure of the region's quadrature points where EXPR ≥ 0"),
+    (
+        "peak",
+        "peak(REGION, EXPR)",
+        "the largest value of EXPR over the region's quadrature points, or 0 if none is positive",
+    ),
+];
+
+/// Any other call in a series column, `NAME(u)`, is a functional of the files in use (checked
+/// when the problem is bound).
+pub const FUNCTIONAL_CALL: &str = "NAME(u)";
+
+/// The reducers of a summary key, over the rows of the series.
+pub const SUMMARY_REDUCERS: &[(&str, &str, &str)] = &[
+    ("initial", "initial(COLUMN)", "the first row's value"),
+    ("final", "final(COLUMN)", "the last row's value"),
+    ("min", "min(COLUMN)", "the least value"),
+    ("max", "max(COLUMN)", "the largest value"),
+    ("first", "first(COLUMN, WHEN)", "COLUMN at the first row where WHEN > 0 (null if none)"),
+];
+
 /// Fields whose initial value a problem may give.
 pub const INITIAL_FIELDS: &[&str] = &["u", "v"];
 
@@ -172,6 +208,28 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
                     .with_label(prev, "first here"),
             );
         }
+    }
+    // Pointwise expressions see the fields, the problem's coefs and the obstacles' g and nc.
+    let mut pointwise = constants.clone();
+    pointwise.extend([("u".to_string(), Vector), ("v".to_string(), Vector)]);
+    for d in &p.coefs {
+        let shape = c.problem_ty(&d.value, &constants).map_or(Scalar, |t| t.shape);
+        pointwise.push((d.name.name.clone(), shape));
+    }
+    if !p.obstacles.is_empty() {
+        pointwise.extend([("g".to_string(), Scalar), ("nc".to_string(), Vector)]);
+    }
+    let regions: Vec<&str> = p.regions.iter().map(|r| r.name.name.as_str()).collect();
+    let mut earlier: Vec<&str> = Vec::new();
+    for (d, _) in &p.series {
+        let scope = RowScope { constants: &constants, pointwise: &pointwise, regions: &regions, earlier: &earlier };
+        row(c, &d.value, &scope, diags);
+        earlier.push(&d.name.name);
+    }
+    // Every row has its time.
+    earlier.push("t");
+    for d in &p.summary {
+        summary(&d.value, &earlier, &constants, diags);
     }
     for pl in &p.plots {
         for col in &pl.columns {
@@ -298,4 +356,197 @@ pub fn unknown_among<'a>(id: &Ident, known: impl Iterator<Item = &'a str> + Clon
         return d.with_note(format!("there is no {what}"));
     }
     d.with_note(format!("the {what}s: {}", list.join(", ")))
+}
+
+/// What a series column may name.
+struct RowScope<'a> {
+    constants: &'a [(String, Shape)],
+    pointwise: &'a [(String, Shape)],
+    regions: &'a [&'a str],
+    earlier: &'a [&'a str],
+}
+
+/// A series column: arithmetic of numbers, params, row values, earlier columns, reducers and
+/// functionals.
+fn row(c: &mut Checker, e: &Expr, s: &RowScope, diags: &mut Vec<Diagnostic>) {
+    use crate::syntax::ast::ExprKind as K;
+    match &e.kind {
+        K::Number(_) => {}
+        K::Name(id) => {
+            let known = s
+                .constants
+                .iter()
+                .map(|(n, _)| n.as_str())
+                .chain(ROW_VALUES.iter().map(|(n, _)| *n))
+                .chain(s.earlier.iter().copied());
+            if !known.clone().any(|n| n == id.name) {
+                diags.push(unknown_among(id, known, "row value").with_note(row_help()));
+            }
+        }
+        K::Neg(a) => row(c, a, s, diags),
+        K::Binary(_, a, b) => {
+            row(c, a, s, diags);
+            row(c, b, s, diags);
+        }
+        K::Index(a, i) => {
+            let is_force = matches!(&a.kind, K::Call(f, _) if f.name == "force");
+            if !is_force {
+                diags.push(Diagnostic::error("E0301", "shape mismatch", a.span, "only `force(SLOT)` is a vector here"));
+            } else if !crate::check::const_value(i).is_some_and(|k| k >= 0.0 && k.fract() == 0.0 && k < 3.0) {
+                diags.push(Diagnostic::error("E0302", "a component index must be 0, 1 or 2", i.span, "not one"));
+            }
+            row(c, a, s, diags);
+        }
+        K::Vector(_) => diags.push(Diagnostic::error("E0301", "shape mismatch", e.span, "a series column is a number")),
+        K::Call(f, args) => reducer(c, e, f, args, s, diags),
+    }
+}
+
+fn row_help() -> String {
+    let values: Vec<&str> = ROW_VALUES.iter().map(|(n, _)| *n).collect();
+    let reducers: Vec<&str> = ROW_REDUCERS.iter().map(|(_, w, _)| *w).collect();
+    format!(
+        "a column reads the row values ({}), earlier columns, params, and reducers: {}, or a functional `{FUNCTIONAL_CALL}`",
+        values.join(", "),
+        reducers.join(", ")
+    )
+}
+
+fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, diags: &mut Vec<Diagnostic>) {
+    use crate::syntax::ast::ExprKind as K;
+    let arity = |want: usize, diags: &mut Vec<Diagnostic>| {
+        if args.len() != want {
+            let usage = ROW_REDUCERS.iter().find(|(n, _, _)| *n == f.name).map_or(FUNCTIONAL_CALL, |(_, u, _)| u);
+            diags.push(
+                Diagnostic::error(
+                    "E0201",
+                    format!("`{}` takes {want} argument(s)", f.name),
+                    e.span,
+                    format!("{} given", args.len()),
+                )
+                .with_help(format!("write `{usage}`")),
+            );
+            return false;
+        }
+        true
+    };
+    // `u[k]` or `v[k]`.
+    let component = |a: &Expr, diags: &mut Vec<Diagnostic>| {
+        let ok = matches!(&a.kind, K::Index(b, i) if matches!(&b.kind, K::Name(n) if n.name == "u" || n.name == "v")
+            && crate::check::const_value(i).is_some_and(|k| k >= 0.0 && k.fract() == 0.0 && k < 3.0));
+        if !ok {
+            diags.push(
+                Diagnostic::error("E0301", "shape mismatch", a.span, "a component of a field is needed here")
+                    .with_help("write `u[1]` or `v[0]`"),
+            );
+        }
+    };
+    let region = |a: &Expr, diags: &mut Vec<Diagnostic>| match &a.kind {
+        K::Name(id) if s.regions.contains(&id.name.as_str()) => {}
+        K::Name(id) => diags.push(unknown_among(id, s.regions.iter().copied(), "region")),
+        _ => diags.push(Diagnostic::error("E0301", "shape mismatch", a.span, "a region's name is needed here")),
+    };
+    match f.name.as_str() {
+        "mean" | "nodal_mean" => {
+            if arity(1, diags) {
+                component(&args[0], diags);
+            }
+        }
+        "at_min" => {
+            if arity(2, diags) {
+                component(&args[0], diags);
+                scalar(c, &args[1], s.constants, diags, false);
+            }
+        }
+        "force" => {
+            if arity(1, diags) && !matches!(&args[0].kind, K::Name(_)) {
+                diags.push(Diagnostic::error("E0301", "shape mismatch", args[0].span, "a slot's name is needed here"));
+            }
+        }
+        "measure" | "peak" => {
+            if arity(2, diags) {
+                region(&args[0], diags);
+                scalar(c, &args[1], s.pointwise, diags, false);
+            }
+        }
+        _ => {
+            let fields = args.iter().all(|a| matches!(&a.kind, K::Name(n) if n.name == "u"));
+            if args.is_empty() || !fields {
+                diags.push(
+                    Diagnostic::error(
+                        "E0201",
+                        format!("`{}` is not a reducer", f.name),
+                        e.span,
+                        "nor a functional of u",
+                    )
+                    .with_help(row_help()),
+                );
+            }
+        }
+    }
+}
+
+/// A summary key: arithmetic of numbers, params and reducers of columns.
+fn summary(e: &Expr, columns: &[&str], constants: &[(String, Shape)], diags: &mut Vec<Diagnostic>) {
+    use crate::syntax::ast::ExprKind as K;
+    let column = |a: &Expr, diags: &mut Vec<Diagnostic>| match &a.kind {
+        K::Name(id) if columns.contains(&id.name.as_str()) => {}
+        K::Name(id) => diags.push(unknown_among(id, columns.iter().copied(), "column")),
+        _ => diags.push(Diagnostic::error("E0301", "shape mismatch", a.span, "a column's name is needed here")),
+    };
+    match &e.kind {
+        K::Number(_) => {}
+        K::Name(id) => {
+            if !constants.iter().any(|(n, _)| *n == id.name) {
+                diags.push(
+                    unknown_among(id, constants.iter().map(|(n, _)| n.as_str()), "param").with_note(summary_help()),
+                );
+            }
+        }
+        K::Neg(a) => summary(a, columns, constants, diags),
+        K::Binary(_, a, b) => {
+            summary(a, columns, constants, diags);
+            summary(b, columns, constants, diags);
+        }
+        K::Call(f, args) => match SUMMARY_REDUCERS.iter().find(|(n, _, _)| *n == f.name) {
+            Some((name, usage, _)) => {
+                let want = if *name == "first" { 2 } else { 1 };
+                if args.len() != want {
+                    diags.push(
+                        Diagnostic::error(
+                            "E0201",
+                            format!("`{name}` takes {want} argument(s)"),
+                            e.span,
+                            format!("{} given", args.len()),
+                        )
+                        .with_help(format!("write `{usage}`")),
+                    );
+                } else {
+                    args.iter().for_each(|a| column(a, diags));
+                }
+            }
+            None => diags.push(unknown_among(f, SUMMARY_REDUCERS.iter().map(|(n, _, _)| *n), "summary reducer")),
+        },
+        K::Index(..) | K::Vector(_) => diags.push(
+            Diagnostic::error("E0301", "shape mismatch", e.span, "a summary value is a number")
+                .with_help(summary_help()),
+        ),
+    }
+}
+
+fn summary_help() -> String {
+    let reducers: Vec<&str> = SUMMARY_REDUCERS.iter().map(|(_, u, _)| *u).collect();
+    format!("a summary reduces the columns: {}", reducers.join(", "))
+}
+
+/// W0004: coef `name` of a problem is read by none of `files` (the files of the run).
+pub fn unread_coef(name: &Ident, files: &[&str]) -> Diagnostic {
+    Diagnostic::warning(
+        "W0004",
+        format!("coef `{}` is set, but no file in use reads it", name.name),
+        name.span,
+        "not read",
+    )
+    .with_note(format!("the files in use: {}", files.join(", ")))
+    .with_help("check its name against the forms' `coef` lines, or add the file that reads it (--forms, --material)")
 }

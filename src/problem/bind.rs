@@ -1,0 +1,364 @@
+//! A problem bound to its params: the mesh (a Gmsh file or a generator) with the problem's
+//! regions, the coefs the problem sets (obstacles' `g` and `nc` among them), the initial
+//! fields, and the run's settings. Errors point at the problem file.
+
+use std::path::Path;
+
+use super::ProblemFile;
+use super::expr::{At, Exprs, PointFn};
+use crate::cases::CaseError;
+use crate::compiler::Diagnostic;
+use crate::compiler::ir::lower::Val;
+use crate::compiler::syntax::ast::{Expr, MeshSource, NamedCall, RegionSource};
+use crate::runtime::kernel::Coef;
+use crate::runtime::mesh::{CellSize, Mesh};
+
+/// The dimension of the problem's mesh: its generator's, or the file's (read here).
+pub fn dimension(pf: &ProblemFile, mesh_file: Option<&Path>) -> Result<usize, CaseError> {
+    match (&pf.problem().mesh[0], mesh_file) {
+        (MeshSource::Generator(call), Some(path)) => {
+            let d = read(path)?.dim();
+            let g = crate::compiler::check::problem::GENERATORS.iter().find(|g| g.name == call.name.name);
+            match g {
+                Some(g) if g.dim != d => Err(CaseError::Option(format!(
+                    "problem `{}` is {}D (its mesh is a {}): {} is a {d}D mesh",
+                    pf.name(),
+                    g.dim,
+                    g.name,
+                    path.display()
+                ))),
+                _ => Ok(d),
+            }
+        }
+        (_, Some(path)) => Ok(read(path)?.dim()),
+        (MeshSource::Generator(call), None) => {
+            let g = crate::compiler::check::problem::GENERATORS.iter().find(|g| g.name == call.name.name);
+            Ok(g.map_or(0, |g| g.dim))
+        }
+        (MeshSource::File { path, span }, None) => Ok(read_own(pf, path, *span)?.dim()),
+    }
+}
+
+fn read(path: &Path) -> Result<Mesh, CaseError> {
+    Ok(crate::cases::read_mesh(path)?)
+}
+
+/// The problem's own mesh file, its errors located at the `mesh` line.
+fn read_own(pf: &ProblemFile, path: &str, span: crate::compiler::Span) -> Result<Mesh, CaseError> {
+    let full = pf.dir.join(path);
+    crate::cases::read_mesh(&full).map_err(|e| {
+        pf.render(Diagnostic::error("E0101", format!("cannot read the mesh {}", full.display()), span, e.to_string()))
+    })
+}
+
+/// A named argument of a generator or helper.
+fn arg<'a>(call: &'a NamedCall, name: &str) -> Option<&'a Expr> {
+    call.args.iter().find(|a| a.name.name == name).map(|a| &a.value)
+}
+
+/// The mesh: `mesh_file` (`--mesh`) or the problem's, with the problem's regions, validated.
+/// The label says what it is in summaries.
+pub fn mesh(
+    pf: &ProblemFile,
+    ex: &mut Exprs,
+    mesh_file: Option<&Path>,
+    cell_size: CellSize,
+) -> Result<(Mesh, String), CaseError> {
+    let p = pf.problem();
+    let name = pf.name();
+    let d = ex.dim();
+    let (mut mesh, label) = match (&p.mesh[0], mesh_file) {
+        (_, Some(path)) => (read(path)?, path.display().to_string()),
+        (MeshSource::File { path, span }, None) => {
+            (read_own(pf, path, *span)?, pf.dir.join(path).display().to_string())
+        }
+        (MeshSource::Generator(call), None) => generate(pf, ex, call)?,
+    };
+    if mesh_file.is_some() || matches!(p.mesh[0], MeshSource::File { .. }) {
+        crate::resources::check(name, (mesh.num_nodes() * mesh.dim()) as f64, mesh.dim(), None)?;
+    }
+    if mesh.dim() != d {
+        return Err(CaseError::Option(format!("problem `{name}` is {d}D: {label} is {}D", mesh.dim())));
+    }
+    // The mesh's own groups, for messages.
+    let groups: Vec<String> = mesh.regions.iter().map(|g| g.name.clone()).collect();
+    for r in &p.regions {
+        let mut found = false;
+        for source in &r.sources {
+            match source {
+                RegionSource::Group { name: group, span } => {
+                    // A group the mesh has is the region, even empty (an error, not a fallback).
+                    if let Some(g) = mesh.regions.iter().find(|g| g.name == *group) {
+                        let facets = g.facets.clone();
+                        if facets.is_empty() {
+                            return Err(pf.render(Diagnostic::error(
+                                "E0101",
+                                format!("group \"{group}\" of {label} has no facets"),
+                                *span,
+                                format!("region `{}` would be empty", r.name.name),
+                            )));
+                        }
+                        found = true;
+                        mesh.regions.retain(|x| x.name != r.name.name);
+                        mesh.regions.push(crate::runtime::mesh::Region { name: r.name.name.clone(), facets });
+                    }
+                }
+                RegionSource::Boundary { conditions, .. } => {
+                    let mut tests = Vec::new();
+                    for c in conditions {
+                        let lhs = ex.lower(&c.lhs, &[]).map_err(|e| pf.render(*e))?;
+                        let rhs = ex.lower(&c.rhs, &[]).map_err(|e| pf.render(*e))?;
+                        let both = Val { shape: lhs.shape, c: vec![lhs.c[0].clone(), rhs.c[0].clone()] };
+                        tests.push((ex.function(&both, &c.lhs).map_err(|e| pf.render(*e))?, c.op));
+                    }
+                    let work = std::cell::RefCell::new((Vec::new(), [0.0; 2]));
+                    let region = mesh.add_region_where(&r.name.name, |n, x| {
+                        let (scratch, out) = &mut *work.borrow_mut();
+                        tests.iter().all(|(f, op)| {
+                            f.eval(&At { x, n, ..At::default() }, scratch, out);
+                            op.holds(out[0], out[1])
+                        })
+                    });
+                    found = !region.facets.is_empty();
+                }
+            }
+            if found {
+                break;
+            }
+        }
+        if !found {
+            let groups: Vec<&str> = groups.iter().map(String::as_str).collect();
+            let mut d = Diagnostic::error(
+                "E0101",
+                format!("region `{}` names no facet of {label}", r.name.name),
+                r.span,
+                "empty region",
+            );
+            if let Some(RegionSource::Group { name: g, .. }) = r.sources.first()
+                && let Some(close) = crate::compiler::check::suggest_name(g, groups.iter().copied())
+            {
+                d = d.with_help(format!("did you mean group \"{close}\"?"));
+            }
+            let list = if groups.is_empty() { "none".to_string() } else { groups.join(", ") };
+            return Err(pf.render(d.with_note(format!("the mesh's facet groups: {list}"))));
+        }
+    }
+    mesh.set_cell_size(cell_size);
+    mesh.validate()?;
+    for r in &p.regions {
+        mesh.region(&r.name.name)?;
+    }
+    Ok((mesh, label))
+}
+
+/// A built-in generator's mesh, after a check that it fits in memory.
+fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh, String), CaseError> {
+    use crate::runtime::mesh::{ball::ball, disc::disc, structured};
+    // The scalar arguments, evaluated up front (the checker knows which each generator takes).
+    let mut scalars: Vec<(String, f64)> = Vec::new();
+    for a in &call.args {
+        if let Ok(v) = ex.scalar(&a.value) {
+            scalars.push((a.name.name.clone(), v));
+        }
+    }
+    let mut values = Vec::new();
+    let mut get = |name: &str, default: f64| -> Result<f64, CaseError> {
+        let v = scalars.iter().find(|(n, _)| n == name).map_or(default, |(_, v)| *v);
+        values.push(format!("{name} = {v}"));
+        Ok(v)
+    };
+    let count = |name: &str, v: f64| -> Result<usize, CaseError> {
+        if (1.0..=1e7).contains(&v) && v.fract() == 0.0 {
+            Ok(v as usize)
+        } else {
+            Err(CaseError::Option(format!(
+                "{}: `{name}` must be a whole number of cells in [1, 10⁷], not {v}",
+                pf.file
+            )))
+        }
+    };
+    let positive = |name: &str, v: f64| -> Result<f64, CaseError> {
+        if v > 0.0 && v.is_finite() {
+            Ok(v)
+        } else {
+            Err(CaseError::Option(format!("{}: `{name}` must be positive, not {v}", pf.file)))
+        }
+    };
+    let name = pf.name().to_string();
+    let gen_name = call.name.name.as_str();
+    let mesh = match gen_name {
+        "interval" => {
+            let (length, cells, start) = (get("length", 0.0)?, get("cells", 0.0)?, get("start", 0.0)?);
+            let cells = count("cells", cells)?;
+            crate::resources::check(&name, cells as f64 + 1.0, 1, None)?;
+            structured::interval(cells, start, start + positive("length", length)?)
+        }
+        "disc" | "ball" => {
+            let (radius, h) = (positive("radius", get("radius", 0.0)?)?, positive("h", get("h", 0.0)?)?);
+            let centre = match arg(call, "centre") {
+                Some(e) => ex.vector(e).map_err(|e| pf.render(*e))?,
+                None => vec![0.0; 3],
+            };
+            values.push(format!("centre = {centre:?}"));
+            if gen_name == "disc" {
+                // P2 nodes: 3m² vertices on m rings.
+                let dofs = 2.0 * 4.0 * 3.0 * (radius / h).ceil().powi(2);
+                crate::resources::check(&name, dofs, 2, Some(h))?;
+                disc(radius, [centre[0], centre[1]], h)
+            } else {
+                // P2 nodes: the (2n+1)³ lattice.
+                let dofs = 3.0 * (4.0 * (radius / h).round() + 1.0).powi(3);
+                crate::resources::check(&name, dofs, 3, Some(h))?;
+                ball(radius, [centre[0], centre[1], centre[2]], h)
+            }
+        }
+        "rectangle" => {
+            let (w, h) = (positive("width", get("width", 0.0)?)?, positive("height", get("height", 0.0)?)?);
+            let (nx, ny) = (count("nx", get("nx", 0.0)?)?, count("ny", get("ny", 0.0)?)?);
+            let degree = get("degree", 1.0)?;
+            let degree = if degree == 2.0 { 2 } else { 1 };
+            crate::resources::check(&name, 2.0 * ((degree * nx + 1) * (degree * ny + 1)) as f64, 2, None)?;
+            structured::rectangle(nx, ny, [0.0, w], [0.0, h], structured::Diagonal::Right, degree as u32)
+        }
+        _ => {
+            // `box`: the checker knows no other generator.
+            let size = match arg(call, "size") {
+                Some(e) => ex.vector(e).map_err(|e| pf.render(*e))?,
+                None => vec![1.0; 3],
+            };
+            let n = [count("nx", get("nx", 0.0)?)?, count("ny", get("ny", 0.0)?)?, count("nz", get("nz", 0.0)?)?];
+            let degree = if get("degree", 1.0)? == 2.0 { 2 } else { 1 };
+            let nodes: usize = n.iter().map(|k| degree * k + 1).product();
+            crate::resources::check(&name, 3.0 * nodes as f64, 3, None)?;
+            structured::cuboid(n, [0.0, size[0]], [0.0, size[1]], [0.0, size[2]], degree as u32)
+        }
+    };
+    Ok((mesh, format!("built-in {gen_name}({})", values.join(", "))))
+}
+
+/// The coefs the problem sets, by name: its `coef` lines, then its obstacles' `g` and `nc`.
+pub fn coefs(pf: &ProblemFile, ex: &mut Exprs) -> Result<Vec<(String, PointFn)>, CaseError> {
+    let p = pf.problem();
+    let mut out = Vec::new();
+    for c in &p.coefs {
+        let v = ex.lower(&c.value, &[]).map_err(|e| pf.render(*e))?;
+        out.push((c.name.name.clone(), ex.function(&v, &c.value).map_err(|e| pf.render(*e))?));
+    }
+    for (g, nc, e) in obstacle_vals(pf, ex)? {
+        out.push(("g".into(), ex.function(&g, e).map_err(|e| pf.render(*e))?));
+        out.push(("nc".into(), ex.function(&nc, e).map_err(|e| pf.render(*e))?));
+    }
+    Ok(out)
+}
+
+/// The values of every coef the problem sets, for pointwise observables: (name, value).
+pub fn coef_vals(pf: &ProblemFile, ex: &mut Exprs) -> Result<Vec<(String, Val)>, CaseError> {
+    let p = pf.problem();
+    let mut out = Vec::new();
+    for c in &p.coefs {
+        out.push((c.name.name.clone(), ex.lower(&c.value, &[]).map_err(|e| pf.render(*e))?));
+    }
+    for (g, nc, _) in obstacle_vals(pf, ex)? {
+        out.push(("g".into(), g));
+        out.push(("nc".into(), nc));
+    }
+    Ok(out)
+}
+
+/// Each obstacle's gap and normal as values, with the expression to blame.
+fn obstacle_vals<'p>(pf: &'p ProblemFile, ex: &mut Exprs) -> Result<Vec<(Val, Val, &'p Expr)>, CaseError> {
+    let p = pf.problem();
+    if p.obstacles.len() > 1 {
+        return Err(pf.render(Diagnostic::error(
+            "E0102",
+            "one obstacle per problem for now",
+            p.obstacles[1].span,
+            "a second obstacle",
+        )));
+    }
+    let mut out = Vec::new();
+    for o in &p.obstacles {
+        let lower = |ex: &mut Exprs, name: &str| -> Result<(Val, &'p Expr), CaseError> {
+            let e = arg(&o.shape, name).expect("checked: required argument");
+            Ok((ex.lower(e, &[]).map_err(|d| pf.render(*d))?, e))
+        };
+        let x = ex.lower(&x_expr(o.shape.span), &[]).map_err(|e| pf.render(*e))?;
+        match o.shape.name.name.as_str() {
+            "plane" => {
+                let ((point, e), (normal, _)) = (lower(ex, "point")?, lower(ex, "normal")?);
+                let g = &mut ex.low.g;
+                // gap = (x − point)·normal, nc = −normal.
+                let mut gap = g.zero();
+                for k in 0..x.c.len() {
+                    let dx = g.sub(x.c[k].v, point.c[k].v);
+                    let term = g.mul(dx, normal.c[k].v);
+                    gap = g.add(gap, term);
+                }
+                let nc = normal.c.iter().map(|j| crate::compiler::ir::lower::Jet { v: g.neg(j.v), g: None }).collect();
+                out.push((scalar(gap), Val { shape: normal.shape, c: nc }, e));
+            }
+            _ => {
+                // `sphere`: gap = |x − centre| − radius, nc = (centre − x)/|x − centre|.
+                let ((centre, e), (radius, _)) = (lower(ex, "centre")?, lower(ex, "radius")?);
+                let g = &mut ex.low.g;
+                let diff: Vec<_> = (0..x.c.len()).map(|k| g.sub(x.c[k].v, centre.c[k].v)).collect();
+                let mut r2 = g.zero();
+                for &dk in &diff {
+                    let sq = g.mul(dk, dk);
+                    r2 = g.add(r2, sq);
+                }
+                let dist = g.sqrt(r2);
+                let gap = g.sub(dist, radius.c[0].v);
+                let nc = diff
+                    .iter()
+                    .map(|&dk| {
+                        let q = g.div(dk, dist);
+                        crate::compiler::ir::lower::Jet { v: g.neg(q), g: None }
+                    })
+                    .collect();
+                out.push((scalar(gap), Val { shape: centre.shape, c: nc }, e));
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn scalar(v: crate::compiler::ir::graph::NodeId) -> Val {
+    Val { shape: crate::compiler::syntax::ast::Shape::Scalar, c: vec![crate::compiler::ir::lower::Jet { v, g: None }] }
+}
+
+/// The expression `x`, at `span`.
+fn x_expr(span: crate::compiler::Span) -> Expr {
+    use crate::compiler::syntax::ast::{ExprKind, Ident};
+    Expr { kind: ExprKind::Name(Ident { name: "x".into(), span }), span }
+}
+
+/// Settings as the problem gives them (`run dt = ...`, `quadrature cell = ...`), by name.
+pub fn settings(
+    pf: &ProblemFile,
+    ex: &mut Exprs,
+    list: &[crate::compiler::syntax::ast::Defined],
+) -> Result<Vec<(String, f64)>, CaseError> {
+    list.iter().map(|d| Ok((d.name.name.clone(), ex.scalar(&d.value).map_err(|e| pf.render(*e))?))).collect()
+}
+
+/// An initial field at the mesh's nodes at time `t0` (zeros if the problem gives none), with
+/// no negative zeros.
+pub fn initial(pf: &ProblemFile, ex: &mut Exprs, mesh: &Mesh, field: &str, t0: f64) -> Result<Vec<f64>, CaseError> {
+    let d = mesh.dim();
+    let mut values = vec![0.0; mesh.num_nodes() * d];
+    let Some(def) = pf.problem().initial.iter().find(|i| i.name.name == field) else { return Ok(values) };
+    let v = ex.lower(&def.value, &[]).map_err(|e| pf.render(*e))?;
+    let f = ex.function(&v, &def.value).map_err(|e| pf.render(*e))?;
+    let mut scratch = Vec::new();
+    for (i, out) in values.chunks_mut(d).enumerate() {
+        f.eval(&At { x: mesh.node(i), t: t0, ..At::default() }, &mut scratch, out);
+        out.iter_mut().for_each(|x| *x += 0.0);
+    }
+    Ok(values)
+}
+
+/// What a coef lookup by name gives the forms.
+pub fn coef_lookup(coefs: &[(String, PointFn)]) -> impl Fn(&str) -> Option<Coef> + '_ {
+    move |name| coefs.iter().find(|(n, _)| n == name).map(|(_, f)| f.clone().coef())
+}

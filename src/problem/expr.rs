@@ -1,0 +1,215 @@
+//! A problem's expressions, evaluated: lowered into the compiler's expression DAG for the
+//! problem's dimension (params as constants, `let`s in order), and compiled to the one IR
+//! evaluator ([`Program`]) as functions of the position `x`, the time `t`, the facet normal `n`,
+//! the fields `u` and `v` and values measured elsewhere (a series column's reducers).
+
+use crate::compiler::Diagnostic;
+use crate::compiler::check::Unit;
+use crate::compiler::ir::eval::Program;
+use crate::compiler::ir::graph::{NodeId, Sym};
+use crate::compiler::ir::lower::{Jet, Lowerer, Val};
+use crate::compiler::syntax::ast::{Defined, Expr, Shape};
+
+type Res<T> = Result<T, Box<Diagnostic>>;
+
+/// The lowering context of one problem in one dimension.
+pub struct Exprs<'u> {
+    pub low: Lowerer<'u>,
+    scope: Vec<(String, Val)>,
+    d: usize,
+}
+
+impl<'u> Exprs<'u> {
+    /// The problem's params (by name, with their values) and its `let`s, in order.
+    pub fn new(unit: &'u Unit, d: usize, params: &[(String, f64)], lets: &[Defined]) -> Res<Exprs<'u>> {
+        let mut low = Lowerer::new(unit, d);
+        let mut scope: Vec<(String, Val)> = params.iter().map(|(n, v)| (n.clone(), low.constant_val(*v))).collect();
+        for l in lets {
+            let v = low.problem_expr(&l.value, scope.clone())?;
+            scope.push((l.name.name.clone(), v));
+        }
+        Ok(Exprs { low, scope, d })
+    }
+
+    pub fn dim(&self) -> usize {
+        self.d
+    }
+
+    /// Lowers `e` with `extra` names visible (fields, coefs, measured values) besides the params
+    /// and `let`s.
+    pub fn lower(&mut self, e: &Expr, extra: &[(String, Val)]) -> Res<Val> {
+        let mut scope = self.scope.clone();
+        scope.extend(extra.iter().cloned());
+        self.low.problem_expr(e, scope)
+    }
+
+    /// A constant scalar (params and numbers only).
+    pub fn scalar(&mut self, e: &Expr) -> Res<f64> {
+        let v = self.lower(e, &[])?;
+        self.low.g.as_const(v.c[0].v).ok_or_else(|| not_constant(e))
+    }
+
+    /// A constant vector of the problem's dimension.
+    pub fn vector(&mut self, e: &Expr) -> Res<Vec<f64>> {
+        let v = self.lower(e, &[])?;
+        v.c.iter().map(|j| self.low.g.as_const(j.v).ok_or_else(|| not_constant(e))).collect()
+    }
+
+    /// A field argument (`u` is 0, `v` is 1) as a value of the problem's dimension.
+    pub fn field(&mut self, arg: u8) -> Val {
+        let c = (0..self.d).map(|k| Jet { v: self.low.g.sym(Sym::Field { arg, comp: k as u8 }), g: None }).collect();
+        Val { shape: Shape::Vector, c }
+    }
+
+    /// A measured value (`id`) of `components` components, as a leaf.
+    pub fn measured(&mut self, id: usize, components: usize) -> Val {
+        let c = (0..components)
+            .map(|k| Jet { v: self.low.g.sym(Sym::Coef { id: id as u16, comp: k as u8 }), g: None })
+            .collect();
+        Val { shape: if components == 1 { Shape::Scalar } else { Shape::Vector }, c }
+    }
+
+    /// A constant as a value.
+    pub fn constant(&mut self, values: &[f64]) -> Val {
+        let c = values.iter().map(|&x| self.low.constant_val(x).c[0].clone()).collect();
+        Val { shape: if values.len() == 1 { Shape::Scalar } else { Shape::Vector }, c }
+    }
+
+    /// Compiles the components of `v` (at `e`, for errors).
+    pub fn function(&self, v: &Val, e: &Expr) -> Res<PointFn> {
+        let roots: Vec<NodeId> = v.c.iter().map(|j| j.v).collect();
+        PointFn::new(Program::new(&self.low.g, &roots)).map_err(|what| {
+            Box::new(Diagnostic::error("E0501", format!("{what} means nothing here"), e.span, "not known at a point"))
+        })
+    }
+}
+
+fn not_constant(e: &Expr) -> Box<Diagnostic> {
+    Box::new(
+        Diagnostic::error("E0603", "not a constant", e.span, "depends on x, t or a field")
+            .with_help("mesh arguments, run and quadrature settings are numbers and params"),
+    )
+}
+
+/// What a leaf of a point function reads.
+#[derive(Clone, Copy, Debug)]
+enum Leaf {
+    X(usize),
+    T,
+    N(usize),
+    U(usize),
+    V(usize),
+    Measured(usize, usize),
+}
+
+/// Where a point function is evaluated.
+#[derive(Clone, Copy, Default)]
+pub struct At<'a> {
+    pub x: &'a [f64],
+    pub t: f64,
+    pub n: &'a [f64],
+    pub u: &'a [f64],
+    pub v: &'a [f64],
+    pub measured: &'a [Vec<f64>],
+}
+
+/// Compiled components of an expression: `eval` writes one value per component.
+#[derive(Clone, Debug)]
+pub struct PointFn {
+    program: Program,
+    leaves: Vec<Leaf>,
+}
+
+impl PointFn {
+    fn new(program: Program) -> Result<PointFn, &'static str> {
+        let leaves = program
+            .syms()
+            .iter()
+            .map(|s| {
+                Ok(match *s {
+                    Sym::Coord(k) => Leaf::X(k as usize),
+                    Sym::Time => Leaf::T,
+                    Sym::Normal(k) => Leaf::N(k as usize),
+                    Sym::Field { arg: 0, comp } => Leaf::U(comp as usize),
+                    Sym::Field { comp, .. } => Leaf::V(comp as usize),
+                    Sym::Coef { id, comp } => Leaf::Measured(id as usize, comp as usize),
+                    Sym::CellDiameter => return Err("`h`, the cell size,"),
+                    _ => return Err("a derivative"),
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(PointFn { program, leaves })
+    }
+
+    /// Number of components.
+    pub fn len(&self) -> usize {
+        self.program.outputs()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The values, when they depend on nothing.
+    pub fn constant(&self) -> Option<Vec<f64>> {
+        self.leaves.is_empty().then(|| {
+            let mut out = vec![0.0; self.len()];
+            self.eval(&At::default(), &mut Vec::new(), &mut out);
+            out
+        })
+    }
+
+    /// Whether the values depend on the time.
+    pub fn reads_time(&self) -> bool {
+        self.leaves.iter().any(|l| matches!(l, Leaf::T))
+    }
+
+    /// Whether the values depend on the velocity.
+    pub fn reads_v(&self) -> bool {
+        self.leaves.iter().any(|l| matches!(l, Leaf::V(_)))
+    }
+
+    /// Whether the values depend on the fields or measured values (not only on x, t, n).
+    pub fn reads_fields(&self) -> bool {
+        self.leaves.iter().any(|l| matches!(l, Leaf::U(_) | Leaf::V(_) | Leaf::Measured(..)))
+    }
+
+    /// Writes the values at `at` into `out` (`scratch` is reused between calls).
+    pub fn eval(&self, at: &At, scratch: &mut Vec<f64>, out: &mut [f64]) {
+        let nan = f64::NAN;
+        let get = |s: &[f64], k: usize| s.get(k).copied().unwrap_or(nan);
+        self.program.prepare(scratch);
+        for (slot, l) in scratch.iter_mut().zip(&self.leaves) {
+            *slot = match *l {
+                Leaf::X(k) => get(at.x, k),
+                Leaf::T => at.t,
+                Leaf::N(k) => get(at.n, k),
+                Leaf::U(k) => get(at.u, k),
+                Leaf::V(k) => get(at.v, k),
+                Leaf::Measured(i, k) => at.measured.get(i).map_or(nan, |m| get(m, k)),
+            };
+        }
+        self.program.exec(scratch);
+        for (i, o) in out.iter_mut().enumerate().take(self.len()) {
+            *o = self.program.root(scratch, i);
+        }
+    }
+
+    /// As a coef of the forms: a constant, a function of x, or of x and t. Values have no
+    /// negative zeros (`−0` and `0` are one value of a coef; the kernels then do the same
+    /// arithmetic whichever was written).
+    pub fn coef(self) -> crate::runtime::kernel::Coef {
+        use crate::runtime::kernel::Coef;
+        if let Some(values) = self.constant() {
+            return Coef::constant(values.into_iter().map(|v| v + 0.0).collect::<Vec<_>>());
+        }
+        let n = self.len();
+        let steady = !self.reads_time();
+        // Assembly calls coefs from every thread: each has its scratch.
+        thread_local!(static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) });
+        let f = move |x: &[f64], t: f64, out: &mut [f64]| {
+            SCRATCH.with(|s| self.eval(&At { x, t, ..At::default() }, &mut s.borrow_mut(), out));
+        };
+        if steady { Coef::of_position(n, move |x, out| f(x, 0.0, out)) } else { Coef::function(n, f) }
+    }
+}

@@ -1,0 +1,481 @@
+//! What a problem measures: its series columns at every row (the initial state, each step, each
+//! intermediate stage) and its summary keys over the rows. A column is an expression of
+//! measured values (row values such as `energy`, earlier columns, reducers such as
+//! `mean(u[1])`, functionals of the files in use such as `contact_energy(u)`), each measured
+//! once per row and read by the column's compiled expression.
+
+use super::ProblemFile;
+use super::expr::{At, Exprs, PointFn};
+use crate::cases::CaseError;
+use crate::compiler::ir::lower::Val;
+use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
+use crate::driver::ActiveForms;
+use crate::runtime::assembly::Assembler;
+use crate::runtime::evaluate::{FacetSample, facet_samples};
+use crate::runtime::library::{Binding, BoundFunctional};
+use crate::runtime::mesh::Facet;
+use crate::runtime::scheme::BoundForm;
+use crate::simulation::{AxisMean, Tools, resultant};
+
+/// One measured value of a row.
+enum Measure<'m> {
+    Time,
+    Energy,
+    Kinetic,
+    Newton,
+    ActivePoints,
+    /// An earlier column.
+    Column(usize),
+    Mean {
+        field: u8,
+        weights: AxisMean,
+    },
+    NodalMean {
+        field: u8,
+        axis: usize,
+    },
+    AtMin {
+        field: u8,
+        axis: usize,
+        node: usize,
+    },
+    /// The resultant of slot form `slot`'s residual.
+    Force {
+        slot: usize,
+    },
+    /// `measure(REGION, EXPR)`: the weight of the region's points where EXPR ≥ 0.
+    Area {
+        region: usize,
+        f: PointFn,
+    },
+    /// `peak(REGION, EXPR)`: the largest EXPR over the region's points, and 0.
+    Peak {
+        region: usize,
+        f: PointFn,
+    },
+    Functional {
+        f: Box<dyn BoundFunctional + 'm>,
+    },
+}
+
+/// A row's state: what the measures read.
+pub struct State<'a> {
+    pub t: f64,
+    pub u: &'a [f64],
+    pub v: Option<&'a [f64]>,
+    pub newton: usize,
+}
+
+/// The problem's series, compiled for a bound run.
+pub struct Observer<'m> {
+    measures: Vec<Measure<'m>>,
+    /// Per column: its name, whether series.csv shows it, its expression of the measures.
+    columns: Vec<(String, bool, PointFn)>,
+    /// The regions sampled by `measure` and `peak`, with their facets.
+    regions: Vec<&'m [Facet]>,
+    degree: u32,
+    /// Slot forms the measures read, by name (`contact`: the active set).
+    slots: Vec<(String, Box<dyn BoundForm + 'm>)>,
+    /// The column each measure was added for.
+    owner: Vec<usize>,
+}
+
+/// The placeholder name of measured value `id` in a rewritten expression.
+fn placeholder(id: usize) -> String {
+    format!("#{id}")
+}
+
+impl<'m> Observer<'m> {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        pf: &ProblemFile,
+        ex: &mut Exprs,
+        tools: &Tools<'m>,
+        forms: &ActiveForms,
+        coefs: &dyn Fn(&str) -> Option<crate::runtime::kernel::Coef>,
+        binding: &Binding<'m>,
+        coef_vals: &[(String, Val)],
+        degree: u32,
+    ) -> Result<Observer<'m>, CaseError> {
+        let p = pf.problem();
+        let mut inst = forms.instantiate(coefs, binding)?;
+        let slots = inst.take_form("contact").map(|f| ("contact".to_string(), f)).into_iter().collect();
+        let mut o = Observer {
+            measures: Vec::new(),
+            columns: Vec::new(),
+            regions: Vec::new(),
+            degree,
+            slots,
+            owner: Vec::new(),
+        };
+        let mut region_names: Vec<String> = Vec::new();
+        let u = ex.field(0);
+        let v = ex.field(1);
+        let mut pointwise: Vec<(String, Val)> = vec![("u".into(), u), ("v".into(), v)];
+        pointwise.extend(coef_vals.iter().cloned());
+        for (d, written) in &p.series {
+            let mut leaves: Vec<(usize, usize)> = Vec::new();
+            let rewritten =
+                o.rewrite(pf, ex, tools, &mut inst, &d.value, &mut leaves, &pointwise, &mut region_names, binding)?;
+            let scope: Vec<(String, Val)> =
+                leaves.iter().map(|&(id, comps)| (placeholder(id), ex.measured(id, comps))).collect();
+            let val = ex.lower(&rewritten, &scope).map_err(|e| pf.render(*e))?;
+            let f = ex.function(&val, &d.value).map_err(|e| pf.render(*e))?;
+            if f.len() != 1 {
+                return Err(pf.render(crate::compiler::Diagnostic::error(
+                    "E0301",
+                    "shape mismatch",
+                    d.value.span,
+                    "a column is a number: take a component",
+                )));
+            }
+            let c = o.columns.len();
+            o.owner.resize(o.measures.len(), c);
+            o.columns.push((d.name.name.clone(), *written, f));
+        }
+        Ok(o)
+    }
+
+    /// `e` with every measured value replaced by a placeholder name; the measures are added.
+    #[allow(clippy::too_many_arguments)]
+    fn rewrite(
+        &mut self,
+        pf: &ProblemFile,
+        ex: &mut Exprs,
+        tools: &Tools<'m>,
+        inst: &mut crate::driver::Instance<'m>,
+        e: &Expr,
+        leaves: &mut Vec<(usize, usize)>,
+        pointwise: &[(String, Val)],
+        region_names: &mut Vec<String>,
+        binding: &Binding<'m>,
+    ) -> Result<Expr, CaseError> {
+        let d = tools.asm.mesh().dim();
+        let mut add = |o: &mut Self, m: Measure<'m>, comps: usize, span| {
+            o.measures.push(m);
+            let id = o.measures.len() - 1;
+            leaves.push((id, comps));
+            Expr { kind: ExprKind::Name(Ident { name: placeholder(id), span }), span }
+        };
+        let component = |a: &Expr| -> (u8, usize) {
+            let ExprKind::Index(f, k) = &a.kind else { unreachable!("checked: u[k] or v[k]") };
+            let field = matches!(&f.kind, ExprKind::Name(n) if n.name == "v") as u8;
+            (field, crate::compiler::check::const_value(k).unwrap_or(0.0) as usize)
+        };
+        let bad_axis = |a: &Expr, axis: usize| {
+            pf.render(crate::compiler::Diagnostic::error(
+                "E0302",
+                "wrong dimension",
+                a.span,
+                format!("component {axis} of a field in a {d}D problem"),
+            ))
+        };
+        Ok(match &e.kind {
+            ExprKind::Number(_) => e.clone(),
+            ExprKind::Name(id) => {
+                let row = match id.name.as_str() {
+                    "t" => Some(Measure::Time),
+                    "energy" => Some(Measure::Energy),
+                    "kinetic" => Some(Measure::Kinetic),
+                    "newton" => Some(Measure::Newton),
+                    "active_points" => Some(Measure::ActivePoints),
+                    name => self.columns.iter().position(|(n, _, _)| n == name).map(Measure::Column),
+                };
+                match row {
+                    Some(m) => add(self, m, 1, e.span),
+                    None => e.clone(), // a param or a let
+                }
+            }
+            ExprKind::Neg(a) => {
+                let a = self.rewrite(pf, ex, tools, inst, a, leaves, pointwise, region_names, binding)?;
+                Expr { kind: ExprKind::Neg(Box::new(a)), span: e.span }
+            }
+            ExprKind::Binary(op, a, b) => {
+                let a = self.rewrite(pf, ex, tools, inst, a, leaves, pointwise, region_names, binding)?;
+                let b = self.rewrite(pf, ex, tools, inst, b, leaves, pointwise, region_names, binding)?;
+                Expr { kind: ExprKind::Binary(*op, Box::new(a), Box::new(b)), span: e.span }
+            }
+            ExprKind::Index(a, k) => {
+                let a = self.rewrite(pf, ex, tools, inst, a, leaves, pointwise, region_names, binding)?;
+                Expr { kind: ExprKind::Index(Box::new(a), k.clone()), span: e.span }
+            }
+            ExprKind::Vector(_) => unreachable!("checked: no vector in a column"),
+            ExprKind::Call(f, args) => match f.name.as_str() {
+                "mean" | "nodal_mean" | "at_min" => {
+                    let (field, axis) = component(&args[0]);
+                    if axis >= d {
+                        return Err(bad_axis(&args[0], axis));
+                    }
+                    let m = match f.name.as_str() {
+                        "mean" => Measure::Mean { field, weights: tools.axis_mean(axis) },
+                        "nodal_mean" => Measure::NodalMean { field, axis },
+                        _ => {
+                            let val = ex.lower(&args[1], &[]).map_err(|e| pf.render(*e))?;
+                            let key = ex.function(&val, &args[1]).map_err(|e| pf.render(*e))?;
+                            let mesh = tools.asm.mesh();
+                            let (mut scratch, mut out) = (Vec::new(), [0.0]);
+                            let mut at = |i: usize| {
+                                key.eval(&At { x: mesh.node(i), ..At::default() }, &mut scratch, &mut out);
+                                out[0]
+                            };
+                            let values: Vec<f64> = (0..mesh.num_nodes()).map(&mut at).collect();
+                            let node = (0..mesh.num_nodes())
+                                .min_by(|&a, &b| values[a].total_cmp(&values[b]))
+                                .ok_or_else(|| CaseError::Option("the mesh has no node".into()))?;
+                            Measure::AtMin { field, axis, node }
+                        }
+                    };
+                    add(self, m, 1, e.span)
+                }
+                "force" => {
+                    let ExprKind::Name(slot) = &args[0].kind else { unreachable!("checked: a slot name") };
+                    let index = match self.slots.iter().position(|(n, _)| *n == slot.name) {
+                        Some(i) => i,
+                        None => {
+                            let form = inst.take_form(&slot.name).ok_or_else(|| {
+                                pf.render(crate::compiler::Diagnostic::error(
+                                    "E0101",
+                                    format!("no form of the files in use provides slot `{}`", slot.name),
+                                    slot.span,
+                                    "not provided",
+                                ))
+                            })?;
+                            self.slots.push((slot.name.clone(), form));
+                            self.slots.len() - 1
+                        }
+                    };
+                    add(self, Measure::Force { slot: index }, d, e.span)
+                }
+                "measure" | "peak" => {
+                    let ExprKind::Name(region) = &args[0].kind else { unreachable!("checked: a region name") };
+                    let facets = binding
+                        .regions
+                        .iter()
+                        .find(|(n, _)| *n == region.name)
+                        .map(|(_, f)| *f)
+                        .ok_or_else(|| CaseError::Option(format!("region `{}` is not bound", region.name)))?;
+                    let index = match region_names.iter().position(|n| *n == region.name) {
+                        Some(i) => i,
+                        None => {
+                            region_names.push(region.name.clone());
+                            self.regions.push(facets);
+                            self.regions.len() - 1
+                        }
+                    };
+                    let val = ex.lower(&args[1], pointwise).map_err(|e| pf.render(*e))?;
+                    let pf_fn = ex.function(&val, &args[1]).map_err(|e| pf.render(*e))?;
+                    let m = if f.name == "measure" {
+                        Measure::Area { region: index, f: pf_fn }
+                    } else {
+                        Measure::Peak { region: index, f: pf_fn }
+                    };
+                    add(self, m, 1, e.span)
+                }
+                name => {
+                    let func = inst.take_functional(name).ok_or_else(|| {
+                        pf.render(crate::compiler::Diagnostic::error(
+                            "E0101",
+                            format!("no functional `{name}` in the files in use"),
+                            f.span,
+                            "not provided",
+                        ))
+                    })?;
+                    add(self, Measure::Functional { f: func }, 1, e.span)
+                }
+            },
+        })
+    }
+
+    /// The names of the columns series.csv shows, in order.
+    pub fn written(&self) -> impl Iterator<Item = &str> {
+        self.columns.iter().filter(|c| c.1).map(|c| c.0.as_str())
+    }
+
+    /// Every column's name (shown or not), in the order of a row's values.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.columns.iter().map(|c| c.0.as_str())
+    }
+
+    /// Which of a row's values series.csv shows.
+    pub fn shown(&self) -> Vec<bool> {
+        self.columns.iter().map(|c| c.1).collect()
+    }
+
+    /// The row at a state: one value per column, and the `contact` slot's switch at each of
+    /// its quadrature points (the active set; empty without the slot).
+    pub fn row(&self, tools: &Tools, s: &State) -> (Vec<f64>, Vec<bool>) {
+        let asm: &Assembler = tools.asm;
+        let mesh = asm.mesh();
+        let d = mesh.dim();
+        let n = asm.size();
+        let mut measured: Vec<Vec<f64>> = Vec::with_capacity(self.measures.len());
+        let mut columns: Vec<f64> = Vec::with_capacity(self.columns.len());
+        let mut samples: Vec<Option<Vec<FacetSample>>> = self.regions.iter().map(|_| None).collect();
+        let mut samples_v: Vec<Option<Vec<FacetSample>>> = self.regions.iter().map(|_| None).collect();
+        let field = |f: u8| if f == 0 { Some(s.u) } else { s.v };
+        let mut kinetic = None;
+        let mut scratch = Vec::new();
+        let mut switches = Vec::new();
+        if let Some((_, probe)) = self.slots.iter().find(|(n, _)| n == "contact") {
+            probe.switches(asm, &[s.u], 0, s.t, &mut switches);
+        }
+        let mut next = 0;
+        for (c, (_, _, f)) in self.columns.iter().enumerate() {
+            // The measures of this column (in the order they were added).
+            while next < self.measures.len() && !self.belongs_after(next, c) {
+                let value: Vec<f64> = match &self.measures[next] {
+                    Measure::Time => vec![s.t],
+                    Measure::Energy => {
+                        let k = *kinetic.get_or_insert_with(|| tools.kinetic(s.v));
+                        vec![tools.energy_with_kinetic(s.u, k)]
+                    }
+                    Measure::Kinetic => vec![*kinetic.get_or_insert_with(|| tools.kinetic(s.v))],
+                    Measure::Newton => vec![s.newton as f64],
+                    Measure::ActivePoints => vec![switches.iter().filter(|b| **b).count() as f64],
+                    Measure::Column(i) => vec![columns[*i]],
+                    Measure::Mean { field: fi, weights, .. } => vec![field(*fi).map_or(f64::NAN, |x| weights.of(x))],
+                    Measure::NodalMean { field: fi, axis } => vec![
+                        field(*fi).map_or(f64::NAN, |x| x.iter().skip(*axis).step_by(d).sum::<f64>() / (n / d) as f64),
+                    ],
+                    Measure::AtMin { field: fi, axis, node } => {
+                        vec![field(*fi).map_or(f64::NAN, |x| x[d * node + axis])]
+                    }
+                    Measure::Force { slot } => {
+                        let mut r = vec![0.0; n];
+                        self.slots[*slot].1.residual(asm, &[s.u], s.t, &mut r);
+                        resultant(&r, d)
+                    }
+                    Measure::Area { region, f } | Measure::Peak { region, f } => {
+                        let us = samples[*region]
+                            .get_or_insert_with(|| facet_samples(mesh, self.regions[*region], self.degree, s.u));
+                        let vs = match (f.reads_v(), s.v) {
+                            (true, Some(v)) => Some(
+                                &*samples_v[*region]
+                                    .get_or_insert_with(|| facet_samples(mesh, self.regions[*region], self.degree, v)),
+                            ),
+                            _ => None,
+                        };
+                        let mut out = [0.0];
+                        let values: Vec<f64> = us
+                            .iter()
+                            .enumerate()
+                            .map(|(i, p)| {
+                                let v = vs.map_or(&[][..], |vs| vs[i].value.as_slice());
+                                f.eval(
+                                    &At { x: &p.x, t: s.t, u: &p.value, v, ..At::default() },
+                                    &mut scratch,
+                                    &mut out,
+                                );
+                                out[0]
+                            })
+                            .collect();
+                        if matches!(self.measures[next], Measure::Area { .. }) {
+                            vec![us.iter().zip(&values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum()]
+                        } else {
+                            vec![values.iter().fold(0.0f64, |m, e| m.max(*e))]
+                        }
+                    }
+                    Measure::Functional { f } => vec![f.value(asm, &[s.u], s.t)],
+                };
+                measured.push(value);
+                next += 1;
+            }
+            let mut out = [0.0];
+            f.eval(&At { measured: &measured, ..At::default() }, &mut scratch, &mut out);
+            columns.push(out[0]);
+        }
+        (columns, switches)
+    }
+
+    /// Whether measure `m` was added for a column after column `c` (measures are added in
+    /// column order, so a column's are measured just before it).
+    fn belongs_after(&self, m: usize, c: usize) -> bool {
+        self.owner.get(m).is_some_and(|&o| o > c)
+    }
+}
+
+/// A summary reducer over the rows.
+enum Reduce {
+    Initial(Option<usize>),
+    Final(Option<usize>),
+    Min(Option<usize>),
+    Max(Option<usize>),
+    /// The first column at the first row where the second is positive.
+    First(Option<usize>, Option<usize>),
+}
+
+/// The problem's summary keys, compiled.
+pub struct SummaryKeys {
+    items: Vec<(String, Vec<Reduce>, PointFn)>,
+}
+
+impl SummaryKeys {
+    /// `columns`: every column's name, in row order (`t` is the rows' time).
+    pub fn new(pf: &ProblemFile, ex: &mut Exprs, columns: &[String]) -> Result<SummaryKeys, CaseError> {
+        let mut items = Vec::new();
+        for d in &pf.problem().summary {
+            let mut reduces = Vec::new();
+            let rewritten = summary_rewrite(&d.value, columns, &mut reduces);
+            let scope: Vec<(String, Val)> = (0..reduces.len()).map(|i| (placeholder(i), ex.measured(i, 1))).collect();
+            let val = ex.lower(&rewritten, &scope).map_err(|e| pf.render(*e))?;
+            items.push((d.name.name.clone(), reduces, ex.function(&val, &d.value).map_err(|e| pf.render(*e))?));
+        }
+        Ok(SummaryKeys { items })
+    }
+
+    /// The keys and their values over `rows` (time, values); null where a reducer has none.
+    pub fn values(&self, rows: &[(f64, Vec<f64>)]) -> Vec<(String, Option<f64>)> {
+        let get = |r: &(f64, Vec<f64>), c: Option<usize>| c.map_or(r.0, |i| r.1[i]);
+        self.items
+            .iter()
+            .map(|(name, reduces, f)| {
+                let measured: Option<Vec<Vec<f64>>> = reduces
+                    .iter()
+                    .map(|r| {
+                        Some(vec![match *r {
+                            Reduce::Initial(c) => get(rows.first()?, c),
+                            Reduce::Final(c) => get(rows.last()?, c),
+                            Reduce::Min(c) => rows.iter().map(|r| get(r, c)).fold(f64::INFINITY, f64::min),
+                            Reduce::Max(c) => rows.iter().map(|r| get(r, c)).fold(f64::NEG_INFINITY, f64::max),
+                            Reduce::First(c, when) => get(rows.iter().find(|r| get(r, when) > 0.0)?, c),
+                        }])
+                    })
+                    .collect();
+                let value = measured.map(|m| {
+                    let mut out = [0.0];
+                    f.eval(&At { measured: &m, ..At::default() }, &mut Vec::new(), &mut out);
+                    out[0]
+                });
+                (name.clone(), value)
+            })
+            .collect()
+    }
+}
+
+fn summary_rewrite(e: &Expr, columns: &[String], reduces: &mut Vec<Reduce>) -> Expr {
+    let col = |a: &Expr| match &a.kind {
+        ExprKind::Name(n) if n.name == "t" => None,
+        ExprKind::Name(n) => columns.iter().position(|c| *c == n.name),
+        _ => unreachable!("checked: a column name"),
+    };
+    let kind = match &e.kind {
+        ExprKind::Call(f, args) => {
+            reduces.push(match f.name.as_str() {
+                "initial" => Reduce::Initial(col(&args[0])),
+                "final" => Reduce::Final(col(&args[0])),
+                "min" => Reduce::Min(col(&args[0])),
+                "max" => Reduce::Max(col(&args[0])),
+                _ => Reduce::First(col(&args[0]), col(&args[1])),
+            });
+            ExprKind::Name(Ident { name: placeholder(reduces.len() - 1), span: e.span })
+        }
+        ExprKind::Neg(a) => ExprKind::Neg(Box::new(summary_rewrite(a, columns, reduces))),
+        ExprKind::Binary(op, a, b) => ExprKind::Binary(
+            *op,
+            Box::new(summary_rewrite(a, columns, reduces)),
+            Box::new(summary_rewrite(b, columns, reduces)),
+        ),
+        other => other.clone(),
+    };
+    Expr { kind, span: e.span }
+}

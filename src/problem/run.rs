@@ -1,0 +1,606 @@
+//! The one loop every problem runs through: bind the problem (mesh, regions, coefs) and the
+//! files in use (scheme, laws, params), initialize, step with cuts and the energy watch, measure
+//! every row, checkpoint, then write series.csv, stages.csv, summary.json, the figure and the
+//! VTU collection. Nothing in it names a problem.
+
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::ProblemFile;
+use super::expr::Exprs;
+use super::observe::{Observer, State, SummaryKeys};
+use crate::cases::CaseError;
+use crate::cases::bar::MassChoice;
+use crate::checkpoint::Control;
+use crate::driver::{Active, ParamValue, Setup};
+use crate::runtime::assembly::{Assembler, Quadrature};
+use crate::runtime::library::Binding;
+use crate::runtime::mesh::CellSize;
+use crate::runtime::newton::NewtonOptions;
+use crate::runtime::problem::Constraints;
+use crate::simulation::{Problem, Simulation, Snapshots};
+
+/// How to run a problem: the command line's or a case file's choices over the problem's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    /// A library problem by name, or a problem file.
+    pub problem: String,
+    /// Scheme, contact law, extra forms, params (the problem's params among them).
+    pub setup: Setup,
+    pub mass: MassChoice,
+    pub cell_size: CellSize,
+    /// A Gmsh file instead of the problem's mesh.
+    pub mesh: Option<PathBuf>,
+    /// Run settings over the problem's `run` line.
+    pub dt: Option<f64>,
+    pub t_start: Option<f64>,
+    pub t_end: Option<f64>,
+    pub newton: NewtonOptions,
+    pub out: Option<PathBuf>,
+    pub vtu_every: usize,
+    pub progress: bool,
+    pub checkpoint_every: usize,
+    pub resume: bool,
+}
+
+impl Options {
+    pub fn new(problem: &str) -> Options {
+        Options {
+            problem: problem.to_string(),
+            setup: Setup::default(),
+            mass: MassChoice::Consistent,
+            cell_size: CellSize::Diameter,
+            mesh: None,
+            dt: None,
+            t_start: None,
+            t_end: None,
+            newton: NewtonOptions::default(),
+            out: None,
+            vtu_every: 0,
+            progress: false,
+            checkpoint_every: 0,
+            resume: false,
+        }
+    }
+}
+
+/// A finished run: its summary and rows (every column, shown or not).
+pub struct Run {
+    /// summary.json's keys in order: the shared ones, with the problem's own after `steps`.
+    pub summary: Summary,
+    /// Every column's name, in row order.
+    pub columns: Vec<String>,
+    /// (time, values) per row.
+    pub rows: Vec<(f64, Vec<f64>)>,
+    /// The `contact` slot's switch at each of its quadrature points, per row (the active set).
+    pub switches: Vec<Vec<bool>>,
+    /// Multi-stage schemes: (stage name, time, values) at every intermediate stage.
+    pub stages: Vec<(String, f64, Vec<f64>)>,
+}
+
+impl Run {
+    /// A column's values over the rows.
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let i = self.columns.iter().position(|c| c == name)?;
+        Some(self.rows.iter().map(|r| r.1[i]).collect())
+    }
+}
+
+/// The run's settings: the problem's `run` line under the options.
+struct Settings {
+    dt: f64,
+    t_start: f64,
+    t_end: f64,
+}
+
+/// Binds a problem with the library's defaults without running it: its params, the files in use
+/// and their coefs, the mesh with its regions, the coefs' and initial fields' expressions in the
+/// problem's dimension (`signorini check` on a problem file).
+pub fn check(problem: &str) -> Result<(), CaseError> {
+    let opts = Options::new(problem);
+    bound(&opts, |pf, _, ex, _| {
+        let p = pf.problem();
+        super::bind::settings(pf, ex, &p.run)?;
+        super::bind::settings(pf, ex, &p.quadrature)?;
+        let (mesh, _) = super::bind::mesh(pf, ex, None, CellSize::Diameter)?;
+        super::bind::coefs(pf, ex)?;
+        super::bind::coef_vals(pf, ex)?;
+        super::bind::initial(pf, ex, &mesh, "u", 0.0)?;
+        super::bind::initial(pf, ex, &mesh, "v", 0.0)?;
+        Ok(())
+    })
+}
+
+pub fn run(opts: &Options) -> Result<Run, CaseError> {
+    bound(opts, |pf, params, ex, active| {
+        let given = super::bind::settings(pf, ex, &pf.problem().run)?;
+        let setting = |name: &str, over: Option<f64>, default: f64| {
+            over.or_else(|| given.iter().find(|(n, _)| n == name).map(|(_, v)| *v)).unwrap_or(default)
+        };
+        let settings = Settings {
+            dt: setting("dt", opts.dt, f64::NAN),
+            t_start: setting("t_start", opts.t_start, 0.0),
+            t_end: setting("t_end", opts.t_end, f64::NAN),
+        };
+        let positive = |x: f64| x > 0.0 && x.is_finite();
+        if !positive(settings.dt) || !positive(settings.t_end) || settings.t_end / settings.dt > 1e7 {
+            return Err(CaseError::Option(
+                "--dt and --t-end (or the problem's `run dt = ..., t_end = ...`) must be positive, with at most 10⁷ steps"
+                    .into(),
+            ));
+        }
+        if !(settings.t_start >= 0.0 && settings.t_start < settings.t_end) {
+            return Err(CaseError::Option(format!("--t-start must be in [0, t_end), not {}", settings.t_start)));
+        }
+        simulate(opts, pf, params, ex, active, &settings)
+    })
+}
+
+/// Loads the problem, resolves its params and the files in use (the problem's `set` values as
+/// the case's overrides, the user's settings over them), checks what the driver needs of it,
+/// and hands the bound pieces to `f`.
+fn bound<R>(
+    opts: &Options,
+    f: impl FnOnce(&ProblemFile, &[super::ProblemParam], &mut Exprs, &Active) -> Result<R, CaseError>,
+) -> Result<R, CaseError> {
+    let pf = super::load(&opts.problem)?;
+    let (params, rest) = super::params(&pf, &opts.setup.params)?;
+    let setup = Setup { params: rest, ..opts.setup.clone() };
+    let d = super::bind::dimension(&pf, opts.mesh.as_deref())?;
+    let values: Vec<(String, f64)> = params.iter().map(|p| (p.name.clone(), p.value)).collect();
+    let p = pf.problem();
+    let mut ex = Exprs::new(&pf.program.unit, d, &values, &p.lets).map_err(|e| pf.render(*e))?;
+    let mut sets = Vec::new();
+    for s in &p.sets {
+        sets.push((s.name.name.clone(), ex.scalar(&s.value).map_err(|e| pf.render(*e))?));
+    }
+    let overrides: Vec<(&str, f64)> = sets.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+    let active = Active::resolve(&setup, &overrides)?;
+    unsupported(&pf)?;
+    unset_coefs(&pf, &active)?;
+    f(&pf, &params, &mut ex, &active)
+}
+
+/// The problem items the driver does not run yet: an error at each, not a silent omission.
+fn unsupported(pf: &ProblemFile) -> Result<(), CaseError> {
+    use crate::compiler::Diagnostic;
+    let p = pf.problem();
+    let not_yet = |span, what: &str| {
+        pf.render(
+            Diagnostic::error("E0101", format!("{what} are not run by the driver yet"), span, "not supported yet")
+                .with_note("the problem checks; its run needs this item, which a later version adds"),
+        )
+    };
+    if let Some(d) = p.dirichlet.first() {
+        return Err(not_yet(d.span, "Dirichlet conditions"));
+    }
+    if let Some(b) = p.binds.first() {
+        return Err(not_yet(b.span, "`bind` lines (use --scheme, --contact, --material, --forms)"));
+    }
+    if let Some(r) = &p.reference {
+        return Err(not_yet(r.span, "references"));
+    }
+    if let Some(r) = p.regions.iter().find(|r| r.name.name != "Gamma_C") {
+        return Err(not_yet(r.span, "regions other than `Gamma_C`"));
+    }
+    if !p.regions.iter().any(|r| r.name.name == "Gamma_C") {
+        return Err(pf.render(
+            Diagnostic::error("E0101", "no region `Gamma_C`", p.name.span, "the contact forms integrate over it")
+                .with_help("add `region Gamma_C = group \"NAME\"` or `region Gamma_C = boundary where ...`"),
+        ));
+    }
+    Ok(())
+}
+
+/// Every coef the files in use read must be set by the problem (a `coef` line, or an
+/// obstacle's `g` and `nc`): a located error before anything runs. A coef the problem sets that
+/// no file reads is a warning (a misspelt name, or a file left out).
+fn unset_coefs(pf: &ProblemFile, active: &Active) -> Result<(), CaseError> {
+    use crate::compiler::Diagnostic;
+    let p = pf.problem();
+    let read: Vec<String> = active.forms.units.iter().flat_map(|u| u.coefs()).map(|(n, _)| n).collect();
+    for c in &p.coefs {
+        if !read.contains(&c.name.name) {
+            let files: Vec<&str> = active.forms.units.iter().map(|u| u.file()).collect();
+            let w = crate::compiler::check::problem::unread_coef(&c.name, &files);
+            eprintln!("{}", crate::compiler::render_all(&[w], &pf.program.unit.sources).trim_end());
+        }
+    }
+    let mut set: Vec<&str> = p.coefs.iter().map(|c| c.name.name.as_str()).collect();
+    if !p.obstacles.is_empty() {
+        set.extend(["g", "nc"]);
+    }
+    for unit in &active.forms.units {
+        for (c, _) in unit.coefs() {
+            if !set.contains(&c.as_str()) {
+                let mut d = Diagnostic::error(
+                    "E0101",
+                    format!("problem `{}` does not set coef `{c}`, which {} reads", pf.name(), unit.file()),
+                    p.name.span,
+                    "no `coef` line for it",
+                )
+                .with_help(format!("add `coef {c} = EXPR` (an expression of x and t) to the problem"));
+                if let Some(close) = crate::compiler::check::suggest_name(&c, set.iter().copied()) {
+                    d = d.with_note(format!("the problem sets `{close}`: a misspelling?"));
+                }
+                return Err(pf.render(d));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Each coef the problem sets has the components the files in use read it with.
+fn coef_shapes(
+    pf: &ProblemFile,
+    active: &Active,
+    coefs: &[(String, super::expr::PointFn)],
+    d: usize,
+) -> Result<(), CaseError> {
+    use crate::compiler::Diagnostic;
+    for unit in &active.forms.units {
+        for (name, rank) in unit.coefs() {
+            let Some((_, f)) = coefs.iter().find(|(n, _)| *n == name) else { continue };
+            let need = d.pow(rank);
+            if f.len() != need {
+                let at = pf
+                    .problem()
+                    .coefs
+                    .iter()
+                    .find(|c| c.name.name == name)
+                    .map_or(pf.problem().name.span, |c| c.value.span);
+                let shape = ["a scalar", "a vector", "a tensor"][rank.min(2) as usize];
+                return Err(pf.render(Diagnostic::error(
+                    "E0301",
+                    "shape mismatch",
+                    at,
+                    format!("{} reads `{name}` as {shape} ({need} components in {d}D), not {}", unit.file(), f.len()),
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn simulate(
+    opts: &Options,
+    pf: &ProblemFile,
+    params: &[super::ProblemParam],
+    ex: &mut Exprs,
+    active: &Active,
+    settings: &Settings,
+) -> Result<Run, CaseError> {
+    let start = Instant::now();
+    let p = pf.problem();
+    let (mesh, mesh_label) = super::bind::mesh(pf, ex, opts.mesh.as_deref(), opts.cell_size)?;
+    let asm = Assembler::new(&mesh);
+    let n = asm.size();
+    let quad = super::bind::settings(pf, ex, &p.quadrature)?;
+    let max = crate::compiler::ir::MAX_DEGREE as f64;
+    let degree = |name: &str| -> Result<Option<u32>, CaseError> {
+        match quad.iter().find(|(n, _)| n == name) {
+            None => Ok(None),
+            Some((_, v)) if (1.0..=max).contains(v) && v.fract() == 0.0 => Ok(Some(*v as u32)),
+            Some((_, v)) => Err(CaseError::Option(format!(
+                "{}: quadrature {name} = {v}: a degree is a whole number in [1, {max}]",
+                pf.file
+            ))),
+        }
+    };
+    let quadrature = Quadrature { cell: degree("cell")?, facet: degree("facet")? };
+    let coef_fns = super::bind::coefs(pf, ex)?;
+    coef_shapes(pf, active, &coef_fns, mesh.dim())?;
+    let coefs = super::bind::coef_lookup(&coef_fns);
+    let contact = "Gamma_C";
+    let problem = Problem {
+        coefs: &coefs,
+        quadrature,
+        contact,
+        constraints: Constraints::none(n),
+        mass: opts.mass,
+        newton: opts.newton,
+    };
+    let mut control = Control::new(
+        opts.checkpoint_every,
+        opts.out.clone(),
+        identity(opts, pf, params, active, &mesh, settings),
+        opts.resume,
+    )?;
+    let mut sim = Simulation::new(&asm, problem, active)?;
+    let t0 = settings.t_start;
+    let u0 = super::bind::initial(pf, ex, &mesh, "u", t0)?;
+    let v0 = super::bind::initial(pf, ex, &mesh, "v", t0)?;
+    sim.initialize_at(t0, u0, v0)?;
+    let binding = Binding { quadrature, regions: vec![(contact.into(), sim.tools.contact_facets)], dim: mesh.dim() };
+    let coef_vals = super::bind::coef_vals(pf, ex)?;
+    let observer =
+        Observer::new(pf, ex, &sim.tools, &active.forms, &coefs, &binding, &coef_vals, quadrature.facet.unwrap_or(7))?;
+    let columns: Vec<String> = observer.names().map(str::to_string).collect();
+    let shown = observer.shown();
+    let summary_fns = SummaryKeys::new(pf, ex, &columns)?;
+    let row = |tools: &crate::simulation::Tools, u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| {
+        let (values, switches) = observer.row(tools, &State { t, u, v, newton });
+        ((t, values), switches)
+    };
+    let (first, first_switches) = row(&sim.tools, &sim.states[0], sim.velocity(), 0, t0);
+    let mut series = vec![first];
+    let mut switches = vec![first_switches];
+    // Newton iterations of each row's step (0 for the initial state).
+    let mut iterations: Vec<usize> = vec![0];
+    let steps = ((settings.t_end - t0) / settings.dt).round() as usize;
+    let name = pf.name().to_string();
+    let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, &name);
+    // A scheme without a velocity state: the step's mean velocity.
+    let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64], dt: f64| -> Vec<f64> {
+        match v_index {
+            Some(i) => states[i].clone(),
+            None => states[0].iter().zip(before).map(|(a, b)| (a - b) / dt).collect(),
+        }
+    };
+    let v_index = sim.v_index;
+    let stage_rows: RefCell<Vec<(String, f64, Vec<f64>)>> = RefCell::new(Vec::new());
+    let (mut saved_rows, mut saved_stages, mut saved_snapshots) = (0, 0, 0);
+    match control.observer() {
+        Some(records) => {
+            let stages = sim.stepper.desc().stages;
+            series.clear();
+            iterations.clear();
+            switches.clear();
+            for bytes in records {
+                let record: Record = postcard::from_bytes(bytes)
+                    .map_err(|e| CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})")))?;
+                series.extend(record.series);
+                iterations.extend(record.iterations);
+                switches.extend(record.switches);
+                for (stage, t, values) in record.stages {
+                    if !stages.iter().any(|s| s.name == stage) {
+                        return Err(CaseError::Option(format!(
+                            "the checkpoint has a stage `{stage}`, which this scheme has not"
+                        )));
+                    }
+                    stage_rows.borrow_mut().push((stage, t, values));
+                }
+                snapshots.extend_written(record.snapshots);
+            }
+            (saved_rows, saved_stages, saved_snapshots) =
+                (series.len(), stage_rows.borrow().len(), snapshots.written().len());
+        }
+        None => snapshots.write(
+            &sim.tools,
+            0,
+            t0,
+            &sim.states[0],
+            &velocity(&sim.states, v_index, &sim.states[0], settings.dt),
+        )?,
+    }
+    let names = sim.stepper.desc().states;
+    let outcome = sim.run(
+        t0,
+        settings.dt,
+        steps,
+        opts.progress,
+        &mut control,
+        &mut |tools, stage, v_index| {
+            if let Some(u) = stage.value_of(names[0]) {
+                let v = v_index.and_then(|i| stage.value_of(names[i]));
+                let ((t, values), _) = row(tools, u, v, 0, stage.time);
+                stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
+            }
+        },
+        &mut |tools, step, record| {
+            let v = v_index.map(|i| step.states[i].as_slice());
+            let (values, active) = row(tools, &step.states[0], v, step.report.iterations(), step.t);
+            series.push(values);
+            switches.push(active);
+            iterations.push(step.report.iterations());
+            snapshots.write(
+                tools,
+                step.k,
+                step.t,
+                &step.states[0],
+                &velocity(step.states, v_index, step.before, step.dt),
+            )?;
+            if let Some(record) = record {
+                let stages = stage_rows.borrow();
+                *record = postcard::to_stdvec(&Record {
+                    series: series[saved_rows..].to_vec(),
+                    iterations: iterations[saved_rows..].to_vec(),
+                    switches: switches[saved_rows..].to_vec(),
+                    stages: stages[saved_stages..].to_vec(),
+                    snapshots: snapshots.written()[saved_snapshots..].to_vec(),
+                })
+                .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
+                (saved_rows, saved_stages, saved_snapshots) = (series.len(), stages.len(), snapshots.written().len());
+            }
+            Ok(())
+        },
+    )?;
+    let stage_rows = stage_rows.into_inner();
+    snapshots.finish()?;
+    let wall = start.elapsed().as_secs_f64();
+    let counters = sim.stepper.counters();
+    let mut summary = Summary::default();
+    let mut put = |k: &str, v: serde_json::Value| summary.keys.push((k.to_string(), v));
+    put("case", name.clone().into());
+    put("problem", pf.file.clone().into());
+    put("scheme", active.scheme_name().into());
+    put("contact", active.forms.contact_name().into());
+    put("interpreted", json(&active.interpreted()));
+    put("params", json(&all_params(active, params, pf)));
+    put("mass", json(&opts.mass));
+    put("cell_size", json(&opts.cell_size));
+    put("mesh", mesh_label.clone().into());
+    put("cells", mesh.num_cells().into());
+    put("dofs", n.into());
+    put("dt", json(&settings.dt));
+    put("steps", steps.into());
+    let own = summary_fns.values(&series);
+    for (k, v) in &own {
+        put(k, json(v));
+    }
+    put("newton_total", iterations.iter().sum::<usize>().into());
+    put("newton_max", iterations.iter().max().copied().unwrap_or(0).into());
+    put("wall_seconds", json(&wall));
+    put("seconds_per_step", json(&(wall / steps.max(1) as f64)));
+    put("stepping_seconds", json(&outcome.step_seconds.iter().sum::<f64>()));
+    put("step_median_seconds", json(&crate::bench::median(outcome.step_seconds.clone())));
+    put("factorizations", counters.numeric.into());
+    put("low_rank_updates", counters.updates.into());
+    put("matrix_nnz", sim.tools.asm.pattern().nnz().into());
+    put("factor_nnz", json(&sim.stepper.factor_nnz()));
+    put("solver", json(&opts.newton.solver));
+    put("krylov_iterations", counters.iterations.into());
+    put("peak_memory_bytes", json(&crate::bench::peak_memory()));
+    put("step_cuts", outcome.cuts.into());
+    if let Some(stopped) = &outcome.stopped {
+        put("stopped", stopped.to_string().into());
+    }
+    if let Some(resumed) = &outcome.resumed {
+        put("resumed", json(resumed));
+    }
+    summary.own = own.into_iter().map(|(k, _)| k).collect();
+    let run = Run { summary, columns, rows: series, switches, stages: stage_rows };
+    if let Some(dir) = &opts.out {
+        write_outputs(dir, pf, &run, &shown)?;
+    }
+    if let Some(e) = outcome.stopped {
+        return Err(e);
+    }
+    Ok(run)
+}
+
+/// A run's summary: keys in order.
+#[derive(Default)]
+pub struct Summary {
+    pub keys: Vec<(String, serde_json::Value)>,
+    /// The problem's own keys (`summary NAME = ...`).
+    pub own: Vec<String>,
+}
+
+impl Summary {
+    pub fn get(&self, key: &str) -> Option<&serde_json::Value> {
+        self.keys.iter().find(|(k, _)| k == key).map(|(_, v)| v)
+    }
+
+    /// A number of the summary (`None` when absent or null).
+    pub fn number(&self, key: &str) -> Option<f64> {
+        self.get(key)?.as_f64()
+    }
+}
+
+impl Serialize for Summary {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = s.serialize_map(Some(self.keys.len()))?;
+        for (k, v) in &self.keys {
+            map.serialize_entry(k, v)?;
+        }
+        map.end()
+    }
+}
+
+/// A value as JSON (non-finite numbers become null, as serde_json writes them).
+fn json<T: Serialize + ?Sized>(v: &T) -> serde_json::Value {
+    serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
+}
+
+/// Every param in effect: the problem's, the scheme's and the form files'.
+fn all_params(active: &Active, params: &[super::ProblemParam], pf: &ProblemFile) -> BTreeMap<String, ParamValue> {
+    let mut out = active.forms.params.values();
+    for q in params {
+        let declared = pf.problem().params.iter().find(|d| d.name.name == q.name).map(|d| d.span);
+        let line = declared.map_or(0, |s| pf.program.unit.sources.line_col(s.file, s.start).0);
+        out.insert(
+            format!("{}.{}", pf.name(), q.name),
+            ParamValue { value: q.value, source: q.source, declared: format!("{}:{line}", pf.file) },
+        );
+    }
+    out
+}
+
+/// What a checkpoint keeps of the run: what is new since the checkpoint before.
+#[derive(Serialize, Deserialize)]
+struct Record {
+    series: Vec<(f64, Vec<f64>)>,
+    iterations: Vec<usize>,
+    switches: Vec<Vec<bool>>,
+    stages: Vec<(String, f64, Vec<f64>)>,
+    snapshots: Vec<(f64, String)>,
+}
+
+/// What a resumed run must share with its checkpoint.
+fn identity(
+    opts: &Options,
+    pf: &ProblemFile,
+    params: &[super::ProblemParam],
+    active: &Active,
+    mesh: &crate::runtime::mesh::Mesh,
+    s: &Settings,
+) -> crate::checkpoint::Identity {
+    let mut more = vec![
+        ("problem file", format!("{} ({:016x})", pf.file, pf.text_hash)),
+        ("mass", format!("{:?}", opts.mass)),
+        ("cell size", format!("{:?}", opts.cell_size)),
+        ("dt", format!("{:?}", s.dt)),
+        ("t_start", format!("{:?}", s.t_start)),
+        ("t_end", format!("{:?}", s.t_end)),
+        ("Newton options", format!("{:?}", opts.newton)),
+        ("checkpoint period", opts.checkpoint_every.to_string()),
+    ];
+    let problem_params: Vec<String> = params.iter().map(|p| format!("{} = {:?}", p.name, p.value)).collect();
+    more.push(("problem params", problem_params.join(", ")));
+    crate::checkpoint::identity(pf.name(), active, mesh, &more)
+}
+
+fn write_outputs(dir: &Path, pf: &ProblemFile, run: &Run, shown: &[bool]) -> Result<(), CaseError> {
+    let header: Vec<&str> = std::iter::once("t")
+        .chain(run.columns.iter().zip(shown).filter(|(_, s)| **s).map(|(c, _)| c.as_str()))
+        .collect();
+    let header = header.join(",");
+    let line = |t: f64, values: &[f64]| {
+        let mut s = format!("{t}");
+        for (v, _) in values.iter().zip(shown).filter(|(_, s)| **s) {
+            s.push_str(&format!(",{v}"));
+        }
+        s.push('\n');
+        s
+    };
+    let mut csv = format!("{header}\n");
+    run.rows.iter().for_each(|(t, v)| csv.push_str(&line(*t, v)));
+    let err = |path: PathBuf| move |source| CaseError::Write { path: path.display().to_string(), source };
+    crate::output::write_atomic(&dir.join("series.csv"), csv.as_bytes()).map_err(err(dir.join("series.csv")))?;
+    crate::output::write_json(&dir.join("summary.json"), &run.summary).map_err(err(dir.join("summary.json")))?;
+    if !run.stages.is_empty() {
+        let mut csv = format!("stage,{header}\n");
+        for (stage, t, values) in &run.stages {
+            csv.push_str(&format!("{stage},{}", line(*t, values)));
+        }
+        crate::output::write_atomic(&dir.join("stages.csv"), csv.as_bytes()).map_err(err(dir.join("stages.csv")))?;
+    }
+    let plots = &pf.problem().plots;
+    if plots.is_empty() {
+        return Ok(());
+    }
+    use crate::plot::Curve;
+    let panels: Vec<(&str, &str, Vec<Curve>)> = plots
+        .iter()
+        .map(|pl| {
+            let curves = pl
+                .columns
+                .iter()
+                .filter_map(|c| {
+                    let i = run.columns.iter().position(|n| *n == c.name)?;
+                    let points = run.rows.iter().map(|(t, v)| (*t, v[i])).collect();
+                    Some(Curve { label: c.name.as_str(), points, dashed: false })
+                })
+                .collect();
+            (pl.title.as_str(), pl.title.as_str(), curves)
+        })
+        .collect();
+    crate::plot::panels(&dir.join(format!("{}.png", pf.name())), "t", &panels)
+        .map_err(|e| CaseError::Write { path: dir.display().to_string(), source: std::io::Error::other(e) })
+}
