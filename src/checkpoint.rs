@@ -46,6 +46,8 @@ pub struct DriverState {
     /// The energy check: E(0), the largest work of the loads so far, u(0).
     pub energy_initial: f64,
     pub energy_work: f64,
+    /// The work of a time-dependent load so far.
+    pub energy_varying_work: f64,
     pub energy_u0: Vec<f64>,
     pub states: Vec<Vec<f64>>,
     /// Written every N steps (resumes bit for bit), or on an interrupt (to round-off).
@@ -245,6 +247,7 @@ mod tests {
             cuts: 1,
             energy_initial: 1.5,
             energy_work: 0.0,
+            energy_varying_work: 0.0,
             energy_u0: vec![0.0, 1.0],
             states: vec![vec![f64::NAN, -0.0, 1e-300], vec![f64::INFINITY, 2.0, 3.0]],
             periodic: true,

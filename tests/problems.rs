@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use signorini::driver::{Setting, Setup};
+use signorini::driver::Setting;
 use signorini::problem::run::{Options, Run, run};
 
 fn temp_dir(tag: &str) -> PathBuf {
@@ -41,9 +41,8 @@ fn a_library_problem_copied_elsewhere_runs_by_path_with_the_same_bits() {
 #[test]
 fn a_user_coef_set_by_the_problem_reaches_the_forms() {
     let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems");
-    let mut o = Options::new(here.join("graded_density.wf").to_str().unwrap());
-    o.setup = Setup { material: here.join("graded_material.wf").display().to_string(), ..Setup::default() };
-    let r = run(&o).unwrap();
+    // The problem binds its material file (graded_material.wf, beside it).
+    let r = run(&Options::new(here.join("graded_density.wf").to_str().unwrap())).unwrap();
     // Mass ρζ and load ρζg: the free fall is a rigid translation, u = −g t²/2 at every node.
     let t_star = 40f64.sqrt();
     let (mean, lowest) = (r.column("uy_mean").unwrap(), r.column("uy_lowest").unwrap());
@@ -58,8 +57,9 @@ fn a_user_coef_set_by_the_problem_reaches_the_forms() {
     }
     assert!(checked > 100);
     // The graded density is in the forms: the contact then differs from the uniform disc's.
+    // The user's choice wins over the problem's bind: the library's uniform material.
     let mut uniform = Options::new(here.join("graded_density.wf").to_str().unwrap());
-    uniform.setup = Setup::default();
+    uniform.chosen.material = true;
     let u = run(&uniform).unwrap();
     let (a, b) = (r.column("uy_mean").unwrap(), u.column("uy_mean").unwrap());
     assert!((a.last().unwrap() - b.last().unwrap()).abs() > 1e-6, "zeta changed nothing after impact");
@@ -104,4 +104,105 @@ fn a_ball_obstacle_tends_to_the_plane_as_its_radius_grows() {
         assert!((8.0..12.0).contains(&ratio), "differences {d:?}: ratio {ratio}");
     }
     assert!(d[2] < 1e-5, "{d:?}");
+}
+
+/// Dirichlet conditions: the compressed bar posed as a problem (held at x = 1) reproduces the
+/// built-in bar's columns bit for bit, and the elastic force at the held end at t = 0 is that of
+/// u₀ = (1 − x)/2: E u₀' = −1/2, so −(K u₀) at x = 1 is +1/2.
+#[test]
+fn the_bar_posed_with_a_dirichlet_condition_is_the_built_in_bar() {
+    use signorini::cases::bar;
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems/bar.wf");
+    let mut o = Options::new(file.to_str().unwrap());
+    o.t_end = Some(3.0);
+    let posed = run(&o).unwrap();
+    let built_in = bar::run(&bar::Options { t_end: 3.0, ..bar::Options::default() }).unwrap();
+    assert_eq!(posed.rows.len(), built_in.series.len());
+    let col = |name: &str| posed.column(name).unwrap();
+    type Of = fn(&bar::Row) -> f64;
+    let pairs: [(&str, Of); 6] = [
+        ("u_c", |r| r.u_c),
+        ("v_c", |r| r.v_c),
+        ("lambda", |r| r.lambda),
+        ("energy", |r| r.energy),
+        ("energy_aug", |r| r.energy_aug),
+        ("penetration", |r| r.penetration),
+    ];
+    for (name, of) in pairs {
+        let a = col(name);
+        for (i, r) in built_in.series.iter().enumerate() {
+            assert_eq!(a[i].to_bits(), of(r).to_bits(), "{name} at t = {}: {} vs {}", r.t, a[i], of(r));
+        }
+    }
+    let wall = col("wall_force");
+    assert!((wall[0] - 0.5).abs() < 1e-12, "{}", wall[0]);
+    // Contact happened: the comparison covers the impact.
+    assert!(col("lambda").iter().any(|l| *l < 0.0));
+}
+
+/// A time-dependent traction (a user coef on a region of the problem, read by a material file
+/// of the user's): the bar pulled at its end by p t follows d'Alembert's u(1, t) = p t²/2 until
+/// the wave reflected at the free end comes back at t = 2, with the error of the end
+/// displacement falling at order 2 under refinement at a fixed Courant number.
+#[test]
+fn a_traction_on_a_region_of_the_problem_follows_d_alembert() {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems");
+    let error = |ne: usize| {
+        let mut o = Options::new(here.join("traction_bar.wf").to_str().unwrap());
+        o.setup.params.push(Setting { name: "ne".into(), value: ne as f64, origin: "test".into() });
+        o.dt = Some(0.5 / ne as f64);
+        let r = run(&o).unwrap();
+        assert!(r.column("active_points").unwrap().iter().all(|a| *a == 0.0), "the bar reached the obstacle");
+        let (t, u) = (r.rows.last().unwrap().0, r.column("u_end").unwrap());
+        assert!((t - 1.9).abs() < 1e-12 && *u.last().unwrap() > 0.18, "t = {t}");
+        r.column("error").unwrap().iter().fold(0.0f64, |m, e| m.max(e.abs()))
+    };
+    let e: Vec<f64> = [80, 160, 320].iter().map(|&ne| error(ne)).collect();
+    for w in e.windows(2) {
+        let order = (w[0] / w[1]).log2();
+        assert!((1.8..3.0).contains(&order), "errors {e:?}: order {order}");
+    }
+    // About 1e-6 of u(1, 1.9) = 0.1805 on the finest mesh.
+    assert!(e[2] < 2e-6 * 0.1805, "{e:?}");
+}
+
+/// The ring of examples/problems (a Gmsh annulus with physical groups) thrown with a spin onto
+/// an inclined plane: before it lands, its centre of mass follows the parabola exactly, its
+/// momentum changes by the gravity impulse, and its linearized angular momentum about the
+/// centre is conserved to round-off (K annihilates an infinitesimal rotation and gravity has no
+/// moment about the centre of mass); after, Newmark with Nitsche θ = 1 keeps E_aug on every step
+/// whose active set is unchanged.
+#[test]
+fn the_thrown_ring_flies_exactly_and_keeps_its_energy_law_after_landing() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/problems/ring.wf");
+    let r = run(&Options::new(file.to_str().unwrap())).unwrap();
+    let (v0, g) = (0.5, 0.1);
+    let col = |name: &str| r.column(name).unwrap();
+    let (ux, uy, vy, l) = (col("ux_cm"), col("uy_cm"), col("vy_cm"), col("angular_momentum"));
+    let first = r.summary.number("first_contact").expect("the ring lands");
+    let mut flight = 0;
+    for (i, (t, _)) in r.rows.iter().enumerate().take_while(|(_, (t, _))| *t < first - 1e-9) {
+        assert!((ux[i] - v0 * t).abs() < 1e-10, "t = {t}: x {} vs {}", ux[i], v0 * t);
+        assert!((uy[i] + 0.5 * g * t * t).abs() < 1e-10, "t = {t}: y {}", uy[i]);
+        assert!((vy[i] + g * t).abs() < 1e-10, "t = {t}: vy {}", vy[i]);
+        assert!((l[i] - l[0]).abs() < 1e-12 * l[0].abs(), "t = {t}: L {} vs {}", l[i], l[0]);
+        flight += 1;
+    }
+    assert!(flight > 100 && l[0].abs() > 1.0, "{flight} rows of flight, L = {}", l[0]);
+    // After landing: the contact's moment changes L, and E_aug is kept while the set is.
+    assert!((l.last().unwrap() - l[0]).abs() > 1e-3 * l[0].abs());
+    let e = col("energy_aug");
+    let (mut kept, mut changed) = (0, 0);
+    for i in 1..r.rows.len() {
+        if r.rows[i].0 < first {
+            continue;
+        }
+        if r.switches[i] == r.switches[i - 1] {
+            kept += 1;
+            assert!((e[i] - e[i - 1]).abs() < 1e-9 * e[0].abs(), "t = {}: ΔE_aug {}", r.rows[i].0, e[i] - e[i - 1]);
+        } else {
+            changed += 1;
+        }
+    }
+    assert!(kept > 50 && changed > 3, "kept {kept}, changed {changed}");
 }

@@ -63,6 +63,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0818", "scheme: a stage time that is not finite for some parameter values"),
     ("E0819", "scheme: an unknown claim, or one that is not a function of the parameters"),
     ("E0901", "problem: no mesh"),
+    ("E0905", "problem: a Dirichlet condition on a contact region"),
     ("W0001", "unused parameter (warning)"),
     ("W0002", "a scheme `let` hides another name (warning)"),
     ("W0003", "a `fn` or `form` argument hides a name of the file (warning)"),

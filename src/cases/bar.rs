@@ -188,6 +188,7 @@ fn simulate(opts: &Options, active: &Active) -> Result<Run, CaseError> {
         coefs: &coefs,
         quadrature: Quadrature::default(),
         contact: "left",
+        regions: &[],
         constraints,
         mass: opts.mass,
         newton: opts.newton,

@@ -213,6 +213,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         progress: opts.progress,
         checkpoint_every: opts.checkpoint_every,
         resume: opts.resume,
+        chosen: crate::problem::run::Chosen::all(),
     };
     let run = crate::problem::run::run(&problem)?;
     from_problem(opts, &run)

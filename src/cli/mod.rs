@@ -847,6 +847,11 @@ fn run_problem(problem: &str, a: ProblemArgs) -> ExitCode {
         progress: true,
         checkpoint_every: a.checkpoint.checkpoint_every,
         resume: a.checkpoint.resume.is_some(),
+        chosen: crate::problem::run::Chosen {
+            scheme: a.methods.scheme.is_some(),
+            contact: a.methods.contact.is_some(),
+            material: a.methods.material.is_some(),
+        },
     };
     finish_problem(crate::problem::run::run(&opts))
 }

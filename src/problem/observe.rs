@@ -39,9 +39,10 @@ enum Measure<'m> {
         axis: usize,
         node: usize,
     },
-    /// The resultant of slot form `slot`'s residual.
+    /// The resultant of slot form `slot`'s residual, over the dofs listed (all without a list).
     Force {
         slot: usize,
+        dofs: Option<Vec<usize>>,
     },
     /// `measure(REGION, EXPR)`: the weight of the region's points where EXPR ≥ 0.
     Area {
@@ -55,6 +56,11 @@ enum Measure<'m> {
     },
     Functional {
         f: Box<dyn BoundFunctional + 'm>,
+    },
+    /// `inner_mass(A, B)`: aᵀ M b with the scheme's mass, A and B evaluated at the nodes.
+    InnerMass {
+        a: PointFn,
+        b: PointFn,
     },
 }
 
@@ -244,7 +250,24 @@ impl<'m> Observer<'m> {
                             self.slots.len() - 1
                         }
                     };
-                    add(self, Measure::Force { slot: index }, d, e.span)
+                    // Over a region: the dofs of its nodes, component by component.
+                    let dofs = match args.get(1).map(|a| &a.kind) {
+                        Some(ExprKind::Name(region)) => {
+                            let mesh = tools.asm.mesh();
+                            let nodes = mesh.region_nodes(mesh.region(&region.name)?);
+                            Some(nodes.iter().flat_map(|&n| (0..d).map(move |k| n as usize * d + k)).collect())
+                        }
+                        _ => None,
+                    };
+                    add(self, Measure::Force { slot: index, dofs }, d, e.span)
+                }
+                "inner_mass" => {
+                    let mut field = |e: &Expr| -> Result<PointFn, CaseError> {
+                        let val = ex.lower(e, pointwise).map_err(|d| pf.render(*d))?;
+                        ex.function(&val, e).map_err(|d| pf.render(*d))
+                    };
+                    let (a, b) = (field(&args[0])?, field(&args[1])?);
+                    add(self, Measure::InnerMass { a, b }, 1, e.span)
                 }
                 "measure" | "peak" => {
                     let ExprKind::Name(region) = &args[0].kind else { unreachable!("checked: a region name") };
@@ -340,10 +363,15 @@ impl<'m> Observer<'m> {
                     Measure::AtMin { field: fi, axis, node } => {
                         vec![field(*fi).map_or(f64::NAN, |x| x[d * node + axis])]
                     }
-                    Measure::Force { slot } => {
+                    Measure::Force { slot, dofs } => {
                         let mut r = vec![0.0; n];
                         self.slots[*slot].1.residual(asm, &[s.u], s.t, &mut r);
-                        resultant(&r, d)
+                        match dofs {
+                            None => resultant(&r, d),
+                            Some(dofs) => (0..d)
+                                .map(|k| -dofs.iter().filter(|&&i| i % d == k).map(|&i| r[i]).sum::<f64>())
+                                .collect(),
+                        }
                     }
                     Measure::Area { region, f } | Measure::Peak { region, f } => {
                         let us = samples[*region]
@@ -376,6 +404,19 @@ impl<'m> Observer<'m> {
                         }
                     }
                     Measure::Functional { f } => vec![f.value(asm, &[s.u], s.t)],
+                    Measure::InnerMass { a, b } => {
+                        let nodal = |f: &PointFn, scratch: &mut Vec<f64>| {
+                            let mut out = vec![0.0; n];
+                            for (i, o) in out.chunks_mut(d).enumerate() {
+                                let u = &s.u[d * i..d * i + d];
+                                let v = s.v.map_or(&[][..], |v| &v[d * i..d * i + d]);
+                                f.eval(&At { x: mesh.node(i), t: s.t, u, v, ..At::default() }, scratch, o);
+                            }
+                            out
+                        };
+                        let (a, b) = (nodal(a, &mut scratch), nodal(b, &mut scratch));
+                        vec![Tools::quad(&tools.scheme_mass, &a, &b)]
+                    }
                 };
                 measured.push(value);
                 next += 1;

@@ -45,6 +45,25 @@ pub struct Options {
     pub progress: bool,
     pub checkpoint_every: usize,
     pub resume: bool,
+    /// The roles the user chose explicitly (`--scheme`, ...): the problem's `bind` lines give
+    /// the others.
+    pub chosen: Chosen,
+}
+
+/// Which of the setup's files the user chose; a problem's `bind` replaces the library's
+/// defaults only.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Chosen {
+    pub scheme: bool,
+    pub contact: bool,
+    pub material: bool,
+}
+
+impl Chosen {
+    /// Every role chosen: the setup is taken as it is (programs that build their own).
+    pub fn all() -> Chosen {
+        Chosen { scheme: true, contact: true, material: true }
+    }
 }
 
 impl Options {
@@ -64,6 +83,7 @@ impl Options {
             progress: false,
             checkpoint_every: 0,
             resume: false,
+            chosen: Chosen::default(),
         }
     }
 }
@@ -149,7 +169,8 @@ fn bound<R>(
 ) -> Result<R, CaseError> {
     let pf = super::load(&opts.problem)?;
     let (params, rest) = super::params(&pf, &opts.setup.params)?;
-    let setup = Setup { params: rest, ..opts.setup.clone() };
+    let mut setup = Setup { params: rest, ..opts.setup.clone() };
+    bind_files(&pf, &mut setup, opts.chosen);
     let d = super::bind::dimension(&pf, opts.mesh.as_deref())?;
     let values: Vec<(String, f64)> = params.iter().map(|p| (p.name.clone(), p.value)).collect();
     let p = pf.problem();
@@ -165,6 +186,26 @@ fn bound<R>(
     f(&pf, &params, &mut ex, &active)
 }
 
+/// The problem's `bind` lines, for the roles the user did not choose; a path is relative to the
+/// problem file.
+fn bind_files(pf: &ProblemFile, setup: &mut Setup, chosen: Chosen) {
+    for b in &pf.problem().binds {
+        let target = if b.is_path { pf.dir.join(&b.target).display().to_string() } else { b.target.clone() };
+        match b.role.name.as_str() {
+            "scheme" if !chosen.scheme => setup.scheme = target,
+            "contact" if !chosen.contact => setup.contact = target,
+            "material" if !chosen.material => setup.material = target,
+            "forms" => {
+                let path = std::path::PathBuf::from(target);
+                if !setup.forms.contains(&path) {
+                    setup.forms.push(path);
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
 /// The problem items the driver does not run yet: an error at each, not a silent omission.
 fn unsupported(pf: &ProblemFile) -> Result<(), CaseError> {
     use crate::compiler::Diagnostic;
@@ -175,17 +216,8 @@ fn unsupported(pf: &ProblemFile) -> Result<(), CaseError> {
                 .with_note("the problem checks; its run needs this item, which a later version adds"),
         )
     };
-    if let Some(d) = p.dirichlet.first() {
-        return Err(not_yet(d.span, "Dirichlet conditions"));
-    }
-    if let Some(b) = p.binds.first() {
-        return Err(not_yet(b.span, "`bind` lines (use --scheme, --contact, --material, --forms)"));
-    }
     if let Some(r) = &p.reference {
         return Err(not_yet(r.span, "references"));
-    }
-    if let Some(r) = p.regions.iter().find(|r| r.name.name != "Gamma_C") {
-        return Err(not_yet(r.span, "regions other than `Gamma_C`"));
     }
     if !p.regions.iter().any(|r| r.name.name == "Gamma_C") {
         return Err(pf.render(
@@ -266,6 +298,52 @@ fn coef_shapes(
     Ok(())
 }
 
+/// The problem's Dirichlet conditions: the listed components of every node of each region held.
+/// The stepper holds the stage unknown's values there, so a held displacement must be zero (a
+/// prescribed nonzero or moving one needs the time derivatives the schemes do not expose yet).
+fn dirichlet(pf: &ProblemFile, ex: &mut Exprs, mesh: &crate::runtime::mesh::Mesh) -> Result<Constraints, CaseError> {
+    use crate::compiler::Diagnostic;
+    let d = mesh.dim();
+    let mut c = Constraints::none(mesh.num_nodes() * d);
+    for dc in &pf.problem().dirichlet {
+        let components: Vec<usize> = match &dc.component {
+            Some(k) => {
+                let k = crate::compiler::check::const_value(k).unwrap_or(0.0) as usize;
+                if k >= d {
+                    return Err(pf.render(Diagnostic::error(
+                        "E0302",
+                        "wrong dimension",
+                        dc.span,
+                        format!("component {k} in a {d}D problem"),
+                    )));
+                }
+                vec![k]
+            }
+            None => (0..d).collect(),
+        };
+        let value = ex.lower(&dc.value, &[]).map_err(|e| pf.render(*e))?;
+        let held = ex.function(&value, &dc.value).map_err(|e| pf.render(*e))?;
+        if held.constant().is_none_or(|v| v.iter().any(|x| *x != 0.0)) {
+            return Err(pf.render(
+                Diagnostic::error(
+                    "E0101",
+                    "a nonzero held displacement is not run by the driver yet",
+                    dc.value.span,
+                    "not zero",
+                )
+                .with_note("the stepper holds the stage unknown, which is not always the displacement: zero is right for every scheme"),
+            ));
+        }
+        let region = mesh.region(&dc.region.name)?;
+        for node in mesh.region_nodes(region) {
+            for &k in &components {
+                c.fix(node as usize * d + k);
+            }
+        }
+    }
+    Ok(c)
+}
+
 fn simulate(
     opts: &Options,
     pf: &ProblemFile,
@@ -296,11 +374,14 @@ fn simulate(
     coef_shapes(pf, active, &coef_fns, mesh.dim())?;
     let coefs = super::bind::coef_lookup(&coef_fns);
     let contact = "Gamma_C";
+    let others: Vec<String> = p.regions.iter().map(|r| r.name.name.clone()).filter(|r| r != contact).collect();
+    let constraints = dirichlet(pf, ex, &mesh)?;
     let problem = Problem {
         coefs: &coefs,
         quadrature,
         contact,
-        constraints: Constraints::none(n),
+        regions: &others,
+        constraints: constraints.clone(),
         mass: opts.mass,
         newton: opts.newton,
     };
@@ -312,10 +393,17 @@ fn simulate(
     )?;
     let mut sim = Simulation::new(&asm, problem, active)?;
     let t0 = settings.t_start;
-    let u0 = super::bind::initial(pf, ex, &mesh, "u", t0)?;
-    let v0 = super::bind::initial(pf, ex, &mesh, "v", t0)?;
+    // The initial fields take the held values on the held dofs.
+    let mut u0 = super::bind::initial(pf, ex, &mesh, "u", t0)?;
+    let mut v0 = super::bind::initial(pf, ex, &mesh, "v", t0)?;
+    constraints.impose(&mut u0);
+    constraints.zero(&mut v0);
     sim.initialize_at(t0, u0, v0)?;
-    let binding = Binding { quadrature, regions: vec![(contact.into(), sim.tools.contact_facets)], dim: mesh.dim() };
+    let mut regions = vec![(contact.to_string(), sim.tools.contact_facets)];
+    for name in &others {
+        regions.push((name.clone(), asm.region(name)?));
+    }
+    let binding = Binding { quadrature, regions, dim: mesh.dim() };
     let coef_vals = super::bind::coef_vals(pf, ex)?;
     let observer =
         Observer::new(pf, ex, &sim.tools, &active.forms, &coefs, &binding, &coef_vals, quadrature.facet.unwrap_or(7))?;

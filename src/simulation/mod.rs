@@ -31,6 +31,8 @@ pub struct Problem<'p> {
     pub quadrature: Quadrature,
     /// The mesh region bound to the forms' `Gamma_C`.
     pub contact: &'p str,
+    /// Other mesh regions the forms may integrate over, bound by their names.
+    pub regions: &'p [String],
     /// Dirichlet conditions of the dynamics.
     pub constraints: Constraints,
     pub mass: MassChoice,
@@ -55,6 +57,9 @@ pub struct Tools<'m> {
     pub scheme_mass: Matrix,
     pub stiffness: Matrix,
     pub load: Vec<f64>,
+    /// The `load` slot when it changes with time (a traction p(t)): the energy check then sums
+    /// its work step by step instead of taking the load at t = 0.
+    pub varying_load: Option<Box<dyn BoundForm + 'm>>,
     /// The nodes of the contact region.
     pub contact_nodes: Vec<u32>,
     /// The energies' quadratic forms, ½uᵀKu and ½vᵀMv with the scheme's mass, evaluated every
@@ -205,11 +210,11 @@ impl<'m> Simulation<'m> {
         let mesh: &Mesh = asm.mesh();
         let n = asm.size();
         let contact_facets = asm.region(problem.contact)?;
-        let binding = Binding {
-            quadrature: problem.quadrature,
-            regions: vec![("Gamma_C".into(), contact_facets)],
-            dim: mesh.dim(),
-        };
+        let mut regions = vec![("Gamma_C".to_string(), contact_facets)];
+        for name in problem.regions {
+            regions.push((name.clone(), asm.region(name)?));
+        }
+        let binding = Binding { quadrature: problem.quadrature, regions, dim: mesh.dim() };
         let mut inst = active.forms.instantiate(problem.coefs, &binding)?;
         let mut forms = active.scheme_forms(&mut inst)?;
         let missing = |what: &str| {
@@ -263,6 +268,11 @@ impl<'m> Simulation<'m> {
             scheme_mass,
             stiffness,
             load,
+            varying_load: active
+                .forms
+                .instantiate(problem.coefs, &binding)?
+                .take_form("load")
+                .filter(|f| f.time_dependent() && f.fields() == 0),
             contact_nodes,
         };
         let names = stepper.desc().states;
@@ -347,8 +357,12 @@ impl<'m> Simulation<'m> {
             states.clone_from_slice(&saved.states);
             (first, accepted, level, streak) = (saved.steps_done, saved.accepted, saved.level, saved.streak);
             outcome.cuts = saved.cuts;
-            energy =
-                EnergyWatch { initial: saved.energy_initial, u0: saved.energy_u0.clone(), work: saved.energy_work };
+            energy = EnergyWatch {
+                initial: saved.energy_initial,
+                u0: saved.energy_u0.clone(),
+                work: saved.energy_work,
+                varying_work: saved.energy_varying_work,
+            };
             outcome.resumed = Some(Resumed { step: saved.steps_done, bit_for_bit: saved.periodic });
             stepper.forget();
         }
@@ -412,6 +426,9 @@ impl<'m> Simulation<'m> {
                     streak = 0;
                 }
                 let last = k + 1 == steps && done == full;
+                if let Some(load) = &tools.varying_load {
+                    energy.step_work(tools, load.as_ref(), &before, &states[0], t + 0.5 * h);
+                }
                 if let Some(grown) = energy.check(tools, states, *v_index, &before, h, accepted, last)
                     && guard.max_energy_growth > 0.0
                     && grown.ratio > guard.max_energy_growth
@@ -434,6 +451,7 @@ impl<'m> Simulation<'m> {
                         cuts: outcome.cuts,
                         energy_initial: energy.initial,
                         energy_work: energy.work,
+                        energy_varying_work: energy.varying_work,
                         energy_u0: energy.u0.clone(),
                         states: states.to_vec(),
                         periodic: !interrupted,
@@ -529,6 +547,8 @@ struct EnergyWatch {
     initial: f64,
     u0: Vec<f64>,
     work: f64,
+    /// The work of a load that changes with time, summed step by step (midpoint rule).
+    varying_work: f64,
 }
 
 /// An energy above its bound.
@@ -546,7 +566,14 @@ impl EnergyWatch {
     fn new(tools: &Tools, states: &[Vec<f64>], v_index: Option<usize>) -> Self {
         let u = &states[0];
         let v = v_index.map(|i| states[i].as_slice());
-        EnergyWatch { initial: Self::energy(tools, u, v), u0: u.clone(), work: 0.0 }
+        EnergyWatch { initial: Self::energy(tools, u, v), u0: u.clone(), work: 0.0, varying_work: 0.0 }
+    }
+
+    /// Adds the work of a time-dependent load over one step: L(t_mid)·(u − u_before).
+    fn step_work(&mut self, tools: &Tools, load: &dyn BoundForm, before: &[f64], u: &[f64], t_mid: f64) {
+        let mut l = vec![0.0; u.len()];
+        load.residual(tools.asm, &[], t_mid, &mut l);
+        self.varying_work += l.iter().zip(u.iter().zip(before)).map(|(l, (a, b))| l * (a - b)).sum::<f64>();
     }
 
     fn energy(tools: &Tools, u: &[f64], v: Option<&[f64]>) -> f64 {
@@ -578,7 +605,10 @@ impl EnergyWatch {
             }
         };
         let energy = Self::energy(tools, u, Some(v));
-        let work: f64 = tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum();
+        let work: f64 = match tools.varying_load {
+            Some(_) => self.varying_work,
+            None => tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum(),
+        };
         self.work = self.work.max(work.abs());
         let bound = (self.initial + self.work).max(f64::MIN_POSITIVE);
         Some(Grown { energy, bound, ratio: energy / bound })

@@ -388,12 +388,13 @@ fn check_distinct(names: &[Ident], what: &str, diags: &mut Vec<Diagnostic>) {
 
 /// Names visible everywhere, for "did you mean" suggestions.
 pub fn suggest_name<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<String> {
+    // At equal distance, a name that differs only in case is the likelier one.
     candidates
         .filter(|c| *c != name)
-        .map(|c| (strsim::damerau_levenshtein(name, c), c))
-        .filter(|(d, c)| *d <= 1.max(name.len() / 3) && *d < c.len())
+        .map(|c| (strsim::damerau_levenshtein(name, c), !c.eq_ignore_ascii_case(name), c))
+        .filter(|(d, _, c)| *d <= 1.max(name.len() / 3) && *d < c.len())
         .min()
-        .map(|(_, c)| c.to_string())
+        .map(|(_, _, c)| c.to_string())
 }
 
 /// Used params, as a set of indices.

@@ -92,6 +92,15 @@ pub const RUN_SETTINGS: &[(&str, &str)] = &[
     ("t_start", "the start time (initial fields are evaluated there)"),
 ];
 
+/// The roles a problem binds files to (`bind scheme = hybrid`): the scheme, the contact law,
+/// the material, and extra form files (repeatable).
+pub const ROLES: &[(&str, &str)] = &[
+    ("scheme", "the time scheme (forms/schemes/ by name, or a .wf file)"),
+    ("contact", "the contact law (`nitsche`, `penalty`, ..., or a .wf file)"),
+    ("material", "the material's form file"),
+    ("forms", "an extra form file whose slots the scheme applies (repeatable)"),
+];
+
 /// Quadrature settings: degrees of the cell and contact-facet rules.
 pub const QUADRATURE_SETTINGS: &[&str] = &["cell", "facet"];
 
@@ -109,7 +118,16 @@ pub const ROW_REDUCERS: &[(&str, &str, &str)] = &[
     ("mean", "mean(u[k])", "mass-weighted mean of a component of u or v over the body (the centre of mass's)"),
     ("nodal_mean", "nodal_mean(u[k])", "plain mean of a component of u or v over the nodes"),
     ("at_min", "at_min(u[k], EXPR)", "a component of u or v at the node where EXPR (of x) is least"),
-    ("force", "force(SLOT)", "the resultant of a slot's residual on the body (a vector): force(contact)"),
+    (
+        "force",
+        "force(SLOT[, REGION])",
+        "the resultant of a slot's residual on the body, or at a region's nodes (a vector): force(contact), force(stiffness, Gamma_D)",
+    ),
+    (
+        "inner_mass",
+        "inner_mass(A, B)",
+        "aᵀ M b with the mass the scheme steps with, for vector fields A and B of x, t, u, v at the nodes (∫ρ A·B)",
+    ),
     ("measure", "measure(REGION, EXPR)", "the measure of the region's quadrature points where EXPR ≥ 0"),
     (
         "peak",
@@ -177,6 +195,19 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
             }
         }
     }
+    let mut bound: HashMap<&str, Span> = HashMap::new();
+    for b in &p.binds {
+        if !ROLES.iter().any(|(r, _)| *r == b.role.name) {
+            diags.push(unknown_among(&b.role, ROLES.iter().map(|(r, _)| *r), "role"));
+        } else if b.role.name != "forms"
+            && let Some(prev) = bound.insert(&b.role.name, b.role.span)
+        {
+            diags.push(
+                Diagnostic::error("E0103", format!("`{}` bound twice", b.role.name), b.role.span, "again here")
+                    .with_label(prev, "first here"),
+            );
+        }
+    }
     settings(&p.run, RUN_SETTINGS.iter().map(|(n, _)| *n), "run setting", c, &constants, diags);
     settings(&p.quadrature, QUADRATURE_SETTINGS.iter().copied(), "quadrature setting", c, &constants, diags);
     let fields = &constants;
@@ -191,11 +222,39 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
         }
         vector(c, &d.value, fields, diags);
     }
+    let regions: Vec<&str> = p.regions.iter().map(|r| r.name.name.as_str()).collect();
     for d in &p.dirichlet {
         if d.field.name != "u" {
             diags.push(unknown_among(&d.field, ["u"].into_iter(), "Dirichlet field"));
         }
-        vector(c, &d.value, fields, diags);
+        if !regions.contains(&d.region.name.as_str()) {
+            diags.push(unknown_among(&d.region, regions.iter().copied(), "region"));
+        }
+        // An obstacle's region is where contact is imposed: a displacement held there too
+        // leaves the contact nothing to decide.
+        if let Some(o) =
+            p.obstacles.iter().find(|o| o.region.as_ref().map_or("Gamma_C", |r| r.name.as_str()) == d.region.name)
+        {
+            diags.push(
+                Diagnostic::error(
+                    "E0905",
+                    "a Dirichlet condition on a contact region",
+                    d.region.span,
+                    "contact is imposed here",
+                )
+                .with_label(o.span, "the obstacle faces this region")
+                .with_help("hold another part of the boundary: a region of its own (`region Gamma_D = ...`)"),
+            );
+        }
+        match &d.component {
+            Some(k) => {
+                if !crate::check::const_value(k).is_some_and(|k| k >= 0.0 && k.fract() == 0.0 && k < 3.0) {
+                    diags.push(Diagnostic::error("E0302", "a component index must be 0, 1 or 2", k.span, "not one"));
+                }
+                scalar(c, &d.value, fields, diags, false);
+            }
+            None => vector(c, &d.value, fields, diags),
+        }
     }
     for o in &p.obstacles {
         builtin_call(c, &o.shape, OBSTACLES, "obstacle", fields, diags);
@@ -219,7 +278,6 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
     if !p.obstacles.is_empty() {
         pointwise.extend([("g".to_string(), Scalar), ("nc".to_string(), Vector)]);
     }
-    let regions: Vec<&str> = p.regions.iter().map(|r| r.name.name.as_str()).collect();
     let mut earlier: Vec<&str> = Vec::new();
     for (d, _) in &p.series {
         let scope = RowScope { constants: &constants, pointwise: &pointwise, regions: &regions, earlier: &earlier };
@@ -459,8 +517,20 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
             }
         }
         "force" => {
-            if arity(1, diags) && !matches!(&args[0].kind, K::Name(_)) {
+            // force(SLOT) over the body, force(SLOT, REGION) over the region's nodes.
+            if args.len() == 2 {
+                region(&args[1], diags);
+            } else if !arity(1, diags) {
+                return;
+            }
+            if !matches!(&args[0].kind, K::Name(_)) {
                 diags.push(Diagnostic::error("E0301", "shape mismatch", args[0].span, "a slot's name is needed here"));
+            }
+        }
+        "inner_mass" => {
+            if arity(2, diags) {
+                vector(c, &args[0], s.pointwise, diags);
+                vector(c, &args[1], s.pointwise, diags);
             }
         }
         "measure" | "peak" => {

@@ -326,11 +326,12 @@ pub struct Defined {
     pub span: Span,
 }
 
-/// `dirichlet REGION: FIELD = EXPR`.
+/// `dirichlet REGION: FIELD = EXPR`, or `FIELD[k] = EXPR` for one component.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dirichlet {
     pub region: Ident,
     pub field: Ident,
+    pub component: Option<Expr>,
     pub value: Expr,
     pub span: Span,
 }

@@ -510,16 +510,7 @@ impl Builder {
         let mut implicit = Stage::default();
         for p in rest {
             match p.as_rule() {
-                Rule::scheme_params => {
-                    for q in p.into_inner() {
-                        let span = self.span(&q);
-                        let mut it = q.into_inner();
-                        let name = self.ident(it.next().expect("param name"));
-                        let default = self.expr(it.next().expect("param default"))?;
-                        let range = it.next().map(|r| self.range(r)).transpose()?;
-                        params.push(SchemeParam { name, default, range, span });
-                    }
-                }
+                Rule::scheme_params => params = self.params(p.into_inner())?,
                 Rule::uses_decl => {
                     let list = p.into_inner().next().expect("slot names");
                     uses.extend(list.into_inner().map(|i| self.ident(i)));
@@ -617,16 +608,7 @@ impl Builder {
             let mut it = p.into_inner();
             let mut next = || it.next().expect("grammar guarantees the child");
             match rule {
-                Rule::scheme_params => {
-                    for q in it {
-                        let span = self.span(&q);
-                        let mut it = q.into_inner();
-                        let name = self.ident(it.next().expect("param name"));
-                        let default = self.expr(it.next().expect("param default"))?;
-                        let range = it.next().map(|r| self.range(r)).transpose()?;
-                        pb.params.push(SchemeParam { name, default, range, span });
-                    }
-                }
+                Rule::scheme_params => pb.params = self.params(it)?,
                 Rule::mesh_decl => {
                     let q = next();
                     pb.mesh.push(match q.as_rule() {
@@ -682,8 +664,14 @@ impl Builder {
                 Rule::dirichlet_decl => {
                     let region = self.ident(next());
                     let field = self.ident(next());
-                    let value = self.expr(next())?;
-                    pb.dirichlet.push(Dirichlet { region, field, value, span });
+                    let mut rest = next();
+                    let mut component = None;
+                    if rest.as_rule() == Rule::index {
+                        component = Some(self.expr(rest.into_inner().next().expect("index expression"))?);
+                        rest = next();
+                    }
+                    let value = self.expr(rest)?;
+                    pb.dirichlet.push(Dirichlet { region, field, component, value, span });
                 }
                 Rule::plot_decl => {
                     let title = unquote(next().as_str());
@@ -703,6 +691,19 @@ impl Builder {
             }
         }
         Ok(pb)
+    }
+
+    /// The params of a scheme or a problem: `name = default in RANGE, ...`.
+    fn params(&self, list: pest::iterators::Pairs<Rule>) -> Result<Vec<SchemeParam>, Box<Diagnostic>> {
+        list.map(|q| {
+            let span = self.span(&q);
+            let mut it = q.into_inner();
+            let name = self.ident(it.next().expect("param name"));
+            let default = self.expr(it.next().expect("param default"))?;
+            let range = it.next().map(|r| self.range(r)).transpose()?;
+            Ok(SchemeParam { name, default, range, span })
+        })
+        .collect()
     }
 
     /// `name = expr` from its two pairs.

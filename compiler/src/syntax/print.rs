@@ -170,7 +170,8 @@ fn problem(p: &Problem, out: &mut String) {
         out.push_str(&format!("  obstacle {}{on}\n", named_call(&o.shape)));
     }
     for d in &p.dirichlet {
-        out.push_str(&format!("  dirichlet {}: {} = {}\n", d.region.name, d.field.name, expr(&d.value)));
+        let k = d.component.as_ref().map_or(String::new(), |k| format!("[{}]", expr(k)));
+        out.push_str(&format!("  dirichlet {}: {}{k} = {}\n", d.region.name, d.field.name, expr(&d.value)));
     }
     for (d, written) in &p.series {
         line(out, if *written { "series" } else { "observe" }, d);

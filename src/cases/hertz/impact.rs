@@ -153,6 +153,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         coefs: &coefs,
         quadrature: Quadrature::default(),
         contact: meshes::CONTACT,
+        regions: &[],
         constraints: meshes::symmetry(&mesh)?,
         mass: opts.mass,
         newton: opts.newton,
