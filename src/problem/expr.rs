@@ -78,7 +78,7 @@ impl<'u> Exprs<'u> {
     /// Compiles the components of `v` (at `e`, for errors).
     pub fn function(&self, v: &Val, e: &Expr) -> Res<PointFn> {
         let roots: Vec<NodeId> = v.c.iter().map(|j| j.v).collect();
-        PointFn::new(Program::new(&self.low.g, &roots)).map_err(|what| {
+        PointFn::new(Program::new(&self.low.g, &roots), roots.clone()).map_err(|what| {
             Box::new(Diagnostic::error("E0501", format!("{what} means nothing here"), e.span, "not known at a point"))
         })
     }
@@ -118,10 +118,14 @@ pub struct At<'a> {
 pub struct PointFn {
     program: Program,
     leaves: Vec<Leaf>,
+    /// When every component is a leaf or a constant: which, so that `eval` copies them.
+    trivial: Option<Vec<Result<usize, f64>>>,
+    /// The roots in the problem's graph: equal keys, equal functions (the graph is hash-consed).
+    pub key: Vec<NodeId>,
 }
 
 impl PointFn {
-    fn new(program: Program) -> Result<PointFn, &'static str> {
+    fn new(program: Program, key: Vec<NodeId>) -> Result<PointFn, &'static str> {
         let leaves = program
             .syms()
             .iter()
@@ -138,7 +142,8 @@ impl PointFn {
                 })
             })
             .collect::<Result<_, _>>()?;
-        Ok(PointFn { program, leaves })
+        let trivial = program.trivial_roots();
+        Ok(PointFn { program, leaves, trivial, key })
     }
 
     /// Number of components.
@@ -178,16 +183,26 @@ impl PointFn {
     pub fn eval(&self, at: &At, scratch: &mut Vec<f64>, out: &mut [f64]) {
         let nan = f64::NAN;
         let get = |s: &[f64], k: usize| s.get(k).copied().unwrap_or(nan);
+        let leaf = |l: Leaf| match l {
+            Leaf::X(k) => get(at.x, k),
+            Leaf::T => at.t,
+            Leaf::N(k) => get(at.n, k),
+            Leaf::U(k) => get(at.u, k),
+            Leaf::V(k) => get(at.v, k),
+            Leaf::Measured(i, k) => at.measured.get(i).map_or(nan, |m| get(m, k)),
+        };
+        if let Some(roots) = &self.trivial {
+            for (o, r) in out.iter_mut().zip(roots) {
+                *o = match r {
+                    Ok(i) => leaf(self.leaves[*i]),
+                    Err(c) => *c,
+                };
+            }
+            return;
+        }
         self.program.prepare(scratch);
         for (slot, l) in scratch.iter_mut().zip(&self.leaves) {
-            *slot = match *l {
-                Leaf::X(k) => get(at.x, k),
-                Leaf::T => at.t,
-                Leaf::N(k) => get(at.n, k),
-                Leaf::U(k) => get(at.u, k),
-                Leaf::V(k) => get(at.v, k),
-                Leaf::Measured(i, k) => at.measured.get(i).map_or(nan, |m| get(m, k)),
-            };
+            *slot = leaf(*l);
         }
         self.program.exec(scratch);
         for (i, o) in out.iter_mut().enumerate().take(self.len()) {
@@ -205,6 +220,30 @@ impl PointFn {
         }
         let n = self.len();
         let steady = !self.reads_time();
+        // Components that are coordinates or constants (a plane's gap `x[1]`): copied, with no
+        // program to run at each quadrature point.
+        let copies: Option<Vec<Result<usize, f64>>> = self.trivial.as_ref().and_then(|roots| {
+            roots
+                .iter()
+                .map(|r| match r {
+                    Ok(i) => match self.leaves[*i] {
+                        Leaf::X(k) => Some(Ok(k)),
+                        _ => None,
+                    },
+                    Err(c) => Some(Err(*c + 0.0)),
+                })
+                .collect()
+        });
+        if let Some(copies) = copies {
+            return Coef::of_position(n, move |x, out| {
+                for (o, c) in out.iter_mut().zip(&copies) {
+                    *o = match c {
+                        Ok(k) => x.get(*k).copied().unwrap_or(f64::NAN),
+                        Err(v) => *v,
+                    };
+                }
+            });
+        }
         // Assembly calls coefs from every thread: each has its scratch.
         thread_local!(static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) });
         let f = move |x: &[f64], t: f64, out: &mut [f64]| {

@@ -179,14 +179,17 @@ impl<'m> Observer<'m> {
         Ok(match &e.kind {
             ExprKind::Number(_) => e.clone(),
             ExprKind::Name(id) => {
-                let row = match id.name.as_str() {
+                // An earlier column first: `series energy = energy` is then read, not measured
+                // again, by the columns after it.
+                let column = self.columns.iter().position(|(n, _, _)| *n == id.name).map(Measure::Column);
+                let row = column.or(match id.name.as_str() {
                     "t" => Some(Measure::Time),
                     "energy" => Some(Measure::Energy),
                     "kinetic" => Some(Measure::Kinetic),
                     "newton" => Some(Measure::Newton),
                     "active_points" => Some(Measure::ActivePoints),
-                    name => self.columns.iter().position(|(n, _, _)| n == name).map(Measure::Column),
-                };
+                    _ => None,
+                });
                 match row {
                     Some(m) => add(self, m, 1, e.span),
                     None => e.clone(), // a param or a let
@@ -335,6 +338,8 @@ impl<'m> Observer<'m> {
         let mut columns: Vec<f64> = Vec::with_capacity(self.columns.len());
         let mut samples: Vec<Option<Vec<FacetSample>>> = self.regions.iter().map(|_| None).collect();
         let mut samples_v: Vec<Option<Vec<FacetSample>>> = self.regions.iter().map(|_| None).collect();
+        // The values of each sampled expression, by region and expression.
+        let mut sampled: Vec<(usize, Vec<crate::compiler::ir::graph::NodeId>, Vec<f64>)> = Vec::new();
         let field = |f: u8| if f == 0 { Some(s.u) } else { s.v };
         let mut kinetic = None;
         let mut scratch = Vec::new();
@@ -374,6 +379,19 @@ impl<'m> Observer<'m> {
                         }
                     }
                     Measure::Area { region, f } | Measure::Peak { region, f } => {
+                        // `measure` and `peak` of one expression share its values.
+                        let cached = sampled.iter().find(|(r, k, _)| *r == *region && *k == f.key);
+                        if let Some((_, _, values)) = cached {
+                            let us = samples[*region].as_ref().expect("sampled with the values");
+                            let value = if matches!(self.measures[next], Measure::Area { .. }) {
+                                us.iter().zip(values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum()
+                            } else {
+                                values.iter().fold(0.0f64, |m, e| m.max(*e))
+                            };
+                            measured.push(vec![value]);
+                            next += 1;
+                            continue;
+                        }
                         let us = samples[*region]
                             .get_or_insert_with(|| facet_samples(mesh, self.regions[*region], self.degree, s.u));
                         let vs = match (f.reads_v(), s.v) {
@@ -397,11 +415,13 @@ impl<'m> Observer<'m> {
                                 out[0]
                             })
                             .collect();
-                        if matches!(self.measures[next], Measure::Area { .. }) {
+                        let value = if matches!(self.measures[next], Measure::Area { .. }) {
                             vec![us.iter().zip(&values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum()]
                         } else {
                             vec![values.iter().fold(0.0f64, |m, e| m.max(*e))]
-                        }
+                        };
+                        sampled.push((*region, f.key.clone(), values));
+                        value
                     }
                     Measure::Functional { f } => vec![f.value(asm, &[s.u], s.t)],
                     Measure::InnerMass { a, b } => {

@@ -118,6 +118,25 @@ impl Program {
         &self.syms
     }
 
+    /// When the program computes nothing (each root is a leaf or a constant): per root, the
+    /// index of its leaf in [`Program::syms`] or its constant value. Callers then copy instead of
+    /// running it (a gap `g = x[1]` at every quadrature point).
+    pub fn trivial_roots(&self) -> Option<Vec<Result<usize, f64>>> {
+        if !self.ops.is_empty() {
+            return None;
+        }
+        let leaves = self.syms.len();
+        Some(
+            self.roots
+                .iter()
+                .map(|&r| match (r as usize).checked_sub(leaves) {
+                    None => Ok(r as usize),
+                    Some(c) => Err(self.consts[c]),
+                })
+                .collect(),
+        )
+    }
+
     /// Number of roots (outputs).
     pub fn outputs(&self) -> usize {
         self.roots.len()
