@@ -79,7 +79,7 @@ fn mistakes_are_reported_with_their_line() {
         ("law.toml", "case = \"bar\"\ncontact = \"nitche\"\n", "did you mean `nitsche`?"),
         ("alpha.toml", "case = \"bar\"\nscheme = \"midpoint\"\nalpha = 0.1\n", ":3: unknown param `alpha`"),
         ("type.toml", "case = \"disc\"\ndt = \"x\"\n", ":2: invalid type"),
-        ("case.toml", "case = \"beam\"\n", ":1: `case`: `beam` is not a case"),
+        ("case.toml", "case = \"beam\"\n", ":1: `case`: no problem `beam` in the library"),
     ];
     for (name, text, want) in cases {
         let path = write(name, text);
@@ -87,4 +87,33 @@ fn mistakes_are_reported_with_their_line() {
         assert_eq!(code, 1, "{name}");
         assert!(err.contains(name) && err.contains(want), "{name}: expected `{want}` in `{err}`");
     }
+}
+
+/// A case file names any problem, a library one or a file (relative to the case file), and its
+/// `[params]` reach the problem's params as well as the files'.
+#[test]
+fn a_case_file_runs_a_problem_file_with_its_params() {
+    let ring = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/problems/ring.wf");
+    let path = write(
+        "ring.toml",
+        &format!(
+            "case = {:?}\nscheme = \"hybrid\"\nt_end = 0.4\nout = \"ring-out\"\n[params]\nomega = 0.05\ngamma0 = 500\n",
+            ring.display().to_string()
+        ),
+    );
+    let (code, err) = signorini(&["run", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let dir = path.parent().unwrap().join("ring-out");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["scheme"], "hybrid");
+    assert_eq!(s["steps"], 20);
+    assert_eq!(s["params"]["ring.omega"]["value"], 0.05);
+    assert_eq!(s["params"]["gamma0"]["value"], 500.0);
+    assert!(std::fs::read_to_string(dir.join("series.csv")).unwrap().starts_with("t,energy,energy_aug,ux_cm"));
+    // A misspelt problem is refused at the key.
+    let bad = write("bad_problem.toml", "case = \"sphre\"\n");
+    let (code, err) = signorini(&["run", bad.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(err.contains("bad_problem.toml:1: `case`") && err.contains("did you mean `sphere`?"), "{err}");
 }

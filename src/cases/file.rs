@@ -1,4 +1,5 @@
-//! Case files: `signorini run case.toml` with every option of `run bar` / `run disc` as keys,
+//! Case files: `signorini run case.toml` with every option of `run bar` / `run disc` (or of a
+//! problem: `case = "sphere"`, `case = "my_problem.wf"`) as keys,
 //! and the params of the scheme and form files in `[params]` (`alpha = 0.1`, or per file:
 //! `[params.elasticity] rho = 2`). Unknown keys, unknown params, keys of the other case and
 //! out-of-range values are refused with the line of the key.
@@ -35,6 +36,8 @@ struct CaseFile {
     cell_size: Option<Spanned<String>>,
     dt: Option<Spanned<f64>>,
     t_end: Option<Spanned<f64>>,
+    /// Problems: the start time (the problem's default otherwise).
+    t_start: Option<Spanned<f64>>,
     out: Option<Spanned<String>>,
     /// bar only.
     ne: Option<Spanned<i64>>,
@@ -50,6 +53,9 @@ struct CaseFile {
 pub enum Case {
     Bar(bar::Options),
     Disc(disc::Options),
+    /// Any other problem of the library (`case = "sphere"`) or a problem file (`case =
+    /// "ring.wf"`, relative to the case file).
+    Problem(Box<crate::problem::run::Options>),
 }
 
 struct Reader<'a> {
@@ -128,6 +134,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Case, CaseError> {
     match parsed.case.get_ref().as_str() {
         "bar" => {
             r.absent(&parsed.mesh, "mesh", "bar")?;
+            r.absent(&parsed.t_start, "t_start", "bar")?;
             r.absent(&parsed.h, "h", "bar")?;
             let d = bar::Options::default();
             let elements = match &parsed.ne {
@@ -161,7 +168,42 @@ pub fn parse(text: &str, path: &Path) -> Result<Case, CaseError> {
                 ..d
             }))
         }
-        other => Err(r.error(&parsed.case, "case", format!("`{other}` is not a case with a file form (bar, disc)"))),
+        other => {
+            r.absent(&parsed.ne, "ne", "problem")?;
+            let problem = name_or_path(other, &base);
+            // The problem must exist (its own errors are located in its file).
+            crate::problem::load(&problem).map_err(|e| match e {
+                CaseError::Option(m) => r.error(&parsed.case, "case", m),
+                e => e,
+            })?;
+            let positive = |v: &Option<Spanned<f64>>, key: &str| -> Result<Option<f64>, CaseError> {
+                v.as_ref().map(|_| r.number(v, key, |x| x > 0.0, "positive", 0.0)).transpose()
+            };
+            let mut setup = setup;
+            if let Some(h) = &parsed.h {
+                let origin = format!("{}:{}", r.file, r.line(h.span().start));
+                setup.params.insert(0, Setting { name: "h".into(), value: *h.get_ref(), origin });
+            }
+            let mut opts = crate::problem::run::Options::new(&problem);
+            opts.chosen = crate::problem::run::Chosen {
+                scheme: parsed.scheme.is_some(),
+                contact: parsed.contact.is_some(),
+                material: parsed.material.is_some(),
+            };
+            opts.setup = setup;
+            opts.mass = mass;
+            opts.cell_size = cell_size;
+            opts.mesh = parsed.mesh.as_ref().map(|m| base.join(m.get_ref()));
+            opts.dt = positive(&parsed.dt, "dt")?;
+            opts.t_end = positive(&parsed.t_end, "t_end")?;
+            opts.t_start = parsed
+                .t_start
+                .as_ref()
+                .map(|_| r.number(&parsed.t_start, "t_start", |x| x >= 0.0, "0 or positive", 0.0))
+                .transpose()?;
+            opts.out = out;
+            Ok(Case::Problem(Box::new(opts)))
+        }
     }
 }
 

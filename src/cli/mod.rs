@@ -927,6 +927,13 @@ fn run_file(file: &Path) -> ExitCode {
             opts.progress = true;
             finish_disc(crate::cases::disc::run(&opts))
         }
+        Ok(Case::Problem(mut opts)) => {
+            if let Err(e) = out(&mut opts.out) {
+                return fail(e);
+            }
+            opts.progress = true;
+            finish_problem(crate::problem::run::run(&opts))
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
