@@ -69,12 +69,6 @@ impl<'u> Exprs<'u> {
         Val { shape: if components == 1 { Shape::Scalar } else { Shape::Vector }, c }
     }
 
-    /// A constant as a value.
-    pub fn constant(&mut self, values: &[f64]) -> Val {
-        let c = values.iter().map(|&x| self.low.constant_val(x).c[0].clone()).collect();
-        Val { shape: if values.len() == 1 { Shape::Scalar } else { Shape::Vector }, c }
-    }
-
     /// Compiles the components of `v` (at `e`, for errors).
     pub fn function(&self, v: &Val, e: &Expr) -> Res<PointFn> {
         let roots: Vec<NodeId> = v.c.iter().map(|j| j.v).collect();
@@ -172,11 +166,6 @@ impl PointFn {
     /// Whether the values depend on the velocity.
     pub fn reads_v(&self) -> bool {
         self.leaves.iter().any(|l| matches!(l, Leaf::V(_)))
-    }
-
-    /// Whether the values depend on the fields or measured values (not only on x, t, n).
-    pub fn reads_fields(&self) -> bool {
-        self.leaves.iter().any(|l| matches!(l, Leaf::U(_) | Leaf::V(_) | Leaf::Measured(..)))
     }
 
     /// Writes the values at `at` into `out` (`scratch` is reused between calls).

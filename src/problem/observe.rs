@@ -312,11 +312,6 @@ impl<'m> Observer<'m> {
         })
     }
 
-    /// The names of the columns series.csv shows, in order.
-    pub fn written(&self) -> impl Iterator<Item = &str> {
-        self.columns.iter().filter(|c| c.1).map(|c| c.0.as_str())
-    }
-
     /// Every column's name (shown or not), in the order of a row's values.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.columns.iter().map(|c| c.0.as_str())
