@@ -206,3 +206,22 @@ fn the_thrown_ring_flies_exactly_and_keeps_its_energy_law_after_landing() {
     }
     assert!(kept > 50 && changed > 3, "kept {kept}, changed {changed}");
 }
+
+/// A moving obstacle (a plane rising at speed w, its gap a function of t): the disc's lowest
+/// point meets it in the step where 2 − g t²/2 = w t, and the free fall before is untouched.
+#[test]
+fn a_rising_plane_is_met_when_the_fall_and_the_rise_close_the_gap() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems/rising_plane.wf");
+    let r = run(&Options::new(file.to_str().unwrap())).unwrap();
+    let (g, w, dt) = (0.1, 0.5, 0.01);
+    let t_star: f64 = ((w * w + 4.0 * g) as f64).sqrt() / g - w / g;
+    let first = r.summary.number("first_contact").expect("the plane is met");
+    // Within a few steps after t*: Nitsche's switch turns on at a quadrature point once
+    // P_{1,γ}(u) < 0, a little after the gap closes at the lowest node (0.018 here, closing at
+    // 0.8 per unit time).
+    assert!(first >= t_star - 1e-9 && first <= t_star + 3.0 * dt, "first contact {first}, t* = {t_star}");
+    let mean = r.column("uy_mean").unwrap();
+    for (i, (t, _)) in r.rows.iter().enumerate().filter(|(_, (t, _))| *t < t_star - dt) {
+        assert!((mean[i] + 0.5 * g * t * t).abs() < 1e-10, "t = {t}: {}", mean[i]);
+    }
+}
