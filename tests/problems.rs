@@ -213,8 +213,8 @@ fn the_thrown_ring_flies_exactly_and_keeps_its_energy_law_after_landing() {
 fn a_rising_plane_is_met_when_the_fall_and_the_rise_close_the_gap() {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems/rising_plane.wf");
     let r = run(&Options::new(file.to_str().unwrap())).unwrap();
-    let (g, w, dt) = (0.1, 0.5, 0.01);
-    let t_star: f64 = ((w * w + 4.0 * g) as f64).sqrt() / g - w / g;
+    let (g, w, dt): (f64, f64, f64) = (0.1, 0.5, 0.01);
+    let t_star: f64 = (w * w + 4.0 * g).sqrt() / g - w / g;
     let first = r.summary.number("first_contact").expect("the plane is met");
     // Within a few steps after t*: Nitsche's switch turns on at a quadrature point once
     // P_{1,γ}(u) < 0, a little after the gap closes at the lowest node (0.018 here, closing at
