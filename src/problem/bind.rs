@@ -156,10 +156,18 @@ fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh,
     use crate::runtime::mesh::{ball::ball, disc::disc, structured};
     // The scalar arguments, evaluated up front (the checker knows which each generator takes).
     let mut scalars: Vec<(String, f64)> = Vec::new();
-    for a in &call.args {
-        if let Ok(v) = ex.scalar(&a.value) {
-            scalars.push((a.name.name.clone(), v));
-        }
+    let vectors = crate::compiler::check::problem::GENERATORS
+        .iter()
+        .find(|g| g.name == call.name.name)
+        .map_or(&[][..], |g| g.args)
+        .iter()
+        .filter(|(_, shape, _)| *shape == crate::compiler::syntax::ast::Shape::Vector)
+        .map(|(n, _, _)| *n)
+        .collect::<Vec<_>>();
+    for a in call.args.iter().filter(|a| !vectors.contains(&a.name.name.as_str())) {
+        // A generator's numbers are constants: an expression of x or t is an error here.
+        let v = ex.scalar(&a.value).map_err(|e| pf.render(*e))?;
+        scalars.push((a.name.name.clone(), v));
     }
     let mut values = Vec::new();
     let mut get = |name: &str, default: f64| -> Result<f64, CaseError> {
