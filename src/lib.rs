@@ -22,6 +22,7 @@ pub mod output;
 pub mod plot;
 pub mod problem;
 pub mod progress;
+pub mod references;
 pub mod report;
 pub mod resources;
 pub mod settings;

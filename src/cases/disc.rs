@@ -312,7 +312,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
 }
 
 /// A key of the summary, as its type.
-fn field<T: serde::de::DeserializeOwned>(s: &crate::problem::run::Summary, k: &str) -> Result<T, CaseError> {
+pub(super) fn field<T: serde::de::DeserializeOwned>(s: &crate::problem::run::Summary, k: &str) -> Result<T, CaseError> {
     let v = s.get(k).cloned().unwrap_or(serde_json::Value::Null);
     serde_json::from_value(v).map_err(|e| CaseError::Option(format!("the summary's `{k}`: {e}")))
 }

@@ -1,7 +1,7 @@
-//! Case files: `signorini run case.toml` with every option of `run bar` / `run disc` (or of a
-//! problem: `case = "sphere"`, `case = "my_problem.wf"`) as keys,
-//! and the params of the scheme and form files in `[params]` (`alpha = 0.1`, or per file:
-//! `[params.elasticity] rho = 2`). Unknown keys, unknown params, keys of the other case and
+//! Case files: `signorini run case.toml` names a problem (`case = "bar"`, `case =
+//! "my_problem.wf"`) and sets the options of `signorini run` as keys, the problem's params as
+//! keys of their own (`ne = 40`), and the params of the scheme and form files in `[params]`
+//! (`alpha = 0.1`, or per file: `[params.elasticity] rho = 2`). Unknown keys, unknown params and
 //! out-of-range values are refused with the line of the key.
 
 use std::path::{Path, PathBuf};
@@ -11,8 +11,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::CaseError;
-use super::bar::{self, MassChoice};
-use super::disc;
+use super::bar::MassChoice;
 use crate::driver::{self, Setting, Setup};
 use crate::runtime::mesh::CellSize;
 use crate::simulation::MAX_STEP_CUTS;
@@ -39,23 +38,11 @@ struct CaseFile {
     /// Problems: the start time (the problem's default otherwise).
     t_start: Option<Spanned<f64>>,
     out: Option<Spanned<String>>,
-    /// bar only.
-    ne: Option<Spanned<i64>>,
-    /// disc only.
+    /// A Gmsh file instead of the problem's mesh.
     mesh: Option<Spanned<String>>,
-    h: Option<Spanned<f64>>,
     /// Step cuts and the energy check (`--max-step-cuts`, `--max-energy-growth`).
     max_step_cuts: Option<Spanned<i64>>,
     max_energy_growth: Option<Spanned<f64>>,
-}
-
-/// A case read from a file.
-pub enum Case {
-    Bar(bar::Options),
-    Disc(disc::Options),
-    /// Any other problem of the library (`case = "sphere"`) or a problem file (`case =
-    /// "ring.wf"`, relative to the case file).
-    Problem(Box<crate::problem::run::Options>),
 }
 
 struct Reader<'a> {
@@ -100,30 +87,83 @@ impl Reader<'_> {
             }),
         }
     }
+}
 
-    fn absent<T>(&self, v: &Option<Spanned<T>>, key: &str, case: &str) -> Result<(), CaseError> {
-        match v {
-            Some(s) => Err(self.error(s, key, format!("not an option of the {case} case"))),
-            None => Ok(()),
+/// The top-level keys of a case file that are params of its problem, as settings, and the text
+/// with them blanked out (lines and offsets kept) for the options' parser. None when the text
+/// does not parse or names no problem that loads (the options' parser then says why).
+/// The top-level keys of a case file that are params of its problem.
+struct ProblemKeys {
+    settings: Vec<Result<Setting, CaseError>>,
+    /// The text without them.
+    options: String,
+    /// What the problem calls itself and its params, for the error at an unknown key.
+    problem: String,
+    names: Vec<String>,
+}
+
+fn problem_params(text: &str, file: &str, base: &Path) -> Option<ProblemKeys> {
+    let table: toml::Table = toml::from_str(text).ok()?;
+    let problem = name_or_path(table.get("case")?.as_str()?, base);
+    let pf = crate::problem::load(&problem).ok()?;
+    let names: Vec<&str> = pf.problem().params.iter().map(|q| q.name.name.as_str()).collect();
+    let spans = toml::de::DeTable::parse(text).ok()?;
+    let mut blanked = text.as_bytes().to_vec();
+    let mut settings = Vec::new();
+    for (key, value) in spans.get_ref().iter() {
+        let name: &str = key.get_ref();
+        if !names.contains(&name) {
+            continue;
+        }
+        let (start, end) = (key.span().start, value.span().end.min(text.len()));
+        let line = text[..start].matches('\n').count() + 1;
+        let origin = format!("{file}:{line}");
+        let v = &table[name];
+        settings.push(match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
+            Some(value) => Ok(Setting { name: name.to_string(), value, origin }),
+            None => {
+                Err(CaseError::CaseFile(format!("{origin}: `{name}`: a param of problem `{}` is a number", pf.name())))
+            }
+        });
+        for b in &mut blanked[start..end] {
+            if *b != b'\n' {
+                *b = b' ';
+            }
         }
     }
+    Some(ProblemKeys {
+        settings,
+        options: String::from_utf8(blanked).ok()?,
+        problem: pf.name().to_string(),
+        names: names.iter().map(|n| n.to_string()).collect(),
+    })
 }
 
 /// Reads and checks a case file. Relative paths in it are relative to the file.
-pub fn read(path: &Path) -> Result<Case, CaseError> {
+/// It names a problem of the library (`case = "sphere"`) or a problem file (`case = "ring.wf"`,
+/// relative to the case file): the result is that problem's run.
+pub fn read(path: &Path) -> Result<crate::problem::run::Options, CaseError> {
     let text = std::fs::read_to_string(path).map_err(|e| CaseError::CaseFile(format!("{}: {e}", path.display())))?;
     parse(&text, path)
 }
 
 /// Checks the text of a case file read from `path` (for messages and relative paths).
-pub fn parse(text: &str, path: &Path) -> Result<Case, CaseError> {
+pub fn parse(text: &str, path: &Path) -> Result<crate::problem::run::Options, CaseError> {
     let file = path.display().to_string();
-    let parsed: CaseFile = toml::from_str(text).map_err(|e| {
-        let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
-        CaseError::CaseFile(format!("{file}:{}: {}", line.map_or("?".into(), |l| l.to_string()), e.message()))
-    })?;
-    let r = Reader { file: &file, text };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let keys = problem_params(text, &file, &base);
+    let options = keys.as_ref().map_or(text, |k| k.options.as_str());
+    let parsed: CaseFile = toml::from_str(options).map_err(|e| {
+        let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let mut message = e.message().trim_end().to_string();
+        if let Some(k) = keys.as_ref().filter(|_| message.starts_with("unknown field")) {
+            let params = if k.names.is_empty() { "none".to_string() } else { k.names.join(", ") };
+            message.push_str(&format!("; nor a param of problem `{}` (its params: {params})", k.problem));
+        }
+        CaseError::CaseFile(format!("{file}:{}: {message}", line.map_or("?".into(), |l| l.to_string())))
+    })?;
+    let problem_settings = keys.map(|k| k.settings).unwrap_or_default();
+    let r = Reader { file: &file, text };
     let mass: MassChoice = r.choice(&parsed.mass, "mass", MassChoice::Consistent)?;
     let setup = setup(&r, &parsed, &base)?;
     let cell_size = match &parsed.cell_size {
@@ -131,80 +171,38 @@ pub fn parse(text: &str, path: &Path) -> Result<Case, CaseError> {
         Some(s) => CellSize::parse(s.get_ref()).map_err(|e| r.error(s, "cell_size", e))?,
     };
     let out = parsed.out.as_ref().map(|o| base.join(o.get_ref()));
-    match parsed.case.get_ref().as_str() {
-        "bar" => {
-            r.absent(&parsed.mesh, "mesh", "bar")?;
-            r.absent(&parsed.t_start, "t_start", "bar")?;
-            r.absent(&parsed.h, "h", "bar")?;
-            let d = bar::Options::default();
-            let elements = match &parsed.ne {
-                None => d.elements,
-                Some(s) if (1..=100_000).contains(s.get_ref()) => *s.get_ref() as usize,
-                Some(s) => return Err(r.error(s, "ne", format!("{} is not in 1..=100000", s.get_ref()))),
-            };
-            Ok(Case::Bar(bar::Options {
-                setup,
-                elements,
-                dt: r.number(&parsed.dt, "dt", |x| x > 0.0, "positive", d.dt)?,
-                t_end: r.number(&parsed.t_end, "t_end", |x| x > 0.0, "positive", d.t_end)?,
-                mass,
-                cell_size,
-                out,
-                ..d
-            }))
-        }
-        "disc" => {
-            r.absent(&parsed.ne, "ne", "disc")?;
-            let d = disc::Options::default();
-            Ok(Case::Disc(disc::Options {
-                setup,
-                mass,
-                cell_size,
-                mesh: parsed.mesh.as_ref().map(|m| base.join(m.get_ref())),
-                h: r.number(&parsed.h, "h", |x| x > 0.05 && x <= 10.0, "in (0.05, 10]", d.h)?,
-                dt: r.number(&parsed.dt, "dt", |x| x > 0.0, "positive", d.dt)?,
-                t_end: r.number(&parsed.t_end, "t_end", |x| x > 0.0, "positive", d.t_end)?,
-                out,
-                ..d
-            }))
-        }
-        other => {
-            r.absent(&parsed.ne, "ne", "problem")?;
-            let problem = name_or_path(other, &base);
-            // The problem must exist (its own errors are located in its file).
-            crate::problem::load(&problem).map_err(|e| match e {
-                CaseError::Option(m) => r.error(&parsed.case, "case", m),
-                e => e,
-            })?;
-            let positive = |v: &Option<Spanned<f64>>, key: &str| -> Result<Option<f64>, CaseError> {
-                v.as_ref().map(|_| r.number(v, key, |x| x > 0.0, "positive", 0.0)).transpose()
-            };
-            let mut setup = setup;
-            if let Some(h) = &parsed.h {
-                let origin = format!("{}:{}", r.file, r.line(h.span().start));
-                setup.params.insert(0, Setting { name: "h".into(), value: *h.get_ref(), origin });
-            }
-            let mut opts = crate::problem::run::Options::new(&problem);
-            opts.chosen = crate::problem::run::Chosen {
-                scheme: parsed.scheme.is_some(),
-                contact: parsed.contact.is_some(),
-                material: parsed.material.is_some(),
-            };
-            opts.setup = setup;
-            opts.mass = mass;
-            opts.cell_size = cell_size;
-            opts.mesh = parsed.mesh.as_ref().map(|m| base.join(m.get_ref()));
-            opts.dt = positive(&parsed.dt, "dt")?;
-            opts.t_end = positive(&parsed.t_end, "t_end")?;
-            opts.t_start = parsed
-                .t_start
-                .as_ref()
-                .map(|_| r.number(&parsed.t_start, "t_start", |x| x >= 0.0, "0 or positive", 0.0))
-                .transpose()?;
-            opts.out = out;
-            Ok(Case::Problem(Box::new(opts)))
-        }
+    let problem = name_or_path(parsed.case.get_ref(), &base);
+    // The problem must exist (its own errors are located in its file).
+    crate::problem::load(&problem).map_err(|e| match e {
+        CaseError::Option(m) => r.error(&parsed.case, "case", m),
+        e => e,
+    })?;
+    let positive = |v: &Option<Spanned<f64>>, key: &str| -> Result<Option<f64>, CaseError> {
+        v.as_ref().map(|_| r.number(v, key, |x| x > 0.0, "positive", 0.0)).transpose()
+    };
+    let mut setup = setup;
+    for (i, s) in problem_settings.into_iter().enumerate() {
+        setup.params.insert(i, s?);
     }
+    let mut opts = crate::problem::run::Options::new(&problem);
+    opts.chosen = crate::problem::run::Chosen {
+        scheme: parsed.scheme.is_some(),
+        contact: parsed.contact.is_some(),
+        material: parsed.material.is_some(),
+    };
+    opts.setup = setup;
+    opts.mass = mass;
+    opts.cell_size = cell_size;
+    opts.mesh = parsed.mesh.as_ref().map(|m| base.join(m.get_ref()));
+    opts.dt = positive(&parsed.dt, "dt")?;
+    opts.t_end = positive(&parsed.t_end, "t_end")?;
+    opts.t_start = parsed
+        .t_start
+        .as_ref()
+        .map(|_| r.number(&parsed.t_start, "t_start", |x| x >= 0.0, "0 or positive", 0.0))
+        .transpose()?;
+    opts.out = out;
+    Ok(opts)
 }
 
 /// A name of the library, or a path relative to the case file.

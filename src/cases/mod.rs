@@ -4,7 +4,6 @@ use crate::runtime::kernel::Coef;
 
 pub mod bar;
 pub mod disc;
-pub mod exact;
 pub mod file;
 pub mod hertz;
 pub mod static_block;

@@ -9,7 +9,7 @@ mod compare;
 mod hertz;
 mod list;
 
-use crate::cases::bar::{self, MassChoice};
+use crate::cases::bar::MassChoice;
 use crate::cases::static_block;
 use crate::compiler;
 use crate::driver::{Setting, Setup};
@@ -41,9 +41,63 @@ impl Cli {
     /// the option's own range error instead of clap's "unexpected argument '-0'".
     pub fn parse_args() -> Self {
         use clap::{CommandFactory, FromArgMatches};
-        let matches = negative_values(Self::command()).get_matches();
+        let matches = negative_values(Self::command()).get_matches_from(problem_flags(std::env::args_os().collect()));
         Self::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
     }
+}
+
+/// `run PROBLEM --NAME VALUE` for a param NAME of the problem (`--ne 40`, `--h 0.5`): as
+/// `--param NAME=VALUE`. The problem's file declares its params; an option of `run` of the same
+/// name keeps its meaning.
+fn problem_flags(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    let text = |a: &std::ffi::OsString| a.to_str().map(str::to_string);
+    let Some(run) = args.iter().position(|a| a == "run") else { return args };
+    let Some(problem) = args.get(run + 1).and_then(text) else { return args };
+    if problem.starts_with('-') || problem.ends_with(".toml") {
+        return args;
+    }
+    let Ok(pf) = crate::problem::load(&problem) else { return args };
+    let cmd = <Cli as clap::CommandFactory>::command();
+    let known: Vec<String> = cmd
+        .find_subcommand("run")
+        .map(|r| r.get_arguments().filter_map(|a| a.get_long().map(str::to_string)).collect())
+        .unwrap_or_default();
+    let params: Vec<String> = pf.problem().params.iter().map(|q| q.name.name.clone()).collect();
+    let mut i = run + 2;
+    while i < args.len() {
+        let Some(arg) = text(&args[i]) else {
+            i += 1;
+            continue;
+        };
+        if arg == "--" {
+            break;
+        }
+        let Some(flag) = arg.strip_prefix("--") else {
+            i += 1;
+            continue;
+        };
+        let (name, inline) = match flag.split_once('=') {
+            Some((n, v)) => (n.to_string(), Some(v.to_string())),
+            None => (flag.to_string(), None),
+        };
+        let param = name.replace('-', "_");
+        if known.contains(&name) || !params.contains(&param) {
+            i += 1;
+            continue;
+        }
+        let value = match inline {
+            Some(v) => v,
+            None if i + 1 < args.len() => text(&args.remove(i + 1)).unwrap_or_default(),
+            None => {
+                i += 1;
+                continue;
+            }
+        };
+        args[i] = "--param".into();
+        args.insert(i + 1, format!("{param}={value}").into());
+        i += 2;
+    }
+    args
 }
 
 fn negative_values(cmd: clap::Command) -> clap::Command {
@@ -190,8 +244,6 @@ pub enum MeshCommand {
 pub enum Case {
     /// An elastic block resting on a rigid plane under its own weight (static contact).
     StaticBlock(StaticBlockArgs),
-    /// The compressed 1D bar against its exact solution (docs/mathematics.md §6).
-    Bar(BarArgs),
     /// A cylinder (2D) or ball (3D) pressed onto the plane by its weight, against Hertz.
     HertzStatic(HertzStaticArgs),
     /// A ball hitting the plane at low speed, against Hertz's impact formulas.
@@ -314,9 +366,6 @@ pub struct ProblemArgs {
     /// A Gmsh mesh (MSH 2.2 or 4.1) instead of the problem's.
     #[arg(long)]
     mesh: Option<PathBuf>,
-    /// Shorthand for --param h=VALUE (the mesh size of the disc's and the sphere's built-in mesh).
-    #[arg(long, allow_hyphen_values = true)]
-    h: Option<f64>,
     /// The time step (default: the problem's `run dt = ...`).
     #[arg(long, allow_hyphen_values = true)]
     dt: Option<f64>,
@@ -340,6 +389,11 @@ pub struct ProblemArgs {
     /// above 10 000 unknowns in 3D, 100 000 in 2D).
     #[arg(long, value_parser = Solver::parse, default_value = "auto")]
     solver: Solver,
+    /// Run every scheme × every contact law × {consistent, redistributed} (with the --param
+    /// settings that apply) and print one table of the problem's summary (with --out: one
+    /// subdirectory per run).
+    #[arg(long)]
+    all: bool,
 }
 
 /// Checkpoint and restart of a time-stepping case.
@@ -366,30 +420,6 @@ impl CheckpointArgs {
             None => out_dir(out),
         }
     }
-}
-
-#[derive(clap::Args)]
-pub struct BarArgs {
-    #[command(flatten)]
-    methods: MethodArgs,
-    /// Number of elements.
-    #[arg(long, default_value_t = 20)]
-    ne: usize,
-    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
-    dt: f64,
-    #[arg(long, default_value_t = 12.0, allow_hyphen_values = true)]
-    t_end: f64,
-    #[arg(long, value_enum, default_value_t = MassChoice::Consistent)]
-    mass: MassChoice,
-    /// Directory for series.csv and summary.json (with --all: one subdirectory per run).
-    #[arg(long)]
-    out: Option<PathBuf>,
-    /// Run every scheme × every contact law × {consistent, redistributed} (with the --param
-    /// settings that apply) and print one table.
-    #[arg(long)]
-    all: bool,
-    #[command(flatten)]
-    checkpoint: CheckpointArgs,
 }
 
 #[derive(clap::Args)]
@@ -486,7 +516,6 @@ fn dispatch(cli: Cli) -> ExitCode {
         }
         Command::Run { case: Some(case), .. } => match *case {
             Case::StaticBlock(a) => static_block(a),
-            Case::Bar(a) => run_bar(a),
             Case::HertzStatic(a) => hertz::run_static(a),
             Case::HertzImpact(a) => hertz::run_impact(a),
         },
@@ -692,104 +721,6 @@ fn write_bench(path: &Path, report: &impl serde::Serialize) -> ExitCode {
     }
 }
 
-fn run_bar(a: BarArgs) -> ExitCode {
-    let setup = match a.methods.setup() {
-        Ok(s) => s,
-        Err(e) => return fail(e),
-    };
-    let mut a = a;
-    if a.all && (a.checkpoint.checkpoint_every > 0 || a.checkpoint.resume.is_some()) {
-        return fail("--all runs many cases: it takes no --checkpoint-every or --resume");
-    }
-    a.out = match a.checkpoint.out(a.out.take()) {
-        Ok(dir) => dir,
-        Err(e) => return fail(e),
-    };
-    if a.all {
-        return run_bar_all(a, setup);
-    }
-    let opts = bar::Options {
-        setup,
-        elements: a.ne,
-        dt: a.dt,
-        t_end: a.t_end,
-        mass: a.mass,
-        cell_size: a.methods.cell_size,
-        out: a.out,
-        progress: true,
-        newton: crate::runtime::newton::NewtonOptions { line_search: a.methods.line_search, ..Default::default() },
-        checkpoint_every: a.checkpoint.checkpoint_every,
-        resume: a.checkpoint.resume.is_some(),
-    };
-    finish_bar(bar::run(&opts))
-}
-
-fn run_bar_all(a: BarArgs, base: Setup) -> ExitCode {
-    let masses = [(MassChoice::Consistent, "consistent"), (MassChoice::Redistributed, "redistributed")];
-    println!(
-        "{:<15} {:<16} {:<13} {:>8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>7} {:>4}",
-        "scheme", "contact", "mass", "err_u", "err_λ", "E_aug(0)", "E_aug(T)", "max|ΔE|", "penetr.", "Newton", "max"
-    );
-    let mut failed = false;
-    for scheme in crate::driver::all_schemes() {
-        for contact in crate::driver::contact_names() {
-            for (mass, mass_name) in masses {
-                // A setting that names a param the scheme lacks (alpha for newmark) is left out.
-                let params: Vec<Setting> = base
-                    .params
-                    .iter()
-                    .filter(|p| {
-                        let probe = Setup {
-                            scheme: scheme.into(),
-                            contact: contact.into(),
-                            params: vec![(*p).clone()],
-                            ..base.clone()
-                        };
-                        crate::driver::Active::resolve(&probe, bar::OVERRIDES).is_ok()
-                    })
-                    .cloned()
-                    .collect();
-                let setup = Setup { scheme: scheme.into(), contact: contact.into(), params, ..base.clone() };
-                let label = format!("{scheme}_{contact}_{mass_name}");
-                let opts = bar::Options {
-                    setup,
-                    elements: a.ne,
-                    dt: a.dt,
-                    t_end: a.t_end,
-                    mass,
-                    cell_size: a.methods.cell_size,
-                    out: a.out.as_ref().map(|d| d.join(&label)),
-                    ..Default::default()
-                };
-                match bar::run(&opts) {
-                    Ok(r) => {
-                        let s = r.summary;
-                        println!(
-                            "{:<15} {:<16} {:<13} {:>8.4} {:>8} {:>9.6} {:>9.6} {:>10.2e} {:>10.2e} {:>7} {:>4}",
-                            scheme,
-                            contact,
-                            mass_name,
-                            s.err_linf_l2_u,
-                            optional(s.err_l2_lambda, 4),
-                            s.energy_aug_initial,
-                            s.energy_aug_final,
-                            s.energy_aug_drift_max * s.energy_aug_initial,
-                            s.max_penetration,
-                            s.newton_total,
-                            s.newton_max
-                        );
-                    }
-                    Err(e) => {
-                        println!("{scheme:<15} {contact:<16} {mass_name:<13} failed: {e}");
-                        failed = true;
-                    }
-                }
-            }
-        }
-    }
-    if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
-}
-
 fn verify_scheme(out: &Path, methods: &MethodArgs) -> ExitCode {
     let setup = match methods.setup() {
         Ok(s) => s,
@@ -818,12 +749,27 @@ fn verify_scheme(out: &Path, methods: &MethodArgs) -> ExitCode {
 }
 
 fn run_problem(problem: &str, a: ProblemArgs) -> ExitCode {
-    let mut setup = match a.methods.setup() {
+    let setup = match a.methods.setup() {
         Ok(s) => s,
         Err(e) => return fail(e),
     };
-    if let Some(h) = a.h {
-        setup.params.push(Setting { name: "h".into(), value: h, origin: "--h".into() });
+    if a.all {
+        if a.checkpoint.checkpoint_every > 0 || a.checkpoint.resume.is_some() {
+            return fail("--all runs many cases: it takes no --checkpoint-every or --resume");
+        }
+        let mut opts = crate::problem::run::Options::new(problem);
+        opts.mesh = a.mesh;
+        opts.dt = a.dt;
+        opts.t_start = a.t_start;
+        opts.t_end = a.t_end;
+        opts.cell_size = a.methods.cell_size;
+        opts.newton.solver = a.solver;
+        opts.newton.line_search = a.methods.line_search;
+        opts.out = match out_dir(a.out) {
+            Ok(dir) => dir,
+            Err(e) => return fail(e),
+        };
+        return run_problem_all(opts, setup);
     }
     let opts = crate::problem::run::Options {
         problem: problem.to_string(),
@@ -854,6 +800,93 @@ fn run_problem(problem: &str, a: ProblemArgs) -> ExitCode {
         },
     };
     finish_problem(crate::problem::run::run(&opts))
+}
+
+/// `run PROBLEM --all`: every scheme × contact law × mass matrix, one line each with the
+/// problem's own summary keys.
+fn run_problem_all(base: crate::problem::run::Options, setup: Setup) -> ExitCode {
+    let masses = [(MassChoice::Consistent, "consistent"), (MassChoice::Redistributed, "redistributed")];
+    // The settings that are the problem's params (`ne`, or `bar.ne`).
+    let own: Vec<String> = match crate::problem::load(&base.problem) {
+        Ok(pf) => setup
+            .params
+            .iter()
+            .filter(|p| crate::problem::params(&pf, std::slice::from_ref(*p)).is_ok_and(|(_, rest)| rest.is_empty()))
+            .map(|p| p.name.clone())
+            .collect(),
+        Err(e) => return fail(e),
+    };
+    let mut header: Option<Vec<String>> = None;
+    let mut failed = false;
+    for scheme in crate::driver::all_schemes() {
+        for contact in crate::driver::contact_names() {
+            for (mass, mass_name) in masses {
+                // A setting that names a param the scheme lacks (alpha for newmark) is left out;
+                // the problem's own params are kept.
+                let params: Vec<Setting> = setup
+                    .params
+                    .iter()
+                    .filter(|p| {
+                        let probe = Setup {
+                            scheme: scheme.into(),
+                            contact: contact.into(),
+                            params: vec![(*p).clone()],
+                            ..setup.clone()
+                        };
+                        own.contains(&p.name) || crate::driver::Active::resolve(&probe, &[]).is_ok()
+                    })
+                    .cloned()
+                    .collect();
+                let label = format!("{scheme}_{contact}_{mass_name}");
+                let opts = crate::problem::run::Options {
+                    setup: Setup { scheme: scheme.into(), contact: contact.into(), params, ..setup.clone() },
+                    mass,
+                    out: base.out.as_ref().map(|d| d.join(&label)),
+                    chosen: crate::problem::run::Chosen::all(),
+                    ..base.clone()
+                };
+                match crate::problem::run::run(&opts) {
+                    Ok(r) => {
+                        let s = &r.summary;
+                        let keys = header.get_or_insert_with(|| {
+                            let keys = s.own.clone();
+                            let names: Vec<String> =
+                                keys.iter().map(|k| format!("{k:>w$}", w = k.len().max(11))).collect();
+                            println!(
+                                "{:<15} {:<16} {:<13} {} {:>7} {:>4}",
+                                "scheme",
+                                "contact",
+                                "mass",
+                                names.join(" "),
+                                "Newton",
+                                "max"
+                            );
+                            keys
+                        });
+                        let values: Vec<String> = keys
+                            .iter()
+                            .map(|k| {
+                                let w = k.len().max(11);
+                                s.number(k).map_or(format!("{:>w$}", "—"), |v| format!("{v:>w$.4e}"))
+                            })
+                            .collect();
+                        let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0);
+                        println!(
+                            "{scheme:<15} {contact:<16} {mass_name:<13} {} {:>7} {:>4}",
+                            values.join(" "),
+                            count("newton_total"),
+                            count("newton_max")
+                        );
+                    }
+                    Err(e) => {
+                        println!("{scheme:<15} {contact:<16} {mass_name:<13} failed: {e}");
+                        failed = true;
+                    }
+                }
+            }
+        }
+    }
+    if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
 }
 
 fn finish_problem(result: Result<crate::problem::run::Run, crate::cases::CaseError>) -> ExitCode {
@@ -907,27 +940,13 @@ fn finish_problem(result: Result<crate::problem::run::Run, crate::cases::CaseErr
 }
 
 fn run_file(file: &Path) -> ExitCode {
-    use crate::cases::file::{self, Case};
+    use crate::cases::file;
     let out = |opts_out: &mut Option<PathBuf>| -> Result<(), String> {
         *opts_out = out_dir(Some(opts_out.take().unwrap_or_else(|| file::default_out(file))))?;
         Ok(())
     };
     match file::read(file) {
-        Ok(Case::Bar(mut opts)) => {
-            if let Err(e) = out(&mut opts.out) {
-                return fail(e);
-            }
-            opts.progress = true;
-            finish_bar(bar::run(&opts))
-        }
-        Ok(Case::Disc(mut opts)) => {
-            if let Err(e) = out(&mut opts.out) {
-                return fail(e);
-            }
-            opts.progress = true;
-            finish_disc(crate::cases::disc::run(&opts))
-        }
-        Ok(Case::Problem(mut opts)) => {
+        Ok(mut opts) => {
             if let Err(e) = out(&mut opts.out) {
                 return fail(e);
             }
@@ -948,77 +967,6 @@ fn interpreted_note(files: &[String]) {
             "note: {f} ran interpreted (compiled at run time, same results as compiled); to compile it, copy it into forms/ (a scheme: forms/schemes/) and rebuild"
         );
     }
-}
-
-fn finish_bar(result: Result<bar::Run, crate::cases::CaseError>) -> ExitCode {
-    match result {
-        Ok(r) => {
-            let s = &r.summary;
-            interpreted_note(&s.interpreted);
-            println!(
-                "bar: {} {}{}, {} steps: err_u {:.4}, err_λ {}, E_aug {:.6} → {:.6}, penetration {:.3e}, Newton {} (max {}), {:.2} s",
-                s.scheme,
-                s.contact,
-                params_text(&s.params),
-                s.steps,
-                s.err_linf_l2_u,
-                optional(s.err_l2_lambda, 4),
-                s.energy_aug_initial,
-                s.energy_aug_final,
-                s.max_penetration,
-                s.newton_total,
-                s.newton_max,
-                s.wall_seconds
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
-fn finish_disc(result: Result<crate::cases::disc::Run, crate::cases::CaseError>) -> ExitCode {
-    match result {
-        Ok(r) => {
-            let s = &r.summary;
-            interpreted_note(&s.interpreted);
-            println!(
-                "{}: {} {}{}, {} dofs, {} steps, first contact at t = {}, max penetration {:.3e}, E_aug {:.6} → {:.6}, Newton {} (max {}), {:.2} s ({:.3} ms/step){}",
-                s.case,
-                s.scheme,
-                s.contact,
-                params_text(&s.params),
-                s.dofs,
-                s.steps,
-                s.first_contact.map_or("never".to_string(), |t| format!("{t:.2}")),
-                s.max_penetration,
-                s.energy_aug_initial,
-                s.energy_aug_final,
-                s.newton_total,
-                s.newton_max,
-                s.wall_seconds,
-                1e3 * s.seconds_per_step,
-                s.peak_memory_bytes.map_or(String::new(), |b| format!(", peak memory {:.0} MB", b as f64 / 1e6))
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
-/// The params the user or the case set (not the files' defaults), for one-line summaries.
-fn params_text(params: &std::collections::BTreeMap<String, crate::driver::ParamValue>) -> String {
-    let set: Vec<String> = params
-        .iter()
-        .filter(|(_, p)| p.source != crate::driver::params::Source::File)
-        .map(|(n, p)| format!("{n} = {}", p.value))
-        .collect();
-    if set.is_empty() { String::new() } else { format!(" ({})", set.join(", ")) }
 }
 
 /// A metric with `digits` decimals, or "—" where it is undefined.

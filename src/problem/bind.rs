@@ -21,7 +21,7 @@ pub fn dimension(pf: &ProblemFile, mesh_file: Option<&Path>) -> Result<usize, Ca
             let g = crate::compiler::check::problem::GENERATORS.iter().find(|g| g.name == call.name.name);
             match g {
                 Some(g) if g.dim != d => Err(CaseError::Option(format!(
-                    "problem `{}` is {}D (its mesh is a {}): {} is a {d}D mesh",
+                    "problem `{}` is {}D (its mesh: {}): {} is a {d}D mesh",
                     pf.name(),
                     g.dim,
                     g.name,

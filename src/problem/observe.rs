@@ -10,6 +10,7 @@ use crate::cases::CaseError;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
 use crate::driver::ActiveForms;
+use crate::references::Reference;
 use crate::runtime::assembly::Assembler;
 use crate::runtime::evaluate::{FacetSample, facet_samples};
 use crate::runtime::library::{Binding, BoundFunctional};
@@ -18,7 +19,7 @@ use crate::runtime::scheme::BoundForm;
 use crate::simulation::{AxisMean, Tools, resultant};
 
 /// One measured value of a row.
-enum Measure<'m> {
+enum Measure {
     Time,
     Energy,
     Kinetic,
@@ -38,6 +39,8 @@ enum Measure<'m> {
         field: u8,
         axis: usize,
         node: usize,
+        /// The node carries no mass (redistributed): its velocity is the step's mean one.
+        massless: bool,
     },
     /// The resultant of slot form `slot`'s residual, over the dofs listed (all without a list).
     Force {
@@ -54,8 +57,15 @@ enum Measure<'m> {
         region: usize,
         f: PointFn,
     },
+    /// A functional of the files in use, at the row's state or at the step's midpoint.
     Functional {
-        f: Box<dyn BoundFunctional + 'm>,
+        index: usize,
+        mid: bool,
+    },
+    /// Functional `which` of the problem's reference.
+    Reference {
+        which: usize,
+        mid: bool,
     },
     /// `inner_mass(A, B)`: aᵀ M b with the scheme's mass, A and B evaluated at the nodes.
     InnerMass {
@@ -70,11 +80,14 @@ pub struct State<'a> {
     pub u: &'a [f64],
     pub v: Option<&'a [f64]>,
     pub newton: usize,
+    /// The displacement at the start of the step and the step (none at the initial row and at
+    /// stages).
+    pub before: Option<(&'a [f64], f64)>,
 }
 
 /// The problem's series, compiled for a bound run.
 pub struct Observer<'m> {
-    measures: Vec<Measure<'m>>,
+    measures: Vec<Measure>,
     /// Per column: its name, whether series.csv shows it, its expression of the measures.
     columns: Vec<(String, bool, PointFn)>,
     /// The regions sampled by `measure` and `peak`, with their facets.
@@ -84,6 +97,9 @@ pub struct Observer<'m> {
     slots: Vec<(String, Box<dyn BoundForm + 'm>)>,
     /// The column each measure was added for.
     owner: Vec<usize>,
+    reference: Option<&'static dyn Reference>,
+    /// The functionals the measures read, by name.
+    functionals: Vec<(String, Box<dyn BoundFunctional + 'm>)>,
 }
 
 /// The placeholder name of measured value `id` in a rewritten expression.
@@ -102,6 +118,7 @@ impl<'m> Observer<'m> {
         binding: &Binding<'m>,
         coef_vals: &[(String, Val)],
         degree: u32,
+        reference: Option<&'static dyn Reference>,
     ) -> Result<Observer<'m>, CaseError> {
         let p = pf.problem();
         let mut inst = forms.instantiate(coefs, binding)?;
@@ -113,6 +130,8 @@ impl<'m> Observer<'m> {
             degree,
             slots,
             owner: Vec::new(),
+            reference,
+            functionals: Vec::new(),
         };
         let mut region_names: Vec<String> = Vec::new();
         let u = ex.field(0);
@@ -157,7 +176,7 @@ impl<'m> Observer<'m> {
         binding: &Binding<'m>,
     ) -> Result<Expr, CaseError> {
         let d = tools.asm.mesh().dim();
-        let mut add = |o: &mut Self, m: Measure<'m>, comps: usize, span| {
+        let mut add = |o: &mut Self, m: Measure, comps: usize, span| {
             o.measures.push(m);
             let id = o.measures.len() - 1;
             leaves.push((id, comps));
@@ -231,7 +250,8 @@ impl<'m> Observer<'m> {
                             let node = (0..mesh.num_nodes())
                                 .min_by(|&a, &b| values[a].total_cmp(&values[b]))
                                 .ok_or_else(|| CaseError::Option("the mesh has no node".into()))?;
-                            Measure::AtMin { field, axis, node }
+                            let massless = tools.redistributed && tools.contact_nodes.contains(&(node as u32));
+                            Measure::AtMin { field, axis, node, massless }
                         }
                     };
                     add(self, m, 1, e.span)
@@ -298,15 +318,42 @@ impl<'m> Observer<'m> {
                     add(self, m, 1, e.span)
                 }
                 name => {
-                    let func = inst.take_functional(name).ok_or_else(|| {
-                        pf.render(crate::compiler::Diagnostic::error(
-                            "E0101",
-                            format!("no functional `{name}` in the files in use"),
-                            f.span,
-                            "not provided",
-                        ))
-                    })?;
-                    add(self, Measure::Functional { f: func }, 1, e.span)
+                    let mid = matches!(&args[0].kind, ExprKind::Name(n) if n.name == "u_mid");
+                    let by_reference = self.reference.and_then(|r| {
+                        r.functionals()
+                            .iter()
+                            .position(|(n, _)| *n == name)
+                            .map(|which| Measure::Reference { which, mid })
+                    });
+                    let known = self.functionals.iter().position(|(n, _)| n == name);
+                    let index = known.or_else(|| {
+                        let f = inst.take_functional(name)?;
+                        self.functionals.push((name.to_string(), f));
+                        Some(self.functionals.len() - 1)
+                    });
+                    let m = match index {
+                        Some(index) => Measure::Functional { index, mid },
+                        None => by_reference.ok_or_else(|| {
+                            let mut d = crate::compiler::Diagnostic::error(
+                                "E0101",
+                                format!("no functional `{name}` in the files in use"),
+                                f.span,
+                                "not provided",
+                            );
+                            match self.reference {
+                                Some(r) => {
+                                    let names: Vec<&str> = r.functionals().iter().map(|(n, _)| *n).collect();
+                                    d = d.with_note(format!("nor in reference `{}`: {}", r.name(), names.join(", ")));
+                                    if let Some(s) = crate::compiler::check::suggest_name(name, names.iter().copied()) {
+                                        d = d.with_help(format!("did you mean `{s}`?"));
+                                    }
+                                }
+                                None => d = d.with_note("the problem names no reference (`reference NAME`)"),
+                            }
+                            pf.render(d)
+                        })?,
+                    };
+                    add(self, m, 1, e.span)
                 }
             },
         })
@@ -339,6 +386,12 @@ impl<'m> Observer<'m> {
         let mut kinetic = None;
         let mut scratch = Vec::new();
         let mut switches = Vec::new();
+        // The step's midpoint, for the functionals at `u_mid` (none without a step).
+        let mut mid: Option<Option<(Vec<f64>, f64)>> = None;
+        let mut midpoint = || -> Option<(Vec<f64>, f64)> {
+            let (before, dt) = s.before?;
+            Some((before.iter().zip(s.u).map(|(a, b)| 0.5 * (a + b)).collect(), s.t - 0.5 * dt))
+        };
         if let Some((_, probe)) = self.slots.iter().find(|(n, _)| n == "contact") {
             probe.switches(asm, &[s.u], 0, s.t, &mut switches);
         }
@@ -360,7 +413,12 @@ impl<'m> Observer<'m> {
                     Measure::NodalMean { field: fi, axis } => vec![
                         field(*fi).map_or(f64::NAN, |x| x.iter().skip(*axis).step_by(d).sum::<f64>() / (n / d) as f64),
                     ],
-                    Measure::AtMin { field: fi, axis, node } => {
+                    Measure::AtMin { field: 1, axis, node, massless: true } if s.before.is_some() => {
+                        let (before, dt) = s.before.expect("a step");
+                        let i = d * node + axis;
+                        vec![(s.u[i] - before[i]) / dt]
+                    }
+                    Measure::AtMin { field: fi, axis, node, .. } => {
                         vec![field(*fi).map_or(f64::NAN, |x| x[d * node + axis])]
                     }
                     Measure::Force { slot, dofs } => {
@@ -418,7 +476,26 @@ impl<'m> Observer<'m> {
                         sampled.push((*region, f.key.clone(), values));
                         value
                     }
-                    Measure::Functional { f } => vec![f.value(asm, &[s.u], s.t)],
+                    Measure::Functional { index, mid: false } => {
+                        vec![self.functionals[*index].1.value(asm, &[s.u], s.t)]
+                    }
+                    Measure::Functional { index, mid: true } => {
+                        let f = &self.functionals[*index].1;
+                        vec![
+                            mid.get_or_insert_with(&mut midpoint)
+                                .as_ref()
+                                .map_or(f64::NAN, |(u, t)| f.value(asm, &[u], *t)),
+                        ]
+                    }
+                    Measure::Reference { which, mid: false } => {
+                        vec![self.reference.map_or(f64::NAN, |r| r.value(*which, tools, s.u, s.t))]
+                    }
+                    Measure::Reference { which, mid: true } => vec![
+                        mid.get_or_insert_with(&mut midpoint)
+                            .as_ref()
+                            .zip(self.reference)
+                            .map_or(f64::NAN, |((u, t), r)| r.value(*which, tools, u, *t)),
+                    ],
                     Measure::InnerMass { a, b } => {
                         let nodal = |f: &PointFn, scratch: &mut Vec<f64>| {
                             let mut out = vec![0.0; n];
@@ -451,86 +528,158 @@ impl<'m> Observer<'m> {
 }
 
 /// A summary reducer over the rows.
+#[derive(Clone, Copy)]
 enum Reduce {
-    Initial(Option<usize>),
-    Final(Option<usize>),
-    Min(Option<usize>),
-    Max(Option<usize>),
-    /// The first column at the first row where the second is positive.
-    First(Option<usize>, Option<usize>),
+    Initial,
+    Final,
+    Min,
+    Max,
+    Sum,
+    /// The first argument at the first row where the second is positive.
+    First,
+}
+
+/// A reducer's argument: a column as it is (`None`: the row's time), or an expression of the
+/// row (its columns, `t` and the keys before).
+enum Arg {
+    Column(Option<usize>),
+    Expr(PointFn),
+}
+
+/// One summary key: its reducers and its expression of their values and the keys before it.
+struct Key {
+    name: String,
+    reduces: Vec<(Reduce, Vec<Arg>)>,
+    f: PointFn,
 }
 
 /// The problem's summary keys, compiled.
 pub struct SummaryKeys {
-    items: Vec<(String, Vec<Reduce>, PointFn)>,
+    keys: Vec<Key>,
+    columns: usize,
 }
 
 impl SummaryKeys {
-    /// `columns`: every column's name, in row order (`t` is the rows' time).
+    /// `columns`: every column's name, in row order.
     pub fn new(pf: &ProblemFile, ex: &mut Exprs, columns: &[String]) -> Result<SummaryKeys, CaseError> {
-        let mut items = Vec::new();
+        let mut keys: Vec<Key> = Vec::new();
+        // In a reducer's argument: column i is measured value i, key j is measured value
+        // columns + j.
+        let mut row_scope: Vec<(String, Val)> =
+            columns.iter().enumerate().map(|(i, c)| (c.clone(), ex.measured(i, 1))).collect();
         for d in &pf.problem().summary {
+            let mut calls = Vec::new();
+            let rewritten = summary_rewrite(&d.value, &mut calls);
             let mut reduces = Vec::new();
-            let rewritten = summary_rewrite(&d.value, columns, &mut reduces);
-            let scope: Vec<(String, Val)> = (0..reduces.len()).map(|i| (placeholder(i), ex.measured(i, 1))).collect();
+            for (r, args) in calls {
+                let mut compiled = Vec::new();
+                for a in &args {
+                    compiled.push(match &a.kind {
+                        ExprKind::Name(n) if n.name == "t" => Arg::Column(None),
+                        ExprKind::Name(n) if columns.contains(&n.name) => {
+                            Arg::Column(columns.iter().position(|c| *c == n.name))
+                        }
+                        _ => {
+                            let val = ex.lower(a, &row_scope).map_err(|e| pf.render(*e))?;
+                            Arg::Expr(ex.function(&val, a).map_err(|e| pf.render(*e))?)
+                        }
+                    });
+                }
+                reduces.push((r, compiled));
+            }
+            // Reducer i is measured value i; key j is measured value reducers + j.
+            let mut scope: Vec<(String, Val)> =
+                (0..reduces.len()).map(|i| (placeholder(i), ex.measured(i, 1))).collect();
+            for (j, k) in keys.iter().enumerate() {
+                scope.push((k.name.clone(), ex.measured(reduces.len() + j, 1)));
+            }
             let val = ex.lower(&rewritten, &scope).map_err(|e| pf.render(*e))?;
-            items.push((d.name.name.clone(), reduces, ex.function(&val, &d.value).map_err(|e| pf.render(*e))?));
+            let f = ex.function(&val, &d.value).map_err(|e| pf.render(*e))?;
+            row_scope.push((d.name.name.clone(), ex.measured(columns.len() + keys.len(), 1)));
+            keys.push(Key { name: d.name.name.clone(), reduces, f });
         }
-        Ok(SummaryKeys { items })
+        Ok(SummaryKeys { keys, columns: columns.len() })
     }
 
     /// The keys and their values over `rows` (time, values); null where a reducer has none.
     pub fn values(&self, rows: &[(f64, Vec<f64>)]) -> Vec<(String, Option<f64>)> {
-        let get = |r: &(f64, Vec<f64>), c: Option<usize>| c.map_or(r.0, |i| r.1[i]);
-        self.items
-            .iter()
-            .map(|(name, reduces, f)| {
-                let measured: Option<Vec<Vec<f64>>> = reduces
-                    .iter()
-                    .map(|r| {
-                        Some(vec![match *r {
-                            Reduce::Initial(c) => get(rows.first()?, c),
-                            Reduce::Final(c) => get(rows.last()?, c),
-                            Reduce::Min(c) => rows.iter().map(|r| get(r, c)).fold(f64::INFINITY, f64::min),
-                            Reduce::Max(c) => rows.iter().map(|r| get(r, c)).fold(f64::NEG_INFINITY, f64::max),
-                            Reduce::First(c, when) => get(rows.iter().find(|r| get(r, when) > 0.0)?, c),
-                        }])
-                    })
-                    .collect();
-                let value = measured.map(|m| {
-                    let mut out = [0.0];
-                    f.eval(&At { measured: &m, ..At::default() }, &mut Vec::new(), &mut out);
-                    out[0]
-                });
-                (name.clone(), value)
-            })
-            .collect()
+        let mut out: Vec<(String, Option<f64>)> = Vec::new();
+        // A row as measured values: its columns, then the keys so far.
+        let mut at_row: Vec<Vec<f64>> = vec![vec![0.0]; self.columns + self.keys.len()];
+        let mut scratch = Vec::new();
+        for key in &self.keys {
+            for (j, (_, v)) in out.iter().enumerate() {
+                at_row[self.columns + j][0] = v.unwrap_or(f64::NAN);
+            }
+            let mut arg = |a: &Arg, r: &(f64, Vec<f64>)| -> f64 {
+                match a {
+                    Arg::Column(c) => c.map_or(r.0, |i| r.1[i]),
+                    Arg::Expr(f) => {
+                        for (slot, v) in at_row.iter_mut().zip(&r.1) {
+                            slot[0] = *v;
+                        }
+                        let mut o = [0.0];
+                        f.eval(&At { t: r.0, measured: &at_row, ..At::default() }, &mut scratch, &mut o);
+                        o[0]
+                    }
+                }
+            };
+            let measured: Option<Vec<Vec<f64>>> = key
+                .reduces
+                .iter()
+                .map(|(r, args)| {
+                    let a = &args[0];
+                    Some(vec![match r {
+                        Reduce::Initial => arg(a, rows.first()?),
+                        Reduce::Final => arg(a, rows.last()?),
+                        Reduce::Min => rows.iter().map(|row| arg(a, row)).fold(f64::INFINITY, f64::min),
+                        Reduce::Max => rows.iter().map(|row| arg(a, row)).fold(f64::NEG_INFINITY, f64::max),
+                        Reduce::Sum => {
+                            rows.iter().map(|row| arg(a, row)).filter(|v| !v.is_nan()).fold(0.0, |s, v| s + v)
+                        }
+                        Reduce::First => {
+                            let row = rows.iter().find(|row| arg(&args[1], row) > 0.0)?;
+                            arg(a, row)
+                        }
+                    }])
+                })
+                .collect();
+            let value = measured.map(|mut m| {
+                m.extend(out.iter().map(|(_, v)| vec![v.unwrap_or(f64::NAN)]));
+                let mut o = [0.0];
+                key.f.eval(&At { measured: &m, ..At::default() }, &mut scratch, &mut o);
+                o[0]
+            });
+            out.push((key.name.clone(), value));
+        }
+        out
     }
 }
 
-fn summary_rewrite(e: &Expr, columns: &[String], reduces: &mut Vec<Reduce>) -> Expr {
-    let col = |a: &Expr| match &a.kind {
-        ExprKind::Name(n) if n.name == "t" => None,
-        ExprKind::Name(n) => columns.iter().position(|c| *c == n.name),
-        _ => unreachable!("checked: a column name"),
-    };
+/// `e` with each reducer call replaced by a placeholder; the calls are collected.
+fn summary_rewrite(e: &Expr, calls: &mut Vec<(Reduce, Vec<Expr>)>) -> Expr {
     let kind = match &e.kind {
         ExprKind::Call(f, args) => {
-            reduces.push(match f.name.as_str() {
-                "initial" => Reduce::Initial(col(&args[0])),
-                "final" => Reduce::Final(col(&args[0])),
-                "min" => Reduce::Min(col(&args[0])),
-                "max" => Reduce::Max(col(&args[0])),
-                _ => Reduce::First(col(&args[0]), col(&args[1])),
-            });
-            ExprKind::Name(Ident { name: placeholder(reduces.len() - 1), span: e.span })
+            let r = match f.name.as_str() {
+                "initial" => Reduce::Initial,
+                "final" => Reduce::Final,
+                "min" => Reduce::Min,
+                "max" => Reduce::Max,
+                "sum" => Reduce::Sum,
+                "first" => Reduce::First,
+                // A function of a number (`sqrt`): kept, its argument rewritten.
+                _ => {
+                    let args = args.iter().map(|a| summary_rewrite(a, calls)).collect();
+                    return Expr { kind: ExprKind::Call(f.clone(), args), span: e.span };
+                }
+            };
+            calls.push((r, args.clone()));
+            ExprKind::Name(Ident { name: placeholder(calls.len() - 1), span: e.span })
         }
-        ExprKind::Neg(a) => ExprKind::Neg(Box::new(summary_rewrite(a, columns, reduces))),
-        ExprKind::Binary(op, a, b) => ExprKind::Binary(
-            *op,
-            Box::new(summary_rewrite(a, columns, reduces)),
-            Box::new(summary_rewrite(b, columns, reduces)),
-        ),
+        ExprKind::Neg(a) => ExprKind::Neg(Box::new(summary_rewrite(a, calls))),
+        ExprKind::Binary(op, a, b) => {
+            ExprKind::Binary(*op, Box::new(summary_rewrite(a, calls)), Box::new(summary_rewrite(b, calls)))
+        }
         other => other.clone(),
     };
     Expr { kind, span: e.span }

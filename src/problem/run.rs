@@ -206,19 +206,10 @@ fn bind_files(pf: &ProblemFile, setup: &mut Setup, chosen: Chosen) {
     }
 }
 
-/// The problem items the driver does not run yet: an error at each, not a silent omission.
+/// What the driver needs of every problem: the region the contact forms integrate over.
 fn unsupported(pf: &ProblemFile) -> Result<(), CaseError> {
     use crate::compiler::Diagnostic;
     let p = pf.problem();
-    let not_yet = |span, what: &str| {
-        pf.render(
-            Diagnostic::error("E0101", format!("{what} are not run by the driver yet"), span, "not supported yet")
-                .with_note("the problem checks; its run needs this item, which a later version adds"),
-        )
-    };
-    if let Some(r) = &p.reference {
-        return Err(not_yet(r.span, "references"));
-    }
     if !p.regions.iter().any(|r| r.name.name == "Gamma_C") {
         return Err(pf.render(
             Diagnostic::error("E0101", "no region `Gamma_C`", p.name.span, "the contact forms integrate over it")
@@ -226,6 +217,27 @@ fn unsupported(pf: &ProblemFile) -> Result<(), CaseError> {
         ));
     }
     Ok(())
+}
+
+/// The problem's reference, if it names one, for a problem of dimension `d`.
+fn reference(pf: &ProblemFile, d: usize) -> Result<Option<&'static dyn crate::references::Reference>, CaseError> {
+    use crate::compiler::Diagnostic;
+    let Some(name) = &pf.problem().reference else { return Ok(None) };
+    let names = crate::references::ALL.iter().map(|r| r.name());
+    let r = crate::references::find(&name.name)
+        .ok_or_else(|| pf.render(crate::compiler::check::problem::unknown_among(name, names, "reference")))?;
+    if r.dim() != d {
+        return Err(pf.render(
+            Diagnostic::error(
+                "E0302",
+                "wrong dimension",
+                name.span,
+                format!("reference `{}` is {}D, the problem {d}D", r.name(), r.dim()),
+            )
+            .with_note(format!("{}: {}", r.name(), r.doc())),
+        ));
+    }
+    Ok(Some(r))
 }
 
 /// Every coef the files in use read must be set by the problem (a `coef` line, or an
@@ -405,16 +417,27 @@ fn simulate(
     }
     let binding = Binding { quadrature, regions, dim: mesh.dim() };
     let coef_vals = super::bind::coef_vals(pf, ex)?;
-    let observer =
-        Observer::new(pf, ex, &sim.tools, &active.forms, &coefs, &binding, &coef_vals, quadrature.facet.unwrap_or(7))?;
+    let observer = Observer::new(
+        pf,
+        ex,
+        &sim.tools,
+        &active.forms,
+        &coefs,
+        &binding,
+        &coef_vals,
+        quadrature.facet.unwrap_or(7),
+        reference(pf, mesh.dim())?,
+    )?;
     let columns: Vec<String> = observer.names().map(str::to_string).collect();
     let shown = observer.shown();
     let summary_fns = SummaryKeys::new(pf, ex, &columns)?;
-    let row = |tools: &crate::simulation::Tools, u: &[f64], v: Option<&[f64]>, newton: usize, t: f64| {
-        let (values, switches) = observer.row(tools, &State { t, u, v, newton });
+    let row = |tools: &crate::simulation::Tools, state: State| {
+        let t = state.t;
+        let (values, switches) = observer.row(tools, &state);
         ((t, values), switches)
     };
-    let (first, first_switches) = row(&sim.tools, &sim.states[0], sim.velocity(), 0, t0);
+    let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None };
+    let (first, first_switches) = row(&sim.tools, first);
     let mut series = vec![first];
     let mut switches = vec![first_switches];
     // Newton iterations of each row's step (0 for the initial state).
@@ -475,13 +498,20 @@ fn simulate(
         &mut |tools, stage, v_index| {
             if let Some(u) = stage.value_of(names[0]) {
                 let v = v_index.and_then(|i| stage.value_of(names[i]));
-                let ((t, values), _) = row(tools, u, v, 0, stage.time);
+                let ((t, values), _) = row(tools, State { t: stage.time, u, v, newton: 0, before: None });
                 stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
             }
         },
         &mut |tools, step, record| {
             let v = v_index.map(|i| step.states[i].as_slice());
-            let (values, active) = row(tools, &step.states[0], v, step.report.iterations(), step.t);
+            let state = State {
+                t: step.t,
+                u: &step.states[0],
+                v,
+                newton: step.report.iterations(),
+                before: Some((step.before, step.dt)),
+            };
+            let (values, active) = row(tools, state);
             series.push(values);
             switches.push(active);
             iterations.push(step.report.iterations());
@@ -526,6 +556,8 @@ fn simulate(
     put("dofs", n.into());
     put("dt", json(&settings.dt));
     put("steps", steps.into());
+    // The time reached (t_end, or where the run stopped).
+    put("t_end", json(&series.last().map_or(t0, |r| r.0)));
     let own = summary_fns.values(&series);
     for (k, v) in &own {
         put(k, json(v));
@@ -549,6 +581,19 @@ fn simulate(
     }
     if let Some(resumed) = &outcome.resumed {
         put("resumed", json(resumed));
+    }
+    // Why a key is null: undefined on this run (0/0 or no row where `first` finds one).
+    let notes: Vec<String> = own
+        .iter()
+        .filter(|(_, v)| !v.is_some_and(f64::is_finite))
+        .map(|(k, _)| {
+            let at = p.summary.iter().find(|d| d.name.name == *k).map(|d| d.span);
+            let line = at.map_or(0, |s| pf.program.unit.sources.line_col(s.file, s.start).0);
+            format!("{k} is undefined on this run (its expression at {}:{line} has no value)", pf.file)
+        })
+        .collect();
+    if !notes.is_empty() {
+        put("notes", json(&notes));
     }
     summary.own = own.into_iter().map(|(k, _)| k).collect();
     let run = Run { summary, columns, rows: series, switches, stages: stage_rows };

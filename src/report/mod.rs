@@ -71,7 +71,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
             s.newton_total,
             s.newton_max
         );
-        let _ = writeln!(figures, "**{label}**\n\n![{label}](bar/{label}/contact.png)\n");
+        let _ = writeln!(figures, "**{label}**\n\n![{label}](bar/{label}/bar.png)\n");
         // Energies that stay bounded (the explicit-contact variant grows: its own row says so).
         let bounded = r.summary.energy_aug_drift_max < 1.0;
         if mass == MassChoice::Consistent && contact == default_contact && bounded {

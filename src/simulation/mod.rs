@@ -62,6 +62,8 @@ pub struct Tools<'m> {
     pub varying_load: Option<Box<dyn BoundForm + 'm>>,
     /// The nodes of the contact region.
     pub contact_nodes: Vec<u32>,
+    /// The mass is redistributed: the contact nodes carry none.
+    pub redistributed: bool,
     /// The energies' quadratic forms, ½uᵀKu and ½vᵀMv with the scheme's mass, evaluated every
     /// step by the observers.
     pub energies: Energies,
@@ -274,6 +276,7 @@ impl<'m> Simulation<'m> {
                 .take_form("load")
                 .filter(|f| f.time_dependent() && f.fields() == 0),
             contact_nodes,
+            redistributed,
         };
         let names = stepper.desc().states;
         let states = names.iter().map(|_| vec![0.0; n]).collect();

@@ -136,18 +136,33 @@ pub const ROW_REDUCERS: &[(&str, &str, &str)] = &[
     ),
 ];
 
-/// Any other call in a series column, `NAME(u)`, is a functional of the files in use (checked
-/// when the problem is bound).
+/// Any other call in a series column, `NAME(u)`, is a functional of the files in use or of the
+/// problem's reference (checked when the problem is bound).
 pub const FUNCTIONAL_CALL: &str = "NAME(u)";
 
-/// The reducers of a summary key, over the rows of the series.
-pub const SUMMARY_REDUCERS: &[(&str, &str, &str)] = &[
-    ("initial", "initial(COLUMN)", "the first row's value"),
-    ("final", "final(COLUMN)", "the last row's value"),
-    ("min", "min(COLUMN)", "the least value"),
-    ("max", "max(COLUMN)", "the largest value"),
-    ("first", "first(COLUMN, WHEN)", "COLUMN at the first row where WHEN > 0 (null if none)"),
+/// The states a functional is evaluated at: a name and its meaning.
+pub const FUNCTIONAL_STATES: &[(&str, &str)] = &[
+    ("u", "the row's displacement, at the row's time"),
+    (
+        "u_mid",
+        "the step's midpoint (uⁿ + uⁿ⁺¹)/2 at t − Δt/2, where the midpoint and hybrid schemes impose contact (NaN at the initial row and at stages)",
+    ),
 ];
+
+/// The reducers of a summary key, over the rows of the series. Their argument is an expression
+/// of the row (columns, `t`, earlier summary keys, params); rows where it is NaN (undefined, as
+/// a `u_mid` value at the initial row) are left out of `min`, `max` and `sum`.
+pub const SUMMARY_REDUCERS: &[(&str, &str, &str)] = &[
+    ("initial", "initial(EXPR)", "the first row's value"),
+    ("final", "final(EXPR)", "the last row's value"),
+    ("min", "min(EXPR)", "the least value"),
+    ("max", "max(EXPR)", "the largest value"),
+    ("sum", "sum(EXPR)", "the sum over the rows, in order"),
+    ("first", "first(EXPR, WHEN)", "EXPR at the first row where WHEN > 0 (null if none)"),
+];
+
+/// Functions of one number a summary key may apply, inside or outside its reducers.
+pub const SUMMARY_FUNCTIONS: &[&str] = &["sqrt", "abs", "pos"];
 
 /// Fields whose initial value a problem may give.
 pub const INITIAL_FIELDS: &[&str] = &["u", "v"];
@@ -286,8 +301,11 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
     }
     // Every row has its time.
     earlier.push("t");
+    let mut keys: Vec<&str> = Vec::new();
     for d in &p.summary {
-        summary(&d.value, &earlier, &constants, diags);
+        let scope = SummaryScope { columns: &earlier, keys: &keys, constants: &constants };
+        summary(&d.value, &scope, false, diags);
+        keys.push(&d.name.name);
     }
     for pl in &p.plots {
         for col in &pl.columns {
@@ -464,9 +482,10 @@ fn row_help() -> String {
     let values: Vec<&str> = ROW_VALUES.iter().map(|(n, _)| *n).collect();
     let reducers: Vec<&str> = ROW_REDUCERS.iter().map(|(_, w, _)| *w).collect();
     format!(
-        "a column reads the row values ({}), earlier columns, params, and reducers: {}, or a functional `{FUNCTIONAL_CALL}`",
+        "a column reads the row values ({}), earlier columns, params, and reducers: {}, or a functional `{FUNCTIONAL_CALL}` (also at {})",
         values.join(", "),
-        reducers.join(", ")
+        reducers.join(", "),
+        FUNCTIONAL_STATES.iter().skip(1).map(|(s, _)| *s).collect::<Vec<_>>().join(", ")
     )
 }
 
@@ -540,7 +559,8 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
             }
         }
         _ => {
-            let fields = args.iter().all(|a| matches!(&a.kind, K::Name(n) if n.name == "u"));
+            let state = |n: &str| FUNCTIONAL_STATES.iter().any(|(s, _)| *s == n);
+            let fields = args.iter().all(|a| matches!(&a.kind, K::Name(n) if state(&n.name)));
             if args.is_empty() || !fields {
                 diags.push(
                     Diagnostic::error(
@@ -556,47 +576,70 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
     }
 }
 
-/// A summary key: arithmetic of numbers, params and reducers of columns.
-fn summary(e: &Expr, columns: &[&str], constants: &[(String, Shape)], diags: &mut Vec<Diagnostic>) {
+/// What a summary key may name.
+struct SummaryScope<'a> {
+    /// The series' columns and `t`: read per row, inside a reducer.
+    columns: &'a [&'a str],
+    /// The summary keys before this one.
+    keys: &'a [&'a str],
+    constants: &'a [(String, Shape)],
+}
+
+/// A summary key: arithmetic of numbers, params, earlier keys, functions and reducers, whose
+/// arguments (`in_row`) read the row's columns too.
+fn summary(e: &Expr, s: &SummaryScope, in_row: bool, diags: &mut Vec<Diagnostic>) {
     use crate::syntax::ast::ExprKind as K;
-    let column = |a: &Expr, diags: &mut Vec<Diagnostic>| match &a.kind {
-        K::Name(id) if columns.contains(&id.name.as_str()) => {}
-        K::Name(id) => diags.push(unknown_among(id, columns.iter().copied(), "column")),
-        _ => diags.push(Diagnostic::error("E0301", "shape mismatch", a.span, "a column's name is needed here")),
-    };
     match &e.kind {
         K::Number(_) => {}
         K::Name(id) => {
-            if !constants.iter().any(|(n, _)| *n == id.name) {
-                diags.push(
-                    unknown_among(id, constants.iter().map(|(n, _)| n.as_str()), "param").with_note(summary_help()),
-                );
-            }
-        }
-        K::Neg(a) => summary(a, columns, constants, diags),
-        K::Binary(_, a, b) => {
-            summary(a, columns, constants, diags);
-            summary(b, columns, constants, diags);
-        }
-        K::Call(f, args) => match SUMMARY_REDUCERS.iter().find(|(n, _, _)| *n == f.name) {
-            Some((name, usage, _)) => {
-                let want = if *name == "first" { 2 } else { 1 };
-                if args.len() != want {
-                    diags.push(
-                        Diagnostic::error(
-                            "E0201",
-                            format!("`{name}` takes {want} argument(s)"),
-                            e.span,
-                            format!("{} given", args.len()),
-                        )
-                        .with_help(format!("write `{usage}`")),
-                    );
+            let columns = s.columns.iter().copied().filter(|_| in_row);
+            let known = s.constants.iter().map(|(n, _)| n.as_str()).chain(s.keys.iter().copied()).chain(columns);
+            if !known.clone().any(|n| n == id.name) {
+                let mut d = unknown_among(id, known, if in_row { "column" } else { "name" });
+                d = if s.columns.contains(&id.name.as_str()) {
+                    d.with_help(format!("a column is read through a reducer: `max({})`", id.name))
                 } else {
-                    args.iter().for_each(|a| column(a, diags));
-                }
+                    d.with_note(summary_help())
+                };
+                diags.push(d);
             }
-            None => diags.push(unknown_among(f, SUMMARY_REDUCERS.iter().map(|(n, _, _)| *n), "summary reducer")),
-        },
+        }
+        K::Neg(a) => summary(a, s, in_row, diags),
+        K::Binary(_, a, b) => {
+            summary(a, s, in_row, diags);
+            summary(b, s, in_row, diags);
+        }
+        K::Call(f, args) => {
+            let (want, usage) = match SUMMARY_REDUCERS.iter().find(|(n, _, _)| *n == f.name) {
+                Some((name, usage, _)) => (if *name == "first" { 2 } else { 1 }, *usage),
+                None if SUMMARY_FUNCTIONS.contains(&f.name.as_str()) => (1, ""),
+                None => {
+                    let known = SUMMARY_REDUCERS.iter().map(|(n, _, _)| *n).chain(SUMMARY_FUNCTIONS.iter().copied());
+                    diags.push(unknown_among(f, known, "summary function"));
+                    return;
+                }
+            };
+            let reducer = !usage.is_empty();
+            if reducer && in_row {
+                diags.push(
+                    Diagnostic::error("E0201", format!("`{}` inside a reducer", f.name), e.span, "a reducer of a row")
+                        .with_help("a reducer's argument is a value of one row: reduce it once"),
+                );
+            } else if args.len() != want {
+                let usage = if reducer { usage.to_string() } else { format!("{}(EXPR)", f.name) };
+                diags.push(
+                    Diagnostic::error(
+                        "E0201",
+                        format!("`{}` takes {want} argument(s)", f.name),
+                        e.span,
+                        format!("{} given", args.len()),
+                    )
+                    .with_help(format!("write `{usage}`")),
+                );
+            } else {
+                args.iter().for_each(|a| summary(a, s, in_row || reducer, diags));
+            }
+        }
         K::Index(..) | K::Vector(_) => diags.push(
             Diagnostic::error("E0301", "shape mismatch", e.span, "a summary value is a number")
                 .with_help(summary_help()),
@@ -606,7 +649,11 @@ fn summary(e: &Expr, columns: &[&str], constants: &[(String, Shape)], diags: &mu
 
 fn summary_help() -> String {
     let reducers: Vec<&str> = SUMMARY_REDUCERS.iter().map(|(_, u, _)| *u).collect();
-    format!("a summary reduces the columns: {}", reducers.join(", "))
+    format!(
+        "a summary reduces expressions of the columns: {}; it may apply {} and read the keys before it",
+        reducers.join(", "),
+        SUMMARY_FUNCTIONS.join(", ")
+    )
 }
 
 /// W0004: coef `name` of a problem is read by none of `files` (the files of the run).

@@ -1,5 +1,52 @@
 //! The exact solution of the compressed bar (docs/mathematics.md §6): Ω = (0, 1), E = ρ = 1, u(1, t) = 0,
 //! contact at x = 0, u₀(x) = (1 − x)/2, v₀ = 0. Period 3; zones by s = τ − ⌊τ⌋, τ = t mod 3.
+//! A problem reads it as `reference bar` (forms/problems/bar.wf).
+
+use super::Reference;
+use crate::simulation::Tools;
+
+/// `reference bar`: the run against the exact solution.
+pub struct Bar;
+
+impl Reference for Bar {
+    fn name(&self) -> &'static str {
+        "bar"
+    }
+
+    fn doc(&self) -> &'static str {
+        "the compressed bar's exact solution (1D, on [0, 1], E = ρ = 1, u₀ = (1 − x)/2 at rest, held at x = 1)"
+    }
+
+    fn dim(&self) -> usize {
+        1
+    }
+
+    fn functionals(&self) -> &'static [(&'static str, &'static str)] {
+        &[
+            ("exact_u_error", "‖u − I_h u_ex(t)‖_M, with the mass the scheme steps with"),
+            ("exact_u_norm", "‖I_h u_ex(t)‖_M, the same norm of the interpolated exact displacement"),
+            ("exact_contact_stress", "the exact contact stress E u_x(0, t) (of t only)"),
+            ("exact_contact_displacement", "the exact displacement of the contact point u(0, t) (of t only)"),
+        ]
+    }
+
+    fn value(&self, which: usize, tools: &Tools, u: &[f64], t: f64) -> f64 {
+        let mesh = tools.asm.mesh();
+        let interpolant = || -> Vec<f64> { (0..u.len()).map(|i| displacement(mesh.node(i)[0], t)).collect() };
+        match which {
+            0 => {
+                let diff: Vec<f64> = u.iter().zip(interpolant()).map(|(a, b)| a - b).collect();
+                Tools::quad(&tools.scheme_mass, &diff, &diff).sqrt()
+            }
+            1 => {
+                let exact = interpolant();
+                Tools::quad(&tools.scheme_mass, &exact, &exact).sqrt()
+            }
+            2 => contact_stress(t),
+            _ => displacement(0.0, t),
+        }
+    }
+}
 
 /// u(x, t).
 pub fn displacement(x: f64, t: f64) -> f64 {

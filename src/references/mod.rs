@@ -1,0 +1,29 @@
+//! Analytic references a problem names (`reference NAME`): Rust functions that compare a run
+//! with a known solution, read in the problem's columns as functionals of the state
+//! (`exact_u_error(u)`). A new reference is a module here and a line in [`ALL`]; the problem
+//! file says what it measures with it.
+
+use crate::simulation::Tools;
+
+pub mod bar;
+
+/// An analytic solution's functionals.
+pub trait Reference: Sync {
+    fn name(&self) -> &'static str;
+    /// One line for `signorini list`.
+    fn doc(&self) -> &'static str;
+    /// The dimension of the problems it describes.
+    fn dim(&self) -> usize;
+    /// Its functionals: name and meaning.
+    fn functionals(&self) -> &'static [(&'static str, &'static str)];
+    /// Functional `which` (an index into [`Reference::functionals`]) at displacement `u`, time `t`.
+    fn value(&self, which: usize, tools: &Tools, u: &[f64], t: f64) -> f64;
+}
+
+/// Every reference, by name.
+pub const ALL: &[&dyn Reference] = &[&bar::Bar];
+
+/// The reference called `name`.
+pub fn find(name: &str) -> Option<&'static dyn Reference> {
+    ALL.iter().copied().find(|r| r.name() == name)
+}
