@@ -225,3 +225,31 @@ fn a_rising_plane_is_met_when_the_fall_and_the_rise_close_the_gap() {
         assert!((mean[i] + 0.5 * g * t * t).abs() < 1e-10, "t = {t}: {}", mean[i]);
     }
 }
+
+/// A rigid cylinder pressed into an elastic block held at its base (examples/problems/
+/// indenter.wf: a moving obstacle, each step an equilibrium of the quasi-static scheme beside
+/// it): the contact half-width and the peak pressure agree with Hertz's for the measured force
+/// within 3 % on the finest mesh; the half-width's error falls under refinement and the peak
+/// pressure converges (its successive differences fall), to within the finite block's own
+/// departure from the half-space.
+#[test]
+fn a_cylinder_pressed_into_a_block_follows_hertz() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/problems");
+    let runs: Vec<(f64, f64, f64)> = ["indenter_hf020.msh", "indenter_hf010.msh", "indenter_hf005.msh"]
+        .iter()
+        .map(|mesh| {
+            let mut o = Options::new(dir.join("indenter.wf").to_str().unwrap());
+            o.mesh = Some(dir.join(mesh));
+            let r = run(&o).unwrap();
+            let force = r.column("force").unwrap();
+            assert!(force.windows(2).all(|w| w[1] > w[0]), "the force grows with the indentation: {force:?}");
+            let key = |k: &str| r.summary.number(k).unwrap();
+            (key("half_width_error"), key("peak_pressure_error"), *r.column("peak_pressure").unwrap().last().unwrap())
+        })
+        .collect();
+    let (b, p): (Vec<f64>, Vec<f64>) = runs.iter().map(|r| (r.0.abs(), r.1.abs())).unzip();
+    assert!(b[2] < 0.03 && p[2] < 0.03, "relative errors against Hertz: half-width {b:?}, peak pressure {p:?}");
+    assert!(b[0] > b[1] && b[1] > b[2], "the half-width's error falls: {b:?}");
+    let (d1, d2) = ((runs[1].2 - runs[0].2).abs(), (runs[2].2 - runs[1].2).abs());
+    assert!(d2 < d1 / 2.0, "the peak pressure converges: differences {d1:e}, {d2:e}");
+}

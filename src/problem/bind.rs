@@ -305,11 +305,46 @@ fn obstacle_vals<'p>(pf: &'p ProblemFile, ex: &mut Exprs) -> Result<Vec<(Val, Va
                 let nc = normal.c.iter().map(|j| crate::compiler::ir::lower::Jet { v: g.neg(j.v), g: None }).collect();
                 out.push((scalar(gap), Val { shape: normal.shape, c: nc }, e));
             }
-            _ => {
+            shape => {
                 // `sphere`: gap = |x − centre| − radius, nc = (centre − x)/|x − centre|.
-                let ((centre, e), (radius, _)) = (lower(ex, "centre")?, lower(ex, "radius")?);
+                // `cylinder`: the same with the part of x − point across the axis.
+                let centre_arg = if shape == "sphere" { "centre" } else { "point" };
+                let ((centre, e), (radius, _)) = (lower(ex, centre_arg)?, lower(ex, "radius")?);
+                let axis = match arg(&o.shape, "axis") {
+                    Some(a) if x.c.len() == 3 => Some(ex.lower(a, &[]).map_err(|d| pf.render(*d))?),
+                    Some(a) => {
+                        return Err(pf.render(
+                            Diagnostic::error("E0302", "wrong dimension", a.span, "a 2D cylinder has no axis")
+                                .with_help("in 2D a cylinder is its section, the disc of `radius` about `point`"),
+                        ));
+                    }
+                    None if shape == "cylinder" && x.c.len() == 3 => {
+                        return Err(pf.render(Diagnostic::error(
+                            "E0201",
+                            "a cylinder in 3D needs its `axis`",
+                            o.shape.span,
+                            "no `axis = [...]`",
+                        )));
+                    }
+                    None => None,
+                };
                 let g = &mut ex.low.g;
-                let diff: Vec<_> = (0..x.c.len()).map(|k| g.sub(x.c[k].v, centre.c[k].v)).collect();
+                let mut diff: Vec<_> = (0..x.c.len()).map(|k| g.sub(x.c[k].v, centre.c[k].v)).collect();
+                if let Some(axis) = axis {
+                    // d − (d·a) a / (a·a)
+                    let (mut along, mut norm2) = (g.zero(), g.zero());
+                    for k in 0..diff.len() {
+                        let p = g.mul(diff[k], axis.c[k].v);
+                        along = g.add(along, p);
+                        let q = g.mul(axis.c[k].v, axis.c[k].v);
+                        norm2 = g.add(norm2, q);
+                    }
+                    let s = g.div(along, norm2);
+                    for k in 0..diff.len() {
+                        let p = g.mul(s, axis.c[k].v);
+                        diff[k] = g.sub(diff[k], p);
+                    }
+                }
                 let mut r2 = g.zero();
                 for &dk in &diff {
                     let sq = g.mul(dk, dk);

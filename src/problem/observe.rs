@@ -67,6 +67,12 @@ enum Measure {
         which: usize,
         mid: bool,
     },
+    /// `density_min(F(u))` (`min`) or `density_support(F(u))`: the least value of functional
+    /// `index`'s integrand over its region's sample points, or the measure where it is not zero.
+    Density {
+        index: usize,
+        min: bool,
+    },
     /// `inner_mass(A, B)`: aᵀ M b with the scheme's mass, A and B evaluated at the nodes.
     InnerMass {
         a: PointFn,
@@ -229,6 +235,10 @@ impl<'m> Observer<'m> {
             }
             ExprKind::Vector(_) => unreachable!("checked: no vector in a column"),
             ExprKind::Call(f, args) => match f.name.as_str() {
+                name if crate::compiler::check::problem::SUMMARY_FUNCTIONS.contains(&name) => {
+                    let a = self.rewrite(pf, ex, tools, inst, &args[0], leaves, pointwise, region_names, binding)?;
+                    Expr { kind: ExprKind::Call(f.clone(), vec![a]), span: e.span }
+                }
                 "mean" | "nodal_mean" | "at_min" => {
                     let (field, axis) = component(&args[0]);
                     if axis >= d {
@@ -291,6 +301,26 @@ impl<'m> Observer<'m> {
                     };
                     let (a, b) = (field(&args[0])?, field(&args[1])?);
                     add(self, Measure::InnerMass { a, b }, 1, e.span)
+                }
+                "density_min" | "density_support" => {
+                    let ExprKind::Call(name, _) = &args[0].kind else { unreachable!("checked: a functional") };
+                    let known = self.functionals.iter().position(|(n, _)| *n == name.name);
+                    let index = match known {
+                        Some(i) => i,
+                        None => {
+                            let func = inst.take_functional(&name.name).ok_or_else(|| {
+                                pf.render(crate::compiler::Diagnostic::error(
+                                    "E0101",
+                                    format!("no functional `{}` in the files in use", name.name),
+                                    name.span,
+                                    "not provided",
+                                ))
+                            })?;
+                            self.functionals.push((name.name.clone(), func));
+                            self.functionals.len() - 1
+                        }
+                    };
+                    add(self, Measure::Density { index, min: f.name == "density_min" }, 1, e.span)
                 }
                 "measure" | "peak" => {
                     let ExprKind::Name(region) = &args[0].kind else { unreachable!("checked: a region name") };
@@ -496,6 +526,15 @@ impl<'m> Observer<'m> {
                             .zip(self.reference)
                             .map_or(f64::NAN, |((u, t), r)| r.value(*which, tools, u, *t)),
                     ],
+                    Measure::Density { index, min } => {
+                        let rule = crate::runtime::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
+                        let points = self.functionals[*index].1.facet_point_values(asm, &rule, &[s.u], s.t);
+                        vec![if *min {
+                            points.iter().map(|p| p.value).fold(f64::INFINITY, f64::min)
+                        } else {
+                            points.iter().filter(|p| p.value != 0.0).map(|p| p.weight).sum()
+                        }]
+                    }
                     Measure::InnerMass { a, b } => {
                         let nodal = |f: &PointFn, scratch: &mut Vec<f64>| {
                             let mut out = vec![0.0; n];

@@ -227,13 +227,27 @@ impl<'m> Simulation<'m> {
         };
         let zero = vec![0.0; n];
         let mut mass = asm.zero_matrix();
-        forms[slot(&forms, "mass")?].1.tangent(asm, &[&zero], 0, 0.0, &mut mass);
+        // A scheme without inertia (quasi-static: equilibrium at every step) does not apply the
+        // mass; the material's still weighs the means and the figures.
+        let inertia = forms.iter().any(|(s, _)| *s == "mass");
+        match forms.iter().find(|(s, _)| *s == "mass") {
+            Some((_, f)) => f.tangent(asm, &[&zero], 0, 0.0, &mut mass),
+            None => {
+                let material = active.forms.instantiate(problem.coefs, &binding)?.take_form("mass");
+                material.ok_or_else(|| missing("mass"))?.tangent(asm, &[&zero], 0, 0.0, &mut mass);
+            }
+        }
         let mut stiffness = asm.zero_matrix();
         forms[slot(&forms, "stiffness")?].1.tangent(asm, &[&zero], 0, 0.0, &mut stiffness);
         let mut load = vec![0.0; n];
         forms[slot(&forms, "load")?].1.residual(asm, &[], 0.0, &mut load);
         let contact_nodes = mesh.region_nodes(mesh.region(problem.contact)?);
         let redistributed = problem.mass == MassChoice::Redistributed;
+        if redistributed && !inertia {
+            return Err(CaseError::Option(
+                "--mass redistributed: the scheme has no inertia (it applies no `mass`) to redistribute".into(),
+            ));
+        }
         let scheme_mass = if redistributed {
             let r = crate::runtime::redistribute::redistribute(mesh, &mass, &contact_nodes)
                 .map_err(|e| CaseError::Option(e.to_string()))?;
@@ -289,7 +303,12 @@ impl<'m> Simulation<'m> {
             .map(|(name, p)| format!("{name} = {}", p.value))
             .collect::<Vec<_>>()
             .join(", ");
-        Ok(Simulation { stepper, tools, states, v_index, guard: active.guard, params })
+        // Without inertia each step is an equilibrium of its own: no energy accumulates to watch.
+        let mut guard = active.guard;
+        if !inertia {
+            guard.max_energy_growth = 0.0;
+        }
+        Ok(Simulation { stepper, tools, states, v_index, guard, params })
     }
 
     /// Sets the displacement and solves the scheme's initial problem (the acceleration).

@@ -83,6 +83,12 @@ pub const OBSTACLES: &[Builtin] = &[
         args: &[("centre", Vector, false), ("radius", Scalar, false)],
         doc: "a rigid disc (2D) or ball (3D), possibly moving with t: g = |x − centre| − radius, nc = (centre − x)/|x − centre|",
     },
+    Builtin {
+        name: "cylinder",
+        dim: 0,
+        args: &[("point", Vector, false), ("radius", Scalar, false), ("axis", Vector, true)],
+        doc: "a rigid circular cylinder through `point` along `axis` (3D; in 2D its section, a disc, with no axis), possibly moving with t: g = |d| − radius, nc = −d/|d| for d the part of x − point across the axis",
+    },
 ];
 
 /// Run settings a problem may give defaults for (each overridable from the command line).
@@ -134,6 +140,16 @@ pub const ROW_REDUCERS: &[(&str, &str, &str)] = &[
         "peak(REGION, EXPR)",
         "the largest value of EXPR over the region's quadrature points, or 0 if none is positive",
     ),
+    (
+        "density_min",
+        "density_min(NAME(u))",
+        "the least value of a boundary functional's integrand over 16 points per edge of its region: -density_min(contact_pressure(u)) is the peak contact pressure",
+    ),
+    (
+        "density_support",
+        "density_support(NAME(u))",
+        "the measure of the points of a boundary functional's region where its integrand is not zero: the contact zone's, of contact_pressure(u)",
+    ),
 ];
 
 /// Any other call in a series column, `NAME(u)`, is a functional of the files in use or of the
@@ -161,7 +177,8 @@ pub const SUMMARY_REDUCERS: &[(&str, &str, &str)] = &[
     ("first", "first(EXPR, WHEN)", "EXPR at the first row where WHEN > 0 (null if none)"),
 ];
 
-/// Functions of one number a summary key may apply, inside or outside its reducers.
+/// Functions of one number a series column or a summary key may apply (in a summary, inside or
+/// outside its reducers).
 pub const SUMMARY_FUNCTIONS: &[&str] = &["sqrt", "abs", "pos"];
 
 /// Fields whose initial value a problem may give.
@@ -454,7 +471,8 @@ fn row(c: &mut Checker, e: &Expr, s: &RowScope, diags: &mut Vec<Diagnostic>) {
                 .iter()
                 .map(|(n, _)| n.as_str())
                 .chain(ROW_VALUES.iter().map(|(n, _)| *n))
-                .chain(s.earlier.iter().copied());
+                .chain(s.earlier.iter().copied())
+                .chain(["pi"]);
             if !known.clone().any(|n| n == id.name) {
                 diags.push(unknown_among(id, known, "row value").with_note(row_help()));
             }
@@ -482,10 +500,11 @@ fn row_help() -> String {
     let values: Vec<&str> = ROW_VALUES.iter().map(|(n, _)| *n).collect();
     let reducers: Vec<&str> = ROW_REDUCERS.iter().map(|(_, w, _)| *w).collect();
     format!(
-        "a column reads the row values ({}), earlier columns, params, and reducers: {}, or a functional `{FUNCTIONAL_CALL}` (also at {})",
+        "a column reads the row values ({}), earlier columns, params, and reducers: {}, or a functional `{FUNCTIONAL_CALL}` (also at {}), with arithmetic and {}",
         values.join(", "),
         reducers.join(", "),
-        FUNCTIONAL_STATES.iter().skip(1).map(|(s, _)| *s).collect::<Vec<_>>().join(", ")
+        FUNCTIONAL_STATES.iter().skip(1).map(|(s, _)| *s).collect::<Vec<_>>().join(", "),
+        SUMMARY_FUNCTIONS.join(", ")
     )
 }
 
@@ -524,6 +543,11 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
         _ => diags.push(Diagnostic::error("E0301", "shape mismatch", a.span, "a region's name is needed here")),
     };
     match f.name.as_str() {
+        name if SUMMARY_FUNCTIONS.contains(&name) => {
+            if arity(1, diags) {
+                row(c, &args[0], s, diags);
+            }
+        }
         "mean" | "nodal_mean" => {
             if arity(1, diags) {
                 component(&args[0], diags);
@@ -556,6 +580,18 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
             if arity(2, diags) {
                 region(&args[0], diags);
                 scalar(c, &args[1], s.pointwise, diags, false);
+            }
+        }
+        "density_min" | "density_support" => {
+            let functional = |a: &Expr| {
+                matches!(&a.kind, K::Call(_, xs) if xs.len() == 1
+                && matches!(&xs[0].kind, K::Name(n) if n.name == "u"))
+            };
+            if arity(1, diags) && !functional(&args[0]) {
+                diags.push(
+                    Diagnostic::error("E0301", "shape mismatch", args[0].span, "a functional of u is needed here")
+                        .with_help(format!("write `{}(contact_pressure(u))`", f.name)),
+                );
             }
         }
         _ => {
@@ -593,7 +629,8 @@ fn summary(e: &Expr, s: &SummaryScope, in_row: bool, diags: &mut Vec<Diagnostic>
         K::Number(_) => {}
         K::Name(id) => {
             let columns = s.columns.iter().copied().filter(|_| in_row);
-            let known = s.constants.iter().map(|(n, _)| n.as_str()).chain(s.keys.iter().copied()).chain(columns);
+            let known =
+                s.constants.iter().map(|(n, _)| n.as_str()).chain(s.keys.iter().copied()).chain(columns).chain(["pi"]);
             if !known.clone().any(|n| n == id.name) {
                 let mut d = unknown_among(id, known, if in_row { "column" } else { "name" });
                 d = if s.columns.contains(&id.name.as_str()) {

@@ -337,6 +337,7 @@ fn found_token(rest: &str) -> &str {
 fn rule_name(r: Rule) -> Option<&'static str> {
     Some(match r {
         Rule::ident => "a name",
+        Rule::role => "a role (`scheme`, `contact`, `material`, `forms`)",
         Rule::number => "a number",
         Rule::expr | Rule::call | Rule::neg => "an expression",
         Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::pow => "an operator",
