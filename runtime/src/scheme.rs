@@ -261,7 +261,24 @@ pub enum StepError {
     NonFinite { t: f64 },
     #[error("stage `{stage}` at t = {t}: {source}")]
     Newton { stage: &'static str, t: f64, source: NewtonError },
+    #[error(
+        "stage `{stage}` of scheme `{scheme}` has no displacement quantity (u', um, ...) that depends on its unknown: a moving held displacement cannot be imposed there"
+    )]
+    NoDisplacement { scheme: &'static str, stage: &'static str },
 }
+
+/// Displacements held at values that change with time (a moving Dirichlet condition): the
+/// held dofs (among the constraints' fixed ones) and their values at a time, in that order.
+/// Each stage holds its unknown where its displacement quantity takes the values at the stage's
+/// time, through the stage's own relation (u' = w for most schemes; an acceleration unknown is
+/// solved for from u' = u + Δt v + ... + c a').
+pub struct Prescribed {
+    pub dofs: Vec<usize>,
+    pub values: HeldValues,
+}
+
+/// Writes the held values at a time, in the order of [`Prescribed::dofs`].
+pub type HeldValues = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
 
 /// How many load vectors the stepper remembers (a step evaluates loads at two or three times).
 const LOAD_CACHE: usize = 4;
@@ -289,6 +306,8 @@ pub struct Stepper<'a> {
     /// Extra Dirichlet conditions for the initial problem only (e.g. a⁰ = 0 on massless
     /// contact dofs after mass redistribution).
     pub initial_constraints: Option<Constraints>,
+    /// Held displacements that move: see [`Stepper::prescribe`].
+    prescribed: Option<Prescribed>,
     structure: Structure,
     pub newton_options: NewtonOptions,
     /// Per stage: its Newton (keeps its factorization) and the constant operator for `dt`.
@@ -441,6 +460,7 @@ impl<'a> Stepper<'a> {
             forms,
             constraints,
             initial_constraints: None,
+            prescribed: None,
             structure,
             newton_options,
             stages,
@@ -477,6 +497,56 @@ impl<'a> Stepper<'a> {
     /// The matrix of a linear one-field form (e.g. `mass`, for energies).
     pub fn matrix(&self, form: &str) -> Option<&Matrix> {
         self.matrices.get(form)
+    }
+
+    /// Holds `p.dofs` (fixed in the constraints) at the moving values `p.values`: refused when a
+    /// stage has no displacement quantity depending on its unknown. The initial problem keeps
+    /// its held values (zero: the held motion's acceleration at the start is taken as zero).
+    pub fn prescribe(&mut self, p: Prescribed) -> Result<(), StepError> {
+        for stage in self.desc.stages {
+            if self.displacement(stage).is_none() {
+                return Err(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name });
+            }
+        }
+        self.prescribed = Some(p);
+        Ok(())
+    }
+
+    /// The stage's displacement quantity (named after the first state with a suffix: `u'`,
+    /// `um`) when it depends on the unknown.
+    fn displacement(&self, stage: &StageDesc) -> Option<usize> {
+        let u = self.desc.states.first()?;
+        let q = stage.quantities.iter().position(|q| q.starts_with(u) && q.len() > u.len())?;
+        stage.values.get(q).filter(|c| c.unknown.is_some()).map(|_| q)
+    }
+
+    /// Sets the held values of the stage's unknown so that its displacement quantity takes the
+    /// prescribed values at `time`: w = w₀ + (g − u(w₀)) / c_w, u affine in w.
+    fn hold(
+        &mut self,
+        stage: &StageDesc,
+        reference: Level,
+        states: &[Vec<f64>],
+        quantities: &[Vec<Vec<f64>>],
+        time: f64,
+    ) -> Result<(), StepError> {
+        let Some(p) = &self.prescribed else { return Ok(()) };
+        let q =
+            self.displacement(stage).ok_or(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name })?;
+        let c = &stage.values[q];
+        let cw = c.unknown.map_or(0.0, |k| self.coefs[k]);
+        let mut g = vec![0.0; p.dofs.len()];
+        (p.values)(time, &mut g);
+        let mut at_reference = vec![0.0; self.asm.size()];
+        self.combine(c, reference, None, states, quantities, &mut at_reference);
+        let w0 = match reference {
+            Level::State(i) => &states[i],
+            Level::Stage(s, k) => &quantities[s][k],
+        };
+        for (&i, gi) in p.dofs.iter().zip(&g) {
+            self.constraints.values[i] = w0[i] + (gi - at_reference[i]) / cw;
+        }
+        Ok(())
     }
 
     /// Solves the initial problem (e.g. M a⁰ = L⁰ − B(u⁰)) for its state, if the scheme has one.
@@ -543,6 +613,10 @@ impl<'a> Stepper<'a> {
             let name = stage.quantities[0];
             let reference =
                 Level::State(desc.states.iter().position(|st| name.trim_end_matches('\'') == *st).unwrap_or(0));
+            if self.prescribed.is_some() {
+                let time = self.coefs.get(stage.time).copied().unwrap_or(t + dt);
+                self.hold(stage, reference, states, &quantities, time)?;
+            }
             let (delta, r) = self.solve_stage(stage, s, states, &quantities, reference, dt, t)?;
             report.stages.push(r);
             let mut values: Vec<Vec<f64>> = Vec::with_capacity(stage.values.len());

@@ -310,13 +310,19 @@ fn coef_shapes(
     Ok(())
 }
 
-/// The problem's Dirichlet conditions: the listed components of every node of each region held.
-/// The stepper holds the stage unknown's values there, so a held displacement must be zero (a
-/// prescribed nonzero or moving one needs the time derivatives the schemes do not expose yet).
-fn dirichlet(pf: &ProblemFile, ex: &mut Exprs, mesh: &crate::runtime::mesh::Mesh) -> Result<Constraints, CaseError> {
+/// The problem's Dirichlet conditions: the listed components of every node of each region
+/// held, by elimination. Held at zero, they are the constraints alone; held at other values, or
+/// at values that move with `t`, they are also the stepper's prescribed displacements (each
+/// stage holds its displacement quantity at the values of its time).
+fn dirichlet(
+    pf: &ProblemFile,
+    ex: &mut Exprs,
+    mesh: &crate::runtime::mesh::Mesh,
+) -> Result<(Constraints, Option<Held>), CaseError> {
     use crate::compiler::Diagnostic;
     let d = mesh.dim();
     let mut c = Constraints::none(mesh.num_nodes() * d);
+    let mut held = Held { dofs: Vec::new(), at: Vec::new(), values: Vec::new() };
     for dc in &pf.problem().dirichlet {
         let components: Vec<usize> = match &dc.component {
             Some(k) => {
@@ -334,26 +340,79 @@ fn dirichlet(pf: &ProblemFile, ex: &mut Exprs, mesh: &crate::runtime::mesh::Mesh
             None => (0..d).collect(),
         };
         let value = ex.lower(&dc.value, &[]).map_err(|e| pf.render(*e))?;
-        let held = ex.function(&value, &dc.value).map_err(|e| pf.render(*e))?;
-        if held.constant().is_none_or(|v| v.iter().any(|x| *x != 0.0)) {
-            return Err(pf.render(
-                Diagnostic::error(
-                    "E0101",
-                    "a nonzero held displacement is not run by the driver yet",
-                    dc.value.span,
-                    "not zero",
-                )
-                .with_note("the stepper holds the stage unknown, which is not always the displacement: zero is right for every scheme"),
-            ));
-        }
+        let f = ex.function(&value, &dc.value).map_err(|e| pf.render(*e))?;
+        let zero = f.constant().is_some_and(|v| v.iter().all(|x| *x == 0.0));
         let region = mesh.region(&dc.region.name)?;
+        if !zero {
+            held.values.push(f);
+        }
         for node in mesh.region_nodes(region) {
-            for &k in &components {
-                c.fix(node as usize * d + k);
+            for (j, &k) in components.iter().enumerate() {
+                let dof = node as usize * d + k;
+                c.fix(dof);
+                if !zero {
+                    // A later condition on the same dof replaces an earlier one.
+                    if let Some(i) = held.dofs.iter().position(|&x| x == dof) {
+                        held.dofs.remove(i);
+                        held.at.remove(i);
+                    }
+                    let comp = if dc.component.is_some() { 0 } else { j };
+                    held.dofs.push(dof);
+                    held.at.push((node as usize, held.values.len() - 1, comp));
+                }
             }
         }
     }
-    Ok(c)
+    let held = (!held.dofs.is_empty()).then_some(held);
+    Ok((c, held))
+}
+
+/// Held displacements at nonzero or moving values: per dof, its node, its condition's values
+/// and the component of them.
+#[derive(Clone)]
+struct Held {
+    dofs: Vec<usize>,
+    at: Vec<(usize, usize, usize)>,
+    values: Vec<super::expr::PointFn>,
+}
+
+impl Held {
+    /// The held values at time `t`, in the order of `dofs`.
+    fn eval(&self, nodes: &[Vec<f64>], t: f64, out: &mut [f64]) {
+        let mut scratch = Vec::new();
+        let mut v = Vec::new();
+        for (o, &(node, cond, comp)) in out.iter_mut().zip(&self.at) {
+            let f = &self.values[cond];
+            v.resize(f.len(), 0.0);
+            f.eval(&super::expr::At { x: &nodes[node], t, ..Default::default() }, &mut scratch, &mut v);
+            *o = v[comp];
+        }
+    }
+
+    /// For the stepper: the values at a time.
+    fn prescribed(&self, mesh: &crate::runtime::mesh::Mesh) -> crate::runtime::scheme::Prescribed {
+        let nodes: Vec<Vec<f64>> = (0..mesh.num_nodes()).map(|i| mesh.node(i).to_vec()).collect();
+        let me = self.clone();
+        crate::runtime::scheme::Prescribed {
+            dofs: self.dofs.clone(),
+            values: Box::new(move |t, out| me.eval(&nodes, t, out)),
+        }
+    }
+
+    /// Imposes the held values at `t0` on u₀ and their rate (a centred difference) on v₀.
+    fn initial(&self, mesh: &crate::runtime::mesh::Mesh, t0: f64, u0: &mut [f64], v0: &mut [f64]) {
+        let nodes: Vec<Vec<f64>> = (0..mesh.num_nodes()).map(|i| mesh.node(i).to_vec()).collect();
+        let n = self.dofs.len();
+        let (mut g, mut up, mut down) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let eps = 1e-6 * t0.abs().max(1.0);
+        self.eval(&nodes, t0, &mut g);
+        self.eval(&nodes, t0 + eps, &mut up);
+        self.eval(&nodes, t0 - eps, &mut down);
+        for (k, &i) in self.dofs.iter().enumerate() {
+            u0[i] = g[k];
+            v0[i] = (up[k] - down[k]) / (2.0 * eps);
+        }
+    }
 }
 
 fn simulate(
@@ -387,13 +446,14 @@ fn simulate(
     let coefs = super::bind::coef_lookup(&coef_fns);
     let contact = "Gamma_C";
     let others: Vec<String> = p.regions.iter().map(|r| r.name.name.clone()).filter(|r| r != contact).collect();
-    let constraints = dirichlet(pf, ex, &mesh)?;
+    let (constraints, held) = dirichlet(pf, ex, &mesh)?;
     let problem = Problem {
         coefs: &coefs,
         quadrature,
         contact,
         regions: &others,
         constraints: constraints.clone(),
+        prescribed: held.as_ref().map(|h| h.prescribed(&mesh)),
         mass: opts.mass,
         newton: opts.newton,
     };
@@ -410,6 +470,9 @@ fn simulate(
     let mut v0 = super::bind::initial(pf, ex, &mesh, "v", t0)?;
     constraints.impose(&mut u0);
     constraints.zero(&mut v0);
+    if let Some(h) = &held {
+        h.initial(&mesh, t0, &mut u0, &mut v0);
+    }
     sim.initialize_at(t0, u0, v0)?;
     let mut regions = vec![(contact.to_string(), sim.tools.contact_facets)];
     for name in &others {

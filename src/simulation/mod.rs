@@ -35,6 +35,8 @@ pub struct Problem<'p> {
     pub regions: &'p [String],
     /// Dirichlet conditions of the dynamics.
     pub constraints: Constraints,
+    /// Held displacements that move (among the constraints' fixed dofs).
+    pub prescribed: Option<crate::runtime::scheme::Prescribed>,
     pub mass: MassChoice,
     pub newton: NewtonOptions,
 }
@@ -64,6 +66,8 @@ pub struct Tools<'m> {
     pub contact_nodes: Vec<u32>,
     /// The mass is redistributed: the contact nodes carry none.
     pub redistributed: bool,
+    /// The dofs held at moving values: the energy check adds the work of their reactions.
+    pub held: Vec<usize>,
     /// The energies' quadratic forms, ½uᵀKu and ½vᵀMv with the scheme's mass, evaluated every
     /// step by the observers.
     pub energies: Energies,
@@ -260,6 +264,10 @@ impl<'m> Simulation<'m> {
         let constraints = problem.constraints;
         let mut stepper =
             Stepper::new(active.time_scheme()?, asm, forms, constraints.clone(), Structure::Auto, problem.newton)?;
+        let held = problem.prescribed.as_ref().map_or_else(Vec::new, |p| p.dofs.clone());
+        if let Some(p) = problem.prescribed {
+            stepper.prescribe(p)?;
+        }
         if redistributed {
             let d = mesh.dim();
             let mut initial = constraints;
@@ -291,6 +299,7 @@ impl<'m> Simulation<'m> {
                 .filter(|f| f.time_dependent() && f.fields() == 0),
             contact_nodes,
             redistributed,
+            held,
         };
         let names = stepper.desc().states;
         let states = names.iter().map(|_| vec![0.0; n]).collect();
@@ -451,6 +460,9 @@ impl<'m> Simulation<'m> {
                 if let Some(load) = &tools.varying_load {
                     energy.step_work(tools, load.as_ref(), &before, &states[0], t + 0.5 * h);
                 }
+                if !tools.held.is_empty() {
+                    energy.held_work(tools, &before, &states[0], t + 0.5 * h);
+                }
                 if let Some(grown) = energy.check(tools, states, *v_index, &before, h, accepted, last)
                     && guard.max_energy_growth > 0.0
                     && grown.ratio > guard.max_energy_growth
@@ -598,6 +610,24 @@ impl EnergyWatch {
         self.varying_work += l.iter().zip(u.iter().zip(before)).map(|(l, (a, b))| l * (a - b)).sum::<f64>();
     }
 
+    /// Adds the work of the held dofs' reactions over one step, taken as the elastic reaction
+    /// (K u − F at the held dofs, at the step's midpoint) times their motion: the quasi-static
+    /// part of the support's force, what a blow-up check needs.
+    fn held_work(&mut self, tools: &Tools, before: &[f64], u: &[f64], t_mid: f64) {
+        let mid: Vec<f64> = before.iter().zip(u).map(|(a, b)| 0.5 * (a + b)).collect();
+        let mut ku = vec![0.0; u.len()];
+        tools.stiffness.mul_vec(&mid, &mut ku);
+        let load = match &tools.varying_load {
+            Some(form) => {
+                let mut l = vec![0.0; u.len()];
+                form.residual(tools.asm, &[], t_mid, &mut l);
+                l
+            }
+            None => tools.load.clone(),
+        };
+        self.varying_work += tools.held.iter().map(|&i| (ku[i] - load[i]) * (u[i] - before[i])).sum::<f64>();
+    }
+
     fn energy(tools: &Tools, u: &[f64], v: Option<&[f64]>) -> f64 {
         tools.elastic(u) + tools.kinetic(v)
     }
@@ -627,9 +657,17 @@ impl EnergyWatch {
             }
         };
         let energy = Self::energy(tools, u, Some(v));
+        // The work summed step by step (a varying load's, the held dofs'), and a constant
+        // load's from u(0).
         let work: f64 = match tools.varying_load {
             Some(_) => self.varying_work,
-            None => tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum(),
+            None if tools.held.is_empty() => {
+                tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum()
+            }
+            None => {
+                self.varying_work
+                    + tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum::<f64>()
+            }
         };
         self.work = self.work.max(work.abs());
         let bound = (self.initial + self.work).max(f64::MIN_POSITIVE);

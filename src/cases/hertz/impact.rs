@@ -155,6 +155,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         contact: meshes::CONTACT,
         regions: &[],
         constraints: meshes::symmetry(&mesh)?,
+        prescribed: None,
         mass: opts.mass,
         newton: opts.newton,
     };
