@@ -106,6 +106,16 @@ pub struct Observer<'m> {
     reference: Option<&'static dyn Reference>,
     /// The functionals the measures read, by name.
     functionals: Vec<(String, Box<dyn BoundFunctional + 'm>)>,
+    /// Buffers a row reuses (a row's measures are small vectors: allocating them took a tenth
+    /// of a 1D run).
+    reuse: std::cell::RefCell<Reuse>,
+}
+
+#[derive(Default)]
+struct Reuse {
+    measured: Vec<Vec<f64>>,
+    spare: Vec<Vec<f64>>,
+    scratch: Vec<f64>,
 }
 
 /// The placeholder name of measured value `id` in a rewritten expression.
@@ -138,6 +148,7 @@ impl<'m> Observer<'m> {
             owner: Vec::new(),
             reference,
             functionals: Vec::new(),
+            reuse: Default::default(),
         };
         let mut region_names: Vec<String> = Vec::new();
         let u = ex.field(0);
@@ -406,7 +417,15 @@ impl<'m> Observer<'m> {
         let mesh = asm.mesh();
         let d = mesh.dim();
         let n = asm.size();
-        let mut measured: Vec<Vec<f64>> = Vec::with_capacity(self.measures.len());
+        let mut reuse = self.reuse.borrow_mut();
+        let Reuse { measured, spare, scratch } = &mut *reuse;
+        spare.append(measured);
+        let mut one = |x: f64| {
+            let mut v = spare.pop().unwrap_or_default();
+            v.clear();
+            v.push(x);
+            v
+        };
         let mut columns: Vec<f64> = Vec::with_capacity(self.columns.len());
         let mut samples: Vec<Option<Vec<FacetSample>>> = self.regions.iter().map(|_| None).collect();
         let mut samples_v: Vec<Option<Vec<FacetSample>>> = self.regions.iter().map(|_| None).collect();
@@ -414,7 +433,6 @@ impl<'m> Observer<'m> {
         let mut sampled: Vec<(usize, Vec<crate::compiler::ir::graph::NodeId>, Vec<f64>)> = Vec::new();
         let field = |f: u8| if f == 0 { Some(s.u) } else { s.v };
         let mut kinetic = None;
-        let mut scratch = Vec::new();
         let mut switches = Vec::new();
         // The step's midpoint, for the functionals at `u_mid` (none without a step).
         let mut mid: Option<Option<(Vec<f64>, f64)>> = None;
@@ -429,131 +447,129 @@ impl<'m> Observer<'m> {
         for (c, (_, _, f)) in self.columns.iter().enumerate() {
             // The measures of this column (in the order they were added).
             while next < self.measures.len() && !self.belongs_after(next, c) {
-                let value: Vec<f64> = match &self.measures[next] {
-                    Measure::Time => vec![s.t],
-                    Measure::Energy => {
-                        let k = *kinetic.get_or_insert_with(|| tools.kinetic(s.v));
-                        vec![tools.energy_with_kinetic(s.u, k)]
-                    }
-                    Measure::Kinetic => vec![*kinetic.get_or_insert_with(|| tools.kinetic(s.v))],
-                    Measure::Newton => vec![s.newton as f64],
-                    Measure::ActivePoints => vec![switches.iter().filter(|b| **b).count() as f64],
-                    Measure::Column(i) => vec![columns[*i]],
-                    Measure::Mean { field: fi, weights, .. } => vec![field(*fi).map_or(f64::NAN, |x| weights.of(x))],
-                    Measure::NodalMean { field: fi, axis } => vec![
-                        field(*fi).map_or(f64::NAN, |x| x.iter().skip(*axis).step_by(d).sum::<f64>() / (n / d) as f64),
-                    ],
-                    Measure::AtMin { field: 1, axis, node, massless: true } if s.before.is_some() => {
-                        let (before, dt) = s.before.expect("a step");
-                        let i = d * node + axis;
-                        vec![(s.u[i] - before[i]) / dt]
-                    }
-                    Measure::AtMin { field: fi, axis, node, .. } => {
-                        vec![field(*fi).map_or(f64::NAN, |x| x[d * node + axis])]
-                    }
-                    Measure::Force { slot, dofs } => {
-                        let mut r = vec![0.0; n];
-                        self.slots[*slot].1.residual(asm, &[s.u], s.t, &mut r);
-                        match dofs {
-                            None => resultant(&r, d),
-                            Some(dofs) => (0..d)
-                                .map(|k| -dofs.iter().filter(|&&i| i % d == k).map(|&i| r[i]).sum::<f64>())
-                                .collect(),
+                let value: Vec<f64> =
+                    match &self.measures[next] {
+                        Measure::Time => one(s.t),
+                        Measure::Energy => {
+                            let k = *kinetic.get_or_insert_with(|| tools.kinetic(s.v));
+                            one(tools.energy_with_kinetic(s.u, k))
                         }
-                    }
-                    Measure::Area { region, f } | Measure::Peak { region, f } => {
-                        // `measure` and `peak` of one expression share its values.
-                        let cached = sampled.iter().find(|(r, k, _)| *r == *region && *k == f.key);
-                        if let Some((_, _, values)) = cached {
-                            let us = samples[*region].as_ref().expect("sampled with the values");
+                        Measure::Kinetic => one(*kinetic.get_or_insert_with(|| tools.kinetic(s.v))),
+                        Measure::Newton => one(s.newton as f64),
+                        Measure::ActivePoints => one(switches.iter().filter(|b| **b).count() as f64),
+                        Measure::Column(i) => one(columns[*i]),
+                        Measure::Mean { field: fi, weights, .. } => one(field(*fi).map_or(f64::NAN, |x| weights.of(x))),
+                        Measure::NodalMean { field: fi, axis } => one(field(*fi)
+                            .map_or(f64::NAN, |x| x.iter().skip(*axis).step_by(d).sum::<f64>() / (n / d) as f64)),
+                        Measure::AtMin { field: 1, axis, node, massless: true } if s.before.is_some() => {
+                            let (before, dt) = s.before.expect("a step");
+                            let i = d * node + axis;
+                            one((s.u[i] - before[i]) / dt)
+                        }
+                        Measure::AtMin { field: fi, axis, node, .. } => {
+                            one(field(*fi).map_or(f64::NAN, |x| x[d * node + axis]))
+                        }
+                        Measure::Force { slot, dofs } => {
+                            let mut r = vec![0.0; n];
+                            self.slots[*slot].1.residual(asm, &[s.u], s.t, &mut r);
+                            match dofs {
+                                None => resultant(&r, d),
+                                Some(dofs) => (0..d)
+                                    .map(|k| -dofs.iter().filter(|&&i| i % d == k).map(|&i| r[i]).sum::<f64>())
+                                    .collect(),
+                            }
+                        }
+                        Measure::Area { region, f } | Measure::Peak { region, f } => {
+                            // `measure` and `peak` of one expression share its values.
+                            let cached = sampled.iter().find(|(r, k, _)| *r == *region && *k == f.key);
+                            if let Some((_, _, values)) = cached {
+                                let us = samples[*region].as_ref().expect("sampled with the values");
+                                let value = if matches!(self.measures[next], Measure::Area { .. }) {
+                                    us.iter().zip(values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum()
+                                } else {
+                                    values.iter().fold(0.0f64, |m, e| m.max(*e))
+                                };
+                                measured.push(one(value));
+                                next += 1;
+                                continue;
+                            }
+                            let us = samples[*region]
+                                .get_or_insert_with(|| facet_samples(mesh, self.regions[*region], self.degree, s.u));
+                            let vs =
+                                match (f.reads_v(), s.v) {
+                                    (true, Some(v)) => Some(&*samples_v[*region].get_or_insert_with(|| {
+                                        facet_samples(mesh, self.regions[*region], self.degree, v)
+                                    })),
+                                    _ => None,
+                                };
+                            let mut out = [0.0];
+                            let values: Vec<f64> = us
+                                .iter()
+                                .enumerate()
+                                .map(|(i, p)| {
+                                    let v = vs.map_or(&[][..], |vs| vs[i].value.as_slice());
+                                    f.eval(
+                                        &At { x: &p.x, t: s.t, u: &p.value, v, ..At::default() },
+                                        &mut *scratch,
+                                        &mut out,
+                                    );
+                                    out[0]
+                                })
+                                .collect();
                             let value = if matches!(self.measures[next], Measure::Area { .. }) {
-                                us.iter().zip(values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum()
+                                one(us.iter().zip(&values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum())
                             } else {
-                                values.iter().fold(0.0f64, |m, e| m.max(*e))
+                                one(values.iter().fold(0.0f64, |m, e| m.max(*e)))
                             };
-                            measured.push(vec![value]);
-                            next += 1;
-                            continue;
+                            sampled.push((*region, f.key.clone(), values));
+                            value
                         }
-                        let us = samples[*region]
-                            .get_or_insert_with(|| facet_samples(mesh, self.regions[*region], self.degree, s.u));
-                        let vs = match (f.reads_v(), s.v) {
-                            (true, Some(v)) => Some(
-                                &*samples_v[*region]
-                                    .get_or_insert_with(|| facet_samples(mesh, self.regions[*region], self.degree, v)),
-                            ),
-                            _ => None,
-                        };
-                        let mut out = [0.0];
-                        let values: Vec<f64> = us
-                            .iter()
-                            .enumerate()
-                            .map(|(i, p)| {
-                                let v = vs.map_or(&[][..], |vs| vs[i].value.as_slice());
-                                f.eval(
-                                    &At { x: &p.x, t: s.t, u: &p.value, v, ..At::default() },
-                                    &mut scratch,
-                                    &mut out,
-                                );
-                                out[0]
-                            })
-                            .collect();
-                        let value = if matches!(self.measures[next], Measure::Area { .. }) {
-                            vec![us.iter().zip(&values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum()]
-                        } else {
-                            vec![values.iter().fold(0.0f64, |m, e| m.max(*e))]
-                        };
-                        sampled.push((*region, f.key.clone(), values));
-                        value
-                    }
-                    Measure::Functional { index, mid: false } => {
-                        vec![self.functionals[*index].1.value(asm, &[s.u], s.t)]
-                    }
-                    Measure::Functional { index, mid: true } => {
-                        let f = &self.functionals[*index].1;
-                        vec![
-                            mid.get_or_insert_with(&mut midpoint)
+                        Measure::Functional { index, mid: false } => {
+                            one(self.functionals[*index].1.value(asm, &[s.u], s.t))
+                        }
+                        Measure::Functional { index, mid: true } => {
+                            let f = &self.functionals[*index].1;
+                            one(mid
+                                .get_or_insert_with(&mut midpoint)
                                 .as_ref()
-                                .map_or(f64::NAN, |(u, t)| f.value(asm, &[u], *t)),
-                        ]
-                    }
-                    Measure::Reference { which, mid: false } => {
-                        vec![self.reference.map_or(f64::NAN, |r| r.value(*which, tools, s.u, s.t))]
-                    }
-                    Measure::Reference { which, mid: true } => vec![
-                        mid.get_or_insert_with(&mut midpoint)
+                                .map_or(f64::NAN, |(u, t)| f.value(asm, &[u], *t)))
+                        }
+                        Measure::Reference { which, mid: false } => {
+                            one(self.reference.map_or(f64::NAN, |r| r.value(*which, tools, s.u, s.t)))
+                        }
+                        Measure::Reference { which, mid: true } => one(mid
+                            .get_or_insert_with(&mut midpoint)
                             .as_ref()
                             .zip(self.reference)
-                            .map_or(f64::NAN, |((u, t), r)| r.value(*which, tools, u, *t)),
-                    ],
-                    Measure::Density { index, min } => {
-                        let rule = crate::runtime::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
-                        let points = self.functionals[*index].1.facet_point_values(asm, &rule, &[s.u], s.t);
-                        vec![if *min {
-                            points.iter().map(|p| p.value).fold(f64::INFINITY, f64::min)
-                        } else {
-                            points.iter().filter(|p| p.value != 0.0).map(|p| p.weight).sum()
-                        }]
-                    }
-                    Measure::InnerMass { a, b } => {
-                        let nodal = |f: &PointFn, scratch: &mut Vec<f64>| {
-                            let mut out = vec![0.0; n];
-                            for (i, o) in out.chunks_mut(d).enumerate() {
-                                let u = &s.u[d * i..d * i + d];
-                                let v = s.v.map_or(&[][..], |v| &v[d * i..d * i + d]);
-                                f.eval(&At { x: mesh.node(i), t: s.t, u, v, ..At::default() }, scratch, o);
-                            }
-                            out
-                        };
-                        let (a, b) = (nodal(a, &mut scratch), nodal(b, &mut scratch));
-                        vec![Tools::quad(&tools.scheme_mass, &a, &b)]
-                    }
-                };
+                            .map_or(f64::NAN, |((u, t), r)| r.value(*which, tools, u, *t))),
+                        Measure::Density { index, min } => {
+                            let rule = crate::runtime::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
+                            let points = self.functionals[*index].1.facet_point_values(asm, &rule, &[s.u], s.t);
+                            one(if *min {
+                                points.iter().map(|p| p.value).fold(f64::INFINITY, f64::min)
+                            } else {
+                                points.iter().filter(|p| p.value != 0.0).map(|p| p.weight).sum()
+                            })
+                        }
+                        Measure::InnerMass { a, b } => {
+                            let nodal = |f: &PointFn, scratch: &mut Vec<f64>| {
+                                let mut out = vec![0.0; n];
+                                for (i, o) in out.chunks_mut(d).enumerate() {
+                                    let u = &s.u[d * i..d * i + d];
+                                    let v = s.v.map_or(&[][..], |v| &v[d * i..d * i + d]);
+                                    f.eval(&At { x: mesh.node(i), t: s.t, u, v, ..At::default() }, scratch, o);
+                                }
+                                out
+                            };
+                            let (a, b) = (nodal(a, &mut *scratch), nodal(b, &mut *scratch));
+                            one(Tools::quad(&tools.scheme_mass, &a, &b))
+                        }
+                    };
                 measured.push(value);
                 next += 1;
             }
             let mut out = [0.0];
-            f.eval(&At { measured: &measured, ..At::default() }, &mut scratch, &mut out);
+            f.eval(&At { measured, ..At::default() }, &mut *scratch, &mut out);
             columns.push(out[0]);
         }
         (columns, switches)
