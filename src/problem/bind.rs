@@ -402,6 +402,16 @@ pub fn initial(pf: &ProblemFile, ex: &mut Exprs, mesh: &Mesh, field: &str, t0: f
 }
 
 /// What a coef lookup by name gives the forms.
+/// The region the contact laws integrate over.
+pub const CONTACT: &str = "Gamma_C";
+
+/// A problem without contact: no region `Gamma_C` and no obstacle. The contact law of the run
+/// is bound on an empty region, and the coefs only it reads are zero.
+pub fn contact_free(pf: &ProblemFile) -> bool {
+    let p = pf.problem();
+    p.obstacles.is_empty() && !p.regions.iter().any(|r| r.name.name == CONTACT)
+}
+
 pub fn coef_lookup(coefs: &[(String, PointFn)]) -> impl Fn(&str) -> Option<Coef> + '_ {
     move |name| coefs.iter().find(|(n, _)| n == name).map(|(_, f)| f.clone().coef())
 }

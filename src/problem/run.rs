@@ -181,7 +181,6 @@ fn bound<R>(
     }
     let overrides: Vec<(&str, f64)> = sets.iter().map(|(n, v)| (n.as_str(), *v)).collect();
     let active = Active::resolve(&setup, &overrides)?;
-    unsupported(&pf)?;
     unset_coefs(&pf, &active)?;
     f(&pf, &params, &mut ex, &active)
 }
@@ -204,19 +203,6 @@ fn bind_files(pf: &ProblemFile, setup: &mut Setup, chosen: Chosen) {
             _ => {}
         }
     }
-}
-
-/// What the driver needs of every problem: the region the contact forms integrate over.
-fn unsupported(pf: &ProblemFile) -> Result<(), CaseError> {
-    use crate::compiler::Diagnostic;
-    let p = pf.problem();
-    if !p.regions.iter().any(|r| r.name.name == "Gamma_C") {
-        return Err(pf.render(
-            Diagnostic::error("E0101", "no region `Gamma_C`", p.name.span, "the contact forms integrate over it")
-                .with_help("add `region Gamma_C = group \"NAME\"` or `region Gamma_C = boundary where ...`"),
-        ));
-    }
-    Ok(())
 }
 
 /// The problem's reference, if it names one, for a problem of dimension `d`.
@@ -258,7 +244,11 @@ fn unset_coefs(pf: &ProblemFile, active: &Active) -> Result<(), CaseError> {
     if !p.obstacles.is_empty() {
         set.extend(["g", "nc"]);
     }
-    for unit in &active.forms.units {
+    let free = super::bind::contact_free(pf);
+    for (i, unit) in active.forms.units.iter().enumerate() {
+        if free && i == active.forms.contact {
+            continue; // integrates over no facet: its coefs are zero
+        }
         for (c, _) in unit.coefs() {
             if !set.contains(&c.as_str()) {
                 let mut d = Diagnostic::error(
@@ -443,14 +433,33 @@ fn simulate(
     let quadrature = Quadrature { cell: degree("cell")?, facet: degree("facet")? };
     let coef_fns = super::bind::coefs(pf, ex)?;
     coef_shapes(pf, active, &coef_fns, mesh.dim())?;
-    let coefs = super::bind::coef_lookup(&coef_fns);
-    let contact = "Gamma_C";
+    let lookup = super::bind::coef_lookup(&coef_fns);
+    // Without contact, the coefs only the contact law reads are zero (it integrates over no facet).
+    let zeros: Vec<(String, usize)> = if super::bind::contact_free(pf) {
+        let law = &active.forms.units[active.forms.contact];
+        law.coefs().into_iter().map(|(name, rank)| (name, mesh.dim().pow(rank))).collect()
+    } else {
+        Vec::new()
+    };
+    let coefs = |name: &str| {
+        lookup(name).or_else(|| {
+            let (_, len) = zeros.iter().find(|(n, _)| n == name)?;
+            Some(crate::runtime::kernel::Coef::constant(vec![0.0; *len]))
+        })
+    };
+    // The contact law's `Gamma_C` is the obstacle's region (`on REGION`, or `Gamma_C`); none
+    // without an obstacle or a region `Gamma_C`.
+    let contact = super::bind::CONTACT;
+    let contact_region: Option<&str> = match p.obstacles.first() {
+        Some(o) => Some(o.region.as_ref().map_or(contact, |r| r.name.as_str())),
+        None => p.regions.iter().any(|r| r.name.name == contact).then_some(contact),
+    };
     let others: Vec<String> = p.regions.iter().map(|r| r.name.name.clone()).filter(|r| r != contact).collect();
     let (constraints, held) = dirichlet(pf, ex, &mesh)?;
     let problem = Problem {
         coefs: &coefs,
         quadrature,
-        contact,
+        contact: contact_region,
         regions: &others,
         constraints: constraints.clone(),
         prescribed: held.as_ref().map(|h| h.prescribed(&mesh)),

@@ -29,8 +29,9 @@ pub struct Problem<'p> {
     /// The case's coefficients by name (`f`, `g`, `nc`, ...).
     pub coefs: &'p dyn Fn(&str) -> Option<Coef>,
     pub quadrature: Quadrature,
-    /// The mesh region bound to the forms' `Gamma_C`.
-    pub contact: &'p str,
+    /// The mesh region bound to the forms' `Gamma_C` (none: the contact law integrates over no
+    /// facet).
+    pub contact: Option<&'p str>,
     /// Other mesh regions the forms may integrate over, bound by their names.
     pub regions: &'p [String],
     /// Dirichlet conditions of the dynamics.
@@ -215,7 +216,10 @@ impl<'m> Simulation<'m> {
     pub fn new(asm: &'m Assembler<'m>, problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
         let mesh: &Mesh = asm.mesh();
         let n = asm.size();
-        let contact_facets = asm.region(problem.contact)?;
+        let contact_facets = match problem.contact {
+            Some(name) => asm.region(name)?,
+            None => &[],
+        };
         let mut regions = vec![("Gamma_C".to_string(), contact_facets)];
         for name in problem.regions {
             regions.push((name.clone(), asm.region(name)?));
@@ -245,7 +249,10 @@ impl<'m> Simulation<'m> {
         forms[slot(&forms, "stiffness")?].1.tangent(asm, &[&zero], 0, 0.0, &mut stiffness);
         let mut load = vec![0.0; n];
         forms[slot(&forms, "load")?].1.residual(asm, &[], 0.0, &mut load);
-        let contact_nodes = mesh.region_nodes(mesh.region(problem.contact)?);
+        let contact_nodes = match problem.contact {
+            Some(name) => mesh.region_nodes(mesh.region(name)?),
+            None => Vec::new(),
+        };
         let redistributed = problem.mass == MassChoice::Redistributed;
         if redistributed && !inertia {
             return Err(CaseError::Option(

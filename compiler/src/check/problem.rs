@@ -290,6 +290,17 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
     }
     for o in &p.obstacles {
         builtin_call(c, &o.shape, OBSTACLES, "obstacle", fields, diags);
+        // The contact law imposes it on its region: `on REGION`, or `Gamma_C`.
+        match &o.region {
+            Some(r) if !regions.contains(&r.name.as_str()) => {
+                diags.push(unknown_among(r, regions.iter().copied(), "region"))
+            }
+            None if !regions.contains(&"Gamma_C") => diags.push(
+                Diagnostic::error("E0101", "an obstacle without its region", o.span, "faces `Gamma_C`, not defined")
+                    .with_help("add `on REGION`, or `region Gamma_C = group \"NAME\"` (or `boundary where ...`)"),
+            ),
+            _ => {}
+        }
     }
     let mut columns: HashMap<&str, Span> = HashMap::new();
     for d in p.series.iter().map(|(d, _)| d).chain(&p.summary) {

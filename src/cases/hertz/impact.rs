@@ -152,7 +152,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     let problem = Problem {
         coefs: &coefs,
         quadrature: Quadrature::default(),
-        contact: meshes::CONTACT,
+        contact: Some(meshes::CONTACT),
         regions: &[],
         constraints: meshes::symmetry(&mesh)?,
         prescribed: None,
