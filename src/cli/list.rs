@@ -41,7 +41,14 @@ pub fn text() -> String {
     }
     out.push_str("\nProblems (signorini run NAME, or a problem .wf file):\n");
     problems(&mut out);
-    out.push_str("\nSet a param with --param NAME=VALUE (OWNER.NAME when two files declare NAME).\n");
+    out.push_str("\nReferences (`reference NAME` in a problem; their functionals read as NAME(u)):\n");
+    for r in crate::references::ALL {
+        let _ = writeln!(out, "  {:<16} {}", r.name(), r.doc());
+        for (f, doc) in r.functionals() {
+            let _ = writeln!(out, "    {f:<26} {doc}");
+        }
+    }
+    out.push_str("\nSet a param with --param NAME=VALUE (OWNER.NAME when two files declare NAME); a problem's params are also options: --NAME VALUE.\n");
     out
 }
 
