@@ -262,7 +262,7 @@ pub enum StepError {
     #[error("stage `{stage}` at t = {t}: {source}")]
     Newton { stage: &'static str, t: f64, source: NewtonError },
     #[error(
-        "stage `{stage}` of scheme `{scheme}` has no displacement quantity (u', um, ...) that depends on its unknown: a moving held displacement cannot be imposed there"
+        "stage `{stage}` of scheme `{scheme}` has no displacement quantity (u', um, ...) that depends on its unknown (a nonzero coefficient at this Δt): a moving held displacement cannot be imposed there"
     )]
     NoDisplacement { scheme: &'static str, stage: &'static str },
 }
@@ -535,6 +535,9 @@ impl<'a> Stepper<'a> {
             self.displacement(stage).ok_or(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name })?;
         let c = &stage.values[q];
         let cw = c.unknown.map_or(0.0, |k| self.coefs[k]);
+        if cw == 0.0 || !cw.is_finite() {
+            return Err(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name });
+        }
         let mut g = vec![0.0; p.dofs.len()];
         (p.values)(time, &mut g);
         let mut at_reference = vec![0.0; self.asm.size()];

@@ -89,9 +89,6 @@ impl Reader<'_> {
     }
 }
 
-/// The top-level keys of a case file that are params of its problem, as settings, and the text
-/// with them blanked out (lines and offsets kept) for the options' parser. None when the text
-/// does not parse or names no problem that loads (the options' parser then says why).
 /// The top-level keys of a case file that are params of its problem.
 struct ProblemKeys {
     settings: Vec<Result<Setting, CaseError>>,
@@ -102,12 +99,24 @@ struct ProblemKeys {
     names: Vec<String>,
 }
 
-fn problem_params(text: &str, file: &str, base: &Path) -> Option<ProblemKeys> {
-    let table: toml::Table = toml::from_str(text).ok()?;
-    let problem = name_or_path(table.get("case")?.as_str()?, base);
-    let pf = crate::problem::load(&problem).ok()?;
+/// The top-level keys of a case file that are params of its problem, as settings, and the text
+/// with them blanked out (lines and offsets kept) for the options' parser. None when the text
+/// does not parse or has no `case` string (the options' parser then says why); the problem's
+/// own error, at the `case` line, when it does not load.
+fn problem_params(text: &str, file: &str, base: &Path) -> Result<Option<ProblemKeys>, CaseError> {
+    let (Ok(table), Ok(spans)) = (toml::from_str::<toml::Table>(text), toml::de::DeTable::parse(text)) else {
+        return Ok(None);
+    };
+    let Some(case) = table.get("case").and_then(|c| c.as_str()) else { return Ok(None) };
+    let pf = crate::problem::load(&name_or_path(case, base)).map_err(|e| match e {
+        CaseError::Option(m) => {
+            let at = spans.get_ref().iter().find(|(k, _)| k.get_ref() == "case").map_or(0, |(k, _)| k.span().start);
+            let line = text[..at.min(text.len())].matches('\n').count() + 1;
+            CaseError::CaseFile(format!("{file}:{line}: `case`: {m}"))
+        }
+        e => e,
+    })?;
     let names: Vec<&str> = pf.problem().params.iter().map(|q| q.name.name.as_str()).collect();
-    let spans = toml::de::DeTable::parse(text).ok()?;
     let mut blanked = text.as_bytes().to_vec();
     let mut settings = Vec::new();
     for (key, value) in spans.get_ref().iter() {
@@ -131,12 +140,13 @@ fn problem_params(text: &str, file: &str, base: &Path) -> Option<ProblemKeys> {
             }
         }
     }
-    Some(ProblemKeys {
+    let Ok(options) = String::from_utf8(blanked) else { return Ok(None) };
+    Ok(Some(ProblemKeys {
         settings,
-        options: String::from_utf8(blanked).ok()?,
+        options,
         problem: pf.name().to_string(),
         names: names.iter().map(|n| n.to_string()).collect(),
-    })
+    }))
 }
 
 /// Reads and checks a case file. Relative paths in it are relative to the file.
@@ -151,7 +161,7 @@ pub fn read(path: &Path) -> Result<crate::problem::run::Options, CaseError> {
 pub fn parse(text: &str, path: &Path) -> Result<crate::problem::run::Options, CaseError> {
     let file = path.display().to_string();
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let keys = problem_params(text, &file, &base);
+    let keys = problem_params(text, &file, &base)?;
     let options = keys.as_ref().map_or(text, |k| k.options.as_str());
     let parsed: CaseFile = toml::from_str(options).map_err(|e| {
         let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);

@@ -765,6 +765,8 @@ fn run_problem(problem: &str, a: ProblemArgs) -> ExitCode {
         opts.cell_size = a.methods.cell_size;
         opts.newton.solver = a.solver;
         opts.newton.line_search = a.methods.line_search;
+        opts.vtu_every = a.vtu_every;
+        opts.chosen.material = a.methods.material.is_some();
         opts.out = match out_dir(a.out) {
             Ok(dir) => dir,
             Err(e) => return fail(e),
@@ -806,82 +808,83 @@ fn run_problem(problem: &str, a: ProblemArgs) -> ExitCode {
 /// problem's own summary keys.
 fn run_problem_all(base: crate::problem::run::Options, setup: Setup) -> ExitCode {
     let masses = [(MassChoice::Consistent, "consistent"), (MassChoice::Redistributed, "redistributed")];
-    // The settings that are the problem's params (`ne`, or `bar.ne`).
-    let own: Vec<String> = match crate::problem::load(&base.problem) {
-        Ok(pf) => setup
-            .params
-            .iter()
-            .filter(|p| crate::problem::params(&pf, std::slice::from_ref(*p)).is_ok_and(|(_, rest)| rest.is_empty()))
-            .map(|p| p.name.clone())
-            .collect(),
+    // The problem's own params (`ne`, or `bar.ne`) apply to every run: checked once.
+    let rest = match crate::problem::load(&base.problem).and_then(|pf| crate::problem::params(&pf, &setup.params)) {
+        Ok((_, rest)) => rest,
         Err(e) => return fail(e),
     };
+    // A file's param applies to the runs whose files declare it (alpha to hht, not newmark);
+    // one that no run takes is misspelt or out of range everywhere: an error, not a silent drop.
+    let combinations: Vec<(&str, &str)> = crate::driver::all_schemes()
+        .into_iter()
+        .flat_map(|s| crate::driver::contact_names().into_iter().map(move |c| (s, c)))
+        .collect();
+    let takes = |scheme: &str, contact: &str, p: &Setting| {
+        let probe = Setup { scheme: scheme.into(), contact: contact.into(), params: vec![p.clone()], ..setup.clone() };
+        crate::driver::Active::resolve(&probe, &[])
+    };
+    for p in &rest {
+        let results: Vec<_> = combinations.iter().map(|(s, c)| takes(s, c, p)).collect();
+        if results.iter().all(Result::is_err) {
+            // Out of range where it is declared says more than unknown where it is not.
+            let errors: Vec<String> = results.into_iter().filter_map(Result::err).map(|e| e.to_string()).collect();
+            let why = errors.iter().find(|e| !e.contains("unknown param")).or(errors.last());
+            return fail(format!("{} applies to none of the runs: {}", p.origin, why.map_or("", |e| e.as_str())));
+        }
+    }
     let mut header: Option<Vec<String>> = None;
     let mut failed = false;
-    for scheme in crate::driver::all_schemes() {
-        for contact in crate::driver::contact_names() {
-            for (mass, mass_name) in masses {
-                // A setting that names a param the scheme lacks (alpha for newmark) is left out;
-                // the problem's own params are kept.
-                let params: Vec<Setting> = setup
-                    .params
-                    .iter()
-                    .filter(|p| {
-                        let probe = Setup {
-                            scheme: scheme.into(),
-                            contact: contact.into(),
-                            params: vec![(*p).clone()],
-                            ..setup.clone()
-                        };
-                        own.contains(&p.name) || crate::driver::Active::resolve(&probe, &[]).is_ok()
-                    })
-                    .cloned()
-                    .collect();
-                let label = format!("{scheme}_{contact}_{mass_name}");
-                let opts = crate::problem::run::Options {
-                    setup: Setup { scheme: scheme.into(), contact: contact.into(), params, ..setup.clone() },
-                    mass,
-                    out: base.out.as_ref().map(|d| d.join(&label)),
-                    chosen: crate::problem::run::Chosen::all(),
-                    ..base.clone()
-                };
-                match crate::problem::run::run(&opts) {
-                    Ok(r) => {
-                        let s = &r.summary;
-                        let keys = header.get_or_insert_with(|| {
-                            let keys = s.own.clone();
-                            let names: Vec<String> =
-                                keys.iter().map(|k| format!("{k:>w$}", w = k.len().max(11))).collect();
-                            println!(
-                                "{:<15} {:<16} {:<13} {} {:>7} {:>4}",
-                                "scheme",
-                                "contact",
-                                "mass",
-                                names.join(" "),
-                                "Newton",
-                                "max"
-                            );
-                            keys
-                        });
-                        let values: Vec<String> = keys
-                            .iter()
-                            .map(|k| {
-                                let w = k.len().max(11);
-                                s.number(k).map_or(format!("{:>w$}", "—"), |v| format!("{v:>w$.4e}"))
-                            })
-                            .collect();
-                        let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0);
+    for (scheme, contact) in combinations.iter().copied() {
+        for (mass, mass_name) in masses {
+            let params: Vec<Setting> = setup
+                .params
+                .iter()
+                .filter(|p| !rest.contains(p) || takes(scheme, contact, p).is_ok())
+                .cloned()
+                .collect();
+            let label = format!("{scheme}_{contact}_{mass_name}");
+            let opts = crate::problem::run::Options {
+                setup: Setup { scheme: scheme.into(), contact: contact.into(), params, ..setup.clone() },
+                mass,
+                out: base.out.as_ref().map(|d| d.join(&label)),
+                chosen: crate::problem::run::Chosen { scheme: true, contact: true, ..base.chosen },
+                ..base.clone()
+            };
+            match crate::problem::run::run(&opts) {
+                Ok(r) => {
+                    let s = &r.summary;
+                    let keys = header.get_or_insert_with(|| {
+                        let keys = s.own.clone();
+                        let names: Vec<String> = keys.iter().map(|k| format!("{k:>w$}", w = k.len().max(11))).collect();
                         println!(
-                            "{scheme:<15} {contact:<16} {mass_name:<13} {} {:>7} {:>4}",
-                            values.join(" "),
-                            count("newton_total"),
-                            count("newton_max")
+                            "{:<15} {:<16} {:<13} {} {:>7} {:>4}",
+                            "scheme",
+                            "contact",
+                            "mass",
+                            names.join(" "),
+                            "Newton",
+                            "max"
                         );
-                    }
-                    Err(e) => {
-                        println!("{scheme:<15} {contact:<16} {mass_name:<13} failed: {e}");
-                        failed = true;
-                    }
+                        keys
+                    });
+                    let values: Vec<String> = keys
+                        .iter()
+                        .map(|k| {
+                            let w = k.len().max(11);
+                            s.number(k).map_or(format!("{:>w$}", "—"), |v| format!("{v:>w$.4e}"))
+                        })
+                        .collect();
+                    let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0);
+                    println!(
+                        "{scheme:<15} {contact:<16} {mass_name:<13} {} {:>7} {:>4}",
+                        values.join(" "),
+                        count("newton_total"),
+                        count("newton_max")
+                    );
+                }
+                Err(e) => {
+                    println!("{scheme:<15} {contact:<16} {mass_name:<13} failed: {e}");
+                    failed = true;
                 }
             }
         }

@@ -311,7 +311,20 @@ fn obstacle_vals<'p>(pf: &'p ProblemFile, ex: &mut Exprs) -> Result<Vec<(Val, Va
                 let centre_arg = if shape == "sphere" { "centre" } else { "point" };
                 let ((centre, e), (radius, _)) = (lower(ex, centre_arg)?, lower(ex, "radius")?);
                 let axis = match arg(&o.shape, "axis") {
-                    Some(a) if x.c.len() == 3 => Some(ex.lower(a, &[]).map_err(|d| pf.render(*d))?),
+                    Some(a) if x.c.len() == 3 => {
+                        let axis = ex.lower(a, &[]).map_err(|d| pf.render(*d))?;
+                        // A constant axis must have a direction (one that moves is the user's).
+                        let constant: Option<Vec<f64>> = axis.c.iter().map(|j| ex.low.g.as_const(j.v)).collect();
+                        if constant.is_some_and(|v| v.iter().all(|x| *x == 0.0)) {
+                            return Err(pf.render(Diagnostic::error(
+                                "E0301",
+                                "a cylinder's axis is not zero",
+                                a.span,
+                                "no direction",
+                            )));
+                        }
+                        Some(axis)
+                    }
                     Some(a) => {
                         return Err(pf.render(
                             Diagnostic::error("E0302", "wrong dimension", a.span, "a 2D cylinder has no axis")

@@ -10,7 +10,6 @@ use crate::cases::CaseError;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
 use crate::driver::ActiveForms;
-use crate::references::Reference;
 use crate::runtime::assembly::Assembler;
 use crate::runtime::evaluate::{FacetSample, facet_samples};
 use crate::runtime::library::{Binding, BoundFunctional};
@@ -103,7 +102,7 @@ pub struct Observer<'m> {
     slots: Vec<(String, Box<dyn BoundForm + 'm>)>,
     /// The column each measure was added for.
     owner: Vec<usize>,
-    reference: Option<&'static dyn Reference>,
+    reference: Option<crate::references::Bound>,
     /// The functionals the measures read, by name.
     functionals: Vec<(String, Box<dyn BoundFunctional + 'm>)>,
     /// Buffers a row reuses (a row's measures are small vectors: allocating them took a tenth
@@ -134,7 +133,7 @@ impl<'m> Observer<'m> {
         binding: &Binding<'m>,
         coef_vals: &[(String, Val)],
         degree: u32,
-        reference: Option<&'static dyn Reference>,
+        reference: Option<crate::references::Bound>,
     ) -> Result<Observer<'m>, CaseError> {
         let p = pf.problem();
         let mut inst = forms.instantiate(coefs, binding)?;
@@ -360,7 +359,7 @@ impl<'m> Observer<'m> {
                 }
                 name => {
                     let mid = matches!(&args[0].kind, ExprKind::Name(n) if n.name == "u_mid");
-                    let by_reference = self.reference.and_then(|r| {
+                    let by_reference = self.reference.as_ref().and_then(|(r, _)| {
                         r.functionals()
                             .iter()
                             .position(|(n, _)| *n == name)
@@ -381,8 +380,8 @@ impl<'m> Observer<'m> {
                                 f.span,
                                 "not provided",
                             );
-                            match self.reference {
-                                Some(r) => {
+                            match &self.reference {
+                                Some((r, _)) => {
                                     let names: Vec<&str> = r.functionals().iter().map(|(n, _)| *n).collect();
                                     d = d.with_note(format!("nor in reference `{}`: {}", r.name(), names.join(", ")));
                                     if let Some(s) = crate::compiler::check::suggest_name(name, names.iter().copied()) {
@@ -535,12 +534,12 @@ impl<'m> Observer<'m> {
                                 .map_or(f64::NAN, |(u, t)| f.value(asm, &[u], *t)))
                         }
                         Measure::Reference { which, mid: false } => {
-                            one(self.reference.map_or(f64::NAN, |r| r.value(*which, tools, s.u, s.t)))
+                            one(self.reference.as_ref().map_or(f64::NAN, |(_, r)| r.value(*which, tools, s.u, s.t)))
                         }
                         Measure::Reference { which, mid: true } => one(mid
                             .get_or_insert_with(&mut midpoint)
                             .as_ref()
-                            .zip(self.reference)
+                            .zip(self.reference.as_ref().map(|(_, r)| r))
                             .map_or(f64::NAN, |((u, t), r)| r.value(*which, tools, u, *t))),
                         Measure::Density { index, min } => {
                             let rule = crate::runtime::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });

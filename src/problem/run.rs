@@ -124,6 +124,7 @@ pub fn check(problem: &str) -> Result<(), CaseError> {
     let opts = Options::new(problem);
     bound(&opts, |pf, _, ex, _| {
         let p = pf.problem();
+        reference(pf, ex.dim())?;
         super::bind::settings(pf, ex, &p.run)?;
         super::bind::settings(pf, ex, &p.quadrature)?;
         let (mesh, _) = super::bind::mesh(pf, ex, None, CellSize::Diameter)?;
@@ -203,6 +204,32 @@ fn bind_files(pf: &ProblemFile, setup: &mut Setup, chosen: Chosen) {
             _ => {}
         }
     }
+}
+
+/// The problem's reference bound to this run, after it checked the run is one it describes.
+fn bound_reference(
+    pf: &ProblemFile,
+    active: &Active,
+    mesh: &crate::runtime::mesh::Mesh,
+    t_start: f64,
+) -> Result<Option<crate::references::Bound>, CaseError> {
+    let Some(r) = reference(pf, mesh.dim())? else { return Ok(None) };
+    let param = |name: &str| active.forms.params.get(name);
+    let facts = crate::references::RunFacts { mesh, param: &param, t_start };
+    let bound = r.bind(&facts).map_err(|why| {
+        let at = pf.problem().reference.as_ref().map_or(pf.problem().name.span, |n| n.span);
+        pf.render(
+            crate::compiler::Diagnostic::error(
+                "E0101",
+                format!("reference `{}` does not describe this run", r.name()),
+                at,
+                "named here",
+            )
+            .with_note(why)
+            .with_note(format!("{}: {}", r.name(), r.doc())),
+        )
+    })?;
+    Ok(Some((r, bound)))
 }
 
 /// The problem's reference, if it names one, for a problem of dimension `d`.
@@ -340,12 +367,12 @@ fn dirichlet(
             for (j, &k) in components.iter().enumerate() {
                 let dof = node as usize * d + k;
                 c.fix(dof);
+                // A later condition on the same dof replaces an earlier one.
+                if let Some(i) = held.dofs.iter().position(|&x| x == dof) {
+                    held.dofs.remove(i);
+                    held.at.remove(i);
+                }
                 if !zero {
-                    // A later condition on the same dof replaces an earlier one.
-                    if let Some(i) = held.dofs.iter().position(|&x| x == dof) {
-                        held.dofs.remove(i);
-                        held.at.remove(i);
-                    }
                     let comp = if dc.component.is_some() { 0 } else { j };
                     held.dofs.push(dof);
                     held.at.push((node as usize, held.values.len() - 1, comp));
@@ -498,7 +525,7 @@ fn simulate(
         &binding,
         &coef_vals,
         quadrature.facet.unwrap_or(7),
-        reference(pf, mesh.dim())?,
+        bound_reference(pf, active, &mesh, t0)?,
     )?;
     let columns: Vec<String> = observer.names().map(str::to_string).collect();
     let shown = observer.shown();

@@ -2,11 +2,33 @@
 //! contact at x = 0, u₀(x) = (1 − x)/2, v₀ = 0. Period 3; zones by s = τ − ⌊τ⌋, τ = t mod 3.
 //! A problem reads it as `reference bar` (forms/problems/bar.wf).
 
-use super::Reference;
+use std::cell::RefCell;
+
+use super::{BoundReference, Reference, RunFacts};
 use crate::simulation::Tools;
 
 /// `reference bar`: the run against the exact solution.
 pub struct Bar;
+
+/// Its functionals, in the order of [`Bar::functionals`]'s names.
+#[derive(Clone, Copy)]
+enum Functional {
+    Error,
+    Norm,
+    ContactStress,
+    ContactDisplacement,
+}
+
+const FUNCTIONALS: &[(&str, &str, Functional)] = &[
+    ("exact_u_error", "‖u − I_h u_ex(t)‖_M, with the mass the scheme steps with", Functional::Error),
+    ("exact_u_norm", "‖I_h u_ex(t)‖_M, the same norm of the interpolated exact displacement", Functional::Norm),
+    ("exact_contact_stress", "the exact contact stress E u_x(0, t) (of t only)", Functional::ContactStress),
+    (
+        "exact_contact_displacement",
+        "the exact displacement of the contact point u(0, t) (of t only)",
+        Functional::ContactDisplacement,
+    ),
+];
 
 impl Reference for Bar {
     fn name(&self) -> &'static str {
@@ -14,47 +36,61 @@ impl Reference for Bar {
     }
 
     fn doc(&self) -> &'static str {
-        "the compressed bar's exact solution (1D, on [0, 1], E = ρ = 1, u₀ = (1 − x)/2 at rest, held at x = 1)"
+        "the compressed bar's exact solution (1D, on [0, 1], E = ρ = 1, u₀ = (1 − x)/2 at rest from t = 0, held at x = 1)"
     }
 
     fn dim(&self) -> usize {
         1
     }
 
-    fn functionals(&self) -> &'static [(&'static str, &'static str)] {
-        &[
-            ("exact_u_error", "‖u − I_h u_ex(t)‖_M, with the mass the scheme steps with"),
-            ("exact_u_norm", "‖I_h u_ex(t)‖_M, the same norm of the interpolated exact displacement"),
-            ("exact_contact_stress", "the exact contact stress E u_x(0, t) (of t only)"),
-            ("exact_contact_displacement", "the exact displacement of the contact point u(0, t) (of t only)"),
-        ]
+    fn functionals(&self) -> Vec<(&'static str, &'static str)> {
+        FUNCTIONALS.iter().map(|(name, doc, _)| (*name, *doc)).collect()
     }
 
+    fn bind(&self, run: &RunFacts) -> Result<Box<dyn BoundReference>, String> {
+        for p in ["E", "rho"] {
+            if let Some(v) = (run.param)(p).filter(|v| *v != 1.0) {
+                return Err(format!("it is the solution for E = ρ = 1, and this run has {p} = {v}"));
+            }
+        }
+        if run.t_start != 0.0 {
+            return Err(format!("it starts at t = 0, and this run at t = {}", run.t_start));
+        }
+        let nodes: Vec<f64> = (0..run.mesh.num_nodes()).map(|i| run.mesh.node(i)[0]).collect();
+        let (lo, hi) = nodes.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+        if lo != 0.0 || hi != 1.0 {
+            return Err(format!("it is the solution on [0, 1], and this mesh spans [{lo}, {hi}]"));
+        }
+        Ok(Box::new(BoundBar { nodes, interpolant: RefCell::new((f64::NAN, Vec::new())) }))
+    }
+}
+
+/// The bar's solution on one run's mesh.
+struct BoundBar {
+    /// The nodes' positions (one unknown per node in 1D).
+    nodes: Vec<f64>,
+    /// The interpolant at the last time asked (a row asks for the error and the norm at one).
+    interpolant: RefCell<(f64, Vec<f64>)>,
+}
+
+impl BoundReference for BoundBar {
     fn value(&self, which: usize, tools: &Tools, u: &[f64], t: f64) -> f64 {
-        let mesh = tools.asm.mesh();
-        // A row asks for the error and the norm at one time: the interpolant is made once.
-        // Keyed by the time and the mesh (where its nodes are stored, and its end nodes).
-        type Last = ((u64, usize, u64, u64), Vec<f64>);
-        thread_local!(static LAST: std::cell::RefCell<Last> = const { std::cell::RefCell::new(((0, 0, 0, 0), Vec::new())) });
         let with_interpolant = |f: &dyn Fn(&[f64]) -> f64| {
-            let ends = (mesh.node(0)[0].to_bits(), mesh.node(u.len() - 1)[0].to_bits());
-            let key = (t.to_bits(), mesh.node(0).as_ptr() as usize, ends.0, ends.1);
-            LAST.with(|last| {
-                let mut last = last.borrow_mut();
-                if last.0 != key || last.1.len() != u.len() {
-                    *last = (key, (0..u.len()).map(|i| displacement(mesh.node(i)[0], t)).collect());
-                }
-                f(&last.1)
-            })
+            let mut last = self.interpolant.borrow_mut();
+            if last.0.to_bits() != t.to_bits() {
+                *last = (t, self.nodes.iter().map(|&x| displacement(x, t)).collect());
+            }
+            f(&last.1)
         };
-        match which {
-            0 => with_interpolant(&|exact| {
+        match FUNCTIONALS.get(which).map(|f| f.2) {
+            Some(Functional::Error) => with_interpolant(&|exact| {
                 let diff: Vec<f64> = u.iter().zip(exact).map(|(a, b)| a - b).collect();
                 Tools::quad(&tools.scheme_mass, &diff, &diff).sqrt()
             }),
-            1 => with_interpolant(&|exact| Tools::quad(&tools.scheme_mass, exact, exact).sqrt()),
-            2 => contact_stress(t),
-            _ => displacement(0.0, t),
+            Some(Functional::Norm) => with_interpolant(&|exact| Tools::quad(&tools.scheme_mass, exact, exact).sqrt()),
+            Some(Functional::ContactStress) => contact_stress(t),
+            Some(Functional::ContactDisplacement) => displacement(0.0, t),
+            None => f64::NAN,
         }
     }
 }

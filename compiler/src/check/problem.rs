@@ -295,6 +295,16 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
             Some(r) if !regions.contains(&r.name.as_str()) => {
                 diags.push(unknown_among(r, regions.iter().copied(), "region"))
             }
+            // The contact law's `Gamma_C` is bound to the obstacle's region: a region of that
+            // name besides would be hidden.
+            Some(r) if r.name != "Gamma_C" && regions.contains(&"Gamma_C") => diags.push(
+                Diagnostic::error("E0103", "two contact regions", r.span, "the contact law's `Gamma_C` is bound here")
+                    .with_label(
+                        p.regions.iter().find(|x| x.name.name == "Gamma_C").map_or(r.span, |x| x.name.span),
+                        "and a region `Gamma_C` is defined here",
+                    )
+                    .with_help("name the obstacle's region `Gamma_C`, or rename the other region"),
+            ),
             None if !regions.contains(&"Gamma_C") => diags.push(
                 Diagnostic::error("E0101", "an obstacle without its region", o.span, "faces `Gamma_C`, not defined")
                     .with_help("add `on REGION`, or `region Gamma_C = group \"NAME\"` (or `boundary where ...`)"),
