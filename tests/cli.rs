@@ -287,3 +287,31 @@ fn the_command_line_definition_is_consistent() {
     let (code, _, err) = signorini(&["run", "hertz-static", "--level", "0", "--load", "0.5"]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// A problem's params are options of its run wherever they stand after `run` (`--ne 4`,
+/// `--ne=4`, before or after the problem's name), as `--param ne=4`; a run option of its own
+/// keeps its meaning.
+#[test]
+fn a_problems_params_are_options_of_its_run() {
+    let dir = std::env::temp_dir().join(format!("signorini-flags-{}", std::process::id()));
+    for (k, args) in [
+        vec!["run", "bar", "--ne", "4"],
+        vec!["run", "--ne", "4", "bar"],
+        vec!["run", "--scheme", "hht", "bar", "--ne=4"],
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let out = dir.join(k.to_string());
+        let mut args = args;
+        args.extend(["--t-end", "0.05", "--out", out.to_str().unwrap()]);
+        let (code, _, err) = signorini(&args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        let s: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+        assert_eq!(s["params"]["bar.ne"]["value"], 4.0, "{args:?}");
+        assert_eq!(s["params"]["bar.ne"]["source"], "user", "{args:?}");
+        assert_eq!(s["dofs"], 5, "{args:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -52,18 +52,36 @@ impl Cli {
 fn problem_flags(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
     let text = |a: &std::ffi::OsString| a.to_str().map(str::to_string);
     let Some(run) = args.iter().position(|a| a == "run") else { return args };
-    let Some(problem) = args.get(run + 1).and_then(text) else { return args };
-    if problem.starts_with('-') || problem.ends_with(".toml") {
+    let cmd = <Cli as clap::CommandFactory>::command();
+    // The options of `run`, and whether each takes a value.
+    let known: Vec<(String, bool)> = cmd
+        .find_subcommand("run")
+        .map(|r| {
+            r.get_arguments()
+                .filter_map(|a| a.get_long().map(|l| (l.to_string(), a.get_action().takes_values())))
+                .collect()
+        })
+        .unwrap_or_default();
+    let takes_value = |flag: &str| known.iter().find(|(l, _)| l == flag).map(|(_, v)| *v);
+    // The problem: the first word after `run` that is no option's (an unknown option, maybe a
+    // param of the problem, takes the word after it).
+    let mut i = run + 1;
+    let problem = loop {
+        let Some(arg) = args.get(i).and_then(text) else { return args };
+        match arg.strip_prefix("--") {
+            Some("") => return args,
+            Some(flag) if flag.contains('=') => i += 1,
+            Some(flag) => i += if takes_value(flag) == Some(false) { 1 } else { 2 },
+            None if arg.starts_with('-') => i += 1,
+            None => break arg,
+        }
+    };
+    if problem.ends_with(".toml") {
         return args;
     }
     let Ok(pf) = crate::problem::load(&problem) else { return args };
-    let cmd = <Cli as clap::CommandFactory>::command();
-    let known: Vec<String> = cmd
-        .find_subcommand("run")
-        .map(|r| r.get_arguments().filter_map(|a| a.get_long().map(str::to_string)).collect())
-        .unwrap_or_default();
     let params: Vec<String> = pf.problem().params.iter().map(|q| q.name.name.clone()).collect();
-    let mut i = run + 2;
+    let mut i = run + 1;
     while i < args.len() {
         let Some(arg) = text(&args[i]) else {
             i += 1;
@@ -81,7 +99,7 @@ fn problem_flags(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
             None => (flag.to_string(), None),
         };
         let param = name.replace('-', "_");
-        if known.contains(&name) || !params.contains(&param) {
+        if takes_value(&name).is_some() || !params.contains(&param) {
             i += 1;
             continue;
         }
