@@ -13,7 +13,7 @@ use signorini::runtime::mesh::structured;
 use signorini::runtime::scheme::{Bound, BoundForm};
 
 fn run(setup: Setup, steps: usize) -> bar::Run {
-    let opts = Options { setup, t_end: steps as f64 * 0.01, ..Options::default() };
+    let opts = Options { setup, t_end: Some(steps as f64 * 0.01), ..Options::default() };
     bar::run(&opts).unwrap()
 }
 

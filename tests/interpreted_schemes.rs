@@ -33,7 +33,7 @@ fn schemes_and_laws_by_path_match_the_compiled_library() {
             let by_path = Setup { scheme: file.clone(), contact: law_file.clone(), ..Setup::default() };
             // The bar: 100 steps of 0.03 (first impact at t = 1).
             let bar_run = |setup: Setup| {
-                let o = bar::Options { setup, dt: 0.03, t_end: 3.0, ..bar::Options::default() };
+                let o = bar::Options { setup, dt: Some(0.03), t_end: Some(3.0), ..bar::Options::default() };
                 bar::run(&o).unwrap_or_else(|e| panic!("{scheme} {law}: {e}"))
             };
             let (a, b) = (bar_run(compiled.clone()), bar_run(by_path.clone()));

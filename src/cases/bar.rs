@@ -23,9 +23,10 @@ pub enum MassChoice {
 pub struct Options {
     /// Scheme, contact law, extra forms and params.
     pub setup: Setup,
-    pub elements: usize,
-    pub dt: f64,
-    pub t_end: f64,
+    /// Elements, Δt and the end time; none: forms/problems/bar.wf's.
+    pub elements: Option<usize>,
+    pub dt: Option<f64>,
+    pub t_end: Option<f64>,
     pub mass: MassChoice,
     /// What `h` means in γ = γ0/h.
     pub cell_size: CellSize,
@@ -43,9 +44,9 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             setup: Setup::default(),
-            elements: 20,
-            dt: 0.01,
-            t_end: 12.0,
+            elements: None,
+            dt: None,
+            t_end: None,
             mass: MassChoice::Consistent,
             cell_size: CellSize::Diameter,
             newton: NewtonOptions::default(),
@@ -139,16 +140,16 @@ pub struct Run {
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
     let mut setup = opts.setup.clone();
     // The problem's mesh param, as the user's setting (before theirs: theirs wins).
-    setup
-        .params
-        .insert(0, crate::driver::Setting { name: "ne".into(), value: opts.elements as f64, origin: "--ne".into() });
+    if let Some(ne) = opts.elements {
+        setup.params.insert(0, crate::driver::Setting { name: "ne".into(), value: ne as f64, origin: "--ne".into() });
+    }
     let problem = crate::problem::run::Options {
         problem: "bar".to_string(),
         setup,
         mass: opts.mass,
         cell_size: opts.cell_size,
-        dt: Some(opts.dt),
-        t_end: Some(opts.t_end),
+        dt: opts.dt,
+        t_end: opts.t_end,
         newton: opts.newton,
         out: opts.out.clone(),
         progress: opts.progress,
@@ -191,6 +192,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
     let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
     let mut params: std::collections::BTreeMap<String, ParamValue> = super::disc::field(s, "params")?;
+    let elements = params.get("bar.ne").map_or(0, |p| p.value as usize);
     params.retain(|k, _| !k.starts_with("bar."));
     let summary = Summary {
         case: "bar",
@@ -200,8 +202,8 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         params,
         mass: opts.mass,
         cell_size: opts.cell_size,
-        elements: opts.elements,
-        dt: opts.dt,
+        elements,
+        dt: number("dt"),
         t_end: number("t_end"),
         dofs: count("dofs"),
         steps: count("steps"),

@@ -57,7 +57,7 @@ impl Point {
 
 fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
     let setup = Setup { scheme: scheme.into(), ..Setup::default() };
-    let r = bar::run(&bar::Options { setup, mass, dt, ..Default::default() })?;
+    let r = bar::run(&bar::Options { setup, mass, dt: Some(dt), ..Default::default() })?;
     let s = &r.summary;
     // The first contact phase of the exact solution is t ∈ [1, 2]: look at [0.5, 2.5].
     let variation = |f: fn(&bar::Row) -> f64| -> f64 {

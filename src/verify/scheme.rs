@@ -139,7 +139,7 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
     };
     progress(&format!("{scheme}: bar before impact"));
     let bar_orders = bar_orders(setup)?;
-    let before = bar::run(&bar::Options { setup: setup.clone(), t_end: 0.8, ..bar::Options::default() })?;
+    let before = bar::run(&bar::Options { setup: setup.clone(), t_end: Some(0.8), ..bar::Options::default() })?;
     let e0 = before.series[0].energy;
     let bar_energy_drift = before.series.iter().map(|r| (r.energy - e0).abs()).fold(0.0, f64::max) / e0;
     progress(&format!("{scheme}: bar and disc beside the library"));

@@ -60,7 +60,8 @@ fn bar_differences(setup: &Setup) -> Result<Vec<(f64, f64)>, CaseError> {
     let runs: Vec<Vec<bar::Row>> = BAR_STEPS
         .iter()
         .map(|&dt| {
-            let opts = bar::Options { setup: setup.clone(), dt, t_end: BAR_END, ..bar::Options::default() };
+            let opts =
+                bar::Options { setup: setup.clone(), dt: Some(dt), t_end: Some(BAR_END), ..bar::Options::default() };
             Ok(bar::run(&opts)?.series)
         })
         .collect::<Result<_, CaseError>>()?;

@@ -7,7 +7,7 @@ use signorini::driver::Setup;
 signorini::forms!(mod wbz = "wbz.wf");
 
 fn series(setup: Setup) -> Vec<f64> {
-    let opts = bar::Options { setup, t_end: 3.0, ..bar::Options::default() };
+    let opts = bar::Options { setup, t_end: Some(3.0), ..bar::Options::default() };
     bar::run(&opts).unwrap().series.iter().map(|r| r.u_c).collect()
 }
 
