@@ -330,6 +330,18 @@ impl<'m> Observer<'m> {
                             self.functionals.len() - 1
                         }
                     };
+                    // Its integrand must live on facets: a cell functional has none to read.
+                    let rule = crate::runtime::quadrature::sampling_rule(d - 1, 1);
+                    let zero = vec![0.0; tools.asm.size()];
+                    if self.functionals[index].1.facet_point_values(tools.asm, &rule, &[&zero], 0.0).is_empty() {
+                        return Err(pf.render(crate::compiler::Diagnostic::error(
+                            "E0301",
+                            format!("`{}` integrates over no boundary facet", name.name),
+                            name.span,
+                            "no facet to sample",
+                        )
+                        .with_help("density_min and density_support read a functional over a boundary region: `int(Gamma_C) ...`")));
+                    }
                     add(self, Measure::Density { index, min: f.name == "density_min" }, 1, e.span)
                 }
                 "measure" | "peak" => {
