@@ -291,3 +291,32 @@ fn a_moving_held_displacement_pulls_the_bar_as_d_alembert_says() {
     let (ua, ub) = (a.column("u_free").unwrap(), b.column("u_free").unwrap());
     assert!(ua.iter().zip(&ub).all(|(x, y)| (x - y).abs() < 1e-13), "the acceleration form departs from Newmark's");
 }
+
+/// `run static`: one equilibrium by the static driver. A block resting on the ground under its
+/// weight (held against sliding on one side) is carried by the contact force, ρ g |Ω|, to
+/// round-off; the same problem as one step of the quasi-static scheme (no inertia) reaches the
+/// same equilibrium.
+#[test]
+fn a_static_problem_is_one_equilibrium() {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems");
+    let file = here.join("resting_block.wf");
+    let r = run(&Options::new(file.to_str().unwrap())).unwrap();
+    assert_eq!(r.rows.len(), 1);
+    let weight_error = r.summary.number("weight_error").unwrap();
+    assert!(weight_error.abs() < 1e-12, "{weight_error:e}");
+    assert_eq!(r.summary.get("scheme").and_then(|s| s.as_str()), Some("static"));
+    // As a time run of one step with the quasi-static scheme.
+    let dir = temp_dir("static");
+    let text = std::fs::read_to_string(&file).unwrap().replace("run static", "run dt = 1, t_end = 1");
+    std::fs::write(dir.join("resting_block.wf"), text).unwrap();
+    let mut o = Options::new(dir.join("resting_block.wf").to_str().unwrap());
+    o.setup.scheme =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/problems/quasistatic.wf").display().to_string();
+    o.chosen.scheme = true;
+    let q = run(&o).unwrap();
+    for c in ["force", "penetration"] {
+        let (a, b) = (r.column(c).unwrap()[0], *q.column(c).unwrap().last().unwrap());
+        assert!((a - b).abs() <= 1e-9 * a.abs(), "{c}: static {a:e}, quasi-static {b:e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

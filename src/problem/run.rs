@@ -138,6 +138,16 @@ pub fn check(problem: &str) -> Result<(), CaseError> {
 
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
     bound(opts, |pf, params, ex, active| {
+        if pf.problem().run_static.is_some() {
+            if opts.dt.is_some() || opts.t_end.is_some() || opts.t_start.is_some() {
+                return Err(CaseError::Option(format!(
+                    "{} is static (`run static`): it takes no --dt, --t-end or --t-start",
+                    pf.file
+                )));
+            }
+            let settings = Settings { dt: f64::NAN, t_start: 0.0, t_end: 0.0 };
+            return simulate(opts, pf, params, ex, active, &settings);
+        }
         let given = super::bind::settings(pf, ex, &pf.problem().run)?;
         let setting = |name: &str, over: Option<f64>, default: f64| {
             over.or_else(|| given.iter().find(|(n, _)| n == name).map(|(_, v)| *v)).unwrap_or(default)
@@ -509,7 +519,20 @@ fn simulate(
     if let Some(h) = &held {
         h.initial(&mesh, t0, &mut u0, &mut v0);
     }
-    sim.initialize_at(t0, u0, v0)?;
+    // A static problem is one equilibrium, from u₀ (no initial acceleration to solve for).
+    let statics = p.run_static.is_some();
+    let static_start = if statics {
+        if held.is_some() {
+            return Err(CaseError::Option(format!(
+                "{}: a static problem holds its Dirichlet values at zero (a nonzero held value needs a time run)",
+                pf.file
+            )));
+        }
+        Some(u0)
+    } else {
+        sim.initialize_at(t0, u0, v0)?;
+        None
+    };
     let mut regions = vec![(contact.to_string(), sim.tools.contact_facets)];
     for name in &others {
         regions.push((name.clone(), asm.region(name)?));
@@ -535,116 +558,140 @@ fn simulate(
         let (values, switches) = observer.row(tools, &state);
         ((t, values), switches)
     };
-    let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None };
-    let (first, first_switches) = row(&sim.tools, first);
-    let mut series = vec![first];
-    let mut switches = vec![first_switches];
-    // Newton iterations of each row's step (0 for the initial state).
-    let mut iterations: Vec<usize> = vec![0];
-    let steps = ((settings.t_end - t0) / settings.dt).round() as usize;
     let name = pf.name().to_string();
     let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, &name);
-    // A scheme without a velocity state: the step's mean velocity.
-    let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64], dt: f64| -> Vec<f64> {
-        match v_index {
-            Some(i) => states[i].clone(),
-            None => states[0].iter().zip(before).map(|(a, b)| (a - b) / dt).collect(),
-        }
-    };
-    let v_index = sim.v_index;
-    let stage_rows: RefCell<Vec<(String, f64, Vec<f64>)>> = RefCell::new(Vec::new());
-    let (mut saved_rows, mut saved_stages, mut saved_snapshots) = (0, 0, 0);
-    match control.observer() {
-        Some(records) => {
-            let stages = sim.stepper.desc().stages;
-            series.clear();
-            iterations.clear();
-            switches.clear();
-            for bytes in records {
-                let record: Record = postcard::from_bytes(bytes)
-                    .map_err(|e| CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})")))?;
-                series.extend(record.series);
-                iterations.extend(record.iterations);
-                switches.extend(record.switches);
-                for (stage, t, values) in record.stages {
-                    if !stages.iter().any(|s| s.name == stage) {
-                        return Err(CaseError::Option(format!(
-                            "the checkpoint has a stage `{stage}`, which this scheme has not"
-                        )));
+    let (series, switches, iterations, stage_rows, outcome, counters, steps) = if let Some(u0) = static_start {
+        // One equilibrium by the static driver: its single row is the solution.
+        let contact = contact_region.ok_or_else(|| {
+            CaseError::Option(format!("{}: a static problem needs its contact (an obstacle, or `Gamma_C`)", pf.file))
+        })?;
+        let clock = Instant::now();
+        let problem = crate::simulation::statics::StaticProblem {
+            coefs: &coefs,
+            contact,
+            contact_degree: quadrature.facet,
+            constraints: constraints.clone(),
+            newton: opts.newton,
+        };
+        let solution = crate::simulation::statics::solve(&asm, problem, &active.forms, u0)?;
+        let seconds = clock.elapsed().as_secs_f64();
+        let newton = solution.newton.iterations();
+        let (row, switches) = row(&sim.tools, State { t: t0, u: &solution.u, v: None, newton, before: None });
+        snapshots.write(&sim.tools, 0, t0, &solution.u, &vec![0.0; n])?;
+        let outcome = crate::simulation::Outcome { step_seconds: vec![seconds], cuts: 0, stopped: None, resumed: None };
+        (vec![row], vec![switches], vec![newton], Vec::new(), outcome, solution.counters, 0)
+    } else {
+        let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None };
+        let (first, first_switches) = row(&sim.tools, first);
+        let mut series = vec![first];
+        let mut switches = vec![first_switches];
+        // Newton iterations of each row's step (0 for the initial state).
+        let mut iterations: Vec<usize> = vec![0];
+        let steps = ((settings.t_end - t0) / settings.dt).round() as usize;
+        // A scheme without a velocity state: the step's mean velocity.
+        let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64], dt: f64| -> Vec<f64> {
+            match v_index {
+                Some(i) => states[i].clone(),
+                None => states[0].iter().zip(before).map(|(a, b)| (a - b) / dt).collect(),
+            }
+        };
+        let v_index = sim.v_index;
+        let stage_rows: RefCell<Vec<(String, f64, Vec<f64>)>> = RefCell::new(Vec::new());
+        let (mut saved_rows, mut saved_stages, mut saved_snapshots) = (0, 0, 0);
+        match control.observer() {
+            Some(records) => {
+                let stages = sim.stepper.desc().stages;
+                series.clear();
+                iterations.clear();
+                switches.clear();
+                for bytes in records {
+                    let record: Record = postcard::from_bytes(bytes).map_err(|e| {
+                        CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})"))
+                    })?;
+                    series.extend(record.series);
+                    iterations.extend(record.iterations);
+                    switches.extend(record.switches);
+                    for (stage, t, values) in record.stages {
+                        if !stages.iter().any(|s| s.name == stage) {
+                            return Err(CaseError::Option(format!(
+                                "the checkpoint has a stage `{stage}`, which this scheme has not"
+                            )));
+                        }
+                        stage_rows.borrow_mut().push((stage, t, values));
                     }
-                    stage_rows.borrow_mut().push((stage, t, values));
+                    snapshots.extend_written(record.snapshots);
                 }
-                snapshots.extend_written(record.snapshots);
+                (saved_rows, saved_stages, saved_snapshots) =
+                    (series.len(), stage_rows.borrow().len(), snapshots.written().len());
             }
-            (saved_rows, saved_stages, saved_snapshots) =
-                (series.len(), stage_rows.borrow().len(), snapshots.written().len());
+            None => snapshots.write(
+                &sim.tools,
+                0,
+                t0,
+                &sim.states[0],
+                &velocity(&sim.states, v_index, &sim.states[0], settings.dt),
+            )?,
         }
-        None => snapshots.write(
-            &sim.tools,
-            0,
+        let names = sim.stepper.desc().states;
+        let outcome = sim.run(
             t0,
-            &sim.states[0],
-            &velocity(&sim.states, v_index, &sim.states[0], settings.dt),
-        )?,
-    }
-    let names = sim.stepper.desc().states;
-    let outcome = sim.run(
-        t0,
-        settings.dt,
-        steps,
-        opts.progress,
-        &mut control,
-        &mut |tools, stage, v_index| {
-            if let Some(u) = stage.value_of(names[0]) {
-                let v = v_index.and_then(|i| stage.value_of(names[i]));
-                let ((t, values), _) = row(tools, State { t: stage.time, u, v, newton: 0, before: None });
-                stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
-            }
-        },
-        &mut |tools, step, record| {
-            let v = v_index.map(|i| step.states[i].as_slice());
-            let state = State {
-                t: step.t,
-                u: &step.states[0],
-                v,
-                newton: step.report.iterations(),
-                before: Some((step.before, step.dt)),
-            };
-            let (values, active) = row(tools, state);
-            series.push(values);
-            switches.push(active);
-            iterations.push(step.report.iterations());
-            snapshots.write(
-                tools,
-                step.k,
-                step.t,
-                &step.states[0],
-                &velocity(step.states, v_index, step.before, step.dt),
-            )?;
-            if let Some(record) = record {
-                let stages = stage_rows.borrow();
-                *record = postcard::to_stdvec(&Record {
-                    series: series[saved_rows..].to_vec(),
-                    iterations: iterations[saved_rows..].to_vec(),
-                    switches: switches[saved_rows..].to_vec(),
-                    stages: stages[saved_stages..].to_vec(),
-                    snapshots: snapshots.written()[saved_snapshots..].to_vec(),
-                })
-                .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
-                (saved_rows, saved_stages, saved_snapshots) = (series.len(), stages.len(), snapshots.written().len());
-            }
-            Ok(())
-        },
-    )?;
-    let stage_rows = stage_rows.into_inner();
+            settings.dt,
+            steps,
+            opts.progress,
+            &mut control,
+            &mut |tools, stage, v_index| {
+                if let Some(u) = stage.value_of(names[0]) {
+                    let v = v_index.and_then(|i| stage.value_of(names[i]));
+                    let ((t, values), _) = row(tools, State { t: stage.time, u, v, newton: 0, before: None });
+                    stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
+                }
+            },
+            &mut |tools, step, record| {
+                let v = v_index.map(|i| step.states[i].as_slice());
+                let state = State {
+                    t: step.t,
+                    u: &step.states[0],
+                    v,
+                    newton: step.report.iterations(),
+                    before: Some((step.before, step.dt)),
+                };
+                let (values, active) = row(tools, state);
+                series.push(values);
+                switches.push(active);
+                iterations.push(step.report.iterations());
+                snapshots.write(
+                    tools,
+                    step.k,
+                    step.t,
+                    &step.states[0],
+                    &velocity(step.states, v_index, step.before, step.dt),
+                )?;
+                if let Some(record) = record {
+                    let stages = stage_rows.borrow();
+                    *record = postcard::to_stdvec(&Record {
+                        series: series[saved_rows..].to_vec(),
+                        iterations: iterations[saved_rows..].to_vec(),
+                        switches: switches[saved_rows..].to_vec(),
+                        stages: stages[saved_stages..].to_vec(),
+                        snapshots: snapshots.written()[saved_snapshots..].to_vec(),
+                    })
+                    .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
+                    (saved_rows, saved_stages, saved_snapshots) =
+                        (series.len(), stages.len(), snapshots.written().len());
+                }
+                Ok(())
+            },
+        )?;
+        let stage_rows = stage_rows.into_inner();
+        (series, switches, iterations, stage_rows, outcome, sim.stepper.counters(), steps)
+    };
     snapshots.finish()?;
     let wall = start.elapsed().as_secs_f64();
-    let counters = sim.stepper.counters();
     let mut summary = Summary::default();
     let mut put = |k: &str, v: serde_json::Value| summary.keys.push((k.to_string(), v));
     put("case", name.clone().into());
     put("problem", pf.file.clone().into());
-    put("scheme", active.scheme_name().into());
+    put("scheme", if statics { "static".into() } else { active.scheme_name().into() });
     put("contact", active.forms.contact_name().into());
     put("interpreted", json(&active.interpreted()));
     put("params", json(&all_params(active, params, pf)));

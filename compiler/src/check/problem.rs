@@ -241,6 +241,13 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
         }
     }
     settings(&p.run, RUN_SETTINGS.iter().map(|(n, _)| *n), "run setting", c, &constants, diags);
+    if let (Some(at), Some(first)) = (p.run_static, p.run.first()) {
+        diags.push(
+            Diagnostic::error("E0103", "`run static` with time settings", first.name.span, "a time setting")
+                .with_label(at, "one equilibrium")
+                .with_help("a static problem has no time: drop `run dt = ...`, or `run static` for a time run"),
+        );
+    }
     settings(&p.quadrature, QUADRATURE_SETTINGS.iter().copied(), "quadrature setting", c, &constants, diags);
     let fields = &constants;
     distinct(p.coefs.iter().map(|d| &d.name), "coef", diags);

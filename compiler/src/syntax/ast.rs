@@ -374,6 +374,8 @@ pub struct Problem {
     pub plots: Vec<Plot>,
     /// Run settings: `dt`, `t_end`, `t_start`.
     pub run: Vec<Defined>,
+    /// `run static`: the problem is one equilibrium (K u + C(u) = F), not a time run.
+    pub run_static: Option<Span>,
     /// Quadrature degrees: `cell`, `facet`.
     pub quadrature: Vec<Defined>,
     /// An analytic reference solution provided by the runtime, by name.

@@ -598,6 +598,7 @@ impl Builder {
             summary: Vec::new(),
             plots: Vec::new(),
             run: Vec::new(),
+            run_static: None,
             quadrature: Vec::new(),
             reference: None,
             lets: Vec::new(),
@@ -649,7 +650,14 @@ impl Builder {
                     }
                 }
                 Rule::set_decl => pb.sets.extend(self.assignments(next())?),
-                Rule::run_decl => pb.run.extend(self.assignments(next())?),
+                Rule::run_decl => {
+                    let q = next();
+                    if q.as_rule() == Rule::run_static {
+                        pb.run_static = Some(self.span(&q));
+                    } else {
+                        pb.run.extend(self.assignments(q)?);
+                    }
+                }
                 Rule::quadrature_decl => pb.quadrature.extend(self.assignments(next())?),
                 Rule::coef_def => pb.coefs.push(self.defined(span, next(), it.next())?),
                 Rule::initial_field => pb.initial.push(self.defined(span, next(), it.next())?),

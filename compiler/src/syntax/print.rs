@@ -152,6 +152,9 @@ fn problem(p: &Problem, out: &mut String) {
         let target = if b.is_path { format!("{:?}", b.target) } else { b.target.clone() };
         out.push_str(&format!("  bind {} = {target}\n", b.role.name));
     }
+    if p.run_static.is_some() {
+        out.push_str("  run static\n");
+    }
     let groups: [(&str, &Vec<Defined>); 6] = [
         ("run", &p.run),
         ("quadrature", &p.quadrature),
