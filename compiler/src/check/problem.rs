@@ -187,6 +187,17 @@ pub const INITIAL_FIELDS: &[&str] = &["u", "v"];
 pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
     let mut names: Vec<(String, Shape)> = p.params.iter().map(|q| (q.name.name.clone(), Scalar)).collect();
     distinct(p.params.iter().map(|q| &q.name), "parameter", diags);
+    // A param named like a built-in value would hide it (`n`, the normal in region predicates).
+    // `h` stays a param's name: problems read no cell size.
+    for q in p.params.iter().map(|q| &q.name).chain(p.lets.iter().map(|l| &l.name)) {
+        if ["x", "t", "n", "pi"].contains(&q.name.as_str()) {
+            diags.push(
+                Diagnostic::error("E0103", format!("`{}` is a built-in name", q.name), q.span, "would hide it")
+                    .with_note("x is the position, t the time, n the facet normal, pi is π")
+                    .with_help("give it another name"),
+            );
+        }
+    }
     // Params are constants with a default in their range (as a scheme's).
     for q in &p.params {
         c.problem_ty(&q.default, &[]);
