@@ -192,7 +192,7 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
     for q in p.params.iter().map(|q| &q.name).chain(p.lets.iter().map(|l| &l.name)) {
         if ["x", "t", "n", "pi"].contains(&q.name.as_str()) {
             diags.push(
-                Diagnostic::error("E0103", format!("`{}` is a built-in name", q.name), q.span, "would hide it")
+                Diagnostic::error("E0106", format!("`{}` is a built-in name", q.name), q.span, "would hide it")
                     .with_note("x is the position, t the time, n the facet normal, pi is π")
                     .with_help("give it another name"),
             );
