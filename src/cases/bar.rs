@@ -10,14 +10,7 @@ use super::CaseError;
 use crate::driver::{ParamValue, Setup};
 use crate::runtime::mesh::CellSize;
 use crate::runtime::newton::NewtonOptions;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum MassChoice {
-    Consistent,
-    /// Mass redistribution (docs/mathematics.md §4): no inertia at the contact node.
-    Redistributed,
-}
+pub use crate::simulation::MassChoice;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
@@ -163,15 +156,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
 
 fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, CaseError> {
     let names = ["u_c", "v_c", "lambda", "lambda_half", "energy", "energy_aug", "penetration", "newton", "p1"];
-    let index: Vec<usize> = names
-        .iter()
-        .map(|n| {
-            run.columns
-                .iter()
-                .position(|c| c == n)
-                .ok_or_else(|| CaseError::Option(format!("the bar problem file has no column `{n}`")))
-        })
-        .collect::<Result<_, _>>()?;
+    let index = run.indices(&names, "bar")?;
     let series = run
         .rows
         .iter()
@@ -191,14 +176,14 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     let s = &run.summary;
     let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
     let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
-    let mut params: std::collections::BTreeMap<String, ParamValue> = super::disc::field(s, "params")?;
+    let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
     let elements = params.get("bar.ne").map_or(0, |p| p.value as usize);
     params.retain(|k, _| !k.starts_with("bar."));
     let summary = Summary {
         case: "bar",
-        scheme: super::disc::field(s, "scheme")?,
-        contact: super::disc::field(s, "contact")?,
-        interpreted: super::disc::field(s, "interpreted")?,
+        scheme: s.field("scheme")?,
+        contact: s.field("contact")?,
+        interpreted: s.field("interpreted")?,
         params,
         mass: opts.mass,
         cell_size: opts.cell_size,
@@ -222,11 +207,8 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         wall_seconds: number("wall_seconds"),
         step_cuts: count("step_cuts"),
         stopped: s.get("stopped").and_then(|v| v.as_str()).map(str::to_string),
-        resumed: match s.get("resumed") {
-            Some(v) => Some(serde_json::from_value(v.clone()).map_err(|e| CaseError::Option(e.to_string()))?),
-            None => None,
-        },
-        notes: super::disc::field::<Option<Vec<String>>>(s, "notes")?.unwrap_or_default(),
+        resumed: s.field("resumed")?,
+        notes: s.field::<Option<Vec<String>>>("notes")?.unwrap_or_default(),
     };
     Ok(Run { summary, series })
 }

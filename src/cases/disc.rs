@@ -10,10 +10,10 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use super::CaseError;
-use super::bar::MassChoice;
 use crate::driver::{ParamValue, Setup};
 use crate::runtime::mesh::CellSize;
 use crate::runtime::newton::NewtonOptions;
+use crate::simulation::MassChoice;
 
 /// Gravity of the benchmark (the free fall before the first contact is exact: u = −g t²/2).
 pub const GRAVITY: f64 = 0.1;
@@ -236,15 +236,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         "penetration".to_string(),
         "newton".to_string(),
     ];
-    let index: Vec<usize> = names
-        .iter()
-        .map(|n| {
-            run.columns
-                .iter()
-                .position(|c| c == n)
-                .ok_or_else(|| CaseError::Option(format!("the {} problem file has no column `{n}`", opts.body.name())))
-        })
-        .collect::<Result<_, _>>()?;
+    let index = run.indices(&names, opts.body.name())?;
     let row = |t: f64, v: &[f64], switches: Vec<bool>| Row {
         t,
         energy: v[index[0]],
@@ -267,17 +259,17 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     let s = &run.summary;
     let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
     let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
-    let mut params: std::collections::BTreeMap<String, ParamValue> = field(s, "params")?;
+    let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
     params.retain(|k, _| !k.starts_with(&format!("{}.", opts.body.name())));
     let summary = Summary {
         case: opts.body.name(),
-        scheme: field(s, "scheme")?,
-        contact: field(s, "contact")?,
-        interpreted: field(s, "interpreted")?,
+        scheme: s.field("scheme")?,
+        contact: s.field("contact")?,
+        interpreted: s.field("interpreted")?,
         params,
         mass: opts.mass,
         cell_size: opts.cell_size,
-        mesh: field(s, "mesh")?,
+        mesh: s.field("mesh")?,
         cells: count("cells"),
         dofs: count("dofs"),
         dt: number("dt"),
@@ -303,16 +295,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         peak_memory_bytes: s.get("peak_memory_bytes").and_then(|v| v.as_u64()),
         step_cuts: count("step_cuts"),
         stopped: s.get("stopped").and_then(|v| v.as_str()).map(str::to_string),
-        resumed: match s.get("resumed") {
-            Some(v) => Some(serde_json::from_value(v.clone()).map_err(|e| CaseError::Option(e.to_string()))?),
-            None => None,
-        },
+        resumed: s.field("resumed")?,
     };
     Ok(Run { summary, series, stages })
-}
-
-/// A key of the summary, as its type.
-pub(super) fn field<T: serde::de::DeserializeOwned>(s: &crate::problem::run::Summary, k: &str) -> Result<T, CaseError> {
-    let v = s.get(k).cloned().unwrap_or(serde_json::Value::Null);
-    serde_json::from_value(v).map_err(|e| CaseError::Option(format!("the summary's `{k}`: {e}")))
 }

@@ -11,10 +11,10 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::CaseError;
-use super::bar::MassChoice;
 use crate::driver::{self, Setting, Setup};
 use crate::runtime::mesh::CellSize;
 use crate::simulation::MAX_STEP_CUTS;
+use crate::simulation::MassChoice;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -4,10 +4,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use super::{MethodArgs, fail};
-use crate::cases::bar::MassChoice;
 use crate::cases::hertz::{impact, statics};
 use crate::runtime::linalg::Solver;
 use crate::runtime::newton::NewtonOptions;
+use crate::simulation::MassChoice;
 
 #[derive(clap::Args)]
 pub struct HertzStaticArgs {

@@ -9,12 +9,12 @@ mod compare;
 mod hertz;
 mod list;
 
-use crate::cases::bar::MassChoice;
 use crate::cases::static_block;
 use crate::compiler;
 use crate::driver::{Setting, Setup};
 use crate::runtime::linalg::Solver;
 use crate::runtime::mesh::CellSize;
+use crate::simulation::MassChoice;
 use hertz::{HertzImpactArgs, HertzStaticArgs};
 
 #[derive(Parser)]

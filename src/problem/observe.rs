@@ -545,14 +545,15 @@ impl<'m> Observer<'m> {
                                 .as_ref()
                                 .map_or(f64::NAN, |(u, t)| f.value(asm, &[u], *t)))
                         }
-                        Measure::Reference { which, mid: false } => {
-                            one(self.reference.as_ref().map_or(f64::NAN, |(_, r)| r.value(*which, tools, s.u, s.t)))
-                        }
+                        Measure::Reference { which, mid: false } => one(self
+                            .reference
+                            .as_ref()
+                            .map_or(f64::NAN, |(_, r)| r.value(*which, &tools.scheme_mass, s.u, s.t))),
                         Measure::Reference { which, mid: true } => one(mid
                             .get_or_insert_with(&mut midpoint)
                             .as_ref()
                             .zip(self.reference.as_ref().map(|(_, r)| r))
-                            .map_or(f64::NAN, |((u, t), r)| r.value(*which, tools, u, *t))),
+                            .map_or(f64::NAN, |((u, t), r)| r.value(*which, &tools.scheme_mass, u, *t))),
                         Measure::Density { index, min } => {
                             let rule = crate::runtime::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
                             let points = self.functionals[*index].1.facet_point_values(asm, &rule, &[s.u], s.t);

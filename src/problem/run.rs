@@ -14,7 +14,6 @@ use super::ProblemFile;
 use super::expr::Exprs;
 use super::observe::{Observer, State, SummaryKeys};
 use crate::cases::CaseError;
-use crate::cases::bar::MassChoice;
 use crate::checkpoint::Control;
 use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
@@ -22,6 +21,7 @@ use crate::runtime::library::Binding;
 use crate::runtime::mesh::CellSize;
 use crate::runtime::newton::NewtonOptions;
 use crate::runtime::problem::Constraints;
+use crate::simulation::MassChoice;
 use crate::simulation::{Problem, Simulation, Snapshots};
 
 /// How to run a problem: the command line's or a case file's choices over the problem's.
@@ -103,6 +103,20 @@ pub struct Run {
 }
 
 impl Run {
+    /// Where each named column is in a row's values (typed views of a problem's rows).
+    pub fn indices<S: AsRef<str>>(&self, names: &[S], problem: &str) -> Result<Vec<usize>, CaseError> {
+        names
+            .iter()
+            .map(|n| {
+                let n = n.as_ref();
+                self.columns
+                    .iter()
+                    .position(|c| c == n)
+                    .ok_or_else(|| CaseError::Option(format!("the {problem} problem file has no column `{n}`")))
+            })
+            .collect()
+    }
+
     /// A column's values over the rows.
     pub fn column(&self, name: &str) -> Option<Vec<f64>> {
         let i = self.columns.iter().position(|c| c == name)?;
@@ -768,6 +782,12 @@ impl Summary {
     /// A number of the summary (`None` when absent or null).
     pub fn number(&self, key: &str) -> Option<f64> {
         self.get(key)?.as_f64()
+    }
+
+    /// A key of the summary, as its type (null when absent).
+    pub fn field<T: serde::de::DeserializeOwned>(&self, k: &str) -> Result<T, CaseError> {
+        let v = self.get(k).cloned().unwrap_or(serde_json::Value::Null);
+        serde_json::from_value(v).map_err(|e| CaseError::Option(format!("the summary's `{k}`: {e}")))
     }
 }
 

@@ -5,7 +5,7 @@
 use std::cell::RefCell;
 
 use super::{BoundReference, Reference, RunFacts};
-use crate::simulation::Tools;
+use crate::runtime::linalg::Matrix;
 
 /// `reference bar`: the run against the exact solution.
 pub struct Bar;
@@ -74,7 +74,7 @@ struct BoundBar {
 }
 
 impl BoundReference for BoundBar {
-    fn value(&self, which: usize, tools: &Tools, u: &[f64], t: f64) -> f64 {
+    fn value(&self, which: usize, mass: &Matrix, u: &[f64], t: f64) -> f64 {
         let with_interpolant = |f: &dyn Fn(&[f64]) -> f64| {
             let mut last = self.interpolant.borrow_mut();
             if last.0.to_bits() != t.to_bits() {
@@ -85,9 +85,9 @@ impl BoundReference for BoundBar {
         match FUNCTIONALS.get(which).map(|f| f.2) {
             Some(Functional::Error) => with_interpolant(&|exact| {
                 let diff: Vec<f64> = u.iter().zip(exact).map(|(a, b)| a - b).collect();
-                Tools::quad(&tools.scheme_mass, &diff, &diff).sqrt()
+                mass.quad(&diff, &diff).sqrt()
             }),
-            Some(Functional::Norm) => with_interpolant(&|exact| Tools::quad(&tools.scheme_mass, exact, exact).sqrt()),
+            Some(Functional::Norm) => with_interpolant(&|exact| mass.quad(exact, exact).sqrt()),
             Some(Functional::ContactStress) => contact_stress(t),
             Some(Functional::ContactDisplacement) => displacement(0.0, t),
             None => f64::NAN,

@@ -3,8 +3,8 @@
 //! (`exact_u_error(u)`). A new reference is a module here and a line in [`ALL`]; the problem
 //! file says what it measures with it.
 
+use crate::runtime::linalg::Matrix;
 use crate::runtime::mesh::Mesh;
-use crate::simulation::Tools;
 
 pub mod bar;
 
@@ -32,8 +32,9 @@ pub trait Reference: Sync {
 
 /// A reference bound to a run.
 pub trait BoundReference {
-    /// Functional `which` (an index into [`Reference::functionals`]) at displacement `u`, time `t`.
-    fn value(&self, which: usize, tools: &Tools, u: &[f64], t: f64) -> f64;
+    /// Functional `which` (an index into [`Reference::functionals`]) at displacement `u`, time
+    /// `t`; `mass` is the mass the scheme steps with (for errors in its norm).
+    fn value(&self, which: usize, mass: &Matrix, u: &[f64], t: f64) -> f64;
 }
 
 /// A reference and its binding to a run.

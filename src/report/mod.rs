@@ -8,10 +8,11 @@ use std::fmt::Write;
 use std::path::Path;
 use std::time::Instant;
 
-use crate::cases::bar::{self, MassChoice};
+use crate::cases::bar;
 use crate::cases::{CaseError, disc};
 use crate::driver::Setup;
 use crate::plot::Curve;
+use crate::simulation::MassChoice;
 
 mod hertz;
 pub mod sweep;

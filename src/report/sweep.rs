@@ -9,10 +9,11 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::mass_name;
-use crate::cases::bar::{self, MassChoice};
+use crate::cases::bar;
 use crate::cases::{CaseError, disc};
 use crate::driver::Setup;
 use crate::plot::Curve;
+use crate::simulation::MassChoice;
 
 const BAR_STEPS: [f64; 7] = [0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5];
 const DISC_STEPS: [f64; 7] = [0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0];

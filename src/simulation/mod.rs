@@ -8,7 +8,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use crate::cases::CaseError;
-use crate::cases::bar::MassChoice;
 use crate::checkpoint::Control;
 use crate::driver::Active;
 use crate::runtime::assembly::{Assembler, Quadrature};
@@ -40,6 +39,15 @@ pub struct Problem<'p> {
     pub prescribed: Option<crate::runtime::scheme::Prescribed>,
     pub mass: MassChoice,
     pub newton: NewtonOptions,
+}
+
+/// The mass a scheme steps with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum MassChoice {
+    Consistent,
+    /// Mass redistribution (docs/mathematics.md §4): no inertia at the contact node.
+    Redistributed,
 }
 
 /// What the observers measure with: bound functionals, a fresh contact form, and the linear
@@ -104,11 +112,9 @@ impl Energies {
 }
 
 impl Tools<'_> {
-    /// xᵀ A y, as (Aᵀ x)ᵀ y: the column-gathering product reads half the bytes.
+    /// xᵀ A y ([`Matrix::quad`]).
     pub fn quad(a: &Matrix, x: &[f64], y: &[f64]) -> f64 {
-        let mut atx = vec![0.0; x.len()];
-        a.mul_vec_transposed(x, &mut atx);
-        atx.iter().zip(y).map(|(p, q)| p * q).sum()
+        a.quad(x, y)
     }
 
     /// ½vᵀMv with the scheme's mass (0 without a velocity).

@@ -535,6 +535,12 @@ fn row(c: &mut Checker, e: &Expr, s: &RowScope, diags: &mut Vec<Diagnostic>) {
     }
 }
 
+/// E0201: call `e` of `f` with `given` arguments, not `want`; `usage` shows how to write it.
+fn arity_error(f: &Ident, e: &Expr, want: usize, given: usize, usage: &str) -> Diagnostic {
+    Diagnostic::error("E0201", format!("`{}` takes {want} argument(s)", f.name), e.span, format!("{given} given"))
+        .with_help(format!("write `{usage}`"))
+}
+
 fn row_help() -> String {
     let values: Vec<&str> = ROW_VALUES.iter().map(|(n, _)| *n).collect();
     let reducers: Vec<&str> = ROW_REDUCERS.iter().map(|(_, w, _)| *w).collect();
@@ -552,15 +558,7 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
     let arity = |want: usize, diags: &mut Vec<Diagnostic>| {
         if args.len() != want {
             let usage = ROW_REDUCERS.iter().find(|(n, _, _)| *n == f.name).map_or(FUNCTIONAL_CALL, |(_, u, _)| u);
-            diags.push(
-                Diagnostic::error(
-                    "E0201",
-                    format!("`{}` takes {want} argument(s)", f.name),
-                    e.span,
-                    format!("{} given", args.len()),
-                )
-                .with_help(format!("write `{usage}`")),
-            );
+            diags.push(arity_error(f, e, want, args.len(), usage));
             return false;
         }
         true
@@ -703,15 +701,7 @@ fn summary(e: &Expr, s: &SummaryScope, in_row: bool, diags: &mut Vec<Diagnostic>
                 );
             } else if args.len() != want {
                 let usage = if reducer { usage.to_string() } else { format!("{}(EXPR)", f.name) };
-                diags.push(
-                    Diagnostic::error(
-                        "E0201",
-                        format!("`{}` takes {want} argument(s)", f.name),
-                        e.span,
-                        format!("{} given", args.len()),
-                    )
-                    .with_help(format!("write `{usage}`")),
-                );
+                diags.push(arity_error(f, e, want, args.len(), &usage));
             } else {
                 args.iter().for_each(|a| summary(a, s, in_row || reducer, diags));
             }

@@ -11,11 +11,11 @@ use serde::Serialize;
 use super::closed_form::{Impact, Material};
 use super::{meshes, profile};
 use crate::cases::CaseError;
-use crate::cases::bar::MassChoice;
 use crate::driver::{Active, ParamValue, Setup};
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::mesh::CellSize;
 use crate::runtime::newton::NewtonOptions;
+use crate::simulation::MassChoice;
 use crate::simulation::{Problem, Simulation, Tools};
 
 /// The impact speed of the default run: δ_max/R = 0.29 %, contact time 26.6 R/c_p. Faster
