@@ -69,17 +69,18 @@ fn mesh_info_prints_json_or_the_error() {
 fn static_block_writes_its_summary() {
     let dir = std::env::temp_dir().join(format!("signorini-cli-{}", std::process::id()));
     let (code, out, err) =
-        signorini(&["run", "static-block", "--h", "0.25", "--theta", "-1", "--out", dir.to_str().unwrap()]);
+        signorini(&["run", "static_block", "--cells", "4", "--theta", "-1", "--out", dir.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("static-block:"), "{out}");
+    assert!(out.contains("static_block:"), "{out}");
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    for key in ["contact_force", "weight", "max_penetration", "newton_iterations", "dofs"] {
+    for key in ["contact_force", "weight", "max_penetration", "newton_total", "dofs"] {
         assert!(s.get(key).is_some(), "summary.json lacks {key}");
     }
-    let (code, _, err) = signorini(&["run", "static-block", "--h", "-1"]);
+    assert_eq!(s["scheme"], "static");
+    let (code, _, err) = signorini(&["run", "static_block", "--cells", "0"]);
     assert_eq!(code, 1);
-    assert!(err.contains("--h must be in (0, 1]"), "{err}");
+    assert!(err.contains("param cells of problem `static_block` must be in [1, 256]"), "{err}");
 }
 
 /// The Hertz cases write the case parameters and the `measured` and `hertz` objects the

@@ -1,14 +1,16 @@
-//! Static Signorini problems end to end (the `static-block` case): equilibrium of the contact
-//! resultant with the weight, penetration under refinement, Newton iteration counts, and reuse
-//! of the factorization when the active set does not change.
+//! Static Signorini problems end to end (the library's `static_block` and `static_block_3d`
+//! problems, `run static`): equilibrium of the contact resultant with the weight, penetration
+//! under refinement, Newton iteration counts, and reuse of the factorization when the active
+//! set does not change.
 
-use signorini::cases::static_block::{self, Options};
-use signorini::driver::Setup;
+use signorini::driver::{Setting, Setup};
 use signorini::forms::{contact_nitsche, elasticity};
+use signorini::problem::run::{Options, Run, run as run_problem};
 use signorini::runtime::assembly::{Assembler, Quadrature};
 use signorini::runtime::kernel::Coef;
 use signorini::runtime::linalg::Structure;
 use signorini::runtime::mesh::Facet;
+use signorini::runtime::mesh::structured::{self, Diagonal};
 use signorini::runtime::newton::{Newton, NewtonOptions};
 use signorini::runtime::problem::{Constraints, StaticContact};
 use signorini::runtime::scheme::Bound;
@@ -17,34 +19,43 @@ fn methods() -> Vec<(&'static str, f64)> {
     vec![("nitsche", 1.0), ("nitsche", 0.0), ("nitsche", -1.0), ("penalty", f64::NAN)]
 }
 
-fn run(contact: &str, theta: f64, f: impl FnOnce(&mut Options)) -> static_block::Summary {
+/// The block (`static_block`, or `static_block_3d`) with the contact law, θ and problem params.
+fn block(problem: &str, contact: &str, theta: f64, params: &[(&str, f64)]) -> Options {
     let mut setup = Setup { contact: contact.into(), ..Setup::default() };
     if !theta.is_nan() {
         setup = setup.set("theta", theta);
     }
-    let mut o = Options { setup, ..Options::default() };
-    f(&mut o);
-    static_block::run(&o).unwrap_or_else(|e| panic!("{contact} θ = {theta}: {e}"))
+    for (name, value) in params {
+        setup.params.push(Setting { name: name.to_string(), value: *value, origin: "test".into() });
+    }
+    let mut o = Options::new(problem);
+    o.chosen.contact = true;
+    o.setup = setup;
+    o
+}
+
+fn run(problem: &str, contact: &str, theta: f64, params: &[(&str, f64)]) -> Run {
+    run_problem(&block(problem, contact, theta, params)).unwrap_or_else(|e| panic!("{contact} θ = {theta}: {e}"))
+}
+
+fn number(r: &Run, key: &str) -> f64 {
+    r.summary.number(key).unwrap_or_else(|| panic!("no `{key}` in the summary"))
 }
 
 #[test]
 fn contact_resultant_equals_the_weight_in_2d_and_3d() {
     for (contact, theta) in methods() {
-        for (dim, degree, h) in [(2, 2, 0.125), (3, 1, 0.125), (3, 2, 0.25)] {
-            let s = run(contact, theta, |o| {
-                o.dim = dim;
-                o.degree = degree;
-                o.h = h;
-            });
-            let rel = (s.contact_force - s.weight).abs() / s.weight;
-            assert!(
-                rel < 1e-8,
-                "{contact} θ = {theta}, {dim}D P{degree}: force {} vs weight {}",
-                s.contact_force,
-                s.weight
-            );
-            assert!(s.newton_iterations <= 10, "{contact} θ = {theta}, {dim}D: {} iterations", s.newton_iterations);
-            assert_eq!(s.symbolic_factorizations, 1, "{contact} θ = {theta}, {dim}D P{degree}");
+        for (problem, degree, cells) in
+            [("static_block", 2.0, 8.0), ("static_block_3d", 1.0, 8.0), ("static_block_3d", 2.0, 4.0)]
+        {
+            let params: &[(&str, f64)] =
+                if problem == "static_block" { &[("cells", cells)] } else { &[("cells", cells), ("degree", degree)] };
+            let s = run(problem, contact, theta, params);
+            let rel = number(&s, "force_error").abs();
+            assert!(rel < 1e-8, "{contact} θ = {theta}, {problem} P{degree}: force {:e} off the weight", rel);
+            let newton = number(&s, "newton_total");
+            assert!(newton <= 10.0, "{contact} θ = {theta}, {problem}: {newton} iterations");
+            assert_eq!(number(&s, "symbolic_factorizations"), 1.0, "{contact} θ = {theta}, {problem} P{degree}");
         }
     }
 }
@@ -52,8 +63,10 @@ fn contact_resultant_equals_the_weight_in_2d_and_3d() {
 #[test]
 fn penetration_decreases_under_refinement() {
     for (contact, theta) in methods() {
-        let p: Vec<f64> =
-            [0.25, 0.125, 0.0625].iter().map(|&h| run(contact, theta, |o| o.h = h).max_penetration).collect();
+        let p: Vec<f64> = [4.0, 8.0, 16.0]
+            .iter()
+            .map(|&cells| number(&run("static_block", contact, theta, &[("cells", cells)]), "max_penetration"))
+            .collect();
         assert!(p[0] > p[1] && p[1] > p[2] && p[2] > 0.0, "{contact} θ = {theta}: {p:?}");
     }
 }
@@ -61,22 +74,29 @@ fn penetration_decreases_under_refinement() {
 #[test]
 fn on_a_curved_obstacle_newton_finds_a_partial_contact_zone() {
     for (contact, theta) in methods() {
-        let s = run(contact, theta, |o| o.curvature = 0.5);
-        let rel = (s.contact_force - s.weight).abs() / s.weight;
-        assert!(rel < 1e-8, "{contact} θ = {theta}: force {} vs weight {}", s.contact_force, s.weight);
+        let s = run("static_block", contact, theta, &[("curvature", 0.5)]);
+        let rel = number(&s, "force_error").abs();
+        assert!(rel < 1e-8, "{contact} θ = {theta}: force {rel:e} off the weight");
         let points = 2 * 8 * 4; // bottom facets × Gauss points
-        assert!(s.active_points > 0 && s.active_points < points / 2, "{} of {points} points active", s.active_points);
+        let active = number(&s, "active_points") as usize;
+        assert!(active > 0 && active < points / 2, "{active} of {points} points active");
         // From the all-active start, semi-smooth Newton releases the edges a few points at a
         // time: more iterations than on the plane, but a bounded number.
-        assert!(s.newton_iterations <= 20, "{contact} θ = {theta}: {} iterations", s.newton_iterations);
+        let newton = number(&s, "newton_total");
+        assert!(newton <= 20.0, "{contact} θ = {theta}: {newton} iterations");
     }
+}
+
+/// The 2D block's mesh: [-1, 1] × [0, 1], P2, h = 1/8.
+fn block_mesh() -> signorini::runtime::mesh::Mesh {
+    structured::rectangle(16, 8, [-1.0, 1.0], [0.0, 1.0], Diagonal::Right, 2)
 }
 
 /// One symbolic analysis per pattern; a second solve with a 1% heavier load keeps the active
 /// set, so it reuses the numeric factorization and converges in one (linear) step.
 #[test]
 fn factorization_is_reused_while_the_active_set_is_unchanged() {
-    let mesh = static_block::mesh(&Options::default()).unwrap();
+    let mesh = block_mesh();
     let asm = Assembler::new(&mesh);
     let n = asm.size();
     let (stiffness, load) = elastic(&asm);
@@ -114,19 +134,20 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
 fn newton_failures_are_typed_errors_with_history() {
     use signorini::cases::CaseError;
     use signorini::runtime::newton::NewtonError;
-    let mut o = Options { curvature: 0.5, ..Options::default() };
+    let mut o = block("static_block", "nitsche", 1.0, &[("curvature", 0.5)]);
     o.newton.max_iterations = 2;
-    match static_block::run(&o) {
+    match run_problem(&o) {
         Err(CaseError::Newton(NewtonError::IterationLimit { report, threshold })) => {
             assert_eq!(report.iterations(), 2);
             assert!(report.history.last().unwrap().residual > threshold);
             let text = CaseError::Newton(NewtonError::IterationLimit { report, threshold }).to_string();
             assert!(text.contains("did not converge in 2 iterations"), "{text}");
         }
-        other => panic!("expected an iteration limit, got {other:?}"),
+        Err(other) => panic!("expected an iteration limit, got {other:?}"),
+        Ok(_) => panic!("expected an iteration limit, got a solution"),
     }
 
-    let mesh = static_block::mesh(&Options::default()).unwrap();
+    let mesh = block_mesh();
     let asm = Assembler::new(&mesh);
     let n = asm.size();
     let (stiffness, load) = elastic(&asm);

@@ -6,7 +6,6 @@ pub mod bar;
 pub mod disc;
 pub mod file;
 pub mod hertz;
-pub mod static_block;
 
 /// Reads a Gmsh file, showing on stderr what the reader skipped (also logged as a warning).
 pub fn read_mesh(path: &std::path::Path) -> Result<crate::runtime::mesh::Mesh, crate::runtime::mesh::MeshError> {

@@ -9,7 +9,6 @@ mod compare;
 mod hertz;
 mod list;
 
-use crate::cases::static_block;
 use crate::compiler;
 use crate::driver::{Setting, Setup};
 use crate::runtime::linalg::Solver;
@@ -260,8 +259,6 @@ pub enum MeshCommand {
 /// Built-in cases.
 #[derive(Subcommand)]
 pub enum Case {
-    /// An elastic block resting on a rigid plane under its own weight (static contact).
-    StaticBlock(StaticBlockArgs),
     /// A cylinder (2D) or ball (3D) pressed onto the plane by its weight, against Hertz.
     HertzStatic(HertzStaticArgs),
     /// A ball hitting the plane at low speed, against Hertz's impact formulas.
@@ -440,28 +437,6 @@ impl CheckpointArgs {
     }
 }
 
-#[derive(clap::Args)]
-pub struct StaticBlockArgs {
-    /// The contact law and params (E = 100, γ0 = 5000 here; θ = 1 needs γ0 ≳ 20 E); the scheme
-    /// is not used.
-    #[command(flatten)]
-    methods: MethodArgs,
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
-    dim: u8,
-    /// Polynomial degree (the 2D block is P2; 3D: 1 or 2).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
-    degree: u8,
-    /// Mesh size.
-    #[arg(long, default_value_t = 0.125, allow_hyphen_values = true)]
-    h: f64,
-    /// Curvature c of the obstacle x_d = -c|x'|² (0: the plane).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    curvature: f64,
-    /// Directory for summary.json.
-    #[arg(long)]
-    out: Option<PathBuf>,
-}
-
 #[derive(Clone, Copy, ValueEnum)]
 pub enum Stage {
     Ast,
@@ -533,7 +508,6 @@ fn dispatch(cli: Cli) -> ExitCode {
             }
         }
         Command::Run { case: Some(case), .. } => match *case {
-            Case::StaticBlock(a) => static_block(a),
             Case::HertzStatic(a) => hertz::run_static(a),
             Case::HertzImpact(a) => hertz::run_impact(a),
         },
@@ -544,7 +518,7 @@ fn dispatch(cli: Cli) -> ExitCode {
         Command::Run { case: None, file: None, .. } => {
             let names = crate::problem::library_names().join(", ");
             eprintln!(
-                "error: name a problem ({names}), a problem file, a case (static-block, bar, hertz-static, hertz-impact) or a case file"
+                "error: name a problem ({names}), a problem file, a case (hertz-static, hertz-impact) or a case file"
             );
             ExitCode::FAILURE
         }
@@ -625,40 +599,6 @@ fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
 fn fail(e: impl std::fmt::Display) -> ExitCode {
     eprintln!("error: {e}");
     ExitCode::FAILURE
-}
-
-fn static_block(a: StaticBlockArgs) -> ExitCode {
-    let setup = match a.methods.setup() {
-        Ok(s) => s,
-        Err(e) => return fail(e),
-    };
-    let opts = static_block::Options {
-        setup,
-        cell_size: a.methods.cell_size,
-        dim: a.dim as usize,
-        degree: a.degree as u32,
-        h: a.h,
-        curvature: a.curvature,
-        newton: crate::runtime::newton::NewtonOptions { line_search: a.methods.line_search, ..Default::default() },
-        out: match out_dir(a.out) {
-            Ok(dir) => dir,
-            Err(e) => return fail(e),
-        },
-        ..Default::default()
-    };
-    match static_block::run(&opts) {
-        Ok(s) => {
-            println!(
-                "static-block: {} dofs, contact force {:.10e} (weight {:.10e}), max penetration {:.3e}, {} Newton iterations, {:.2} s",
-                s.dofs, s.contact_force, s.weight, s.max_penetration, s.newton_iterations, s.wall_seconds
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
 }
 
 fn mesh_info(file: &Path) -> ExitCode {

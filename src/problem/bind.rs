@@ -86,10 +86,17 @@ pub fn mesh(
         let mut found = false;
         for source in &r.sources {
             match source {
-                RegionSource::Group { name: group, span } => {
+                RegionSource::Group { name: group, conditions, span } => {
                     // A group the mesh has is the region, even empty (an error, not a fallback).
                     if let Some(g) = mesh.regions.iter().find(|g| g.name == *group) {
-                        let facets = g.facets.clone();
+                        let mut facets = g.facets.clone();
+                        if !conditions.is_empty() {
+                            let test = predicate(pf, ex, conditions)?;
+                            facets.retain(|&f| {
+                                let (n, x) = mesh.facet_normal_and_centroid(f);
+                                test(&n, &x)
+                            });
+                        }
                         if facets.is_empty() {
                             return Err(pf.render(Diagnostic::error(
                                 "E0101",
@@ -104,21 +111,8 @@ pub fn mesh(
                     }
                 }
                 RegionSource::Boundary { conditions, .. } => {
-                    let mut tests = Vec::new();
-                    for c in conditions {
-                        let lhs = ex.lower(&c.lhs, &[]).map_err(|e| pf.render(*e))?;
-                        let rhs = ex.lower(&c.rhs, &[]).map_err(|e| pf.render(*e))?;
-                        let both = Val { shape: lhs.shape, c: vec![lhs.c[0].clone(), rhs.c[0].clone()] };
-                        tests.push((ex.function(&both, &c.lhs).map_err(|e| pf.render(*e))?, c.op));
-                    }
-                    let work = std::cell::RefCell::new((Vec::new(), [0.0; 2]));
-                    let region = mesh.add_region_where(&r.name.name, |n, x| {
-                        let (scratch, out) = &mut *work.borrow_mut();
-                        tests.iter().all(|(f, op)| {
-                            f.eval(&At { x, n, ..At::default() }, scratch, out);
-                            op.holds(out[0], out[1])
-                        })
-                    });
+                    let test = predicate(pf, ex, conditions)?;
+                    let region = mesh.add_region_where(&r.name.name, test);
                     found = !region.facets.is_empty();
                 }
             }
@@ -149,6 +143,29 @@ pub fn mesh(
         mesh.region(&r.name.name)?;
     }
     Ok((mesh, label))
+}
+
+/// A facet test from comparisons of the outward normal `n` and the centroid `x` (all must hold).
+fn predicate(
+    pf: &ProblemFile,
+    ex: &mut Exprs,
+    conditions: &[crate::compiler::syntax::ast::Comparison],
+) -> Result<impl Fn(&[f64], &[f64]) -> bool, CaseError> {
+    let mut tests = Vec::new();
+    for c in conditions {
+        let lhs = ex.lower(&c.lhs, &[]).map_err(|e| pf.render(*e))?;
+        let rhs = ex.lower(&c.rhs, &[]).map_err(|e| pf.render(*e))?;
+        let both = Val { shape: lhs.shape, c: vec![lhs.c[0].clone(), rhs.c[0].clone()] };
+        tests.push((ex.function(&both, &c.lhs).map_err(|e| pf.render(*e))?, c.op));
+    }
+    let work = std::cell::RefCell::new((Vec::new(), [0.0; 2]));
+    Ok(move |n: &[f64], x: &[f64]| {
+        let (scratch, out) = &mut *work.borrow_mut();
+        tests.iter().all(|(f, op)| {
+            f.eval(&At { x, n, ..At::default() }, scratch, out);
+            op.holds(out[0], out[1])
+        })
+    })
 }
 
 /// A built-in generator's mesh, after a check that it fits in memory.
@@ -226,7 +243,16 @@ fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh,
             let degree = get("degree", 1.0)?;
             let degree = if degree == 2.0 { 2 } else { 1 };
             crate::resources::check(&name, 2.0 * ((degree * nx + 1) * (degree * ny + 1)) as f64, 2, None)?;
-            structured::rectangle(nx, ny, [0.0, w], [0.0, h], structured::Diagonal::Right, degree as u32)
+            let o = origin(pf, ex, call, 2)?;
+            values.push(format!("origin = {o:?}"));
+            structured::rectangle(
+                nx,
+                ny,
+                [o[0], o[0] + w],
+                [o[1], o[1] + h],
+                structured::Diagonal::Right,
+                degree as u32,
+            )
         }
         _ => {
             // `box`: the checker knows no other generator.
@@ -238,10 +264,20 @@ fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh,
             let degree = if get("degree", 1.0)? == 2.0 { 2 } else { 1 };
             let nodes: usize = n.iter().map(|k| degree * k + 1).product();
             crate::resources::check(&name, 3.0 * nodes as f64, 3, None)?;
-            structured::cuboid(n, [0.0, size[0]], [0.0, size[1]], [0.0, size[2]], degree as u32)
+            let o = origin(pf, ex, call, 3)?;
+            values.push(format!("origin = {o:?}"));
+            structured::cuboid(n, [o[0], o[0] + size[0]], [o[1], o[1] + size[1]], [o[2], o[2] + size[2]], degree as u32)
         }
     };
     Ok((mesh, format!("built-in {gen_name}({})", values.join(", "))))
+}
+
+/// A generator's `origin` (its least corner; default 0).
+fn origin(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall, dim: usize) -> Result<Vec<f64>, CaseError> {
+    match arg(call, "origin") {
+        Some(e) => ex.vector(e).map_err(|d| pf.render(*d)),
+        None => Ok(vec![0.0; dim]),
+    }
 }
 
 /// The coefs the problem sets, by name: its `coef` lines, then its obstacles' `g` and `nc`.

@@ -361,6 +361,7 @@ fn dirichlet(
     mesh: &crate::runtime::mesh::Mesh,
 ) -> Result<(Constraints, Option<Held>), CaseError> {
     use crate::compiler::Diagnostic;
+    use crate::compiler::syntax::ast::HeldAt;
     let d = mesh.dim();
     let mut c = Constraints::none(mesh.num_nodes() * d);
     let mut held = Held { dofs: Vec::new(), at: Vec::new(), values: Vec::new() };
@@ -383,11 +384,25 @@ fn dirichlet(
         let value = ex.lower(&dc.value, &[]).map_err(|e| pf.render(*e))?;
         let f = ex.function(&value, &dc.value).map_err(|e| pf.render(*e))?;
         let zero = f.constant().is_some_and(|v| v.iter().all(|x| *x == 0.0));
-        let region = mesh.region(&dc.region.name)?;
+        let nodes = match &dc.on {
+            HeldAt::Region(r) => mesh.region_nodes(mesh.region(&r.name)?),
+            HeldAt::Nearest { point, .. } => {
+                let p = ex.vector(point).map_err(|e| pf.render(*e))?;
+                if p.len() != d {
+                    return Err(pf.render(Diagnostic::error(
+                        "E0302",
+                        "wrong dimension",
+                        point.span,
+                        format!("a point of {} components in a {d}D problem", p.len()),
+                    )));
+                }
+                vec![nearest_node(mesh, &p) as u32]
+            }
+        };
         if !zero {
             held.values.push(f);
         }
-        for node in mesh.region_nodes(region) {
+        for node in nodes {
             for (j, &k) in components.iter().enumerate() {
                 let dof = node as usize * d + k;
                 c.fix(dof);
@@ -406,6 +421,12 @@ fn dirichlet(
     }
     let held = (!held.dofs.is_empty()).then_some(held);
     Ok((c, held))
+}
+
+/// The mesh node nearest to `target` (the first of several as near).
+fn nearest_node(mesh: &crate::runtime::mesh::Mesh, target: &[f64]) -> usize {
+    let dist = |i: usize| -> f64 { mesh.node(i).iter().zip(target).map(|(x, y)| (x - y).powi(2)).sum() };
+    (0..mesh.num_nodes()).min_by(|&a, &b| dist(a).total_cmp(&dist(b))).unwrap_or(0)
 }
 
 /// Held displacements at nonzero or moving values: per dof, its node, its condition's values
@@ -523,7 +544,14 @@ fn simulate(
         identity(opts, pf, params, active, &mesh, settings),
         opts.resume,
     )?;
-    let mut sim = Simulation::new(&asm, problem, active)?;
+    // A static problem is one equilibrium, from u₀ (no initial acceleration to solve for): it
+    // binds the tools, and no stepper.
+    let statics = p.run_static.is_some();
+    let (mut sim, static_tools) = if statics {
+        (None, Some(crate::simulation::Tools::bind(&asm, problem, active)?))
+    } else {
+        (Some(Simulation::new(&asm, problem, active)?), None)
+    };
     let t0 = settings.t_start;
     // The initial fields take the held values on the held dofs.
     let mut u0 = super::bind::initial(pf, ex, &mesh, "u", t0)?;
@@ -533,21 +561,22 @@ fn simulate(
     if let Some(h) = &held {
         h.initial(&mesh, t0, &mut u0, &mut v0);
     }
-    // A static problem is one equilibrium, from u₀ (no initial acceleration to solve for).
-    let statics = p.run_static.is_some();
-    let static_start = if statics {
-        if held.is_some() {
-            return Err(CaseError::Option(format!(
-                "{}: a static problem holds its Dirichlet values at zero (a nonzero held value needs a time run)",
-                pf.file
-            )));
+    let static_start = match &mut sim {
+        None => {
+            if held.is_some() {
+                return Err(CaseError::Option(format!(
+                    "{}: a static problem holds its Dirichlet values at zero (a nonzero held value needs a time run)",
+                    pf.file
+                )));
+            }
+            Some(u0)
         }
-        Some(u0)
-    } else {
-        sim.initialize_at(t0, u0, v0)?;
-        None
+        Some(sim) => {
+            sim.initialize_at(t0, u0, v0)?;
+            None
+        }
     };
-    let mut regions = vec![(contact.to_string(), sim.tools.contact_facets)];
+    let mut regions = vec![(contact.to_string(), tools_of(&sim, &static_tools).contact_facets)];
     for name in &others {
         regions.push((name.clone(), asm.region(name)?));
     }
@@ -556,7 +585,7 @@ fn simulate(
     let observer = Observer::new(
         pf,
         ex,
-        &sim.tools,
+        tools_of(&sim, &static_tools),
         &active.forms,
         &coefs,
         &binding,
@@ -590,11 +619,13 @@ fn simulate(
         let solution = crate::simulation::statics::solve(&asm, problem, &active.forms, u0)?;
         let seconds = clock.elapsed().as_secs_f64();
         let newton = solution.newton.iterations();
-        let (row, switches) = row(&sim.tools, State { t: t0, u: &solution.u, v: None, newton, before: None });
-        snapshots.write(&sim.tools, 0, t0, &solution.u, &vec![0.0; n])?;
+        let tools = tools_of(&sim, &static_tools);
+        let (row, switches) = row(tools, State { t: t0, u: &solution.u, v: None, newton, before: None });
+        snapshots.write(tools, 0, t0, &solution.u, &vec![0.0; n])?;
         let outcome = crate::simulation::Outcome { step_seconds: vec![seconds], cuts: 0, stopped: None, resumed: None };
         (vec![row], vec![switches], vec![newton], Vec::new(), outcome, solution.counters, 0)
     } else {
+        let sim = sim.as_mut().expect("a time run has a stepper");
         let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None };
         let (first, first_switches) = row(&sim.tools, first);
         let mut series = vec![first];
@@ -729,9 +760,10 @@ fn simulate(
     put("stepping_seconds", json(&outcome.step_seconds.iter().sum::<f64>()));
     put("step_median_seconds", json(&crate::bench::median(outcome.step_seconds.clone())));
     put("factorizations", counters.numeric.into());
+    put("symbolic_factorizations", counters.symbolic.into());
     put("low_rank_updates", counters.updates.into());
-    put("matrix_nnz", sim.tools.asm.pattern().nnz().into());
-    put("factor_nnz", json(&sim.stepper.factor_nnz()));
+    put("matrix_nnz", asm.pattern().nnz().into());
+    put("factor_nnz", json(&sim.as_ref().and_then(|s| s.stepper.factor_nnz())));
     put("solver", json(&opts.newton.solver));
     put("krylov_iterations", counters.iterations.into());
     put("peak_memory_bytes", json(&crate::bench::peak_memory()));
@@ -764,6 +796,17 @@ fn simulate(
         return Err(e);
     }
     Ok(run)
+}
+
+/// The tools of the run: the stepper's, or a static problem's own.
+fn tools_of<'a, 'm>(
+    sim: &'a Option<Simulation<'m>>,
+    statics: &'a Option<crate::simulation::Tools<'m>>,
+) -> &'a crate::simulation::Tools<'m> {
+    match sim {
+        Some(s) => &s.tools,
+        None => statics.as_ref().expect("a static problem binds its tools"),
+    }
 }
 
 /// A run's summary: keys in order.

@@ -94,6 +94,11 @@ pub struct Energies {
 }
 
 impl Energies {
+    /// Without lower halves: the full products.
+    pub fn full() -> Energies {
+        Energies { stiffness: None, mass: None, work: Default::default() }
+    }
+
     /// With the stepper's lower-half pattern when it has one (the same pattern).
     pub fn new(asm: &Assembler, half: Option<&Arc<HalfPattern>>, stiffness: &Matrix, mass: &Matrix) -> Energies {
         let half = half.cloned().unwrap_or_else(|| Arc::new(HalfPattern::new(asm.pattern())));
@@ -190,36 +195,16 @@ pub fn resultant(c: &[f64], d: usize) -> Vec<f64> {
     (0..d).map(|k| -c.iter().skip(k).step_by(d).sum::<f64>()).collect()
 }
 
-/// The stepper, its states and the tools, ready to run.
-pub struct Simulation<'m> {
-    pub stepper: Stepper<'m>,
-    pub tools: Tools<'m>,
-    /// One vector per state of the scheme; `states[0]` is the displacement.
-    pub states: Vec<Vec<f64>>,
-    /// The index of the velocity state `v`, if the scheme has one.
-    pub v_index: Option<usize>,
-    guard: Guard,
-    /// The params in use, for messages.
-    params: String,
+/// What a run binds before it steps: the tools, the scheme's forms, and whether the scheme
+/// has inertia.
+struct Parts<'m> {
+    tools: Tools<'m>,
+    forms: Vec<(&'static str, Box<dyn BoundForm + 'm>)>,
+    inertia: bool,
 }
 
-/// One finished step, as the observer sees it.
-pub struct Step<'s> {
-    /// The step's number (1 for the first) and its end time.
-    pub k: usize,
-    pub t: f64,
-    /// Its size: the nominal Δt, or a fraction of it after a failed Newton.
-    pub dt: f64,
-    pub states: &'s [Vec<f64>],
-    /// The displacement at the start of the step.
-    pub before: &'s [f64],
-    pub report: &'s StepReport,
-}
-
-impl<'m> Simulation<'m> {
-    /// Binds the files in use on `asm`'s mesh, redistributes the mass when asked (the contact
-    /// nodes carry none; a⁰ = 0 there), and builds the stepper.
-    pub fn new(asm: &'m Assembler<'m>, problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
+impl<'m> Parts<'m> {
+    fn build(asm: &'m Assembler<'m>, problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
         let mesh: &Mesh = asm.mesh();
         let n = asm.size();
         let contact_facets = match problem.contact {
@@ -274,23 +259,6 @@ impl<'m> Simulation<'m> {
         } else {
             mass.clone()
         };
-        let constraints = problem.constraints;
-        let mut stepper =
-            Stepper::new(active.time_scheme()?, asm, forms, constraints.clone(), Structure::Auto, problem.newton)?;
-        let held = problem.prescribed.as_ref().map_or_else(Vec::new, |p| p.dofs.clone());
-        if let Some(p) = problem.prescribed {
-            stepper.prescribe(p)?;
-        }
-        if redistributed {
-            let d = mesh.dim();
-            let mut initial = constraints;
-            for &c in &contact_nodes {
-                for k in 0..d {
-                    initial.fix(d * c as usize + k);
-                }
-            }
-            stepper.initial_constraints = Some(initial);
-        }
         let tools = Tools {
             asm,
             contact_facets,
@@ -300,7 +268,8 @@ impl<'m> Simulation<'m> {
             contact_trial: inst.take_functional("contact_trial"),
             von_mises: inst.take_functional("von_mises"),
             cell_measure: inst.take_functional("measure"),
-            energies: Energies::new(asm, stepper.half_pattern(), &stiffness, &scheme_mass),
+            // The full products until a stepper gives its lower-half pattern.
+            energies: Energies::full(),
             mass,
             scheme_mass,
             stiffness,
@@ -312,8 +281,72 @@ impl<'m> Simulation<'m> {
                 .filter(|f| f.time_dependent() && f.fields() == 0),
             contact_nodes,
             redistributed,
-            held,
+            // The held dofs: the stepper's, set with it.
+            held: Vec::new(),
         };
+        Ok(Parts { tools, forms, inertia })
+    }
+}
+
+impl<'m> Tools<'m> {
+    /// The tools of a problem solved without a stepper (one equilibrium, `run static`).
+    pub fn bind(asm: &'m Assembler<'m>, problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
+        Ok(Parts::build(asm, problem, active)?.tools)
+    }
+}
+
+/// The stepper, its states and the tools, ready to run.
+pub struct Simulation<'m> {
+    pub stepper: Stepper<'m>,
+    pub tools: Tools<'m>,
+    /// One vector per state of the scheme; `states[0]` is the displacement.
+    pub states: Vec<Vec<f64>>,
+    /// The index of the velocity state `v`, if the scheme has one.
+    pub v_index: Option<usize>,
+    guard: Guard,
+    /// The params in use, for messages.
+    params: String,
+}
+
+/// One finished step, as the observer sees it.
+pub struct Step<'s> {
+    /// The step's number (1 for the first) and its end time.
+    pub k: usize,
+    pub t: f64,
+    /// Its size: the nominal Δt, or a fraction of it after a failed Newton.
+    pub dt: f64,
+    pub states: &'s [Vec<f64>],
+    /// The displacement at the start of the step.
+    pub before: &'s [f64],
+    pub report: &'s StepReport,
+}
+
+impl<'m> Simulation<'m> {
+    /// Binds the files in use on `asm`'s mesh, redistributes the mass when asked (the contact
+    /// nodes carry none; a⁰ = 0 there), and builds the stepper.
+    pub fn new(asm: &'m Assembler<'m>, mut problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
+        let constraints = problem.constraints.clone();
+        let newton = problem.newton;
+        let prescribed = problem.prescribed.take();
+        let Parts { mut tools, forms, inertia } = Parts::build(asm, problem, active)?;
+        tools.held = prescribed.as_ref().map_or_else(Vec::new, |p| p.dofs.clone());
+        let mut stepper =
+            Stepper::new(active.time_scheme()?, asm, forms, constraints.clone(), Structure::Auto, newton)?;
+        if let Some(p) = prescribed {
+            stepper.prescribe(p)?;
+        }
+        if tools.redistributed {
+            let d = asm.mesh().dim();
+            let mut initial = constraints;
+            for &c in &tools.contact_nodes {
+                for k in 0..d {
+                    initial.fix(d * c as usize + k);
+                }
+            }
+            stepper.initial_constraints = Some(initial);
+        }
+        tools.energies = Energies::new(asm, stepper.half_pattern(), &tools.stiffness, &tools.scheme_mass);
+        let n = asm.size();
         let names = stepper.desc().states;
         let states = names.iter().map(|_| vec![0.0; n]).collect();
         let v_index = names.iter().position(|s| *s == "v");

@@ -10,7 +10,9 @@ use std::collections::HashMap;
 use super::types::Checker;
 use crate::diagnostic::Diagnostic;
 use crate::source::Span;
-use crate::syntax::ast::{Defined, Expr, Ident, MeshSource, NamedCall, Problem, RegionSource, Shape};
+use crate::syntax::ast::{
+    Defined, Dirichlet, Expr, HeldAt, Ident, MeshSource, NamedCall, Problem, RegionSource, Shape,
+};
 
 /// A built-in mesh generator or obstacle helper: its name, its dimension (0: any) and its
 /// arguments with their shapes (`true`: optional).
@@ -40,8 +42,9 @@ pub const GENERATORS: &[Builtin] = &[
             ("nx", Scalar, false),
             ("ny", Scalar, false),
             ("degree", Scalar, true),
+            ("origin", Vector, true),
         ],
-        doc: "triangles of [0, width] × [0, height], P1 or P2",
+        doc: "triangles of [0, width] × [0, height] (from `origin`, default [0, 0]), P1 or P2",
     },
     Builtin {
         name: "box",
@@ -52,8 +55,9 @@ pub const GENERATORS: &[Builtin] = &[
             ("ny", Scalar, false),
             ("nz", Scalar, false),
             ("degree", Scalar, true),
+            ("origin", Vector, true),
         ],
-        doc: "tetrahedra of [0, size[0]] × [0, size[1]] × [0, size[2]], P1 or P2",
+        doc: "tetrahedra of [0, size[0]] × [0, size[1]] × [0, size[2]] (from `origin`, default 0), P1 or P2",
     },
     Builtin {
         name: "disc",
@@ -229,11 +233,10 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
     let facet = constants.clone();
     for r in &p.regions {
         for s in &r.sources {
-            if let RegionSource::Boundary { conditions, .. } = s {
-                for cmp in conditions {
-                    for side in [&cmp.lhs, &cmp.rhs] {
-                        scalar(c, side, &facet, diags, true);
-                    }
+            let (RegionSource::Boundary { conditions, .. } | RegionSource::Group { conditions, .. }) = s;
+            for cmp in conditions {
+                for side in [&cmp.lhs, &cmp.rhs] {
+                    scalar(c, side, &facet, diags, true);
                 }
             }
         }
@@ -250,6 +253,11 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
                     .with_label(prev, "first here"),
             );
         }
+    }
+    // A reference's arguments are numbers of the params (the reference checks their names).
+    distinct(p.reference_args.iter().map(|a| &a.name), "argument", diags);
+    for a in &p.reference_args {
+        scalar(c, &a.value, &constants, diags, false);
     }
     settings(&p.run, RUN_SETTINGS.iter().map(|(n, _)| *n), "run setting", c, &constants, diags);
     if let (Some(at), Some(first)) = (p.run_static, p.run.first()) {
@@ -277,34 +285,35 @@ pub(super) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
         if d.field.name != "u" {
             diags.push(unknown_among(&d.field, ["u"].into_iter(), "Dirichlet field"));
         }
-        if !regions.contains(&d.region.name.as_str()) {
-            diags.push(unknown_among(&d.region, regions.iter().copied(), "region"));
+        let region = match &d.on {
+            HeldAt::Region(r) => r,
+            HeldAt::Nearest { point, .. } => {
+                // A point: a constant vector (the node is found once, on the mesh).
+                vector(c, point, fields, diags);
+                held_value(c, d, fields, diags);
+                continue;
+            }
+        };
+        if !regions.contains(&region.name.as_str()) {
+            diags.push(unknown_among(region, regions.iter().copied(), "region"));
         }
         // An obstacle's region is where contact is imposed: a displacement held there too
         // leaves the contact nothing to decide.
         if let Some(o) =
-            p.obstacles.iter().find(|o| o.region.as_ref().map_or("Gamma_C", |r| r.name.as_str()) == d.region.name)
+            p.obstacles.iter().find(|o| o.region.as_ref().map_or("Gamma_C", |r| r.name.as_str()) == region.name)
         {
             diags.push(
                 Diagnostic::error(
                     "E0905",
                     "a Dirichlet condition on a contact region",
-                    d.region.span,
+                    region.span,
                     "contact is imposed here",
                 )
                 .with_label(o.span, "the obstacle faces this region")
                 .with_help("hold another part of the boundary: a region of its own (`region Gamma_D = ...`)"),
             );
         }
-        match &d.component {
-            Some(k) => {
-                if !crate::check::const_value(k).is_some_and(|k| k >= 0.0 && k.fract() == 0.0 && k < 3.0) {
-                    diags.push(Diagnostic::error("E0302", "a component index must be 0, 1 or 2", k.span, "not one"));
-                }
-                scalar(c, &d.value, fields, diags, false);
-            }
-            None => vector(c, &d.value, fields, diags),
-        }
+        held_value(c, d, fields, diags);
     }
     for o in &p.obstacles {
         builtin_call(c, &o.shape, OBSTACLES, "obstacle", fields, diags);
@@ -386,6 +395,19 @@ fn settings<'a>(
             diags.push(unknown_among(&d.name, known.clone(), what));
         }
         scalar(c, &d.value, names, diags, false);
+    }
+}
+
+/// A Dirichlet condition's component and value: a scalar for `u[k]`, a vector for `u`.
+fn held_value(c: &mut Checker, d: &Dirichlet, fields: &[(String, Shape)], diags: &mut Vec<Diagnostic>) {
+    match &d.component {
+        Some(k) => {
+            if !crate::check::const_value(k).is_some_and(|k| k >= 0.0 && k.fract() == 0.0 && k < 3.0) {
+                diags.push(Diagnostic::error("E0302", "a component index must be 0, 1 or 2", k.span, "not one"));
+            }
+            scalar(c, &d.value, fields, diags, false);
+        }
+        None => vector(c, &d.value, fields, diags),
     }
 }
 

@@ -293,8 +293,8 @@ impl Compare {
 /// One way to find a region's facets.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RegionSource {
-    /// A Gmsh physical group, by name.
-    Group { name: String, span: Span },
+    /// A Gmsh physical group, by name; with comparisons, its facets that satisfy them all.
+    Group { name: String, conditions: Vec<Comparison>, span: Span },
     /// The boundary facets whose outward normal `n` and centroid `x` satisfy every comparison
     /// (all of the boundary without one).
     Boundary { conditions: Vec<Comparison>, span: Span },
@@ -329,11 +329,37 @@ pub struct Defined {
 /// `dirichlet REGION: FIELD = EXPR`, or `FIELD[k] = EXPR` for one component.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dirichlet {
-    pub region: Ident,
+    pub on: HeldAt,
     pub field: Ident,
     pub component: Option<Expr>,
     pub value: Expr,
     pub span: Span,
+}
+
+/// Where a Dirichlet condition holds the displacement.
+#[derive(Clone, Debug, PartialEq)]
+pub enum HeldAt {
+    /// The nodes of a facet region.
+    Region(Ident),
+    /// `nearest(POINT)`: the one mesh node nearest to a point (a pin that removes a rigid mode).
+    Nearest { point: Expr, span: Span },
+}
+
+impl HeldAt {
+    /// The region's name (`None` for a node).
+    pub fn region(&self) -> Option<&Ident> {
+        match self {
+            HeldAt::Region(r) => Some(r),
+            HeldAt::Nearest { .. } => None,
+        }
+    }
+
+    pub fn span(&self) -> Span {
+        match self {
+            HeldAt::Region(r) => r.span,
+            HeldAt::Nearest { span, .. } => *span,
+        }
+    }
 }
 
 /// `obstacle plane(point = [0, 0], normal = [0, 1]) on Gamma_C`.
@@ -380,6 +406,8 @@ pub struct Problem {
     pub quadrature: Vec<Defined>,
     /// An analytic reference solution provided by the runtime, by name.
     pub reference: Option<Ident>,
+    /// Its arguments (`reference hertz(radius = 10, force = F)`).
+    pub reference_args: Vec<NamedArg>,
     pub lets: Vec<Defined>,
     pub span: Span,
 }

@@ -601,6 +601,7 @@ impl Builder {
             run_static: None,
             quadrature: Vec::new(),
             reference: None,
+            reference_args: Vec::new(),
             lets: Vec::new(),
             span,
         };
@@ -626,8 +627,10 @@ impl Builder {
                         let qspan = self.span(&q);
                         sources.push(match q.as_rule() {
                             Rule::group_source => {
-                                let s = q.into_inner().next().expect("group name");
-                                RegionSource::Group { name: unquote(s.as_str()), span: qspan }
+                                let mut parts = q.into_inner();
+                                let name = unquote(parts.next().expect("group name").as_str());
+                                let conditions = parts.map(|c| self.comparison(c)).collect::<Result<Vec<_>, _>>()?;
+                                RegionSource::Group { name, conditions, span: qspan }
                             }
                             _ => {
                                 let conditions =
@@ -671,7 +674,13 @@ impl Builder {
                     pb.obstacles.push(Obstacle { shape, region, span });
                 }
                 Rule::dirichlet_decl => {
-                    let region = self.ident(next());
+                    let target = next();
+                    let on = if target.as_rule() == Rule::nearest_node {
+                        let span = self.span(&target);
+                        HeldAt::Nearest { point: self.expr(target.into_inner().next().expect("a point"))?, span }
+                    } else {
+                        HeldAt::Region(self.ident(target))
+                    };
                     let field = self.ident(next());
                     let mut rest = next();
                     let mut component = None;
@@ -680,7 +689,7 @@ impl Builder {
                         rest = next();
                     }
                     let value = self.expr(rest)?;
-                    pb.dirichlet.push(Dirichlet { region, field, component, value, span });
+                    pb.dirichlet.push(Dirichlet { on, field, component, value, span });
                 }
                 Rule::plot_decl => {
                     let title = unquote(next().as_str());
@@ -688,13 +697,20 @@ impl Builder {
                     pb.plots.push(Plot { title, columns, span });
                 }
                 Rule::reference_decl => {
-                    let name = self.ident(next());
+                    let target = next();
+                    let (name, args) = if target.as_rule() == Rule::call_named {
+                        let call = self.named_call(target)?;
+                        (call.name, call.args)
+                    } else {
+                        (self.ident(target), Vec::new())
+                    };
                     if let Some(prev) = &pb.reference {
                         let d = Diagnostic::error("E0102", "a problem names one reference", name.span, "second one")
                             .with_label(prev.span, "first one");
                         return Err(Box::new(d));
                     }
                     pb.reference = Some(name);
+                    pb.reference_args = args;
                 }
                 r => unreachable!("not a problem item: {r:?}"),
             }

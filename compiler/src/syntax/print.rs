@@ -135,15 +135,14 @@ fn problem(p: &Problem, out: &mut String) {
         let sources: Vec<String> = r
             .sources
             .iter()
-            .map(|s| match s {
-                RegionSource::Group { name, .. } => format!("group {name:?}"),
-                RegionSource::Boundary { conditions, .. } => {
-                    let c: Vec<String> = conditions
-                        .iter()
-                        .map(|c| format!("{} {} {}", expr(&c.lhs), c.op.symbol(), expr(&c.rhs)))
-                        .collect();
-                    if c.is_empty() { "boundary".into() } else { format!("boundary where {}", c.join(" and ")) }
-                }
+            .map(|s| {
+                let (head, conditions) = match s {
+                    RegionSource::Group { name, conditions, .. } => (format!("group {name:?}"), conditions),
+                    RegionSource::Boundary { conditions, .. } => ("boundary".to_string(), conditions),
+                };
+                let c: Vec<String> =
+                    conditions.iter().map(|c| format!("{} {} {}", expr(&c.lhs), c.op.symbol(), expr(&c.rhs))).collect();
+                if c.is_empty() { head } else { format!("{head} where {}", c.join(" and ")) }
             })
             .collect();
         out.push_str(&format!("  region {} = {}\n", r.name.name, sources.join(" else ")));
@@ -174,7 +173,11 @@ fn problem(p: &Problem, out: &mut String) {
     }
     for d in &p.dirichlet {
         let k = d.component.as_ref().map_or(String::new(), |k| format!("[{}]", expr(k)));
-        out.push_str(&format!("  dirichlet {}: {}{k} = {}\n", d.region.name, d.field.name, expr(&d.value)));
+        let on = match &d.on {
+            HeldAt::Region(r) => r.name.clone(),
+            HeldAt::Nearest { point, .. } => format!("nearest({})", expr(point)),
+        };
+        out.push_str(&format!("  dirichlet {on}: {}{k} = {}\n", d.field.name, expr(&d.value)));
     }
     for (d, written) in &p.series {
         line(out, if *written { "series" } else { "observe" }, d);
@@ -187,6 +190,8 @@ fn problem(p: &Problem, out: &mut String) {
         out.push_str(&format!("  plot {:?}: {}\n", pl.title, c.join(", ")));
     }
     if let Some(r) = &p.reference {
-        out.push_str(&format!("  reference {}\n", r.name));
+        let call = NamedCall { name: r.clone(), args: p.reference_args.clone(), span: r.span };
+        let text = if p.reference_args.is_empty() { r.name.clone() } else { named_call(&call) };
+        out.push_str(&format!("  reference {text}\n"));
     }
 }
