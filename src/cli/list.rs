@@ -44,6 +44,9 @@ pub fn text() -> String {
     out.push_str("\nReferences (`reference NAME` in a problem; their functionals read as NAME(u)):\n");
     for r in crate::references::ALL {
         let _ = writeln!(out, "  {:<16} {}", r.name(), r.doc());
+        for (a, doc) in r.args() {
+            let _ = writeln!(out, "    {:<26} {doc}", format!("{a} = ..."));
+        }
         for (f, doc) in r.functionals() {
             let _ = writeln!(out, "    {f:<26} {doc}");
         }

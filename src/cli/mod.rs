@@ -14,7 +14,7 @@ use crate::driver::{Setting, Setup};
 use crate::runtime::linalg::Solver;
 use crate::runtime::mesh::CellSize;
 use crate::simulation::MassChoice;
-use hertz::{HertzImpactArgs, HertzStaticArgs};
+use hertz::HertzImpactArgs;
 
 #[derive(Parser)]
 #[command(
@@ -259,8 +259,6 @@ pub enum MeshCommand {
 /// Built-in cases.
 #[derive(Subcommand)]
 pub enum Case {
-    /// A cylinder (2D) or ball (3D) pressed onto the plane by its weight, against Hertz.
-    HertzStatic(HertzStaticArgs),
     /// A ball hitting the plane at low speed, against Hertz's impact formulas.
     HertzImpact(HertzImpactArgs),
 }
@@ -508,7 +506,6 @@ fn dispatch(cli: Cli) -> ExitCode {
             }
         }
         Command::Run { case: Some(case), .. } => match *case {
-            Case::HertzStatic(a) => hertz::run_static(a),
             Case::HertzImpact(a) => hertz::run_impact(a),
         },
         Command::Run { case: None, file: Some(file), .. } if file.extension().is_some_and(|e| e == "toml") => {
@@ -517,9 +514,7 @@ fn dispatch(cli: Cli) -> ExitCode {
         Command::Run { case: None, file: Some(problem), args } => run_problem(&problem.to_string_lossy(), *args),
         Command::Run { case: None, file: None, .. } => {
             let names = crate::problem::library_names().join(", ");
-            eprintln!(
-                "error: name a problem ({names}), a problem file, a case (hertz-static, hertz-impact) or a case file"
-            );
+            eprintln!("error: name a problem ({names}), a problem file, a case (hertz-impact) or a case file");
             ExitCode::FAILURE
         }
         Command::Mesh { command: MeshCommand::Info { file } } => mesh_info(&file),

@@ -13,8 +13,10 @@ use crate::compiler::syntax::ast::{Expr, MeshSource, NamedCall, RegionSource};
 use crate::runtime::kernel::Coef;
 use crate::runtime::mesh::{CellSize, Mesh};
 
-/// The dimension of the problem's mesh: its generator's, or the file's (read here).
-pub fn dimension(pf: &ProblemFile, mesh_file: Option<&Path>) -> Result<usize, CaseError> {
+/// The dimension of the problem's mesh: its generator's, or the file's (read here). `params`
+/// are the problem's, for a file name that names them (`"ball_{level}.msh"`).
+pub fn dimension(pf: &ProblemFile, mesh_file: Option<&Path>, params: &[(String, f64)]) -> Result<usize, CaseError> {
+    let value = |name: &str| params.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
     match (&pf.problem().mesh[0], mesh_file) {
         (MeshSource::Generator(call), Some(path)) => {
             let d = read(path)?.dim();
@@ -35,7 +37,7 @@ pub fn dimension(pf: &ProblemFile, mesh_file: Option<&Path>) -> Result<usize, Ca
             let g = crate::compiler::check::problem::GENERATORS.iter().find(|g| g.name == call.name.name);
             Ok(g.map_or(0, |g| g.dim))
         }
-        (MeshSource::File { path, span }, None) => Ok(read_own(pf, path, *span)?.dim()),
+        (MeshSource::File { path, span }, None) => Ok(read_own(pf, &fill(pf, path, *span, &value)?, *span)?.dim()),
     }
 }
 
@@ -49,6 +51,35 @@ fn read_own(pf: &ProblemFile, path: &str, span: crate::compiler::Span) -> Result
     crate::cases::read_mesh(&full).map_err(|e| {
         pf.render(Diagnostic::error("E0101", format!("cannot read the mesh {}", full.display()), span, e.to_string()))
     })
+}
+
+/// A mesh file's name with each `{NAME}` replaced by the value of the param (or constant `let`)
+/// NAME: `"hertz_ball_{level}.msh"` is `"hertz_ball_2.msh"` at level = 2.
+fn fill(
+    pf: &ProblemFile,
+    path: &str,
+    span: crate::compiler::Span,
+    value: &dyn Fn(&str) -> Option<f64>,
+) -> Result<String, CaseError> {
+    let mut out = String::new();
+    let mut rest = path;
+    while let Some(open) = rest.find('{') {
+        out.push_str(&rest[..open]);
+        let Some(close) = rest[open..].find('}') else { break };
+        let name = &rest[open + 1..open + close];
+        let v = value(name).ok_or_else(|| {
+            pf.render(Diagnostic::error(
+                "E0101",
+                format!("`{{{name}}}` in the mesh's file name is not a param of the problem"),
+                span,
+                "in this file name",
+            ))
+        })?;
+        out.push_str(&if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { format!("{v}") });
+        rest = &rest[open + close + 1..];
+    }
+    out.push_str(rest);
+    Ok(out)
 }
 
 /// A named argument of a generator or helper.
@@ -70,7 +101,8 @@ pub fn mesh(
     let (mut mesh, label) = match (&p.mesh[0], mesh_file) {
         (_, Some(path)) => (read(path)?, path.display().to_string()),
         (MeshSource::File { path, span }, None) => {
-            (read_own(pf, path, *span)?, pf.dir.join(path).display().to_string())
+            let path = fill(pf, path, *span, &|name| ex.constant(name))?;
+            (read_own(pf, &path, *span)?, pf.dir.join(&path).display().to_string())
         }
         (MeshSource::Generator(call), None) => generate(pf, ex, call)?,
     };

@@ -35,6 +35,15 @@ impl<'u> Exprs<'u> {
         self.d
     }
 
+    /// A param's or a constant `let`'s value, by name.
+    pub fn constant(&self, name: &str) -> Option<f64> {
+        let (_, v) = self.scope.iter().rev().find(|(n, _)| n == name)?;
+        if v.c.len() != 1 {
+            return None;
+        }
+        self.low.g.as_const(v.c[0].v)
+    }
+
     /// Lowers `e` with `extra` names visible (fields, coefs, measured values) besides the params
     /// and `let`s.
     pub fn lower(&mut self, e: &Expr, extra: &[(String, Val)]) -> Res<Val> {

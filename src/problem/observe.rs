@@ -421,6 +421,14 @@ impl<'m> Observer<'m> {
         self.columns.iter().map(|c| c.1).collect()
     }
 
+    /// The reference's figures of a state into `dir`, if the problem names one.
+    pub fn write_reference(&self, dir: &std::path::Path, tools: &Tools, u: &[f64], t: f64) -> std::io::Result<()> {
+        match &self.reference {
+            Some((_, r)) => r.write(dir, &reference_at(tools, u, t)),
+            None => Ok(()),
+        }
+    }
+
     /// The row at a state: one value per column, and the `contact` slot's switch at each of
     /// its quadrature points (the active set; empty without the slot).
     pub fn row(&self, tools: &Tools, s: &State) -> (Vec<f64>, Vec<bool>) {
@@ -548,12 +556,12 @@ impl<'m> Observer<'m> {
                         Measure::Reference { which, mid: false } => one(self
                             .reference
                             .as_ref()
-                            .map_or(f64::NAN, |(_, r)| r.value(*which, &tools.scheme_mass, s.u, s.t))),
+                            .map_or(f64::NAN, |(_, r)| r.value(*which, &reference_at(tools, s.u, s.t)))),
                         Measure::Reference { which, mid: true } => one(mid
                             .get_or_insert_with(&mut midpoint)
                             .as_ref()
                             .zip(self.reference.as_ref().map(|(_, r)| r))
-                            .map_or(f64::NAN, |((u, t), r)| r.value(*which, &tools.scheme_mass, u, *t))),
+                            .map_or(f64::NAN, |((u, t), r)| r.value(*which, &reference_at(tools, u, *t)))),
                         Measure::Density { index, min } => {
                             let rule = crate::runtime::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
                             let points = self.functionals[*index].1.facet_point_values(asm, &rule, &[s.u], s.t);
@@ -750,4 +758,15 @@ fn summary_rewrite(e: &Expr, calls: &mut Vec<(Reduce, Vec<Expr>)>) -> Expr {
         other => other.clone(),
     };
     Expr { kind, span: e.span }
+}
+
+/// A state as a reference measures it.
+fn reference_at<'a>(tools: &'a Tools<'_>, u: &'a [f64], t: f64) -> crate::references::At<'a> {
+    crate::references::At {
+        asm: tools.asm,
+        mass: &tools.scheme_mass,
+        pressure: tools.contact_pressure.as_deref(),
+        u,
+        t,
+    }
 }

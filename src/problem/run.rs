@@ -196,8 +196,8 @@ fn bound<R>(
     let (params, rest) = super::params(&pf, &opts.setup.params)?;
     let mut setup = Setup { params: rest, ..opts.setup.clone() };
     bind_files(&pf, &mut setup, opts.chosen);
-    let d = super::bind::dimension(&pf, opts.mesh.as_deref())?;
     let values: Vec<(String, f64)> = params.iter().map(|p| (p.name.clone(), p.value)).collect();
+    let d = super::bind::dimension(&pf, opts.mesh.as_deref(), &values)?;
     let p = pf.problem();
     let mut ex = Exprs::new(&pf.program.unit, d, &values, &p.lets).map_err(|e| pf.render(*e))?;
     let mut sets = Vec::new();
@@ -233,13 +233,15 @@ fn bind_files(pf: &ProblemFile, setup: &mut Setup, chosen: Chosen) {
 /// The problem's reference bound to this run, after it checked the run is one it describes.
 fn bound_reference(
     pf: &ProblemFile,
+    ex: &mut Exprs,
     active: &Active,
     mesh: &crate::runtime::mesh::Mesh,
     t_start: f64,
 ) -> Result<Option<crate::references::Bound>, CaseError> {
     let Some(r) = reference(pf, mesh.dim())? else { return Ok(None) };
     let param = |name: &str| active.forms.params.get(name);
-    let facts = crate::references::RunFacts { mesh, param: &param, t_start };
+    let args = reference_args(pf, ex, r)?;
+    let facts = crate::references::RunFacts { mesh, param: &param, t_start, args: &args };
     let bound = r.bind(&facts).map_err(|why| {
         let at = pf.problem().reference.as_ref().map_or(pf.problem().name.span, |n| n.span);
         pf.render(
@@ -263,18 +265,41 @@ fn reference(pf: &ProblemFile, d: usize) -> Result<Option<&'static dyn crate::re
     let names = crate::references::ALL.iter().map(|r| r.name());
     let r = crate::references::find(&name.name)
         .ok_or_else(|| pf.render(crate::compiler::check::problem::unknown_among(name, names, "reference")))?;
-    if r.dim() != d {
+    if !r.dims().contains(&d) {
+        let dims: Vec<String> = r.dims().iter().map(|d| format!("{d}D")).collect();
         return Err(pf.render(
             Diagnostic::error(
                 "E0302",
                 "wrong dimension",
                 name.span,
-                format!("reference `{}` is {}D, the problem {d}D", r.name(), r.dim()),
+                format!("reference `{}` is {}, the problem {d}D", r.name(), dims.join(" or ")),
             )
             .with_note(format!("{}: {}", r.name(), r.doc())),
         ));
     }
     Ok(Some(r))
+}
+
+/// The problem's arguments to its reference, evaluated; a name the reference does not take is
+/// an error with its list.
+fn reference_args(
+    pf: &ProblemFile,
+    ex: &mut Exprs,
+    r: &dyn crate::references::Reference,
+) -> Result<Vec<(String, f64)>, CaseError> {
+    let known = r.args();
+    let mut out = Vec::new();
+    for a in &pf.problem().reference_args {
+        if !known.iter().any(|(n, _)| *n == a.name.name) {
+            return Err(pf.render(crate::compiler::check::problem::unknown_among(
+                &a.name,
+                known.iter().map(|(n, _)| *n),
+                "reference argument",
+            )));
+        }
+        out.push((a.name.name.clone(), ex.scalar(&a.value).map_err(|e| pf.render(*e))?));
+    }
+    Ok(out)
 }
 
 /// Every coef the files in use read must be set by the problem (a `coef` line, or an
@@ -582,6 +607,7 @@ fn simulate(
     }
     let binding = Binding { quadrature, regions, dim: mesh.dim() };
     let coef_vals = super::bind::coef_vals(pf, ex)?;
+    let reference = bound_reference(pf, ex, active, &mesh, t0)?;
     let observer = Observer::new(
         pf,
         ex,
@@ -591,7 +617,7 @@ fn simulate(
         &binding,
         &coef_vals,
         quadrature.facet.unwrap_or(7),
-        bound_reference(pf, active, &mesh, t0)?,
+        reference,
     )?;
     let columns: Vec<String> = observer.names().map(str::to_string).collect();
     let shown = observer.shown();
@@ -603,7 +629,7 @@ fn simulate(
     };
     let name = pf.name().to_string();
     let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, &name);
-    let (series, switches, iterations, stage_rows, outcome, counters, steps) = if let Some(u0) = static_start {
+    let (series, switches, iterations, stage_rows, outcome, counters, steps, last) = if let Some(u0) = static_start {
         // One equilibrium by the static driver: its single row is the solution.
         let contact = contact_region.ok_or_else(|| {
             CaseError::Option(format!("{}: a static problem needs its contact (an obstacle, or `Gamma_C`)", pf.file))
@@ -614,7 +640,7 @@ fn simulate(
             contact,
             contact_degree: quadrature.facet,
             constraints: constraints.clone(),
-            newton: opts.newton,
+            newton: static_newton(opts.newton),
         };
         let solution = crate::simulation::statics::solve(&asm, problem, &active.forms, u0)?;
         let seconds = clock.elapsed().as_secs_f64();
@@ -623,7 +649,8 @@ fn simulate(
         let (row, switches) = row(tools, State { t: t0, u: &solution.u, v: None, newton, before: None });
         snapshots.write(tools, 0, t0, &solution.u, &vec![0.0; n])?;
         let outcome = crate::simulation::Outcome { step_seconds: vec![seconds], cuts: 0, stopped: None, resumed: None };
-        (vec![row], vec![switches], vec![newton], Vec::new(), outcome, solution.counters, 0)
+        let last = (t0, solution.u);
+        (vec![row], vec![switches], vec![newton], Vec::new(), outcome, solution.counters, 0, last)
     } else {
         let sim = sim.as_mut().expect("a time run has a stepper");
         let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None };
@@ -728,7 +755,8 @@ fn simulate(
             },
         )?;
         let stage_rows = stage_rows.into_inner();
-        (series, switches, iterations, stage_rows, outcome, sim.stepper.counters(), steps)
+        let last = (series.last().map_or(t0, |r| r.0), sim.states[0].clone());
+        (series, switches, iterations, stage_rows, outcome, sim.stepper.counters(), steps, last)
     };
     snapshots.finish()?;
     let wall = start.elapsed().as_secs_f64();
@@ -791,11 +819,25 @@ fn simulate(
     let run = Run { summary, columns, rows: series, switches, stages: stage_rows };
     if let Some(dir) = &opts.out {
         write_outputs(dir, pf, &run, &shown)?;
+        // The reference's figures of the last state (Hertz's pressure profile).
+        observer
+            .write_reference(dir, tools_of(&sim, &static_tools), &last.1, last.0)
+            .map_err(|source| CaseError::Write { path: dir.display().to_string(), source })?;
     }
     if let Some(e) = outcome.stopped {
         return Err(e);
     }
     Ok(run)
+}
+
+/// A static problem's Newton options: `--solver auto` factorizes, since without a mass term
+/// Jacobi-CG on the stiffness alone converges slowly (the threshold of `auto` is measured on
+/// time steps); `--solver iterative` still iterates.
+fn static_newton(mut newton: NewtonOptions) -> NewtonOptions {
+    if newton.solver == crate::runtime::linalg::Solver::Auto {
+        newton.solver = crate::runtime::linalg::Solver::Direct;
+    }
+    newton
 }
 
 /// The tools of the run: the stepper's, or a static problem's own.

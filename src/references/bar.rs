@@ -4,8 +4,7 @@
 
 use std::cell::RefCell;
 
-use super::{BoundReference, Reference, RunFacts};
-use crate::runtime::linalg::Matrix;
+use super::{At, BoundReference, Reference, RunFacts};
 
 /// `reference bar`: the run against the exact solution.
 pub struct Bar;
@@ -39,8 +38,8 @@ impl Reference for Bar {
         "the compressed bar's exact solution (1D, on [0, 1], E = ρ = 1, u₀ = (1 − x)/2 at rest from t = 0, held at x = 1)"
     }
 
-    fn dim(&self) -> usize {
-        1
+    fn dims(&self) -> &'static [usize] {
+        &[1]
     }
 
     fn functionals(&self) -> Vec<(&'static str, &'static str)> {
@@ -74,7 +73,8 @@ struct BoundBar {
 }
 
 impl BoundReference for BoundBar {
-    fn value(&self, which: usize, mass: &Matrix, u: &[f64], t: f64) -> f64 {
+    fn value(&self, which: usize, at: &At) -> f64 {
+        let (mass, u, t) = (at.mass, at.u, at.t);
         let with_interpolant = |f: &dyn Fn(&[f64]) -> f64| {
             let mut last = self.interpolant.borrow_mut();
             if last.0.to_bits() != t.to_bits() {

@@ -1,12 +1,18 @@
 //! Analytic references a problem names (`reference NAME`): Rust functions that compare a run
 //! with a known solution, read in the problem's columns as functionals of the state
 //! (`exact_u_error(u)`). A new reference is a module here and a line in [`ALL`]; the problem
-//! file says what it measures with it.
+//! file says what it measures with it, and gives its arguments (`reference hertz(radius = 10,
+//! force = F)`).
 
+use std::path::Path;
+
+use crate::runtime::assembly::Assembler;
+use crate::runtime::library::BoundFunctional;
 use crate::runtime::linalg::Matrix;
 use crate::runtime::mesh::Mesh;
 
 pub mod bar;
+pub mod hertz;
 
 /// What a reference checks of a run before it describes it.
 pub struct RunFacts<'a> {
@@ -14,6 +20,30 @@ pub struct RunFacts<'a> {
     /// A param of the files in use, by name.
     pub param: &'a dyn Fn(&str) -> Option<f64>,
     pub t_start: f64,
+    /// The problem's arguments to the reference, by name (checked against [`Reference::args`]).
+    pub args: &'a [(String, f64)],
+}
+
+impl RunFacts<'_> {
+    /// An argument the problem gave, or why it is needed.
+    pub fn arg(&self, name: &str) -> Result<f64, String> {
+        self.args
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| *v)
+            .ok_or_else(|| format!("it needs the argument `{name}` (`reference NAME({name} = ...)`)"))
+    }
+}
+
+/// One state of the run, as a reference measures it.
+pub struct At<'a> {
+    pub asm: &'a Assembler<'a>,
+    /// The mass the scheme steps with (for errors in its norm).
+    pub mass: &'a Matrix,
+    /// The contact law's `contact_pressure` functional, if it has one.
+    pub pressure: Option<&'a dyn BoundFunctional>,
+    pub u: &'a [f64],
+    pub t: f64,
 }
 
 /// An analytic solution's functionals.
@@ -21,8 +51,12 @@ pub trait Reference: Sync {
     fn name(&self) -> &'static str;
     /// One line for `signorini list`.
     fn doc(&self) -> &'static str;
-    /// The dimension of the problems it describes.
-    fn dim(&self) -> usize;
+    /// The dimensions of the problems it describes.
+    fn dims(&self) -> &'static [usize];
+    /// Its arguments: name and meaning.
+    fn args(&self) -> Vec<(&'static str, &'static str)> {
+        Vec::new()
+    }
     /// Its functionals: name and meaning.
     fn functionals(&self) -> Vec<(&'static str, &'static str)>;
     /// The reference for one run, or why the run is not one it describes (another material,
@@ -32,16 +66,20 @@ pub trait Reference: Sync {
 
 /// A reference bound to a run.
 pub trait BoundReference {
-    /// Functional `which` (an index into [`Reference::functionals`]) at displacement `u`, time
-    /// `t`; `mass` is the mass the scheme steps with (for errors in its norm).
-    fn value(&self, which: usize, mass: &Matrix, u: &[f64], t: f64) -> f64;
+    /// Functional `which` (an index into [`Reference::functionals`]) at a state.
+    fn value(&self, which: usize, at: &At) -> f64;
+
+    /// Figures of the run's last state, written into its output directory (none by default).
+    fn write(&self, _dir: &Path, _at: &At) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 /// A reference and its binding to a run.
 pub type Bound = (&'static dyn Reference, Box<dyn BoundReference>);
 
 /// Every reference, by name.
-pub const ALL: &[&dyn Reference] = &[&bar::Bar];
+pub const ALL: &[&dyn Reference] = &[&bar::Bar, &hertz::Hertz];
 
 /// The reference called `name`.
 pub fn find(name: &str) -> Option<&'static dyn Reference> {

@@ -5,8 +5,9 @@ use std::fmt::Write;
 use std::path::Path;
 
 use crate::cases::CaseError;
-use crate::cases::hertz::{impact, meshes, statics};
+use crate::cases::hertz::{impact, meshes};
 use crate::driver::Setup;
+use crate::problem::run::{Options, run};
 
 /// The finest 3D level the report solves (level 3 has 132k unknowns: minutes per Newton solve).
 const FINEST_3D: usize = 2;
@@ -23,7 +24,8 @@ fn orders(errors: &[f64], sizes: &[f64]) -> Vec<String> {
 }
 
 pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, CaseError> {
-    let mut md = String::from("## 5. Hertz validation (`run hertz-static`, `run hertz-impact`)\n\n");
+    let mut md =
+        String::from("## 5. Hertz validation (`run hertz_cylinder`, `run hertz_ball`, `run hertz-impact`)\n\n");
     let params: Vec<String> =
         crate::cases::hertz::OVERRIDES.iter().map(|(name, value)| format!("{name} = {value}")).collect();
     let _ = write!(
@@ -32,9 +34,9 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         meshes::RADIUS,
         params.join(", ")
     );
-    md.push_str(" onto the plane by a body force whose resultant gives Hertz's a = R/10; graded Gmsh meshes (assets/meshes/hertz_*.geo: one cell size h_c in the contact zone, each level divides every size by 2 in 2D, √2 in 3D). a: the half-width (2D) or radius (3D) of the zone where the pressure is positive; p₀: the centre pressure; profile: ‖p_h − p‖/‖p‖ in L² on Γ_C's projection onto the plane. h: the smallest cell diameter on Γ_C. Errors are against Hertz, whose own error, O((a/R)²), does not shrink with h: the orders log(e_{k−1}/e_k)/log(h_{k−1}/h_k) fall once the discretisation error reaches it (the 2D peak pressure already has).\n\n");
+    md.push_str(" onto the plane by a body force whose resultant gives Hertz's a = R/10 (forms/problems/hertz_cylinder.wf, hertz_ball.wf); graded Gmsh meshes (assets/meshes/hertz_*.geo: one cell size h_c in the contact zone, each level divides every size by 2 in 2D, √2 in 3D). a: the half-width (2D) or radius (3D) of the zone where the pressure is positive; p₀: the centre pressure; profile: ‖p_h − p‖/‖p‖ in L² on Γ_C's projection onto the plane. h: the smallest cell diameter on Γ_C. Errors are against Hertz, whose own error, O((a/R)²), does not shrink with h: the orders log(e_{k−1}/e_k)/log(h_{k−1}/h_k) fall once the discretisation error reaches it (the 2D peak pressure already has).\n\n");
     let contacts = &crate::settings::get().verify.contacts;
-    for dim in [2, 3] {
+    for (dim, problem, size) in [(2, "hertz_cylinder", "half_width"), (3, "hertz_ball", "contact_radius")] {
         let levels = if dim == 2 { meshes::levels(2) } else { FINEST_3D + 1 };
         for contact in contacts {
             let _ = writeln!(md, "### {dim}D, {contact}\n");
@@ -43,29 +45,31 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
             let mut sizes = Vec::new();
             let mut figure = String::new();
             for level in 0..levels {
-                progress(&format!("hertz-static {dim}D {contact} level {level}"));
+                progress(&format!("{problem} {contact} level {level}"));
                 let dir = out.join("hertz").join(format!("static_{dim}d_{contact}_{level}"));
-                let setup = Setup { contact: contact.clone(), ..Setup::default() };
-                let opts = statics::Options { setup, dim, level, out: Some(dir), ..Default::default() };
-                let s = statics::run(&opts)?;
-                let (m, e) = (&s.measured, &s.relative_error);
+                let mut opts = Options::new(problem);
+                opts.setup = Setup { contact: contact.clone(), ..Setup::default() }.set("level", level as f64);
+                opts.chosen.contact = true;
+                opts.out = Some(dir);
+                let s = run(&opts)?.summary;
+                let get = |k: &str| s.number(k).unwrap_or(f64::NAN);
+                let (a, a_err, p0, p0_err) =
+                    (get(size), get(&format!("{size}_error")), get("peak_pressure"), get("peak_pressure_error"));
+                let (profile, h) = (get("profile_l2_error"), get("h_contact"));
                 let _ = writeln!(
                     md,
-                    "| {level} | {} | {:.3} | {:.4} ({:+.2}%) | {:.4} ({:+.2}%) | {:.2}% | {} | {:.1} |",
-                    s.dofs,
-                    s.h_contact,
-                    m.figures.size(),
-                    100.0 * e.size(),
-                    m.figures.peak_pressure,
-                    100.0 * e.peak_pressure,
-                    100.0 * m.profile_l2_error,
-                    s.newton_iterations,
-                    s.wall_seconds
+                    "| {level} | {} | {h:.3} | {a:.4} ({:+.2}%) | {p0:.4} ({:+.2}%) | {:.2}% | {} | {:.1} |",
+                    get("dofs"),
+                    100.0 * a_err,
+                    100.0 * p0_err,
+                    100.0 * profile,
+                    get("newton_total"),
+                    get("wall_seconds")
                 );
-                sizes.push(s.h_contact);
-                errors[0].push(e.size());
-                errors[1].push(e.peak_pressure);
-                errors[2].push(m.profile_l2_error);
+                sizes.push(h);
+                errors[0].push(a_err);
+                errors[1].push(p0_err);
+                errors[2].push(profile);
                 figure = format!("![profile](hertz/static_{dim}d_{contact}_{level}/profile.png)\n");
             }
             let _ = writeln!(

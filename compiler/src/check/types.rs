@@ -616,6 +616,13 @@ impl<'p> Checker<'p> {
                         Some("powers apply to scalars; use dot or inner for products"),
                     );
                 }
+                // A problem's numbers (params, lets of params) may take any real power; the
+                // lowering checks that the base is one.
+                if self.vectors_allowed
+                    && let Some(k) = tb.konst.filter(|k| k.fract() != 0.0 && k.is_finite())
+                {
+                    return Some(Ty { konst: ta.konst.map(|x| x.powf(k)), ..ta });
+                }
                 let k = match tb.konst {
                     Some(k) if k.fract() == 0.0 && k.abs() <= 64.0 && !tb.test => k,
                     _ => {

@@ -179,6 +179,21 @@ impl<'p> Lowerer<'p> {
                 if *op == BinOp::Div && self.g.is_zero(b.c[0].v) {
                     return Err(Box::new(not_finite(e.span, "divides by zero")));
                 }
+                // A real power (problems only: the checker allows it there) of a number.
+                if let (BinOp::Pow, Some(k)) = (op, b_const(e).filter(|k| k.fract() != 0.0)) {
+                    let Some(x) = self.g.as_const(a.c[0].v) else {
+                        return Err(Box::new(
+                            Diagnostic::error(
+                                "E0303",
+                                "a real power of a value that varies",
+                                e.span,
+                                "the base depends on x, t or the fields",
+                            )
+                            .with_help("a real exponent takes numbers and params only; `^` takes integers otherwise"),
+                        ));
+                    };
+                    return Ok(self.constant_val(x.powf(k)));
+                }
                 self.binary(*op, a, b, b_const(e))
             }
             ExprKind::Call(f, args) => {

@@ -8,10 +8,11 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::closed_form::{Impact, Material};
-use super::{meshes, profile};
+use super::meshes;
 use crate::cases::CaseError;
 use crate::driver::{Active, ParamValue, Setup};
+use crate::references::hertz::closed_form::{Impact, Material};
+use crate::references::hertz::profile;
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::mesh::CellSize;
 use crate::runtime::newton::NewtonOptions;
@@ -212,7 +213,8 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     };
     let pressure = sim.tools.contact_pressure.as_ref().expect("checked above");
     let samples = profile::sample(&asm, pressure.as_ref(), &peak_state);
-    let peak_radius = profile::zone(3, &samples, hertz.contact_radius).map_err(CaseError::Option)?.size;
+    let peak_radius =
+        profile::zone(3, meshes::copies(3), &samples, hertz.contact_radius).map_err(CaseError::Option)?.size;
     let measured = Figures { contact_duration: duration, peak_force: peak, contact_radius: peak_radius };
     let hertz_figures = Figures {
         contact_duration: hertz.contact_duration,

@@ -1,14 +1,11 @@
 //! Hertz validation: a cylinder (2D) and a ball (3D) pressed onto the rigid plane, and the
 //! low-velocity impact of a ball, against Hertz's closed forms.
 
-pub mod closed_form;
 pub mod impact;
 pub mod meshes;
-pub mod profile;
-pub mod statics;
 
 use crate::cases::CaseError;
-use closed_form::Material;
+use crate::references::hertz::closed_form::Material;
 
 /// Both cases' material (λ = μ = 20, the sphere's) and γ0 = 100 E (Nitsche with θ = 1 is unstable at
 /// 10 E on the 3D meshes), over the files' defaults.

@@ -38,8 +38,8 @@ pub fn sample(asm: &Assembler, pressure: &dyn BoundFunctional, u: &[f64]) -> Vec
         .collect()
 }
 
-/// What the samples show, for the full body of a model reduced by symmetry (x ≥ 0 in 2D; x, y
-/// ≥ 0 in 3D).
+/// What the samples show, for the full body of a model reduced by symmetry (`copies` of it make
+/// the body: 2 for the half x ≥ 0 in 2D, 4 for the quarter x, y ≥ 0 in 3D).
 #[derive(Clone, Copy, Debug)]
 pub struct Zone {
     /// Half-width (2D) or radius (3D) of the zone where the pressure is positive.
@@ -51,10 +51,10 @@ pub struct Zone {
 /// within a/4 of the first contact point, Σ w p_h / Σ w s(r) with Hertz's shape s(r) =
 /// √(1 − r²/a²) ≥ 0.968 there: a single sample carries the discrete pressure's oscillation
 /// between quadrature points (a penalty's especially), this mean does not.
-pub fn zone(dim: usize, samples: &[Sample], hertz_size: f64) -> Result<Zone, String> {
+pub fn zone(dim: usize, copies: f64, samples: &[Sample], hertz_size: f64) -> Result<Zone, String> {
     let measure: f64 = samples.iter().filter(|s| s.p > 0.0).map(|s| s.weight).sum();
     // The whole body's zone is the strip [−a, a] in 2D, the disc r < a in 3D.
-    let whole = super::meshes::copies(dim) * measure;
+    let whole = copies * measure;
     let size = if dim == 2 { whole / 2.0 } else { (whole / std::f64::consts::PI).sqrt() };
     let (mut pw, mut sw) = (0.0, 0.0);
     for s in samples.iter().filter(|s| s.r < hertz_size / 4.0) {
