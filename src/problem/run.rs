@@ -236,12 +236,13 @@ fn bound_reference(
     ex: &mut Exprs,
     active: &Active,
     mesh: &crate::runtime::mesh::Mesh,
+    contact: &[crate::runtime::mesh::Facet],
     t_start: f64,
 ) -> Result<Option<crate::references::Bound>, CaseError> {
     let Some(r) = reference(pf, mesh.dim())? else { return Ok(None) };
     let param = |name: &str| active.forms.params.get(name);
     let args = reference_args(pf, ex, r)?;
-    let facts = crate::references::RunFacts { mesh, param: &param, t_start, args: &args };
+    let facts = crate::references::RunFacts { mesh, param: &param, t_start, args: &args, contact };
     let bound = r.bind(&facts).map_err(|why| {
         let at = pf.problem().reference.as_ref().map_or(pf.problem().name.span, |n| n.span);
         pf.render(
@@ -572,10 +573,16 @@ fn simulate(
     // A static problem is one equilibrium, from u₀ (no initial acceleration to solve for): it
     // binds the tools, and no stepper.
     let statics = p.run_static.is_some();
-    let (mut sim, static_tools) = if statics {
-        (None, Some(crate::simulation::Tools::bind(&asm, problem, active)?))
+    if statics && held.is_some() {
+        return Err(CaseError::Option(format!(
+            "{}: a static problem holds its Dirichlet values at zero (a nonzero held value needs a time run)",
+            pf.file
+        )));
+    }
+    let mut runner = if statics {
+        Runner::Static(Box::new(crate::simulation::Tools::bind(&asm, problem, active)?))
     } else {
-        (Some(Simulation::new(&asm, problem, active)?), None)
+        Runner::Time(Box::new(Simulation::new(&asm, problem, active)?))
     };
     let t0 = settings.t_start;
     // The initial fields take the held values on the held dofs.
@@ -586,32 +593,17 @@ fn simulate(
     if let Some(h) = &held {
         h.initial(&mesh, t0, &mut u0, &mut v0);
     }
-    let static_start = match &mut sim {
-        None => {
-            if held.is_some() {
-                return Err(CaseError::Option(format!(
-                    "{}: a static problem holds its Dirichlet values at zero (a nonzero held value needs a time run)",
-                    pf.file
-                )));
-            }
-            Some(u0)
-        }
-        Some(sim) => {
-            sim.initialize_at(t0, u0, v0)?;
-            None
-        }
-    };
-    let mut regions = vec![(contact.to_string(), tools_of(&sim, &static_tools).contact_facets)];
+    let mut regions = vec![(contact.to_string(), runner.tools().contact_facets)];
     for name in &others {
         regions.push((name.clone(), asm.region(name)?));
     }
     let binding = Binding { quadrature, regions, dim: mesh.dim() };
     let coef_vals = super::bind::coef_vals(pf, ex)?;
-    let reference = bound_reference(pf, ex, active, &mesh, t0)?;
+    let reference = bound_reference(pf, ex, active, &mesh, runner.tools().contact_facets, t0)?;
     let observer = Observer::new(
         pf,
         ex,
-        tools_of(&sim, &static_tools),
+        runner.tools(),
         &active.forms,
         &coefs,
         &binding,
@@ -629,134 +621,140 @@ fn simulate(
     };
     let name = pf.name().to_string();
     let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, &name);
-    let (series, switches, iterations, stage_rows, outcome, counters, steps, last) = if let Some(u0) = static_start {
-        // One equilibrium by the static driver: its single row is the solution.
-        let contact = contact_region.ok_or_else(|| {
-            CaseError::Option(format!("{}: a static problem needs its contact (an obstacle, or `Gamma_C`)", pf.file))
-        })?;
-        let clock = Instant::now();
-        let problem = crate::simulation::statics::StaticProblem {
-            coefs: &coefs,
-            contact,
-            contact_degree: quadrature.facet,
-            constraints: constraints.clone(),
-            newton: static_newton(opts.newton),
-        };
-        let solution = crate::simulation::statics::solve(&asm, problem, &active.forms, u0)?;
-        let seconds = clock.elapsed().as_secs_f64();
-        let newton = solution.newton.iterations();
-        let tools = tools_of(&sim, &static_tools);
-        let (row, switches) = row(tools, State { t: t0, u: &solution.u, v: None, newton, before: None });
-        snapshots.write(tools, 0, t0, &solution.u, &vec![0.0; n])?;
-        let outcome = crate::simulation::Outcome { step_seconds: vec![seconds], cuts: 0, stopped: None, resumed: None };
-        let last = (t0, solution.u);
-        (vec![row], vec![switches], vec![newton], Vec::new(), outcome, solution.counters, 0, last)
-    } else {
-        let sim = sim.as_mut().expect("a time run has a stepper");
-        let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None };
-        let (first, first_switches) = row(&sim.tools, first);
-        let mut series = vec![first];
-        let mut switches = vec![first_switches];
-        // Newton iterations of each row's step (0 for the initial state).
-        let mut iterations: Vec<usize> = vec![0];
-        let steps = ((settings.t_end - t0) / settings.dt).round() as usize;
-        // A scheme without a velocity state: the step's mean velocity.
-        let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64], dt: f64| -> Vec<f64> {
-            match v_index {
-                Some(i) => states[i].clone(),
-                None => states[0].iter().zip(before).map(|(a, b)| (a - b) / dt).collect(),
-            }
-        };
-        let v_index = sim.v_index;
-        let stage_rows: RefCell<Vec<(String, f64, Vec<f64>)>> = RefCell::new(Vec::new());
-        let (mut saved_rows, mut saved_stages, mut saved_snapshots) = (0, 0, 0);
-        match control.observer() {
-            Some(records) => {
-                let stages = sim.stepper.desc().stages;
-                series.clear();
-                iterations.clear();
-                switches.clear();
-                for bytes in records {
-                    let record: Record = postcard::from_bytes(bytes).map_err(|e| {
-                        CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})"))
-                    })?;
-                    series.extend(record.series);
-                    iterations.extend(record.iterations);
-                    switches.extend(record.switches);
-                    for (stage, t, values) in record.stages {
-                        if !stages.iter().any(|s| s.name == stage) {
-                            return Err(CaseError::Option(format!(
-                                "the checkpoint has a stage `{stage}`, which this scheme has not"
-                            )));
-                        }
-                        stage_rows.borrow_mut().push((stage, t, values));
-                    }
-                    snapshots.extend_written(record.snapshots);
-                }
-                (saved_rows, saved_stages, saved_snapshots) =
-                    (series.len(), stage_rows.borrow().len(), snapshots.written().len());
-            }
-            None => snapshots.write(
-                &sim.tools,
-                0,
-                t0,
-                &sim.states[0],
-                &velocity(&sim.states, v_index, &sim.states[0], settings.dt),
-            )?,
+    let (series, switches, iterations, stage_rows, outcome, counters, steps, last) = match &mut runner {
+        Runner::Static(tools) => {
+            // One equilibrium by the static driver: its single row is the solution.
+            let contact = contact_region.ok_or_else(|| {
+                CaseError::Option(format!(
+                    "{}: a static problem needs its contact (an obstacle, or `Gamma_C`)",
+                    pf.file
+                ))
+            })?;
+            let clock = Instant::now();
+            let problem = crate::simulation::statics::StaticProblem {
+                coefs: &coefs,
+                contact,
+                contact_degree: quadrature.facet,
+                constraints: constraints.clone(),
+                newton: opts.newton,
+            };
+            let solution = crate::simulation::statics::solve(&asm, problem, &active.forms, u0)?;
+            let seconds = clock.elapsed().as_secs_f64();
+            let newton = solution.newton.iterations();
+            let (row, switches) = row(tools, State { t: t0, u: &solution.u, v: None, newton, before: None });
+            snapshots.write(tools, 0, t0, &solution.u, &vec![0.0; n])?;
+            let outcome =
+                crate::simulation::Outcome { step_seconds: vec![seconds], cuts: 0, stopped: None, resumed: None };
+            let last = (t0, solution.u);
+            (vec![row], vec![switches], vec![newton], Vec::new(), outcome, solution.counters, 0, last)
         }
-        let names = sim.stepper.desc().states;
-        let outcome = sim.run(
-            t0,
-            settings.dt,
-            steps,
-            opts.progress,
-            &mut control,
-            &mut |tools, stage, v_index| {
-                if let Some(u) = stage.value_of(names[0]) {
-                    let v = v_index.and_then(|i| stage.value_of(names[i]));
-                    let ((t, values), _) = row(tools, State { t: stage.time, u, v, newton: 0, before: None });
-                    stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
+        Runner::Time(sim) => {
+            sim.initialize_at(t0, u0, v0)?;
+            let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None };
+            let (first, first_switches) = row(&sim.tools, first);
+            let mut series = vec![first];
+            let mut switches = vec![first_switches];
+            // Newton iterations of each row's step (0 for the initial state).
+            let mut iterations: Vec<usize> = vec![0];
+            let steps = ((settings.t_end - t0) / settings.dt).round() as usize;
+            // A scheme without a velocity state: the step's mean velocity.
+            let velocity = |states: &[Vec<f64>], v_index: Option<usize>, before: &[f64], dt: f64| -> Vec<f64> {
+                match v_index {
+                    Some(i) => states[i].clone(),
+                    None => states[0].iter().zip(before).map(|(a, b)| (a - b) / dt).collect(),
                 }
-            },
-            &mut |tools, step, record| {
-                let v = v_index.map(|i| step.states[i].as_slice());
-                let state = State {
-                    t: step.t,
-                    u: &step.states[0],
-                    v,
-                    newton: step.report.iterations(),
-                    before: Some((step.before, step.dt)),
-                };
-                let (values, active) = row(tools, state);
-                series.push(values);
-                switches.push(active);
-                iterations.push(step.report.iterations());
-                snapshots.write(
-                    tools,
-                    step.k,
-                    step.t,
-                    &step.states[0],
-                    &velocity(step.states, v_index, step.before, step.dt),
-                )?;
-                if let Some(record) = record {
-                    let stages = stage_rows.borrow();
-                    *record = postcard::to_stdvec(&Record {
-                        series: series[saved_rows..].to_vec(),
-                        iterations: iterations[saved_rows..].to_vec(),
-                        switches: switches[saved_rows..].to_vec(),
-                        stages: stages[saved_stages..].to_vec(),
-                        snapshots: snapshots.written()[saved_snapshots..].to_vec(),
-                    })
-                    .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
+            };
+            let v_index = sim.v_index;
+            let stage_rows: RefCell<Vec<(String, f64, Vec<f64>)>> = RefCell::new(Vec::new());
+            let (mut saved_rows, mut saved_stages, mut saved_snapshots) = (0, 0, 0);
+            match control.observer() {
+                Some(records) => {
+                    let stages = sim.stepper.desc().stages;
+                    series.clear();
+                    iterations.clear();
+                    switches.clear();
+                    for bytes in records {
+                        let record: Record = postcard::from_bytes(bytes).map_err(|e| {
+                            CaseError::Option(format!("the checkpoint's record of the run is damaged ({e})"))
+                        })?;
+                        series.extend(record.series);
+                        iterations.extend(record.iterations);
+                        switches.extend(record.switches);
+                        for (stage, t, values) in record.stages {
+                            if !stages.iter().any(|s| s.name == stage) {
+                                return Err(CaseError::Option(format!(
+                                    "the checkpoint has a stage `{stage}`, which this scheme has not"
+                                )));
+                            }
+                            stage_rows.borrow_mut().push((stage, t, values));
+                        }
+                        snapshots.extend_written(record.snapshots);
+                    }
                     (saved_rows, saved_stages, saved_snapshots) =
-                        (series.len(), stages.len(), snapshots.written().len());
+                        (series.len(), stage_rows.borrow().len(), snapshots.written().len());
                 }
-                Ok(())
-            },
-        )?;
-        let stage_rows = stage_rows.into_inner();
-        let last = (series.last().map_or(t0, |r| r.0), sim.states[0].clone());
-        (series, switches, iterations, stage_rows, outcome, sim.stepper.counters(), steps, last)
+                None => snapshots.write(
+                    &sim.tools,
+                    0,
+                    t0,
+                    &sim.states[0],
+                    &velocity(&sim.states, v_index, &sim.states[0], settings.dt),
+                )?,
+            }
+            let names = sim.stepper.desc().states;
+            let outcome = sim.run(
+                t0,
+                settings.dt,
+                steps,
+                opts.progress,
+                &mut control,
+                &mut |tools, stage, v_index| {
+                    if let Some(u) = stage.value_of(names[0]) {
+                        let v = v_index.and_then(|i| stage.value_of(names[i]));
+                        let ((t, values), _) = row(tools, State { t: stage.time, u, v, newton: 0, before: None });
+                        stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
+                    }
+                },
+                &mut |tools, step, record| {
+                    let v = v_index.map(|i| step.states[i].as_slice());
+                    let state = State {
+                        t: step.t,
+                        u: &step.states[0],
+                        v,
+                        newton: step.report.iterations(),
+                        before: Some((step.before, step.dt)),
+                    };
+                    let (values, active) = row(tools, state);
+                    series.push(values);
+                    switches.push(active);
+                    iterations.push(step.report.iterations());
+                    snapshots.write(
+                        tools,
+                        step.k,
+                        step.t,
+                        &step.states[0],
+                        &velocity(step.states, v_index, step.before, step.dt),
+                    )?;
+                    if let Some(record) = record {
+                        let stages = stage_rows.borrow();
+                        *record = postcard::to_stdvec(&Record {
+                            series: series[saved_rows..].to_vec(),
+                            iterations: iterations[saved_rows..].to_vec(),
+                            switches: switches[saved_rows..].to_vec(),
+                            stages: stages[saved_stages..].to_vec(),
+                            snapshots: snapshots.written()[saved_snapshots..].to_vec(),
+                        })
+                        .map_err(|e| CaseError::Option(format!("cannot encode the checkpoint: {e}")))?;
+                        (saved_rows, saved_stages, saved_snapshots) =
+                            (series.len(), stages.len(), snapshots.written().len());
+                    }
+                    Ok(())
+                },
+            )?;
+            let stage_rows = stage_rows.into_inner();
+            let last = (series.last().map_or(t0, |r| r.0), sim.states[0].clone());
+            (series, switches, iterations, stage_rows, outcome, sim.stepper.counters(), steps, last)
+        }
     };
     snapshots.finish()?;
     let wall = start.elapsed().as_secs_f64();
@@ -791,7 +789,11 @@ fn simulate(
     put("symbolic_factorizations", counters.symbolic.into());
     put("low_rank_updates", counters.updates.into());
     put("matrix_nnz", asm.pattern().nnz().into());
-    put("factor_nnz", json(&sim.as_ref().and_then(|s| s.stepper.factor_nnz())));
+    let factor_nnz = match &runner {
+        Runner::Time(sim) => sim.stepper.factor_nnz(),
+        Runner::Static(_) => None,
+    };
+    put("factor_nnz", json(&factor_nnz));
     put("solver", json(&opts.newton.solver));
     put("krylov_iterations", counters.iterations.into());
     put("peak_memory_bytes", json(&crate::bench::peak_memory()));
@@ -821,7 +823,7 @@ fn simulate(
         write_outputs(dir, pf, &run, &shown)?;
         // The reference's figures of the last state (Hertz's pressure profile).
         observer
-            .write_reference(dir, tools_of(&sim, &static_tools), &last.1, last.0)
+            .write_reference(dir, runner.tools(), &last.1, last.0)
             .map_err(|source| CaseError::Write { path: dir.display().to_string(), source })?;
     }
     if let Some(e) = outcome.stopped {
@@ -830,24 +832,19 @@ fn simulate(
     Ok(run)
 }
 
-/// A static problem's Newton options: `--solver auto` factorizes, since without a mass term
-/// Jacobi-CG on the stiffness alone converges slowly (the threshold of `auto` is measured on
-/// time steps); `--solver iterative` still iterates.
-fn static_newton(mut newton: NewtonOptions) -> NewtonOptions {
-    if newton.solver == crate::runtime::linalg::Solver::Auto {
-        newton.solver = crate::runtime::linalg::Solver::Direct;
-    }
-    newton
+/// What runs a problem: the stepper (a time run), or a static problem's tools alone (its one
+/// equilibrium is the static driver's).
+enum Runner<'m> {
+    Time(Box<Simulation<'m>>),
+    Static(Box<crate::simulation::Tools<'m>>),
 }
 
-/// The tools of the run: the stepper's, or a static problem's own.
-fn tools_of<'a, 'm>(
-    sim: &'a Option<Simulation<'m>>,
-    statics: &'a Option<crate::simulation::Tools<'m>>,
-) -> &'a crate::simulation::Tools<'m> {
-    match sim {
-        Some(s) => &s.tools,
-        None => statics.as_ref().expect("a static problem binds its tools"),
+impl<'m> Runner<'m> {
+    fn tools(&self) -> &crate::simulation::Tools<'m> {
+        match self {
+            Runner::Time(sim) => &sim.tools,
+            Runner::Static(tools) => tools,
+        }
     }
 }
 

@@ -22,6 +22,8 @@ pub struct RunFacts<'a> {
     pub t_start: f64,
     /// The problem's arguments to the reference, by name (checked against [`Reference::args`]).
     pub args: &'a [(String, f64)],
+    /// The facets where contact is imposed (none without contact).
+    pub contact: &'a [crate::runtime::mesh::Facet],
 }
 
 impl RunFacts<'_> {

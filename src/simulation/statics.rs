@@ -69,7 +69,13 @@ pub fn solve<'m>(
         return Err(CaseError::Option(format!("the initial state has {} values, the mesh {n} unknowns", u.len())));
     }
     static_problem.constraints.zero(&mut u);
-    let mut newton = Newton::new(problem.newton);
+    // `--solver auto` factorizes here: without a mass term, Jacobi-CG on the stiffness alone
+    // converges slowly (the threshold of `auto` is measured on time steps).
+    let mut options = problem.newton;
+    if options.solver == crate::runtime::linalg::Solver::Auto {
+        options.solver = crate::runtime::linalg::Solver::Direct;
+    }
+    let mut newton = Newton::new(options);
     let report = newton.solve(&mut static_problem, &mut u)?;
     let contact_force = super::resultant(&static_problem.contact_residual(&u), d);
     let mut set = Vec::new();

@@ -90,9 +90,8 @@ impl Reference for Hertz {
             closed_form::Material { young: material("E")?, poisson: material("nu")?, density: material("rho")? };
         let dim = run.mesh.dim();
         let (a, p0) = closed_form::static_contact(dim, radius, material.contact_modulus(), force);
-        let cell_size = run.mesh.region(crate::problem::bind::CONTACT).map_or(f64::NAN, |r| {
-            r.facets.iter().map(|f| run.mesh.cell_diameter(f.cell as usize)).fold(f64::INFINITY, f64::min)
-        });
+        let cell_size =
+            run.contact.iter().map(|f| run.mesh.cell_diameter(f.cell as usize)).fold(f64::INFINITY, f64::min);
         Ok(Box::new(BoundHertz { dim, copies, a, p0, cell_size, samples: RefCell::new(None) }))
     }
 }
