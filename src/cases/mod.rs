@@ -1,11 +1,8 @@
 //! Built-in cases (`signorini run NAME`).
 
-use crate::runtime::kernel::Coef;
-
 pub mod bar;
 pub mod disc;
 pub mod file;
-pub mod hertz;
 
 /// Reads a Gmsh file, showing on stderr what the reader skipped (also logged as a warning).
 pub fn read_mesh(path: &std::path::Path) -> Result<crate::runtime::mesh::Mesh, crate::runtime::mesh::MeshError> {
@@ -14,19 +11,6 @@ pub fn read_mesh(path: &std::path::Path) -> Result<crate::runtime::mesh::Mesh, c
         eprintln!("warning: {w}");
     }
     Ok(mesh)
-}
-
-/// The coefficients of a body above the rigid plane {x_d = −lift} (x_d the last coordinate):
-/// the gap `g` = x_d + lift along the obstacle normal `nc` = −e_d, and the body force `f` =
-/// −load e_d per unit volume.
-pub fn above_plane(d: usize, lift: f64, load: f64) -> impl Fn(&str) -> Option<Coef> {
-    let down = move |size: f64| (0..d).map(|k| if k == d - 1 { -size } else { 0.0 }).collect::<Vec<f64>>();
-    move |name| match name {
-        "f" => Some(Coef::constant(down(load))),
-        "g" => Some(Coef::of_position(1, move |x, out| out[0] = x[d - 1] + lift)),
-        "nc" => Some(Coef::constant(down(1.0))),
-        _ => None,
-    }
 }
 
 /// Why a case did not run.

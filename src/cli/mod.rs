@@ -6,7 +6,6 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 mod compare;
-mod hertz;
 mod list;
 
 use crate::compiler;
@@ -14,7 +13,6 @@ use crate::driver::{Setting, Setup};
 use crate::runtime::linalg::Solver;
 use crate::runtime::mesh::CellSize;
 use crate::simulation::MassChoice;
-use hertz::HertzImpactArgs;
 
 #[derive(Parser)]
 #[command(
@@ -162,11 +160,8 @@ pub enum Command {
         command: MeshCommand,
     },
     /// Run a problem of the library by name (`disc`, `sphere`; `signorini list` shows them), a
-    /// problem file (`my_problem.wf`), a built-in case, or a case file (`case.toml`).
-    #[command(args_conflicts_with_subcommands = true)]
+    /// problem file (`my_problem.wf`), or a case file (`case.toml`).
     Run {
-        #[command(subcommand)]
-        case: Option<Box<Case>>,
         /// A problem by name or .wf file, or a TOML case file (`case = "bar"` or `"disc"`, and
         /// the options as keys).
         file: Option<PathBuf>,
@@ -254,13 +249,6 @@ pub enum MeshCommand {
     /// Print a JSON summary of a Gmsh file: nodes, cells by type, boundary facets, regions,
     /// total measure.
     Info { file: PathBuf },
-}
-
-/// Built-in cases.
-#[derive(Subcommand)]
-pub enum Case {
-    /// A ball hitting the plane at low speed, against Hertz's impact formulas.
-    HertzImpact(HertzImpactArgs),
 }
 
 /// The scheme, the form files and their params (`signorini list` shows what there is).
@@ -505,16 +493,11 @@ fn dispatch(cli: Cli) -> ExitCode {
                 }
             }
         }
-        Command::Run { case: Some(case), .. } => match *case {
-            Case::HertzImpact(a) => hertz::run_impact(a),
-        },
-        Command::Run { case: None, file: Some(file), .. } if file.extension().is_some_and(|e| e == "toml") => {
-            run_file(&file)
-        }
-        Command::Run { case: None, file: Some(problem), args } => run_problem(&problem.to_string_lossy(), *args),
-        Command::Run { case: None, file: None, .. } => {
+        Command::Run { file: Some(file), .. } if file.extension().is_some_and(|e| e == "toml") => run_file(&file),
+        Command::Run { file: Some(problem), args } => run_problem(&problem.to_string_lossy(), *args),
+        Command::Run { file: None, .. } => {
             let names = crate::problem::library_names().join(", ");
-            eprintln!("error: name a problem ({names}), a problem file, a case (hertz-impact) or a case file");
+            eprintln!("error: name a problem ({names}), a problem file or a case file");
             ExitCode::FAILURE
         }
         Command::Mesh { command: MeshCommand::Info { file } } => mesh_info(&file),

@@ -612,6 +612,8 @@ enum Reduce {
     Sum,
     /// The first argument at the first row where the second is positive.
     First,
+    /// The first argument at the first row where the second is largest (NaN rows left out).
+    AtMax,
 }
 
 /// A reducer's argument: a column as it is (`None`: the row's time), or an expression of the
@@ -716,6 +718,16 @@ impl SummaryKeys {
                             let row = rows.iter().find(|row| arg(&args[1], row) > 0.0)?;
                             arg(a, row)
                         }
+                        Reduce::AtMax => {
+                            let mut best: Option<(f64, &(f64, Vec<f64>))> = None;
+                            for row in rows {
+                                let w = arg(&args[1], row);
+                                if !w.is_nan() && best.is_none_or(|(b, _)| w > b) {
+                                    best = Some((w, row));
+                                }
+                            }
+                            arg(a, best?.1)
+                        }
                     }])
                 })
                 .collect();
@@ -742,6 +754,7 @@ fn summary_rewrite(e: &Expr, calls: &mut Vec<(Reduce, Vec<Expr>)>) -> Expr {
                 "max" => Reduce::Max,
                 "sum" => Reduce::Sum,
                 "first" => Reduce::First,
+                "at_max" => Reduce::AtMax,
                 // A function of a number (`sqrt`): kept, its argument rewritten.
                 _ => {
                     let args = args.iter().map(|a| summary_rewrite(a, calls)).collect();

@@ -81,7 +81,7 @@ pub trait BoundReference {
 pub type Bound = (&'static dyn Reference, Box<dyn BoundReference>);
 
 /// Every reference, by name.
-pub const ALL: &[&dyn Reference] = &[&bar::Bar, &hertz::Hertz];
+pub const ALL: &[&dyn Reference] = &[&bar::Bar, &hertz::Hertz, &hertz::impact::HertzImpact];
 
 /// The reference called `name`.
 pub fn find(name: &str) -> Option<&'static dyn Reference> {

@@ -9,6 +9,9 @@ pub const BUILTIN_VALUES: &[&str] = &["I", "n", "h", "x", "t", "pi", "inf"];
 pub const BUILTIN_FUNCTIONS: &[&str] =
     &["grad", "div", "sym", "tr", "transpose", "dot", "inner", "outer", "pos", "neg", "H", "min", "max", "abs", "sqrt"];
 
+/// Functions of a problem's numbers (params, `let`s of them), not of values that vary.
+pub const NUMBER_FUNCTIONS: &[&str] = &["ceil", "floor"];
+
 /// Functions of one scalar that are not linear, so a test function must not appear inside.
 pub const NONLINEAR: &[&str] = &["pos", "neg", "H", "min", "max", "abs", "sqrt"];
 

@@ -15,7 +15,7 @@ use crate::source::{FileId, SourceMap, Span};
 use crate::syntax::ast::{self, Expr, Ident, Shape};
 use std::collections::{BTreeSet, HashMap, HashSet};
 
-pub use builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES};
+pub use builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES, NUMBER_FUNCTIONS};
 pub use types::{Ty, const_eval};
 
 /// The value of a constant expression, if it is one.

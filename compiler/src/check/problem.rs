@@ -179,6 +179,7 @@ pub const SUMMARY_REDUCERS: &[(&str, &str, &str)] = &[
     ("max", "max(EXPR)", "the largest value"),
     ("sum", "sum(EXPR)", "the sum over the rows, in order"),
     ("first", "first(EXPR, WHEN)", "EXPR at the first row where WHEN > 0 (null if none)"),
+    ("at_max", "at_max(EXPR, OF)", "EXPR at the first row where OF is largest"),
 ];
 
 /// Functions of one number a series column or a summary key may apply (in a summary, inside or
@@ -707,7 +708,7 @@ fn summary(e: &Expr, s: &SummaryScope, in_row: bool, diags: &mut Vec<Diagnostic>
         }
         K::Call(f, args) => {
             let (want, usage) = match SUMMARY_REDUCERS.iter().find(|(n, _, _)| *n == f.name) {
-                Some((name, usage, _)) => (if *name == "first" { 2 } else { 1 }, *usage),
+                Some((name, usage, _)) => (if matches!(*name, "first" | "at_max") { 2 } else { 1 }, *usage),
                 None if SUMMARY_FUNCTIONS.contains(&f.name.as_str()) => (1, ""),
                 None => {
                     let known = SUMMARY_REDUCERS.iter().map(|(n, _, _)| *n).chain(SUMMARY_FUNCTIONS.iter().copied());

@@ -748,6 +748,25 @@ impl<'p> Checker<'p> {
                 self.error(d);
                 None
             }
+            // A problem's numbers round up or down (the lowering checks that they are numbers).
+            None if self.vectors_allowed && builtins::NUMBER_FUNCTIONS.contains(&f.name.as_str()) => {
+                if args.len() != 1 {
+                    self.arity_error(e, f, 1, args.len());
+                    return None;
+                }
+                let ty = arg_tys.into_iter().next().flatten()?;
+                if ty.shape != Shape::Scalar {
+                    self.error(Diagnostic::error(
+                        "E0301",
+                        "shape mismatch",
+                        args[0].span,
+                        format!("`{}` takes a scalar", f.name),
+                    ));
+                    return None;
+                }
+                let round = if f.name == "ceil" { f64::ceil } else { f64::floor };
+                Some(Ty { konst: ty.konst.map(round), ..ty })
+            }
             None if BUILTIN_FUNCTIONS.contains(&f.name.as_str()) => {
                 let want = builtins::arity(&f.name);
                 if want != args.len() {

@@ -340,6 +340,21 @@ impl<'p> Lowerer<'p> {
             self.calls.insert(key, v.clone());
             return Ok(v);
         }
+        if crate::check::NUMBER_FUNCTIONS.contains(&f) {
+            // `ceil`, `floor` (problems only): of numbers.
+            let Some(x) = self.g.as_const(args[0].c[0].v) else {
+                return Err(Box::new(
+                    Diagnostic::error(
+                        "E0303",
+                        format!("`{f}` of a value that varies"),
+                        span,
+                        "depends on x, t or the fields",
+                    )
+                    .with_help(format!("`{f}` takes numbers and params only")),
+                ));
+            };
+            return Ok(self.constant_val(if f == "ceil" { x.ceil() } else { x.floor() }));
+        }
         Ok(self.builtin(f, args))
     }
 

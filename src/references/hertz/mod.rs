@@ -7,6 +7,7 @@
 //! point is the origin (`forms/problems/hertz_cylinder.wf`, `hertz_ball.wf`).
 
 pub mod closed_form;
+pub mod impact;
 pub mod profile;
 
 use std::cell::RefCell;
@@ -92,34 +93,40 @@ impl Reference for Hertz {
         let (a, p0) = closed_form::static_contact(dim, radius, material.contact_modulus(), force);
         let cell_size =
             run.contact.iter().map(|f| run.mesh.cell_diameter(f.cell as usize)).fold(f64::INFINITY, f64::min);
-        Ok(Box::new(BoundHertz { dim, copies, a, p0, cell_size, samples: RefCell::new(None) }))
+        Ok(Box::new(BoundHertz { dim, copies, a, p0, cell_size, samples: Sampler::default() }))
     }
 }
 
-/// Hertz's figures for one run, and the last state's pressure samples.
+/// Hertz's figures for one run.
 struct BoundHertz {
     dim: usize,
     copies: f64,
     a: f64,
     p0: f64,
     cell_size: f64,
-    /// The samples of the last state asked for (its time and displacement's address): a row
-    /// asks for several figures of one state.
-    samples: RefCell<Option<Sampled>>,
+    samples: Sampler,
 }
 
-/// The pressure samples of one state: (its time's bits, its displacement's address), samples.
+/// The contact pressure's samples of the last state asked for: a row asks for several figures
+/// of one state.
+#[derive(Default)]
+pub(super) struct Sampler {
+    last: RefCell<Option<Sampled>>,
+}
+
+/// (A state's time bits, its displacement's address), its samples.
 type Sampled = ((u64, usize), Vec<profile::Sample>);
 
-impl BoundHertz {
-    fn with_samples<R>(&self, at: &At, f: impl FnOnce(&[profile::Sample]) -> R) -> Option<R> {
+impl Sampler {
+    /// `f` of the samples of the state `at` (none if the contact law has no `contact_pressure`).
+    pub(super) fn with<R>(&self, at: &At, f: impl FnOnce(&[profile::Sample]) -> R) -> Option<R> {
         let pressure = at.pressure?;
         let key = (at.t.to_bits(), at.u.as_ptr() as usize);
-        let mut cache = self.samples.borrow_mut();
-        if cache.as_ref().is_none_or(|(k, _)| *k != key) {
-            *cache = Some((key, profile::sample(at.asm, pressure, at.u)));
+        let mut last = self.last.borrow_mut();
+        if last.as_ref().is_none_or(|(k, _)| *k != key) {
+            *last = Some((key, profile::sample(at.asm, pressure, at.u)));
         }
-        cache.as_ref().map(|(_, s)| f(s))
+        last.as_ref().map(|(_, s)| f(s))
     }
 }
 
@@ -129,12 +136,13 @@ impl BoundReference for BoundHertz {
         match FUNCTIONALS.get(which).map(|f| f.2) {
             Some(Functional::Size) => Some(self.a),
             Some(Functional::PeakPressure) => Some(self.p0),
-            Some(Functional::MeasuredSize) => self.with_samples(at, |s| zone(s).map(|z| z.size)).flatten(),
+            Some(Functional::MeasuredSize) => self.samples.with(at, |s| zone(s).map(|z| z.size)).flatten(),
             Some(Functional::MeasuredPeakPressure) => {
-                self.with_samples(at, |s| zone(s).map(|z| z.peak_pressure)).flatten()
+                self.samples.with(at, |s| zone(s).map(|z| z.peak_pressure)).flatten()
             }
             Some(Functional::PressureError) => self
-                .with_samples(at, |s| profile::l2_error(s, |r| closed_form::pressure(self.a, self.p0, r)))
+                .samples
+                .with(at, |s| profile::l2_error(s, |r| closed_form::pressure(self.a, self.p0, r)))
                 .filter(|e| e.is_finite()),
             Some(Functional::ContactCellSize) => Some(self.cell_size),
             None => None,
@@ -146,7 +154,7 @@ impl BoundReference for BoundHertz {
     fn write(&self, dir: &Path, at: &At) -> std::io::Result<()> {
         use crate::plot::Curve;
         let (a, p0) = (self.a, self.p0);
-        let Some(measured) = self.with_samples(at, |s| profile::binned(s, 1.5 * a, 60)) else { return Ok(()) };
+        let Some(measured) = self.samples.with(at, |s| profile::binned(s, 1.5 * a, 60)) else { return Ok(()) };
         let hertz: Vec<(f64, f64)> =
             (0..=200).map(|i| 1.5 * a * i as f64 / 200.0).map(|r| (r, closed_form::pressure(a, p0, r))).collect();
         let axis = if self.dim == 2 {
