@@ -125,3 +125,35 @@ fn point_values_integrate_to_the_functional() {
     let exact = (2.0 * 10.0 * 0.05 - 0.05f64.powi(2)).sqrt();
     assert!((zone.size - exact).abs() < 5e-3, "zone {} vs {exact}", zone.size);
 }
+
+/// `at_max(radius_measured, fz_contact)` measures its column only where the force reaches a new
+/// maximum; plotting the column makes it measured at every row. The summary is the same.
+#[test]
+fn a_column_only_at_max_reads_is_measured_at_the_new_maxima_only() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("forms/problems/hertz_impact.wf")).unwrap();
+    let meshes = format!("\"{}/", root.join("assets/meshes").display());
+    let every_row = text.replace("\"../../assets/meshes/", &meshes).replace(
+        "plot \"centre of mass velocity\": vz_mean",
+        "plot \"centre of mass velocity\": vz_mean, radius_measured",
+    );
+    let dir = std::env::temp_dir().join(format!("signorini-at-max-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("every_row.wf");
+    std::fs::write(&file, every_row).unwrap();
+    let short = |problem: &str| {
+        let mut o = Options::new(problem);
+        o.setup = Setup::default().set("steps", 10.0);
+        run(&o).unwrap()
+    };
+    let (deferred, every) = (short("hertz_impact"), short(file.to_str().unwrap()));
+    let radius = |r: &signorini::problem::run::Run| r.summary.number("contact_radius").unwrap();
+    assert_eq!(radius(&deferred).to_bits(), radius(&every).to_bits());
+    // Deferred, the column is measured at fewer rows (NaN at the others; measured at every row it
+    // is NaN only where there is no contact), with the same values where it is.
+    let (a, b) = (deferred.column("radius_measured").unwrap(), every.column("radius_measured").unwrap());
+    let measured = |c: &[f64]| c.iter().filter(|x| !x.is_nan()).count();
+    assert!(measured(&a) < measured(&b), "{} rows of {} measured", measured(&a), measured(&b));
+    assert!(a.iter().zip(&b).all(|(x, y)| x.is_nan() || x.to_bits() == y.to_bits()));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -88,6 +88,8 @@ pub struct State<'a> {
     /// The displacement at the start of the step and the step (none at the initial row and at
     /// stages).
     pub before: Option<(&'a [f64], f64)>,
+    /// An intermediate stage's row (not a row of the series).
+    pub stage: bool,
 }
 
 /// The problem's series, compiled for a bound run.
@@ -108,6 +110,9 @@ pub struct Observer<'m> {
     /// Buffers a row reuses (a row's measures are small vectors: allocating them took a tenth
     /// of a 1D run).
     reuse: std::cell::RefCell<Reuse>,
+    /// Columns measured only at the series rows where another column reaches a new maximum
+    /// (NaN elsewhere): (the column, the other, its largest value so far).
+    deferred: Vec<(usize, usize, std::cell::Cell<f64>)>,
 }
 
 #[derive(Default)]
@@ -148,6 +153,7 @@ impl<'m> Observer<'m> {
             reference,
             functionals: Vec::new(),
             reuse: Default::default(),
+            deferred: Vec::new(),
         };
         let mut region_names: Vec<String> = Vec::new();
         let u = ex.field(0);
@@ -421,6 +427,19 @@ impl<'m> Observer<'m> {
         self.columns.iter().map(|c| c.1).collect()
     }
 
+    /// Measures `column` only at the series rows where column `by` exceeds its values at every
+    /// row before (NaN at the others): all `at_max(column, by)` reads of it, when nothing else
+    /// reads it. Refused (false) when `column` is written, comes before `by`, or another column
+    /// reads it.
+    pub fn defer(&mut self, column: usize, by: usize) -> bool {
+        let read = self.measures.iter().any(|m| matches!(m, Measure::Column(i) if *i == column));
+        let ok = by < column && !self.columns.get(column).is_none_or(|c| c.1) && !read;
+        if ok {
+            self.deferred.push((column, by, std::cell::Cell::new(f64::NEG_INFINITY)));
+        }
+        ok
+    }
+
     /// The reference's figures of a state into `dir`, if the problem names one.
     pub fn write_reference(&self, dir: &std::path::Path, tools: &Tools, u: &[f64], t: f64) -> std::io::Result<()> {
         match &self.reference {
@@ -464,6 +483,22 @@ impl<'m> Observer<'m> {
         }
         let mut next = 0;
         for (c, (_, _, f)) in self.columns.iter().enumerate() {
+            if let Some((_, by, best)) = self.deferred.iter().find(|(d, _, _)| *d == c)
+                && !s.stage
+            {
+                let w = columns[*by];
+                if w > best.get() {
+                    best.set(w);
+                } else {
+                    // Not a new maximum of `by`: its measures are left out (nothing else reads them).
+                    while next < self.measures.len() && !self.belongs_after(next, c) {
+                        measured.push(one(f64::NAN));
+                        next += 1;
+                    }
+                    columns.push(f64::NAN);
+                    continue;
+                }
+            }
             // The measures of this column (in the order they were added).
             while next < self.measures.len() && !self.belongs_after(next, c) {
                 let value: Vec<f64> =
@@ -634,12 +669,15 @@ struct Key {
 pub struct SummaryKeys {
     keys: Vec<Key>,
     columns: usize,
+    /// The names the reducers' expression arguments read (not plain columns).
+    read_by_expressions: Vec<String>,
 }
 
 impl SummaryKeys {
     /// `columns`: every column's name, in row order.
     pub fn new(pf: &ProblemFile, ex: &mut Exprs, columns: &[String]) -> Result<SummaryKeys, CaseError> {
         let mut keys: Vec<Key> = Vec::new();
+        let mut read_by_expressions = Vec::new();
         // In a reducer's argument: column i is measured value i, key j is measured value
         // columns + j.
         let mut row_scope: Vec<(String, Val)> =
@@ -657,6 +695,7 @@ impl SummaryKeys {
                             Arg::Column(columns.iter().position(|c| *c == n.name))
                         }
                         _ => {
+                            names_in(a, &mut read_by_expressions);
                             let val = ex.lower(a, &row_scope).map_err(|e| pf.render(*e))?;
                             Arg::Expr(ex.function(&val, a).map_err(|e| pf.render(*e))?)
                         }
@@ -675,7 +714,32 @@ impl SummaryKeys {
             row_scope.push((d.name.name.clone(), ex.measured(columns.len() + keys.len(), 1)));
             keys.push(Key { name: d.name.name.clone(), reduces, f });
         }
-        Ok(SummaryKeys { keys, columns: columns.len() })
+        Ok(SummaryKeys { keys, columns: columns.len(), read_by_expressions })
+    }
+
+    /// The (column, of) pairs of `at_max(column, of)` whose column no other reducer reads: the
+    /// column is needed only at the rows where `of` reaches a new maximum ([`Observer::defer`]).
+    pub fn at_max_columns(&self, names: &[String]) -> Vec<(usize, usize)> {
+        let reads = |c: usize, except: Option<(usize, usize)>| {
+            self.read_by_expressions.contains(&names[c])
+                || self.keys.iter().flat_map(|k| &k.reduces).any(|(r, args)| {
+                    let pair = match (r, &args[..]) {
+                        (Reduce::AtMax, [Arg::Column(Some(e)), Arg::Column(Some(w))]) => Some((*e, *w)),
+                        _ => None,
+                    };
+                    pair != except && args.iter().any(|a| matches!(a, Arg::Column(Some(i)) if *i == c))
+                })
+        };
+        let mut out = Vec::new();
+        for (r, args) in self.keys.iter().flat_map(|k| &k.reduces) {
+            if let (Reduce::AtMax, [Arg::Column(Some(e)), Arg::Column(Some(w))]) = (r, &args[..])
+                && !reads(*e, Some((*e, *w)))
+                && !out.contains(&(*e, *w))
+            {
+                out.push((*e, *w));
+            }
+        }
+        out
     }
 
     /// The keys and their values over `rows` (time, values); null where a reducer has none.
@@ -771,6 +835,25 @@ fn summary_rewrite(e: &Expr, calls: &mut Vec<(Reduce, Vec<Expr>)>) -> Expr {
         other => other.clone(),
     };
     Expr { kind, span: e.span }
+}
+
+/// Every name an expression reads.
+fn names_in(e: &Expr, out: &mut Vec<String>) {
+    match &e.kind {
+        ExprKind::Name(n) => out.push(n.name.clone()),
+        ExprKind::Neg(a) => names_in(a, out),
+        ExprKind::Binary(_, a, b) => {
+            names_in(a, out);
+            names_in(b, out);
+        }
+        ExprKind::Call(_, args) => args.iter().for_each(|a| names_in(a, out)),
+        ExprKind::Vector(items) => items.iter().for_each(|a| names_in(a, out)),
+        ExprKind::Index(a, i) => {
+            names_in(a, out);
+            names_in(i, out);
+        }
+        _ => {}
+    }
 }
 
 /// A state as a reference measures it.

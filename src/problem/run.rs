@@ -600,7 +600,7 @@ fn simulate(
     let binding = Binding { quadrature, regions, dim: mesh.dim() };
     let coef_vals = super::bind::coef_vals(pf, ex)?;
     let reference = bound_reference(pf, ex, active, &mesh, runner.tools().contact_facets, t0)?;
-    let observer = Observer::new(
+    let mut observer = Observer::new(
         pf,
         ex,
         runner.tools(),
@@ -614,6 +614,14 @@ fn simulate(
     let columns: Vec<String> = observer.names().map(str::to_string).collect();
     let shown = observer.shown();
     let summary_fns = SummaryKeys::new(pf, ex, &columns)?;
+    // A column only `at_max` reads (not written, plotted or read by another column or key) is
+    // measured only where its maximand reaches a new maximum: the contact radius at the peak
+    // force samples the pressure at those rows, not at every step.
+    for (column, by) in summary_fns.at_max_columns(&columns) {
+        if !p.plots.iter().flat_map(|pl| &pl.columns).any(|c| c.name == columns[column]) {
+            observer.defer(column, by);
+        }
+    }
     let row = |tools: &crate::simulation::Tools, state: State| {
         let t = state.t;
         let (values, switches) = observer.row(tools, &state);
@@ -641,7 +649,8 @@ fn simulate(
             let solution = crate::simulation::statics::solve(&asm, problem, &active.forms, u0)?;
             let seconds = clock.elapsed().as_secs_f64();
             let newton = solution.newton.iterations();
-            let (row, switches) = row(tools, State { t: t0, u: &solution.u, v: None, newton, before: None });
+            let (row, switches) =
+                row(tools, State { t: t0, u: &solution.u, v: None, newton, before: None, stage: false });
             snapshots.write(tools, 0, t0, &solution.u, &vec![0.0; n])?;
             let outcome =
                 crate::simulation::Outcome { step_seconds: vec![seconds], cuts: 0, stopped: None, resumed: None };
@@ -650,7 +659,7 @@ fn simulate(
         }
         Runner::Time(sim) => {
             sim.initialize_at(t0, u0, v0)?;
-            let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None };
+            let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None, stage: false };
             let (first, first_switches) = row(&sim.tools, first);
             let mut series = vec![first];
             let mut switches = vec![first_switches];
@@ -711,7 +720,8 @@ fn simulate(
                 &mut |tools, stage, v_index| {
                     if let Some(u) = stage.value_of(names[0]) {
                         let v = v_index.and_then(|i| stage.value_of(names[i]));
-                        let ((t, values), _) = row(tools, State { t: stage.time, u, v, newton: 0, before: None });
+                        let ((t, values), _) =
+                            row(tools, State { t: stage.time, u, v, newton: 0, before: None, stage: true });
                         stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
                     }
                 },
@@ -723,6 +733,7 @@ fn simulate(
                         v,
                         newton: step.report.iterations(),
                         before: Some((step.before, step.dt)),
+                        stage: false,
                     };
                     let (values, active) = row(tools, state);
                     series.push(values);
