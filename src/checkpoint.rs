@@ -136,7 +136,8 @@ fn program() -> String {
 pub fn read(dir: &Path, identity: &Identity) -> Result<(DriverState, Vec<Vec<u8>>), CaseError> {
     let path = dir.join(FILE);
     let refuse = |why: String| CaseError::Option(format!("cannot resume from {}: {why}", path.display()));
-    let bytes = std::fs::read(&path).map_err(|e| refuse(e.to_string()))?;
+    use crate::runtime::input::{MAX_CHECKPOINT_BYTES, read_bounded};
+    let bytes = read_bounded(&path, MAX_CHECKPOINT_BYTES, "checkpoint").map_err(|e| refuse(e.to_string()))?;
     if bytes.len() < 12 || &bytes[..8] != MAGIC {
         return Err(refuse("not a signorini checkpoint".into()));
     }
@@ -162,7 +163,8 @@ pub fn read(dir: &Path, identity: &Identity) -> Result<(DriverState, Vec<Vec<u8>
         return Err(refuse(format!("it records {what}, which this run does not have")));
     }
     let log = dir.join(LOG);
-    let bytes = std::fs::read(&log).map_err(|e| refuse(format!("{}: {e}", log.display())))?;
+    let bytes = read_bounded(&log, MAX_CHECKPOINT_BYTES, "checkpoint log")
+        .map_err(|e| refuse(format!("{}: {e}", log.display())))?;
     let covered = usize::try_from(file.log_len).ok().filter(|&n| n <= bytes.len());
     let Some(covered) = covered else {
         return Err(refuse(format!("{} is shorter than the checkpoint says", log.display())));

@@ -81,8 +81,26 @@ pub struct FsLoader;
 
 impl Loader for FsLoader {
     fn load(&self, path: &Path) -> std::io::Result<String> {
-        decode(std::fs::read(path)?)
+        read_source(path)
     }
+}
+
+/// The most bytes of a `.wf` file: a larger one is not a source file (`/dev/zero`, a mesh given
+/// by mistake), and is refused after reading that much.
+pub const MAX_SOURCE_BYTES: u64 = 1 << 20;
+
+/// A `.wf` file's text, read up to [`MAX_SOURCE_BYTES`].
+pub fn read_source(path: &Path) -> std::io::Result<String> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?.take(MAX_SOURCE_BYTES + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_SOURCE_BYTES {
+        return Err(std::io::Error::other(format!(
+            "larger than {} KiB, the limit of a .wf file (not a .wf file?)",
+            MAX_SOURCE_BYTES >> 10
+        )));
+    }
+    decode(bytes)
 }
 
 /// UTF-8 text without the byte-order mark some editors write; invalid UTF-8 is an error whose

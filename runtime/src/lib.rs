@@ -23,6 +23,7 @@ pub mod element;
 pub mod elements;
 pub mod evaluate;
 pub mod geometry;
+pub mod input;
 pub mod kernel;
 pub mod krylov;
 pub mod library;

@@ -153,7 +153,10 @@ fn problem_params(text: &str, file: &str, base: &Path) -> Result<Option<ProblemK
 /// It names a problem of the library (`case = "sphere"`) or a problem file (`case = "ring.wf"`,
 /// relative to the case file): the result is that problem's run.
 pub fn read(path: &Path) -> Result<crate::problem::run::Options, CaseError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CaseError::CaseFile(format!("{}: {e}", path.display())))?;
+    use crate::runtime::input::{MAX_CASE_FILE_BYTES, read_bounded};
+    let err = |e: String| CaseError::CaseFile(format!("{}: {e}", path.display()));
+    let bytes = read_bounded(path, MAX_CASE_FILE_BYTES, "case file").map_err(|e| err(e.to_string()))?;
+    let text = String::from_utf8(bytes).map_err(|_| err("not UTF-8 text".into()))?;
     parse(&text, path)
 }
 

@@ -616,6 +616,14 @@ fn bench_assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) ->
         eprintln!("error: --sizes must lie in 1..=2048");
         return ExitCode::FAILURE;
     }
+    // The P2 plane-strain unknowns of the N×N mesh, 2 (2N + 1)², against the memory there is,
+    // before anything is allocated.
+    for (what, n) in sizes.iter().map(|&n| ("--sizes", n)).chain((factor > 0).then_some(("--factor", factor))) {
+        let dofs = 2.0 * (2.0 * n as f64 + 1.0).powi(2);
+        if let Err(e) = crate::resources::check(&format!("bench assemble {what} {n}"), dofs, 2, None) {
+            return fail(e);
+        }
+    }
     let report = crate::bench::assemble(sizes, (factor > 0).then_some(factor), repeats, &mut |line| println!("{line}"));
     write_bench(&out.join("bench_assemble.json"), &report)
 }

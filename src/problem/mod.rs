@@ -54,7 +54,8 @@ pub fn load(name: &str) -> Result<ProblemFile, CaseError> {
     let is_path = name.ends_with(".wf") || name.contains('/');
     let (file, dir, text) = if is_path {
         let path = Path::new(name);
-        let text = read_text(path).map_err(|e| CaseError::CaseFile(format!("{name}: {e}")))?;
+        let text =
+            crate::compiler::source::read_source(path).map_err(|e| CaseError::CaseFile(format!("{name}: {e}")))?;
         (name.to_string(), path.parent().map(Path::to_path_buf).unwrap_or_default(), text)
     } else {
         let stem = name.replace('-', "_");
@@ -142,18 +143,4 @@ pub fn params(pf: &ProblemFile, settings: &[Setting]) -> Result<(Vec<ProblemPara
         out[i].source = Source::User;
     }
     Ok((out, rest))
-}
-
-/// Most bytes of a problem file (a larger one is not a problem file: `/dev/zero`, a mesh given
-/// by mistake).
-const MAX_FILE_BYTES: u64 = 1 << 20;
-
-fn read_text(path: &Path) -> std::io::Result<String> {
-    use std::io::Read;
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)?.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(std::io::Error::other(format!("larger than {} KiB: not a problem file", MAX_FILE_BYTES >> 10)));
-    }
-    String::from_utf8(bytes).map_err(|_| std::io::Error::other("not UTF-8 text"))
 }

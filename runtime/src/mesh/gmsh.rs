@@ -17,7 +17,8 @@ use crate::element::ElementKind;
 /// Reads a mesh file and validates its geometry.
 pub fn read(path: &Path) -> Result<Mesh, MeshError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| MeshError::File { file: file.clone(), reason: e.to_string() })?;
+    let bytes = crate::input::read_bounded(path, crate::input::MAX_MESH_BYTES, "mesh file")
+        .map_err(|e| MeshError::File { file: file.clone(), reason: e.to_string() })?;
     parse(&bytes, &file)
 }
 
