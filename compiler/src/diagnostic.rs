@@ -62,12 +62,14 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0817", "scheme: a slot that is never applied"),
     ("E0818", "scheme: a stage time that is not finite for some parameter values"),
     ("E0819", "scheme: an unknown claim, or one that is not a function of the parameters"),
+    ("E0820", "scheme: a state read at the start of a step that nothing sets at the start of the run"),
     ("E0901", "problem: no mesh"),
     ("E0905", "problem: a Dirichlet condition on a contact region"),
     ("W0001", "unused parameter (warning)"),
     ("W0002", "a scheme `let` hides another name (warning)"),
     ("W0003", "a `fn` or `form` argument hides a name of the file (warning)"),
     ("W0004", "problem: a coef set that no file in use reads (warning)"),
+    ("W0005", "scheme: a state (other than the displacement and `v`) that is never read (warning)"),
 ];
 
 /// Codes reported when a problem is bound to the files of a run (the facade's bad-input corpus

@@ -305,6 +305,7 @@ impl<'a> Compiler<'a> {
                 }
             }
         }
+        self.initial_values(def);
         let mut slots = Vec::new();
         let complete = self.diags.is_empty();
         for (u, applied) in def.uses.iter().zip(self.applied.clone()) {
@@ -453,6 +454,60 @@ impl<'a> Compiler<'a> {
             d = d.with_note("schemes apply slots, not the forms of imported files: a case binds each slot to a form");
         }
         self.error(d);
+    }
+
+    /// A state read at the start of a step needs a value at the start of the run: the
+    /// displacement (the first state) and `v` are the problem's, any other an `initial` line's
+    /// (E0820: without one it would start at zero, silently). Another state never read is W0005.
+    fn initial_values(&mut self, def: &crate::check::SchemeDef) {
+        fn names(e: &Expr, out: &mut Vec<String>) {
+            match &e.kind {
+                ExprKind::Name(n) => out.push(n.name.clone()),
+                ExprKind::Call(_, args) | ExprKind::Vector(args) => args.iter().for_each(|a| names(a, out)),
+                ExprKind::Neg(a) => names(a, out),
+                ExprKind::Binary(_, a, b) | ExprKind::Index(a, b) => {
+                    names(a, out);
+                    names(b, out);
+                }
+                ExprKind::Number(_) => {}
+            }
+        }
+        let mut read = Vec::new();
+        def.lets.iter().for_each(|(_, e)| names(e, &mut read));
+        for stage in &def.stages {
+            stage.at.iter().for_each(|e| names(e, &mut read));
+            stage.lets.iter().for_each(|(_, e)| names(e, &mut read));
+            stage.relates.iter().for_each(|r| names(&r.value, &mut read));
+            if let Some(r) = &stage.residual {
+                names(&r.lhs, &mut read);
+                names(&r.rhs, &mut read);
+            }
+        }
+        let solved = def.initial.as_ref().map(|i| i.unknown.name.as_str());
+        for (i, s) in def.states.iter().enumerate() {
+            // The displacement and `v` are also the run's output (its observables read them).
+            let output = i == 0 || s.name == "v";
+            let given = output || solved == Some(s.name.as_str());
+            if !read.contains(&s.name) && !output {
+                self.warnings.push(
+                    Diagnostic::warning("W0005", format!("state `{}` is never read", s.name), s.span, "declared here")
+                        .with_note(
+                            "its value at the start of a step does not enter the step: it is only carried along",
+                        ),
+                );
+            } else if !given {
+                self.error(
+                    Diagnostic::error(
+                        "E0820",
+                        format!("state `{}` is read before anything sets it", s.name),
+                        s.span,
+                        "read at the start of every step, and of the first",
+                    )
+                    .with_note("the problem gives the displacement (the first state) and `v`; any other state starts from an `initial` line")
+                    .with_help(format!("solve for it at t = 0: `initial {}: ... == ...`", s.name)),
+                );
+            }
+        }
     }
 
     /// Every name applied in the scheme's residuals, in order of appearance.
