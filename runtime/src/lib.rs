@@ -30,6 +30,7 @@ pub mod library;
 pub mod linalg;
 pub mod lower_half;
 pub mod lowrank;
+pub mod lumping;
 pub mod mesh;
 pub mod newton;
 pub mod pattern;

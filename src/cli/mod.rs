@@ -751,7 +751,8 @@ fn run_problem(problem: &str, a: ProblemArgs) -> ExitCode {
 /// `run PROBLEM --all`: every scheme × contact law × mass matrix, one line each with the
 /// problem's own summary keys.
 fn run_problem_all(base: crate::problem::run::Options, setup: Setup) -> ExitCode {
-    let masses = [(MassChoice::Consistent, "consistent"), (MassChoice::Redistributed, "redistributed")];
+    // The masses of the implicit schemes' comparison (lumped is for explicit ones).
+    let masses = [MassChoice::Consistent, MassChoice::Redistributed].map(|m| (m, m.name()));
     // The problem's own params (`ne`, or `bar.ne`) apply to every run: checked once.
     let rest = match crate::problem::load(&base.problem).and_then(|pf| crate::problem::params(&pf, &setup.params)) {
         Ok((_, rest)) => rest,

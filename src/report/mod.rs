@@ -17,13 +17,6 @@ use crate::simulation::MassChoice;
 mod hertz;
 pub mod sweep;
 
-fn mass_name(m: MassChoice) -> &'static str {
-    match m {
-        MassChoice::Consistent => "consistent",
-        MassChoice::Redistributed => "redistributed",
-    }
-}
-
 /// Runs everything and writes `out/report.md` (and the runs' files below `out`).
 /// `quick`: sections 1 and 2 only.
 pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<(), CaseError> {
@@ -52,7 +45,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     let mut figures = String::new();
     let default_contact = &crate::settings::get().defaults.contact;
     for &(scheme, contact, mass) in &runs {
-        let label = format!("{scheme}-{contact}-{}", mass_name(mass));
+        let label = format!("{scheme}-{contact}-{}", mass.name());
         let dir = out.join("bar").join(&label);
         progress(&format!("bar {label}"));
         let setup = Setup { scheme: scheme.into(), contact: contact.into(), ..Setup::default() };
@@ -62,7 +55,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         let _ = writeln!(
             md,
             "| {scheme} {contact} {} | {:.4} | {} | {} | {:.5} | {:.5} | {:.2e} | {}/{} |",
-            mass_name(mass),
+            mass.name(),
             s.err_linf_l2_u,
             crate::cli::optional(s.err_l2_lambda, 4),
             crate::cli::optional(s.err_l2_lambda_half, 4),

@@ -8,7 +8,6 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::mass_name;
 use crate::cases::bar;
 use crate::cases::{CaseError, disc};
 use crate::driver::Setup;
@@ -129,10 +128,10 @@ pub fn run(progress: &mut dyn FnMut(&str), cases: &[Case]) -> Sweeps {
     for &Case { name: case, steps, measure } in cases {
         for scheme in crate::driver::all_schemes() {
             for mass in MASSES {
-                progress(&format!("{case} Δt sweep {scheme} {}", mass_name(mass)));
+                progress(&format!("{case} Δt sweep {scheme} {}", mass.name()));
                 for &dt in steps {
                     let outcome = measure(scheme, mass, dt).map_err(|e| e.to_string());
-                    points.push(Point { case, scheme: scheme.into(), mass: mass_name(mass), dt, outcome });
+                    points.push(Point { case, scheme: scheme.into(), mass: mass.name(), dt, outcome });
                 }
             }
         }
@@ -158,7 +157,7 @@ impl Sweeps {
         let mut cases: Vec<&str> = self.points.iter().map(|p| p.case).collect();
         cases.dedup();
         let columns: Vec<(&str, &str)> =
-            cases.iter().flat_map(|&c| MASSES.iter().map(move |&m| (c, mass_name(m)))).collect();
+            cases.iter().flat_map(|&c| MASSES.iter().map(move |&m| (c, m.name()))).collect();
         md.push_str("| scheme |");
         for (case, mass) in &columns {
             let _ = write!(md, " {case}, {mass} |");
@@ -230,7 +229,7 @@ impl Sweeps {
                 .flat_map(|&m| {
                     crate::driver::all_schemes().into_iter().map(move |s| {
                         let tag = if m == MassChoice::Redistributed { " (redistributed)" } else { "" };
-                        (format!("{s}{tag}"), s, mass_name(m))
+                        (format!("{s}{tag}"), s, m.name())
                     })
                 })
                 .collect();

@@ -48,6 +48,19 @@ pub enum MassChoice {
     Consistent,
     /// Mass redistribution (docs/mathematics.md §4): no inertia at the contact node.
     Redistributed,
+    /// A diagonal mass (row sums on P1, the scaled diagonal on P2), for explicit schemes.
+    Lumped,
+}
+
+impl MassChoice {
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            MassChoice::Consistent => "consistent",
+            MassChoice::Redistributed => "redistributed",
+            MassChoice::Lumped => "lumped",
+        }
+    }
 }
 
 /// What the observers measure with: bound functionals, a fresh contact form, and the linear
@@ -245,19 +258,29 @@ impl<'m> Parts<'m> {
             None => Vec::new(),
         };
         let redistributed = problem.mass == MassChoice::Redistributed;
-        if redistributed && !inertia {
-            return Err(CaseError::Option(
-                "--mass redistributed: the scheme has no inertia (it applies no `mass`) to redistribute".into(),
-            ));
+        if problem.mass != MassChoice::Consistent && !inertia {
+            return Err(CaseError::Option(format!(
+                "--mass {}: the scheme has no inertia (it applies no `mass`)",
+                problem.mass.name()
+            )));
         }
-        let scheme_mass = if redistributed {
-            let r = crate::runtime::redistribute::redistribute(mesh, &mass, &contact_nodes)
-                .map_err(|e| CaseError::Option(e.to_string()))?;
-            let i = slot(&forms, "mass")?;
-            forms[i] = ("mass", Box::new(MatrixForm { name: "mass".into(), matrix: r.matrix.clone() }));
-            r.matrix
-        } else {
-            mass.clone()
+        // The scheme's mass replaces the material's in its `mass` slot.
+        let scheme_mass = match problem.mass {
+            MassChoice::Consistent => None,
+            MassChoice::Redistributed => Some(
+                crate::runtime::redistribute::redistribute(mesh, &mass, &contact_nodes)
+                    .map_err(|e| CaseError::Option(e.to_string()))?
+                    .matrix,
+            ),
+            MassChoice::Lumped => Some(crate::runtime::lumping::lumped(&mass, mesh.kind.degree(), mesh.dim())),
+        };
+        let scheme_mass = match scheme_mass {
+            Some(matrix) => {
+                let i = slot(&forms, "mass")?;
+                forms[i] = ("mass", Box::new(MatrixForm { name: "mass".into(), matrix: matrix.clone() }));
+                matrix
+            }
+            None => mass.clone(),
         };
         let tools = Tools {
             asm,
