@@ -82,6 +82,18 @@ pub struct SchemeDesc {
     pub coefficients: usize,
 }
 
+impl SchemeDesc {
+    /// Whether every stage is explicit: only `mass` acts on its unknown, so a step solves with
+    /// the mass matrix alone (central differences). A mass with massless dofs (redistributed)
+    /// cannot be solved for them.
+    pub fn explicit(&self) -> bool {
+        !self.stages.is_empty()
+            && self.stages.iter().all(|s| {
+                s.terms.iter().filter(|t| t.args.iter().any(|c| c.unknown.is_some())).all(|t| t.form == "mass")
+            })
+    }
+}
+
 /// A solved stage: its name, its time and its quantities (the unknown first), named as in the
 /// scheme's file.
 pub struct StageView<'v> {

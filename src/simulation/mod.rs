@@ -353,8 +353,14 @@ impl<'m> Simulation<'m> {
         let prescribed = problem.prescribed.take();
         let Parts { mut tools, forms, inertia } = Parts::build(asm, problem, active)?;
         tools.held = prescribed.as_ref().map_or_else(Vec::new, |p| p.dofs.clone());
-        let mut stepper =
-            Stepper::new(active.time_scheme()?, asm, forms, constraints.clone(), Structure::Auto, newton)?;
+        let scheme = active.time_scheme()?;
+        if tools.redistributed && scheme.desc().explicit() {
+            return Err(CaseError::Option(format!(
+                "--mass redistributed: scheme `{}` is explicit (only `mass` acts on its unknown), and the redistributed mass leaves the contact nodes without inertia: their accelerations cannot be solved for at any Δt; use --mass consistent or --mass lumped",
+                scheme.desc().name
+            )));
+        }
+        let mut stepper = Stepper::new(scheme, asm, forms, constraints.clone(), Structure::Auto, newton)?;
         if let Some(p) = prescribed {
             stepper.prescribe(p)?;
         }
