@@ -48,7 +48,19 @@ pub struct DriverState {
     pub energy_work: f64,
     /// The work of a time-dependent load so far.
     pub energy_varying_work: f64,
+    /// The contact law's own work so far (Nitsche θ ≠ 1).
+    pub energy_law_work: f64,
     pub energy_u0: Vec<f64>,
+    /// The largest kinetic energy so far and the largest growth (the guard's scale and record).
+    pub energy_kinetic: f64,
+    pub energy_growth: f64,
+    /// The law's `contact_jump` after the last step (a conserving scheme's allowance).
+    pub energy_contact: f64,
+    /// The lowest E_aug − W so far (a dissipative scheme's bound).
+    pub energy_lowest: f64,
+    /// A conserving scheme's allowance so far, and its active set after the last step.
+    pub energy_allowance: f64,
+    pub energy_switches: Vec<bool>,
     pub states: Vec<Vec<f64>>,
     /// Written every N steps (resumes bit for bit), or on an interrupt (to round-off).
     pub periodic: bool,
@@ -250,7 +262,14 @@ mod tests {
             energy_initial: 1.5,
             energy_work: 0.0,
             energy_varying_work: 0.0,
+            energy_law_work: 0.0,
             energy_u0: vec![0.0, 1.0],
+            energy_kinetic: 0.5,
+            energy_growth: 0.0,
+            energy_contact: 0.0,
+            energy_lowest: 1.5,
+            energy_allowance: 0.0,
+            energy_switches: vec![true],
             states: vec![vec![f64::NAN, -0.0, 1e-300], vec![f64::INFINITY, 2.0, 3.0]],
             periodic: true,
         }

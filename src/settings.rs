@@ -11,6 +11,14 @@ pub struct Settings {
     pub defaults: Defaults,
     pub report: Report,
     pub verify: Verify,
+    pub bench: Bench,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bench {
+    /// `bench disc`: the explicit run timed beside the default one, (scheme, mass matrix).
+    pub disc_explicit: (String, String),
 }
 
 #[derive(Debug, Deserialize)]

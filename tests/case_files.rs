@@ -73,7 +73,7 @@ fn mistakes_are_reported_with_their_line() {
         (
             "other_case.toml",
             "case = \"disc\"\nne = 5\n",
-            ":2: unknown field `ne`, expected one of `case`, `scheme`, `contact`, `material`, `forms`, `params`, `alpha`, `theta`, `gamma0`, `mass`, `cell_size`, `dt`, `t_end`, `t_start`, `out`, `mesh`, `max_step_cuts`, `max_energy_growth`; nor a param of problem `disc` (its params: h)",
+            ":2: unknown field `ne`, expected one of `case`, `scheme`, `contact`, `material`, `forms`, `params`, `alpha`, `theta`, `gamma0`, `mass`, `cell_size`, `dt`, `t_end`, `t_start`, `out`, `mesh`, `max_step_cuts`, `energy_tolerance`, `allow_unstable_dt`; nor a param of problem `disc` (its params: h)",
         ),
         (
             "name.toml",

@@ -120,11 +120,12 @@ fn gmsh_mesh_and_built_in_generator_agree() {
 
 #[test]
 fn an_unstable_setting_fails_with_a_clear_error() {
-    // Nitsche θ = 1 with γ0 = 2E is not coercive: the free fall already diverges, and the
-    // energy check stops it within the first second, long before the values overflow.
+    // Nitsche θ = 1 with γ0 = 2E is not coercive: the free fall already diverges while E_aug
+    // is kept, its potential part going negative, and the energy guard stops it within the
+    // first second, long before the values overflow.
     let o = Options { setup: Setup::default().set("gamma0", 100.0), h: 2.0, t_end: 20.0, ..Options::default() };
     let e = disc::run(&o).err().expect("diverges").to_string();
-    assert!(e.contains("unstable") && e.contains("gamma0 = 100"), "{e}");
+    assert!(e.contains("not coercive") && e.contains("gamma0 = 100"), "{e}");
     let t: f64 = e.trim_start_matches("stopped at t = ").split(':').next().unwrap().parse().unwrap();
     assert!(t < 2.0, "stopped at {t}");
 }

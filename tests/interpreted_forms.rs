@@ -319,7 +319,7 @@ unit_test!(
     "forms/contact_nitsche.wf",
     |d| contact_nitsche::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact, HybridContact],
-    functionals: [ContactEnergy, ContactPressure, ContactTrial]
+    functionals: [ContactEnergy, ContactWork, ContactJump, ContactPressure, ContactTrial]
 );
 
 unit_test!(
@@ -328,7 +328,7 @@ unit_test!(
     "forms/contact_nitsche_traction.wf",
     |d| contact_nitsche_traction::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact, HybridContact],
-    functionals: [ContactEnergy, ContactPressure, ContactTrial]
+    functionals: [ContactEnergy, ContactWork, ContactJump, ContactPressure, ContactTrial]
 );
 
 unit_test!(
@@ -337,7 +337,7 @@ unit_test!(
     "forms/contact_penalty.wf",
     |d| contact_penalty::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact, HybridContact],
-    functionals: [ContactEnergy, ContactPressure, ContactTrial]
+    functionals: [ContactEnergy, ContactJump, ContactPressure, ContactTrial]
 );
 
 fn bound<'m, K: Kernel + 'm>(kernel: K, contact: &'m [Facet]) -> Box<dyn BoundForm + 'm> {
@@ -420,7 +420,9 @@ fn errors_name_the_problem() {
     let e = err(lib.form("contakt", 2, &[], &coefs));
     assert!(
         e.contains("`contakt`")
-            && e.contains("contact, contact_energy, contact_pressure, contact_trial, hybrid_contact"),
+            && e.contains(
+                "contact, contact_energy, contact_work, contact_jump, contact_pressure, contact_trial, hybrid_contact"
+            ),
         "{e}"
     );
     let e = err(lib.form("contact", 2, &[("gamma", 1.0)], &coefs));

@@ -64,7 +64,9 @@ fn a_users_generalized_alpha_has_order_two_and_its_rho_infinity() {
         // Second order: the period error falls 100-fold per decade of ωΔt at small steps.
         let e = |k: usize| v.spectrum[k].period_error.unwrap();
         assert!((e(0) / e(8) - 1e-2).abs() < 2e-3, "period error {} → {}", e(0), e(8));
-        assert_eq!(v.verdicts.len(), 2);
+        // order, ρ∞, and the stability at every ωΔt that a claimed ρ∞ implies.
+        assert_eq!(v.verdicts.len(), 3);
+        assert!(v.stability_limit.is_none(), "{:?}", v.stability_limit);
         assert!(v.holds(), "{:?}", v.verdicts);
         assert!(v.bar_orders.iter().all(|b| (b.order - 2.0).abs() < 0.2), "{:?}", v.bar_orders);
     }

@@ -237,6 +237,33 @@ impl std::ops::Add for Counters {
     }
 }
 
+/// The inverse of `a`'s diagonal if every entry off it is zero (none otherwise, after the first
+/// nonzero found); a zero on it is singular, a non-positive one not positive definite.
+fn diagonal_inverse(a: &Matrix, structure: Structure) -> Result<Option<Vec<f64>>, LinalgError> {
+    let p = &a.pattern;
+    let n = a.size();
+    let mut diagonal = vec![0.0; n];
+    for j in 0..n {
+        for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+            if p.row_idx[k] == j {
+                diagonal[j] = a.values[k];
+            } else if a.values[k] != 0.0 {
+                return Ok(None);
+            }
+        }
+    }
+    for (index, d) in diagonal.iter_mut().enumerate() {
+        if structure == Structure::SymmetricPositiveDefinite && *d <= 0.0 {
+            return Err(LinalgError::NotPositiveDefinite { index });
+        }
+        if *d == 0.0 || !d.is_finite() {
+            return Err(LinalgError::Singular { index: Some(index) });
+        }
+        *d = 1.0 / *d;
+    }
+    Ok(Some(diagonal))
+}
+
 /// How a `Factorization` solves: a sparse direct factorization, preconditioned Krylov
 /// iterations (conjugate gradients for SPD matrices, BiCGStab otherwise; memory of the matrix
 /// only), or by size: direct in 1D, iterative above [`AUTO_ITERATIVE_DOFS`] unknowns in 2D and 3D.
@@ -281,6 +308,8 @@ impl Solver {
 enum Factors {
     None,
     Krylov(Box<crate::krylov::Krylov>),
+    /// A diagonal matrix's inverse (a lumped mass: an explicit scheme's step is a division).
+    Diagonal(Vec<f64>),
     /// faer's factor, and its copy in node blocks that the solves use (faer's values are then
     /// dropped until the next factorization).
     Llt {
@@ -343,6 +372,11 @@ impl Factorization {
     /// always.
     pub fn factor(&mut self, a: &Matrix) -> Result<(), LinalgError> {
         let n = a.size();
+        if let Some(inverse) = diagonal_inverse(a, self.structure)? {
+            self.factors = Factors::Diagonal(inverse);
+            self.pattern = None;
+            return Ok(());
+        }
         if self.solver.iterates(n, a.pattern.dim()) {
             // Keep the last solution as the next first guess across refactorizations.
             let last = match std::mem::replace(&mut self.factors, Factors::None) {
@@ -435,7 +469,9 @@ impl Factorization {
                 )?;
                 *factored = true;
             }
-            Factors::None | Factors::Krylov(_) => unreachable!("symbolic analysis done above"),
+            Factors::None | Factors::Krylov(_) | Factors::Diagonal(_) => {
+                unreachable!("symbolic analysis done above")
+            }
         }
         Ok(())
     }
@@ -450,7 +486,7 @@ impl Factorization {
             Factors::Lu { symbolic, .. } => {
                 Factors::Lu { symbolic: symbolic.clone(), numeric: Box::new(NumericLu::new()), factored: false }
             }
-            Factors::None | Factors::Krylov(_) => Factors::None,
+            Factors::None | Factors::Krylov(_) | Factors::Diagonal(_) => Factors::None,
         };
         let pattern = if matches!(factors, Factors::None) { None } else { self.pattern.clone() };
         Factorization {
@@ -505,6 +541,13 @@ impl Factorization {
     /// direct factorization.
     pub fn solve_many_in_place(&mut self, b: &mut [f64], ncols: usize) -> Result<(), LinalgError> {
         let n = b.len() / ncols.max(1);
+        if let Factors::Diagonal(inverse) = &self.factors {
+            for x in b.chunks_exact_mut(n.max(1)) {
+                x.iter_mut().zip(inverse).for_each(|(x, d)| *x *= d);
+            }
+            self.counters.solves += ncols;
+            return Ok(());
+        }
         let par = self.par;
         let rhs = MatMut::from_column_major_slice_mut(b, n, ncols);
         match &self.factors {
@@ -546,6 +589,11 @@ impl Factorization {
     /// Solves `A x = b` in place with the last factorization; a non-finite result (a
     /// numerically singular matrix) is an error.
     pub fn solve_in_place(&mut self, b: &mut [f64]) -> Result<(), LinalgError> {
+        if let Factors::Diagonal(inverse) = &self.factors {
+            b.iter_mut().zip(inverse).for_each(|(x, d)| *x *= d);
+            self.counters.solves += 1;
+            return Ok(());
+        }
         if let Factors::Krylov(k) = &mut self.factors {
             let result = k.solve_in_place(b);
             self.counters.iterations += k.iterations;

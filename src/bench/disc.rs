@@ -63,6 +63,19 @@ pub struct DiscTiming {
     pub cache_gb_s: f64,
     pub cache_model_ms: f64,
     pub measured_over_cache_model: f64,
+    /// The explicit run of forms/library.toml (central differences, lumped mass): its
+    /// median ms/step, its factorizations, and its estimated critical step.
+    #[serde(default)]
+    pub explicit: Option<ExplicitTiming>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ExplicitTiming {
+    pub scheme: String,
+    pub mass: String,
+    pub ms_per_step: f64,
+    pub factorizations: usize,
+    pub stable_dt: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -96,6 +109,7 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
         let model_ms = 1e3 * model_bytes / stream;
         let cache = triad_bandwidth(model_bytes as usize);
         let cache_model_ms = 1e3 * model_bytes / cache;
+        let explicit = explicit_timing(&opts, repeats)?;
         let fastest = mean.iter().copied().fold(f64::INFINITY, f64::min);
         let slowest = mean.iter().copied().fold(0.0, f64::max);
         let ms_per_step = median(mean);
@@ -122,6 +136,7 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             cache_gb_s: cache / 1e9,
             cache_model_ms,
             measured_over_cache_model: ms_per_step / cache_model_ms,
+            explicit,
         };
         progress(&format!(
             "{}: {} dofs, {} steps, {} Newton iterations, {} factorizations, {} low-rank updates; {:.3} ms/step stepping (runs {:.3}–{:.3}; median step {:.3} ms), {:.3} ms/step whole run; model {:.3} ms ({:.2} MB at STREAM's {:.1} GB/s), measured/model {:.2} (median step/model {:.2}); in cache {:.3} ms (at {:.1} GB/s), measured/model {:.2}",
@@ -145,9 +160,49 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             t.cache_gb_s,
             t.measured_over_cache_model
         ));
+        if let Some(e) = &t.explicit {
+            progress(&format!(
+                "{}: {} with {} mass: {:.3} ms/step stepping, {} factorizations, Δt_c ≈ {}",
+                t.mesh,
+                e.scheme,
+                e.mass,
+                e.ms_per_step,
+                e.factorizations,
+                e.stable_dt.map_or("—".into(), |d| format!("{d:.4}"))
+            ));
+        }
         out.push(t);
     }
     Ok(Report { dt: base.dt, t_end: base.t_end, repeats, meshes: out })
+}
+
+/// The explicit run of forms/library.toml on the same mesh (its summary keys `stable_dt` and
+/// `factorizations`); none when the run is refused (Δt above its critical step on this mesh).
+fn explicit_timing(opts: &Options, repeats: usize) -> Result<Option<ExplicitTiming>, CaseError> {
+    let (scheme, mass) = &crate::settings::get().bench.disc_explicit;
+    let mass = <crate::simulation::MassChoice as clap::ValueEnum>::from_str(mass, true)
+        .map_err(|e| CaseError::Option(format!("forms/library.toml [bench]: {e}")))?;
+    let setup = crate::driver::Setup { scheme: scheme.clone(), ..opts.setup.clone() };
+    let opts = Options { setup, mass, ..opts.clone() };
+    let mut per_step = Vec::new();
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let run = match disc::run(&opts) {
+            Ok(r) => r,
+            Err(CaseError::UnstableStep { .. }) => return Ok(None),
+            Err(e) => return Err(e),
+        };
+        per_step.push(run.summary.stepping_seconds / run.summary.steps.max(1) as f64 * 1e3);
+        last = Some(run);
+    }
+    let run = last.expect("at least one run");
+    Ok(Some(ExplicitTiming {
+        scheme: scheme.clone(),
+        mass: mass.name().into(),
+        ms_per_step: median(per_step),
+        factorizations: run.summary.factorizations,
+        stable_dt: run.summary.stable_dt,
+    }))
 }
 
 /// The last run's `dir/bench_disc.json`, if there is one.

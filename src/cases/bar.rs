@@ -113,6 +113,10 @@ pub struct Summary {
     pub wall_seconds: f64,
     /// Halvings of Δt after a failed Newton (the series has the actual time levels).
     pub step_cuts: usize,
+    /// The energy guard's largest growth of E_aug over the energy scale.
+    pub energy_growth: f64,
+    /// An explicit scheme's estimated critical step.
+    pub stable_dt: Option<f64>,
     /// Why the run ended before t_end, if it did (the series stops at the last good step).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stopped: Option<String>,
@@ -206,6 +210,8 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         newton_max: count("newton_max"),
         wall_seconds: number("wall_seconds"),
         step_cuts: count("step_cuts"),
+        energy_growth: number("energy_growth"),
+        stable_dt: s.get("stable_dt").and_then(|v| v.as_f64()),
         stopped: s.get("stopped").and_then(|v| v.as_str()).map(str::to_string),
         resumed: s.field("resumed")?,
         notes: s.field::<Option<Vec<String>>>("notes")?.unwrap_or_default(),

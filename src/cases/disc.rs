@@ -170,6 +170,11 @@ pub struct Summary {
     pub peak_memory_bytes: Option<u64>,
     /// Halvings of Δt after a failed Newton (the series has the actual time levels).
     pub step_cuts: usize,
+    /// The energy guard's largest growth of E_aug over the energy scale.
+    pub energy_growth: f64,
+    /// An explicit scheme's estimated critical step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stable_dt: Option<f64>,
     /// Why the run ended before t_end, if it did (the series stops at the last good step).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stopped: Option<String>,
@@ -294,6 +299,8 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         krylov_iterations: count("krylov_iterations"),
         peak_memory_bytes: s.get("peak_memory_bytes").and_then(|v| v.as_u64()),
         step_cuts: count("step_cuts"),
+        energy_growth: number("energy_growth"),
+        stable_dt: s.get("stable_dt").and_then(|v| v.as_f64()),
         stopped: s.get("stopped").and_then(|v| v.as_str()).map(str::to_string),
         resumed: s.field("resumed")?,
     };

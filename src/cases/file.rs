@@ -40,9 +40,11 @@ struct CaseFile {
     out: Option<Spanned<String>>,
     /// A Gmsh file instead of the problem's mesh.
     mesh: Option<Spanned<String>>,
-    /// Step cuts and the energy check (`--max-step-cuts`, `--max-energy-growth`).
+    /// Step cuts and the energy check (`--max-step-cuts`, `--energy-tolerance`).
     max_step_cuts: Option<Spanned<i64>>,
-    max_energy_growth: Option<Spanned<f64>>,
+    energy_tolerance: Option<Spanned<f64>>,
+    /// `--allow-unstable-dt`.
+    allow_unstable_dt: Option<Spanned<bool>>,
 }
 
 struct Reader<'a> {
@@ -239,6 +241,7 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
         compiled: Vec::new(),
         params: Vec::new(),
         guard: crate::simulation::Guard {
+            allow_unstable_dt: parsed.allow_unstable_dt.as_ref().map_or(d.guard.allow_unstable_dt, |b| *b.get_ref()),
             max_step_cuts: match &parsed.max_step_cuts {
                 None => d.guard.max_step_cuts,
                 Some(s) if (0..=MAX_STEP_CUTS as i64).contains(s.get_ref()) => *s.get_ref() as usize,
@@ -246,12 +249,12 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
                     return Err(r.error(s, "max_step_cuts", format!("{} is not in 0..={MAX_STEP_CUTS}", s.get_ref())));
                 }
             },
-            max_energy_growth: r.number(
-                &parsed.max_energy_growth,
-                "max_energy_growth",
+            energy_tolerance: r.number(
+                &parsed.energy_tolerance,
+                "energy_tolerance",
                 |x| x >= 0.0,
                 "0 (off) or positive",
-                d.guard.max_energy_growth,
+                d.guard.energy_tolerance,
             )?,
         },
     };

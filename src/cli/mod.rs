@@ -285,10 +285,13 @@ pub struct MethodArgs {
     /// Halvings of Δt allowed when a step's Newton fails (Δt doubles back after two good steps).
     #[arg(long, default_value_t = 6, value_parser = step_cuts)]
     max_step_cuts: usize,
-    /// Stop when ½uᵀKu + ½vᵀMv exceeds this many times its initial value plus the loads' work
-    /// (0: never).
-    #[arg(long, default_value_t = 10.0, value_parser = non_negative)]
-    max_energy_growth: f64,
+    /// Stop when E_aug (elastic + kinetic + contact energy) exceeds E_aug(0) + the loads' work
+    /// by this fraction of the problem's energy scale (0: never).
+    #[arg(long, default_value_t = crate::simulation::ENERGY_TOLERANCE, value_parser = non_negative)]
+    energy_tolerance: f64,
+    /// Run an explicit scheme (one that claims `cfl`) above its estimated critical step Δt_c.
+    #[arg(long)]
+    allow_unstable_dt: bool,
     /// Backtracking line search in Newton (halving the step while ‖R‖ does not decrease).
     #[arg(long)]
     line_search: bool,
@@ -304,7 +307,7 @@ fn step_cuts(s: &str) -> Result<usize, String> {
     }
 }
 
-/// `--max-energy-growth` (0: off) and `--tol`: a number ≥ 0.
+/// `--energy-tolerance` (0: off) and `--tol`: a number ≥ 0.
 fn non_negative(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(x) if x >= 0.0 && x.is_finite() => Ok(x),
@@ -350,7 +353,8 @@ impl MethodArgs {
             params,
             guard: crate::simulation::Guard {
                 max_step_cuts: self.max_step_cuts,
-                max_energy_growth: self.max_energy_growth,
+                energy_tolerance: self.energy_tolerance,
+                allow_unstable_dt: self.allow_unstable_dt,
             },
         })
     }

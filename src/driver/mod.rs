@@ -259,11 +259,22 @@ impl Active {
     /// What the scheme's file claims (`claim order = 2`, `claim rho_inf = rho`), at the param
     /// values in use.
     pub fn scheme_claims(&self) -> Result<Vec<(String, f64)>, CaseError> {
+        let params = self.forms.params.scheme_values(self.scheme.params());
+        Ok(self.scheme_ir()?.map_or_else(Vec::new, |ir| ir.claims_at(&params)))
+    }
+
+    /// The energy law the scheme's file claims (`claim energy = conserving`), if it does.
+    pub fn scheme_energy_law(&self) -> Result<Option<crate::compiler::scheme::EnergyLaw>, CaseError> {
+        Ok(self.scheme_ir()?.and_then(|ir| ir.energy))
+    }
+
+    /// The scheme's compiled file (none for a scheme compiled by a crate of its own: there is
+    /// no source here).
+    fn scheme_ir(&self) -> Result<Option<crate::compiler::scheme::SchemeIr>, CaseError> {
         use crate::compiler::{MemLoader, check_path};
         let name = self.scheme_name();
         let programs = match &self.scheme {
-            // The library file that declares it (a scheme compiled by a crate of its own has
-            // no source here: it claims nothing).
+            // The library file that declares it.
             SchemeSource::Compiled(_) => crate::forms::SCHEME_SOURCES
                 .iter()
                 .filter(|(_, text)| text.contains(&format!("scheme {name}")))
@@ -276,11 +287,11 @@ impl Active {
         };
         for compiled in programs {
             let (program, _) = compiled.map_err(|f| CaseError::Option(f.rendered))?;
-            if let Some(ir) = program.schemes.iter().find(|s| s.name == name) {
-                return Ok(ir.claims_at(&self.forms.params.scheme_values(self.scheme.params())));
+            if let Some(ir) = program.schemes.into_iter().find(|s| s.name == name) {
+                return Ok(Some(ir));
             }
         }
-        Ok(Vec::new())
+        Ok(None)
     }
 
     /// The forms the scheme applies, bound; errors name the slot's declaration.

@@ -652,8 +652,13 @@ fn simulate(
             let (row, switches) =
                 row(tools, State { t: t0, u: &solution.u, v: None, newton, before: None, stage: false });
             snapshots.write(tools, 0, t0, &solution.u, &vec![0.0; n])?;
-            let outcome =
-                crate::simulation::Outcome { step_seconds: vec![seconds], cuts: 0, stopped: None, resumed: None };
+            let outcome = crate::simulation::Outcome {
+                step_seconds: vec![seconds],
+                cuts: 0,
+                stopped: None,
+                resumed: None,
+                energy_growth: 0.0,
+            };
             let last = (t0, solution.u);
             (vec![row], vec![switches], vec![newton], Vec::new(), outcome, solution.counters, 0, last)
         }
@@ -805,10 +810,20 @@ fn simulate(
         Runner::Static(_) => None,
     };
     put("factor_nnz", json(&factor_nnz));
+    // An explicit scheme's critical step, estimated at the start (docs/language.md).
+    if let Runner::Time(sim) = &runner
+        && let Some(stable) = sim.stable
+    {
+        put("stable_dt", json(&stable.dt));
+        put("omega_max", json(&stable.omega_max));
+    }
     put("solver", json(&opts.newton.solver));
     put("krylov_iterations", counters.iterations.into());
     put("peak_memory_bytes", json(&crate::bench::peak_memory()));
     put("step_cuts", outcome.cuts.into());
+    if !statics {
+        put("energy_growth", json(&outcome.energy_growth));
+    }
     if let Some(stopped) = &outcome.stopped {
         put("stopped", stopped.to_string().into());
     }

@@ -9,6 +9,7 @@ use std::time::Instant;
 
 use crate::cases::CaseError;
 use crate::checkpoint::Control;
+use crate::compiler::scheme::EnergyLaw;
 use crate::driver::Active;
 use crate::runtime::assembly::{Assembler, Quadrature};
 use crate::runtime::kernel::Coef;
@@ -21,6 +22,7 @@ use crate::runtime::problem::Constraints;
 use crate::runtime::scheme::{BoundForm, MatrixForm, StageView, StepReport, Stepper};
 use std::sync::Arc;
 
+pub mod stability;
 pub mod statics;
 
 /// What a case gives the driver.
@@ -71,6 +73,12 @@ pub struct Tools<'m> {
     /// The `contact` slot, for its residual (the contact force) and its switches (the active set).
     pub probe: Option<Box<dyn BoundForm + 'm>>,
     pub contact_energy: Option<Box<dyn BoundFunctional + 'm>>,
+    /// The most a conserving scheme's E_aug may jump where contact starts or ends (the energy
+    /// guard's allowance).
+    pub contact_jump: Option<Box<dyn BoundFunctional + 'm>>,
+    /// The work over a step of the part of the law the energy does not keep (Nitsche θ ≠ 1),
+    /// a functional of the step's end and start displacements.
+    pub contact_work: Option<Box<dyn BoundFunctional + 'm>>,
     pub contact_pressure: Option<Box<dyn BoundFunctional + 'm>>,
     pub contact_trial: Option<Box<dyn BoundFunctional + 'm>>,
     pub von_mises: Option<Box<dyn BoundFunctional + 'm>>,
@@ -88,6 +96,8 @@ pub struct Tools<'m> {
     pub contact_nodes: Vec<u32>,
     /// The mass is redistributed: the contact nodes carry none.
     pub redistributed: bool,
+    /// The mass the scheme steps with.
+    pub mass_choice: MassChoice,
     /// The dofs held at moving values: the energy check adds the work of their reactions.
     pub held: Vec<usize>,
     /// The energies' quadratic forms, ½uᵀKu and ½vᵀMv with the scheme's mass, evaluated every
@@ -287,6 +297,8 @@ impl<'m> Parts<'m> {
             contact_facets,
             probe: active.forms.instantiate(problem.coefs, &binding)?.take_form("contact"),
             contact_energy: inst.take_functional("contact_energy"),
+            contact_jump: inst.take_functional("contact_jump"),
+            contact_work: inst.take_functional("contact_work").filter(|f| f.fields() == 2),
             contact_pressure: inst.take_functional("contact_pressure"),
             contact_trial: inst.take_functional("contact_trial"),
             von_mises: inst.take_functional("von_mises"),
@@ -304,6 +316,7 @@ impl<'m> Parts<'m> {
                 .filter(|f| f.time_dependent() && f.fields() == 0),
             contact_nodes,
             redistributed,
+            mass_choice: problem.mass,
             // The held dofs: the stepper's, set with it.
             held: Vec::new(),
         };
@@ -329,6 +342,10 @@ pub struct Simulation<'m> {
     guard: Guard,
     /// The params in use, for messages.
     params: String,
+    /// The energy law the scheme's file claims, which the energy guard applies.
+    law: Option<EnergyLaw>,
+    /// The critical step of a scheme that claims `cfl` (an explicit one).
+    pub stable: Option<stability::StableStep>,
 }
 
 /// One finished step, as the observer sees it.
@@ -349,6 +366,8 @@ impl<'m> Simulation<'m> {
     /// nodes carry none; a⁰ = 0 there), and builds the stepper.
     pub fn new(asm: &'m Assembler<'m>, mut problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
         let constraints = problem.constraints.clone();
+        let held = constraints.clone();
+        let coefs = problem.coefs;
         let newton = problem.newton;
         let prescribed = problem.prescribed.take();
         let Parts { mut tools, forms, inertia } = Parts::build(asm, problem, active)?;
@@ -390,9 +409,14 @@ impl<'m> Simulation<'m> {
         // Without inertia each step is an equilibrium of its own: no energy accumulates to watch.
         let mut guard = active.guard;
         if !inertia {
-            guard.max_energy_growth = 0.0;
+            guard.energy_tolerance = 0.0;
         }
-        Ok(Simulation { stepper, tools, states, v_index, guard, params })
+        let law = active.scheme_energy_law()?;
+        let stable = match active.scheme_claims()?.into_iter().find(|(c, _)| c == "cfl") {
+            Some((_, cfl)) => Some(stability::estimate(&tools, coefs, &held, cfl)?),
+            None => None,
+        };
+        Ok(Simulation { stepper, tools, states, v_index, guard, params, law, stable })
     }
 
     /// Sets the displacement and solves the scheme's initial problem (the acceleration).
@@ -424,9 +448,9 @@ impl<'m> Simulation<'m> {
     /// A step whose Newton fails is retried from its start with Δt halved, up to
     /// `guard.max_step_cuts` halvings; the step size then doubles back after two accepted steps
     /// that end on a multiple of the doubled size, so the run returns to the nominal time levels.
-    /// Every 16 steps (and at the end) the energy ½uᵀKu + ½vᵀMv is checked against
-    /// `guard.max_energy_growth` × (its initial value + the work of the loads so far). A run
-    /// that cannot go on ends with `Outcome::stopped` set, after the observer saw every good
+    /// After every step the energy guard compares E_aug with E_aug(0) + the work of the loads
+    /// so far: a growth beyond `guard.energy_tolerance` × the problem's energy scale (see
+    /// [`EnergyWatch`]) stops the run before the observer sees that step. A run that cannot go on ends with `Outcome::stopped` set, after the observer saw every good
     /// step, so that the case can write its results up to there; an observer's error ends it at
     /// once.
     ///
@@ -445,13 +469,34 @@ impl<'m> Simulation<'m> {
         on_stage: &mut dyn FnMut(&Tools, &StageView, Option<usize>),
         on_step: &mut OnStep,
     ) -> Result<Outcome, CaseError> {
+        if let Some(stable) = self.stable
+            && dt > stable.dt
+            && !self.guard.allow_unstable_dt
+        {
+            return Err(CaseError::UnstableStep {
+                dt,
+                scheme: self.stepper.desc().name.to_string(),
+                stable: stable.dt,
+                cfl: stable.cfl,
+                omega_max: stable.omega_max,
+                active: stable.active,
+                points: stable.points,
+                mass: self.tools.mass_choice.name().to_string(),
+            });
+        }
         let stages = self.stepper.desc().stages;
         let intermediate: Vec<&str> = stages.iter().rev().skip(1).map(|s| s.name).collect();
-        let mut outcome = Outcome { step_seconds: Vec::with_capacity(steps), cuts: 0, stopped: None, resumed: None };
+        let mut outcome = Outcome {
+            step_seconds: Vec::with_capacity(steps),
+            cuts: 0,
+            stopped: None,
+            resumed: None,
+            energy_growth: 0.0,
+        };
         let mut bar = crate::progress::Progress::new(steps, progress);
         let guard = self.guard;
-        let mut energy = EnergyWatch::new(&self.tools, &self.states, self.v_index);
-        let Simulation { stepper, tools, states, v_index, params, .. } = self;
+        let mut energy = EnergyWatch::new(&self.tools, &self.states, self.v_index, t0);
+        let Simulation { stepper, tools, states, v_index, params, law, .. } = self;
         // Progress through a nominal step in units of dt / 2^max_cuts.
         let max_cuts = guard.max_step_cuts.min(MAX_STEP_CUTS);
         let full: u64 = 1 << max_cuts;
@@ -468,6 +513,13 @@ impl<'m> Simulation<'m> {
                 u0: saved.energy_u0.clone(),
                 work: saved.energy_work,
                 varying_work: saved.energy_varying_work,
+                law_work: saved.energy_law_work,
+                kinetic: saved.energy_kinetic,
+                growth: saved.energy_growth,
+                contact: saved.energy_contact,
+                lowest: saved.energy_lowest,
+                allowance: saved.energy_allowance,
+                switches: saved.energy_switches.clone(),
             };
             outcome.resumed = Some(Resumed { step: saved.steps_done, bit_for_bit: saved.periodic });
             stepper.forget();
@@ -484,10 +536,19 @@ impl<'m> Simulation<'m> {
                 let t = t0 + (k as f64 + done as f64 / full as f64) * dt;
                 let saved = (max_cuts > 0).then(|| states.to_vec());
                 let before = states[0].clone();
+                // The held dofs' reaction takes the change of velocity over the step.
+                let v_before = v_index.filter(|_| !tools.held.is_empty()).map(|i| states[i].clone());
                 let clock = Instant::now();
+                // The intermediate stages' displacements and velocities, for the held dofs' work.
+                let mut stages_seen: Vec<(f64, Vec<f64>, Option<Vec<f64>>)> = Vec::new();
                 let result = stepper.step_observed(states, t, h, &mut |stage| {
                     if intermediate.contains(&stage.name) {
                         on_stage(tools, stage, *v_index);
+                        if !tools.held.is_empty()
+                            && let Some(u) = stage.value_of("u")
+                        {
+                            stages_seen.push((stage.time, u.to_vec(), stage.value_of("v").map(<[f64]>::to_vec)));
+                        }
                     }
                 });
                 let report = match result {
@@ -524,32 +585,64 @@ impl<'m> Simulation<'m> {
                 // for bit; without, it writes one of its own (which resumes to round-off).
                 let on_interrupt = interrupted && control.every == 0;
                 let mut record = (done == full && (periodic || on_interrupt)).then(Vec::new);
+                if let Some(load) = &tools.varying_load {
+                    energy.step_work(tools, load.as_ref(), &before, &states[0], t + 0.5 * h);
+                }
+                if !tools.held.is_empty() {
+                    // Over each sub-interval between the step's stages.
+                    let v = v_index.map(|i| states[i].clone());
+                    let mut points = vec![(t, before.clone(), v_before.clone())];
+                    points.append(&mut stages_seen);
+                    points.push((t + h, states[0].clone(), v));
+                    for w in points.windows(2) {
+                        let ((t0, u0, v0), (t1, u1, v1)) = (&w[0], &w[1]);
+                        let vs = v0.as_deref().zip(v1.as_deref());
+                        energy.held_work(tools, u0, u1, vs, t1 - t0, 0.5 * (t0 + t1));
+                    }
+                }
+                if tools.probe.as_ref().is_some_and(|p| p.time_dependent()) {
+                    energy.obstacle_work(tools, &before, &states[0], t, h);
+                }
+                if let Some(work) = &tools.contact_work {
+                    energy.law_work += work.value(tools.asm, &[&states[0], &before], t + 0.5 * h);
+                }
+                // Checked before the observer sees the step: the outputs end at the last good one.
+                if let Some(grown) =
+                    energy.check(tools, states, *v_index, &before, h, t_end, guard.energy_tolerance, *law)
+                {
+                    outcome.stopped = Some(match grown.cause {
+                        Cause::Negative(potential) => CaseError::NotCoercive {
+                            t: t_end,
+                            potential,
+                            scale: grown.scale,
+                            tolerance: guard.energy_tolerance,
+                            params: params.clone(),
+                        },
+                        Cause::LawWork { work, outside } => {
+                            CaseError::LawWork { t: t_end, work, outside, params: params.clone() }
+                        }
+                        Cause::Growth => CaseError::BlowUp {
+                            t: t_end,
+                            energy: grown.energy,
+                            bound: grown.bound,
+                            scale: grown.scale,
+                            tolerance: guard.energy_tolerance,
+                            law: law.map_or_else(
+                                || " (the scheme claims no energy law)".to_string(),
+                                |l| format!(" beyond what a {} scheme allows", l.name()),
+                            ),
+                            params: params.clone(),
+                        },
+                    });
+                    break 'steps;
+                }
+                outcome.energy_growth = energy.growth;
                 let step = Step { k: accepted, t: t_end, dt: h, states, before: &before, report: &report };
                 on_step(tools, &step, record.as_mut())?;
                 streak += 1;
                 if level > 0 && streak >= 2 && done.is_multiple_of(2 * units) {
                     level -= 1;
                     streak = 0;
-                }
-                let last = k + 1 == steps && done == full;
-                if let Some(load) = &tools.varying_load {
-                    energy.step_work(tools, load.as_ref(), &before, &states[0], t + 0.5 * h);
-                }
-                if !tools.held.is_empty() {
-                    energy.held_work(tools, &before, &states[0], t + 0.5 * h);
-                }
-                if let Some(grown) = energy.check(tools, states, *v_index, &before, h, accepted, last)
-                    && guard.max_energy_growth > 0.0
-                    && grown.ratio > guard.max_energy_growth
-                {
-                    outcome.stopped = Some(CaseError::BlowUp {
-                        t: t_end,
-                        energy: grown.energy,
-                        bound: grown.bound,
-                        growth: guard.max_energy_growth,
-                        params: params.clone(),
-                    });
-                    break 'steps;
                 }
                 if let Some(record) = record {
                     let driver = crate::checkpoint::DriverState {
@@ -561,7 +654,14 @@ impl<'m> Simulation<'m> {
                         energy_initial: energy.initial,
                         energy_work: energy.work,
                         energy_varying_work: energy.varying_work,
+                        energy_law_work: energy.law_work,
                         energy_u0: energy.u0.clone(),
+                        energy_kinetic: energy.kinetic,
+                        energy_growth: energy.growth,
+                        energy_contact: energy.contact,
+                        energy_lowest: energy.lowest,
+                        energy_allowance: energy.allowance,
+                        energy_switches: energy.switches.clone(),
                         states: states.to_vec(),
                         periodic: !interrupted,
                     };
@@ -604,6 +704,8 @@ pub struct Outcome {
     pub stopped: Option<CaseError>,
     /// The checkpoint the run resumed from, if it did.
     pub resumed: Option<Resumed>,
+    /// The energy guard's largest growth of E_aug beyond E_aug(0) + work, over the energy scale.
+    pub energy_growth: f64,
 }
 
 /// Where a resumed run started.
@@ -621,17 +723,23 @@ pub struct Resumed {
 pub const MAX_STEP_CUTS: usize = 40;
 
 /// When a step may fail and how much energy a run may gain (`--max-step-cuts`,
-/// `--max-energy-growth`).
+/// `--energy-tolerance`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Guard {
     pub max_step_cuts: usize,
-    /// 0 turns the check off.
-    pub max_energy_growth: f64,
+    /// Run an explicit scheme above its estimated critical step (`--allow-unstable-dt`).
+    pub allow_unstable_dt: bool,
+    /// The growth of E_aug beyond E_aug(0) + the work of the loads that stops a run, as a
+    /// fraction of the energy scale; 0 turns the check off.
+    pub energy_tolerance: f64,
 }
+
+/// `--energy-tolerance`'s default: 5 % of the problem's energy scale.
+pub const ENERGY_TOLERANCE: f64 = 0.05;
 
 impl Default for Guard {
     fn default() -> Self {
-        Guard { max_step_cuts: 6, max_energy_growth: 10.0 }
+        Guard { max_step_cuts: 6, allow_unstable_dt: false, energy_tolerance: ENERGY_TOLERANCE }
     }
 }
 
@@ -651,31 +759,83 @@ fn history(e: &crate::runtime::scheme::StepError) -> String {
     text
 }
 
-/// The energy check: E = ½uᵀKu + ½vᵀMv against E(0) + the work of the loads.
-struct EnergyWatch {
-    initial: f64,
-    u0: Vec<f64>,
-    work: f64,
-    /// The work of a load that changes with time, summed step by step (midpoint rule).
-    varying_work: f64,
+/// The energy guard: the growth of E_aug = ½uᵀKu + ½vᵀMv + the contact law's
+/// `contact_energy(u)` beyond E_aug(0) + the work of the loads, over the problem's energy scale
+/// (the largest of |E_aug(0)|, the work's magnitude so far, and the kinetic energy reached).
+pub(crate) struct EnergyWatch {
+    pub(crate) initial: f64,
+    pub(crate) u0: Vec<f64>,
+    /// The largest magnitude of the work of the loads so far.
+    pub(crate) work: f64,
+    /// The work summed step by step (midpoint rule): a load that changes with time, the held
+    /// dofs' reactions, a moving obstacle's.
+    pub(crate) varying_work: f64,
+    /// The contact law's `contact_work` so far: energy the law itself gives or takes.
+    pub(crate) law_work: f64,
+    /// The largest kinetic energy so far.
+    pub(crate) kinetic: f64,
+    /// The largest growth over the scale so far (the summary's `energy_growth`).
+    pub(crate) growth: f64,
+    /// The law's `contact_jump` after the previous step (a conserving scheme's allowance).
+    pub(crate) contact: f64,
+    /// The lowest E_aug − W so far (a dissipative scheme's bound: what it lost stays lost).
+    pub(crate) lowest: f64,
+    /// A conserving scheme's allowance so far: on each step whose active set changed, the
+    /// larger of `contact_jump` before and after it.
+    pub(crate) allowance: f64,
+    /// The active set after the previous step (a conserving scheme's).
+    pub(crate) switches: Vec<bool>,
 }
 
-/// An energy above its bound.
+/// An energy above what the guard allows.
 struct Grown {
+    /// E_aug and E_aug(0) + W.
     energy: f64,
     bound: f64,
-    ratio: f64,
+    scale: f64,
+    cause: Cause,
 }
 
-/// Steps between two energy checks: a blow-up grows geometrically, so a few steps' delay costs
-/// nothing, and the check's two products stay off most steps.
-const ENERGY_EVERY: usize = 16;
+/// What the guard saw.
+enum Cause {
+    /// E_aug beyond its bound.
+    Growth,
+    /// ½uᵀKu + the contact energy negative beyond the tolerance.
+    Negative(f64),
+    /// The law's own work beyond the energy from outside.
+    LawWork { work: f64, outside: f64 },
+}
 
 impl EnergyWatch {
-    fn new(tools: &Tools, states: &[Vec<f64>], v_index: Option<usize>) -> Self {
+    fn new(tools: &Tools, states: &[Vec<f64>], v_index: Option<usize>, t: f64) -> Self {
         let u = &states[0];
         let v = v_index.map(|i| states[i].as_slice());
-        EnergyWatch { initial: Self::energy(tools, u, v), u0: u.clone(), work: 0.0, varying_work: 0.0 }
+        let kinetic = tools.kinetic(v);
+        let initial = tools.elastic(u) + kinetic + Self::contact(tools, u, t);
+        let contact = Self::value(&tools.contact_jump, tools, u, t);
+        EnergyWatch {
+            initial,
+            u0: u.clone(),
+            work: 0.0,
+            varying_work: 0.0,
+            law_work: 0.0,
+            kinetic,
+            growth: 0.0,
+            contact,
+            lowest: initial,
+            allowance: 0.0,
+            switches: tools.contact_switches(u, t),
+        }
+    }
+
+    /// The contact law's energy (0 for a law without `contact_energy`).
+    fn contact(tools: &Tools, u: &[f64], t: f64) -> f64 {
+        Self::value(&tools.contact_energy, tools, u, t)
+    }
+
+    /// A functional of u alone at `u` (0 without it).
+    fn value(f: &Option<Box<dyn BoundFunctional + '_>>, tools: &Tools, u: &[f64], t: f64) -> f64 {
+        f.as_ref().filter(|f| f.fields() == 1).map_or(0.0, |f| f.value(tools.asm, &[u], t))
     }
 
     /// Adds the work of a time-dependent load over one step: L(t_mid)·(u − u_before).
@@ -685,13 +845,19 @@ impl EnergyWatch {
         self.varying_work += l.iter().zip(u.iter().zip(before)).map(|(l, (a, b))| l * (a - b)).sum::<f64>();
     }
 
-    /// Adds the work of the held dofs' reactions over one step, taken as the elastic reaction
-    /// (K u − F at the held dofs, at the step's midpoint) times their motion: the quasi-static
-    /// part of the support's force, what a blow-up check needs.
-    fn held_work(&mut self, tools: &Tools, before: &[f64], u: &[f64], t_mid: f64) {
+    /// Adds the work of the held dofs' reactions over one step: the reaction at the step's
+    /// midpoint, K u_mid − F + M (v' − v)/Δt at the held dofs (exact for Crank–Nicolson; without
+    /// a velocity state, its quasi-static part), times their motion.
+    fn held_work(&mut self, tools: &Tools, before: &[f64], u: &[f64], v: Option<(&[f64], &[f64])>, h: f64, t_mid: f64) {
         let mid: Vec<f64> = before.iter().zip(u).map(|(a, b)| 0.5 * (a + b)).collect();
-        let mut ku = vec![0.0; u.len()];
-        tools.stiffness.mul_vec(&mid, &mut ku);
+        let mut reaction = vec![0.0; u.len()];
+        tools.stiffness.mul_vec(&mid, &mut reaction);
+        if let Some((v0, v1)) = v {
+            let dv: Vec<f64> = v1.iter().zip(v0).map(|(a, b)| (a - b) / h).collect();
+            let mut inertia = vec![0.0; u.len()];
+            tools.scheme_mass.mul_vec(&dv, &mut inertia);
+            reaction.iter_mut().zip(&inertia).for_each(|(r, m)| *r += m);
+        }
         let load = match &tools.varying_load {
             Some(form) => {
                 let mut l = vec![0.0; u.len()];
@@ -700,14 +866,26 @@ impl EnergyWatch {
             }
             None => tools.load.clone(),
         };
-        self.varying_work += tools.held.iter().map(|&i| (ku[i] - load[i]) * (u[i] - before[i])).sum::<f64>();
+        self.varying_work += tools.held.iter().map(|&i| (reaction[i] - load[i]) * (u[i] - before[i])).sum::<f64>();
     }
 
-    fn energy(tools: &Tools, u: &[f64], v: Option<&[f64]>) -> f64 {
-        tools.elastic(u) + tools.kinetic(v)
+    /// Adds the work of an obstacle that moves (a gap that changes with time) over one step:
+    /// the change of the contact energy with time alone, at the step's mid-displacement.
+    fn obstacle_work(&mut self, tools: &Tools, before: &[f64], u: &[f64], t: f64, h: f64) {
+        let mid: Vec<f64> = before.iter().zip(u).map(|(a, b)| 0.5 * (a + b)).collect();
+        self.varying_work +=
+            Self::value(&tools.contact_energy, tools, &mid, t + h) - Self::value(&tools.contact_energy, tools, &mid, t);
     }
 
-    /// Every `ENERGY_EVERY` accepted steps and at the last: the energy and its bound.
+    /// After each accepted step: the energy, and whether it grew beyond what `law` allows by
+    /// more than `tolerance` × the scale. Without a law, E_aug − W may not exceed its initial
+    /// value. A conserving scheme's E_aug may also jump on the steps where points enter or leave
+    /// contact, by at most the energy of their contact stress (docs/mathematics.md §5:
+    /// (1/2γ)(pⁿ)² or (1/2γ)(pⁿ⁺¹)²), which the law gives as `contact_jump`: on each such step
+    /// the larger of its values before and after is added to what is allowed. A dissipative scheme's
+    /// E_aug − W may not exceed the lowest value it reached. The kinetic energy of this step
+    /// joins the scale only once the step passes (a blow-up's own motion does not widen its
+    /// bound).
     #[allow(clippy::too_many_arguments)]
     fn check(
         &mut self,
@@ -716,12 +894,10 @@ impl EnergyWatch {
         v_index: Option<usize>,
         before: &[f64],
         h: f64,
-        accepted: usize,
-        last: bool,
+        t: f64,
+        tolerance: f64,
+        law: Option<EnergyLaw>,
     ) -> Option<Grown> {
-        if !last && !accepted.is_multiple_of(ENERGY_EVERY) {
-            return None;
-        }
         let u = &states[0];
         let fd: Vec<f64>;
         let v = match v_index {
@@ -731,22 +907,63 @@ impl EnergyWatch {
                 &fd
             }
         };
-        let energy = Self::energy(tools, u, Some(v));
-        // The work summed step by step (a varying load's, the held dofs'), and a constant
-        // load's from u(0).
-        let work: f64 = match tools.varying_load {
-            Some(_) => self.varying_work,
-            None if tools.held.is_empty() => {
-                tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum()
+        let kinetic = tools.kinetic(Some(v));
+        let potential = tools.elastic(u) + Self::contact(tools, u, t);
+        let energy = potential + kinetic;
+        // A conserving scheme: the allowance grows on the steps where the active set changes.
+        let (jump, switches, allowance) = match law {
+            Some(EnergyLaw::Conserving) => {
+                let jump = Self::value(&tools.contact_jump, tools, u, t);
+                let switches = tools.contact_switches(u, t);
+                let changed = switches != self.switches;
+                (jump, switches, self.allowance + if changed { jump.max(self.contact) } else { 0.0 })
             }
-            None => {
-                self.varying_work
-                    + tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum::<f64>()
-            }
+            _ => (0.0, Vec::new(), 0.0),
         };
-        self.work = self.work.max(work.abs());
-        let bound = (self.initial + self.work).max(f64::MIN_POSITIVE);
-        Some(Grown { energy, bound, ratio: energy / bound })
+        // The work summed step by step (a varying load's, the held dofs', a moving obstacle's),
+        // a constant load's from u(0), and the law's own.
+        let constant: f64 = match tools.varying_load {
+            Some(_) => 0.0,
+            None => tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum(),
+        };
+        let external = self.varying_work + constant;
+        self.work = self.work.max(external.abs());
+        let scale = self.initial.abs().max(self.work).max(self.kinetic).max(f64::MIN_POSITIVE);
+        let work = external + self.law_work;
+        let bound = match law {
+            Some(EnergyLaw::Conserving) => self.initial + work + allowance,
+            Some(EnergyLaw::Dissipative) => self.lowest + work,
+            None => self.initial + work,
+        };
+        // The law's own work (Nitsche θ ≠ 1) is part of the balance, but it may not drive the
+        // motion: beyond the energy that came from outside (initially and by the loads), the
+        // balance would hold while the motion grows without bound.
+        let outside = self.initial.abs().max(self.work).max(f64::MIN_POSITIVE);
+        if tolerance > 0.0 && self.law_work.abs() > outside {
+            return Some(Grown { energy, bound, scale, cause: Cause::LawWork { work: self.law_work, outside } });
+        }
+        let growth = (energy - bound) / scale;
+        // NaN compares false: a non-finite energy is a growth beyond any tolerance.
+        self.growth = if growth.is_finite() { self.growth.max(growth) } else { f64::INFINITY };
+        if tolerance > 0.0 && (growth > tolerance || growth.is_nan()) {
+            return Some(Grown { energy, bound, scale, cause: Cause::Growth });
+        }
+        // The potential energy of a coercive law is not negative: where it is, E_aug may be kept
+        // while the motion grows without bound (Nitsche θ = 1 with γ0 too small).
+        if tolerance > 0.0 && potential < -tolerance * scale {
+            return Some(Grown { energy, bound, scale, cause: Cause::Negative(potential) });
+        }
+        // With the guard off, the default tolerance still decides what joins the scale, so that
+        // the summary's `energy_growth` measures the same thing.
+        let admitted = if tolerance > 0.0 { tolerance } else { ENERGY_TOLERANCE };
+        if growth <= admitted {
+            self.kinetic = self.kinetic.max(kinetic);
+        }
+        self.contact = jump;
+        self.switches = switches;
+        self.allowance = allowance;
+        self.lowest = self.lowest.min(energy - work);
+        None
     }
 }
 

@@ -16,6 +16,13 @@ use std::path::Path;
 
 use serde::Serialize;
 
+/// The ωΔt up to which the scheme claims to be stable: its `claim cfl` (an explicit scheme);
+/// none for a scheme that claims no limit.
+pub fn claimed_cfl(setup: &crate::driver::Setup) -> Result<Option<f64>, crate::cases::CaseError> {
+    let active = crate::driver::Active::resolve(setup, &[])?;
+    Ok(active.scheme_claims()?.into_iter().find(|(c, _)| c == "cfl").map(|(_, v)| v))
+}
+
 pub use oscillator::{oscillator_energies, oscillator_error, spectral_radius, with_oscillator, with_oscillator_scheme};
 
 use crate::cases::CaseError;
@@ -168,7 +175,12 @@ impl Verification {
             for b in &r.bar {
                 let _ = write!(md, " {:.2e} | {:.3} |", last(&b.differences), b.order);
             }
-            let _ = writeln!(md, " {:.6} |", r.rho_infinity);
+            let _ = writeln!(
+                md,
+                " {:.6}{} |",
+                r.rho_infinity,
+                r.cfl.map_or(String::new(), |c| format!(" (at ωΔt = cfl = {c})"))
+            );
         }
         md.push_str("\n![time orders](verify/time_orders.png)\n\n");
         md.push_str("### (b) Space order\n\nLinear elasticity with a manufactured solution (u₁ = Πₖ sin πxₖ), the exact solution imposed on the boundary, through the library's compiled elasticity forms. Expected: L2 order p + 1, H1 order p.\n\n| mesh family | P | h (finest) | L2 error | L2 order | H1 error | H1 order |\n|---|---|---|---|---|---|---|\n");

@@ -15,6 +15,7 @@ use serde::Serialize;
 use super::oscillator::{damped_oscillator_error, oscillator_energies, oscillator_error, spectral_radius, step_map};
 use super::time::{BAR_STEPS, BarOrder, OSCILLATOR_STEPS, bar_orders, last_order};
 use crate::cases::{CaseError, bar, disc};
+use crate::compiler::scheme::EnergyLaw;
 use crate::driver::{Active, Setup};
 use crate::plot::Curve;
 
@@ -28,6 +29,13 @@ fn omega_dts() -> Vec<f64> {
 const ORDER_TOLERANCE: f64 = 0.25;
 /// A measured ρ∞ agrees with a claimed one within this.
 const RHO_TOLERANCE: f64 = 1e-3;
+/// A one-step map with ρ above 1 + this is unstable (ρ of a double root on the unit circle
+/// measures 1 + ~1e-11 by the squarings of `spectral_radius`).
+const RHO_UNSTABLE: f64 = 1e-8;
+/// A measured stability limit agrees with a claimed `cfl` within this fraction.
+const CFL_TOLERANCE: f64 = 1e-3;
+/// An energy law holds on the oscillator to this fraction of E₀ (round-off over 1000 steps).
+const ENERGY_LAW_TOLERANCE: f64 = 1e-10;
 
 /// The one-step map at one ωΔt.
 #[derive(Clone, Debug, Serialize)]
@@ -80,6 +88,10 @@ pub struct SchemeVerification {
     pub bar_energy_drift: f64,
     pub bar: Vec<CaseRow>,
     pub disc: Vec<CaseRow>,
+    /// The smallest ωΔt with ρ > 1 (none: stable over [1e-2, 1e6]).
+    pub stability_limit: Option<f64>,
+    /// The energy law the file claims.
+    pub energy_law: Option<String>,
     pub verdicts: Vec<Verdict>,
 }
 
@@ -175,22 +187,13 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
             ],
         });
     }
-    // An order claim holds for the oscillator and, when measured, the damped one.
-    let mut verdicts = Vec::new();
-    for (claim, claimed) in &claims {
-        let measured: Vec<(String, f64, f64)> = match claim.as_str() {
-            "order" => std::iter::once(("order".to_string(), oscillator_order))
-                .chain(damped_order.map(|o| ("order (damped)".to_string(), o)))
-                .map(|(c, m)| (c, m, ORDER_TOLERANCE))
-                .collect(),
-            "rho_inf" => vec![(claim.clone(), rho_infinity, RHO_TOLERANCE)],
-            other => return Err(CaseError::Option(format!("verify cannot measure the claim `{other}` yet"))),
-        };
-        for (name, m, tolerance) in measured {
-            let holds = (m - claimed).abs() <= tolerance;
-            verdicts.push(Verdict { claim: name, claimed: *claimed, measured: m, holds });
-        }
-    }
+    let stability_limit = stability_limit(setup)?;
+    let law = active.scheme_energy_law()?;
+    let energy_law = match law {
+        Some(law) => Some((law, energy_law_defect(setup, law)?)),
+        None => None,
+    };
+    let verdicts = verdicts(&claims, oscillator_order, damped_order, rho_infinity, stability_limit, energy_law)?;
     Ok(SchemeVerification {
         scheme,
         params,
@@ -208,8 +211,103 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
         bar_energy_drift,
         bar: bar_rows,
         disc: disc_rows,
+        stability_limit,
+        energy_law: law.map(|l| l.name().to_string()),
         verdicts,
     })
+}
+
+/// What the file claims against what was measured. An order claim holds for the oscillator
+/// and, when measured, the damped one; `cfl` is the stability limit in ωΔt; a claimed ρ∞
+/// implies stability at every ωΔt; an energy law is measured on the oscillator.
+fn verdicts(
+    claims: &[(String, f64)],
+    oscillator_order: f64,
+    damped_order: Option<f64>,
+    rho_infinity: f64,
+    stability_limit: Option<f64>,
+    energy_law: Option<(EnergyLaw, f64)>,
+) -> Result<Vec<Verdict>, CaseError> {
+    let mut verdicts = Vec::new();
+    let limit = stability_limit.unwrap_or(f64::INFINITY);
+    for (claim, claimed) in claims {
+        let claimed = *claimed;
+        let measured: Vec<(String, f64, f64, bool)> = match claim.as_str() {
+            "order" => std::iter::once(("order".to_string(), oscillator_order))
+                .chain(damped_order.map(|o| ("order (damped)".to_string(), o)))
+                .map(|(c, m)| (c, claimed, m, (m - claimed).abs() <= ORDER_TOLERANCE))
+                .collect(),
+            "rho_inf" => vec![
+                (claim.clone(), claimed, rho_infinity, (rho_infinity - claimed).abs() <= RHO_TOLERANCE),
+                ("stability limit (ωΔt)".into(), f64::INFINITY, limit, stability_limit.is_none()),
+            ],
+            "cfl" => vec![(claim.clone(), claimed, limit, (limit - claimed).abs() <= CFL_TOLERANCE * claimed)],
+            other => return Err(CaseError::Option(format!("verify cannot measure the claim `{other}` yet"))),
+        };
+        for (name, claimed, measured, holds) in measured {
+            verdicts.push(Verdict { claim: name, claimed, measured, holds });
+        }
+    }
+    if let Some((law, defect)) = energy_law {
+        verdicts.push(Verdict {
+            claim: format!("energy = {}", law.name()),
+            claimed: 0.0,
+            measured: defect,
+            holds: defect <= ENERGY_LAW_TOLERANCE,
+        });
+    }
+    Ok(verdicts)
+}
+
+/// A measured value for the tables: four decimals, or four digits in exponent form when it is
+/// small or large.
+fn figure(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-3..1e4).contains(&x.abs()) { format!("{x:.4e}") } else { format!("{x:.4}") }
+}
+
+/// The smallest ωΔt at which the oscillator's one-step map has ρ > 1 (to [`RHO_UNSTABLE`]),
+/// scanned over [`omega_dts`] and bisected; none when it is stable over the whole range.
+fn stability_limit(setup: &Setup) -> Result<Option<f64>, CaseError> {
+    let unstable = |x: f64| -> Result<bool, CaseError> { Ok(spectral_radius(setup, x)? > 1.0 + RHO_UNSTABLE) };
+    let grid = omega_dts();
+    let mut first = None;
+    for (k, &x) in grid.iter().enumerate() {
+        if unstable(x)? {
+            first = Some(k);
+            break;
+        }
+    }
+    let Some(k) = first else { return Ok(None) };
+    if k == 0 {
+        return Ok(Some(grid[0]));
+    }
+    let (mut lo, mut hi) = (grid[k - 1], grid[k]);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if unstable(mid)? {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(Some(lo))
+}
+
+/// How far the oscillator's energy ½(u² + v²) departs from the claimed law, over 1000 steps at
+/// ωΔt = 0.1, 1 and 10, relative to E₀: max |Eₙ − E₀| for a conserving scheme, the largest
+/// step increase max (Eₙ₊₁ − Eₙ) for a dissipative one. (With contact, the runs' energy guard
+/// applies the same law.)
+fn energy_law_defect(setup: &Setup, law: EnergyLaw) -> Result<f64, CaseError> {
+    let mut defect = 0.0f64;
+    for dt in [0.1, 1.0, 10.0] {
+        let e = oscillator_energies(setup, dt, 1000)?;
+        let d = match law {
+            EnergyLaw::Conserving => e.iter().map(|x| (x - e[0]).abs()).fold(0.0, f64::max),
+            EnergyLaw::Dissipative => e.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max),
+        };
+        defect = defect.max(d / e[0]);
+    }
+    Ok(defect)
 }
 
 /// The setup with a reference scheme instead: the settings that apply to it (the form files'
@@ -271,12 +369,17 @@ impl SchemeVerification {
                 })
                 .collect()
         };
-        let rho = curves(&|p| Some(p.rho));
+        // log10 ρ, floored: a growth beyond 1 (an explicit scheme past its limit) shows at its
+        // size, and 0 is the stability line.
+        let rho = curves(&|p| Some(p.rho.max(1e-3).log10()));
         let period = curves(&|p| p.period_error.filter(|e| *e > 0.0).map(f64::log10));
         crate::plot::panels(
             &png,
             "log10 ωΔt",
-            &[("spectral radius of the one-step map", "ρ", rho), ("relative period error", "log10 (T̄/T − 1)", period)],
+            &[
+                ("spectral radius of the one-step map (ρ ≤ 1: stable)", "log10 ρ", rho),
+                ("relative period error", "log10 (T̄/T − 1)", period),
+            ],
         )
         .map_err(super::plot_error(&png))?;
         let json = dir.join(format!("{stem}.json"));
@@ -297,17 +400,19 @@ impl SchemeVerification {
             if params.is_empty() { "none".into() } else { params.join(", ") }
         );
         if self.verdicts.is_empty() {
-            let _ =
-                writeln!(s, "The file claims nothing (`claim order = 2`, `claim rho_inf = ...` would be checked).\n");
+            let _ = writeln!(
+                s,
+                "The file claims nothing (`claim order = 2`, `claim rho_inf = ...`, `claim cfl = ...`, `claim energy = ...` would be checked).\n"
+            );
         } else {
             let _ = writeln!(s, "| claim | claimed | measured | |\n|---|---|---|---|");
             for v in &self.verdicts {
                 let _ = writeln!(
                     s,
-                    "| {} | {} | {:.4} | {} |",
+                    "| {} | {} | {} | {} |",
                     v.claim,
                     v.claimed,
-                    v.measured,
+                    figure(v.measured),
                     if v.holds { "holds" } else { "**contradicted**" }
                 );
             }
@@ -319,8 +424,13 @@ impl SchemeVerification {
         }
         let _ = writeln!(
             s,
-            "\nObserved order {:.2}; spectral radius at ωΔt = 1e12: {:.4}.",
-            self.oscillator_order, self.rho_infinity
+            "\nObserved order {:.2}; spectral radius at ωΔt = 1e12: {}; {}.",
+            self.oscillator_order,
+            figure(self.rho_infinity),
+            match self.stability_limit {
+                Some(x) => format!("stable (ρ ≤ 1) up to ωΔt = {x:.6}, unstable beyond"),
+                None => "stable (ρ ≤ 1) over ωΔt ∈ [1e-2, 1e6]".into(),
+            }
         );
         match self.damped_order {
             Some(order) => {

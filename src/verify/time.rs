@@ -29,8 +29,10 @@ pub struct TimeRow {
     pub oscillator_order: f64,
     /// The bar before impact, per contact law of verify's list (forms/library.toml).
     pub bar: Vec<BarOrder>,
-    /// Spectral radius at ωΔt = 1e12.
+    /// Spectral radius at ωΔt = 1e12, or at its `cfl` for an explicit scheme (unstable beyond).
     pub rho_infinity: f64,
+    /// The stability limit the scheme claims (an explicit one).
+    pub cfl: Option<f64>,
 }
 
 /// The bar before impact with one contact law.
@@ -93,12 +95,14 @@ pub fn orders(progress: &mut dyn FnMut(&str)) -> Result<Vec<TimeRow>, CaseError>
                 .map(|&dt| Ok((dt, oscillator_error(&setup, dt, 10.0)?)))
                 .collect::<Result<_, CaseError>>()?;
             let bar = bar_orders(&setup)?;
+            let cfl = super::claimed_cfl(&setup)?;
             Ok(TimeRow {
                 scheme: scheme.into(),
                 oscillator_order: last_order(&oscillator),
                 oscillator,
                 bar,
-                rho_infinity: spectral_radius(&setup, 1e12)?,
+                rho_infinity: spectral_radius(&setup, cfl.unwrap_or(1e12))?,
+                cfl,
             })
         })
         .collect()

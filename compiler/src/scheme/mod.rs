@@ -96,6 +96,31 @@ pub struct SchemeIr {
     pub updates: Vec<Quantity>,
     /// The author's claims (`claim order = 2`): name and value, a function of the params.
     pub claims: Vec<(String, NodeId)>,
+    /// `claim energy = conserving | dissipative`: the energy law the run's guard applies.
+    pub energy: Option<EnergyLaw>,
+}
+
+/// How a scheme's augmented energy E_aug (kinetic + elastic + the contact law's energy) may
+/// change from step to step with constant loads (docs/mathematics.md §5).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnergyLaw {
+    /// Kept, except on steps where points enter or leave contact, where it may jump by at most
+    /// the contact energy of those points (Crank–Nicolson gains on release, midpoint on entry).
+    Conserving,
+    /// Never grows.
+    Dissipative,
+}
+
+impl EnergyLaw {
+    pub const ALL: [EnergyLaw; 2] = [EnergyLaw::Conserving, EnergyLaw::Dissipative];
+
+    /// Its name in `claim energy = NAME`.
+    pub fn name(self) -> &'static str {
+        match self {
+            EnergyLaw::Conserving => "conserving",
+            EnergyLaw::Dissipative => "dissipative",
+        }
+    }
 }
 
 /// A declaration a scheme `let` hides (W0002).
@@ -107,8 +132,15 @@ struct Hidden {
 }
 
 /// The properties a scheme may claim, and what each means.
-pub const CLAIMS: &[(&str, &str)] =
-    &[("order", "the order of accuracy in time"), ("rho_inf", "the spectral radius of the one-step map as ωΔt → ∞")];
+pub const CLAIMS: &[(&str, &str)] = &[
+    ("order", "the order of accuracy in time"),
+    ("rho_inf", "the spectral radius of the one-step map as ωΔt → ∞"),
+    (
+        "energy",
+        "the energy law: `conserving` (E_aug kept except where contact starts or ends) or `dissipative` (E_aug never grows)",
+    ),
+    ("cfl", "the largest ω_max Δt at which the scheme is stable (an explicit scheme): a run beyond it is refused"),
+];
 
 impl SchemeIr {
     /// The claims' values at these param values (in `params` order).
@@ -319,7 +351,7 @@ impl<'a> Compiler<'a> {
                 ),
             }
         }
-        let claims = self.claims();
+        let (claims, energy) = self.claims();
         if !self.diags.is_empty() {
             return Err(self.diags);
         }
@@ -334,13 +366,16 @@ impl<'a> Compiler<'a> {
             stages,
             updates,
             claims,
+            energy,
         };
         Ok(ir)
     }
 
-    /// `claim NAME = EXPR`: a known property, a scalar of the params (not of t or dt).
-    fn claims(&mut self) -> Vec<(String, NodeId)> {
+    /// `claim NAME = EXPR`: a known property, a scalar of the params (not of t or dt); and
+    /// `claim energy = LAW`.
+    fn claims(&mut self) -> (Vec<(String, NodeId)>, Option<EnergyLaw>) {
         let mut out: Vec<(String, NodeId)> = Vec::new();
+        let mut energy = None;
         for (i, (name, e)) in self.def.claims.iter().enumerate() {
             if !CLAIMS.iter().any(|(c, _)| *c == name.name) {
                 let known: Vec<&str> = CLAIMS.iter().map(|(c, _)| *c).collect();
@@ -364,6 +399,32 @@ impl<'a> Compiler<'a> {
                 );
                 continue;
             }
+            if name.name == "energy" {
+                let law = match &e.kind {
+                    ExprKind::Name(id) => EnergyLaw::ALL.into_iter().find(|l| l.name() == id.name),
+                    _ => None,
+                };
+                match law {
+                    Some(law) => energy = Some(law),
+                    None => {
+                        let names: Vec<&str> = EnergyLaw::ALL.iter().map(|l| l.name()).collect();
+                        let mut d = Diagnostic::error(
+                            "E0819",
+                            "an energy law is `conserving` or `dissipative`",
+                            e.span,
+                            "not an energy law",
+                        )
+                        .with_note(format!("energy laws: {}", names.join(", ")));
+                        if let ExprKind::Name(id) = &e.kind
+                            && let Some(s) = crate::check::suggest_name(&id.name, names.into_iter())
+                        {
+                            d = d.with_help(format!("did you mean `{s}`?"));
+                        }
+                        self.error(d);
+                    }
+                }
+                continue;
+            }
             match self.value(e) {
                 Some(Value::Scalar(n)) if !self.g.depends_on(n, |s| matches!(s, Sym::Time | Sym::Dt)) => {
                     out.push((name.name.clone(), n))
@@ -377,7 +438,7 @@ impl<'a> Compiler<'a> {
                 None => {}
             }
         }
-        out
+        (out, energy)
     }
 
     fn is_slot(&self, name: &str) -> bool {

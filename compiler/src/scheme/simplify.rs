@@ -700,7 +700,7 @@ mod tests {
     }
 
     const LIBRARY: &[&str] =
-        &["genalpha", "hht", "hht_imex", "hht_unweighted", "hybrid", "midpoint", "newmark", "trbdf2"];
+        &["central", "genalpha", "hht", "hht_imex", "hht_unweighted", "hybrid", "midpoint", "newmark", "trbdf2"];
 
     #[test]
     fn trbdf2_pivot_times_its_inverse_is_exactly_minus_one() {

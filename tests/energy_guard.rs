@@ -1,0 +1,95 @@
+//! The energy guard (docs/language.md, "When a run goes wrong"): on the bar and the disc at their
+//! defaults, every library scheme × contact law × mass runs without the guard stopping it,
+//! except IMEX-HHT, whose explicit contact is only conditionally stable (docs/mathematics.md
+//! §5): its energy grows at these steps and the guard must stop it. An explicit scheme is
+//! refused at set-up where it cannot run (redistributed mass; Δt above its critical step).
+//! The blow-ups of issue 32 stop with the cause and exit status 1 (tests/bad_inputs has the
+//! bar's; the disc's are here).
+
+use signorini::cases::{CaseError, bar, disc};
+use signorini::driver::{Setup, all_schemes, contact_names};
+use signorini::simulation::MassChoice;
+
+/// The scheme whose energy the guard must stop at the library's defaults.
+const UNSTABLE: &str = "hht_imex";
+
+/// What a run at the defaults may end with: nothing, a refusal at set-up, or (for
+/// [`UNSTABLE`]) the guard.
+fn judge(problem: &str, scheme: &str, contact: &str, mass: MassChoice, result: Result<f64, CaseError>) -> String {
+    let label = format!("{problem} {scheme} {contact} {}", mass.name());
+    match result {
+        Ok(growth) if scheme != UNSTABLE && growth <= 0.05 => String::new(),
+        Ok(growth) => format!("{label}: ran to the end with energy_growth {growth}"),
+        Err(CaseError::BlowUp { .. }) if scheme == UNSTABLE => String::new(),
+        Err(CaseError::UnstableStep { .. }) => String::new(),
+        Err(CaseError::Option(m)) if m.contains("is explicit") && mass == MassChoice::Redistributed => String::new(),
+        Err(e) => format!("{label}: {e}"),
+    }
+}
+
+fn setup(scheme: &str, contact: &str) -> Setup {
+    Setup { scheme: scheme.into(), contact: contact.into(), ..Setup::default() }
+}
+
+#[test]
+fn no_library_run_trips_the_guard_but_the_unstable_scheme() {
+    let masses = [MassChoice::Consistent, MassChoice::Redistributed, MassChoice::Lumped];
+    let mut runs = Vec::new();
+    for scheme in all_schemes() {
+        for contact in contact_names() {
+            for mass in masses {
+                runs.push((scheme, contact, mass));
+            }
+        }
+    }
+    assert!(runs.iter().any(|r| r.0 == UNSTABLE), "the library has {UNSTABLE}");
+    // Two threads: the disc runs take most of the time.
+    let failures: Vec<String> = std::thread::scope(|s| {
+        let chunks: Vec<_> = runs.chunks(runs.len().div_ceil(2)).collect();
+        let handles: Vec<_> = chunks
+            .into_iter()
+            .map(|chunk| {
+                s.spawn(move || {
+                    let mut out = Vec::new();
+                    for &(scheme, contact, mass) in chunk {
+                        let o = bar::Options { setup: setup(scheme, contact), mass, ..Default::default() };
+                        out.push(judge("bar", scheme, contact, mass, bar::run(&o).map(|r| r.summary.energy_growth)));
+                        let o = disc::Options { setup: setup(scheme, contact), mass, ..Default::default() };
+                        out.push(judge("disc", scheme, contact, mass, disc::run(&o).map(|r| r.summary.energy_growth)));
+                    }
+                    out
+                })
+            })
+            .collect();
+        handles.into_iter().flat_map(|h| h.join().expect("a run panicked")).filter(|f| !f.is_empty()).collect()
+    });
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The disc's blow-ups of issue 32: a contact parameter so large that round-off swamps the
+/// solve, and IMEX-HHT with the redistributed mass. Each stops with the guard's message, and
+/// the series ends at the last good step, below the tolerance.
+#[test]
+fn the_discs_blow_ups_stop() {
+    let stiff = disc::Options { setup: Setup::default().set("gamma0", 1e12), t_end: 8.0, ..Default::default() };
+    let imex =
+        disc::Options { setup: setup(UNSTABLE, "nitsche"), mass: MassChoice::Redistributed, ..Default::default() };
+    for (k, opts) in [stiff, imex].into_iter().enumerate() {
+        let dir = std::env::temp_dir().join(format!("signorini-guard-{}-{k}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let opts = disc::Options { out: Some(dir.clone()), ..opts };
+        match disc::run(&opts) {
+            Err(CaseError::BlowUp { t, energy, bound, scale, tolerance, .. }) => {
+                assert!(energy - bound > tolerance * scale, "{t}: {energy} {bound} {scale}");
+                assert!(t < opts.t_end);
+            }
+            other => panic!("expected the guard to stop the run, got {:?}", other.map(|r| r.summary.energy_growth)),
+        }
+        let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+        assert!(summary.contains("\"stopped\""), "{summary}");
+        let growth: f64 =
+            serde_json::from_str::<serde_json::Value>(&summary).unwrap()["energy_growth"].as_f64().unwrap();
+        assert!(growth <= 0.05, "the written steps passed the guard: {growth}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
