@@ -54,8 +54,6 @@ pub struct DriverState {
     /// The largest kinetic energy so far and the largest growth (the guard's scale and record).
     pub energy_kinetic: f64,
     pub energy_growth: f64,
-    /// The law's `contact_jump` after the last step (a conserving scheme's allowance).
-    pub energy_contact: f64,
     /// The lowest E_aug − W so far (a dissipative scheme's bound).
     pub energy_lowest: f64,
     /// A conserving scheme's allowance so far, and its active set after the last step.
@@ -266,7 +264,6 @@ mod tests {
             energy_u0: vec![0.0, 1.0],
             energy_kinetic: 0.5,
             energy_growth: 0.0,
-            energy_contact: 0.0,
             energy_lowest: 1.5,
             energy_allowance: 0.0,
             energy_switches: vec![true],

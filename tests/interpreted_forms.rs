@@ -21,6 +21,7 @@ use signorini::runtime::scheme::{Bound, BoundForm};
 signorini::forms!("forms/elasticity.wf");
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
+signorini::forms!("tests/problems/power_law_penalty.wf");
 signorini::forms!("forms/contact_nitsche_traction.wf");
 
 const TOL: f64 = 1e-12;
@@ -329,6 +330,15 @@ unit_test!(
     |d| contact_nitsche_traction::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact, HybridContact],
     functionals: [ContactEnergy, ContactWork, ContactJump, ContactPressure, ContactTrial]
+);
+
+unit_test!(
+    real_power_interpreted_matches_compiled,
+    power_law_penalty,
+    "tests/problems/power_law_penalty.wf",
+    |d| power_law_penalty::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
+    forms: [Contact],
+    functionals: [ContactEnergy, ContactPressure, ContactTrial]
 );
 
 unit_test!(

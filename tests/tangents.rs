@@ -9,6 +9,7 @@ use signorini::runtime::kernel::{Coef, FacetTabulation, FormKernel, facet_matrix
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
 signorini::forms!("forms/contact_nitsche_traction.wf");
+signorini::forms!("tests/problems/power_law_penalty.wf");
 
 /// Gap to the plane {x_d = 0} with the obstacle below: g = x_d, n_c = −e_d.
 fn gap(d: usize) -> Coef {
@@ -138,6 +139,30 @@ fn nitsche_tangent_matches_finite_differences_in_2d() {
 #[test]
 fn penalty_tangent_matches_finite_differences_in_2d() {
     check_2d(&penalty(5.0, 2), "penalty");
+}
+
+/// A real power in a law (ε [u_N − g]_+^(3/2)): its derivative (3/2) ε [u_N − g]_+^(1/2) in
+/// the compiled tangent, and in 1D against the closed form.
+#[test]
+fn a_real_power_differentiates_as_p_times_the_power_below() {
+    let p = power_law_penalty::Params::default().with("gamma0", 5.0).unwrap();
+    for d in [1, 2] {
+        let c = power_law_penalty::Coefficients { f: Coef::constant(vec![0.0; d]), g: gap(d), nc: down(d) };
+        let k = power_law_penalty::Contact::new(&p, &c);
+        if d == 2 {
+            check_2d(&k, "power-law penalty");
+            continue;
+        }
+        check_1d(&k, "power-law penalty");
+        // The bar element [0, h] pushed in by δ at x = 0: the tangent's (0, 0) entry is
+        // (3/2) (γ0/h) δ^(1/2) (n = −1 twice).
+        let tab = FacetTabulation::<1, 2>::new(ElementKind::IntervalP1, 1).unwrap();
+        let (h, delta) = (0.25, 0.04);
+        let x = [[0.0], [h]];
+        let jac = facet_matrix(&k, 0, &tab, 0, &x, h, &[&[[-delta], [0.0]]], 0, 0.0);
+        let exact = 1.5 * 5.0 / h * delta.sqrt();
+        assert!((jac[0][0] - exact).abs() < 1e-12 * exact, "{} against {exact}", jac[0][0]);
+    }
 }
 
 /// 1D bar element [0, h] with contact at x = 0 (facet 0).

@@ -30,7 +30,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0207", "a vector literal `[a, b]` or a component `x[1]` outside a problem"),
     ("E0301", "shape mismatch (a vector or tensor where another shape is needed)"),
     ("E0302", "wrong dimension: a vector's length or a component that does not fit the problem's dimension"),
-    ("E0303", "exponent not a constant integer"),
+    ("E0303", "exponent not a constant (an integer from -64 to 64 or a real number written in the file)"),
     ("E0304", "integrand not a scalar"),
     ("E0401", "integrand does not depend on the test function"),
     ("E0402", "test function inside a nonlinear function"),

@@ -103,39 +103,72 @@ pub struct Tools<'m> {
     /// The energies' quadratic forms, ½uᵀKu and ½vᵀMv with the scheme's mass, evaluated every
     /// step by the observers.
     pub energies: Energies,
+    /// The last `contact_switches` asked for: u, t's bits and the answer.
+    last_switches: std::sync::Mutex<Option<Kept<Vec<bool>>>>,
 }
+
+/// A value kept for the vector and the time (its bits) it was computed at.
+type Kept<T> = (Vec<f64>, u64, T);
+
+/// The last vector and value of each energy form (stiffness, mass).
+type LastQuads = [Option<(Vec<f64>, f64)>; 2];
 
 /// The lower halves of the stiffness and of the scheme's mass, for the energies the observers
 /// take every step: a product with a lower half reads half the bytes of the full one, and a mass
 /// matrix's identity blocks one value each. At 12 490 unknowns the full products took a third
 /// of a disc run and pushed the factor out of the cache between steps. A matrix that is not
 /// symmetric (to the stepper's 10⁻¹² test) keeps the full product.
+///
+/// The energy guard and the observers ask for the same energies of the same step: the last
+/// vector and value of each form are kept, and a query with equal values reuses them.
 pub struct Energies {
     stiffness: Option<LowerHalf>,
     mass: Option<LowerHalf>,
     work: std::sync::Mutex<Vec<f64>>,
+    last: std::sync::Mutex<LastQuads>,
 }
 
 impl Energies {
     /// Without lower halves: the full products.
     pub fn full() -> Energies {
-        Energies { stiffness: None, mass: None, work: Default::default() }
+        Energies { stiffness: None, mass: None, work: Default::default(), last: Default::default() }
     }
 
     /// With the stepper's lower-half pattern when it has one (the same pattern).
     pub fn new(asm: &Assembler, half: Option<&Arc<HalfPattern>>, stiffness: &Matrix, mass: &Matrix) -> Energies {
         let half = half.cloned().unwrap_or_else(|| Arc::new(HalfPattern::new(asm.pattern())));
         let lower = |a: &Matrix| a.is_symmetric(1e-12).then(|| LowerHalf::new(a, &half));
-        Energies { stiffness: lower(stiffness), mass: lower(mass), work: Default::default() }
+        Energies { stiffness: lower(stiffness), mass: lower(mass), work: Default::default(), last: Default::default() }
     }
 
-    /// xᵀAx, from `half` when there is one (A's lower half), else from `a`.
-    fn quad(&self, half: &Option<LowerHalf>, a: &Matrix, x: &[f64]) -> f64 {
-        let Some(half) = half else { return Tools::quad(a, x, x) };
-        let mut y = self.work.lock().unwrap_or_else(|e| e.into_inner());
-        y.resize(x.len(), 0.0);
-        half.mul_vec(x, &mut y);
-        y.iter().zip(x).map(|(p, q)| p * q).sum()
+    /// xᵀAx for A the stiffness (`which` 0) or the mass (1): the last value again for the
+    /// same x, else from A's lower half when there is one, else from `a`.
+    fn quad(&self, which: usize, a: &Matrix, x: &[f64]) -> f64 {
+        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((kept, value)) = &last[which]
+            && kept.as_slice() == x
+        {
+            return *value;
+        }
+        let half = if which == 0 { &self.stiffness } else { &self.mass };
+        let value = match half {
+            None => Tools::quad(a, x, x),
+            Some(half) => {
+                let mut y = self.work.lock().unwrap_or_else(|e| e.into_inner());
+                y.resize(x.len(), 0.0);
+                half.mul_vec(x, &mut y);
+                y.iter().zip(x).map(|(p, q)| p * q).sum()
+            }
+        };
+        match &mut last[which] {
+            Some((kept, v)) => {
+                kept.clear();
+                kept.extend_from_slice(x);
+                *v = value;
+            }
+            none => *none = Some((x.to_vec(), value)),
+        }
+        value
     }
 }
 
@@ -147,7 +180,7 @@ impl Tools<'_> {
 
     /// ½vᵀMv with the scheme's mass (0 without a velocity).
     pub fn kinetic(&self, v: Option<&[f64]>) -> f64 {
-        v.map_or(0.0, |v| 0.5 * self.energies.quad(&self.energies.mass, &self.scheme_mass, v))
+        v.map_or(0.0, |v| 0.5 * self.energies.quad(1, &self.scheme_mass, v))
     }
 
     /// E = ½uᵀKu + ½vᵀMv − Fᵀu.
@@ -162,7 +195,7 @@ impl Tools<'_> {
 
     /// ½uᵀKu.
     pub fn elastic(&self, u: &[f64]) -> f64 {
-        0.5 * self.energies.quad(&self.energies.stiffness, &self.stiffness, u)
+        0.5 * self.energies.quad(0, &self.stiffness, u)
     }
 
     /// The resultant of the contact term on the body along each axis (zeros without a
@@ -176,11 +209,22 @@ impl Tools<'_> {
     }
 
     /// The contact slot's switch at each of its quadrature points (none without the slot).
+    ///
+    /// The energy guard and the observers ask for the same step's: the last answer is kept and
+    /// reused for the same u and t.
     pub fn contact_switches(&self, u: &[f64], t: f64) -> Vec<bool> {
+        let mut last = self.last_switches.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((kept, at, switches)) = &*last
+            && *at == t.to_bits()
+            && kept.as_slice() == u
+        {
+            return switches.clone();
+        }
         let mut switches = Vec::new();
         if let Some(probe) = &self.probe {
             probe.switches(self.asm, &[u], 0, t, &mut switches);
         }
+        *last = Some((u.to_vec(), t.to_bits(), switches.clone()));
         switches
     }
 
@@ -292,7 +336,7 @@ impl<'m> Parts<'m> {
             }
             None => mass.clone(),
         };
-        let tools = Tools {
+        let mut tools = Tools {
             asm,
             contact_facets,
             probe: active.forms.instantiate(problem.coefs, &binding)?.take_form("contact"),
@@ -305,6 +349,7 @@ impl<'m> Parts<'m> {
             cell_measure: inst.take_functional("measure"),
             // The full products until a stepper gives its lower-half pattern.
             energies: Energies::full(),
+            last_switches: Default::default(),
             mass,
             scheme_mass,
             stiffness,
@@ -320,6 +365,18 @@ impl<'m> Parts<'m> {
             // The held dofs: the stepper's, set with it.
             held: Vec::new(),
         };
+        // A law that does no work of its own (Nitsche θ = 1: its factor 1 − θ is zero) costs the
+        // energy guard nothing per step. Probed from rest to the body pushed into the obstacle
+        // and strained every way, where any other law's work is not zero.
+        if let Some(work) = &tools.contact_work {
+            let pushed = stability::pushed_into_obstacle(&tools, problem.coefs);
+            let size = pushed.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1.0);
+            let strained: Vec<f64> =
+                pushed.iter().zip(stability::scattered(n)).map(|(p, r)| p + 1e-3 * size * r).collect();
+            if work.value(asm, &[&strained, &vec![0.0; n]], 0.0) == 0.0 {
+                tools.contact_work = None;
+            }
+        }
         Ok(Parts { tools, forms, inertia })
     }
 }
@@ -516,7 +573,6 @@ impl<'m> Simulation<'m> {
                 law_work: saved.energy_law_work,
                 kinetic: saved.energy_kinetic,
                 growth: saved.energy_growth,
-                contact: saved.energy_contact,
                 lowest: saved.energy_lowest,
                 allowance: saved.energy_allowance,
                 switches: saved.energy_switches.clone(),
@@ -658,7 +714,6 @@ impl<'m> Simulation<'m> {
                         energy_u0: energy.u0.clone(),
                         energy_kinetic: energy.kinetic,
                         energy_growth: energy.growth,
-                        energy_contact: energy.contact,
                         energy_lowest: energy.lowest,
                         energy_allowance: energy.allowance,
                         energy_switches: energy.switches.clone(),
@@ -776,8 +831,6 @@ pub(crate) struct EnergyWatch {
     pub(crate) kinetic: f64,
     /// The largest growth over the scale so far (the summary's `energy_growth`).
     pub(crate) growth: f64,
-    /// The law's `contact_jump` after the previous step (a conserving scheme's allowance).
-    pub(crate) contact: f64,
     /// The lowest E_aug − W so far (a dissipative scheme's bound: what it lost stays lost).
     pub(crate) lowest: f64,
     /// A conserving scheme's allowance so far: on each step whose active set changed, the
@@ -812,7 +865,6 @@ impl EnergyWatch {
         let v = v_index.map(|i| states[i].as_slice());
         let kinetic = tools.kinetic(v);
         let initial = tools.elastic(u) + kinetic + Self::contact(tools, u, t);
-        let contact = Self::value(&tools.contact_jump, tools, u, t);
         EnergyWatch {
             initial,
             u0: u.clone(),
@@ -821,7 +873,6 @@ impl EnergyWatch {
             law_work: 0.0,
             kinetic,
             growth: 0.0,
-            contact,
             lowest: initial,
             allowance: 0.0,
             switches: tools.contact_switches(u, t),
@@ -911,14 +962,18 @@ impl EnergyWatch {
         let potential = tools.elastic(u) + Self::contact(tools, u, t);
         let energy = potential + kinetic;
         // A conserving scheme: the allowance grows on the steps where the active set changes.
-        let (jump, switches, allowance) = match law {
+        let (switches, allowance) = match law {
             Some(EnergyLaw::Conserving) => {
-                let jump = Self::value(&tools.contact_jump, tools, u, t);
                 let switches = tools.contact_switches(u, t);
-                let changed = switches != self.switches;
-                (jump, switches, self.allowance + if changed { jump.max(self.contact) } else { 0.0 })
+                let jump = if switches != self.switches {
+                    let value = |x: &[f64], at: f64| Self::value(&tools.contact_jump, tools, x, at);
+                    value(u, t).max(value(before, t - h))
+                } else {
+                    0.0
+                };
+                (switches, self.allowance + jump)
             }
-            _ => (0.0, Vec::new(), 0.0),
+            _ => (Vec::new(), 0.0),
         };
         // The work summed step by step (a varying load's, the held dofs', a moving obstacle's),
         // a constant load's from u(0), and the law's own.
@@ -959,7 +1014,6 @@ impl EnergyWatch {
         if growth <= admitted {
             self.kinetic = self.kinetic.max(kinetic);
         }
-        self.contact = jump;
         self.switches = switches;
         self.allowance = allowance;
         self.lowest = self.lowest.min(energy - work);

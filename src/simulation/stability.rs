@@ -53,17 +53,8 @@ pub fn estimate(
     let mut mass = Factorization::new(Structure::SymmetricPositiveDefinite);
     mass.factor(&tools.scheme_mass).map_err(|e| CaseError::Option(format!("the scheme's mass: {e}")))?;
     let free = |x: &mut [f64]| x.iter_mut().zip(&constraints.fixed).filter(|(_, f)| **f).for_each(|(x, _)| *x = 0.0);
-    // A start with every frequency in it (a fixed pseudo-random sequence: the same estimate on
-    // every run).
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut x: Vec<f64> = (0..n)
-        .map(|_| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        })
-        .collect();
+    // A start with every frequency in it.
+    let mut x = scattered(n);
     free(&mut x);
     let (mut ax, mut lambda) = (vec![0.0; n], 0.0f64);
     for _ in 0..ITERATIONS {
@@ -88,11 +79,25 @@ pub fn estimate(
     Ok(StableStep { cfl, omega_max, dt: cfl / omega_max, active, points })
 }
 
+/// Values in [−½, ½) from a fixed pseudo-random sequence (xorshift): every mode present, the
+/// same on every run.
+pub(crate) fn scattered(n: usize) -> Vec<f64> {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    (0..n)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        })
+        .collect()
+}
+
 /// The body translated along the contact normal at the first contact node far enough that every
 /// contact node is past the obstacle by a thousandth of the body's size: a rigid motion, so
 /// the elastic stress stays zero and a law that compares the stress with the gap (Nitsche's)
 /// sees every point in contact.
-fn pushed_into_obstacle(tools: &Tools, coefs: &dyn Fn(&str) -> Option<Coef>) -> Vec<f64> {
+pub(crate) fn pushed_into_obstacle(tools: &Tools, coefs: &dyn Fn(&str) -> Option<Coef>) -> Vec<f64> {
     let mesh = tools.asm.mesh();
     let d = mesh.dim();
     let n = tools.asm.size();

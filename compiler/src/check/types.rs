@@ -616,10 +616,10 @@ impl<'p> Checker<'p> {
                         Some("powers apply to scalars; use dot or inner for products"),
                     );
                 }
-                // A problem's numbers (params, lets of params) may take any real power; the
-                // lowering checks that the base is one.
-                if self.vectors_allowed
-                    && let Some(k) = tb.konst.filter(|k| k.fract() != 0.0 && k.is_finite())
+                // A real constant exponent: a^p, differentiated as p a^(p−1) (NaN where a < 0;
+                // its derivative infinite at a = 0 for p < 1).
+                if let Some(k) = tb.konst.filter(|k| k.fract() != 0.0 && k.is_finite())
+                    && !ta.test
                 {
                     return Some(Ty { konst: ta.konst.map(|x| x.powf(k)), ..ta });
                 }
@@ -627,13 +627,10 @@ impl<'p> Checker<'p> {
                     Some(k) if k.fract() == 0.0 && k.abs() <= 64.0 && !tb.test => k,
                     _ => {
                         self.error(
-                            Diagnostic::error(
-                                "E0303",
-                                "exponent must be a constant integer",
-                                b.span,
-                                "not a constant integer",
-                            )
-                            .with_help("use sqrt(x) for x^(1/2); `^` takes integers from -64 to 64"),
+                            Diagnostic::error("E0303", "exponent must be a constant", b.span, "not a constant")
+                                .with_help(
+                                    "`^` takes a number written in the file (integers from -64 to 64, or a real such as 3/2); a param's value is not known when the form is compiled",
+                                ),
                         );
                         return None;
                     }

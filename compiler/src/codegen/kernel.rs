@@ -550,6 +550,7 @@ impl Body<'_> {
             Node::Div(a, b) => (format!("{} / {}", wrap(sub(a), MUL), wrap(sub(b), UNARY)), MUL),
             Node::Neg(a) => (format!("-{}", wrap(sub(a), UNARY)), UNARY),
             Node::Powi(a, k) => (format!("{}.powi({k})", wrap(sub(a), ATOM)), ATOM),
+            Node::Powf(a, p) => (format!("{}.powf({:?})", wrap(sub(a), ATOM), f64::from_bits(p)), ATOM),
             Node::Sqrt(a) => (format!("{}.sqrt()", wrap(sub(a), ATOM)), ATOM),
             Node::Heaviside(a) => (format!("heaviside({})", sub(a).0), ATOM),
         }

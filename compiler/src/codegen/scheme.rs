@@ -54,6 +54,7 @@ fn coefficient_code(order: &[NodeId], g: &Graph, s: &SchemeIr) -> String {
             Node::Div(a, b) => format!("{} / {}", name(a), name(b)),
             Node::Neg(a) => format!("-{}", name(a)),
             Node::Powi(a, k) => format!("{}.powi({k})", name(a)),
+            Node::Powf(a, p) => format!("{}.powf({:?})", name(a), f64::from_bits(p)),
             Node::Sqrt(a) => format!("{}.sqrt()", name(a)),
             Node::Heaviside(a) => format!("heaviside({})", name(a)),
         };

@@ -71,6 +71,17 @@ impl Derivative {
                 let cp = g.mul(c, p);
                 g.mul(cp, da)
             }
+            Node::Powf(a, p) => {
+                let da = d(a);
+                if g.is_zero(da) {
+                    return g.zero();
+                }
+                let p = f64::from_bits(p);
+                let q = g.powf(a, p - 1.0);
+                let c = g.constant(p);
+                let cq = g.mul(c, q);
+                g.mul(cq, da)
+            }
             Node::Sqrt(a) => {
                 let da = d(a);
                 if g.is_zero(da) {
@@ -97,6 +108,7 @@ mod tests {
             Node::Neg(a) => -eval(g, a, x),
             Node::Div(a, b) => eval(g, a, x) / eval(g, b, x),
             Node::Powi(a, k) => eval(g, a, x).powi(k),
+            Node::Powf(a, p) => eval(g, a, x).powf(f64::from_bits(p)),
             Node::Sqrt(a) => eval(g, a, x).sqrt(),
             Node::Heaviside(a) => f64::from((eval(g, a, x) > 0.0) as u8),
         }

@@ -23,6 +23,7 @@ enum Op {
     Div(Slot, Slot),
     Neg(Slot),
     Powi(Slot, i32),
+    Powf(Slot, f64),
     Sqrt(Slot),
     Heaviside(Slot),
 }
@@ -102,6 +103,7 @@ impl Program {
                 Node::Div(a, b) => Op::Div(s(a), s(b)),
                 Node::Neg(a) => Op::Neg(s(a)),
                 Node::Powi(a, k) => Op::Powi(s(a), k),
+                Node::Powf(a, p) => Op::Powf(s(a), f64::from_bits(p)),
                 Node::Sqrt(a) => Op::Sqrt(s(a)),
                 Node::Heaviside(a) => Op::Heaviside(s(a)),
                 Node::Const(_) | Node::Sym(_) => continue,
@@ -199,6 +201,7 @@ impl Program {
                 Op::Div(a, b) => v(a) / v(b),
                 Op::Neg(a) => -v(a),
                 Op::Powi(a, k) => v(a).powi(k),
+                Op::Powf(a, p) => v(a).powf(p),
                 Op::Sqrt(a) => v(a).sqrt(),
                 Op::Heaviside(a) => heaviside(v(a)),
             };

@@ -53,6 +53,8 @@ pub enum Node {
     Neg(NodeId),
     Div(NodeId, NodeId),
     Powi(NodeId, i32),
+    /// a^p for a constant real p (its bits), not an integer: NaN where a < 0.
+    Powf(NodeId, u64),
     Sqrt(NodeId),
     /// H(a) = 1 if a > 0, else 0. Every non-smooth built-in is defined through it.
     Heaviside(NodeId),
@@ -237,6 +239,20 @@ impl Graph {
         self.intern(Node::Powi(a, k))
     }
 
+    /// a^p for a constant real p; an integer p is [`Graph::powi`], p = 1/2 [`Graph::sqrt`].
+    pub fn powf(&mut self, a: NodeId, p: f64) -> NodeId {
+        if p.fract() == 0.0 && p.abs() <= i32::MAX as f64 {
+            return self.powi(a, p as i32);
+        }
+        if p == 0.5 {
+            return self.sqrt(a);
+        }
+        match self.as_const(a) {
+            Some(x) => self.constant(x.powf(p)),
+            None => self.intern(Node::Powf(a, p.to_bits())),
+        }
+    }
+
     pub fn sqrt(&mut self, a: NodeId) -> NodeId {
         match self.as_const(a) {
             Some(x) => self.constant(x.sqrt()),
@@ -268,7 +284,7 @@ impl Graph {
         let (a, b) = match self.node(id) {
             Node::Const(_) | Node::Sym(_) => (None, None),
             Node::Add(x, y) | Node::Mul(x, y) | Node::Div(x, y) => (Some(x), Some(y)),
-            Node::Neg(x) | Node::Powi(x, _) | Node::Sqrt(x) | Node::Heaviside(x) => (Some(x), None),
+            Node::Neg(x) | Node::Powi(x, _) | Node::Powf(x, _) | Node::Sqrt(x) | Node::Heaviside(x) => (Some(x), None),
         };
         a.into_iter().chain(b)
     }

@@ -179,20 +179,14 @@ impl<'p> Lowerer<'p> {
                 if *op == BinOp::Div && self.g.is_zero(b.c[0].v) {
                     return Err(Box::new(not_finite(e.span, "divides by zero")));
                 }
-                // A real power (problems only: the checker allows it there) of a number.
+                // A real power: of a number, folded; of a value that varies, a^p with p a^(p−1)
+                // as its derivative.
                 if let (BinOp::Pow, Some(k)) = (op, b_const(e).filter(|k| k.fract() != 0.0)) {
-                    let Some(x) = self.g.as_const(a.c[0].v) else {
-                        return Err(Box::new(
-                            Diagnostic::error(
-                                "E0303",
-                                "a real power of a value that varies",
-                                e.span,
-                                "the base depends on x, t or the fields",
-                            )
-                            .with_help("a real exponent takes numbers and params only; `^` takes integers otherwise"),
-                        ));
-                    };
-                    return Ok(self.constant_val(x.powf(k)));
+                    if let Some(x) = self.g.as_const(a.c[0].v) {
+                        return Ok(self.constant_val(x.powf(k)));
+                    }
+                    let base = a.c[0].clone();
+                    return Ok(Self::scalar(self.jpowf(&base, k)));
                 }
                 self.binary(*op, a, b, b_const(e))
             }
@@ -604,6 +598,17 @@ impl<'p> Lowerer<'p> {
             let c = self.g.constant(k as f64);
             let cp = self.g.mul(c, p);
             ga.iter().map(|&x| self.g.mul(cp, x)).collect()
+        });
+        Jet { v, g }
+    }
+
+    fn jpowf(&mut self, a: &Jet, p: f64) -> Jet {
+        let v = self.g.powf(a.v, p);
+        let g = a.g.as_ref().map(|ga| {
+            let q = self.g.powf(a.v, p - 1.0);
+            let c = self.g.constant(p);
+            let cq = self.g.mul(c, q);
+            ga.iter().map(|&x| if self.g.is_zero(x) { x } else { self.g.mul(cq, x) }).collect()
         });
         Jet { v, g }
     }

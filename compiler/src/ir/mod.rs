@@ -253,7 +253,7 @@ pub fn node_degrees(
             Node::Mul(a, b) | Node::Div(a, b) => dg(a).saturating_add(dg(b)),
             Node::Neg(a) => dg(a),
             Node::Powi(a, k) if k >= 0 => dg(a).saturating_mul(k as u32),
-            Node::Powi(a, _) | Node::Sqrt(a) => dg(a).saturating_add(2),
+            Node::Powi(a, _) | Node::Powf(a, _) | Node::Sqrt(a) => dg(a).saturating_add(2),
             Node::Heaviside(_) => 0,
         };
         deg.insert(id, v);

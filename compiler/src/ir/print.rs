@@ -83,6 +83,7 @@ fn node(g: &Graph, id: NodeId, params: &[String], coefs: &[String]) -> String {
         Node::Neg(a) => format!("neg {}", o(a)),
         Node::Div(a, b) => format!("div {} {}", o(a), o(b)),
         Node::Powi(a, k) => format!("powi {} {k}", o(a)),
+        Node::Powf(a, p) => format!("powf {} {}", o(a), f64::from_bits(p)),
         Node::Sqrt(a) => format!("sqrt {}", o(a)),
         Node::Heaviside(a) => format!("H {}", o(a)),
     }

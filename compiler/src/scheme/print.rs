@@ -231,6 +231,7 @@ fn expr(g: &Graph, id: NodeId) -> (String, u8) {
         Node::Div(a, b) => (format!("{}/{}", wrap(infix(g, a), 2), wrap(infix(g, b), 3)), 2),
         Node::Neg(a) => (format!("-{}", wrap(infix(g, a), 3)), 3),
         Node::Powi(a, k) => (format!("{}^{k}", wrap(infix(g, a), 4)), 4),
+        Node::Powf(a, p) => (format!("{}^{}", wrap(infix(g, a), 4), f64::from_bits(p)), 4),
         Node::Sqrt(a) => (format!("sqrt({})", scalar(g, a)), 4),
         Node::Heaviside(a) => (format!("H({})", scalar(g, a)), 4),
     }

@@ -388,6 +388,8 @@ impl Normalizer {
             Node::Neg(a) => sub(a)?.neg(),
             Node::Div(a, b) => sub(a)?.mul(&sub(b)?.powi(-1)?),
             Node::Powi(a, k) => sub(a)?.powi(k),
+            // Schemes take integer powers only (the checker refuses others there).
+            Node::Powf(..) => Err(GiveUp),
             Node::Sqrt(a) => {
                 let e = sub(a)?;
                 if e.is_zero() { Ok(Expr::default()) } else { Ok(Expr::atom(Atom::Sqrt(Box::new(e)))) }
@@ -667,6 +669,10 @@ fn value_and_scale(g: &Graph, id: NodeId, params: &[f64], dt: f64, t: f64) -> (f
             // A divisor's scale is its value: the pivots are checked to keep away from zero.
             Node::Div(x, y) => (c(x).0 / c(y).0, c(x).1 / c(y).0.abs()),
             Node::Powi(x, k) => (c(x).0.powi(k), if k >= 0 { c(x).1.powi(k) } else { c(x).0.abs().powi(k) }),
+            Node::Powf(x, p) => {
+                let p = f64::from_bits(p);
+                (c(x).0.powf(p), c(x).1.powf(p))
+            }
             Node::Sqrt(x) => (c(x).0.sqrt(), c(x).1.sqrt()),
             Node::Heaviside(x) => (f64::from(c(x).0 > 0.0), 1.0),
         };
