@@ -40,6 +40,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0501", "`n` or `h` in a volume integral"),
     ("E0502", "derivative of something that has none"),
     ("E0503", "form needs a quadrature degree above the cap (20)"),
+    ("E0504", "quadrature degree not an integer from 0 to 20"),
     ("E0601", "parameter default outside its range"),
     ("E0602", "empty parameter range"),
     ("E0603", "parameter default or bound not a finite constant"),

@@ -104,6 +104,34 @@ fn stage_times_must_be_finite() {
 #[test]
 fn high_quadrature_degrees_are_refused() {
     refused("form f(u; v) = int(Omega) dot(u, u)^20 * dot(u, v)\n", "E0503");
+    // The help names the way out, and a degree the file sets is the author's.
+    let text = refused("form f(u; v) = int(Omega) dot(u, u)^20 * dot(u, v)\n", "E0503");
+    assert!(text.contains("int(Omega, degree = 20)"), "{text}");
+    let path = Path::new("forms/limits.wf");
+    let set = "form f(u; v) = int(Omega, degree = 6) dot(u, u)^20 * dot(u, v)\n";
+    let rust = signorini_compiler::compile_to_rust(path, &MemLoader::default().with(path, set), "::rt");
+    assert!(rust.is_ok(), "a set degree compiles");
+}
+
+#[test]
+fn a_quadrature_degree_is_an_integer_in_range() {
+    for k in ["2.5", "21", "1e9"] {
+        refused(&format!("form f(u; v) = int(Omega, degree = {k}) dot(u, v)\n"), "E0504");
+    }
+}
+
+/// `int(REGION, degree = K)` replaces the estimate in the generated kernel's metadata, for
+/// every element degree.
+#[test]
+fn a_set_quadrature_degree_reaches_the_kernel() {
+    let path = Path::new("forms/limits.wf");
+    let text = "form f(u; v) = int(Omega, degree = 3) dot(u, u)^4 * dot(u, v)\n";
+    let compiled = signorini_compiler::compile(path, &MemLoader::default().with(path, text)).expect("compiles");
+    for ir in compiled.irs() {
+        let i = &ir.forms[0].integrals[0];
+        assert_eq!(i.degree, [3, 3]);
+        assert_eq!(i.estimated, [10, 20]);
+    }
 }
 
 #[test]

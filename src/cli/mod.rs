@@ -519,6 +519,7 @@ fn check(files: &[PathBuf]) -> ExitCode {
         match compiler::compile(f, &crate::driver::sources::LibraryLoader) {
             Ok(compiled) => {
                 eprint!("{}", compiled.warnings);
+                print!("{}", quadrature_degrees(f, &compiled));
                 // A problem is also bound: its mesh and regions, the coefs of the files in use.
                 if !compiled.program.unit.problems.is_empty()
                     && let Err(e) = crate::problem::run::check(&f.to_string_lossy())
@@ -534,6 +535,33 @@ fn check(files: &[PathBuf]) -> ExitCode {
         }
     }
     if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
+}
+
+/// Each integral's quadrature degree on P1 and P2 elements (2D): the estimate, or the one the
+/// file sets with `int(REGION, degree = K)`.
+fn quadrature_degrees(file: &Path, compiled: &compiler::Compiled) -> String {
+    let mut out = String::new();
+    let unit = &compiled.program.unit;
+    // The file's own forms (an imported file's are in its own report).
+    let own = |name: &str| unit.forms.iter().any(|f| f.name == name && f.span.file == unit.root);
+    for form in compiled.ir(2).forms.iter().filter(|f| own(&f.name)) {
+        for i in &form.integrals {
+            let how = if i.degree == i.estimated {
+                format!("estimated; `int({}, degree = K)` sets it", i.region)
+            } else {
+                format!("set in the file; estimated {} and {}", i.estimated[0], i.estimated[1])
+            };
+            out.push_str(&format!(
+                "{}: {} over {}: quadrature degree {} on P1, {} on P2 ({how})\n",
+                file.display(),
+                form.name,
+                i.region,
+                i.degree[0],
+                i.degree[1]
+            ));
+        }
+    }
+    out
 }
 
 fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {

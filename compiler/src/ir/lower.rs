@@ -35,6 +35,9 @@ pub struct Val {
 #[derive(Clone, Debug)]
 pub struct Integrand {
     pub region: String,
+    /// The quadrature degree the file sets (`int(REGION, degree = k)`), the largest of the
+    /// region's integrals that set one.
+    pub degree: Option<u32>,
     /// The integrand itself (scalar, linear in the test function).
     pub value: NodeId,
 }
@@ -136,9 +139,30 @@ impl<'p> Lowerer<'p> {
                 }
             };
             let v = if integral.sign < 0.0 { self.g.neg(v) } else { v };
+            let degree = match integral.degree {
+                None => None,
+                Some((k, _)) if k.fract() == 0.0 && (0.0..=super::MAX_DEGREE as f64).contains(&k) => Some(k as u32),
+                Some((k, span)) => {
+                    self.scope.clear();
+                    return Err(Box::new(
+                        Diagnostic::error(
+                            "E0504",
+                            format!("quadrature degree {k} is not an integer from 0 to {}", super::MAX_DEGREE),
+                            span,
+                            "not a quadrature degree",
+                        )
+                        .with_help(
+                            "`int(REGION, degree = K)` takes the degree of polynomial the rule integrates exactly",
+                        ),
+                    ));
+                }
+            };
             match integrands.iter_mut().find(|i| i.region == integral.region.name) {
-                Some(i) => i.value = self.g.add(i.value, v),
-                None => integrands.push(Integrand { region: integral.region.name.clone(), value: v }),
+                Some(i) => {
+                    i.value = self.g.add(i.value, v);
+                    i.degree = i.degree.max(degree);
+                }
+                None => integrands.push(Integrand { region: integral.region.name.clone(), degree, value: v }),
             }
         }
         // Volume integral first: kernels are emitted in this order.

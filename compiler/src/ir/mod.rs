@@ -55,9 +55,12 @@ pub struct IntegralIr {
     pub tangents: Vec<TangentIr>,
     /// The integrand of a functional.
     pub value: Option<NodeId>,
-    /// Suggested quadrature degree for P1 and P2 elements (exact on affine cells when the
-    /// integrand is polynomial).
+    /// The quadrature degree for P1 and P2 elements: the one the file sets
+    /// (`int(REGION, degree = k)`), else the estimate.
     pub degree: [u32; 2],
+    /// The estimated degree (exact on affine cells when the integrand is polynomial), which
+    /// `check` reports.
+    pub estimated: [u32; 2],
 }
 
 /// Index conventions: k = test component, l = test derivative direction, m = trial component,
@@ -108,7 +111,8 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
         for integrand in &lf.integrands {
             if lf.test.is_none() {
                 let roots = [integrand.value];
-                let degree = [1, 2].map(|p| node_degrees(&g, p, roots)[&integrand.value]);
+                let estimated = [1, 2].map(|p| node_degrees(&g, p, roots)[&integrand.value]);
+                let degree = integrand.degree.map_or(estimated, |k| [k, k]);
                 integrals.push(IntegralIr {
                     region: integrand.region.clone(),
                     cell: integrand.region == CELL_REGION,
@@ -117,6 +121,7 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
                     tangents: Vec::new(),
                     value: Some(integrand.value),
                     degree,
+                    estimated,
                 });
                 continue;
             }
@@ -129,7 +134,8 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
                 })
                 .collect();
             let tangents = (0..lf.fields.len()).map(|a| tangent(&mut g, d, a as u8, &f0, &f1)).collect::<Vec<_>>();
-            let degree = [1, 2].map(|p| integral_degree(&g, p, &f0, &f1, &tangents));
+            let estimated = [1, 2].map(|p| integral_degree(&g, p, &f0, &f1, &tangents));
+            let degree = integrand.degree.map_or(estimated, |k| [k, k]);
             integrals.push(IntegralIr {
                 region: integrand.region.clone(),
                 cell: integrand.region == CELL_REGION,
@@ -138,6 +144,7 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
                 tangents,
                 value: None,
                 degree,
+                estimated,
             });
         }
         let tangent_nodes = integrals.iter().flat_map(|i| i.tangents.iter().flat_map(TangentIr::nodes));
@@ -158,8 +165,13 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
 
 /// A form whose estimated quadrature degree (on P1 or P2 elements) passes [`MAX_DEGREE`].
 fn degree_error(prog: &Unit, name: &str, integrals: &[IntegralIr]) -> Option<Diagnostic> {
-    let (i, degree) =
-        integrals.iter().enumerate().map(|(i, x)| (i, x.degree[0].max(x.degree[1]))).max_by_key(|x| x.1)?;
+    // A degree the file sets is the author's (checked when lowered).
+    let (i, degree) = integrals
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| x.degree == x.estimated)
+        .map(|(i, x)| (i, x.degree[0].max(x.degree[1])))
+        .max_by_key(|x| x.1)?;
     if degree <= MAX_DEGREE {
         return None;
     }
@@ -173,7 +185,9 @@ fn degree_error(prog: &Unit, name: &str, integrals: &[IntegralIr]) -> Option<Dia
             integral.integrand.span,
             format!("a polynomial of degree {degree} on P2 elements, above the cap of {MAX_DEGREE}"),
         )
-        .with_help("lower the powers or the nesting of products; a high power of a field is rarely meant"),
+        .with_help(format!(
+            "lower the powers or the nesting of products, or set the degree: `int({region}, degree = {MAX_DEGREE})`"
+        )),
     )
 }
 

@@ -88,6 +88,8 @@ pub struct Integral {
     /// +1 or -1: the sign written before `int`.
     pub sign: f64,
     pub region: Ident,
+    /// `int(REGION, degree = k)`: the quadrature degree the author sets, and where.
+    pub degree: Option<(f64, Span)>,
     pub integrand: Expr,
     pub span: Span,
 }

@@ -355,6 +355,7 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::string | Rule::module_name => "a module name",
         Rule::sign => "`+` or `-`",
         Rule::integral => "`int(REGION)`",
+        Rule::degree_arg => "`degree = K`",
         Rule::integrals => "an integral `int(REGION) ...`",
         Rule::form_args | Rule::ident_list => "argument names",
         Rule::state_decl
@@ -846,8 +847,16 @@ impl Builder {
                     }
                     let mut it = q.into_inner();
                     let region = self.ident(it.next().expect("integral region"));
-                    let integrand = self.expr(it.next().expect("integrand"))?;
-                    out.push(Integral { sign, region, integrand, span });
+                    let mut next = it.next().expect("integrand");
+                    let mut degree = None;
+                    if next.as_rule() == Rule::degree_arg {
+                        let number = next.into_inner().next().expect("degree");
+                        let value = number.as_str().parse::<f64>().unwrap_or(f64::NAN);
+                        degree = Some((value, self.span(&number)));
+                        next = it.next().expect("integrand");
+                    }
+                    let integrand = self.expr(next)?;
+                    out.push(Integral { sign, region, degree, integrand, span });
                     sign = 1.0;
                 }
             }

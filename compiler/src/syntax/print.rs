@@ -90,7 +90,8 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 }
                 for i in integrals {
                     let sign = if i.sign < 0.0 { "-" } else { "+" };
-                    out.push_str(&format!("  {sign} int({}) {}\n", i.region.name, expr(&i.integrand)));
+                    let degree = i.degree.map_or(String::new(), |(k, _)| format!(", degree = {k}"));
+                    out.push_str(&format!("  {sign} int({}{degree}) {}\n", i.region.name, expr(&i.integrand)));
                 }
             }
         }
