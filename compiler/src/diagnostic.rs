@@ -71,6 +71,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("W0003", "a `fn` or `form` argument hides a name of the file (warning)"),
     ("W0004", "problem: a coef set that no file in use reads (warning)"),
     ("W0005", "scheme: a state (other than the displacement and `v`) that is never read (warning)"),
+    ("W0006", "a tangent divides by an expression that is zero where pos/neg clips it: 0/0 there (warning)"),
 ];
 
 /// Codes reported when a problem is bound to the files of a run (the facade's bad-input corpus

@@ -154,7 +154,13 @@ fn front(loaded: load::Loaded, diags: Vec<Diagnostic>) -> Result<(Program, ast::
     let mut irs = Vec::new();
     for &d in &ir::DIMS {
         match ir::build(&unit, d) {
-            Ok(ir) => irs.push(ir),
+            Ok(ir) => {
+                // The first dimension's only: the others repeat them.
+                if irs.is_empty() {
+                    diags.extend(ir::vanishing_denominators(&unit, &ir));
+                }
+                irs.push(ir)
+            }
             // The first dimension's errors only: the others mostly repeat them.
             Err(mut e) => {
                 diags.append(&mut e);

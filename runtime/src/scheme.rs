@@ -274,6 +274,10 @@ pub enum StepError {
     #[error("stage `{stage}` at t = {t}: {source}")]
     Newton { stage: &'static str, t: f64, source: NewtonError },
     #[error(
+        "stage `{stage}` at t = {t}: {at}: its derivative divides by zero there (0/0 where a `pos`/`neg` clips an expression under a `sqrt` or a negative power; `check` warns of it as W0006): write the power directly, `d^(3/2)` rather than `d*sqrt(d)`"
+    )]
+    NonFiniteTangent { stage: &'static str, t: f64, at: NonFiniteTangent },
+    #[error(
         "stage `{stage}` of scheme `{scheme}` has no displacement quantity (u', um, ...) that depends on its unknown (a nonzero coefficient at this Δt): a moving held displacement cannot be imposed there"
     )]
     NoDisplacement { scheme: &'static str, stage: &'static str },
@@ -876,6 +880,7 @@ impl<'a> Stepper<'a> {
             switches,
             magnitude: 0.0,
             recorded: RecordedTangent { valid: false, ..std::mem::take(recorded) },
+            non_finite: None,
         };
         // δ = w − reference, with the constrained values of w imposed: zero but on those.
         let w0 = match reference {
@@ -888,12 +893,43 @@ impl<'a> Stepper<'a> {
             delta[i] = values[i] - w0[i];
         }
         let report = newton.solve(&mut problem, &mut delta);
+        // A NaN or infinite tangent (0/0 in a law's derivative) is said as such, not as the
+        // singular matrix it makes.
+        if report.is_err()
+            && let Some(at) = problem.non_finite.take()
+        {
+            return Err(StepError::NonFiniteTangent { stage: stage.name, t: stage_t, at });
+        }
         (*args, *term, *recorded) = (problem.args, problem.term, problem.recorded);
         self.pool.give(problem.rhs);
         problem.terms.into_iter().flat_map(|t| t.bases).for_each(|b| self.pool.give(b));
         let report = report.map_err(|source| StepError::Newton { stage: stage.name, t: stage_t, source })?;
         Ok((delta, report))
     }
+}
+
+/// The first element whose tangent entries of `form` are not finite: its nodes' positions
+/// (none when the form cannot give its element matrices).
+fn locate_non_finite(
+    asm: &Assembler,
+    form: &dyn BoundForm,
+    fields: &[&[f64]],
+    wrt: usize,
+    t: f64,
+    name: &str,
+) -> NonFiniteTangent {
+    let mut elements = ElementMatrices::default();
+    let mut nodes = Vec::new();
+    if form.tangent_elements(asm, fields, wrt, t, None, &mut elements) && elements.size > 0 {
+        let (size, per) = (elements.size, elements.size * elements.size);
+        let d = asm.mesh().dim();
+        if let Some(e) = elements.values.chunks(per).position(|m| m.iter().any(|v| !v.is_finite())) {
+            let mut seen: Vec<usize> = elements.dofs[e * size..(e + 1) * size].iter().map(|dof| dof / d).collect();
+            seen.dedup();
+            nodes = seen.iter().map(|&node| asm.mesh().node(node).to_vec()).collect();
+        }
+    }
+    NonFiniteTangent { form: name.to_string(), level: wrt, nodes }
 }
 
 /// Largest |Σ c| / Σ |c| of a group of coefficients treated as summing to zero: a few roundings
@@ -1046,6 +1082,29 @@ struct StageProblem<'p, 'a> {
     /// The largest term of the last residual.
     magnitude: f64,
     recorded: RecordedTangent,
+    /// The first non-finite entry of a nonlinear term's tangent: where it is.
+    non_finite: Option<NonFiniteTangent>,
+}
+
+/// Where a tangent is not finite: the form, the time level it is differentiated by, and the
+/// nodes of the first element (cell or facet) with a non-finite entry.
+#[derive(Clone, Debug)]
+pub struct NonFiniteTangent {
+    pub form: String,
+    pub level: usize,
+    pub nodes: Vec<Vec<f64>>,
+}
+
+impl std::fmt::Display for NonFiniteTangent {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let at: Vec<String> = self
+            .nodes
+            .iter()
+            .map(|x| format!("({})", x.iter().map(|c| format!("{c:.6}")).collect::<Vec<_>>().join(", ")))
+            .collect();
+        write!(f, "the tangent of form `{}` (by its field {}) is not finite", self.form, self.level + 1)?;
+        if at.is_empty() { Ok(()) } else { write!(f, " on the element with nodes at {}", at.join(", ")) }
+    }
 }
 
 /// The nonlinear terms' tangent as element matrices, recorded by the last Jacobian assembly
@@ -1122,6 +1181,9 @@ impl StageProblem<'_, '_> {
                         && form.tangent_elements(self.asm, &refs, k, term.t, Some(&mut *m), &mut rec.elements);
                     if !rec.valid {
                         form.tangent(self.asm, &refs, k, term.t, m);
+                    }
+                    if self.non_finite.is_none() && m.values.iter().any(|v| !v.is_finite()) {
+                        self.non_finite = Some(locate_non_finite(self.asm, &**form, &refs, k, term.t, term.form));
                     }
                     match self.support {
                         Some(s) => s.entries.indices.iter().for_each(|&i| j.values[i] += c * m.values[i]),

@@ -34,6 +34,9 @@ pub enum CaseError {
         "stopped at t = {t} after {cuts} step cuts (Δt = {dt:.3e}): {cause}\n  Newton: {history}\n  results up to the last good step are written; more cuts: --max-step-cuts, or try a smaller Δt"
     )]
     Stopped { t: f64, cuts: usize, dt: f64, cause: String, history: String },
+    /// A step failed in a way no smaller Δt mends.
+    #[error("stopped at t = {t}: {cause}\n  results up to the last good step are written")]
+    Failed { t: f64, cause: String },
     /// The energy grew past what a stable scheme allows.
     #[error(
         "stopped at t = {t}: the energy E_aug = ½uᵀKu + ½vᵀMv + contact energy = {energy:.6e} exceeds E_aug(0) + the work of the loads = {bound:.6e} by {:.1} % of the problem's energy scale {scale:.4e} (the largest of |E_aug(0)|, the work and the kinetic energy reached); the tolerance is {:.1} %{law}: the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Δt beyond a conditionally stable scheme's limit (an explicit scheme, an explicit contact term), Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt, a contact parameter so large (γ0 or ε ≳ 1e12 × E) that the contact rows' round-off swamps the solve, or degenerate cells. Results up to the last good step are written; --energy-tolerance sets the tolerance (0 turns this check off)",

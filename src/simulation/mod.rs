@@ -613,6 +613,11 @@ impl<'m> Simulation<'m> {
                         if let Some(saved) = saved {
                             states.clone_from_slice(&saved);
                         }
+                        // A law whose derivative is 0/0 is so at any Δt: no cut helps.
+                        if let crate::runtime::scheme::StepError::NonFiniteTangent { .. } = e {
+                            outcome.stopped = Some(CaseError::Failed { t, cause: e.to_string() });
+                            break 'steps;
+                        }
                         if level < max_cuts {
                             level += 1;
                             streak = 0;

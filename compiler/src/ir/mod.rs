@@ -163,6 +163,49 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
     Ok(DimIr { dim: d, graph: g, forms })
 }
 
+/// W0006: a form whose tangent divides by (or takes a negative power of) an expression of the
+/// fields that a `pos`/`neg` clips to zero on a whole part of its region: the derivative of
+/// `d*sqrt(d)` with d = pos(u_N − g) is 0/0 wherever the body is out of contact, and the first
+/// Jacobian is NaN. One warning per integral.
+pub fn vanishing_denominators(prog: &Unit, ir: &DimIr) -> Vec<Diagnostic> {
+    let g = &ir.graph;
+    // A node that is zero wherever a clip of a field-dependent expression is: it contains
+    // H(a) with `a` depending on the fields.
+    let clipped = |den: NodeId| {
+        g.reachable([den]).into_iter().any(|n| {
+            matches!(g.node(n), Node::Heaviside(a) if g.reachable([a]).into_iter().any(|m| matches!(g.node(m), Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. }))))
+        })
+    };
+    let mut out = Vec::new();
+    for form in ir.forms.iter().filter(|f| f.test.is_some()) {
+        let Some(def) = prog.forms.iter().find(|f| f.name == form.name) else { continue };
+        for integral in &form.integrals {
+            let nodes = g.reachable(integral.tangents.iter().flat_map(TangentIr::nodes));
+            let divides = nodes.iter().find_map(|&n| match g.node(n) {
+                Node::Div(_, den) if clipped(den) => Some("divides by"),
+                Node::Powi(a, k) if k < 0 && clipped(a) => Some("takes a negative power of"),
+                Node::Powf(a, p) if f64::from_bits(p) < 0.0 && clipped(a) => Some("takes a negative power of"),
+                _ => None,
+            });
+            let (Some(what), Some(at)) = (divides, def.integrals.iter().find(|i| i.region.name == integral.region))
+            else {
+                continue;
+            };
+            out.push(
+                Diagnostic::warning(
+                    "W0006",
+                    format!("the tangent of `{}` {what} an expression that is zero where `pos`/`neg` clips it", form.name),
+                    at.integrand.span,
+                    "its derivative is 0/0 (NaN) there",
+                )
+                .with_note("Newton's first Jacobian is then NaN wherever the clip is active (out of contact), and the solve fails as singular")
+                .with_help("write the power directly: `d^(3/2)` rather than `d*sqrt(d)` differentiates to (3/2) d^(1/2), which is 0 at d = 0"),
+            );
+        }
+    }
+    out
+}
+
 /// A form whose estimated quadrature degree (on P1 or P2 elements) passes [`MAX_DEGREE`].
 fn degree_error(prog: &Unit, name: &str, integrals: &[IntegralIr]) -> Option<Diagnostic> {
     // A degree the file sets is the author's (checked when lowered).
