@@ -188,3 +188,24 @@ fn a_low_rank_correction_solves_the_changed_matrix() {
         }
     }
 }
+
+/// The stiffness of a long free bar with a trace of mass is positive definite but so badly
+/// conditioned (κ ~ 1e15) that Jacobi-preconditioned conjugate gradients need ~1e4 iterations
+/// per halving of the residual: the solve gives up once the residual stops halving, after a
+/// few hundred iterations rather than the iteration cap, with the cause and the way out.
+#[test]
+fn a_stalled_solve_gives_up_with_its_cause() {
+    let mesh = interval(4000, 0.0, 1.0);
+    let asm = Assembler::new(&mesh);
+    let zero = vec![0.0; asm.size()];
+    let mut k = asm.zero_matrix();
+    asm.cell_tangent(&MassStiffness { rho: 1e-9, k: 1.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut k);
+    let mut f = Factorization::new(Structure::SymmetricPositiveDefinite).with_solver(Solver::Iterative);
+    f.factor(&k).expect("the preconditioner's blocks invert");
+    let mut x = pseudo_random(k.size(), 5);
+    let e = f.solve_in_place(&mut x).expect_err("no solution").to_string();
+    assert!(e.contains("stalled") && e.contains("--solver direct"), "{e}");
+    let n: usize = e.split("after ").nth(1).and_then(|s| s.split(' ').next()).and_then(|s| s.parse().ok()).unwrap();
+    let cap = 1000 + 20 * (k.size() as f64).sqrt() as usize;
+    assert!(n < cap / 2, "gave up after {n} iterations (the cap is {cap})");
+}

@@ -46,7 +46,7 @@ pub enum CaseError {
     BlowUp { t: f64, energy: f64, bound: f64, scale: f64, tolerance: f64, law: String, params: String },
     /// The potential energy went negative: the contact law is not coercive for its params.
     #[error(
-        "stopped at t = {t}: the potential energy ½uᵀKu + contact energy = {potential:.6e} is negative, beyond {:.1} % of the problem's energy scale {scale:.4e}: the contact law is not coercive for these params (Nitsche θ = 1 or 0 with γ0 too small against the material's stiffness; θ = −1 is coercive for any γ0), and the motion grows without bound while E_aug is kept.\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
+        "stopped at t = {t}: the potential energy ½uᵀKu + contact energy = {potential:.6e} is negative, beyond {:.1} % of the problem's energy scale {scale:.4e}: the discrete problem is not stable. Most likely the contact law is not coercive for these params (Nitsche θ = 1 or 0 with γ0 too small against the material's stiffness; θ = −1 is coercive for any γ0), and the motion grows without bound while E_aug is kept; otherwise the steps' solutions diverge (an iterative solve that is not accurate enough: try --solver direct).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
         100.0 * tolerance
     )]
     NotCoercive { t: f64, potential: f64, scale: f64, tolerance: f64, params: String },
