@@ -71,6 +71,8 @@ pub struct DiscTiming {
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ExplicitTiming {
+    /// The step: the disc's, or 0.8 Δt_c where that is above Δt_c.
+    pub dt: f64,
     pub scheme: String,
     pub mass: String,
     pub ms_per_step: f64,
@@ -162,10 +164,11 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
         ));
         if let Some(e) = &t.explicit {
             progress(&format!(
-                "{}: {} with {} mass: {:.3} ms/step stepping, {} factorizations, Δt_c ≈ {}",
+                "{}: {} with {} mass, Δt = {}: {:.3} ms/step stepping, {} factorizations, Δt_c ≈ {}",
                 t.mesh,
                 e.scheme,
                 e.mass,
+                e.dt,
                 e.ms_per_step,
                 e.factorizations,
                 e.stable_dt.map_or("—".into(), |d| format!("{d:.4}"))
@@ -177,26 +180,29 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
 }
 
 /// The explicit run of forms/library.toml on the same mesh (its summary keys `stable_dt` and
-/// `factorizations`); none when the run is refused (Δt above its critical step on this mesh).
+/// `factorizations`).
 fn explicit_timing(opts: &Options, repeats: usize) -> Result<Option<ExplicitTiming>, CaseError> {
     let (scheme, mass) = &crate::settings::get().bench.disc_explicit;
     let mass = <crate::simulation::MassChoice as clap::ValueEnum>::from_str(mass, true)
         .map_err(|e| CaseError::Option(format!("forms/library.toml [bench]: {e}")))?;
     let setup = crate::driver::Setup { scheme: scheme.clone(), ..opts.setup.clone() };
-    let opts = Options { setup, mass, ..opts.clone() };
+    let mut opts = Options { setup, mass, ..opts.clone() };
+    // Above its critical step on this mesh: at 0.8 Δt_c (three digits, rounded down), to the
+    // same t_end.
+    if let Err(CaseError::UnstableStep { stable, .. }) = disc::run(&Options { t_end: opts.dt, ..opts.clone() }) {
+        let scale = 10f64.powi(stable.log10().floor() as i32 - 2);
+        opts.dt = (0.8 * stable / scale).floor() * scale;
+    }
     let mut per_step = Vec::new();
     let mut last = None;
     for _ in 0..repeats.max(1) {
-        let run = match disc::run(&opts) {
-            Ok(r) => r,
-            Err(CaseError::UnstableStep { .. }) => return Ok(None),
-            Err(e) => return Err(e),
-        };
+        let run = disc::run(&opts)?;
         per_step.push(run.summary.stepping_seconds / run.summary.steps.max(1) as f64 * 1e3);
         last = Some(run);
     }
     let run = last.expect("at least one run");
     Ok(Some(ExplicitTiming {
+        dt: opts.dt,
         scheme: scheme.clone(),
         mass: mass.name().into(),
         ms_per_step: median(per_step),
