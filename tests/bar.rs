@@ -242,3 +242,61 @@ fn a_step_that_fails_at_every_cut_stops_the_run_with_its_history() {
     assert!(times.windows(2).any(|w| w[1] - w[0] < 0.5 * (times[1] - times[0])), "no cut step in the series");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// ω_max of M⁻¹(K + J_C) on the bar (N = 20, E = ρ = 1, Nitsche θ = 1, γ = γ0/h = 100), the end
+/// x = 0 in contact and x = 1 held, computed densely: P1 stiffness (1/h)[1 −1; −1 1] per
+/// element, the lumped mass h/2 per element end or the consistent (h/6)[2 1; 1 2], and the
+/// active contact term (1/γ)(b − γ∇u_N)(b − γ∇u_N)ᵀ − (1/γ) b bᵀ with b = ∇σ_N.
+fn dense_omega_max(lumped: bool) -> f64 {
+    use nalgebra::{DMatrix, SymmetricEigen};
+    let (n, h, gamma) = (20, 1.0 / 20.0, 100.0);
+    let (mut k, mut m) = (DMatrix::<f64>::zeros(n + 1, n + 1), DMatrix::<f64>::zeros(n + 1, n + 1));
+    for e in 0..n {
+        for (a, b, kv, mc, ml) in
+            [(0, 0, 1.0, 2.0, 3.0), (0, 1, -1.0, 1.0, 0.0), (1, 0, -1.0, 1.0, 0.0), (1, 1, 1.0, 2.0, 3.0)]
+        {
+            k[(e + a, e + b)] += kv / h;
+            m[(e + a, e + b)] += if lumped { ml * h / 6.0 } else { mc * h / 6.0 };
+        }
+    }
+    let mut sigma = nalgebra::DVector::<f64>::zeros(n + 1);
+    sigma[0] = -1.0 / h;
+    sigma[1] = 1.0 / h;
+    let mut un = nalgebra::DVector::<f64>::zeros(n + 1);
+    un[0] = -1.0;
+    let p = &sigma - gamma * &un;
+    let a = k + (&p * p.transpose() - &sigma * sigma.transpose()) / gamma;
+    // The held end's dof removed; M = L Lᵀ, and L⁻¹ A L⁻ᵀ is symmetric with M⁻¹A's eigenvalues.
+    let (a, m) = (a.view((0, 0), (n, n)).into_owned(), m.view((0, 0), (n, n)).into_owned());
+    let l = m.cholesky().expect("the mass is positive definite").l();
+    let li = l.try_inverse().expect("invertible");
+    let s = &li * a * li.transpose();
+    SymmetricEigen::new(0.5 * (&s + s.transpose())).eigenvalues.max().sqrt()
+}
+
+/// Central differences (forms/schemes/central.wf, `claim cfl = 2`): the run's power-iteration
+/// estimate of ω_max matches the dense eigenvalue, with either mass; below Δt_c the energy
+/// guard stays quiet with either mass, as for the implicit Crank–Nicolson; above it the run is
+/// refused before it steps.
+#[test]
+fn central_differences_know_their_critical_step() {
+    use signorini::cases::CaseError;
+    use signorini::simulation::MassChoice;
+    for (mass, lumped) in [(MassChoice::Consistent, false), (MassChoice::Lumped, true)] {
+        let central = |dt: f64| {
+            let mut o = Options { mass, dt: Some(dt), ..Options::default() };
+            o.setup.scheme = "central".into();
+            bar::run(&o)
+        };
+        let r = central(0.02).unwrap();
+        let stable = r.summary.stable_dt.expect("an explicit scheme reports Δt_c");
+        let omega = dense_omega_max(lumped);
+        assert!((2.0 / stable - omega).abs() < 1e-8 * omega, "{mass:?}: ω_max {} against {omega}", 2.0 / stable);
+        assert!(r.summary.energy_growth < 0.05, "{mass:?}: {}", r.summary.energy_growth);
+        assert!(r.summary.energy_aug_drift_max < 0.04, "{mass:?}: {}", r.summary.energy_aug_drift_max);
+        match central(1.01 * stable) {
+            Err(CaseError::UnstableStep { stable: s, .. }) => assert_eq!(s, stable),
+            other => panic!("{mass:?}: above Δt_c: {:?}", other.map(|r| r.summary.energy_growth)),
+        }
+    }
+}
