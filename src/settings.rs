@@ -45,7 +45,6 @@ pub struct BarRuns {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Verify {
-    pub energy_conserving: Vec<String>,
     pub contacts: Vec<String>,
     /// `verify --scheme`: the library's schemes every report compares with.
     pub references: Vec<String>,

@@ -19,7 +19,7 @@ fn library_settings_name_library_files() {
         known(scheme, contact);
         <MassChoice as clap::ValueEnum>::from_str(mass, true).unwrap_or_else(|e| panic!("mass `{mass}`: {e}"));
     }
-    for scheme in s.verify.energy_conserving.iter().chain(&s.verify.references) {
+    for scheme in &s.verify.references {
         for contact in &s.verify.contacts {
             known(scheme, contact);
         }
