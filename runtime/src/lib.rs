@@ -1,5 +1,7 @@
-//! The signorini runtime: element catalogue, quadrature, the interface compiled kernels
-//! implement, and (later) meshes, assembly, solvers and time loops.
+//! The signorini runtime: the element catalogue and quadrature, the interface compiled kernels
+//! implement, meshes (the Gmsh reader and the built-in generators), sparse assembly, linear
+//! algebra (faer's factorizations, block-Jacobi Krylov solvers, low-rank corrections), Newton,
+//! the time stepper, and mass redistribution and lumping.
 
 /// Calls `$f::<D, N, ..>(args)` with the D and N of an element kind.
 macro_rules! dispatch {

@@ -1,4 +1,6 @@
-//! Sparse linear algebra: the only module that touches faer (0.x; its API changes land here).
+//! Sparse linear algebra: the faer sparse factorizations are driven from here (faer 0.x: its
+//! sparse API changes land here; `block_factor` reads the Cholesky factor's layout, and
+//! `elements` and `lowrank` use faer's dense matrices).
 //!
 //! A `Matrix` is a CSC matrix over a shared `Pattern`. A `Factorization` computes the
 //! symbolic analysis (fill-reducing ordering, elimination tree) once per pattern and reruns only

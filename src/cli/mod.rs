@@ -1,4 +1,5 @@
-//! The `signorini` command line: `check` and `emit` for .wf files.
+//! The `signorini` command line: the clap types of every subcommand (run, check, emit, list,
+//! verify, report, bench, compare, mesh) and their dispatch.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
