@@ -64,6 +64,9 @@ impl Setup {
     }
 }
 
+/// A scheme file's numeric claims at the params in use, and its energy law.
+pub type ClaimsAndLaw = (Vec<(String, f64)>, Option<crate::compiler::scheme::EnergyLaw>);
+
 /// A scheme, compiled or loaded from a file.
 pub enum SchemeSource {
     Compiled(&'static crate::runtime::library::SchemeUnit),
@@ -266,6 +269,12 @@ impl Active {
     /// The energy law the scheme's file claims (`claim energy = conserving`), if it does.
     pub fn scheme_energy_law(&self) -> Result<Option<crate::compiler::scheme::EnergyLaw>, CaseError> {
         Ok(self.scheme_ir()?.and_then(|ir| ir.energy))
+    }
+
+    /// Both, from one reading of the scheme's file.
+    pub fn scheme_claims_and_law(&self) -> Result<ClaimsAndLaw, CaseError> {
+        let params = self.forms.params.scheme_values(self.scheme.params());
+        Ok(self.scheme_ir()?.map_or((Vec::new(), None), |ir| (ir.claims_at(&params), ir.energy)))
     }
 
     /// The scheme's compiled file (none for a scheme compiled by a crate of its own: there is

@@ -35,6 +35,23 @@ impl RunFacts<'_> {
             .map(|(_, v)| *v)
             .ok_or_else(|| format!("it needs the argument `{name}` (`reference NAME({name} = ...)`)"))
     }
+
+    /// An argument that must be positive and finite; `default` when the problem does not give
+    /// it (none: it is required).
+    pub fn positive(&self, name: &str, default: Option<f64>) -> Result<f64, String> {
+        if let Some(d) = default
+            && !self.args.iter().any(|(n, _)| n == name)
+        {
+            return Ok(d);
+        }
+        let v = self.arg(name)?;
+        if v > 0.0 && v.is_finite() { Ok(v) } else { Err(format!("`{name}` must be positive, not {v}")) }
+    }
+
+    /// An argument, or `default` when the problem does not give it.
+    pub fn arg_or(&self, name: &str, default: f64) -> f64 {
+        self.arg(name).unwrap_or(default)
+    }
 }
 
 /// One state of the run, as a reference measures it.

@@ -468,8 +468,8 @@ impl<'m> Simulation<'m> {
         if !inertia {
             guard.energy_tolerance = 0.0;
         }
-        let law = active.scheme_energy_law()?;
-        let stable = match active.scheme_claims()?.into_iter().find(|(c, _)| c == "cfl") {
+        let (claims, law) = active.scheme_claims_and_law()?;
+        let stable = match claims.into_iter().find(|(c, _)| c == "cfl") {
             Some((_, cfl)) => Some(stability::estimate(&tools, coefs, &held, cfl)?),
             None => None,
         };

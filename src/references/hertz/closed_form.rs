@@ -18,6 +18,15 @@ pub struct Material {
 }
 
 impl Material {
+    /// The material's E, nu and rho from the files in use.
+    pub fn of(run: &crate::references::RunFacts) -> Result<Material, String> {
+        let param = |name: &str| {
+            (run.param)(name)
+                .ok_or_else(|| format!("Hertz's formulas need the material's `{name}`, which the files in use lack"))
+        };
+        Ok(Material { young: param("E")?, poisson: param("nu")?, density: param("rho")? })
+    }
+
     /// E* = E / (1 − ν²) (the plane is rigid).
     pub fn contact_modulus(&self) -> f64 {
         self.young / (1.0 - self.poisson * self.poisson)

@@ -68,19 +68,10 @@ impl Reference for HertzImpact {
     }
 
     fn bind(&self, run: &RunFacts) -> Result<Box<dyn BoundReference>, String> {
-        let positive = |name: &str| -> Result<f64, String> {
-            let v = run.arg(name)?;
-            if v > 0.0 && v.is_finite() { Ok(v) } else { Err(format!("`{name}` must be positive, not {v}")) }
-        };
-        let (radius, speed) = (positive("radius")?, positive("speed")?);
-        let given = |name: &str| run.args.iter().any(|(n, _)| n == name);
-        let copies = if given("copies") { positive("copies")? } else { 1.0 };
-        let t_hit = if given("t_hit") { run.arg("t_hit")? } else { 0.0 };
-        let param = |name: &str| {
-            (run.param)(name)
-                .ok_or_else(|| format!("Hertz's formulas need the material's `{name}`, which the files in use lack"))
-        };
-        let material = Material { young: param("E")?, poisson: param("nu")?, density: param("rho")? };
+        let (radius, speed) = (run.positive("radius", None)?, run.positive("speed", None)?);
+        let copies = run.positive("copies", Some(1.0))?;
+        let t_hit = run.arg_or("t_hit", 0.0);
+        let material = Material::of(run)?;
         let hertz = Impact::new(radius, &material, speed);
         // The history at a twentieth of a thousandth of the contact time: far finer than a step.
         let history = Impact::force_history(radius, &material, speed, hertz.contact_duration / 20_000.0);

@@ -77,18 +77,9 @@ impl Reference for Hertz {
     }
 
     fn bind(&self, run: &RunFacts) -> Result<Box<dyn BoundReference>, String> {
-        let positive = |name: &str| -> Result<f64, String> {
-            let v = run.arg(name)?;
-            if v > 0.0 && v.is_finite() { Ok(v) } else { Err(format!("`{name}` must be positive, not {v}")) }
-        };
-        let (radius, force) = (positive("radius")?, positive("force")?);
-        let copies = if run.args.iter().any(|(n, _)| n == "copies") { positive("copies")? } else { 1.0 };
-        let material = |name: &str| {
-            (run.param)(name)
-                .ok_or_else(|| format!("Hertz's formulas need the material's `{name}`, which the files in use lack"))
-        };
-        let material =
-            closed_form::Material { young: material("E")?, poisson: material("nu")?, density: material("rho")? };
+        let (radius, force) = (run.positive("radius", None)?, run.positive("force", None)?);
+        let copies = run.positive("copies", Some(1.0))?;
+        let material = closed_form::Material::of(run)?;
         let dim = run.mesh.dim();
         let (a, p0) = closed_form::static_contact(dim, radius, material.contact_modulus(), force);
         let cell_size =
