@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::cases::CaseError;
 use crate::driver::Active;
-use crate::runtime::mesh::Mesh;
+use crate::runtime::fem::mesh::Mesh;
 
 /// The files in the output directory.
 pub const FILE: &str = "checkpoint.bin";

@@ -5,7 +5,7 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use crate::runtime::mesh::Mesh;
+use crate::runtime::fem::mesh::Mesh;
 
 /// A data array: name, components, values (`len = count × components`).
 pub struct Field<'a> {

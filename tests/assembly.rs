@@ -1,9 +1,9 @@
 //! Global assembly: the P2 plane-strain stiffness of the benchmark against the Frobenius norm
 //! DOLFINx, GetFEM and FEniCS agree on, mass totals, symmetry, and vectors against matrices.
 
-use signorini::runtime::assembly::{Assembler, Quadrature};
-use signorini::runtime::kernel::Coef;
-use signorini::runtime::mesh::structured::{self, Diagonal};
+use signorini::runtime::fem::assembly::{Assembler, Quadrature};
+use signorini::runtime::fem::kernel::Coef;
+use signorini::runtime::fem::mesh::structured::{self, Diagonal};
 
 signorini::forms!("forms/elasticity.wf");
 

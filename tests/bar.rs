@@ -158,7 +158,7 @@ fn full_traction_nitsche_is_the_normal_law_in_1d() {
         let traction = run(|o| {
             o.setup =
                 signorini::driver::Setup { contact: "nitsche-traction".into(), ..o.setup.clone() }.set("theta", theta);
-            o.cell_size = signorini::runtime::mesh::CellSize::GetFem;
+            o.cell_size = signorini::runtime::fem::mesh::CellSize::GetFem;
         });
         for (a, b) in normal.series.iter().zip(&traction.series) {
             assert!((a.u_c - b.u_c).abs() <= 1e-14, "θ = {theta}, t = {}: {} vs {}", a.t, a.u_c, b.u_c);

@@ -18,7 +18,7 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
             let exact = -0.5 * GRAVITY * row.t * row.t;
             assert!((row.uy_mean - exact).abs() < 1e-12, "{scheme:?} t = {}: mean {} vs {exact}", row.t, row.uy_mean);
             // E = 0 exactly. Round-off only (≤ 5e-12 of a kinetic energy ~56 at t = 6): the
-            // stepper evaluates every scheme in increments (runtime/src/scheme.rs). Before, it
+            // stepper evaluates every scheme in increments (runtime/src/time/stage.rs). Before, it
             // was 4e-11 (Newmark) to 4e-10 (TR-BDF2).
             assert!(row.energy.abs() < 2e-11, "{scheme:?} t = {}: E = {:e}", row.t, row.energy);
             assert!((row.uy_mean_nodal - exact).abs() < 1e-10, "{scheme:?} t = {}: nodal mean", row.t);

@@ -3,8 +3,8 @@
 //! mass sums equal to ρ·|T|·d on straight and curved cells (|T| computed independently, by
 //! Green's or the divergence theorem on the cell boundary).
 
-use signorini::runtime::element::ElementKind;
-use signorini::runtime::kernel::{Coef, Tabulation, cell_matrix};
+use signorini::runtime::fem::element::ElementKind;
+use signorini::runtime::fem::kernel::{Coef, Tabulation, cell_matrix};
 
 signorini::forms!("forms/elasticity.wf");
 
@@ -147,7 +147,7 @@ fn tetrahedron(bulge: f64) -> [[f64; 3]; 10] {
 /// quadratic faces (the integrand is a polynomial of degree 4 on each reference face).
 fn tet_volume(x: &[[f64; 3]; 10]) -> f64 {
     let kind = ElementKind::TetrahedronP2;
-    let rule = signorini::runtime::quadrature::simplex_rule(2, 4);
+    let rule = signorini::runtime::fem::quadrature::simplex_rule(2, 4);
     let mut vol = 0.0;
     for f in 0..4 {
         for (s, w) in rule.points.iter().zip(&rule.weights) {

@@ -7,10 +7,10 @@ use nalgebra::{DMatrix, DVector};
 use signorini::cases::bar::{self, Options};
 use signorini::driver::Setup;
 use signorini::forms::{contact_nitsche, contact_penalty, elasticity};
-use signorini::runtime::assembly::{Assembler, Quadrature};
-use signorini::runtime::kernel::Coef;
-use signorini::runtime::mesh::structured;
-use signorini::runtime::scheme::{Bound, BoundForm};
+use signorini::runtime::fem::assembly::{Assembler, Quadrature};
+use signorini::runtime::fem::bound::{Bound, BoundForm};
+use signorini::runtime::fem::kernel::Coef;
+use signorini::runtime::fem::mesh::structured;
 
 fn run(setup: Setup, steps: usize) -> bar::Run {
     let opts = Options { setup, t_end: Some(steps as f64 * 0.01), ..Options::default() };

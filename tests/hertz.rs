@@ -6,10 +6,10 @@
 use signorini::driver::Setup;
 use signorini::problem::run::{Options, run};
 use signorini::references::hertz::profile;
-use signorini::runtime::assembly::{Assembler, Quadrature};
-use signorini::runtime::kernel::Coef;
+use signorini::runtime::fem::assembly::{Assembler, Quadrature};
+use signorini::runtime::fem::kernel::Coef;
+use signorini::runtime::fem::quadrature::simplex_rule;
 use signorini::runtime::library::Binding;
-use signorini::runtime::quadrature::simplex_rule;
 
 /// The library's Hertz problem (`hertz_cylinder` or `hertz_ball`) at a mesh level: its summary.
 fn pressed(problem: &str, contact: &str, level: usize) -> signorini::problem::run::Summary {
@@ -92,7 +92,7 @@ fn the_impact_lasts_hertz_contact_time_and_reaches_hertz_peak_force() {
 #[test]
 fn point_values_integrate_to_the_functional() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/hertz_cylinder_0.msh");
-    let mut mesh = signorini::runtime::mesh::gmsh::read(&path).unwrap();
+    let mut mesh = signorini::runtime::fem::mesh::gmsh::read(&path).unwrap();
     mesh.add_region_where("Gamma_C", |n, _| n[1] < 0.0);
     let asm = Assembler::new(&mesh);
     let material = [("E", 50.0), ("nu", 0.25), ("rho", 1.0), ("gamma0", 5000.0)];

@@ -7,16 +7,16 @@
 use std::path::Path;
 
 use signorini::interpret::{InterpretError, InterpretedForm, Library};
-use signorini::runtime::assembly::{Assembler, Kernel, Quadrature};
-use signorini::runtime::element::ElementKind;
-use signorini::runtime::geometry;
-use signorini::runtime::kernel::{
+use signorini::runtime::fem::assembly::{Assembler, Kernel, Quadrature};
+use signorini::runtime::fem::bound::{Bound, BoundForm};
+use signorini::runtime::fem::element::ElementKind;
+use signorini::runtime::fem::geometry;
+use signorini::runtime::fem::kernel::{
     CellCtx, Coef, FacetCtx, FacetTabulation, Form, FormKernel, FunctionalKernel, LocalVector, Tabulation, cell_matrix,
     cell_vector, facet_matrix, facet_vector,
 };
-use signorini::runtime::mesh::Facet;
-use signorini::runtime::mesh::structured::{self, Diagonal};
-use signorini::runtime::scheme::{Bound, BoundForm};
+use signorini::runtime::fem::mesh::Facet;
+use signorini::runtime::fem::mesh::structured::{self, Diagonal};
 
 signorini::forms!("forms/elasticity.wf");
 signorini::forms!("forms/contact_nitsche.wf");
@@ -233,7 +233,7 @@ fn compare_form<K: Kernel>(compiled: &K, interp: &InterpretedForm, rng: &mut Rng
     }
 }
 
-fn compare_functional<K: signorini::runtime::assembly::Functional>(
+fn compare_functional<K: signorini::runtime::fem::assembly::Functional>(
     compiled: &K,
     interp: &InterpretedForm,
     rng: &mut Rng,

@@ -2,11 +2,11 @@
 //! second moments are preserved to round-off, and the result is positive definite on the other
 //! dofs (1D P1 and the curved 2D P2 disc).
 
-use signorini::runtime::assembly::{Assembler, Quadrature};
-use signorini::runtime::kernel::Coef;
+use signorini::runtime::fem::assembly::{Assembler, Quadrature};
+use signorini::runtime::fem::kernel::Coef;
+use signorini::runtime::fem::mesh::{Mesh, disc::disc, structured};
+use signorini::runtime::fem::redistribute::redistribute;
 use signorini::runtime::linalg::Matrix;
-use signorini::runtime::mesh::{Mesh, disc::disc, structured};
-use signorini::runtime::redistribute::redistribute;
 
 signorini::forms!("forms/elasticity.wf");
 
@@ -80,7 +80,7 @@ fn curved_p2_disc() {
 /// row sums.
 #[test]
 fn lumping_keeps_the_mass_with_a_positive_diagonal() {
-    use signorini::runtime::lumping::lumped;
+    use signorini::runtime::fem::lumping::lumped;
     for degree in [1, 2] {
         let mesh = structured::rectangle(6, 4, [0.0, 3.0], [0.0, 2.0], structured::Diagonal::Right, degree);
         let (_, m) = mass(&mesh);

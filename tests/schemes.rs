@@ -5,7 +5,8 @@
 //! (interpreted) and compiled, with nothing but its file.
 
 use signorini::driver::{self, Setup};
-use signorini::runtime::scheme::{Stepper, TimeScheme};
+use signorini::runtime::time::scheme::TimeScheme;
+use signorini::runtime::time::stepper::Stepper;
 
 signorini::forms!("tests/wf/newmark_general.wf");
 

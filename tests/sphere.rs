@@ -54,7 +54,7 @@ fn crank_nicolson_keeps_the_augmented_energy_while_the_active_set_is_kept() {
 #[test]
 fn iterative_and_direct_solvers_agree() {
     use signorini::runtime::linalg::Solver;
-    use signorini::runtime::newton::NewtonOptions;
+    use signorini::runtime::nonlinear::newton::NewtonOptions;
     for theta in [1.0, -1.0] {
         let run = |solver| {
             let setup = Setup::default().set("theta", theta);
@@ -78,7 +78,7 @@ fn iterative_and_direct_solvers_agree() {
 #[test]
 fn the_graded_gmsh_ball_falls_exactly() {
     let mesh = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/sphere_graded.msh");
-    let m = signorini::runtime::mesh::gmsh::read(&mesh).unwrap();
+    let m = signorini::runtime::fem::mesh::gmsh::read(&mesh).unwrap();
     let lowest = (0..m.num_nodes()).map(|i| m.node(i)[2]).fold(f64::INFINITY, f64::min);
     assert!((lowest - 2.0).abs() < 1e-9, "the mesh's lowest point is at z = {lowest}");
     let opts = Options { body: Body::Sphere, mesh: Some(mesh), t_end: 0.4, ..Options::default() };

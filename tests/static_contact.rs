@@ -6,14 +6,14 @@
 use signorini::driver::{Setting, Setup};
 use signorini::forms::{contact_nitsche, elasticity};
 use signorini::problem::run::{Options, Run, run as run_problem};
-use signorini::runtime::assembly::{Assembler, Quadrature};
-use signorini::runtime::kernel::Coef;
+use signorini::runtime::fem::assembly::{Assembler, Quadrature};
+use signorini::runtime::fem::bound::Bound;
+use signorini::runtime::fem::kernel::Coef;
+use signorini::runtime::fem::mesh::Facet;
+use signorini::runtime::fem::mesh::structured::{self, Diagonal};
 use signorini::runtime::linalg::Structure;
-use signorini::runtime::mesh::Facet;
-use signorini::runtime::mesh::structured::{self, Diagonal};
-use signorini::runtime::newton::{Newton, NewtonOptions};
-use signorini::runtime::problem::{Constraints, StaticContact};
-use signorini::runtime::scheme::Bound;
+use signorini::runtime::nonlinear::newton::{Newton, NewtonOptions};
+use signorini::runtime::nonlinear::statics::{Constraints, StaticContact};
 
 fn methods() -> Vec<(&'static str, f64)> {
     vec![("nitsche", 1.0), ("nitsche", 0.0), ("nitsche", -1.0), ("penalty", f64::NAN)]
@@ -88,7 +88,7 @@ fn on_a_curved_obstacle_newton_finds_a_partial_contact_zone() {
 }
 
 /// The 2D block's mesh: [-1, 1] × [0, 1], P2, h = 1/8.
-fn block_mesh() -> signorini::runtime::mesh::Mesh {
+fn block_mesh() -> signorini::runtime::fem::mesh::Mesh {
     structured::rectangle(16, 8, [-1.0, 1.0], [0.0, 1.0], Diagonal::Right, 2)
 }
 
@@ -133,7 +133,7 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
 #[test]
 fn newton_failures_are_typed_errors_with_history() {
     use signorini::cases::CaseError;
-    use signorini::runtime::newton::NewtonError;
+    use signorini::runtime::nonlinear::newton::NewtonError;
     let mut o = block("static_block", "nitsche", 1.0, &[("curvature", 0.5)]);
     o.newton.max_iterations = 2;
     match run_problem(&o) {
@@ -183,7 +183,7 @@ fn nitsche_contact(
     facets: &[Facet],
     g: Coef,
     quadrature: Quadrature,
-) -> Box<dyn signorini::runtime::scheme::BoundForm + '_> {
+) -> Box<dyn signorini::runtime::fem::bound::BoundForm + '_> {
     let p = contact_nitsche::Params::default().with("E", 100.0).and_then(|p| p.with("gamma0", 5000.0)).unwrap();
     let c =
         contact_nitsche::Coefficients { f: Coef::constant(vec![0.0, -1.0]), g, nc: Coef::constant(vec![0.0, -1.0]) };

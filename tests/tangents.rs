@@ -3,8 +3,8 @@
 //! quadrature points are active and some are not; and the 1D contact residual against the
 //! closed-form kernel of spec §3.4, which pins down the sign conventions of the .wf files.
 
-use signorini::runtime::element::ElementKind;
-use signorini::runtime::kernel::{Coef, FacetTabulation, FormKernel, facet_matrix, facet_vector};
+use signorini::runtime::fem::element::ElementKind;
+use signorini::runtime::fem::kernel::{Coef, FacetTabulation, FormKernel, facet_matrix, facet_vector};
 
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
@@ -52,7 +52,7 @@ fn fd_error<const D: usize, const N: usize, K: FormKernel<D, N>>(
     x: &[[f64; D]; N],
     u: &[[f64; D]; N],
 ) -> f64 {
-    let h = signorini::runtime::geometry::diameter(x, D + 1);
+    let h = signorini::runtime::fem::geometry::diameter(x, D + 1);
     let jac = facet_matrix(k, 0, tab, 0, x, h, &[u], 0, 0.0);
     let scale = jac.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut worst = 0.0f64;
@@ -77,7 +77,7 @@ fn tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
     x: &[[f64; D]; N],
     u: &[[f64; D]; N],
 ) -> Vec<Vec<f64>> {
-    let h = signorini::runtime::geometry::diameter(x, D + 1);
+    let h = signorini::runtime::fem::geometry::diameter(x, D + 1);
     facet_matrix(k, 0, tab, 0, x, h, &[u], 0, 0.0)
 }
 
@@ -244,7 +244,7 @@ fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
     const { assert!(!contact_nitsche::HybridContact::META.linear) };
     let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 7).unwrap();
     let x = cell_2d();
-    let h = signorini::runtime::geometry::diameter(&x, 3);
+    let h = signorini::runtime::fem::geometry::diameter(&x, 3);
     let mut rng = Rng(4242);
     for trial in 0..5 {
         let u0 = state_2d(&mut rng, 0.0);
@@ -275,11 +275,11 @@ fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
 /// the same switches have the same tangent, and the switches of a mixed state are mixed.
 #[test]
 fn equal_switches_mean_equal_tangents() {
-    use signorini::runtime::kernel::FacetCtx;
+    use signorini::runtime::fem::kernel::FacetCtx;
     const { assert!(contact_nitsche::Contact::META.piecewise && contact_penalty::Contact::META.piecewise) };
     let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 7).unwrap();
     let x = cell_2d();
-    let h = signorini::runtime::geometry::diameter(&x, 3);
+    let h = signorini::runtime::fem::geometry::diameter(&x, 3);
     let k = nitsche(-1.0, 5.0, 1.0, 0.3, 2);
     let switches = |u: &[[f64; 2]; 6]| {
         let (ftab, normal) = &tab.facets[0];

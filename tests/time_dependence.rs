@@ -3,7 +3,7 @@
 //! The stepper assembles a load that does not once.
 
 use signorini::forms::elasticity::{Coefficients, Load, Params};
-use signorini::runtime::kernel::{Coef, Form};
+use signorini::runtime::fem::kernel::{Coef, Form};
 
 fn load(f: Coef) -> Load {
     let p = Params::default().with("E", 1.0).and_then(|p| p.with("nu", 0.3)).and_then(|p| p.with("rho", 1.0));

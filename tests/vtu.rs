@@ -10,7 +10,7 @@ fn snapshots_read_back_with_vtkio() {
     let opts = Options { h: 2.0, t_end: 1.0, vtu_every: 25, out: Some(out.clone()), ..Options::default() };
     let run = disc::run(&opts).unwrap();
     // The problem's mesh at h = 2: the built-in curved disc of radius 10 about (0, 12).
-    let mesh = signorini::runtime::mesh::disc::disc(10.0, [0.0, 12.0], 2.0);
+    let mesh = signorini::runtime::fem::mesh::disc::disc(10.0, [0.0, 12.0], 2.0);
     // The collection: one entry per snapshot, with the physical times.
     let pvd = std::fs::read_to_string(out.join("disc.pvd")).unwrap();
     let times: Vec<f64> =
@@ -58,7 +58,7 @@ fn snapshots_read_back_with_vtkio() {
 #[test]
 fn quadratic_tetrahedra_follow_vtk_node_order() {
     let unit = [0.0, 1.0];
-    let mesh = signorini::runtime::mesh::structured::cuboid([2, 2, 2], unit, unit, unit, 2);
+    let mesh = signorini::runtime::fem::mesh::structured::cuboid([2, 2, 2], unit, unit, unit, 2);
     let path = std::env::temp_dir().join(format!("signorini-tet10-{}.vtu", std::process::id()));
     signorini::vtu::write(&path, &mesh, &[], &[]).unwrap();
     let vtk = vtkio::Vtk::import(&path).unwrap();

@@ -5,7 +5,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use signorini_runtime::mesh::gmsh;
+use signorini_runtime::fem::mesh::gmsh;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(mesh) = gmsh::parse(data, "fuzz.msh") {

@@ -5,14 +5,14 @@
 //! `cargo bench -p signorini-runtime --bench linalg`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use signorini_runtime::assembly::Assembler;
-use signorini_runtime::block_factor::BlockFactor;
+use signorini_runtime::fem::assembly::Assembler;
+use signorini_runtime::linalg::block_factor::BlockFactor;
 use std::sync::Arc;
 
+use signorini_runtime::fem::mesh::structured::{Diagonal, rectangle};
+use signorini_runtime::fem::test_matrices::diagonally_dominant;
+use signorini_runtime::linalg::lower_half::{HalfPattern, LowerHalf};
 use signorini_runtime::linalg::{Factorization, Matrix, Structure};
-use signorini_runtime::lower_half::{HalfPattern, LowerHalf};
-use signorini_runtime::mesh::structured::{Diagonal, rectangle};
-use signorini_runtime::test_matrices::diagonally_dominant;
 
 /// A symmetric, strictly diagonally dominant matrix on a P2 plane-strain pattern.
 fn spd_matrix(cells: usize) -> Matrix {

@@ -4,7 +4,7 @@
 //! `cargo bench -p signorini-runtime --bench mesh`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use signorini_runtime::mesh::ball::ball;
+use signorini_runtime::fem::mesh::ball::ball;
 
 fn checks_against_a_pass(c: &mut Criterion) {
     let mesh = ball(10.0, [0.0, 0.0, 12.0], 10.0 / 17.0);

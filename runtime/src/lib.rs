@@ -1,7 +1,15 @@
-//! The signorini runtime: the element catalogue and quadrature, the interface compiled kernels
-//! implement, meshes (the Gmsh reader and the built-in generators), sparse assembly, linear
-//! algebra (faer's factorizations, block-Jacobi Krylov solvers, low-rank corrections), Newton,
-//! the time stepper, and mass redistribution and lumping.
+//! The signorini runtime, in layers that import only downwards:
+//!
+//! - [`linalg`]: sparse matrices, factorizations, Krylov solvers, low-rank corrections;
+//! - [`fem`]: elements, quadrature, geometry, meshes, the kernel interface compiled forms
+//!   implement, assembly, and forms bound to a mesh;
+//! - [`nonlinear`]: semi-smooth Newton and static problems;
+//! - [`time`]: the stepper that runs a compiled scheme, stage by stage;
+//! - [`library`]: compiled files as data (their params, coefs, slots and schemes), bound to a
+//!   mesh by name;
+//!
+//! with [`descriptors`] (what the compiler writes about a file) shared with the compiler, and
+//! [`input`] (bounded reading of files) used by every reader.
 
 /// Calls `$f::<D, N, ..>(args)` with the D and N of an element kind.
 macro_rules! dispatch {
@@ -10,34 +18,22 @@ macro_rules! dispatch {
     };
     ($kind:expr, $f:ident :: <$($g:ty),*> ($($arg:expr),* $(,)?)) => {
         match $kind {
-            $crate::element::ElementKind::IntervalP1 => $f::<1, 2, $($g),*>($($arg),*),
-            $crate::element::ElementKind::TriangleP1 => $f::<2, 3, $($g),*>($($arg),*),
-            $crate::element::ElementKind::TriangleP2 => $f::<2, 6, $($g),*>($($arg),*),
-            $crate::element::ElementKind::TetrahedronP1 => $f::<3, 4, $($g),*>($($arg),*),
-            $crate::element::ElementKind::TetrahedronP2 => $f::<3, 10, $($g),*>($($arg),*),
+            $crate::fem::element::ElementKind::IntervalP1 => $f::<1, 2, $($g),*>($($arg),*),
+            $crate::fem::element::ElementKind::TriangleP1 => $f::<2, 3, $($g),*>($($arg),*),
+            $crate::fem::element::ElementKind::TriangleP2 => $f::<2, 6, $($g),*>($($arg),*),
+            $crate::fem::element::ElementKind::TetrahedronP1 => $f::<3, 4, $($g),*>($($arg),*),
+            $crate::fem::element::ElementKind::TetrahedronP2 => $f::<3, 10, $($g),*>($($arg),*),
         }
     };
 }
 
-pub mod assembly;
-pub mod block_factor;
-pub mod element;
-pub mod elements;
-pub mod evaluate;
-pub mod geometry;
+/// The descriptions compiled files give of themselves (their own crate: the compiler writes
+/// them too).
+pub use signorini_descriptors as descriptors;
+
+pub mod fem;
 pub mod input;
-pub mod kernel;
-pub mod krylov;
 pub mod library;
 pub mod linalg;
-pub mod lower_half;
-pub mod lowrank;
-pub mod lumping;
-pub mod mesh;
-pub mod newton;
-pub mod pattern;
-pub mod problem;
-pub mod quadrature;
-pub mod redistribute;
-pub mod scheme;
-pub mod test_matrices;
+pub mod nonlinear;
+pub mod time;

@@ -6,59 +6,13 @@
 
 use std::fmt;
 
-use crate::assembly::{Assembler, Functional, Kernel, PointValue, Quadrature};
-use crate::kernel::{Coef, ParamError, ParamRange};
-use crate::mesh::Facet;
-use crate::quadrature::Rule;
-use crate::scheme::{Bound, BoundForm, TimeScheme};
+use signorini_descriptors::{CoefInfo, ParamError, ParamInfo, SchemeDesc, SlotInfo};
 
-/// A param of a form file or a scheme.
-#[derive(Clone, Copy, Debug)]
-pub struct ParamInfo {
-    pub name: &'static str,
-    pub default: f64,
-    pub range: ParamRange,
-    /// The comment on the declaration's line (or the line above), if any.
-    pub doc: &'static str,
-    /// `file.wf:line`.
-    pub declared: &'static str,
-    /// The default and range as written in the file (`0.05 in [0, 1/3]`).
-    pub written: &'static str,
-    /// The file stem or scheme that declares it: `owner.name` is its qualified name.
-    pub owner: &'static str,
-}
-
-/// A `coef` (case data) of a form file.
-#[derive(Clone, Copy, Debug)]
-pub struct CoefInfo {
-    pub name: &'static str,
-    /// 0 scalar, 1 vector, 2 tensor.
-    pub rank: u32,
-    pub doc: &'static str,
-    pub declared: &'static str,
-}
-
-/// A form or functional a file provides, under its name.
-#[derive(Clone, Copy, Debug)]
-pub struct SlotInfo {
-    pub name: &'static str,
-    /// Field arguments (time levels); 0 for a load.
-    pub fields: usize,
-    /// A functional (no test function): a value, not a residual.
-    pub functional: bool,
-    pub doc: &'static str,
-    pub declared: &'static str,
-}
-
-/// A slot a scheme applies.
-#[derive(Clone, Copy, Debug)]
-pub struct SlotUse {
-    pub name: &'static str,
-    /// Time levels it is applied to; 0 for a load.
-    pub fields: usize,
-    /// `file.wf:line:col` of its name in the `uses` line.
-    pub declared: &'static str,
-}
+use crate::fem::assembly::{Functional, Kernel, Quadrature};
+use crate::fem::bound::{Bound, BoundForm, BoundFunctional, BoundValue};
+use crate::fem::kernel::Coef;
+use crate::fem::mesh::Facet;
+use crate::time::scheme::TimeScheme;
 
 /// What a form file's forms are bound to: the quadrature, and the mesh facets of every boundary
 /// region (by its name in the .wf files, e.g. `Gamma_C`).
@@ -103,7 +57,7 @@ pub struct SchemeUnit {
     pub doc: &'static str,
     pub params: &'static [ParamInfo],
     /// Its stages, terms and the slots it applies.
-    pub desc: &'static crate::scheme::SchemeDesc,
+    pub desc: &'static SchemeDesc,
     pub make: MakeScheme,
 }
 
@@ -196,55 +150,6 @@ impl<'m> Binding<'m> {
 /// The coef `name` from the case, or an error naming its declaration.
 pub fn need_coef(coefs: &dyn Fn(&str) -> Option<Coef>, info: &CoefInfo) -> Result<Coef, LibraryError> {
     coefs(info.name).ok_or(LibraryError::MissingCoef { name: info.name, declared: info.declared })
-}
-
-/// A functional bound to a mesh: its integral, or its integral per cell.
-pub trait BoundFunctional {
-    fn name(&self) -> &str;
-    fn fields(&self) -> usize;
-    /// The integral over the cells (if it has a volume part) and its boundary regions.
-    fn value(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> f64;
-    /// The volume integral on each cell.
-    fn cell_values(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> Vec<f64>;
-    /// The integrand of its boundary regions at the points of `rule` on each facet
-    /// ([`Assembler::facet_point_values`]).
-    fn facet_point_values(&self, asm: &Assembler, rule: &Rule, fields: &[&[f64]], t: f64) -> Vec<PointValue>;
-}
-
-/// A functional kernel with its integration data.
-pub struct BoundValue<'m, K: Functional> {
-    pub kernel: K,
-    pub quadrature: Quadrature,
-    pub regions: Vec<(String, &'m [Facet])>,
-}
-
-impl<K: Functional> BoundFunctional for BoundValue<'_, K> {
-    fn name(&self) -> &str {
-        self.kernel.meta().name
-    }
-    fn fields(&self) -> usize {
-        self.kernel.meta().fields.len()
-    }
-    fn value(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> f64 {
-        let mut v = 0.0;
-        if self.kernel.meta().cell_degree.is_some() {
-            v += asm.cell_value(&self.kernel, self.quadrature, fields, t);
-        }
-        for (region, facets) in &self.regions {
-            v += asm.facet_value(&self.kernel, region, facets, self.quadrature, fields, t);
-        }
-        v
-    }
-    fn cell_values(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> Vec<f64> {
-        asm.cell_values(&self.kernel, self.quadrature, fields, t)
-    }
-    fn facet_point_values(&self, asm: &Assembler, rule: &Rule, fields: &[&[f64]], t: f64) -> Vec<PointValue> {
-        let mut out = Vec::new();
-        for (region, facets) in &self.regions {
-            out.extend(asm.facet_point_values(&self.kernel, region, facets, rule, fields, t));
-        }
-        out
-    }
 }
 
 #[cfg(test)]

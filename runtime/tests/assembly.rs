@@ -6,10 +6,10 @@
 mod common;
 
 use common::{MassStiffness, pseudo_random};
-use signorini_runtime::assembly::{Assembler, Quadrature};
-use signorini_runtime::mesh::Mesh;
-use signorini_runtime::mesh::ball::ball;
-use signorini_runtime::mesh::structured::{Diagonal, cuboid, interval, rectangle};
+use signorini_runtime::fem::assembly::{Assembler, Quadrature};
+use signorini_runtime::fem::mesh::Mesh;
+use signorini_runtime::fem::mesh::ball::ball;
+use signorini_runtime::fem::mesh::structured::{Diagonal, cuboid, interval, rectangle};
 
 /// The unit interval, square and cube in P1 and P2 (volume 1).
 fn unit_meshes() -> Vec<Mesh> {

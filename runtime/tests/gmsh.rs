@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use signorini_runtime::element::ElementKind;
-use signorini_runtime::mesh::{Mesh, MeshError, gmsh};
+use signorini_runtime::fem::element::ElementKind;
+use signorini_runtime::fem::mesh::{Mesh, MeshError, gmsh};
 
 /// A reference mesh of `assets/meshes`.
 fn shared(name: &str) -> Option<PathBuf> {

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use signorini_runtime::element::ElementKind;
-use signorini_runtime::mesh::{Facet, Mesh, MeshError, Region, gmsh};
+use signorini_runtime::fem::element::ElementKind;
+use signorini_runtime::fem::mesh::{Facet, Mesh, MeshError, Region, gmsh};
 
 /// An MSH 2.2 file: nodes (x, y, z) numbered from 1, elements as (type, physical, nodes).
 fn msh22(nodes: &[[f64; 3]], elements: &[(u32, i64, &[u64])]) -> String {

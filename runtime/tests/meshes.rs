@@ -1,7 +1,7 @@
 //! Structured and disc meshes: measures, boundary facets, regions, node placement, validity.
 
-use signorini_runtime::element::ElementKind;
-use signorini_runtime::mesh::{Mesh, disc::disc, structured};
+use signorini_runtime::fem::element::ElementKind;
+use signorini_runtime::fem::mesh::{Mesh, disc::disc, structured};
 
 fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * b.abs().max(1.0)
@@ -77,8 +77,8 @@ fn disc_is_curved_p2_with_its_boundary_on_the_circle() {
 /// σ_min² + σ_max² = ‖J‖²_F; on P2 cells with straight edges the same value.
 #[test]
 fn getfem_cell_size_of_straight_triangles() {
-    use signorini_runtime::mesh::CellSize;
-    use signorini_runtime::mesh::structured::{Diagonal, rectangle};
+    use signorini_runtime::fem::mesh::CellSize;
+    use signorini_runtime::fem::mesh::structured::{Diagonal, rectangle};
     for degree in [1, 2] {
         let mut mesh = rectangle(4, 2, [0.0, 1.0], [0.0, 0.3], Diagonal::Right, degree);
         mesh.set_cell_size(CellSize::GetFem);

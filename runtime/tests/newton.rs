@@ -8,11 +8,11 @@
 mod common;
 
 use common::{MassStiffness, pseudo_random};
-use signorini_runtime::assembly::{Assembler, Quadrature};
+use signorini_runtime::fem::assembly::{Assembler, Quadrature};
+use signorini_runtime::fem::mesh::structured::interval;
 use signorini_runtime::linalg::{Counters, Matrix, Solver, Structure};
-use signorini_runtime::mesh::structured::interval;
-use signorini_runtime::newton::{Newton, NewtonOptions, NonlinearProblem};
-use signorini_runtime::problem::Constraints;
+use signorini_runtime::nonlinear::newton::{Newton, NewtonOptions, NonlinearProblem};
+use signorini_runtime::nonlinear::statics::Constraints;
 
 const EPS: f64 = 1e4;
 const PSI: f64 = -0.25;

@@ -7,11 +7,11 @@
 mod common;
 
 use common::{MassStiffness, pseudo_random};
-use signorini_runtime::assembly::{Assembler, Quadrature};
+use signorini_runtime::fem::assembly::{Assembler, Quadrature};
+use signorini_runtime::fem::mesh::Mesh;
+use signorini_runtime::fem::mesh::structured::{Diagonal, cuboid, interval, rectangle};
+use signorini_runtime::linalg::lowrank::LowRank;
 use signorini_runtime::linalg::{Factorization, Matrix, Solver, Structure};
-use signorini_runtime::lowrank::LowRank;
-use signorini_runtime::mesh::Mesh;
-use signorini_runtime::mesh::structured::{Diagonal, cuboid, interval, rectangle};
 
 fn meshes() -> Vec<Mesh> {
     let unit = [0.0, 1.0];

@@ -14,15 +14,15 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use common::MassStiffness;
-use signorini_runtime::assembly::{Assembler, Quadrature};
-use signorini_runtime::library::SlotUse;
+use signorini_runtime::descriptors::{Combination, InitialDesc, Level, SchemeDesc, SlotUse, StageDesc, TermDesc};
+use signorini_runtime::fem::assembly::{Assembler, Quadrature};
+use signorini_runtime::fem::bound::{Bound, BoundForm};
+use signorini_runtime::fem::mesh::structured::interval;
 use signorini_runtime::linalg::{Matrix, Structure};
-use signorini_runtime::mesh::structured::interval;
-use signorini_runtime::newton::NewtonOptions;
-use signorini_runtime::problem::Constraints;
-use signorini_runtime::scheme::{
-    Bound, BoundForm, Combination, InitialDesc, Level, SchemeDesc, StageDesc, Stepper, TermDesc, TimeScheme,
-};
+use signorini_runtime::nonlinear::newton::NewtonOptions;
+use signorini_runtime::nonlinear::statics::Constraints;
+use signorini_runtime::time::scheme::TimeScheme;
+use signorini_runtime::time::stepper::Stepper;
 
 thread_local! {
     /// Allocations of at least `THRESHOLD` bytes on this thread since it was last reset.

@@ -12,10 +12,10 @@ use serde::Serialize;
 
 use super::median;
 use crate::forms::elasticity::{Coefficients, Mass, Params, Stiffness};
-use crate::runtime::assembly::{Assembler, Quadrature};
-use crate::runtime::kernel::Coef;
+use crate::runtime::fem::assembly::{Assembler, Quadrature};
+use crate::runtime::fem::kernel::Coef;
+use crate::runtime::fem::mesh::structured::{self, Diagonal};
 use crate::runtime::linalg::{Factorization, Structure};
-use crate::runtime::mesh::structured::{self, Diagonal};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct AssemblyTiming {

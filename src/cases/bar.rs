@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use super::CaseError;
 use crate::driver::{ParamValue, Setup};
-use crate::runtime::mesh::CellSize;
-use crate::runtime::newton::NewtonOptions;
+use crate::runtime::fem::mesh::CellSize;
+use crate::runtime::nonlinear::newton::NewtonOptions;
 pub use crate::simulation::MassChoice;
 
 #[derive(Clone, Debug, PartialEq)]

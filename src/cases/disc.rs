@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use super::CaseError;
 use crate::driver::{ParamValue, Setup};
-use crate::runtime::mesh::CellSize;
-use crate::runtime::newton::NewtonOptions;
+use crate::runtime::fem::mesh::CellSize;
+use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;
 
 /// Gravity of the benchmark (the free fall before the first contact is exact: u = −g t²/2).

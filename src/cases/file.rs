@@ -12,9 +12,8 @@ use toml::Spanned;
 
 use super::CaseError;
 use crate::driver::{self, Setting, Setup};
-use crate::runtime::mesh::CellSize;
-use crate::simulation::MAX_STEP_CUTS;
-use crate::simulation::MassChoice;
+use crate::runtime::fem::mesh::CellSize;
+use crate::simulation::{MAX_STEP_CUTS, MassChoice};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

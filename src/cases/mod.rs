@@ -5,8 +5,10 @@ pub mod disc;
 pub mod file;
 
 /// Reads a Gmsh file, showing on stderr what the reader skipped (also logged as a warning).
-pub fn read_mesh(path: &std::path::Path) -> Result<crate::runtime::mesh::Mesh, crate::runtime::mesh::MeshError> {
-    let mesh = crate::runtime::mesh::gmsh::read(path)?;
+pub fn read_mesh(
+    path: &std::path::Path,
+) -> Result<crate::runtime::fem::mesh::Mesh, crate::runtime::fem::mesh::MeshError> {
+    let mesh = crate::runtime::fem::mesh::gmsh::read(path)?;
     for w in &mesh.warnings {
         eprintln!("warning: {w}");
     }
@@ -22,11 +24,11 @@ pub enum CaseError {
     #[error("{0}")]
     CaseFile(String),
     #[error(transparent)]
-    Mesh(#[from] crate::runtime::mesh::MeshError),
+    Mesh(#[from] crate::runtime::fem::mesh::MeshError),
     #[error(transparent)]
-    Newton(#[from] crate::runtime::newton::NewtonError),
+    Newton(#[from] crate::runtime::nonlinear::newton::NewtonError),
     #[error("time stepping failed: {0}")]
-    Step(#[from] crate::runtime::scheme::StepError),
+    Step(#[from] crate::runtime::time::stepper::StepError),
     #[error("cannot write {path}: {source}")]
     Write { path: String, source: std::io::Error },
     /// Newton failed at a step even after `cuts` halvings of Δt.

@@ -3,7 +3,8 @@
 use std::fmt::Write;
 
 use crate::compiler::docs::first_sentence;
-use crate::runtime::library::{ParamInfo, Unit};
+use crate::runtime::descriptors::ParamInfo;
+use crate::runtime::library::Unit;
 
 fn params(out: &mut String, params: &[ParamInfo]) {
     for p in params {

@@ -11,8 +11,8 @@ mod list;
 
 use crate::compiler;
 use crate::driver::{Setting, Setup};
+use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::linalg::Solver;
-use crate::runtime::mesh::CellSize;
 use crate::simulation::MassChoice;
 
 #[derive(Parser)]
@@ -613,7 +613,7 @@ fn fail(e: impl std::fmt::Display) -> ExitCode {
 }
 
 fn mesh_info(file: &Path) -> ExitCode {
-    match crate::runtime::mesh::gmsh::read(file) {
+    match crate::runtime::fem::mesh::gmsh::read(file) {
         Ok(mesh) => {
             let regions: serde_json::Map<String, serde_json::Value> = mesh
                 .regions
@@ -759,7 +759,7 @@ fn run_problem(problem: &str, a: ProblemArgs) -> ExitCode {
         dt: a.dt,
         t_start: a.t_start,
         t_end: a.t_end,
-        newton: crate::runtime::newton::NewtonOptions {
+        newton: crate::runtime::nonlinear::newton::NewtonOptions {
             solver: a.solver,
             line_search: a.methods.line_search,
             ..Default::default()

@@ -7,12 +7,12 @@ use std::path::Path;
 use crate::compiler::ir::eval::Program;
 use crate::compiler::ir::graph::{Graph, NodeId};
 use crate::compiler::scheme::layout::{self, Combination, TermLayout};
-use crate::compiler::scheme::scheme_leaf;
-use crate::compiler::scheme::{Quantity, SchemeIr};
+use crate::compiler::scheme::{Quantity, SchemeIr, scheme_leaf};
 use crate::compiler::{check_path, docs};
 use crate::driver::sources::LibraryLoader;
-use crate::runtime::library::{LibraryError, ParamInfo, SlotUse};
-use crate::runtime::scheme::{self as rs, SchemeDesc, TimeScheme};
+use crate::runtime::descriptors::{self as rs, ParamInfo, SchemeDesc, SlotUse};
+use crate::runtime::library::LibraryError;
+use crate::runtime::time::scheme::TimeScheme;
 
 /// A scheme compiled at run time.
 pub struct Interpreted {
@@ -142,7 +142,7 @@ impl Interpreted {
     /// An instance with param values in declaration order (range-checked).
     pub fn instance(&self, values: &[f64]) -> Result<Box<dyn TimeScheme>, LibraryError> {
         for (p, v) in self.params.iter().zip(values) {
-            crate::runtime::kernel::check_param(&p.range, *v)?;
+            rs::check_param(&p.range, *v)?;
         }
         Ok(Box::new(Running {
             desc: self.desc,

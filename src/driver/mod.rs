@@ -11,9 +11,11 @@ use std::path::{Path, PathBuf};
 
 use crate::cases::CaseError;
 use crate::forms::LIBRARY;
-use crate::runtime::kernel::Coef;
-use crate::runtime::library::{Binding, BoundFunctional, ParamInfo, SlotForm, Unit};
-use crate::runtime::scheme::{BoundForm, SchemeDesc, TimeScheme};
+use crate::runtime::descriptors::{ParamInfo, SchemeDesc};
+use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
+use crate::runtime::fem::kernel::Coef;
+use crate::runtime::library::{Binding, SlotForm, Unit};
+use crate::runtime::time::scheme::TimeScheme;
 
 pub use params::{ParamValue, Setting};
 pub use sources::FormSource;

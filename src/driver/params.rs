@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::{FormSource, SchemeSource};
 use crate::cases::CaseError;
-use crate::runtime::library::ParamInfo;
+use crate::runtime::descriptors::ParamInfo;
 
 /// A user's `name = value`, with where it was written (for errors).
 #[derive(Clone, Debug, PartialEq)]

@@ -6,8 +6,9 @@ use std::path::Path;
 
 use crate::compiler::{SourceMap, Span, check_path, docs, module_name};
 use crate::interpret::Library;
-use crate::runtime::kernel::{Coef, ParamRange};
-use crate::runtime::library::{Binding, LibraryError, Made, ParamInfo, SlotInfo, Unit};
+use crate::runtime::descriptors::{ParamInfo, ParamRange, SlotInfo};
+use crate::runtime::fem::kernel::Coef;
+use crate::runtime::library::{Binding, LibraryError, Made, Unit};
 
 /// A form file in use.
 pub enum FormSource {

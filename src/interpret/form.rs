@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use signorini_runtime::kernel::{Coef, Form, FormMeta, check_coef};
+use signorini_runtime::fem::kernel::{Coef, Form, FormMeta, check_coef};
 
 use super::compile::DimKernels;
 use super::{InterpretError, Unit};

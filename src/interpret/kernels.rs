@@ -4,8 +4,8 @@
 
 use std::cell::Cell;
 
-use signorini_runtime::geometry;
-use signorini_runtime::kernel::{
+use signorini_runtime::fem::geometry;
+use signorini_runtime::fem::kernel::{
     CellCtx, FacetCtx, FormKernel, FunctionalKernel, LocalMatrix, LocalVector, Tabulation,
 };
 

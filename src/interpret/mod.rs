@@ -3,11 +3,11 @@
 //! and 3; [`Library::form`] binds one form to parameter and coef values as an
 //! [`InterpretedForm`], which implements the runtime's `Form`, `FormKernel` and
 //! `FunctionalKernel` with the semantics of the generated kernels (so it works with
-//! `runtime::scheme::Bound` and the `Assembler`).
+//! `runtime::fem::bound::Bound` and the `Assembler`).
 //!
 //! ```no_run
 //! use signorini::interpret::Library;
-//! use signorini::runtime::kernel::Coef;
+//! use signorini::runtime::fem::kernel::Coef;
 //!
 //! let lib = Library::load("forms/contact_nitsche.wf".as_ref())?;
 //! let coefs = [
@@ -29,7 +29,7 @@ use std::sync::Arc;
 use signorini_compiler::check::ParamRange;
 use signorini_compiler::ir::DimIr;
 use signorini_compiler::{FsLoader, Program, Span};
-use signorini_runtime::kernel::{Coef, FormMeta};
+use signorini_runtime::fem::kernel::{Coef, FormMeta};
 
 pub use form::InterpretedForm;
 
@@ -49,7 +49,7 @@ pub enum InterpretError {
     MissingCoef { name: String, at: String },
     #[error("unknown coef `{name}` (declared: {})", list(.known))]
     UnknownCoef { name: String, known: Vec<String> },
-    /// A coef with the wrong number of components for its shape (`runtime::kernel::check_coef`).
+    /// A coef with the wrong number of components for its shape (`runtime::fem::kernel::check_coef`).
     #[error("{0}")]
     CoefShape(String),
     #[error("interpreted forms exist in dimensions 1, 2 and 3, not {0}")]

@@ -10,8 +10,8 @@ use crate::cases::CaseError;
 use crate::compiler::Diagnostic;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, MeshSource, NamedCall, RegionSource};
-use crate::runtime::kernel::Coef;
-use crate::runtime::mesh::{CellSize, Mesh};
+use crate::runtime::fem::kernel::Coef;
+use crate::runtime::fem::mesh::{CellSize, Mesh};
 
 /// The dimension of the problem's mesh: its generator's, or the file's (read here). `params`
 /// are the problem's, for a file name that names them (`"ball_{level}.msh"`).
@@ -139,7 +139,7 @@ pub fn mesh(
                         }
                         found = true;
                         mesh.regions.retain(|x| x.name != r.name.name);
-                        mesh.regions.push(crate::runtime::mesh::Region { name: r.name.name.clone(), facets });
+                        mesh.regions.push(crate::runtime::fem::mesh::Region { name: r.name.name.clone(), facets });
                     }
                 }
                 RegionSource::Boundary { conditions, .. } => {
@@ -202,7 +202,7 @@ fn predicate(
 
 /// A built-in generator's mesh, after a check that it fits in memory.
 fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh, String), CaseError> {
-    use crate::runtime::mesh::{ball::ball, disc::disc, structured};
+    use crate::runtime::fem::mesh::{ball::ball, disc::disc, structured};
     // The scalar arguments, evaluated up front (the checker knows which each generator takes).
     let mut scalars: Vec<(String, f64)> = Vec::new();
     let vectors = crate::compiler::check::problem::GENERATORS

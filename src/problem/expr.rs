@@ -211,8 +211,8 @@ impl PointFn {
     /// As a coef of the forms: a constant, a function of x, or of x and t. Values have no
     /// negative zeros (`−0` and `0` are one value of a coef; the kernels then do the same
     /// arithmetic whichever was written).
-    pub fn coef(self) -> crate::runtime::kernel::Coef {
-        use crate::runtime::kernel::Coef;
+    pub fn coef(self) -> crate::runtime::fem::kernel::Coef {
+        use crate::runtime::fem::kernel::Coef;
         if let Some(values) = self.constant() {
             return Coef::constant(values.into_iter().map(|v| v + 0.0).collect::<Vec<_>>());
         }

@@ -10,11 +10,11 @@ use crate::cases::CaseError;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
 use crate::driver::ActiveForms;
-use crate::runtime::assembly::Assembler;
-use crate::runtime::evaluate::{FacetSample, facet_samples};
-use crate::runtime::library::{Binding, BoundFunctional};
-use crate::runtime::mesh::Facet;
-use crate::runtime::scheme::BoundForm;
+use crate::runtime::fem::assembly::Assembler;
+use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
+use crate::runtime::fem::evaluate::{FacetSample, facet_samples};
+use crate::runtime::fem::mesh::Facet;
+use crate::runtime::library::Binding;
 use crate::simulation::{AxisMean, Tools, resultant};
 
 /// One measured value of a row.
@@ -134,7 +134,7 @@ impl<'m> Observer<'m> {
         ex: &mut Exprs,
         tools: &Tools<'m>,
         forms: &ActiveForms,
-        coefs: &dyn Fn(&str) -> Option<crate::runtime::kernel::Coef>,
+        coefs: &dyn Fn(&str) -> Option<crate::runtime::fem::kernel::Coef>,
         binding: &Binding<'m>,
         coef_vals: &[(String, Val)],
         degree: u32,
@@ -337,7 +337,7 @@ impl<'m> Observer<'m> {
                         }
                     };
                     // Its integrand must live on facets: a cell functional has none to read.
-                    let rule = crate::runtime::quadrature::sampling_rule(d - 1, 1);
+                    let rule = crate::runtime::fem::quadrature::sampling_rule(d - 1, 1);
                     let zero = vec![0.0; tools.asm.size()];
                     if self.functionals[index].1.facet_point_values(tools.asm, &rule, &[&zero], 0.0).is_empty() {
                         return Err(pf.render(crate::compiler::Diagnostic::error(
@@ -504,125 +504,126 @@ impl<'m> Observer<'m> {
             }
             // The measures of this column (in the order they were added).
             while next < self.measures.len() && !self.belongs_after(next, c) {
-                let value: Vec<f64> =
-                    match &self.measures[next] {
-                        Measure::Time => one(s.t),
-                        Measure::Energy => {
-                            let k = *kinetic.get_or_insert_with(|| tools.kinetic(s.v));
-                            one(tools.energy_with_kinetic(s.u, k))
+                let value: Vec<f64> = match &self.measures[next] {
+                    Measure::Time => one(s.t),
+                    Measure::Energy => {
+                        let k = *kinetic.get_or_insert_with(|| tools.kinetic(s.v));
+                        one(tools.energy_with_kinetic(s.u, k))
+                    }
+                    Measure::Kinetic => one(*kinetic.get_or_insert_with(|| tools.kinetic(s.v))),
+                    Measure::Newton => one(s.newton as f64),
+                    Measure::ActivePoints => one(switches.iter().filter(|b| **b).count() as f64),
+                    Measure::Column(i) => one(columns[*i]),
+                    Measure::Mean { field: fi, weights, .. } => one(field(*fi).map_or(f64::NAN, |x| weights.of(x))),
+                    Measure::NodalMean { field: fi, axis } => {
+                        one(field(*fi)
+                            .map_or(f64::NAN, |x| x.iter().skip(*axis).step_by(d).sum::<f64>() / (n / d) as f64))
+                    }
+                    Measure::AtMin { field: 1, axis, node, massless: true } if s.before.is_some() => {
+                        let (before, dt) = s.before.expect("a step");
+                        let i = d * node + axis;
+                        one((s.u[i] - before[i]) / dt)
+                    }
+                    Measure::AtMin { field: fi, axis, node, .. } => {
+                        one(field(*fi).map_or(f64::NAN, |x| x[d * node + axis]))
+                    }
+                    Measure::Force { slot, dofs } => {
+                        let mut r = vec![0.0; n];
+                        self.slots[*slot].1.residual(asm, &[s.u], s.t, &mut r);
+                        match dofs {
+                            None => resultant(&r, d),
+                            Some(dofs) => (0..d)
+                                .map(|k| -dofs.iter().filter(|&&i| i % d == k).map(|&i| r[i]).sum::<f64>())
+                                .collect(),
                         }
-                        Measure::Kinetic => one(*kinetic.get_or_insert_with(|| tools.kinetic(s.v))),
-                        Measure::Newton => one(s.newton as f64),
-                        Measure::ActivePoints => one(switches.iter().filter(|b| **b).count() as f64),
-                        Measure::Column(i) => one(columns[*i]),
-                        Measure::Mean { field: fi, weights, .. } => one(field(*fi).map_or(f64::NAN, |x| weights.of(x))),
-                        Measure::NodalMean { field: fi, axis } => one(field(*fi)
-                            .map_or(f64::NAN, |x| x.iter().skip(*axis).step_by(d).sum::<f64>() / (n / d) as f64)),
-                        Measure::AtMin { field: 1, axis, node, massless: true } if s.before.is_some() => {
-                            let (before, dt) = s.before.expect("a step");
-                            let i = d * node + axis;
-                            one((s.u[i] - before[i]) / dt)
-                        }
-                        Measure::AtMin { field: fi, axis, node, .. } => {
-                            one(field(*fi).map_or(f64::NAN, |x| x[d * node + axis]))
-                        }
-                        Measure::Force { slot, dofs } => {
-                            let mut r = vec![0.0; n];
-                            self.slots[*slot].1.residual(asm, &[s.u], s.t, &mut r);
-                            match dofs {
-                                None => resultant(&r, d),
-                                Some(dofs) => (0..d)
-                                    .map(|k| -dofs.iter().filter(|&&i| i % d == k).map(|&i| r[i]).sum::<f64>())
-                                    .collect(),
-                            }
-                        }
-                        Measure::Area { region, f } | Measure::Peak { region, f } => {
-                            // `measure` and `peak` of one expression share its values.
-                            let cached = sampled.iter().find(|(r, k, _)| *r == *region && *k == f.key);
-                            if let Some((_, _, values)) = cached {
-                                let us = samples[*region].as_ref().expect("sampled with the values");
-                                let value = if matches!(self.measures[next], Measure::Area { .. }) {
-                                    us.iter().zip(values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum()
-                                } else {
-                                    values.iter().fold(0.0f64, |m, e| m.max(*e))
-                                };
-                                measured.push(one(value));
-                                next += 1;
-                                continue;
-                            }
-                            let us = samples[*region]
-                                .get_or_insert_with(|| facet_samples(mesh, self.regions[*region], self.degree, s.u));
-                            let vs =
-                                match (f.reads_v(), s.v) {
-                                    (true, Some(v)) => Some(&*samples_v[*region].get_or_insert_with(|| {
-                                        facet_samples(mesh, self.regions[*region], self.degree, v)
-                                    })),
-                                    _ => None,
-                                };
-                            let mut out = [0.0];
-                            let values: Vec<f64> = us
-                                .iter()
-                                .enumerate()
-                                .map(|(i, p)| {
-                                    let v = vs.map_or(&[][..], |vs| vs[i].value.as_slice());
-                                    f.eval(
-                                        &At { x: &p.x, t: s.t, u: &p.value, v, ..At::default() },
-                                        &mut *scratch,
-                                        &mut out,
-                                    );
-                                    out[0]
-                                })
-                                .collect();
+                    }
+                    Measure::Area { region, f } | Measure::Peak { region, f } => {
+                        // `measure` and `peak` of one expression share its values.
+                        let cached = sampled.iter().find(|(r, k, _)| *r == *region && *k == f.key);
+                        if let Some((_, _, values)) = cached {
+                            let us = samples[*region].as_ref().expect("sampled with the values");
                             let value = if matches!(self.measures[next], Measure::Area { .. }) {
-                                one(us.iter().zip(&values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum())
+                                us.iter().zip(values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum()
                             } else {
-                                one(values.iter().fold(0.0f64, |m, e| m.max(*e)))
+                                values.iter().fold(0.0f64, |m, e| m.max(*e))
                             };
-                            sampled.push((*region, f.key.clone(), values));
-                            value
+                            measured.push(one(value));
+                            next += 1;
+                            continue;
                         }
-                        Measure::Functional { index, mid: false } => {
-                            one(self.functionals[*index].1.value(asm, &[s.u], s.t))
-                        }
-                        Measure::Functional { index, mid: true } => {
-                            let f = &self.functionals[*index].1;
-                            one(mid
-                                .get_or_insert_with(&mut midpoint)
-                                .as_ref()
-                                .map_or(f64::NAN, |(u, t)| f.value(asm, &[u], *t)))
-                        }
-                        Measure::Reference { which, mid: false } => one(self
-                            .reference
-                            .as_ref()
-                            .map_or(f64::NAN, |(_, r)| r.value(*which, &reference_at(tools, s.u, s.t)))),
-                        Measure::Reference { which, mid: true } => one(mid
+                        let us = samples[*region]
+                            .get_or_insert_with(|| facet_samples(mesh, self.regions[*region], self.degree, s.u));
+                        let vs = match (f.reads_v(), s.v) {
+                            (true, Some(v)) => Some(
+                                &*samples_v[*region]
+                                    .get_or_insert_with(|| facet_samples(mesh, self.regions[*region], self.degree, v)),
+                            ),
+                            _ => None,
+                        };
+                        let mut out = [0.0];
+                        let values: Vec<f64> = us
+                            .iter()
+                            .enumerate()
+                            .map(|(i, p)| {
+                                let v = vs.map_or(&[][..], |vs| vs[i].value.as_slice());
+                                f.eval(
+                                    &At { x: &p.x, t: s.t, u: &p.value, v, ..At::default() },
+                                    &mut *scratch,
+                                    &mut out,
+                                );
+                                out[0]
+                            })
+                            .collect();
+                        let value = if matches!(self.measures[next], Measure::Area { .. }) {
+                            one(us.iter().zip(&values).filter(|(_, e)| **e >= 0.0).map(|(p, _)| p.weight).sum())
+                        } else {
+                            one(values.iter().fold(0.0f64, |m, e| m.max(*e)))
+                        };
+                        sampled.push((*region, f.key.clone(), values));
+                        value
+                    }
+                    Measure::Functional { index, mid: false } => {
+                        one(self.functionals[*index].1.value(asm, &[s.u], s.t))
+                    }
+                    Measure::Functional { index, mid: true } => {
+                        let f = &self.functionals[*index].1;
+                        one(mid
                             .get_or_insert_with(&mut midpoint)
                             .as_ref()
-                            .zip(self.reference.as_ref().map(|(_, r)| r))
-                            .map_or(f64::NAN, |((u, t), r)| r.value(*which, &reference_at(tools, u, *t)))),
-                        Measure::Density { index, min } => {
-                            let rule = crate::runtime::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
-                            let points = self.functionals[*index].1.facet_point_values(asm, &rule, &[s.u], s.t);
-                            one(if *min {
-                                points.iter().map(|p| p.value).fold(f64::INFINITY, f64::min)
-                            } else {
-                                points.iter().filter(|p| p.value != 0.0).map(|p| p.weight).sum()
-                            })
-                        }
-                        Measure::InnerMass { a, b } => {
-                            let nodal = |f: &PointFn, scratch: &mut Vec<f64>| {
-                                let mut out = vec![0.0; n];
-                                for (i, o) in out.chunks_mut(d).enumerate() {
-                                    let u = &s.u[d * i..d * i + d];
-                                    let v = s.v.map_or(&[][..], |v| &v[d * i..d * i + d]);
-                                    f.eval(&At { x: mesh.node(i), t: s.t, u, v, ..At::default() }, scratch, o);
-                                }
-                                out
-                            };
-                            let (a, b) = (nodal(a, &mut *scratch), nodal(b, &mut *scratch));
-                            one(Tools::quad(&tools.scheme_mass, &a, &b))
-                        }
-                    };
+                            .map_or(f64::NAN, |(u, t)| f.value(asm, &[u], *t)))
+                    }
+                    Measure::Reference { which, mid: false } => one(self
+                        .reference
+                        .as_ref()
+                        .map_or(f64::NAN, |(_, r)| r.value(*which, &reference_at(tools, s.u, s.t)))),
+                    Measure::Reference { which, mid: true } => one(mid
+                        .get_or_insert_with(&mut midpoint)
+                        .as_ref()
+                        .zip(self.reference.as_ref().map(|(_, r)| r))
+                        .map_or(f64::NAN, |((u, t), r)| r.value(*which, &reference_at(tools, u, *t)))),
+                    Measure::Density { index, min } => {
+                        let rule = crate::runtime::fem::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
+                        let points = self.functionals[*index].1.facet_point_values(asm, &rule, &[s.u], s.t);
+                        one(if *min {
+                            points.iter().map(|p| p.value).fold(f64::INFINITY, f64::min)
+                        } else {
+                            points.iter().filter(|p| p.value != 0.0).map(|p| p.weight).sum()
+                        })
+                    }
+                    Measure::InnerMass { a, b } => {
+                        let nodal = |f: &PointFn, scratch: &mut Vec<f64>| {
+                            let mut out = vec![0.0; n];
+                            for (i, o) in out.chunks_mut(d).enumerate() {
+                                let u = &s.u[d * i..d * i + d];
+                                let v = s.v.map_or(&[][..], |v| &v[d * i..d * i + d]);
+                                f.eval(&At { x: mesh.node(i), t: s.t, u, v, ..At::default() }, scratch, o);
+                            }
+                            out
+                        };
+                        let (a, b) = (nodal(a, &mut *scratch), nodal(b, &mut *scratch));
+                        one(Tools::quad(&tools.scheme_mass, &a, &b))
+                    }
+                };
                 measured.push(value);
                 next += 1;
             }

@@ -16,13 +16,12 @@ use super::observe::{Observer, State, SummaryKeys};
 use crate::cases::CaseError;
 use crate::checkpoint::Control;
 use crate::driver::{Active, ParamValue, Setup};
-use crate::runtime::assembly::{Assembler, Quadrature};
+use crate::runtime::fem::assembly::{Assembler, Quadrature};
+use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::library::Binding;
-use crate::runtime::mesh::CellSize;
-use crate::runtime::newton::NewtonOptions;
-use crate::runtime::problem::Constraints;
-use crate::simulation::MassChoice;
-use crate::simulation::{Problem, Simulation, Snapshots};
+use crate::runtime::nonlinear::newton::NewtonOptions;
+use crate::runtime::nonlinear::statics::Constraints;
+use crate::simulation::{MassChoice, Problem, Simulation, Snapshots};
 
 /// How to run a problem: the command line's or a case file's choices over the problem's.
 #[derive(Clone, Debug, PartialEq)]
@@ -235,8 +234,8 @@ fn bound_reference(
     pf: &ProblemFile,
     ex: &mut Exprs,
     active: &Active,
-    mesh: &crate::runtime::mesh::Mesh,
-    contact: &[crate::runtime::mesh::Facet],
+    mesh: &crate::runtime::fem::mesh::Mesh,
+    contact: &[crate::runtime::fem::mesh::Facet],
     t_start: f64,
 ) -> Result<Option<crate::references::Bound>, CaseError> {
     let Some(r) = reference(pf, mesh.dim())? else { return Ok(None) };
@@ -384,7 +383,7 @@ fn coef_shapes(
 fn dirichlet(
     pf: &ProblemFile,
     ex: &mut Exprs,
-    mesh: &crate::runtime::mesh::Mesh,
+    mesh: &crate::runtime::fem::mesh::Mesh,
 ) -> Result<(Constraints, Option<Held>), CaseError> {
     use crate::compiler::Diagnostic;
     use crate::compiler::syntax::ast::HeldAt;
@@ -450,7 +449,7 @@ fn dirichlet(
 }
 
 /// The mesh node nearest to `target` (the first of several as near).
-fn nearest_node(mesh: &crate::runtime::mesh::Mesh, target: &[f64]) -> usize {
+fn nearest_node(mesh: &crate::runtime::fem::mesh::Mesh, target: &[f64]) -> usize {
     let dist = |i: usize| -> f64 { mesh.node(i).iter().zip(target).map(|(x, y)| (x - y).powi(2)).sum() };
     (0..mesh.num_nodes()).min_by(|&a, &b| dist(a).total_cmp(&dist(b))).unwrap_or(0)
 }
@@ -478,17 +477,17 @@ impl Held {
     }
 
     /// For the stepper: the values at a time.
-    fn prescribed(&self, mesh: &crate::runtime::mesh::Mesh) -> crate::runtime::scheme::Prescribed {
+    fn prescribed(&self, mesh: &crate::runtime::fem::mesh::Mesh) -> crate::runtime::time::stepper::Prescribed {
         let nodes: Vec<Vec<f64>> = (0..mesh.num_nodes()).map(|i| mesh.node(i).to_vec()).collect();
         let me = self.clone();
-        crate::runtime::scheme::Prescribed {
+        crate::runtime::time::stepper::Prescribed {
             dofs: self.dofs.clone(),
             values: Box::new(move |t, out| me.eval(&nodes, t, out)),
         }
     }
 
     /// Imposes the held values at `t0` on u₀ and their rate (a centred difference) on v₀.
-    fn initial(&self, mesh: &crate::runtime::mesh::Mesh, t0: f64, u0: &mut [f64], v0: &mut [f64]) {
+    fn initial(&self, mesh: &crate::runtime::fem::mesh::Mesh, t0: f64, u0: &mut [f64], v0: &mut [f64]) {
         let nodes: Vec<Vec<f64>> = (0..mesh.num_nodes()).map(|i| mesh.node(i).to_vec()).collect();
         let n = self.dofs.len();
         let (mut g, mut up, mut down) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
@@ -542,7 +541,7 @@ fn simulate(
     let coefs = |name: &str| {
         lookup(name).or_else(|| {
             let (_, len) = zeros.iter().find(|(n, _)| n == name)?;
-            Some(crate::runtime::kernel::Coef::constant(vec![0.0; *len]))
+            Some(crate::runtime::fem::kernel::Coef::constant(vec![0.0; *len]))
         })
     };
     // The contact law's `Gamma_C` is the obstacle's region (`on REGION`, or `Gamma_C`); none
@@ -945,7 +944,7 @@ fn identity(
     pf: &ProblemFile,
     params: &[super::ProblemParam],
     active: &Active,
-    mesh: &crate::runtime::mesh::Mesh,
+    mesh: &crate::runtime::fem::mesh::Mesh,
     s: &Settings,
 ) -> crate::checkpoint::Identity {
     let mut more = vec![

@@ -6,10 +6,10 @@
 
 use std::path::Path;
 
-use crate::runtime::assembly::Assembler;
-use crate::runtime::library::BoundFunctional;
+use crate::runtime::fem::assembly::Assembler;
+use crate::runtime::fem::bound::BoundFunctional;
+use crate::runtime::fem::mesh::Mesh;
 use crate::runtime::linalg::Matrix;
-use crate::runtime::mesh::Mesh;
 
 pub mod bar;
 pub mod hertz;
@@ -23,7 +23,7 @@ pub struct RunFacts<'a> {
     /// The problem's arguments to the reference, by name (checked against [`Reference::args`]).
     pub args: &'a [(String, f64)],
     /// The facets where contact is imposed (none without contact).
-    pub contact: &'a [crate::runtime::mesh::Facet],
+    pub contact: &'a [crate::runtime::fem::mesh::Facet],
 }
 
 impl RunFacts<'_> {

@@ -11,15 +11,17 @@ use crate::cases::CaseError;
 use crate::checkpoint::Control;
 use crate::compiler::scheme::EnergyLaw;
 use crate::driver::Active;
-use crate::runtime::assembly::{Assembler, Quadrature};
-use crate::runtime::kernel::Coef;
-use crate::runtime::library::{Binding, BoundFunctional};
+use crate::runtime::fem::assembly::{Assembler, Quadrature};
+use crate::runtime::fem::bound::{BoundForm, BoundFunctional, MatrixForm};
+use crate::runtime::fem::kernel::Coef;
+use crate::runtime::fem::mesh::{Facet, Mesh};
+use crate::runtime::library::Binding;
+use crate::runtime::linalg::lower_half::{HalfPattern, LowerHalf};
 use crate::runtime::linalg::{Matrix, Structure};
-use crate::runtime::lower_half::{HalfPattern, LowerHalf};
-use crate::runtime::mesh::{Facet, Mesh};
-use crate::runtime::newton::NewtonOptions;
-use crate::runtime::problem::Constraints;
-use crate::runtime::scheme::{BoundForm, MatrixForm, StageView, StepReport, Stepper};
+use crate::runtime::nonlinear::newton::NewtonOptions;
+use crate::runtime::nonlinear::statics::Constraints;
+use crate::runtime::time::scheme::StageView;
+use crate::runtime::time::stepper::{StepReport, Stepper};
 use std::sync::Arc;
 
 pub mod stability;
@@ -38,7 +40,7 @@ pub struct Problem<'p> {
     /// Dirichlet conditions of the dynamics.
     pub constraints: Constraints,
     /// Held displacements that move (among the constraints' fixed dofs).
-    pub prescribed: Option<crate::runtime::scheme::Prescribed>,
+    pub prescribed: Option<crate::runtime::time::stepper::Prescribed>,
     pub mass: MassChoice,
     pub newton: NewtonOptions,
 }
@@ -322,11 +324,11 @@ impl<'m> Parts<'m> {
         let scheme_mass = match problem.mass {
             MassChoice::Consistent => None,
             MassChoice::Redistributed => Some(
-                crate::runtime::redistribute::redistribute(mesh, &mass, &contact_nodes)
+                crate::runtime::fem::redistribute::redistribute(mesh, &mass, &contact_nodes)
                     .map_err(|e| CaseError::Option(e.to_string()))?
                     .matrix,
             ),
-            MassChoice::Lumped => Some(crate::runtime::lumping::lumped(&mass, mesh.kind.degree(), mesh.dim())),
+            MassChoice::Lumped => Some(crate::runtime::fem::lumping::lumped(&mass, mesh.kind.degree(), mesh.dim())),
         };
         let scheme_mass = match scheme_mass {
             Some(matrix) => {
@@ -614,7 +616,7 @@ impl<'m> Simulation<'m> {
                             states.clone_from_slice(&saved);
                         }
                         // A law whose derivative is 0/0 is so at any Δt: no cut helps.
-                        if let crate::runtime::scheme::StepError::NonFiniteTangent { .. } = e {
+                        if let crate::runtime::time::stepper::StepError::NonFiniteTangent { .. } = e {
                             outcome.stopped = Some(CaseError::Failed { t, cause: e.to_string() });
                             break 'steps;
                         }
@@ -804,9 +806,9 @@ impl Default for Guard {
 }
 
 /// The residual history of a failed Newton, for the stop message.
-fn history(e: &crate::runtime::scheme::StepError) -> String {
-    use crate::runtime::newton::NewtonError;
-    use crate::runtime::scheme::StepError;
+fn history(e: &crate::runtime::time::stepper::StepError) -> String {
+    use crate::runtime::nonlinear::newton::NewtonError;
+    use crate::runtime::time::stepper::StepError;
     let StepError::Newton { source, .. } = e else { return String::new() };
     let report = match source {
         NewtonError::IterationLimit { report, .. } | NewtonError::NonFinite { report } => report,

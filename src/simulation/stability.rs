@@ -8,9 +8,9 @@
 
 use super::Tools;
 use crate::cases::CaseError;
-use crate::runtime::kernel::Coef;
+use crate::runtime::fem::kernel::Coef;
 use crate::runtime::linalg::{Factorization, Structure};
-use crate::runtime::problem::Constraints;
+use crate::runtime::nonlinear::statics::Constraints;
 
 /// The estimate, for the refusal's message and the summary.
 #[derive(Clone, Copy, Debug)]

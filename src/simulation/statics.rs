@@ -3,13 +3,14 @@
 
 use crate::cases::CaseError;
 use crate::driver::ActiveForms;
-use crate::runtime::assembly::{Assembler, Quadrature};
-use crate::runtime::kernel::Coef;
-use crate::runtime::library::{Binding, BoundFunctional};
+use crate::runtime::fem::assembly::{Assembler, Quadrature};
+use crate::runtime::fem::bound::BoundFunctional;
+use crate::runtime::fem::kernel::Coef;
+use crate::runtime::fem::mesh::Facet;
+use crate::runtime::library::Binding;
 use crate::runtime::linalg::{Counters, Structure};
-use crate::runtime::mesh::Facet;
-use crate::runtime::newton::{Newton, NewtonOptions, NewtonReport, NonlinearProblem};
-use crate::runtime::problem::{Constraints, StaticContact};
+use crate::runtime::nonlinear::newton::{Newton, NewtonOptions, NewtonReport, NonlinearProblem};
+use crate::runtime::nonlinear::statics::{Constraints, StaticContact};
 
 /// What a static case gives the driver.
 pub struct StaticProblem<'p> {

@@ -2,16 +2,17 @@
 //! error against cos t, and the spectral radius of a scheme's one-step map.
 
 use crate::cases::CaseError;
-use crate::driver::Slot;
-use crate::driver::{Active, Setup};
-use crate::runtime::assembly::{Assembler, Quadrature};
-use crate::runtime::kernel::Coef;
+use crate::driver::{Active, Setup, Slot};
+use crate::runtime::fem::assembly::{Assembler, Quadrature};
+use crate::runtime::fem::bound::MatrixForm;
+use crate::runtime::fem::kernel::Coef;
+use crate::runtime::fem::mesh::structured;
 use crate::runtime::library::Binding;
 use crate::runtime::linalg::Structure;
-use crate::runtime::mesh::structured;
-use crate::runtime::newton::NewtonOptions;
-use crate::runtime::problem::Constraints;
-use crate::runtime::scheme::{MatrixForm, Stepper, TimeScheme};
+use crate::runtime::nonlinear::newton::NewtonOptions;
+use crate::runtime::nonlinear::statics::Constraints;
+use crate::runtime::time::scheme::TimeScheme;
+use crate::runtime::time::stepper::Stepper;
 
 /// Runs `f` with a stepper of `setup`'s scheme on the oscillator: one P1 element, E = 1,
 /// ρ = 3, so M = ρh/3 = 1 and K = E/h = 1 on the free dof; no contact facets.

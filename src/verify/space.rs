@@ -12,13 +12,13 @@ use serde::Serialize;
 
 use crate::cases::CaseError;
 use crate::forms::elasticity;
-use crate::runtime::assembly::{Assembler, Quadrature};
-use crate::runtime::evaluate::errors;
-use crate::runtime::kernel::Coef;
+use crate::runtime::fem::assembly::{Assembler, Quadrature};
+use crate::runtime::fem::evaluate::errors;
+use crate::runtime::fem::kernel::Coef;
+use crate::runtime::fem::mesh::structured::{self, Diagonal};
+use crate::runtime::fem::mesh::{Mesh, disc::disc};
 use crate::runtime::linalg::Structure;
-use crate::runtime::mesh::structured::{self, Diagonal};
-use crate::runtime::mesh::{Mesh, disc::disc};
-use crate::runtime::problem::{Constraints, solve_linear};
+use crate::runtime::nonlinear::statics::{Constraints, solve_linear};
 
 /// Exact value and gradient (`[component][direction]`) at x.
 fn exact(x: &[f64]) -> (Vec<f64>, Vec<f64>) {

@@ -52,18 +52,18 @@ fn module_text(prog: &Program, irs: &[&DimIr], opts: &Options) -> String {
     );
     let _ = writeln!(
         s,
-        "use {rt}::kernel::{{CellCtx, Coef, FacetCtx, Form, FormKernel, FormMeta, FunctionalKernel, LocalMatrix, LocalVector, ParamError, ParamRange, check_coef, check_param, heaviside}};"
+        "use {rt}::fem::kernel::{{CellCtx, Coef, FacetCtx, Form, FormKernel, FormMeta, FunctionalKernel, LocalMatrix, LocalVector, check_coef, heaviside}};"
     );
     let _ = writeln!(
         s,
-        "use {rt}::library::{{Binding, CoefInfo, FormUnit, LibraryError, Made, ParamInfo, SchemeUnit, SlotInfo, SlotUse, Unit, need_coef}};"
+        "use {rt}::descriptors::{{CoefInfo, ParamError, ParamInfo, ParamRange, SlotInfo, SlotUse, check_param}};"
     );
-    let _ = writeln!(s, "use {rt}::geometry;");
+    let _ = writeln!(s, "use {rt}::library::{{Binding, FormUnit, LibraryError, Made, SchemeUnit, Unit, need_coef}};");
+    let _ = writeln!(s, "use {rt}::fem::geometry;");
     if !prog.schemes.is_empty() {
-        let _ = writeln!(
-            s,
-            "use {rt}::scheme::{{Combination, InitialDesc, Level, SchemeDesc, StageDesc, TermDesc, TimeScheme}};"
-        );
+        let _ =
+            writeln!(s, "use {rt}::descriptors::{{Combination, InitialDesc, Level, SchemeDesc, StageDesc, TermDesc}};");
+        let _ = writeln!(s, "use {rt}::time::scheme::TimeScheme;");
     }
     // Kernels for the forms declared in this file; imported files have modules of their own.
     let own: Vec<usize> = (0..prog.forms.len()).filter(|&i| prog.forms[i].span.file == prog.root).collect();

@@ -209,7 +209,7 @@ impl Program {
     }
 }
 
-/// H(a) = 1 if a > 0, else 0 (as `runtime::kernel::heaviside`).
+/// H(a) = 1 if a > 0, else 0 (as `runtime::fem::kernel::heaviside`).
 #[inline(always)]
 pub fn heaviside(a: f64) -> f64 {
     if a > 0.0 { 1.0 } else { 0.0 }

@@ -19,7 +19,7 @@ use crate::check::{CELL_REGION, Unit};
 use crate::diagnostic::Diagnostic;
 
 /// Highest polynomial degree a form may need to be integrated exactly. The runtime has rules
-/// of every degree (runtime/src/quadrature.rs: collapsed Gauss products past its symmetric
+/// of every degree (runtime/src/fem/quadrature.rs: collapsed Gauss products past its symmetric
 /// rules), but their point counts grow as degree^dim and only degrees up to 10 are tested
 /// there; an estimate past this is a mistake (`u^40`) rather than an integrand.
 pub const MAX_DEGREE: u32 = 20;

@@ -1,8 +1,8 @@
 //! A form written by hand against the kernel interface, so the runtime is tested without the
 //! compiler: ∫ ρ u·v + k ∇u : ∇v (vector-valued, every component alike).
 
-use signorini_runtime::geometry::{gradient, interpolate, jacobian, physical_gradients};
-use signorini_runtime::kernel::{CellCtx, Form, FormKernel, FormMeta, LocalMatrix, LocalVector};
+use signorini_runtime::fem::geometry::{gradient, interpolate, jacobian, physical_gradients};
+use signorini_runtime::fem::kernel::{CellCtx, Form, FormKernel, FormMeta, LocalMatrix, LocalVector};
 
 pub struct MassStiffness {
     pub rho: f64,

@@ -1,9 +1,9 @@
 //! The contact zone and the pressure profile of a solution, sampled at many points of the
 //! contact facets (the pressure is the contact law's `contact_pressure` integrand).
 
-use crate::runtime::assembly::Assembler;
-use crate::runtime::library::BoundFunctional;
-use crate::runtime::quadrature::sampling_rule;
+use crate::runtime::fem::assembly::Assembler;
+use crate::runtime::fem::bound::BoundFunctional;
+use crate::runtime::fem::quadrature::sampling_rule;
 
 /// Sampling points per edge (2D), or sub-triangles per edge of a face (3D): the measure of the
 /// contact zone is exact up to the part of a facet between two samples.

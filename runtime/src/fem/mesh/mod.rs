@@ -16,8 +16,9 @@ use std::collections::HashMap;
 pub use boundary::facet_key;
 pub use validate::MeshError;
 
-use crate::element::ElementKind;
-use crate::geometry;
+use crate::fem::element::ElementKind;
+use crate::fem::geometry;
+use crate::linalg::pattern::Connectivity;
 
 /// A boundary facet: a local facet of a cell.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -112,6 +113,16 @@ impl Mesh {
         &self.cells[c * n..(c + 1) * n]
     }
 
+    /// The cells' nodes, for the sparsity pattern of a vector field on this mesh.
+    pub fn connectivity(&self) -> Connectivity<'_> {
+        Connectivity {
+            dim: self.dim(),
+            num_nodes: self.num_nodes(),
+            nodes_per_cell: self.kind.nodes(),
+            cells: &self.cells,
+        }
+    }
+
     pub fn node(&self, i: usize) -> &[f64] {
         let d = self.dim();
         &self.coords[i * d..(i + 1) * d]
@@ -140,7 +151,7 @@ impl Mesh {
             CellSize::GetFem => (0..self.num_cells())
                 .map(|c| {
                     let nodes: Vec<&[f64]> = self.cell(c).iter().map(|&n| self.node(n as usize)).collect();
-                    crate::geometry::getfem_size(self.kind, &nodes)
+                    crate::fem::geometry::getfem_size(self.kind, &nodes)
                 })
                 .collect(),
         };
@@ -295,7 +306,7 @@ impl Mesh {
     /// Total measure (length, area, volume), integrated with the isoparametric map.
     pub fn measure(&self) -> f64 {
         let d = self.dim();
-        let rule = crate::quadrature::simplex_rule(d, 2 * d as u32);
+        let rule = crate::fem::quadrature::simplex_rule(d, 2 * d as u32);
         let tab: Vec<Vec<Vec<f64>>> = rule.points.iter().map(|p| self.kind.basis_gradients(p)).collect();
         let mut total = 0.0;
         for c in 0..self.num_cells() {

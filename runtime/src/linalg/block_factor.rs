@@ -21,8 +21,7 @@
 //! the ancestors of k's node in the elimination tree (a few percent of the columns on a 2D
 //! mesh). The low-rank corrections of a changed Jacobian are built from these (`lowrank`).
 
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
-use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 
 /// L in node blocks, with the ordering it was computed in.
 #[derive(Clone, Debug)]
@@ -453,10 +452,10 @@ impl Blocks {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::Assembler;
-    use crate::linalg::node_ordering;
-    use crate::mesh::structured::{Diagonal, cuboid, interval, rectangle};
-    use crate::test_matrices::diagonally_dominant;
+    use crate::fem::assembly::Assembler;
+    use crate::fem::mesh::structured::{Diagonal, cuboid, interval, rectangle};
+    use crate::fem::test_matrices::diagonally_dominant;
+    use crate::linalg::factorization::node_ordering;
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::sparse::linalg::SupernodalThreshold;
     use faer::sparse::linalg::cholesky::{self, LltRef, SymmetricOrdering};

@@ -1,8 +1,8 @@
 //! Point values of fields: at the quadrature points of boundary facets (for penetration and
 //! contact pressure) and at nodes.
 
-use crate::kernel::FacetTabulation;
-use crate::mesh::{Facet, Mesh};
+use crate::fem::kernel::FacetTabulation;
+use crate::fem::mesh::{Facet, Mesh};
 
 /// A field sampled at a facet quadrature point.
 #[derive(Clone, Debug, PartialEq)]
@@ -34,9 +34,9 @@ fn samples<const D: usize, const N: usize>(
         let (tab, normal) = &tabs.facets[f.local as usize];
         for q in 0..tab.len() {
             let phi = &tab.phi[q];
-            let jac = crate::geometry::jacobian(&coords, &tab.dphi[q]);
-            let (_, scale) = crate::geometry::facet_normal(&jac, normal);
-            let x = crate::geometry::interpolate(&coords, phi);
+            let jac = crate::fem::geometry::jacobian(&coords, &tab.dphi[q]);
+            let (_, scale) = crate::fem::geometry::facet_normal(&jac, normal);
+            let x = crate::fem::geometry::interpolate(&coords, phi);
             let mut value = vec![0.0; D];
             for j in 0..N {
                 for k in 0..D {
@@ -65,19 +65,19 @@ fn cell_errors<const D: usize, const N: usize>(
     degree: u32,
     exact: &ExactSolution,
 ) -> (f64, f64) {
-    let tab = crate::kernel::Tabulation::<D, N>::cell(mesh.kind, degree).expect("kind matches D and N");
+    let tab = crate::fem::kernel::Tabulation::<D, N>::cell(mesh.kind, degree).expect("kind matches D and N");
     let (mut l2, mut h1) = (0.0, 0.0);
     for c in 0..mesh.num_cells() {
         let coords = mesh.cell_coords::<D, N>(c);
         let cell = mesh.cell(c);
         let local: [[f64; D]; N] = std::array::from_fn(|j| std::array::from_fn(|k| field[cell[j] as usize * D + k]));
         for q in 0..tab.len() {
-            let jac = crate::geometry::jacobian(&coords, &tab.dphi[q]);
+            let jac = crate::fem::geometry::jacobian(&coords, &tab.dphi[q]);
             let w = tab.weights[q] * jac.det.abs();
-            let dphi = crate::geometry::physical_gradients(&jac, &tab.dphi[q]);
-            let x = crate::geometry::interpolate(&coords, &tab.phi[q]);
-            let uh = crate::geometry::interpolate(&local, &tab.phi[q]);
-            let gh = crate::geometry::gradient(&local, &dphi);
+            let dphi = crate::fem::geometry::physical_gradients(&jac, &tab.dphi[q]);
+            let x = crate::fem::geometry::interpolate(&coords, &tab.phi[q]);
+            let uh = crate::fem::geometry::interpolate(&local, &tab.phi[q]);
+            let gh = crate::fem::geometry::gradient(&local, &dphi);
             let (u, g) = exact(&x);
             for k in 0..D {
                 l2 += w * (uh[k] - u[k]).powi(2);

@@ -4,7 +4,7 @@
 //! `contact` (outward normal with n_y < 0, the lower half).
 
 use super::Mesh;
-use crate::element::ElementKind;
+use crate::fem::element::ElementKind;
 
 /// The disc of `radius` about `center`, with rings about `h` apart.
 pub fn disc(radius: f64, center: [f64; 2], h: f64) -> Mesh {

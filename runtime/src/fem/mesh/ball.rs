@@ -9,7 +9,7 @@
 
 use super::Mesh;
 use super::structured::{kuhn, orient_positively};
-use crate::element::ElementKind;
+use crate::fem::element::ElementKind;
 
 /// The ball of `radius` about `center`, with about `radius/h` cells along each half axis.
 pub fn ball(radius: f64, center: [f64; 3], h: f64) -> Mesh {
@@ -66,7 +66,7 @@ mod tests {
         let mut errors = Vec::new();
         for h in [5.0, 2.5, 1.25] {
             let mesh = ball(10.0, [0.0, 0.0, 12.0], h);
-            assert_eq!(mesh.kind, crate::element::ElementKind::TetrahedronP2);
+            assert_eq!(mesh.kind, crate::fem::element::ElementKind::TetrahedronP2);
             mesh.validate().unwrap();
             // Shape: no cell much thinner than it is long (radius ratio of the straight tets).
             let worst = (0..mesh.num_cells()).map(|c| mesh.cell_size(c)).fold(0.0f64, f64::max);

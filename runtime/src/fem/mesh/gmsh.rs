@@ -12,7 +12,7 @@ use std::path::Path;
 
 use super::boundary::facet_key;
 use super::{Facet, Mesh, MeshError, Region};
-use crate::element::ElementKind;
+use crate::fem::element::ElementKind;
 
 /// Reads a mesh file and validates its geometry.
 pub fn read(path: &Path) -> Result<Mesh, MeshError> {
@@ -636,7 +636,7 @@ fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         None => {
             let k = cells[0].kind;
             let supported: Vec<String> =
-                crate::element::ELEMENTS.iter().map(|e| format!("{} ({})", e.name, e.gmsh)).collect();
+                crate::fem::element::ELEMENTS.iter().map(|e| format!("{} ({})", e.name, e.gmsh)).collect();
             return Err(err(
                 file,
                 cells[0].at,

@@ -12,8 +12,8 @@ use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
-use crate::linalg::Matrix;
-use crate::pattern::Pattern;
+use crate::linalg::matrix::Matrix;
+use crate::linalg::pattern::Pattern;
 
 /// Columns (nodes) per task: fixed, so the sums do not depend on the number of threads.
 const NODES_PER_TASK: usize = 512;
@@ -406,9 +406,9 @@ fn reverse_cuthill_mckee(p: &Pattern) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::Assembler;
-    use crate::mesh::structured::{Diagonal, cuboid, interval, rectangle};
-    use crate::test_matrices::diagonally_dominant;
+    use crate::fem::assembly::Assembler;
+    use crate::fem::mesh::structured::{Diagonal, cuboid, interval, rectangle};
+    use crate::fem::test_matrices::diagonally_dominant;
 
     #[test]
     fn the_lower_half_product_is_the_full_product_for_any_number_of_threads() {

@@ -2,10 +2,10 @@
 //! assembled once, C a contact form on a boundary region, and L the loads; Dirichlet
 //! conditions on chosen dofs.
 
-use crate::assembly::Assembler;
+use crate::fem::assembly::Assembler;
+use crate::fem::bound::BoundForm;
 use crate::linalg::{Matrix, Structure};
-use crate::newton::NonlinearProblem;
-use crate::scheme::BoundForm;
+use crate::nonlinear::newton::NonlinearProblem;
 
 /// Dirichlet conditions: dofs held at given values (zero unless set).
 #[derive(Clone, Debug, PartialEq)]
@@ -33,11 +33,11 @@ impl Constraints {
     /// Holds the listed components of every node of a boundary region at `value(x)`.
     pub fn fix_region(
         &mut self,
-        mesh: &crate::mesh::Mesh,
+        mesh: &crate::fem::mesh::Mesh,
         region: &str,
         components: &[usize],
         value: impl Fn(&[f64]) -> Vec<f64>,
-    ) -> Result<(), crate::mesh::MeshError> {
+    ) -> Result<(), crate::fem::mesh::MeshError> {
         let d = mesh.dim();
         let region = mesh.region(region)?;
         for node in mesh.region_nodes(region) {
@@ -144,7 +144,7 @@ impl<'m> StaticContact<'m> {
 
 impl NonlinearProblem for StaticContact<'_> {
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
-        use crate::newton::norm_inf;
+        use crate::linalg::norms::norm_inf;
         self.stiffness.mul_vec(u, r);
         let stiffness = norm_inf(r);
         self.contact.residual(self.asm, &[u], 0.0, r);

@@ -130,7 +130,7 @@ pub fn facet_normal<const D: usize>(jac: &Jacobian<D>, ref_normal: &[f64; D]) ->
 /// GetFEM's `element_size` of a cell with nodes `coords` (in node order): √d times the largest,
 /// over the reference nodes ξ, of the smallest singular value of J(ξ) = Σⱼ xⱼ ⊗ ∇φⱼ(ξ), the
 /// Jacobian of the map from the unit-leg reference simplex (in 1D, the length).
-pub fn getfem_size(kind: crate::element::ElementKind, coords: &[&[f64]]) -> f64 {
+pub fn getfem_size(kind: crate::fem::element::ElementKind, coords: &[&[f64]]) -> f64 {
     let d = kind.dim();
     let mut size: f64 = 0.0;
     for xi in kind.reference_nodes() {
@@ -203,7 +203,7 @@ mod tests {
 
     #[test]
     fn getfem_size_of_straight_cells() {
-        use crate::element::ElementKind;
+        use crate::fem::element::ElementKind;
         // The reference triangle: J = I, σ_min = 1, size √2. Scaled by 3 along x: σ_min = 1.
         let tri = |p: &[[f64; 2]]| getfem_size(ElementKind::TriangleP1, &p.iter().map(|x| &x[..]).collect::<Vec<_>>());
         assert!((tri(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]) - 2f64.sqrt()).abs() < 1e-15);

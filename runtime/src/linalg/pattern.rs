@@ -4,8 +4,29 @@
 //! For each cell it stores, for every pair of its nodes (i, j), the offset of node i's first
 //! row inside node j's columns, so element matrices are added in place without searching.
 
-use crate::kernel::LocalMatrix;
-use crate::mesh::Mesh;
+/// Element matrix: `[test node][test component][trial node][trial component]`, the same
+/// memory as a row-major (N·D)×(N·D) matrix.
+pub type LocalMatrix<const D: usize, const N: usize> = [[[[f64; D]; N]; D]; N];
+
+/// The cells whose nodes a pattern couples: `nodes_per_cell` node indices per cell, `dim`
+/// components per node.
+#[derive(Clone, Copy, Debug)]
+pub struct Connectivity<'a> {
+    pub dim: usize,
+    pub num_nodes: usize,
+    pub nodes_per_cell: usize,
+    pub cells: &'a [u32],
+}
+
+impl Connectivity<'_> {
+    pub fn num_cells(&self) -> usize {
+        self.cells.len() / self.nodes_per_cell
+    }
+
+    pub fn cell(&self, c: usize) -> &[u32] {
+        &self.cells[c * self.nodes_per_cell..(c + 1) * self.nodes_per_cell]
+    }
+}
 
 /// The sparsity pattern of a vector field on a mesh (CSC, rows sorted in each column).
 #[derive(Debug)]
@@ -29,10 +50,10 @@ pub struct Entries {
 }
 
 /// The cells of each node: node i's are `cells[ptr[i]..ptr[i + 1]]`, in increasing order.
-pub(crate) fn cells_of_nodes(mesh: &Mesh) -> (Vec<usize>, Vec<u32>) {
-    let nodes = mesh.num_nodes();
+pub(crate) fn cells_of_nodes(mesh: &Connectivity) -> (Vec<usize>, Vec<u32>) {
+    let nodes = mesh.num_nodes;
     let mut ptr = vec![0usize; nodes + 1];
-    for &n in &mesh.cells {
+    for &n in mesh.cells {
         ptr[n as usize + 1] += 1;
     }
     for i in 0..nodes {
@@ -51,10 +72,10 @@ pub(crate) fn cells_of_nodes(mesh: &Mesh) -> (Vec<usize>, Vec<u32>) {
 
 impl Pattern {
     /// Couples every pair of nodes sharing a cell.
-    pub fn new(mesh: &Mesh) -> Pattern {
-        let d = mesh.dim();
-        let npc = mesh.kind.nodes();
-        let nodes = mesh.num_nodes();
+    pub fn new(mesh: &Connectivity) -> Pattern {
+        let d = mesh.dim;
+        let npc = mesh.nodes_per_cell;
+        let nodes = mesh.num_nodes;
         let cells = mesh.num_cells();
         let (inc_ptr, inc) = cells_of_nodes(mesh);
         // Node adjacency, sorted.

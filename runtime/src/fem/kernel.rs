@@ -9,14 +9,12 @@
 use std::fmt;
 use std::sync::Arc;
 
-use crate::element::ElementKind;
-use crate::quadrature::{Rule, simplex_rule};
+use crate::fem::element::ElementKind;
+use crate::fem::quadrature::{Rule, simplex_rule};
 
 /// Element vector: `[node][component]`.
 pub type LocalVector<const D: usize, const N: usize> = [[f64; D]; N];
-/// Element matrix: `[test node][test component][trial node][trial component]`, the same
-/// memory as a row-major (N·D)×(N·D) matrix.
-pub type LocalMatrix<const D: usize, const N: usize> = [[[[f64; D]; N]; D]; N];
+pub use crate::linalg::pattern::LocalMatrix;
 
 /// Basis functions and reference gradients at the points of a quadrature rule.
 #[derive(Clone, Debug)]
@@ -236,71 +234,6 @@ pub fn check_coef(name: &str, coef: &Coef, shape_rank: u32, dim: usize) -> Resul
         )));
     }
     Ok(())
-}
-
-/// A parameter value refused by a generated `Params`.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ParamError {
-    Unknown { name: String, known: &'static [&'static str] },
-    OutOfRange { name: &'static str, value: f64, range: String },
-}
-
-impl fmt::Display for ParamError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ParamError::Unknown { name, known } => {
-                write!(f, "unknown parameter `{name}` (known: {})", known.join(", "))
-            }
-            ParamError::OutOfRange { name, value, range } => {
-                write!(f, "parameter `{name}` = {value} is outside its range {range}")
-            }
-        }
-    }
-}
-
-impl std::error::Error for ParamError {}
-
-/// The declared range of a parameter (unbounded sides are infinite and open).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ParamRange {
-    pub name: &'static str,
-    pub lo: f64,
-    pub lo_closed: bool,
-    pub hi: f64,
-    pub hi_closed: bool,
-}
-
-impl ParamRange {
-    pub fn contains(&self, v: f64) -> bool {
-        let above = if self.lo_closed { v >= self.lo } else { v > self.lo };
-        let below = if self.hi_closed { v <= self.hi } else { v < self.hi };
-        v.is_finite() && above && below
-    }
-}
-
-impl fmt::Display for ParamRange {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let b = |v: f64| {
-            if v.is_infinite() { if v > 0.0 { "inf".to_string() } else { "-inf".to_string() } } else { format!("{v}") }
-        };
-        write!(
-            f,
-            "{}{}, {}{}",
-            if self.lo_closed { "[" } else { "(" },
-            b(self.lo),
-            b(self.hi),
-            if self.hi_closed { "]" } else { ")" }
-        )
-    }
-}
-
-/// Range check used by generated `Params::set`: the value if it lies in the range.
-pub fn check_param(range: &ParamRange, value: f64) -> Result<f64, ParamError> {
-    if range.contains(value) {
-        Ok(value)
-    } else {
-        Err(ParamError::OutOfRange { name: range.name, value, range: range.to_string() })
-    }
 }
 
 /// Static description of a compiled form.

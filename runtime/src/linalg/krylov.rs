@@ -11,7 +11,7 @@
 
 use rayon::prelude::*;
 
-use crate::linalg::{LinalgError, Matrix};
+use crate::linalg::matrix::{LinalgError, Matrix};
 
 /// Relative residual ‖b − A x‖₂ ≤ TOLERANCE ‖b‖₂ at which a solve stops.
 pub const TOLERANCE: f64 = 1e-12;

@@ -15,7 +15,7 @@
 //!
 //!   x₀ = J₀⁻¹ b,  (I + G E) y = x₀[D],  x = x₀ − Z E y.
 //!
-//! * Cholesky reference whose change is given as rank-one terms (`elements`): with E = X S Xᵀ,
+//! * Cholesky reference whose change is given as rank-one terms (`element_matrices`): with E = X S Xᵀ,
 //!   X k×r (each column on one element's dofs) and S = diag(λ), the same correction with
 //!   Ŵ = W X in place of W, S in place of E and the r×r matrix I + XᵀGX S in place of M; r is
 //!   the number of switched quadrature points, about k/2.7 on the disc.
@@ -28,10 +28,11 @@
 use faer::Mat;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 
-use crate::block_factor::SparseColumn;
-use crate::elements::{ChangeSplitter, ElementMatrices, RankOneTerms};
-use crate::linalg::{Factorization, LinalgError, Matrix};
-use crate::pattern::Entries;
+use crate::linalg::block_factor::SparseColumn;
+use crate::linalg::element_matrices::{ChangeSplitter, ElementMatrices, RankOneTerms};
+use crate::linalg::factorization::Factorization;
+use crate::linalg::matrix::{LinalgError, Matrix};
+use crate::linalg::pattern::Entries;
 
 /// The correction of a factored reference J₀ towards the current matrix.
 pub struct LowRank {
@@ -529,7 +530,7 @@ impl LowRank {
                 *vc = (0..k).map(|x| self.e[c * k + x] * rho[x]).sum();
             }
         }
-        crate::newton::norm_inf(&v)
+        crate::linalg::norms::norm_inf(&v)
     }
 }
 
@@ -732,10 +733,10 @@ fn unscatter(w: &SparseColumn, d: usize, x: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::Assembler;
-    use crate::linalg::Structure;
-    use crate::mesh::structured::{Diagonal, cuboid, rectangle};
-    use crate::test_matrices::diagonally_dominant;
+    use crate::fem::assembly::Assembler;
+    use crate::fem::mesh::structured::{Diagonal, cuboid, rectangle};
+    use crate::fem::test_matrices::diagonally_dominant;
+    use crate::linalg::factorization::Structure;
 
     #[test]
     fn dense_columns_hold_each_column_over_the_union_of_their_nodes() {
@@ -886,9 +887,9 @@ mod tests {
                 }
                 let jx = j_times(&x);
                 let residual: Vec<f64> = jx.iter().zip(&b).map(|(p, q)| p - q).collect();
-                let size = crate::newton::norm_inf(&residual);
+                let size = crate::linalg::norms::norm_inf(&residual);
                 let err = residual.iter().zip(&expected).fold(0.0f64, |s, (p, q)| s.max((p - q).abs()));
-                let roundoff = 64.0 * f64::EPSILON * a.norm_inf() * crate::newton::norm_inf(&x);
+                let roundoff = 64.0 * f64::EPSILON * a.norm_inf() * crate::linalg::norms::norm_inf(&x);
                 assert!(size > 1e3 * roundoff, "{n} unknowns: the perturbation shows ({size:.1e})");
                 assert!(
                     err <= roundoff,

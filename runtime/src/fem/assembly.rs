@@ -14,16 +14,16 @@ use std::sync::{Arc, OnceLock};
 
 use rayon::prelude::*;
 
-use crate::element::ElementKind;
-use crate::elements::ElementMatrices;
-use crate::kernel::{
+use crate::fem::element::ElementKind;
+use crate::fem::kernel::{
     CellCtx, FacetCtx, FacetTabulation, Form, FormKernel, FormMeta, FunctionalKernel, LocalMatrix, LocalVector,
     Tabulation,
 };
+use crate::fem::mesh::{Facet, Mesh, MeshError};
+use crate::fem::quadrature::Rule;
 use crate::linalg::Matrix;
-use crate::mesh::{Facet, Mesh, MeshError};
-pub use crate::pattern::Pattern;
-use crate::quadrature::Rule;
+use crate::linalg::element_matrices::ElementMatrices;
+pub use crate::linalg::pattern::Pattern;
 
 /// A kernel usable on every element kind of the catalogue (every generated form is).
 pub trait Kernel:
@@ -91,7 +91,7 @@ pub struct Assembler<'m> {
 
 impl<'m> Assembler<'m> {
     pub fn new(mesh: &'m Mesh) -> Self {
-        Assembler { mesh, pattern: Arc::new(Pattern::new(mesh)), colours: OnceLock::new() }
+        Assembler { mesh, pattern: Arc::new(Pattern::new(&mesh.connectivity())), colours: OnceLock::new() }
     }
 
     /// The cells grouped so that no two cells of a group share a node, each group in
@@ -314,7 +314,7 @@ fn with_refs<const D: usize, const N: usize, R>(
 /// Greedy colouring of the cells: each takes the smallest colour none of the cells sharing one
 /// of its nodes has taken.
 fn colour_cells(mesh: &Mesh) -> Vec<Vec<u32>> {
-    let (inc_ptr, inc) = crate::pattern::cells_of_nodes(mesh);
+    let (inc_ptr, inc) = crate::linalg::pattern::cells_of_nodes(&mesh.connectivity());
     let mut colour = vec![u32::MAX; mesh.num_cells()];
     // taken[k] == c + 1: colour k is used by a neighbour of cell c.
     let mut taken: Vec<usize> = Vec::new();
@@ -633,11 +633,11 @@ fn facet_points<const D: usize, const N: usize, K: FunctionalKernel<D, N>>(
         gather(mesh.cell(c), fields, &mut local);
         let (tab, ref_normal) = &tabs.facets[f.local as usize];
         for (q, one) in single[f.local as usize].iter().enumerate() {
-            let jac = crate::geometry::jacobian(&coords, &tab.dphi[q]);
-            let (normal, scale) = crate::geometry::facet_normal(&jac, ref_normal);
+            let jac = crate::fem::geometry::jacobian(&coords, &tab.dphi[q]);
+            let (normal, scale) = crate::fem::geometry::facet_normal(&jac, ref_normal);
             let ctx = FacetCtx { tab: one, ref_normal, coords: &coords, h: mesh.cell_size(c), t };
             let value = with_refs(&local, |refs| k.facet_value(region, &ctx, refs)) / scale;
-            let x = crate::geometry::interpolate(&coords, &tab.phi[q]);
+            let x = crate::fem::geometry::interpolate(&coords, &tab.phi[q]);
             out.push(PointValue { x: x.to_vec(), normal: normal.to_vec(), weight: tab.weights[q] * scale, value });
         }
     }

@@ -3,7 +3,7 @@
 //! regions: `left`/`right` (x), `bottom`/`top` (y in 2D, z in 3D), `front`/`back` (y in 3D).
 
 use super::{Facet, Mesh, Region};
-use crate::element::ElementKind;
+use crate::fem::element::ElementKind;
 
 /// Which diagonal cuts each square of a rectangle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,6 +1,6 @@
 //! Matrices with known properties on a mesh's pattern, for tests and benchmarks.
 
-use crate::assembly::Assembler;
+use crate::fem::assembly::Assembler;
 use crate::linalg::Matrix;
 
 /// A symmetric, strictly diagonally dominant (so positive definite) matrix on the mesh's

@@ -8,8 +8,8 @@
 //! system A W⁻¹ Aᵀ Λ = b, W weighting each off-diagonal unknown by 2. The result must be
 //! positive definite on the non-contact dofs (checked by Cholesky).
 
+use crate::fem::mesh::Mesh;
 use crate::linalg::{Factorization, LinalgError, Matrix, Structure};
-use crate::mesh::Mesh;
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RedistributionError {

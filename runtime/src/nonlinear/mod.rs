@@ -1,0 +1,4 @@
+//! Nonlinear solves: semi-smooth Newton and the static problems solved with it.
+
+pub mod newton;
+pub mod statics;

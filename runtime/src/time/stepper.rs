@@ -1,0 +1,665 @@
+//! Time schemes compiled from `.wf` files: the static description a generated scheme provides,
+//! and the engine that steps with it.
+//!
+//! Per stage, the compiler has written every term's arguments as `α·w + Σ βₖ·knownₖ` (w the
+//! stage's unknown). The engine precomputes the known parts once per stage, assembles the
+//! constant operator Σ coef·α·K of the linear forms once per time step size, and runs Newton on
+//! the rest (the contact terms), reusing the factorization while the active set is unchanged.
+//!
+//! Newton solves for the increment δ = w − w₀ from a known reference level w₀ (the state the
+//! unknown updates, e.g. u for u'), and every combination is evaluated in increments: the
+//! levels whose coefficients (the unknown's counted at w₀) sum to zero enter as
+//! Σ βₖ·(knownₖ − reference). Such sums are zero in exact arithmetic (a' and v' of a rigid
+//! translation), but not once the coefficients are rounded: TR-BDF2's BDF2 stage writes
+//! a' = 29142·u' + 6036·u − 35178·um + …, whose rounded coefficients sum to 7e-12, a spurious
+//! force proportional to the displacement on every step. The increment form drops that sum
+//! and cancels the large terms before scaling them (see `zero_sum_groups`).
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use signorini_descriptors::{Combination, Level, SchemeDesc, StageDesc};
+
+use crate::fem::assembly::Assembler;
+use crate::fem::bound::BoundForm;
+use crate::linalg::lower_half::{HalfPattern, LowerHalf, MAX_FUSED};
+use crate::linalg::{Matrix, Structure};
+use crate::nonlinear::newton::{Newton, NewtonError, NewtonOptions, NewtonReport};
+use crate::nonlinear::statics::Constraints;
+use crate::time::scheme::{StageView, TimeScheme};
+use crate::time::stage::{
+    ActiveTerm, Linear, NonFiniteTangent, Part, RecordedTangent, StageProblem, Support, SwitchMemo, probe_structure,
+    tangent_support, zero_sum_groups,
+};
+
+#[derive(Debug, thiserror::Error)]
+pub enum StepError {
+    #[error("scheme `{scheme}` applies slot `{form}` ({declared}), which no form file in use provides")]
+    MissingForm { scheme: &'static str, form: String, declared: &'static str },
+    #[error("form `{form}` takes {expected} field(s), but the scheme applies it to {given}")]
+    Arity { form: String, expected: usize, given: usize },
+    #[error(
+        "the solution is no longer finite at t = {t}: the scheme is unstable with these parameters (Nitsche with θ = 1 needs γ0 large enough for coercivity)"
+    )]
+    NonFinite { t: f64 },
+    #[error("stage `{stage}` at t = {t}: {source}")]
+    Newton { stage: &'static str, t: f64, source: NewtonError },
+    #[error(
+        "stage `{stage}` at t = {t}: {at}: its derivative divides by zero there (0/0 where a `pos`/`neg` clips an expression under a `sqrt` or a negative power; `check` warns of it as W0006): write the power directly, `d^(3/2)` rather than `d*sqrt(d)`"
+    )]
+    NonFiniteTangent { stage: &'static str, t: f64, at: NonFiniteTangent },
+    #[error(
+        "stage `{stage}` of scheme `{scheme}` has no displacement quantity (u', um, ...) that depends on its unknown (a nonzero coefficient at this Δt): a moving held displacement cannot be imposed there"
+    )]
+    NoDisplacement { scheme: &'static str, stage: &'static str },
+}
+
+/// Displacements held at values that change with time (a moving Dirichlet condition): the
+/// held dofs (among the constraints' fixed ones) and their values at a time, in that order.
+/// Each stage holds its unknown where its displacement quantity takes the values at the stage's
+/// time, through the stage's own relation (u' = w for most schemes; an acceleration unknown is
+/// solved for from u' = u + Δt v + ... + c a').
+pub struct Prescribed {
+    pub dofs: Vec<usize>,
+    pub values: HeldValues,
+}
+
+/// Writes the held values at a time, in the order of [`Prescribed::dofs`].
+pub type HeldValues = Box<dyn Fn(f64, &mut [f64]) + Send + Sync>;
+
+/// How many load vectors the stepper remembers (a step evaluates loads at two or three times).
+const LOAD_CACHE: usize = 4;
+
+/// Statistics of one step.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct StepReport {
+    /// Newton report per stage.
+    pub stages: Vec<NewtonReport>,
+}
+
+impl StepReport {
+    pub fn iterations(&self) -> usize {
+        self.stages.iter().map(NewtonReport::iterations).sum()
+    }
+}
+
+/// Steps a scheme on a mesh with bound forms.
+pub struct Stepper<'a> {
+    pub scheme: Box<dyn TimeScheme + 'a>,
+    desc: SchemeDesc,
+    asm: &'a Assembler<'a>,
+    forms: HashMap<String, Box<dyn BoundForm + 'a>>,
+    pub constraints: Constraints,
+    /// Extra Dirichlet conditions for the initial problem only (e.g. a⁰ = 0 on massless
+    /// contact dofs after mass redistribution).
+    pub initial_constraints: Option<Constraints>,
+    /// Held displacements that move: see [`Stepper::prescribe`].
+    prescribed: Option<Prescribed>,
+    structure: Structure,
+    pub newton_options: NewtonOptions,
+    /// Per stage: its Newton (keeps its factorization) and the constant operator for `dt`.
+    stages: Vec<StageCache>,
+    /// Linear forms' matrices (assembled once).
+    matrices: HashMap<String, Matrix>,
+    /// The pattern's lower half, when the stage matrices are symmetric.
+    half_pattern: Option<Arc<HalfPattern>>,
+    /// Recently assembled loads, by (form, time).
+    loads: Vec<((&'static str, u64), Vec<f64>)>,
+    coefs: Vec<f64>,
+    /// Vectors of the problem's size no longer in use (states replaced, bases, products), for
+    /// the next step: a step allocates none once the first has run.
+    pool: Pool,
+}
+
+/// Spare vectors, reused.
+#[derive(Default)]
+struct Pool(Vec<Vec<f64>>);
+
+impl Pool {
+    /// A vector of length `n`, contents unspecified.
+    fn take(&mut self, n: usize) -> Vec<f64> {
+        let mut v = self.0.pop().unwrap_or_default();
+        v.resize(n, 0.0);
+        v
+    }
+
+    /// A vector of `n` zeros.
+    fn zeros(&mut self, n: usize) -> Vec<f64> {
+        let mut v = self.take(n);
+        v.fill(0.0);
+        v
+    }
+
+    /// A copy of `x`.
+    fn copy(&mut self, x: &[f64]) -> Vec<f64> {
+        let mut v = self.take(x.len());
+        v.copy_from_slice(x);
+        v
+    }
+
+    fn give(&mut self, v: Vec<f64>) {
+        // Bounded, should a scheme give back more than it takes.
+        if v.capacity() > 0 && self.0.len() < 64 {
+            self.0.push(v);
+        }
+    }
+}
+
+struct StageCache {
+    newton: Newton,
+    dt: f64,
+    constant: Option<Linear>,
+    /// The nonlinear terms' forms, and the entries their tangents add to (None: anywhere).
+    support: Option<(Vec<&'static str>, Option<Support>)>,
+    /// Scratch for the nonlinear terms' tangents: zero outside `support`.
+    scratch: Option<Matrix>,
+    /// The linear terms' forms, and their matrices' lower halves fused for one product (in
+    /// groups of at most [`MAX_FUSED`]), when the matrices are symmetric.
+    linear: Option<(Vec<&'static str>, Vec<LowerHalf>)>,
+    /// The nonlinear terms' arguments and residual, kept from one step to the next.
+    args: Vec<Vec<f64>>,
+    term: Vec<f64>,
+    switches: SwitchMemo,
+    /// The last Jacobian assembly's recorded tangent, its storage kept from one step to the
+    /// next (a new stage problem starts it invalid: its coefficients and times may differ).
+    recorded: RecordedTangent,
+}
+
+impl<'a> Stepper<'a> {
+    /// `forms` binds the form names the scheme uses to bound kernels (a slot may hold any form
+    /// of the right arity: `contact` is Nitsche's or the penalty's). `structure`: Cholesky for
+    /// symmetric positive definite stage Jacobians, LU otherwise.
+    pub fn new(
+        scheme: Box<dyn TimeScheme + 'a>,
+        asm: &'a Assembler<'a>,
+        forms: Vec<(&'static str, Box<dyn BoundForm + 'a>)>,
+        constraints: Constraints,
+        structure: Structure,
+        newton_options: NewtonOptions,
+    ) -> Result<Self, StepError> {
+        let forms: HashMap<String, Box<dyn BoundForm + 'a>> =
+            forms.into_iter().map(|(slot, f)| (slot.to_string(), f)).collect();
+        let desc = *scheme.desc();
+        let all_terms =
+            desc.stages.iter().flat_map(|s| s.terms.iter()).chain(desc.initial.iter().flat_map(|i| i.terms.iter()));
+        for term in all_terms {
+            let form = forms.get(term.form).ok_or_else(|| StepError::MissingForm {
+                scheme: desc.name,
+                form: term.form.to_string(),
+                declared: desc.uses.iter().find(|u| u.name == term.form).map_or("", |u| u.declared),
+            })?;
+            if form.fields() != term.args.len() {
+                return Err(StepError::Arity {
+                    form: term.form.to_string(),
+                    expected: form.fields(),
+                    given: term.args.len(),
+                });
+            }
+        }
+        let mut matrices = HashMap::new();
+        let zero = vec![0.0; asm.size()];
+        for (name, f) in &forms {
+            if f.linear() && f.fields() == 1 {
+                let mut m = asm.zero_matrix();
+                f.tangent(asm, &[&zero], 0, 0.0, &mut m);
+                matrices.insert(name.clone(), m);
+            }
+        }
+        let structure = match structure {
+            Structure::Auto => probe_structure(asm, &forms, &matrices),
+            s => s,
+        };
+        let half_pattern =
+            (structure == Structure::SymmetricPositiveDefinite).then(|| Arc::new(HalfPattern::new(asm.pattern())));
+        let stages = (0..desc.stages.len() + 1)
+            .map(|_| StageCache {
+                newton: Newton::new(newton_options),
+                dt: f64::NAN,
+                constant: None,
+                support: None,
+                scratch: None,
+                linear: None,
+                args: Vec::new(),
+                term: Vec::new(),
+                switches: SwitchMemo::default(),
+                recorded: RecordedTangent::default(),
+            })
+            .collect();
+        Ok(Stepper {
+            scheme,
+            desc,
+            asm,
+            forms,
+            constraints,
+            initial_constraints: None,
+            prescribed: None,
+            structure,
+            newton_options,
+            stages,
+            matrices,
+            half_pattern,
+            loads: Vec::new(),
+            coefs: vec![0.0; desc.coefficients],
+            pool: Pool::default(),
+        })
+    }
+
+    /// The scheme's description (states, stages, slots).
+    /// The lower half of the mesh's pattern (in reverse Cuthill–McKee order) that the stages'
+    /// symmetric matrices are stored on, when they are: for other symmetric products on the
+    /// same pattern.
+    pub fn half_pattern(&self) -> Option<&Arc<HalfPattern>> {
+        self.half_pattern.as_ref()
+    }
+
+    pub fn desc(&self) -> &SchemeDesc {
+        &self.desc
+    }
+
+    /// Factorizations and solves of all stages so far.
+    pub fn counters(&self) -> crate::linalg::Counters {
+        self.stages.iter().map(|s| s.newton.counters()).fold(Default::default(), |a, c| a + c)
+    }
+
+    /// The largest stage's Cholesky factor (stored values), if the stages factor by Cholesky.
+    pub fn factor_nnz(&self) -> Option<usize> {
+        self.stages.iter().filter_map(|s| s.newton.factor_nnz()).max()
+    }
+
+    /// The matrix of a linear one-field form (e.g. `mass`, for energies).
+    pub fn matrix(&self, form: &str) -> Option<&Matrix> {
+        self.matrices.get(form)
+    }
+
+    /// Holds `p.dofs` (fixed in the constraints) at the moving values `p.values`: refused when a
+    /// stage has no displacement quantity depending on its unknown. The initial problem keeps
+    /// its held values (zero: the held motion's acceleration at the start is taken as zero).
+    pub fn prescribe(&mut self, p: Prescribed) -> Result<(), StepError> {
+        for stage in self.desc.stages {
+            if self.displacement(stage).is_none() {
+                return Err(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name });
+            }
+        }
+        self.prescribed = Some(p);
+        Ok(())
+    }
+
+    /// The stage's displacement quantity (named after the first state with a suffix: `u'`,
+    /// `um`) when it depends on the unknown.
+    fn displacement(&self, stage: &StageDesc) -> Option<usize> {
+        let u = self.desc.states.first()?;
+        let q = stage.quantities.iter().position(|q| q.starts_with(u) && q.len() > u.len())?;
+        stage.values.get(q).filter(|c| c.unknown.is_some()).map(|_| q)
+    }
+
+    /// Sets the held values of the stage's unknown so that its displacement quantity takes the
+    /// prescribed values at `time`: w = w₀ + (g − u(w₀)) / c_w, u affine in w.
+    fn hold(
+        &mut self,
+        stage: &StageDesc,
+        reference: Level,
+        states: &[Vec<f64>],
+        quantities: &[Vec<Vec<f64>>],
+        time: f64,
+    ) -> Result<(), StepError> {
+        let Some(p) = &self.prescribed else { return Ok(()) };
+        let q =
+            self.displacement(stage).ok_or(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name })?;
+        let c = &stage.values[q];
+        let cw = c.unknown.map_or(0.0, |k| self.coefs[k]);
+        if cw == 0.0 || !cw.is_finite() {
+            return Err(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name });
+        }
+        let mut g = vec![0.0; p.dofs.len()];
+        (p.values)(time, &mut g);
+        let mut at_reference = vec![0.0; self.asm.size()];
+        self.combine(c, reference, None, states, quantities, &mut at_reference);
+        let w0 = match reference {
+            Level::State(i) => &states[i],
+            Level::Stage(s, k) => &quantities[s][k],
+        };
+        for (&i, gi) in p.dofs.iter().zip(&g) {
+            self.constraints.values[i] = w0[i] + (gi - at_reference[i]) / cw;
+        }
+        Ok(())
+    }
+
+    /// Solves the initial problem (e.g. M a⁰ = L⁰ − B(u⁰)) for its state, if the scheme has one.
+    pub fn initialize(&mut self, states: &mut [Vec<f64>], t: f64) -> Result<Option<NewtonReport>, StepError> {
+        let Some(init) = self.desc.initial else { return Ok(None) };
+        self.scheme.coefficients(1.0, t, &mut self.coefs);
+        let reference = Level::State(init.state);
+        let stage = StageDesc { name: "initial", time: 0, quantities: &[], values: &[], terms: init.terms };
+        let cache = self.stages.len() - 1;
+        let saved = self.initial_constraints.as_ref().map(|c| std::mem::replace(&mut self.constraints, c.clone()));
+        let result = self.solve_stage(&stage, cache, states, &[], reference, 1.0, t);
+        let result = result.map(|(delta, report)| {
+            let mut w: Vec<f64> = states[init.state].iter().zip(&delta).map(|(r, d)| r + d).collect();
+            self.constraints.impose(&mut w);
+            (w, report)
+        });
+        if let Some(c) = saved {
+            self.constraints = c;
+        }
+        let (w, report) = result?;
+        states[init.state] = w;
+        // The stages' Jacobians have the initial problem's pattern: one ordering and symbolic
+        // analysis serves all, and the first stage factors into the initial problem's storage.
+        if let Some((initial, stages)) = self.stages.split_last_mut()
+            && let Some((first, rest)) = stages.split_first_mut()
+        {
+            rest.iter_mut().for_each(|s| s.newton.share_analysis(&initial.newton));
+            first.newton.inherit(&mut initial.newton);
+        }
+        Ok(Some(report))
+    }
+
+    /// Drops the stages' factorizations, constant operators and loads: the next step runs as in
+    /// a new stepper (see [`crate::nonlinear::newton::Newton::forget`]).
+    pub fn forget(&mut self) {
+        for s in &mut self.stages {
+            s.newton.forget();
+            s.constant = None;
+            s.switches = SwitchMemo::default();
+        }
+        self.loads.clear();
+    }
+
+    /// Advances `states` from t to t + dt.
+    pub fn step(&mut self, states: &mut [Vec<f64>], t: f64, dt: f64) -> Result<StepReport, StepError> {
+        self.step_observed(states, t, dt, &mut |_| {})
+    }
+
+    /// As [`Stepper::step`], showing each stage's quantities to `observe` once solved.
+    pub fn step_observed(
+        &mut self,
+        states: &mut [Vec<f64>],
+        t: f64,
+        dt: f64,
+        observe: &mut dyn FnMut(&StageView),
+    ) -> Result<StepReport, StepError> {
+        let desc = self.desc;
+        let n = self.asm.size();
+        self.scheme.coefficients(dt, t, &mut self.coefs);
+        let mut quantities: Vec<Vec<Vec<f64>>> = Vec::with_capacity(desc.stages.len());
+        let mut report = StepReport::default();
+        for (s, stage) in desc.stages.iter().enumerate() {
+            // Newton starts from the state the unknown updates (u for u'), else the first state.
+            let name = stage.quantities[0];
+            let reference =
+                Level::State(desc.states.iter().position(|st| name.trim_end_matches('\'') == *st).unwrap_or(0));
+            if self.prescribed.is_some() {
+                let time = self.coefs.get(stage.time).copied().unwrap_or(t + dt);
+                self.hold(stage, reference, states, &quantities, time)?;
+            }
+            let (delta, r) = self.solve_stage(stage, s, states, &quantities, reference, dt, t)?;
+            report.stages.push(r);
+            let mut values: Vec<Vec<f64>> = Vec::with_capacity(stage.values.len());
+            for c in stage.values {
+                let mut v = self.pool.take(n);
+                self.combine(c, reference, Some(&delta), states, &quantities, &mut v);
+                values.push(v);
+            }
+            self.pool.give(delta);
+            let time = self.coefs.get(stage.time).copied().unwrap_or(t + dt);
+            observe(&StageView { name: stage.name, time, quantities: stage.quantities, values: &values });
+            quantities.push(values);
+        }
+        // A stage quantity that becomes one state only is moved there, not copied.
+        let uses = |level: &Level| desc.updates.iter().filter(|l| *l == level).count();
+        let new_states: Vec<Vec<f64>> = desc
+            .updates
+            .iter()
+            .map(|l| match *l {
+                Level::State(i) => self.pool.copy(&states[i]),
+                Level::Stage(s, q) if uses(l) == 1 => std::mem::take(&mut quantities[s][q]),
+                Level::Stage(s, q) => self.pool.copy(&quantities[s][q]),
+            })
+            .collect();
+        if new_states.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(StepError::NonFinite { t: t + dt });
+        }
+        for (st, v) in states.iter_mut().zip(new_states) {
+            self.pool.give(std::mem::replace(st, v));
+        }
+        quantities.into_iter().flatten().for_each(|v| self.pool.give(v));
+        Ok(report)
+    }
+
+    /// `c_w·w + Σ c·level` with the unknown w = reference + δ (δ = 0 if `delta` is `None`):
+    /// `c_w·δ`, plus the levels (the reference with c_w added to its coefficient) grouped by
+    /// [`zero_sum_groups`], each group as Σ c·(level − its reference level), each other level as
+    /// c·level.
+    fn combine(
+        &self,
+        c: &Combination,
+        reference: Level,
+        delta: Option<&[f64]>,
+        states: &[Vec<f64>],
+        quantities: &[Vec<Vec<f64>>],
+        out: &mut [f64],
+    ) {
+        let level = |l: Level| -> &[f64] {
+            match l {
+                Level::State(i) => &states[i],
+                Level::Stage(s, q) => &quantities[s][q],
+            }
+        };
+        let mut terms: Vec<(Level, f64)> = Vec::with_capacity(c.known.len() + 1);
+        let mut add = |l: Level, a: f64| match terms.iter_mut().find(|(m, _)| *m == l) {
+            Some((_, b)) => *b += a,
+            None => terms.push((l, a)),
+        };
+        // The sum's parts in order: out += a·x, or out += a·(x − y).
+        let mut parts: Vec<Part> = Vec::new();
+        if let Some(k) = c.unknown {
+            let a = self.coefs[k];
+            if let Some(d) = delta {
+                parts.push((a, d, None));
+            }
+            add(reference, a);
+        }
+        for &(l, k) in c.known {
+            add(l, self.coefs[k]);
+        }
+        terms.retain(|(_, a)| *a != 0.0);
+        let coefs: Vec<f64> = terms.iter().map(|(_, a)| *a).collect();
+        for group in zero_sum_groups(&coefs) {
+            if group.len() == 1 {
+                let (l, a) = terms[group[0]];
+                parts.push((a, level(l), None));
+                continue;
+            }
+            let r = group.iter().copied().find(|&i| terms[i].0 == reference).unwrap_or(group[0]);
+            let x0 = level(terms[r].0);
+            for &i in group.iter().filter(|&&i| i != r) {
+                let (l, a) = terms[i];
+                parts.push((a, level(l), Some(x0)));
+            }
+        }
+        // Strip by strip, each part in turn: one pass over memory, the same sums as part by part.
+        const STRIP: usize = 512;
+        for (k, o) in out.chunks_mut(STRIP).enumerate() {
+            let range = k * STRIP..k * STRIP + o.len();
+            o.fill(0.0);
+            for &(a, x, y) in &parts {
+                match y {
+                    None => o.iter_mut().zip(&x[range.clone()]).for_each(|(o, x)| *o += a * x),
+                    Some(y) => o
+                        .iter_mut()
+                        .zip(&x[range.clone()])
+                        .zip(&y[range.clone()])
+                        .for_each(|((o, x), y)| *o += a * (x - y)),
+                }
+            }
+        }
+    }
+
+    /// Adds Σ coef·K·base over a stage's linear terms (forms, coefficients, bases) to `rhs`:
+    /// one pass over the matrices' fused lower halves when they are symmetric.
+    fn add_linear(
+        &mut self,
+        cache: usize,
+        (forms, coefs, bases): &(Vec<&'static str>, Vec<f64>, Vec<Vec<f64>>),
+        rhs: &mut [f64],
+    ) {
+        if forms.is_empty() {
+            return;
+        }
+        let mut product = self.pool.take(rhs.len());
+        let Some(half) = self.half_pattern.as_ref() else {
+            for ((form, coef), base) in forms.iter().zip(coefs).zip(bases) {
+                self.matrices[*form].mul_vec(base, &mut product);
+                rhs.iter_mut().zip(&product).for_each(|(r, x)| *r += coef * x);
+            }
+            self.pool.give(product);
+            return;
+        };
+        let entry = &mut self.stages[cache];
+        if entry.linear.as_ref().is_none_or(|(cached, _)| cached != forms) {
+            let matrices: Vec<&Matrix> = forms.iter().map(|f| &self.matrices[*f]).collect();
+            let groups = matrices.chunks(MAX_FUSED).map(|g| LowerHalf::fused(g, half)).collect();
+            entry.linear = Some((forms.clone(), groups));
+        }
+        let (_, groups) = entry.linear.as_ref().expect("built above");
+        let terms: Vec<(f64, &[f64])> = coefs.iter().zip(bases).map(|(c, b)| (*c, b.as_slice())).collect();
+        for (group, terms) in groups.iter().zip(terms.chunks(MAX_FUSED)) {
+            group.mul_sum(terms, &mut product);
+            rhs.iter_mut().zip(&product).for_each(|(r, x)| *r += x);
+        }
+        self.pool.give(product);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn solve_stage(
+        &mut self,
+        stage: &StageDesc,
+        cache: usize,
+        states: &[Vec<f64>],
+        quantities: &[Vec<Vec<f64>>],
+        reference: Level,
+        dt: f64,
+        t: f64,
+    ) -> Result<(Vec<f64>, NewtonReport), StepError> {
+        let n = self.asm.size();
+        let stage_t = self.coefs.get(stage.time).copied().filter(|_| !stage.quantities.is_empty()).unwrap_or(t);
+        // Known parts of every argument, and the constant part of the residual.
+        let mut constant_rhs = self.pool.zeros(n);
+        let mut nonlinear: Vec<ActiveTerm> = Vec::new();
+        // Linear terms coef·K·(α w + base): their forms, coefficients and bases.
+        let mut linear: (Vec<&'static str>, Vec<f64>, Vec<Vec<f64>>) = Default::default();
+        let rebuild = self.stages[cache].dt != dt || self.stages[cache].constant.is_none();
+        let mut constant = if rebuild { Some(self.asm.zero_matrix()) } else { None };
+        for term in stage.terms {
+            let coef = self.coefs[term.coef];
+            let form = &self.forms[term.form];
+            let term_t = self.coefs[term.time];
+            if term.args.is_empty() {
+                // Loads depend on time only: the one at t + dt this step is the one at t next step,
+                // and a steady one is the same at every time.
+                let key = (term.form, if form.time_dependent() { term_t.to_bits() } else { u64::MAX });
+                let b = match self.loads.iter().position(|(k, _)| *k == key) {
+                    Some(i) => &self.loads[i].1,
+                    None => {
+                        let mut b = vec![0.0; n];
+                        form.residual(self.asm, &[], term_t, &mut b);
+                        if self.loads.len() == LOAD_CACHE {
+                            self.loads.remove(0);
+                        }
+                        self.loads.push((key, b));
+                        &self.loads.last().expect("just pushed").1
+                    }
+                };
+                constant_rhs.iter_mut().zip(b).for_each(|(r, x)| *r += coef * x);
+                continue;
+            }
+            let mut bases: Vec<Vec<f64>> = Vec::with_capacity(term.args.len());
+            for c in term.args {
+                let mut b = self.pool.take(n);
+                self.combine(c, reference, None, states, quantities, &mut b);
+                bases.push(b);
+            }
+            let alphas: Vec<f64> = term.args.iter().map(|c| c.unknown.map_or(0.0, |k| self.coefs[k])).collect();
+            match self.matrices.get(term.form) {
+                Some(k) if alphas.len() == 1 => {
+                    if let Some(c) = constant.as_mut() {
+                        c.add_scaled(coef * alphas[0], k);
+                    }
+                    linear.0.push(term.form);
+                    linear.1.push(coef);
+                    linear.2.extend(bases);
+                }
+                _ if alphas.iter().all(|a| *a == 0.0) => {
+                    let refs: Vec<&[f64]> = bases.iter().map(Vec::as_slice).collect();
+                    let mut b = self.pool.zeros(n);
+                    form.residual(self.asm, &refs, term_t, &mut b);
+                    constant_rhs.iter_mut().zip(&b).for_each(|(r, x)| *r += coef * x);
+                    self.pool.give(b);
+                    bases.into_iter().for_each(|b| self.pool.give(b));
+                }
+                _ => nonlinear.push(ActiveTerm { form: term.form, coef, alphas, bases, t: term_t }),
+            }
+        }
+        self.add_linear(cache, &linear, &mut constant_rhs);
+        linear.2.into_iter().for_each(|b| self.pool.give(b));
+        if let Some(c) = constant {
+            let entry = &mut self.stages[cache];
+            entry.constant = Some(Linear::new(c, self.half_pattern.as_ref()));
+            entry.dt = dt;
+            entry.newton.invalidate();
+        }
+        let piecewise = nonlinear.iter().all(|a| self.forms[a.form].piecewise());
+        let StageCache { newton, constant, support, scratch, args, term, switches, recorded, .. } =
+            &mut self.stages[cache];
+        // The same forms at every step in practice; should they change, so may the entries where
+        // J varies, and the references compared there only are dropped.
+        if support.as_ref().is_none_or(|(forms, _)| !forms.iter().eq(nonlinear.iter().map(|a| &a.form))) {
+            let forms = nonlinear.iter().map(|a| a.form).collect();
+            *support = Some((forms, tangent_support(self.asm, &self.forms, &nonlinear)));
+            *scratch = None;
+            newton.invalidate();
+        }
+        let support = support.as_ref().and_then(|(_, s)| s.as_ref());
+        let mut problem = StageProblem {
+            asm: self.asm,
+            forms: &self.forms,
+            constant: constant.as_ref().expect("built above"),
+            rhs: constant_rhs,
+            terms: nonlinear,
+            constraints: &self.constraints,
+            structure: self.structure,
+            piecewise,
+            support,
+            scratch,
+            args: std::mem::take(args),
+            term: std::mem::take(term),
+            switches,
+            magnitude: 0.0,
+            recorded: RecordedTangent { valid: false, ..std::mem::take(recorded) },
+            non_finite: None,
+        };
+        // δ = w − reference, with the constrained values of w imposed: zero but on those.
+        let w0 = match reference {
+            Level::State(i) => &states[i],
+            Level::Stage(s, q) => &quantities[s][q],
+        };
+        let mut delta = self.pool.zeros(n);
+        let Constraints { fixed, values } = &self.constraints;
+        for (i, _) in fixed.iter().enumerate().filter(|(_, f)| **f) {
+            delta[i] = values[i] - w0[i];
+        }
+        let report = newton.solve(&mut problem, &mut delta);
+        // A NaN or infinite tangent (0/0 in a law's derivative) is said as such, not as the
+        // singular matrix it makes.
+        if report.is_err()
+            && let Some(at) = problem.non_finite.take()
+        {
+            return Err(StepError::NonFiniteTangent { stage: stage.name, t: stage_t, at });
+        }
+        (*args, *term, *recorded) = (problem.args, problem.term, problem.recorded);
+        self.pool.give(problem.rhs);
+        problem.terms.into_iter().flat_map(|t| t.bases).for_each(|b| self.pool.give(b));
+        let report = report.map_err(|source| StepError::Newton { stage: stage.name, t: stage_t, source })?;
+        Ok((delta, report))
+    }
+}
