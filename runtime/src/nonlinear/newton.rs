@@ -22,9 +22,9 @@ use tracing::debug;
 use crate::linalg::norms::norm_inf;
 
 use crate::linalg::element_matrices::ElementMatrices;
-use crate::linalg::lowrank::LowRank;
 use crate::linalg::pattern::Entries;
 use crate::linalg::{Factorization, LinalgError, Matrix, Solver, Structure};
+use crate::nonlinear::reuse::JacobianReuse;
 
 /// A residual at most this times its terms' magnitude is round-off (a few hundred roundings).
 pub const ROUNDOFF: f64 = 512.0 * f64::EPSILON;
@@ -114,13 +114,6 @@ pub struct NewtonOptions {
 /// Default `max_rank`.
 pub const MAX_RANK: usize = 1024;
 
-/// The cached columns of a correction (8·n bytes each) take at most this much memory.
-const COLUMN_BYTES: usize = 256 << 20;
-
-/// The previous reference factorization is kept (for an active set that comes back, such as
-/// no contact between bounces) while its factor takes at most this many bytes.
-const KEEP_BYTES: usize = 512 << 20;
-
 impl Default for NewtonOptions {
     fn default() -> Self {
         NewtonOptions { tol: 1e-10, max_iterations: 25, line_search: false, solver: Solver::Auto, max_rank: MAX_RANK }
@@ -168,36 +161,8 @@ pub enum NewtonError {
 /// Newton's method with a reusable factorization.
 pub struct Newton {
     pub options: NewtonOptions,
-    factorization: Option<Factorization>,
-    /// With `Structure::Auto`: the factorization of the other structure, kept for its symbolic
-    /// analysis, and whether Cholesky has failed (then LU from there on).
-    spare: Option<Factorization>,
-    spd_failed: bool,
-    jacobian: Option<Matrix>,
-    /// `jacobian` was last written by the problem, which has not changed since.
-    jacobian_current: bool,
-    /// The active set the current operator (factorization and correction) was built for.
-    factored_for: Option<Vec<bool>>,
-    /// The correction of the factorization towards the current Jacobian (direct solver,
-    /// piecewise problems), and how many corrections were made.
-    low_rank: Option<LowRank>,
-    updates: usize,
-    /// Σ over solves of the correction's size since the last factorization, and whether it
-    /// has grown past the cost of refactoring.
-    overhead: usize,
-    force_refactor: bool,
-    /// The reference before the last refactorization, with its correction.
-    previous: Option<Reference>,
-    /// Counters of factorizations no longer kept.
-    retired: crate::linalg::Counters,
-    /// ‖J‖∞ of the current operator, for the round-off of its solves, and their relative
-    /// accuracy once its first solve has been checked.
-    jacobian_norm: f64,
-    solve_accuracy: Option<f64>,
-    /// ‖J₀‖∞ of the factored reference (a bound on ‖J‖∞ is this plus the correction's), and
-    /// the relative accuracy its solves are trusted to, once its first solve was checked.
-    reference_norm: f64,
-    reference_accuracy: Option<f64>,
+    /// The factored operator and when it is reused, corrected or refactored.
+    reuse: JacobianReuse,
     scratch: Scratch,
 }
 
@@ -212,160 +177,44 @@ struct Scratch {
     after: Vec<bool>,
 }
 
-/// A factored Jacobian, its correction towards the current one, and the correction's cost so far.
-struct Reference {
-    factorization: Option<Factorization>,
-    low_rank: Option<LowRank>,
-    overhead: usize,
-    /// ‖J₀‖∞ and its solves' trusted accuracy.
-    norm: f64,
-    accuracy: Option<f64>,
-}
-
 impl Newton {
     pub fn new(options: NewtonOptions) -> Self {
-        Newton {
-            options,
-            factorization: None,
-            spare: None,
-            spd_failed: false,
-            jacobian: None,
-            jacobian_current: false,
-            factored_for: None,
-            low_rank: None,
-            updates: 0,
-            overhead: 0,
-            force_refactor: false,
-            previous: None,
-            retired: Default::default(),
-            jacobian_norm: f64::INFINITY,
-            solve_accuracy: None,
-            reference_norm: f64::INFINITY,
-            reference_accuracy: None,
-            scratch: Scratch::default(),
-        }
+        Newton { options, reuse: JacobianReuse::default(), scratch: Scratch::default() }
     }
 
     /// Starts from `other`'s symbolic analysis and takes its factor's storage, if this Newton
     /// has no factorization and the other has one (a scheme's initial problem, solved once, and
     /// its first stage); `other` is left to refactor at its next solve.
     pub fn inherit(&mut self, other: &mut Newton) {
-        if self.factorization.is_none()
-            && let Some(f) = other.factorization.as_mut()
-        {
-            self.factorization = Some(f.fork_with_storage());
-            other.invalidate();
-        }
+        self.reuse.inherit(&mut other.reuse);
     }
 
     /// Starts from `other`'s symbolic analysis, if this Newton has none and the other has one
     /// (a problem with the same Jacobian pattern: a scheme's initial problem and its stages).
     pub fn share_analysis(&mut self, other: &Newton) {
-        if self.factorization.is_none() {
-            self.factorization = other.factorization.as_ref().map(Factorization::fork);
-        }
+        self.reuse.share_analysis(&other.reuse);
     }
 
     /// Forgets the factorization's validity (the linear part of the problem changed).
     pub fn invalidate(&mut self) {
-        self.factored_for = None;
-        self.jacobian_current = false;
-        self.solve_accuracy = None;
-        self.reference_accuracy = None;
-        self.low_rank = None;
-        self.overhead = 0;
-        self.force_refactor = false;
-        self.retire_previous();
+        self.reuse.invalidate();
     }
 
     /// Drops every factorization and correction (their counters are kept): the next solve
     /// runs exactly as a new `Newton`'s would. Checkpoints use it, so that a resumed run and an
     /// uninterrupted one follow the same factorizations and agree bit for bit.
     pub fn forget(&mut self) {
-        self.invalidate();
-        for f in [self.factorization.take(), self.spare.take()].into_iter().flatten() {
-            self.retired = self.retired + f.counters;
-        }
-        self.spd_failed = false;
-        self.jacobian = None;
-    }
-
-    fn retire_previous(&mut self) {
-        if let Some(f) = self.previous.take().and_then(|r| r.factorization) {
-            self.retired = self.retired + f.counters;
-        }
-    }
-
-    /// Exchanges the current reference with the previous one.
-    fn swap_references(&mut self) {
-        if let Some(prev) = self.previous.as_mut() {
-            std::mem::swap(&mut self.factorization, &mut prev.factorization);
-            std::mem::swap(&mut self.low_rank, &mut prev.low_rank);
-            std::mem::swap(&mut self.overhead, &mut prev.overhead);
-            std::mem::swap(&mut self.reference_norm, &mut prev.norm);
-            std::mem::swap(&mut self.reference_accuracy, &mut prev.accuracy);
-        }
-    }
-
-    /// The factor's mean column count c = nnz(L)/n. A solve pair reads 2·n·c values and a
-    /// factorization does about n·c² flops (c/2 solve pairs' worth). A correction reads
-    /// `LowRank::entries` more values per solve (k·n for k dense columns; with the factor in node
-    /// blocks, the columns of W = L⁻¹U are sparse, about 0.07·n each on the disc): it is
-    /// accepted while it reads at most what the factor does (k ≲ c for dense columns), while its
-    /// k×k system costs no more than a factorization (k³ ≲ n·c²), and until the corrections
-    /// since the factorization have read c/2 solve pairs' worth (Σ entries ≈ n·c²).
-    fn mean_column_count(&self, n: usize) -> Option<usize> {
-        let nnz = self.factorization.as_ref().and_then(Factorization::factor_nnz)?;
-        Some(nnz / n.max(1))
-    }
-
-    /// Largest correction size accepted instead of a refactorization.
-    fn rank_limit(&self, n: usize) -> usize {
-        let c = self.mean_column_count(n).unwrap_or(0).max(32);
-        let sparse = self.factorization.as_ref().is_some_and(|f| f.block().is_some());
-        let k = if sparse { ((n * c * c) as f64).cbrt() as usize } else { c };
-        self.options.max_rank.min(k).min(self.column_limit(n))
-    }
-
-    /// Values a correction may read per solve.
-    fn entries_limit(&self, n: usize) -> usize {
-        self.mean_column_count(n).unwrap_or(0).max(32) * n
-    }
-
-    /// Columns the corrections may cache in all (current and previous reference).
-    fn column_limit(&self, n: usize) -> usize {
-        COLUMN_BYTES / (8 * n.max(1))
-    }
-
-    /// Columns cached by both references' corrections.
-    fn cached_columns(&self) -> usize {
-        let current = self.low_rank.as_ref().map_or(0, LowRank::cached);
-        current + self.previous.as_ref().and_then(|r| r.low_rank.as_ref()).map_or(0, LowRank::cached)
-    }
-
-    /// Σ of values read by corrections over solves after which the reference is refactored:
-    /// with dense columns, what a refactorization costs. Sparse columns are never refactored
-    /// away: their cost per solve is bounded by `entries_limit` and `rank_limit`, and a
-    /// reference refactored at one contact state is as far from the next (bench disc).
-    fn overhead_budget(&self, n: usize) -> usize {
-        if self.factorization.as_ref().is_some_and(|f| f.block().is_some()) {
-            return usize::MAX;
-        }
-        self.mean_column_count(n).unwrap_or(0).max(32).pow(2) * n
+        self.reuse.forget();
     }
 
     /// Stored values of the current Cholesky factor, if there is one.
     pub fn factor_nnz(&self) -> Option<usize> {
-        self.factorization.as_ref().and_then(Factorization::factor_nnz)
+        self.reuse.factor_nnz()
     }
 
     /// Symbolic and numeric factorizations, low-rank corrections and solves so far.
     pub fn counters(&self) -> crate::linalg::Counters {
-        let c = |f: &Option<Factorization>| f.as_ref().map(|f| f.counters).unwrap_or_default();
-        let previous = self.previous.as_ref().map(|r| c(&r.factorization)).unwrap_or_default();
-        let mut all = c(&self.factorization) + c(&self.spare) + previous + self.retired;
-        all.updates = self.updates;
-        all
+        self.reuse.counters()
     }
 
     /// Solves R(w) = 0 starting from `w`, which holds the solution on success.
@@ -422,32 +271,34 @@ impl Newton {
             }
             known = false;
             let active = set.iter().filter(|b| **b).count();
-            let changed = !piecewise || self.force_refactor || self.factored_for.as_deref() != Some(set.as_slice());
+            let changed =
+                !piecewise || self.reuse.force_refactor || self.reuse.factored_for.as_deref() != Some(set.as_slice());
             let (mut refactor, mut updated) = (false, false);
             if changed {
-                self.factored_for = None;
-                match self.new_operator(p, w, piecewise) {
+                self.reuse.factored_for = None;
+                match self.reuse.new_operator(p, w, piecewise, &self.options) {
                     Ok(full) => (refactor, updated) = (full, !full),
                     Err(source) => return Err(NewtonError::Linear { source, report }),
                 }
-                self.factored_for = piecewise.then(|| set.clone());
-                self.jacobian_norm = match (updated, &self.low_rank) {
-                    (true, Some(lr)) => self.reference_norm + lr.change_norm(),
+                self.reuse.factored_for = piecewise.then(|| set.clone());
+                self.reuse.jacobian_norm = match (updated, &self.reuse.low_rank) {
+                    (true, Some(lr)) => self.reuse.reference_norm + lr.change_norm(),
                     _ => {
-                        self.reference_norm = self.jacobian.as_ref().map_or(f64::INFINITY, Matrix::norm_inf);
-                        self.reference_norm
+                        self.reuse.reference_norm =
+                            self.reuse.jacobian.as_ref().map_or(f64::INFINITY, Matrix::norm_inf);
+                        self.reuse.reference_norm
                     }
                 };
-                self.solve_accuracy = None;
+                self.reuse.solve_accuracy = None;
             }
             delta.iter_mut().zip(r.iter()).for_each(|(d, ri)| *d = -ri);
-            let trusted = if piecewise && !self.options.line_search { self.solve_accuracy } else { None };
+            let trusted = if piecewise && !self.options.line_search { self.reuse.solve_accuracy } else { None };
             // A correction of a reference whose solves are trusted reports the residual it
             // leaves itself (`LowRank::solve`): its first solve needs no product J δ then.
             let defect =
-                trusted.is_none() && piecewise && !self.options.line_search && self.reference_accuracy.is_some();
-            let f = self.factorization.as_mut().expect("factored above");
-            let solved = match &self.low_rank {
+                trusted.is_none() && piecewise && !self.options.line_search && self.reuse.reference_accuracy.is_some();
+            let f = self.reuse.factorization.as_mut().expect("factored above");
+            let solved = match &self.reuse.low_rank {
                 Some(lr) => lr.solve(f, delta, defect),
                 None => f.solve_in_place(delta).map(|()| None),
             };
@@ -455,9 +306,9 @@ impl Newton {
                 Ok(defect) => defect,
                 Err(source) => return Err(NewtonError::Linear { source, report }),
             };
-            if let Some(lr) = &self.low_rank {
-                self.overhead = self.overhead.saturating_add(lr.entries());
-                self.force_refactor = self.overhead > self.overhead_budget(n);
+            if let Some(lr) = &self.reuse.low_rank {
+                self.reuse.overhead = self.reuse.overhead.saturating_add(lr.entries());
+                self.reuse.force_refactor = self.reuse.overhead > self.reuse.overhead_budget(n);
             }
             // A direct solve is backward stable unless the operator is numerically singular or
             // its correction ill-conditioned: the first solve with a new operator is checked
@@ -466,10 +317,12 @@ impl Newton {
             // corrected operator's first solve is estimated instead, when its reference's solves
             // are trusted: their accuracy plus the correction's own residual, if that is small.
             // (`norm_r` is ‖r‖∞ here: the loop goes on only after a step that evaluated r.)
-            let estimate =
-                defect.zip(self.reference_accuracy).map(|(d, a)| a + d / norm_r).filter(|e| *e <= TRUSTED_ACCURACY);
+            let estimate = defect
+                .zip(self.reuse.reference_accuracy)
+                .map(|(d, a)| a + d / norm_r)
+                .filter(|e| *e <= TRUSTED_ACCURACY);
             let checked = trusted.is_none() && estimate.is_none();
-            let j = self.jacobian.as_ref().expect("assembled above");
+            let j = self.reuse.jacobian.as_ref().expect("assembled above");
             let linear = if let Some(e) = estimate {
                 e
             } else if !checked {
@@ -494,12 +347,12 @@ impl Newton {
                 jd.iter().zip(r.iter()).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_r
             };
             if linear.is_nan() || linear > LINEAR_TOLERANCE {
-                if self.low_rank.as_ref().is_some_and(|lr| lr.rank() > 0) {
+                if self.reuse.low_rank.as_ref().is_some_and(|lr| lr.rank() > 0) {
                     // An ill-conditioned correction: refactor at this iterate and retry.
                     debug!(linear_residual = linear, "low-rank correction inaccurate: refactoring");
-                    self.force_refactor = true;
-                    self.factored_for = None;
-                    self.solve_accuracy = None;
+                    self.reuse.force_refactor = true;
+                    self.reuse.factored_for = None;
+                    self.reuse.solve_accuracy = None;
                     continue;
                 }
                 let source = LinalgError::Singular { index: None };
@@ -510,13 +363,13 @@ impl Newton {
             // ill-conditioned one (a huge penalty or Nitsche parameter) is checked at every solve.
             if trusted.is_none()
                 && linear <= TRUSTED_ACCURACY
-                && self.factorization.as_ref().is_some_and(Factorization::is_direct)
+                && self.reuse.factorization.as_ref().is_some_and(Factorization::is_direct)
             {
-                self.solve_accuracy = Some(10.0 * linear);
+                self.reuse.solve_accuracy = Some(10.0 * linear);
                 // A new factorization's first solve, checked: the reference its corrections
                 // are estimated from.
                 if refactor && checked {
-                    self.reference_accuracy = self.solve_accuracy;
+                    self.reuse.reference_accuracy = self.reuse.solve_accuracy;
                 }
             }
             // The relative accuracy of this solve, where it is not measured by a product.
@@ -531,7 +384,7 @@ impl Newton {
                 // After a trusted or estimated solve R there is the solve's error: its relative
                 // accuracy times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
                 let norm_delta = norm_inf(delta);
-                let bound = accuracy.map(|a| a * norm_r + ROUNDOFF * self.jacobian_norm * norm_delta + carried);
+                let bound = accuracy.map(|a| a * norm_r + ROUNDOFF * self.reuse.jacobian_norm * norm_delta + carried);
                 let estimated = kept && bound.is_some_and(|b| b <= threshold);
                 if estimated {
                     res = bound.expect("trusted");
@@ -578,142 +431,6 @@ impl Newton {
             }
         }
         Ok(report)
-    }
-
-    /// Makes the operator the Jacobian at w: a low-rank correction of the factored reference
-    /// when the problem is piecewise, the factorization direct and the change small enough,
-    /// else a refactorization (which becomes the new reference). Returns whether it refactored.
-    fn new_operator(&mut self, p: &mut impl NonlinearProblem, w: &[f64], piecewise: bool) -> Result<bool, LinalgError> {
-        let mut assembled = false;
-        if piecewise && !self.force_refactor && self.low_rank.is_some() {
-            assembled = true;
-            let mut j = self.jacobian.take().expect("assembled with the reference");
-            Self::assemble(p, w, &mut j, self.jacobian_current);
-            self.jacobian_current = true;
-            let entries = p.varying_entries();
-            let mut dofs = self.low_rank.as_ref().map(|lr| lr.changed_dofs(&j, entries)).unwrap_or_default();
-            // The previous reference, if the active set has come back near it.
-            let budget = self.overhead_budget(j.size());
-            if let Some(other) = self
-                .previous
-                .as_ref()
-                .filter(|r| r.overhead <= budget)
-                .and_then(|r| r.low_rank.as_ref())
-                .map(|lr| lr.changed_dofs(&j, entries))
-                && other.len() < dofs.len()
-            {
-                self.swap_references();
-                dofs = other;
-            }
-            let new_columns = self.low_rank.as_ref().map_or(0, |lr| lr.missing(&dofs));
-            let updated = dofs.len() <= self.rank_limit(j.size())
-                && self.cached_columns() + new_columns <= self.column_limit(j.size())
-                && match (self.low_rank.as_mut(), self.factorization.as_mut()) {
-                    (Some(lr), Some(f)) => {
-                        let elements = if lr.has_elements() { p.tangent_elements(w) } else { None };
-                        lr.update(&j, dofs, f, elements.as_ref()).is_ok()
-                            && lr.entries() <= self.entries_limit(j.size())
-                    }
-                    _ => false,
-                };
-            self.jacobian = Some(j);
-            if updated {
-                let lr = self.low_rank.as_ref().expect("updated");
-                debug!(rank = lr.rank(), entries = lr.entries(), cached = lr.cached(), "low-rank update");
-                self.updates += 1;
-                return Ok(false);
-            }
-        }
-        self.force_refactor = false;
-        // The factored reference becomes the previous one, if it is worth keeping; the new
-        // factorization shares its symbolic analysis.
-        let keep = piecewise
-            && self.low_rank.is_some()
-            && self.factorization.as_ref().and_then(Factorization::factor_nnz).is_some_and(|nnz| 8 * nnz <= KEEP_BYTES);
-        if keep && let Some(f) = self.factorization.as_ref() {
-            let fork = f.fork();
-            self.retire_previous();
-            let old = self.factorization.replace(fork);
-            self.previous = Some(Reference {
-                factorization: old,
-                low_rank: self.low_rank.take(),
-                overhead: self.overhead,
-                norm: self.reference_norm,
-                accuracy: self.reference_accuracy,
-            });
-        }
-        self.low_rank = None;
-        self.overhead = 0;
-        self.reference_accuracy = None;
-        self.refactor(p, w, assembled)?;
-        let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
-        if piecewise && direct && self.options.max_rank > 0 {
-            let mut lr = LowRank::new(self.jacobian.as_ref().expect("assembled by refactor"));
-            lr.set_elements(p.tangent_elements(w));
-            self.low_rank = Some(lr);
-        }
-        Ok(true)
-    }
-
-    /// Assembles and factors the Jacobian at w; a failed Cholesky falls back to LU.
-    /// `assembled`: the Jacobian at w is already in place (from a low-rank attempt).
-    fn refactor(&mut self, p: &mut impl NonlinearProblem, w: &[f64], assembled: bool) -> Result<(), LinalgError> {
-        let current = self.jacobian.is_some() && self.jacobian_current;
-        let j = self.jacobian.get_or_insert_with(|| p.jacobian_matrix());
-        if !assembled {
-            Self::assemble(p, w, j, current);
-        }
-        self.jacobian_current = true;
-        let want = match p.structure() {
-            Structure::Auto if self.spd_failed || !j.is_symmetric(1e-12) => Structure::General,
-            Structure::Auto => Structure::SymmetricPositiveDefinite,
-            s => s,
-        };
-        if self.factorization.as_ref().is_some_and(|f| f.structure() != want) {
-            std::mem::swap(&mut self.factorization, &mut self.spare);
-        }
-        let f = match &mut self.factorization {
-            Some(f) if f.structure() == want => f,
-            slot => {
-                let old = slot.replace(Factorization::new(want).with_solver(self.options.solver));
-                if let Some(old) = old
-                    && let Some(replaced) = self.spare.replace(old)
-                {
-                    self.retired = self.retired + replaced.counters;
-                }
-                slot.as_mut().expect("just set")
-            }
-        };
-        match f.factor(j) {
-            Err(LinalgError::NotPositiveDefinite { .. }) if f.structure() == Structure::SymmetricPositiveDefinite => {
-                debug!("Jacobian not positive definite: switching to LU");
-                self.spd_failed = true;
-                let counters = f.counters;
-                let mut lu = Factorization::new(Structure::General).with_solver(self.options.solver);
-                lu.counters = counters;
-                lu.factor(j)?;
-                *f = lu;
-                Ok(())
-            }
-            other => other,
-        }
-    }
-
-    /// Writes the Jacobian at w into `j`: only what can differ if `current` (j holds the
-    /// problem's last Jacobian) and the problem can, else from zero.
-    fn assemble(p: &mut impl NonlinearProblem, w: &[f64], j: &mut Matrix, current: bool) {
-        if current && p.update_jacobian(w, j) {
-            // Test builds check the update against the whole assembly, bit for bit.
-            if cfg!(debug_assertions) {
-                let mut whole = p.jacobian_matrix();
-                p.jacobian(w, &mut whole);
-                let same = whole.values.iter().zip(&j.values).all(|(a, b)| a.to_bits() == b.to_bits());
-                assert!(same, "update_jacobian differs from jacobian");
-            }
-            return;
-        }
-        j.values.iter_mut().for_each(|v| *v = 0.0);
-        p.jacobian(w, j);
     }
 
     /// Takes the step (with backtracking if enabled); leaves R at the new iterate in `r`.
