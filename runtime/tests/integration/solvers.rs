@@ -4,9 +4,7 @@
 //! block-diagonal matrix; the iterates have the same bits for one and two threads; a low-rank
 //! correction of a factorization solves the changed matrix.
 
-mod common;
-
-use common::{MassStiffness, pseudo_random};
+use crate::common::{MassStiffness, pseudo_random};
 use signorini_runtime::fem::assembly::{Assembler, Quadrature};
 use signorini_runtime::fem::mesh::Mesh;
 use signorini_runtime::fem::mesh::structured::{Diagonal, cuboid, interval, rectangle};

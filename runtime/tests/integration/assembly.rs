@@ -3,9 +3,7 @@
 //! ∫|∇x₁|² = |Ω| for the interpolated linear field x₁ and annihilates constants, matrices are
 //! symmetric, and the residual of a linear form is its tangent times the field.
 
-mod common;
-
-use common::{MassStiffness, pseudo_random};
+use crate::common::{MassStiffness, pseudo_random};
 use signorini_runtime::fem::assembly::{Assembler, Quadrature};
 use signorini_runtime::fem::mesh::Mesh;
 use signorini_runtime::fem::mesh::ball::ball;

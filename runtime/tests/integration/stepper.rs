@@ -8,12 +8,10 @@
 //! obstacle that counts its evaluations: a steady form's active set is evaluated once a step,
 //! a moving one's twice (the stage reuses the last set for the same arguments).
 
-mod common;
-
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use common::MassStiffness;
+use crate::common::MassStiffness;
 use signorini_runtime::descriptors::{Combination, InitialDesc, Level, SchemeDesc, SlotUse, StageDesc, TermDesc};
 use signorini_runtime::fem::assembly::{Assembler, Quadrature};
 use signorini_runtime::fem::bound::{Bound, BoundForm};

@@ -5,9 +5,7 @@
 //! whether the Jacobian is reused while the active set is unchanged, nor on whether active-set
 //! changes are solved by a low-rank correction of the factorization or by refactoring.
 
-mod common;
-
-use common::{MassStiffness, pseudo_random};
+use crate::common::{MassStiffness, pseudo_random};
 use signorini_runtime::fem::assembly::{Assembler, Quadrature};
 use signorini_runtime::fem::mesh::structured::interval;
 use signorini_runtime::linalg::{Counters, Matrix, Solver, Structure};
