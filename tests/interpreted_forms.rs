@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use signorini::interpret::{InterpretError, InterpretedForm, Library};
-use signorini::runtime::fem::assembly::{Assembler, Kernel, Quadrature};
+use signorini::runtime::fem::assembly::{Assembler, FacetIntegral, Kernel, Quadrature};
 use signorini::runtime::fem::bound::{Bound, BoundForm};
 use signorini::runtime::fem::element::ElementKind;
 use signorini::runtime::fem::geometry;
@@ -412,8 +412,16 @@ fn assembled_nitsche_contact_matches_compiled() {
     let q = Quadrature::default();
     let energy = (contact_nitsche::ContactEnergy::new(&p, &c), interp("contact_energy"));
     let (ec, ei) = (
-        asm.facet_value(&energy.0, "Gamma_C", bottom, q, &[&u], T),
-        asm.facet_value(&energy.1, "Gamma_C", bottom, q, &[&u], T),
+        asm.facet_value(
+            FacetIntegral { kernel: &energy.0, region: "Gamma_C", facets: bottom, quadrature: q },
+            &[&u],
+            T,
+        ),
+        asm.facet_value(
+            FacetIntegral { kernel: &energy.1, region: "Gamma_C", facets: bottom, quadrature: q },
+            &[&u],
+            T,
+        ),
     );
     stats.close("assembled contact energy", &[ec], &[ei]);
     let vm = (elasticity::VonMises::new(&ep, &ecoefs), interp_e("von_mises"));

@@ -2,7 +2,7 @@
 //! facets of the boundary regions it integrates over, behind object-safe traits so that the
 //! forms of one scheme or problem may differ in type.
 
-use crate::fem::assembly::{Assembler, Functional, Kernel, PointValue, Quadrature};
+use crate::fem::assembly::{Assembler, FacetIntegral, Functional, Kernel, PointValue, Quadrature};
 use crate::fem::mesh::Facet;
 use crate::fem::quadrature::Rule;
 use crate::linalg::Matrix;
@@ -51,6 +51,13 @@ pub struct Bound<'m, K: Kernel> {
     pub regions: Vec<(String, &'m [Facet])>,
 }
 
+impl<K: Kernel> Bound<'_, K> {
+    /// The form's integral over `region` on `facets`.
+    fn on<'a>(&'a self, region: &'a str, facets: &'a [Facet]) -> FacetIntegral<'a, K> {
+        FacetIntegral { kernel: &self.kernel, region, facets, quadrature: self.quadrature }
+    }
+}
+
 impl<K: Kernel> BoundForm for Bound<'_, K> {
     fn name(&self) -> &str {
         self.kernel.meta().name
@@ -69,7 +76,7 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
             asm.cell_residual(&self.kernel, self.quadrature, fields, t, out);
         }
         for (region, facets) in &self.regions {
-            asm.facet_residual(&self.kernel, region, facets, self.quadrature, fields, t, out);
+            asm.facet_residual(self.on(region, facets), fields, t, out);
         }
     }
     fn tangent(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
@@ -77,12 +84,12 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
             asm.cell_tangent(&self.kernel, self.quadrature, fields, wrt, t, m);
         }
         for (region, facets) in &self.regions {
-            asm.facet_tangent(&self.kernel, region, facets, self.quadrature, fields, wrt, t, m);
+            asm.facet_tangent(self.on(region, facets), fields, wrt, t, m);
         }
     }
     fn switches(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, out: &mut Vec<bool>) {
         for (region, facets) in &self.regions {
-            asm.facet_switches(&self.kernel, region, facets, self.quadrature, fields, wrt, t, out);
+            asm.facet_switches(self.on(region, facets), fields, wrt, t, out);
         }
     }
     fn support(&self) -> Option<Vec<u32>> {
@@ -104,8 +111,7 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
             return false;
         }
         for (region, facets) in &self.regions {
-            let (q, m) = (self.quadrature, m.as_deref_mut());
-            asm.facet_tangent_elements(&self.kernel, region, facets, q, fields, wrt, t, m, out);
+            asm.facet_tangent_elements(self.on(region, facets), fields, wrt, t, m.as_deref_mut(), out);
         }
         true
     }
@@ -180,7 +186,8 @@ impl<K: Functional> BoundFunctional for BoundValue<'_, K> {
             v += asm.cell_value(&self.kernel, self.quadrature, fields, t);
         }
         for (region, facets) in &self.regions {
-            v += asm.facet_value(&self.kernel, region, facets, self.quadrature, fields, t);
+            let on = FacetIntegral { kernel: &self.kernel, region, facets, quadrature: self.quadrature };
+            v += asm.facet_value(on, fields, t);
         }
         v
     }
