@@ -5,6 +5,8 @@
 //! `forms!` macro and the helpers here all use it. Modules, lowest first: `syntax`, `check`,
 //! `ir`, `scheme`, `program`, `codegen`, `pipeline`.
 
+#![forbid(unsafe_code)]
+
 pub mod check;
 pub mod codegen;
 pub mod diagnostic;

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::check::{self, load};
+use crate::check::{self, SchemeDef, load};
 use crate::codegen;
 use crate::diagnostic::{self, Diagnostic, render_all};
 use crate::ir::{self, DimIr};
@@ -148,9 +148,17 @@ pub fn display_name(path: &Path) -> String {
 /// Checks a loaded unit and compiles its schemes; returns the program and the root's AST.
 fn front(loaded: load::Loaded, diags: Vec<Diagnostic>) -> Result<(Program, ast::File), (Vec<Diagnostic>, SourceMap)> {
     let load::Loaded { sources, mut files, root } = loaded;
-    let mut unit = check::check(sources, root, &files, diags)?;
-    let mut diags = std::mem::take(&mut unit.warnings);
-    let schemes = scheme::compile(&unit, &unit.scheme_defs, &mut diags);
+    let (mut unit, mut diags) = check::check(sources, root, &files, diags);
+    let checked = !diags.iter().any(Diagnostic::is_error);
+    // The schemes need nothing the forms' errors break: their mistakes are shown in the same
+    // run. A scheme whose declaration has a syntax error is not compiled.
+    let broken = check::broken_names(&files);
+    let defs: Vec<&SchemeDef> = unit.scheme_defs.iter().filter(|d| !broken.contains(&d.name.name)).collect();
+    let schemes = scheme::compile(&unit, &defs, &mut diags);
+    if !checked {
+        diagnostic::normalize(&mut diags);
+        return Err((diags, unit.sources));
+    }
     let mut irs = Vec::new();
     for &d in &ir::DIMS {
         match ir::build(&unit, d) {
