@@ -32,6 +32,19 @@ impl Failure {
     }
 }
 
+/// A stage of the compilation, as [`Compiled::print`] shows it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// The root file's syntax tree.
+    Ast,
+    /// The forms' IR for one dimension.
+    Ir,
+    /// The time schemes, their relations solved (coefficients simplified for reading).
+    Scheme,
+    /// The generated Rust module, formatted.
+    Rust,
+}
+
 /// Every stage of a unit that compiled.
 pub struct Compiled {
     /// The checked program, schemes compiled.
@@ -73,6 +86,35 @@ impl Compiled {
     /// The generated Rust formatted for reading, with its line count in a header comment.
     pub fn rust_pretty(&self, opts: &codegen::Options) -> Result<String, Failure> {
         Ok(codegen::pretty(&self.rust(opts)?, &opts.source_name))
+    }
+
+    /// A stage as text, the one way every tool shows it (`signorini emit`, the snapshots):
+    /// the AST, the IR of dimension `dim` (1, 2 or 3), the schemes, or the Rust module named
+    /// after the root file, for the runtime at [`codegen::DEFAULT_RUNTIME`]. `dim` matters to
+    /// the IR only.
+    pub fn print(&self, stage: Stage, dim: usize) -> Result<String, Failure> {
+        let prog = &self.program;
+        match stage {
+            Stage::Ast => Ok(crate::syntax::print::print_file(&self.ast, &prog.sources)),
+            Stage::Ir => {
+                if !ir::DIMS.contains(&dim) {
+                    return Err(Failure::internal(format!("dimension {dim} is not one of {:?}", ir::DIMS)));
+                }
+                let params: Vec<String> = prog.params.iter().map(|p| p.name.clone()).collect();
+                let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
+                Ok(ir::print::print(self.ir(dim), &params, &coefs))
+            }
+            Stage::Scheme => Ok(self.schemes().iter().map(scheme::print::print).collect::<Vec<_>>().join("\n")),
+            Stage::Rust => {
+                let root = prog.sources.path(prog.root);
+                let opts = codegen::Options {
+                    runtime: codegen::DEFAULT_RUNTIME.to_string(),
+                    module: module_name(root),
+                    source_name: display_name(root),
+                };
+                self.rust_pretty(&opts)
+            }
+        }
     }
 }
 
