@@ -154,6 +154,14 @@ pub fn problem_only(span: Span) -> Diagnostic {
     .with_help("a form serves every dimension: use `dot(a, b)`, `outer`, or a `coef: vector` the problem sets")
 }
 
+/// A declared range as written (`[0, 1/3]`, without its `in`), its runs of whitespace made
+/// single spaces.
+pub fn range_written(sources: &SourceMap, r: &ast::Range) -> String {
+    let text = sources.slice(r.span).trim_start();
+    let text = text.strip_prefix("in").unwrap_or(text);
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
 /// The region name of volume integrals.
 pub const CELL_REGION: &str = "Omega";
 

@@ -31,6 +31,8 @@ pub struct SchemeParamInfo {
     pub range: Option<ParamRange>,
     /// The declaration (`alpha = 0.05 in [0, 1/3]`).
     pub span: Span,
+    /// The range as written.
+    pub range_expr: Option<ast::Range>,
 }
 
 /// Names every scheme sees: the step, the time, π.
@@ -89,7 +91,7 @@ pub fn may_be_quantity(unit: &Unit, name: &str) -> bool {
 
 /// The parameters: distinct names (E0103), finite constant defaults (E0603) inside their
 /// ranges (E0601). A default that is no constant is NaN.
-pub fn params(def: &SchemeDef, errors: &mut Vec<Diagnostic>) -> Vec<SchemeParamInfo> {
+pub fn params(unit: &Unit, def: &SchemeDef, errors: &mut Vec<Diagnostic>) -> Vec<SchemeParamInfo> {
     let mut out = Vec::new();
     for (i, p) in def.params.iter().enumerate() {
         if let Some(prev) = def.params[..i].iter().find(|q| q.name.name == p.name.name) {
@@ -127,10 +129,19 @@ pub fn params(def: &SchemeDef, errors: &mut Vec<Diagnostic>) -> Vec<SchemeParamI
                 "E0601",
                 format!("default of `{}` is outside its range", p.name.name),
                 p.default.span,
-                format!("{default} is not in {}", r.describe()),
+                format!(
+                    "{default} is not in {}",
+                    super::range_written(&unit.sources, p.range.as_ref().expect("a range"))
+                ),
             ));
         }
-        out.push(SchemeParamInfo { name: p.name.name.clone(), default, range, span: p.span });
+        out.push(SchemeParamInfo {
+            name: p.name.name.clone(),
+            default,
+            range,
+            span: p.span,
+            range_expr: p.range.clone(),
+        });
     }
     out
 }

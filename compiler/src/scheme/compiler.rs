@@ -95,7 +95,7 @@ impl<'a> Compiler<'a> {
     /// scope. `false` when one of them is wrong (the stages are not compiled then).
     fn declarations(&mut self) -> bool {
         let def = self.def;
-        self.params = schemes::params(def, &mut self.diags);
+        self.params = schemes::params(self.prog, def, &mut self.diags);
         for (i, p) in def.params.iter().enumerate() {
             let node = self.g.sym(Sym::Param(i as u16));
             self.g.name(node, &p.name.name);

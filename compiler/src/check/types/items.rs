@@ -3,7 +3,7 @@
 
 use super::{Checker, LetState, Ty};
 use crate::check::builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES};
-use crate::check::{CELL_REGION, Global, ParamRange, const_eval};
+use crate::check::{CELL_REGION, Global, ParamRange, const_eval, range_written};
 use crate::diagnostic::Diagnostic;
 use crate::source::Span;
 use crate::syntax::ast::{Expr, ExprKind, Ident, Shape};
@@ -36,7 +36,7 @@ impl Checker<'_> {
                         "E0602",
                         "empty parameter range",
                         r.span,
-                        format!("no value lies in {}", range.describe()),
+                        format!("no value lies in {}", range_written(&self.prog.sources, r)),
                     ));
                     return None;
                 }
@@ -51,7 +51,10 @@ impl Checker<'_> {
                         "E0601",
                         format!("default of `{name}` is outside its range"),
                         p.default_expr.span,
-                        format!("{v} is not in {}", r.describe()),
+                        format!(
+                            "{v} is not in {}",
+                            range_written(&self.prog.sources, p.range_expr.as_ref().expect("a range"))
+                        ),
                     )
                     .with_label(p.range_expr.as_ref().map_or(p.span, |r| r.span), "the declared range"),
                 );
