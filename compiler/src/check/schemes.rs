@@ -1,8 +1,8 @@
 //! The rules of a scheme's names and slots: its parameters (distinct, constant defaults in
 //! their ranges), its `uses` line, its states, what its `let`s hide, its claims, which states
-//! need an initial value, and how its slots are applied. The scheme compiler
-//! (`crate::scheme`) applies them as it reads a scheme, so that a scheme whose declarations are
-//! wrong stops before its stages; nothing here builds coefficients.
+//! need an initial value, and how its slots are applied. The scheme compiler applies them as
+//! it reads a scheme, so that a scheme whose declarations are wrong stops before its stages;
+//! nothing here builds coefficients.
 
 use super::{Global, ParamRange, Unit, const_eval, suggest_name};
 use crate::diagnostic::Diagnostic;
