@@ -5,6 +5,8 @@
 //! `forms!` macro and the helpers here all use it. Modules, lowest first: `syntax`, `check`,
 //! `ir`, `scheme`, `program`, `codegen`, `pipeline`.
 
+#![forbid(unsafe_code)]
+
 pub mod check;
 pub mod codegen;
 pub mod diagnostic;
@@ -18,8 +20,8 @@ pub mod syntax;
 
 pub use diagnostic::{Diagnostic, Severity, render_all};
 pub use pipeline::{
-    Checked, Compiled, Expansion, Failure, check_file, check_path, check_text, compile, compile_text, compile_to_rust,
-    display_name, expand, module_name,
+    Checked, Compiled, Expansion, Failure, Stage, check_file, check_path, check_text, compile, compile_text,
+    compile_to_rust, display_name, expand, module_name,
 };
 pub use program::Program;
 pub use source::{FileId, FsLoader, Loader, MemLoader, SourceMap, Span};

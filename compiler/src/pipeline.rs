@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::check::{self, load};
+use crate::check::{self, SchemeDef, load};
 use crate::codegen;
 use crate::diagnostic::{self, Diagnostic, render_all};
 use crate::ir::{self, DimIr};
@@ -30,6 +30,19 @@ impl Failure {
     fn internal(e: impl std::fmt::Display) -> Failure {
         Failure { rendered: format!("error: {e}\n") }
     }
+}
+
+/// A stage of the compilation, as [`Compiled::print`] shows it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// The root file's syntax tree.
+    Ast,
+    /// The forms' IR for one dimension.
+    Ir,
+    /// The time schemes, their relations solved (coefficients simplified for reading).
+    Scheme,
+    /// The generated Rust module, formatted.
+    Rust,
 }
 
 /// Every stage of a unit that compiled.
@@ -73,6 +86,35 @@ impl Compiled {
     /// The generated Rust formatted for reading, with its line count in a header comment.
     pub fn rust_pretty(&self, opts: &codegen::Options) -> Result<String, Failure> {
         Ok(codegen::pretty(&self.rust(opts)?, &opts.source_name))
+    }
+
+    /// A stage as text, the one way every tool shows it (`signorini emit`, the snapshots):
+    /// the AST, the IR of dimension `dim` (1, 2 or 3), the schemes, or the Rust module named
+    /// after the root file, for the runtime at [`codegen::DEFAULT_RUNTIME`]. `dim` matters to
+    /// the IR only.
+    pub fn print(&self, stage: Stage, dim: usize) -> Result<String, Failure> {
+        let prog = &self.program;
+        match stage {
+            Stage::Ast => Ok(crate::syntax::print::print_file(&self.ast, &prog.sources)),
+            Stage::Ir => {
+                if !ir::DIMS.contains(&dim) {
+                    return Err(Failure::internal(format!("dimension {dim} is not one of {:?}", ir::DIMS)));
+                }
+                let params: Vec<String> = prog.params.iter().map(|p| p.name.clone()).collect();
+                let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
+                Ok(ir::print::print(self.ir(dim), &params, &coefs))
+            }
+            Stage::Scheme => Ok(self.schemes().iter().map(scheme::print::print).collect::<Vec<_>>().join("\n")),
+            Stage::Rust => {
+                let root = prog.sources.path(prog.root);
+                let opts = codegen::Options {
+                    runtime: codegen::DEFAULT_RUNTIME.to_string(),
+                    module: module_name(root),
+                    source_name: display_name(root),
+                };
+                self.rust_pretty(&opts)
+            }
+        }
     }
 }
 
@@ -148,9 +190,17 @@ pub fn display_name(path: &Path) -> String {
 /// Checks a loaded unit and compiles its schemes; returns the program and the root's AST.
 fn front(loaded: load::Loaded, diags: Vec<Diagnostic>) -> Result<(Program, ast::File), (Vec<Diagnostic>, SourceMap)> {
     let load::Loaded { sources, mut files, root } = loaded;
-    let mut unit = check::check(sources, root, &files, diags)?;
-    let mut diags = std::mem::take(&mut unit.warnings);
-    let schemes = scheme::compile(&unit, &unit.scheme_defs, &mut diags);
+    let (mut unit, mut diags) = check::check(sources, root, &files, diags);
+    let checked = !diags.iter().any(Diagnostic::is_error);
+    // The schemes need nothing the forms' errors break: their mistakes are shown in the same
+    // run. A scheme whose declaration has a syntax error is not compiled.
+    let broken = check::broken_names(&files);
+    let defs: Vec<&SchemeDef> = unit.scheme_defs.iter().filter(|d| !broken.contains(&d.name.name)).collect();
+    let schemes = scheme::compile(&unit, &defs, &mut diags);
+    if !checked {
+        diagnostic::normalize(&mut diags);
+        return Err((diags, unit.sources));
+    }
     let mut irs = Vec::new();
     for &d in &ir::DIMS {
         match ir::build(&unit, d) {

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use signorini_compiler::{FsLoader, codegen, compile, ir, syntax};
+use signorini_compiler::{FsLoader, Stage, compile};
 
 fn library() -> Vec<PathBuf> {
     let mut files = Vec::new();
@@ -37,12 +37,7 @@ fn library_compiles_without_warnings() {
 fn generated_rust_snapshots() {
     for f in library() {
         let compiled = compile(&f, &FsLoader).unwrap();
-        let opts = codegen::Options {
-            runtime: codegen::DEFAULT_RUNTIME.into(),
-            module: stem(&f),
-            source_name: signorini_compiler::display_name(&f),
-        };
-        let code = compiled.rust_pretty(&opts).unwrap();
+        let code = compiled.print(Stage::Rust, 2).unwrap();
         insta::with_settings!({ snapshot_path => "snapshots/rust", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(stem(&f), code);
         });
@@ -53,17 +48,14 @@ fn generated_rust_snapshots() {
 fn ast_ir_and_scheme_snapshots() {
     for f in library() {
         let compiled = compile(&f, &FsLoader).unwrap();
-        let prog = &compiled.program;
-        let ast_text = syntax::print::print_file(&compiled.ast, &prog.sources);
-        let params: Vec<String> = prog.params.iter().map(|p| p.name.clone()).collect();
-        let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
-        let ir_text = ir::print::print(compiled.ir(2), &params, &coefs);
-        let schemes: Vec<String> = prog.schemes.iter().map(signorini_compiler::scheme::print::print).collect();
+        let ast_text = compiled.print(Stage::Ast, 2).unwrap();
+        let ir_text = compiled.print(Stage::Ir, 2).unwrap();
+        let schemes = compiled.print(Stage::Scheme, 2).unwrap();
         insta::with_settings!({ snapshot_path => "snapshots/stages", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(format!("{}.ast", stem(&f)), ast_text);
             insta::assert_snapshot!(format!("{}.ir2d", stem(&f)), ir_text);
-            if !schemes.is_empty() {
-                insta::assert_snapshot!(format!("{}.scheme", stem(&f)), schemes.join("\n"));
+            if !compiled.schemes().is_empty() {
+                insta::assert_snapshot!(format!("{}.scheme", stem(&f)), schemes);
             }
         });
     }
@@ -84,7 +76,7 @@ fn library_problems_check_clean_and_print() {
         let compiled = compile(f, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", f.display()));
         assert!(compiled.warnings.is_empty(), "{}:\n{}", f.display(), compiled.warnings);
         assert!(compiled.program.unit.problems.len() == 1, "{}: one problem per file", f.display());
-        let ast = syntax::print::print_file(&compiled.ast, &compiled.program.unit.sources);
+        let ast = compiled.print(Stage::Ast, 2).unwrap();
         insta::with_settings!({ snapshot_path => "snapshots/problems", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(format!("{}.ast", stem(f)), ast);
         });

@@ -574,26 +574,13 @@ fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
         }
     };
     eprint!("{}", compiled.warnings);
-    let prog = &compiled.program;
-    let out = match stage {
-        Stage::Ast => Ok(compiler::syntax::print::print_file(&compiled.ast, &prog.sources)),
-        Stage::Ir => {
-            let params: Vec<String> = prog.params.iter().map(|p| p.name.clone()).collect();
-            let coefs: Vec<String> = prog.coefs.iter().map(|c| c.name.clone()).collect();
-            Ok(compiler::ir::print::print(compiled.ir(dim), &params, &coefs))
-        }
-        Stage::Scheme => {
-            Ok(compiled.schemes().iter().map(compiler::scheme::print::print).collect::<Vec<_>>().join("\n"))
-        }
-        Stage::Rust => {
-            let opts = compiler::codegen::Options {
-                runtime: compiler::codegen::DEFAULT_RUNTIME.to_string(),
-                module: compiler::module_name(file),
-                source_name: compiler::display_name(file),
-            };
-            compiled.rust_pretty(&opts)
-        }
+    let stage = match stage {
+        Stage::Ast => compiler::Stage::Ast,
+        Stage::Ir => compiler::Stage::Ir,
+        Stage::Scheme => compiler::Stage::Scheme,
+        Stage::Rust => compiler::Stage::Rust,
     };
+    let out = compiled.print(stage, dim);
     match out {
         Ok(text) => {
             print!("{text}");

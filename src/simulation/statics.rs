@@ -9,7 +9,8 @@ use crate::runtime::fem::kernel::Coef;
 use crate::runtime::fem::mesh::Facet;
 use crate::runtime::library::Binding;
 use crate::runtime::linalg::{Counters, Structure};
-use crate::runtime::nonlinear::newton::{Newton, NewtonOptions, NewtonReport, NonlinearProblem};
+use crate::runtime::nonlinear::newton::{Newton, NewtonOptions, NewtonReport};
+use crate::runtime::nonlinear::problem::NonlinearProblem;
 use crate::runtime::nonlinear::statics::{Constraints, StaticContact};
 
 /// What a static case gives the driver.

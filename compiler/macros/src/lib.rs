@@ -4,6 +4,8 @@
 //! `compile_error!` with the rendered diagnostics; editing any of the files triggers a
 //! rebuild. The macro never panics: a compiler bug is reported as an error too.
 
+#![forbid(unsafe_code)]
+
 use std::path::{Path, PathBuf};
 
 use proc_macro::TokenStream;

@@ -8,14 +8,16 @@
 mod builtins;
 pub mod load;
 pub mod problem;
+pub mod schemes;
 mod types;
 
-use crate::diagnostic::{self, Diagnostic};
+use crate::diagnostic::Diagnostic;
 use crate::source::{FileId, SourceMap, Span};
 use crate::syntax::ast::{self, Expr, Ident, Shape};
 use std::collections::{BTreeSet, HashMap, HashSet};
 
 pub use builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES, NUMBER_FUNCTIONS};
+pub use schemes::{CLAIMS, EnergyLaw, SchemeDef, SchemeParamInfo};
 pub use types::{Ty, const_eval};
 
 /// The value of a constant expression, if it is one.
@@ -24,7 +26,7 @@ pub fn const_value(e: &Expr) -> Option<f64> {
 }
 
 /// A checked compilation unit: the root file and its imports. Its schemes are declared, not
-/// yet compiled (`crate::scheme::compile` does that; `crate::Program` holds the result).
+/// yet compiled (the pipeline compiles them; `crate::Program` holds the result).
 pub struct Unit {
     pub sources: SourceMap,
     pub root: FileId,
@@ -38,20 +40,6 @@ pub struct Unit {
     pub globals: HashMap<String, Global>,
     /// Warnings (errors make `check` return `Err`).
     pub warnings: Vec<Diagnostic>,
-}
-
-/// A scheme as written.
-#[derive(Clone, Debug)]
-pub struct SchemeDef {
-    pub name: Ident,
-    pub params: Vec<ast::SchemeParam>,
-    pub uses: Vec<Ident>,
-    pub states: Vec<Ident>,
-    pub lets: Vec<(Ident, Expr)>,
-    pub initial: Option<ast::Initial>,
-    pub claims: Vec<(Ident, Expr)>,
-    pub stages: Vec<ast::Stage>,
-    pub span: Span,
 }
 
 #[derive(Clone, Debug)]
@@ -166,16 +154,32 @@ pub fn problem_only(span: Span) -> Diagnostic {
     .with_help("a form serves every dimension: use `dot(a, b)`, `outer`, or a `coef: vector` the problem sets")
 }
 
+/// A declared range as written (`[0, 1/3]`, without its `in`), its runs of whitespace made
+/// single spaces.
+pub fn range_written(sources: &SourceMap, r: &ast::Range) -> String {
+    let text = sources.slice(r.span).trim_start();
+    let text = text.strip_prefix("in").unwrap_or(text);
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
 /// The region name of volume integrals.
 pub const CELL_REGION: &str = "Omega";
 
-/// Result of checking: the unit (with warnings) or every diagnostic, in source order, together
-/// with the sources needed to render them.
-pub type Checked = Result<Unit, (Vec<Diagnostic>, SourceMap)>;
+/// The names whose declaration has a syntax error (already reported): uses of them are not
+/// reported again, and a scheme among them is not compiled.
+pub fn broken_names(files: &[(FileId, ast::File)]) -> HashSet<String> {
+    files.iter().flat_map(|(_, f)| f.broken_names.iter().cloned()).collect()
+}
 
 /// Checks a loaded unit (`load::load`); `diags` holds what loading found (syntax errors,
-/// missing imports). Schemes are declared, not compiled.
-pub fn check(sources: SourceMap, root: FileId, files: &[(FileId, ast::File)], mut diags: Vec<Diagnostic>) -> Checked {
+/// missing imports). Returns the unit and every diagnostic found, errors and warnings, not
+/// yet in source order (`diagnostic::normalize`). Schemes are declared, not compiled.
+pub fn check(
+    sources: SourceMap,
+    root: FileId,
+    files: &[(FileId, ast::File)],
+    mut diags: Vec<Diagnostic>,
+) -> (Unit, Vec<Diagnostic>) {
     let mut prog = Unit {
         sources,
         root,
@@ -187,7 +191,7 @@ pub fn check(sources: SourceMap, root: FileId, files: &[(FileId, ast::File)], mu
         globals: HashMap::new(),
         warnings: Vec::new(),
     };
-    let broken: HashSet<String> = files.iter().flat_map(|(_, f)| f.broken_names.iter().cloned()).collect();
+    let broken = broken_names(files);
     declare(&mut prog, files, &mut diags);
     shadowing(&prog, files, &mut diags);
     let used = {
@@ -222,20 +226,7 @@ pub fn check(sources: SourceMap, root: FileId, files: &[(FileId, ast::File)], mu
             );
         }
     }
-    if diags.iter().any(Diagnostic::is_error) {
-        // The schemes need nothing the forms' errors break: their mistakes are shown in the
-        // same run (a clean unit compiles them in `pipeline`).
-        let defs: Vec<SchemeDef> =
-            prog.scheme_defs.iter().filter(|d| !broken.contains(&d.name.name)).cloned().collect();
-        crate::scheme::compile(&prog, &defs, &mut diags);
-    }
-    diagnostic::normalize(&mut diags);
-    if diags.iter().any(Diagnostic::is_error) {
-        Err((diags, prog.sources))
-    } else {
-        prog.warnings = diags;
-        Ok(prog)
-    }
+    (prog, diags)
 }
 
 /// Arguments of a `fn` or a `form` named like a global of the unit (a param, a let, ...):

@@ -1,12 +1,13 @@
 //! Element kernels of one form in one dimension: for each integral, the residual and the
 //! tangent with respect to each field argument, as loops over quadrature points and local
-//! nodes with the pointwise coefficients written out as straight-line code.
+//! nodes with the pointwise coefficients written out as straight-line code (`emit`).
 
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
 
-use super::names::{Namer, ident};
-use crate::ir::graph::{Graph, Node, NodeId, Sym};
+use super::emit::{Emitter, UNARY};
+use super::names::{Namer, ident, words};
+use crate::ir::graph::{Graph, NodeId, Sym};
 use crate::ir::{DimIr, FormIr, IntegralIr};
 use crate::program::Program;
 
@@ -37,74 +38,107 @@ const RESERVED: &[&str] = &[
     "Coefficients",
     "total",
     "value",
+    "std",
 ];
+
+/// A method's parameters, named `_name` where its body does not read them.
+fn params(body: &str, list: &[(&str, String)]) -> String {
+    let words = words(body);
+    let named: Vec<String> = list
+        .iter()
+        .map(|(name, ty)| if words.contains(*name) { format!("{name}: {ty}") } else { format!("_{name}: {ty}") })
+        .collect();
+    named.join(", ")
+}
+
+/// `match on { k => { ... } ... _ => {} }` over the arms that have something to do, or an `if`
+/// for a single one; `None` without any.
+fn dispatch(on: &str, arms: Vec<(usize, String)>) -> Option<String> {
+    match arms.as_slice() {
+        [] => None,
+        // One arm around another: one `if` (clippy's collapsible_if).
+        [(k, body)] => match body.strip_prefix("if ").and_then(|rest| rest.split_once(" {\n")) {
+            Some((inner, block)) => Some(format!("if {on} == {k} && {inner} {{\n{block}")),
+            None => Some(format!("if {on} == {k} {{\n{body}}}\n")),
+        },
+        _ => {
+            let arms: String = arms.iter().map(|(k, body)| format!("{k} => {{\n{body}}}\n")).collect();
+            Some(format!("match {on} {{\n{arms}_ => {{}}\n}}\n"))
+        }
+    }
+}
+
+/// A method of a kernel trait: its name, its parameters after `&self` with their types, and
+/// its body, if it has something to do.
+type Method<'a> = (&'a str, Vec<(&'a str, String)>, Option<String>);
 
 /// `impl<const N: usize> FormKernel<D, N> for Struct { ... }`.
 pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -> String {
     let d = ir.dim;
     let g = &ir.graph;
     let body = |integral: &IntegralIr, mode: Mode| Body { prog, g, d, form, integral, mode }.emit();
-    // One `match wrt` arm per field argument with something to do; `None` if none has.
+    // One arm per field argument with something to do.
     let per_field = |integral: &IntegralIr, mode: fn(usize) -> Mode| {
-        let arms: Vec<String> = (0..form.fields.len())
-            .filter_map(|a| {
-                let b = body(integral, mode(a));
-                (!b.is_empty()).then(|| format!("{a} => {{ // d/d{}\n{b}}}\n", form.fields[a]))
-            })
-            .collect();
-        (!arms.is_empty()).then(|| format!("match wrt {{\n{}_ => {{}}\n}}\n", arms.concat()))
+        let arms = (0..form.fields.len()).map(|a| (a, body(integral, mode(a)))).filter(|(_, b)| !b.is_empty());
+        dispatch("wrt", arms.collect())
     };
     let cell = form.integrals.iter().find(|i| i.cell);
     let facets: Vec<&IntegralIr> = form.integrals.iter().filter(|i| !i.cell).collect();
-    // One `match region` arm per boundary region with something to do; `None` if none has.
+    // One arm per boundary region with something to do.
     let per_region = |f: &dyn Fn(&IntegralIr) -> Option<String>| {
-        let arms: Vec<String> = facets
-            .iter()
-            .enumerate()
-            .filter_map(|(r, i)| f(i).map(|b| format!("{r} => {{ // int({})\n{b}}}\n", i.region)))
-            .collect();
-        (!arms.is_empty()).then(|| format!("match region {{\n{}_ => {{}}\n}}\n", arms.concat()))
+        dispatch("region", facets.iter().enumerate().filter_map(|(r, i)| f(i).map(|b| (r, b))).collect())
     };
     let nonempty = |b: String| (!b.is_empty()).then_some(b);
     let (vec, mat, fields) =
-        (format!("LocalVector<{d}, N>"), format!("LocalMatrix<{d}, N>"), format!("&[&LocalVector<{d}, N>]"));
+        (format!("&mut LocalVector<{d}, N>"), format!("&mut LocalMatrix<{d}, N>"), format!("&[&LocalVector<{d}, N>]"));
     let (cctx, fctx) = (format!("&CellCtx<'_, {d}, N>"), format!("&FacetCtx<'_, {d}, N>"));
-    let mut s = String::new();
-    let _ = writeln!(s, "impl<const N: usize> FormKernel<{d}, N> for {struct_name} {{");
+    let switches = "&mut Vec<bool>".to_string();
+    let wrt = "usize".to_string();
+    let region = "usize".to_string();
     // Methods with nothing to add keep the trait's default (which adds nothing).
-    let methods = [
+    let methods: [Method; 6] = [
         (
-            format!("fn cell_residual(&self, ctx: {cctx}, fields: {fields}, out: &mut {vec})"),
+            "cell_residual",
+            vec![("ctx", cctx.clone()), ("fields", fields.clone()), ("out", vec.clone())],
             cell.and_then(|i| nonempty(body(i, Mode::Residual))),
         ),
         (
-            format!("fn cell_tangent(&self, ctx: {cctx}, fields: {fields}, wrt: usize, out: &mut {mat})"),
+            "cell_tangent",
+            vec![("ctx", cctx.clone()), ("fields", fields.clone()), ("wrt", wrt.clone()), ("out", mat.clone())],
             cell.and_then(|i| per_field(i, Mode::Tangent)),
         ),
         (
-            format!("fn cell_switches(&self, ctx: {cctx}, fields: {fields}, wrt: usize, out: &mut Vec<bool>)"),
+            "cell_switches",
+            vec![("ctx", cctx), ("fields", fields.clone()), ("wrt", wrt.clone()), ("out", switches.clone())],
             cell.and_then(|i| per_field(i, Mode::Switches)),
         ),
         (
-            format!("fn facet_residual(&self, region: usize, ctx: {fctx}, fields: {fields}, out: &mut {vec})"),
+            "facet_residual",
+            vec![("region", region.clone()), ("ctx", fctx.clone()), ("fields", fields.clone()), ("out", vec)],
             per_region(&|i| nonempty(body(i, Mode::Residual))),
         ),
         (
-            format!(
-                "fn facet_tangent(&self, region: usize, ctx: {fctx}, fields: {fields}, wrt: usize, out: &mut {mat})"
-            ),
+            "facet_tangent",
+            vec![
+                ("region", region.clone()),
+                ("ctx", fctx.clone()),
+                ("fields", fields.clone()),
+                ("wrt", wrt.clone()),
+                ("out", mat),
+            ],
             per_region(&|i| per_field(i, Mode::Tangent)),
         ),
         (
-            format!(
-                "fn facet_switches(&self, region: usize, ctx: {fctx}, fields: {fields}, wrt: usize, out: &mut Vec<bool>)"
-            ),
+            "facet_switches",
+            vec![("region", region), ("ctx", fctx), ("fields", fields), ("wrt", wrt), ("out", switches)],
             per_region(&|i| per_field(i, Mode::Switches)),
         ),
     ];
-    for (sig, text) in methods {
+    let mut s = String::new();
+    let _ = writeln!(s, "impl<const N: usize> FormKernel<{d}, N> for {struct_name} {{");
+    for (name, list, text) in methods {
         if let Some(text) = text {
-            let _ = writeln!(s, "{sig} {{\n{text}}}");
+            let _ = writeln!(s, "fn {name}(&self, {}) {{\n{text}}}", params(&text, &list));
         }
     }
     s.push_str("}\n");
@@ -125,21 +159,21 @@ pub fn functional_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &
     let _ = writeln!(s, "impl<const N: usize> FunctionalKernel<{d}, N> for {struct_name} {{");
     // A functional without a volume (facet) integral keeps the trait's default: 0.
     if let Some(cell) = form.integrals.iter().find(|i| i.cell) {
-        let _ = writeln!(
-            s,
-            "fn cell_value(&self, ctx: &CellCtx<'_, {d}, N>, fields: {fields}) -> f64 {{\n{}}}",
-            body(cell)
-        );
+        let text = body(cell);
+        let list = [("ctx", format!("&CellCtx<'_, {d}, N>")), ("fields", fields.clone())];
+        let _ = writeln!(s, "fn cell_value(&self, {}) -> f64 {{\n{text}}}", params(&text, &list));
     }
-    let mut arms = String::new();
-    for (r, i) in form.integrals.iter().filter(|i| !i.cell).enumerate() {
-        let _ = writeln!(arms, "{r} => {{ // int({})\n{}}}", i.region, body(i));
-    }
+    let arms: Vec<String> = form
+        .integrals
+        .iter()
+        .filter(|i| !i.cell)
+        .enumerate()
+        .map(|(r, i)| format!("{r} => {{\n{}}}\n", body(i)))
+        .collect();
     if !arms.is_empty() {
-        let _ = writeln!(
-            s,
-            "fn facet_value(&self, region: usize, ctx: &FacetCtx<'_, {d}, N>, fields: {fields}) -> f64 {{\nmatch region {{\n{arms}_ => 0.0,\n}}\n}}"
-        );
+        let text = format!("match region {{\n{}_ => 0.0,\n}}\n", arms.concat());
+        let list = [("region", "usize".to_string()), ("ctx", format!("&FacetCtx<'_, {d}, N>")), ("fields", fields)];
+        let _ = writeln!(s, "fn facet_value(&self, {}) -> f64 {{\n{text}}}", params(&text, &list));
     }
     s.push_str("}\n");
     s
@@ -176,17 +210,73 @@ fn output(outputs: &Outputs, kind: &str, flat: usize) -> Option<String> {
     outputs.iter().find(|(k, _)| *k == kind)?.1.get(flat)?.as_ref().map(|o| o.name.clone())
 }
 
-const ATOM: u8 = 4;
-const UNARY: u8 = 3;
-const MUL: u8 = 2;
-const ADD: u8 = 1;
+/// The leaves of a body: their names, and the lines that read them from the context.
+struct Leaves {
+    leaf: HashMap<Sym, String>,
+    /// Before the loop: params, field dofs, `t` and `h`.
+    prologue: String,
+    /// Per field argument: its dofs and its value (`None` when not read).
+    field_val: Vec<Option<(String, String)>>,
+    /// Per field argument: its dofs and its gradient.
+    field_grad: Vec<Option<(String, String)>>,
+    /// The coefs read, and their locals.
+    coefs: Vec<(u16, String)>,
+    uses_x: bool,
+    uses_normal: bool,
+}
 
 impl Body<'_> {
     fn emit(&self) -> String {
-        let d = self.d;
         let g = self.g;
+        let outputs = self.outputs();
+        let roots: Vec<NodeId> = outputs.iter().flat_map(|(_, l)| l.iter().flatten()).map(|o| o.node).collect();
+        if roots.is_empty() {
+            return String::new();
+        }
+        let nodes = g.reachable(roots.iter().copied());
+        let syms: HashSet<Sym> = nodes
+            .iter()
+            .filter_map(|&n| if let crate::ir::graph::Node::Sym(s) = g.node(n) { Some(s) } else { None })
+            .collect();
+        let mut namer = self.namer(&outputs);
+        let leaves = self.leaves(&syms, &mut namer);
+        let emitter = Emitter::new(g, &leaves.leaf);
+        // Constant over the cell: hoisted out of the quadrature loop.
+        let varies = |s: Sym| !matches!(s, Sym::Param(_) | Sym::CellDiameter | Sym::Time);
+        let lines = emitter.bind(&roots, varies, true, &mut namer);
+        // Weighted outputs (switches are signs: no weight).
+        let mut weighted = String::new();
+        let weight = if matches!(self.mode, Mode::Switches(_)) { "" } else { "w * " };
+        for o in outputs.iter().flat_map(|(_, l)| l.iter().flatten()) {
+            let (text, prec) = emitter.value(o.node, &lines);
+            let text = if prec < UNARY && !weight.is_empty() { format!("({text})") } else { text };
+            let _ = writeln!(weighted, "let {} = {weight}{text};", o.name);
+        }
+        let mut s = String::new();
+        s.push_str(&leaves.prologue);
+        s.push_str(&lines.invariant);
+        s.push_str("for q in 0..ctx.tab.len() {\n");
+        s.push_str(&self.point(&outputs, &leaves));
+        s.push_str(&lines.varying);
+        s.push_str(&weighted);
+        match self.mode {
+            Mode::Residual => s.push_str(&self.residual_loop(&outputs)),
+            Mode::Tangent(_) => s.push_str(&self.tangent_loop(&outputs)),
+            Mode::Switches(_) => {
+                for o in outputs.iter().flat_map(|(_, l)| l.iter().flatten()) {
+                    let _ = writeln!(s, "out.push({} > 0.0);", o.name);
+                }
+            }
+            Mode::Value => s.push_str("total += value;\n"),
+        }
+        s.push_str("}\n");
+        s
+    }
+
+    /// The pointwise coefficients this body needs, by the index conventions of ir::TangentIr.
+    fn outputs(&self) -> Outputs {
+        let (d, g) = (self.d, self.g);
         let idx = |v: &[usize]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join("_");
-        // The pointwise coefficients this body needs, by the index conventions of ir::TangentIr.
         let mut outputs: Outputs = Vec::new();
         let mut add = |kind: &'static str, nodes: &[NodeId], dims: usize| {
             let list = nodes
@@ -229,17 +319,14 @@ impl Body<'_> {
                 outputs.push(("s", list.map(|(k, &node)| Some(Output { name: format!("s_{k}"), node })).collect()));
             }
         }
-        let roots: Vec<NodeId> = outputs.iter().flat_map(|(_, l)| l.iter().flatten()).map(|o| o.node).collect();
-        if roots.is_empty() {
-            return String::new();
-        }
-        let nodes = g.reachable(roots.iter().copied());
-        let syms: HashSet<Sym> =
-            nodes.iter().filter_map(|&n| if let Node::Sym(s) = g.node(n) { Some(s) } else { None }).collect();
+        outputs
+    }
 
-        // Names of leaves.
+    /// The body's locals: the kernel's own, the outputs and the tangent's rows taken.
+    fn namer(&self, outputs: &Outputs) -> Namer {
+        let d = self.d;
         let mut namer = Namer::new(RESERVED);
-        for (_, list) in &outputs {
+        for (_, list) in outputs {
             for o in list.iter().flatten() {
                 namer.fresh(&o.name);
             }
@@ -252,6 +339,11 @@ impl Body<'_> {
                 }
             }
         }
+        namer
+    }
+
+    /// Names of the leaves the body reads, and the prologue that reads the cell-constant ones.
+    fn leaves(&self, syms: &HashSet<Sym>, namer: &mut Namer) -> Leaves {
         let mut leaf: HashMap<Sym, String> = HashMap::new();
         let mut prologue = String::new();
         let mut params: Vec<u16> =
@@ -285,9 +377,9 @@ impl Body<'_> {
             syms.iter().filter_map(|s| if let Sym::Coef { id, .. } = s { Some(*id) } else { None }).collect();
         coef_ids.sort_unstable();
         coef_ids.dedup();
-        let coef_locals: Vec<(u16, String)> =
+        let coefs: Vec<(u16, String)> =
             coef_ids.iter().map(|&id| (id, namer.fresh(&self.prog.coefs[id as usize].name))).collect();
-        for s in &syms {
+        for s in syms {
             let name = match *s {
                 Sym::Param(_) => continue,
                 Sym::Field { arg, comp } => {
@@ -302,139 +394,72 @@ impl Body<'_> {
                 Sym::Time => "t".into(),
                 Sym::Dt => "dt".into(), // never in a form
                 Sym::Coef { id, comp } => {
-                    format!("{}[{comp}]", coef_locals.iter().find(|(i, _)| *i == id).expect("named above").1)
+                    format!("{}[{comp}]", coefs.iter().find(|(i, _)| *i == id).expect("named above").1)
                 }
                 Sym::Test { .. } | Sym::TestGrad { .. } => "0.0".into(), // linear forms: never reached
             };
             leaf.insert(*s, name);
         }
-        let uses_t = syms.contains(&Sym::Time) || !coef_ids.is_empty();
-        let uses_x = syms.iter().any(|s| matches!(s, Sym::Coord(_))) || !coef_ids.is_empty();
-        let uses_h = syms.contains(&Sym::CellDiameter);
-        if uses_t {
+        // Coefs are functions of position and time.
+        if syms.contains(&Sym::Time) || !coefs.is_empty() {
             prologue.push_str("let t = ctx.t;\n");
         }
-        if uses_h {
+        if syms.contains(&Sym::CellDiameter) {
             prologue.push_str("let h = ctx.h;\n");
         }
+        let uses_x = syms.iter().any(|s| matches!(s, Sym::Coord(_))) || !coefs.is_empty();
+        let uses_normal = syms.iter().any(|s| matches!(s, Sym::Normal(_)));
+        Leaves { leaf, prologue, field_val, field_grad, coefs, uses_x, uses_normal }
+    }
 
-        // Which nodes depend on the quadrature point, and how often each is used.
-        let mut pointwise: HashMap<NodeId, bool> = HashMap::new();
-        let mut uses: HashMap<NodeId, usize> = HashMap::new();
-        // Cell-constant nodes read inside the loop (by a pointwise node or as an output).
-        let mut read_in_loop: HashSet<NodeId> = roots.iter().copied().collect();
-        for &n in &nodes {
-            let pw = match g.node(n) {
-                // Constant over the cell: hoisted out of the quadrature loop.
-                Node::Const(_) | Node::Sym(Sym::Param(_) | Sym::CellDiameter | Sym::Time) => false,
-                Node::Sym(_) => true,
-                _ => g.children(n).any(|c| pointwise[&c]),
-            };
-            pointwise.insert(n, pw);
-            for c in g.children(n) {
-                *uses.entry(c).or_default() += 1;
-                if pw {
-                    read_in_loop.insert(c);
-                }
-            }
-        }
-        for r in &roots {
-            *uses.entry(*r).or_default() += 1;
-        }
-
-        // Let-bound nodes: named in the source, used more than once, or hoisted out of the loop.
-        let mut bound: HashMap<NodeId, String> = HashMap::new();
-        let mut hoisted = String::new();
-        let mut point = String::new();
-        for &n in &nodes {
-            if matches!(g.node(n), Node::Const(_) | Node::Sym(_)) {
-                continue;
-            }
-            let named = g.names.get(&n);
-            let crosses = !pointwise[&n] && read_in_loop.contains(&n);
-            if named.is_none() && uses.get(&n).copied().unwrap_or(0) <= 1 && !crosses {
-                continue;
-            }
-            let (text, _) = self.expr(n, &leaf, &bound);
-            let local = namer.fresh(named.map_or(&format!("t{n}"), |s| s));
-            let line = format!("let {local} = {text};\n");
-            if pointwise[&n] {
-                point.push_str(&line)
-            } else {
-                hoisted.push_str(&line)
-            }
-            bound.insert(n, local);
-        }
-
-        // Weighted outputs (switches are signs: no weight).
-        let mut weighted = String::new();
-        let weight = if matches!(self.mode, Mode::Switches(_)) { "" } else { "w * " };
-        for (_, list) in &outputs {
-            for o in list.iter().flatten() {
-                let (text, prec) = match bound.get(&o.node) {
-                    Some(local) => (local.clone(), ATOM),
-                    None => self.expr(o.node, &leaf, &bound),
-                };
-                let text = if prec < UNARY && !weight.is_empty() { format!("({text})") } else { text };
-                let _ = writeln!(weighted, "let {} = {weight}{text};", o.name);
-            }
-        }
-
-        // Geometry needed at the point.
+    /// The geometry, coefs and fields at quadrature point `q`.
+    fn point(&self, outputs: &Outputs, leaves: &Leaves) -> String {
         let needs = |kinds: &[&str]| outputs.iter().any(|(k, l)| kinds.contains(k) && l.iter().any(Option::is_some));
-        let field_vals = field_val.iter().any(Option::is_some);
-        let field_grads = field_grad.iter().any(Option::is_some);
-        let need_phi = field_vals || uses_x || needs(&["f0", "c00", "c01", "c10"]);
+        let field_vals = leaves.field_val.iter().any(Option::is_some);
+        let field_grads = leaves.field_grad.iter().any(Option::is_some);
+        let need_phi = field_vals || leaves.uses_x || needs(&["f0", "c00", "c01", "c10"]);
         let need_dphi = field_grads || needs(&["f1", "c01", "c10", "c11"]);
-
+        // Switches are signs: they need no quadrature weight.
+        let weighted = !matches!(self.mode, Mode::Switches(_));
+        let normal = !self.integral.cell && (weighted || leaves.uses_normal);
         let mut s = String::new();
-        s.push_str(&prologue);
-        s.push_str(&hoisted);
-        s.push_str("for q in 0..ctx.tab.len() {\n");
         if need_phi {
             s.push_str("let phi = &ctx.tab.phi[q];\n");
         }
-        s.push_str("let jac = geometry::jacobian(ctx.coords, &ctx.tab.dphi[q]);\n");
-        if self.integral.cell {
-            s.push_str("let w = ctx.tab.weights[q] * jac.det.abs();\n");
-        } else {
-            s.push_str("let (n, scale) = geometry::facet_normal(&jac, ctx.ref_normal);\n");
-            s.push_str("let w = ctx.tab.weights[q] * scale;\n");
+        if weighted || need_dphi || normal {
+            s.push_str("let jac = geometry::jacobian(ctx.coords, &ctx.tab.dphi[q]);\n");
+        }
+        if normal {
+            let n = if leaves.uses_normal { "n" } else { "_" };
+            let scale = if weighted { "scale" } else { "_" };
+            let _ = writeln!(s, "let ({n}, {scale}) = geometry::facet_normal(&jac, ctx.ref_normal);");
+        }
+        match (weighted, self.integral.cell) {
+            (false, _) => {}
+            (true, true) => s.push_str("let w = ctx.tab.weights[q] * jac.det.abs();\n"),
+            (true, false) => s.push_str("let w = ctx.tab.weights[q] * scale;\n"),
         }
         if need_dphi {
             s.push_str("let dphi = geometry::physical_gradients(&jac, &ctx.tab.dphi[q]);\n");
         }
-        if uses_x {
+        if leaves.uses_x {
             s.push_str("let x = geometry::interpolate(ctx.coords, phi);\n");
         }
-        for (id, local) in &coef_locals {
+        for (id, local) in &leaves.coefs {
             let c = &self.prog.coefs[*id as usize];
-            let len = crate::ir::lower::components(c.shape, d);
+            let len = crate::ir::lower::components(c.shape, self.d);
             let _ = writeln!(
                 s,
                 "let mut {local} = [0.0; {len}];\nself.coefs.{}.eval(&x, t, &mut {local});",
                 ident(&c.name)
             );
         }
-        for (dofs, val) in field_val.iter().flatten() {
+        for (dofs, val) in leaves.field_val.iter().flatten() {
             let _ = writeln!(s, "let {val} = geometry::interpolate({dofs}, phi);");
         }
-        for (dofs, grad) in field_grad.iter().flatten() {
+        for (dofs, grad) in leaves.field_grad.iter().flatten() {
             let _ = writeln!(s, "let {grad} = geometry::gradient({dofs}, &dphi);");
         }
-        s.push_str(&point);
-        s.push_str(&weighted);
-        match self.mode {
-            Mode::Residual => s.push_str(&self.residual_loop(&outputs)),
-            Mode::Tangent(_) => s.push_str(&self.tangent_loop(&outputs)),
-            Mode::Switches(_) => {
-                for o in outputs.iter().flat_map(|(_, l)| l.iter().flatten()) {
-                    let _ = writeln!(s, "out.push({} > 0.0);", o.name);
-                }
-            }
-            Mode::Value => s.push_str("total += value;\n"),
-        }
-        s.push_str("}\n");
         s
     }
 
@@ -521,51 +546,5 @@ impl Body<'_> {
             }
         }
         format!("for i in 0..N {{\n{rows}for j in 0..N {{\n{cols}}}\n}}\n")
-    }
-
-    /// Rust text of a node and its precedence; let-bound nodes and leaves are names.
-    fn expr(&self, id: NodeId, leaf: &HashMap<Sym, String>, bound: &HashMap<NodeId, String>) -> (String, u8) {
-        let g = self.g;
-        let sub = |x: NodeId| -> (String, u8) {
-            if let Some(b) = bound.get(&x) {
-                return (b.clone(), ATOM);
-            }
-            self.expr(x, leaf, bound)
-        };
-        let wrap = |(t, p): (String, u8), min: u8| if p < min { format!("({t})") } else { t };
-        match g.node(id) {
-            Node::Const(b) => literal(f64::from_bits(b)),
-            Node::Sym(s) => (leaf[&s].clone(), ATOM),
-            Node::Add(a, b) => {
-                let l = wrap(sub(a), ADD);
-                match g.node(b) {
-                    Node::Neg(x) if !bound.contains_key(&b) => (format!("{l} - {}", wrap(sub(x), MUL)), ADD),
-                    Node::Const(c) if f64::from_bits(c) < 0.0 => {
-                        (format!("{l} - {}", literal(-f64::from_bits(c)).0), ADD)
-                    }
-                    _ => (format!("{l} + {}", wrap(sub(b), MUL)), ADD),
-                }
-            }
-            Node::Mul(a, b) => (format!("{} * {}", wrap(sub(a), MUL), wrap(sub(b), UNARY)), MUL),
-            Node::Div(a, b) => (format!("{} / {}", wrap(sub(a), MUL), wrap(sub(b), UNARY)), MUL),
-            Node::Neg(a) => (format!("-{}", wrap(sub(a), UNARY)), UNARY),
-            Node::Powi(a, k) => (format!("{}.powi({k})", wrap(sub(a), ATOM)), ATOM),
-            Node::Powf(a, p) => (format!("{}.powf({:?})", wrap(sub(a), ATOM), f64::from_bits(p)), ATOM),
-            Node::Sqrt(a) => (format!("{}.sqrt()", wrap(sub(a), ATOM)), ATOM),
-            Node::Heaviside(a) => (format!("heaviside({})", sub(a).0), ATOM),
-        }
-    }
-}
-
-/// A float literal (negative ones have unary precedence).
-fn literal(v: f64) -> (String, u8) {
-    if v.is_nan() {
-        ("f64::NAN".into(), ATOM)
-    } else if v.is_infinite() {
-        (if v > 0.0 { "f64::INFINITY".into() } else { "-f64::INFINITY".into() }, if v > 0.0 { ATOM } else { UNARY })
-    } else {
-        let s = format!("{v:?}");
-        let s = if s.contains(['.', 'e', 'E']) { s } else { format!("{s}.0") };
-        if v < 0.0 { (s, UNARY) } else { (s, ATOM) }
     }
 }

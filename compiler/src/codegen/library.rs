@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use super::names::ident;
+use super::names::{case_allowance, ident};
 use crate::docs;
 use crate::program::Program;
 use crate::scheme::SchemeIr;
@@ -76,7 +76,11 @@ pub fn forms_items(prog: &Program, own: &[(usize, &str)]) -> String {
         slots.join(", ")
     );
     s.push_str("/// Instantiates every form of this file on a mesh: param values in `PARAMS` order, coefs by name.\n");
-    s.push_str("pub fn make<'m>(values: &[f64], coefs: &dyn Fn(&str) -> Option<Coef>, bind: &Binding<'m>) -> Result<Made<'m>, LibraryError> {\n");
+    let coefs = if prog.coefs.is_empty() { "_coefs" } else { "coefs" };
+    let _ = writeln!(
+        s,
+        "pub fn make<'m>(values: &[f64], {coefs}: &dyn Fn(&str) -> Option<Coef>, bind: &Binding<'m>) -> Result<Made<'m>, LibraryError> {{"
+    );
     s.push_str("let mut params = Params::default();\n");
     s.push_str("for (name, value) in Params::NAMES.iter().zip(values) { params.set(name, *value)?; }\n");
     let fields: Vec<String> = prog
@@ -106,8 +110,9 @@ pub fn scheme_unit(prog: &Program, sch: &SchemeIr, struct_name: &str) -> (String
     let mut items = String::new();
     let _ = writeln!(
         items,
-        "/// Scheme `{}` with param values in declaration order.\nfn {make}(values: &[f64]) -> Result<Box<dyn TimeScheme>, LibraryError> {{\nlet mut scheme = {struct_name}::default();\nfor (name, value) in {struct_name}::NAMES.iter().zip(values) {{ scheme.set(name, *value)?; }}\nOk(Box::new(scheme))\n}}",
-        sch.name
+        "/// Scheme `{}` with param values in declaration order.\n{}fn {make}(values: &[f64]) -> Result<Box<dyn TimeScheme>, LibraryError> {{\nlet mut scheme = {struct_name}::default();\nfor (name, value) in {struct_name}::NAMES.iter().zip(values) {{ scheme.set(name, *value)?; }}\nOk(Box::new(scheme))\n}}",
+        sch.name,
+        case_allowance([make.as_str()])
     );
     let params: Vec<String> = sch
         .params

@@ -41,14 +41,59 @@ pub fn camel(name: &str) -> String {
     out
 }
 
+/// Whether rustc takes `name` for snake case (`non_snake_case`): no uppercase letter, and no
+/// two underscores in a row but at its ends.
+pub fn is_snake_case(name: &str) -> bool {
+    let inner = name.trim_matches('_');
+    !inner.chars().any(char::is_uppercase) && !inner.contains("__")
+}
+
+/// `#[allow(non_snake_case)]` before an item that declares one of `names` as the file wrote
+/// it (`param E`, `fn P`), else nothing.
+pub fn case_allowance<'a>(names: impl IntoIterator<Item = &'a str>) -> &'static str {
+    if names.into_iter().all(is_snake_case) { "" } else { "#[allow(non_snake_case)]\n" }
+}
+
+/// The identifiers of some Rust text.
+pub fn words(text: &str) -> HashSet<&str> {
+    text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).collect()
+}
+
+/// The names generated Rust binds with `let` (`let x`, `let mut x`, `let (a, b)`).
+pub fn locals(text: &str) -> Vec<&str> {
+    let mut out = Vec::new();
+    for rest in text.split("let ").skip(1) {
+        let rest = rest.trim_start_matches("mut ");
+        let pattern = match rest.strip_prefix('(') {
+            Some(tuple) => tuple.split(')').next().unwrap_or(""),
+            None => rest.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).next().unwrap_or(""),
+        };
+        out.extend(pattern.split(',').map(str::trim).filter(|w| !w.is_empty()));
+    }
+    out
+}
+
 /// Allocates unique local names within one generated function.
 pub struct Namer {
     taken: HashSet<String>,
+    /// Temporaries allocated so far.
+    temporaries: usize,
 }
 
 impl Namer {
     pub fn new(reserved: &[&str]) -> Self {
-        Namer { taken: reserved.iter().map(|s| s.to_string()).collect() }
+        Namer { taken: reserved.iter().map(|s| s.to_string()).collect(), temporaries: 0 }
+    }
+
+    /// A name for a subexpression the source did not name: `tmp1`, `tmp2`, ...
+    pub fn temporary(&mut self) -> String {
+        loop {
+            self.temporaries += 1;
+            let name = format!("tmp{}", self.temporaries);
+            if self.taken.insert(name.clone()) {
+                return name;
+            }
+        }
     }
 
     /// `want` if free, else `want_`, `want_2`, `want_3`, ...

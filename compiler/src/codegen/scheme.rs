@@ -1,81 +1,77 @@
 //! Rust for a compiled scheme: a parameter struct named after the scheme, and its
 //! `TimeScheme` implementation: the static description of stages, terms and updates, and the
-//! evaluation of every coefficient for a step size.
+//! evaluation of every coefficient for a step size (written by `emit`, as the kernels are).
 
+use std::collections::HashMap;
 use std::fmt::Write;
 
-use super::names::ident;
-use crate::ir::graph::{Graph, Node, NodeId, Sym};
+use super::emit::Emitter;
+use super::names::{Namer, case_allowance, ident};
+use super::params::{ParamDecl, params_struct};
+use crate::ir::graph::{Node, NodeId, Sym};
 use crate::program::Program;
 use crate::scheme::layout::{self, Combination, Layout, TermLayout};
 use crate::scheme::{Quantity, SchemeIr};
 
 pub fn scheme_text(prog: &Program, s: &SchemeIr, struct_name: &str) -> String {
-    let params: Vec<(String, f64, Option<crate::check::ParamRange>)> =
-        s.params.iter().map(|p| (p.name.clone(), p.default, p.range)).collect();
-    let sig: Vec<String> = s.params.iter().map(|p| format!("{} = {}", p.name, p.default)).collect();
+    let params: Vec<ParamDecl> = s
+        .params
+        .iter()
+        .map(|p| ParamDecl {
+            name: &p.name,
+            default: p.default,
+            range: p.range,
+            range_expr: p.range_expr.as_ref(),
+            written: crate::docs::written(&prog.sources, p.span),
+        })
+        .collect();
+    let sig: Vec<String> = params.iter().map(|p| format!("{} = {}", p.name, p.written)).collect();
     let doc = format!("/// `scheme {}({})`: its parameters; it implements `TimeScheme`.\n", s.name, sig.join(", "));
-    let mut out = super::params_struct(struct_name, &doc, &params);
+    let mut out = params_struct(struct_name, &doc, &params);
     let layout = layout::layout(s);
     let desc = describe(prog, s, &layout);
     let _ = writeln!(out, "impl {struct_name} {{ pub const DESC: SchemeDesc = {desc}; }}");
+    let coefficients = coefficients_fn(&layout.coefficients, s);
+    out.push_str(case_allowance(super::names::locals(&coefficients)));
     let _ = writeln!(out, "impl TimeScheme for {struct_name} {{");
     out.push_str("fn desc(&self) -> &SchemeDesc { &Self::DESC }\n");
-    out.push_str("fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]) {\n");
-    out.push_str(&coefficient_code(&layout.coefficients, &s.graph, s));
-    out.push_str("}\n}\n");
+    out.push_str(&coefficients);
+    out.push_str("}\n");
     out
 }
 
-/// Straight-line evaluation of the needed nodes, then the stores.
-fn coefficient_code(order: &[NodeId], g: &Graph, s: &SchemeIr) -> String {
-    let mut out = String::new();
+/// `fn coefficients`: every coefficient of the layout, `out[k]`, by the one emitter: the
+/// scheme's params and `let`s by their names, shared subexpressions once, the rest inline.
+fn coefficients_fn(order: &[NodeId], s: &SchemeIr) -> String {
+    let g = &s.graph;
     let nodes = g.reachable(order.iter().copied());
-    let used_params: Vec<usize> =
-        (0..s.params.len()).filter(|&i| nodes.iter().any(|&n| g.node(n) == Node::Sym(Sym::Param(i as u16)))).collect();
-    for i in used_params {
-        let _ = writeln!(out, "let {} = self.{};", ident(&s.params[i].name), ident(&s.params[i].name));
-    }
-    let name = |n: NodeId| -> String {
-        match g.node(n) {
-            Node::Const(b) => literal(f64::from_bits(b)),
-            Node::Sym(Sym::Param(i)) => ident(&s.params[i as usize].name),
-            Node::Sym(Sym::Dt) => "dt".into(),
-            Node::Sym(Sym::Time) => "t".into(),
-            Node::Sym(_) => "f64::NAN".into(),
-            _ => format!("c{n}"),
-        }
-    };
+    let mut namer = Namer::new(&["self", "dt", "t", "out", "std", "f64", "heaviside"]);
+    let mut leaf: HashMap<Sym, String> = HashMap::new();
+    let mut body = String::new();
     for &n in &nodes {
-        let text = match g.node(n) {
-            Node::Const(_) | Node::Sym(_) => continue,
-            Node::Add(a, b) => format!("{} + {}", name(a), name(b)),
-            Node::Mul(a, b) => format!("{} * {}", name(a), name(b)),
-            Node::Div(a, b) => format!("{} / {}", name(a), name(b)),
-            Node::Neg(a) => format!("-{}", name(a)),
-            Node::Powi(a, k) => format!("{}.powi({k})", name(a)),
-            Node::Powf(a, p) => format!("{}.powf({:?})", name(a), f64::from_bits(p)),
-            Node::Sqrt(a) => format!("{}.sqrt()", name(a)),
-            Node::Heaviside(a) => format!("heaviside({})", name(a)),
+        let Node::Sym(sym) = g.node(n) else { continue };
+        let name = match sym {
+            Sym::Param(i) => {
+                let p = &s.params[i as usize].name;
+                let local = namer.fresh(p);
+                let _ = writeln!(body, "let {local} = self.{};", ident(p));
+                local
+            }
+            Sym::Dt => "dt".into(),
+            Sym::Time => "t".into(),
+            _ => "f64::NAN".into(),
         };
-        let _ = writeln!(out, "let c{n} = {text};");
+        leaf.insert(sym, name);
     }
+    let emitter = Emitter::new(g, &leaf);
+    let lines = emitter.bind(order, |_| false, false, &mut namer);
+    body.push_str(&lines.invariant);
     for (k, &n) in order.iter().enumerate() {
-        let _ = writeln!(out, "out[{k}] = {};", name(n));
+        let _ = writeln!(body, "out[{k}] = {};", emitter.value(n, &lines).0);
     }
-    out
-}
-
-fn literal(v: f64) -> String {
-    if v.is_nan() {
-        return "f64::NAN".into();
-    }
-    if v.is_infinite() {
-        return if v > 0.0 { "f64::INFINITY".into() } else { "f64::NEG_INFINITY".into() };
-    }
-    let s = format!("{v:?}");
-    let s = if s.contains(['.', 'e', 'E']) { s } else { format!("{s}.0") };
-    if v < 0.0 { format!("({s})") } else { s }
+    let words = super::names::words(&body);
+    let arg = |name: &str| if words.contains(name) { name.to_string() } else { format!("_{name}") };
+    format!("fn coefficients(&self, {}: f64, {}: f64, out: &mut [f64]) {{\n{body}}}\n", arg("dt"), arg("t"))
 }
 
 fn level(q: Quantity) -> String {

@@ -2,8 +2,16 @@
 
 use std::collections::BTreeMap;
 
-use super::Quantity;
 use crate::ir::graph::{Graph, NodeId, Sym};
+
+/// A vector known when a stage starts, or one of its new quantities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Quantity {
+    /// A state at the start of the step.
+    State(usize),
+    /// New quantity `index` of stage `stage`.
+    Stage { stage: usize, index: usize },
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Key {

@@ -7,7 +7,7 @@ use tracing::debug;
 
 use crate::linalg::lowrank::LowRank;
 use crate::linalg::{Counters, Factorization, LinalgError, Matrix, Solver, Structure};
-use crate::nonlinear::newton::{NewtonOptions, NonlinearProblem};
+use crate::nonlinear::problem::NonlinearProblem;
 
 /// Bytes of cached correction columns (current and previous reference together).
 const COLUMN_BYTES: usize = 256 << 20;
@@ -212,7 +212,8 @@ impl JacobianReuse {
         p: &mut impl NonlinearProblem,
         w: &[f64],
         piecewise: bool,
-        options: &NewtonOptions,
+        solver: Solver,
+        max_rank: usize,
     ) -> Result<bool, LinalgError> {
         let mut assembled = false;
         if piecewise && !self.force_refactor && self.low_rank.is_some() {
@@ -236,7 +237,7 @@ impl JacobianReuse {
                 dofs = other;
             }
             let new_columns = self.low_rank.as_ref().map_or(0, |lr| lr.missing(&dofs));
-            let updated = dofs.len() <= self.rank_limit(j.size(), options.max_rank)
+            let updated = dofs.len() <= self.rank_limit(j.size(), max_rank)
                 && self.cached_columns() + new_columns <= self.column_limit(j.size())
                 && match (self.low_rank.as_mut(), self.factorization.as_mut()) {
                     (Some(lr), Some(f)) => {
@@ -275,9 +276,9 @@ impl JacobianReuse {
         self.low_rank = None;
         self.overhead = 0;
         self.reference_accuracy = None;
-        self.refactor(p, w, assembled, options.solver)?;
+        self.refactor(p, w, assembled, solver)?;
         let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
-        if piecewise && direct && options.max_rank > 0 {
+        if piecewise && direct && max_rank > 0 {
             let mut lr = LowRank::new(self.jacobian.as_ref().expect("assembled by refactor"));
             lr.set_elements(p.tangent_elements(w));
             self.low_rank = Some(lr);

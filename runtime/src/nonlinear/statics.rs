@@ -5,7 +5,7 @@
 use crate::fem::assembly::Assembler;
 use crate::fem::bound::BoundForm;
 use crate::linalg::{Matrix, Structure};
-use crate::nonlinear::newton::NonlinearProblem;
+use crate::nonlinear::problem::NonlinearProblem;
 
 /// Dirichlet conditions: dofs held at given values (zero unless set).
 #[derive(Clone, Debug, PartialEq)]

@@ -11,7 +11,7 @@ use crate::linalg::element_matrices::ElementMatrices;
 use crate::linalg::lower_half::{HalfPattern, LowerHalf};
 use crate::linalg::pattern::Entries;
 use crate::linalg::{Matrix, Structure};
-use crate::nonlinear::newton::NonlinearProblem;
+use crate::nonlinear::problem::NonlinearProblem;
 use crate::nonlinear::statics::Constraints;
 
 /// The first element whose tangent entries of `form` are not finite: its nodes' positions

@@ -9,7 +9,8 @@ use crate::common::{MassStiffness, pseudo_random};
 use signorini_runtime::fem::assembly::{Assembler, Quadrature};
 use signorini_runtime::fem::mesh::structured::interval;
 use signorini_runtime::linalg::{Counters, Matrix, Solver, Structure};
-use signorini_runtime::nonlinear::newton::{Newton, NewtonOptions, NonlinearProblem};
+use signorini_runtime::nonlinear::newton::{Newton, NewtonOptions};
+use signorini_runtime::nonlinear::problem::NonlinearProblem;
 use signorini_runtime::nonlinear::statics::Constraints;
 
 const EPS: f64 = 1e4;

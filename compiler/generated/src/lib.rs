@@ -1,0 +1,67 @@
+//! The Rust the compiler generates for every file of the form library (`forms/`,
+//! `forms/schemes/`), as `signorini emit --stage rust` prints it and the snapshots record it,
+//! compiled here with every warning an error: generated code that warns (rustc's lints, or
+//! clippy's under `cargo clippy`) fails the build of this crate, and so `cargo test`.
+
+#![deny(warnings)]
+
+include!(concat!(env!("OUT_DIR"), "/generated.rs"));
+
+#[cfg(test)]
+mod tests {
+    use std::path::{Path, PathBuf};
+
+    use signorini_compiler::scheme::{eval_all, layout};
+    use signorini_compiler::{FsLoader, compile};
+
+    fn library() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../forms")
+    }
+
+    /// The stems of the `.wf` files of a folder.
+    fn stems(dir: &Path) -> Vec<String> {
+        let entries = std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+        entries
+            .map(|e| e.expect("a readable entry").path())
+            .filter(|p| p.extension().is_some_and(|e| e == "wf"))
+            .map(|p| p.file_stem().expect("a file name").to_string_lossy().into_owned())
+            .collect()
+    }
+
+    #[test]
+    fn every_file_of_the_library_is_compiled_here() {
+        let mut expected = stems(&library());
+        expected.extend(stems(&library().join("schemes")));
+        expected.sort();
+        let mut compiled: Vec<&str> = super::UNITS.iter().map(|u| u.name).collect();
+        compiled.sort();
+        assert_eq!(compiled, expected);
+    }
+
+    /// A scheme's generated `coefficients` computes what the IR evaluator computes from the
+    /// compiled scheme, bit for bit: the emitter writes each node as one operation, in the
+    /// graph's order, whether it binds it to a `let` or inlines it.
+    #[test]
+    fn generated_scheme_coefficients_are_the_ir_evaluators_to_the_bit() {
+        let mut checked = 0;
+        for unit in super::UNITS {
+            for s in unit.schemes {
+                let path = library().join("schemes").join(unit.file);
+                let compiled = compile(&path, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", path.display()));
+                let ir = compiled.schemes().iter().find(|i| i.name == s.name).expect("the scheme compiles");
+                let order = layout::layout(ir).coefficients;
+                let defaults: Vec<f64> = s.params.iter().map(|p| p.default).collect();
+                let scheme = (s.make)(&defaults).expect("the defaults are in range");
+                for (dt, t) in [(1e-3, 0.0), (0.05, 0.7), (2.0, 3.0)] {
+                    let mut generated = vec![f64::NAN; s.desc.coefficients];
+                    scheme.coefficients(dt, t, &mut generated);
+                    let evaluated = eval_all(&ir.graph, &order, &defaults, dt, t);
+                    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    assert_eq!(bits(&generated), bits(&evaluated), "{} at dt = {dt}, t = {t}", s.name);
+                }
+                checked += 1;
+            }
+        }
+        assert!(checked >= 9, "{checked} schemes");
+    }
+}

@@ -1,0 +1,405 @@
+//! Checks of a `problem` item that need no mesh and no bound files: its params, one mesh, a
+//! known generator or obstacle helper with its arguments, distinct names, the run and
+//! quadrature settings, and the shape of every expression with the names its place allows
+//! (`x` and `t` in coefs and fields, `n` in region predicates). What depends on the mesh (its
+//! groups, empty regions, the dimension) or on the files bound to the slots (unset coefs,
+//! observables) is checked when the problem is bound (`signorini check` does both).
+//!
+//! `catalogue` is the vocabulary a problem may use, `measures` the checks of its series and
+//! summary.
+
+mod catalogue;
+mod measures;
+
+use std::collections::HashMap;
+
+pub use catalogue::*;
+use measures::{RowScope, SummaryScope, row, summary};
+
+use super::types::Checker;
+use crate::diagnostic::Diagnostic;
+use crate::source::Span;
+use crate::syntax::ast::{
+    Defined, Dirichlet, Expr, HeldAt, Ident, MeshSource, NamedCall, Problem, RegionSource, Shape,
+};
+
+use Shape::{Scalar, Vector};
+
+/// Names with their shapes, as an expression of the problem sees them.
+type Names = [(String, Shape)];
+
+pub(in crate::check) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
+    let constants = params_and_lets(c, p, diags);
+    mesh(c, p, &constants, diags);
+    region_predicates(c, p, &constants, diags);
+    bindings(p, diags);
+    settings_of_the_run(c, p, &constants, diags);
+    let fields = &constants;
+    distinct(p.coefs.iter().map(|d| &d.name), "coef", diags);
+    for d in &p.coefs {
+        expression(c, &d.value, fields, diags, false);
+    }
+    distinct(p.initial.iter().map(|d| &d.name), "initial field", diags);
+    for d in &p.initial {
+        if !INITIAL_FIELDS.contains(&d.name.name.as_str()) {
+            diags.push(unknown_among(&d.name, INITIAL_FIELDS.iter().copied(), "initial field"));
+        }
+        vector(c, &d.value, fields, diags);
+    }
+    let regions: Vec<&str> = p.regions.iter().map(|r| r.name.name.as_str()).collect();
+    dirichlet(c, p, fields, &regions, diags);
+    obstacles(c, p, fields, &regions, diags);
+    measures(c, p, &constants, &regions, diags);
+}
+
+/// The params (constants with a default in their range, as a scheme's) and the lets, in order,
+/// each seeing the ones before: the names every later expression sees.
+fn params_and_lets(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) -> Vec<(String, Shape)> {
+    let mut names: Vec<(String, Shape)> = p.params.iter().map(|q| (q.name.name.clone(), Scalar)).collect();
+    distinct(p.params.iter().map(|q| &q.name), "parameter", diags);
+    // A param named like a built-in value would hide it (`n`, the normal in region predicates).
+    // `h` stays a param's name: problems read no cell size.
+    for q in p.params.iter().map(|q| &q.name).chain(p.lets.iter().map(|l| &l.name)) {
+        if ["x", "t", "n", "pi"].contains(&q.name.as_str()) {
+            diags.push(
+                Diagnostic::error("E0106", format!("`{}` is a built-in name", q.name), q.span, "would hide it")
+                    .with_note("x is the position, t the time, n the facet normal, pi is π")
+                    .with_help("give it another name"),
+            );
+        }
+    }
+    for q in &p.params {
+        c.problem_ty(&q.default, &[]);
+    }
+    distinct(p.lets.iter().map(|d| &d.name), "let", diags);
+    for d in &p.lets {
+        let shape = expression(c, &d.value, &names.clone(), diags, false).unwrap_or(Scalar);
+        names.push((d.name.name.clone(), shape));
+    }
+    names
+}
+
+/// One mesh: a file, or a known generator with its arguments.
+fn mesh(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut Vec<Diagnostic>) {
+    match p.mesh.as_slice() {
+        [] => diags.push(
+            Diagnostic::error("E0901", format!("problem `{}` has no mesh", p.name.name), p.name.span, "no `mesh` line")
+                .with_help("add `mesh \"body.msh\"` (a Gmsh file beside the problem) or a generator such as `mesh disc(radius = 10, centre = [0, 12], h = 1)`"),
+        ),
+        [MeshSource::Generator(call)] => builtin_call(c, call, GENERATORS, "mesh generator", constants, diags),
+        [_] => {}
+        [_, second, ..] => {
+            let span = match second {
+                MeshSource::File { span, .. } => *span,
+                MeshSource::Generator(call) => call.span,
+            };
+            diags.push(Diagnostic::error("E0102", "a problem has one mesh", span, "second `mesh`"));
+        }
+    }
+}
+
+/// Distinct region names; their predicates are scalars that may read `n`.
+fn region_predicates(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut Vec<Diagnostic>) {
+    distinct(p.regions.iter().map(|r| &r.name), "region", diags);
+    // `x` and `t` are built-in names; `n` too, but it means something only on a facet.
+    for r in &p.regions {
+        for s in &r.sources {
+            let (RegionSource::Boundary { conditions, .. } | RegionSource::Group { conditions, .. }) = s;
+            for cmp in conditions {
+                for side in [&cmp.lhs, &cmp.rhs] {
+                    scalar(c, side, constants, diags, true);
+                }
+            }
+        }
+    }
+}
+
+/// Known roles, each bound once (but `forms`).
+fn bindings(p: &Problem, diags: &mut Vec<Diagnostic>) {
+    let mut bound: HashMap<&str, Span> = HashMap::new();
+    for b in &p.binds {
+        if !ROLES.iter().any(|(r, _)| *r == b.role.name) {
+            diags.push(unknown_among(&b.role, ROLES.iter().map(|(r, _)| *r), "role"));
+        } else if b.role.name != "forms"
+            && let Some(prev) = bound.insert(&b.role.name, b.role.span)
+        {
+            diags.push(
+                Diagnostic::error("E0103", format!("`{}` bound twice", b.role.name), b.role.span, "again here")
+                    .with_label(prev, "first here"),
+            );
+        }
+    }
+}
+
+/// The reference's arguments, the run settings (or `run static`) and the quadrature settings.
+fn settings_of_the_run(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut Vec<Diagnostic>) {
+    // A reference's arguments are numbers of the params (the reference checks their names).
+    distinct(p.reference_args.iter().map(|a| &a.name), "argument", diags);
+    for a in &p.reference_args {
+        scalar(c, &a.value, constants, diags, false);
+    }
+    settings(&p.run, RUN_SETTINGS.iter().map(|(n, _)| *n), "run setting", c, constants, diags);
+    if let (Some(at), Some(first)) = (p.run_static, p.run.first()) {
+        diags.push(
+            Diagnostic::error("E0103", "`run static` with time settings", first.name.span, "a time setting")
+                .with_label(at, "one equilibrium")
+                .with_help("a static problem has no time: drop `run dt = ...`, or `run static` for a time run"),
+        );
+    }
+    settings(&p.quadrature, QUADRATURE_SETTINGS.iter().copied(), "quadrature setting", c, constants, diags);
+}
+
+/// Dirichlet conditions: on `u`, on a known region that is not a contact region, or at the
+/// node nearest a point.
+fn dirichlet(c: &mut Checker, p: &Problem, fields: &Names, regions: &[&str], diags: &mut Vec<Diagnostic>) {
+    for d in &p.dirichlet {
+        if d.field.name != "u" {
+            diags.push(unknown_among(&d.field, ["u"].into_iter(), "Dirichlet field"));
+        }
+        let region = match &d.on {
+            HeldAt::Region(r) => r,
+            HeldAt::Nearest { point, .. } => {
+                // A point: a constant vector (the node is found once, on the mesh).
+                vector(c, point, fields, diags);
+                held_value(c, d, fields, diags);
+                continue;
+            }
+        };
+        if !regions.contains(&region.name.as_str()) {
+            diags.push(unknown_among(region, regions.iter().copied(), "region"));
+        }
+        // An obstacle's region is where contact is imposed: a displacement held there too
+        // leaves the contact nothing to decide.
+        if let Some(o) =
+            p.obstacles.iter().find(|o| o.region.as_ref().map_or("Gamma_C", |r| r.name.as_str()) == region.name)
+        {
+            diags.push(
+                Diagnostic::error(
+                    "E0905",
+                    "a Dirichlet condition on a contact region",
+                    region.span,
+                    "contact is imposed here",
+                )
+                .with_label(o.span, "the obstacle faces this region")
+                .with_help("hold another part of the boundary: a region of its own (`region Gamma_D = ...`)"),
+            );
+        }
+        held_value(c, d, fields, diags);
+    }
+}
+
+/// Obstacles: a known helper with its arguments, facing a known region.
+fn obstacles(c: &mut Checker, p: &Problem, fields: &Names, regions: &[&str], diags: &mut Vec<Diagnostic>) {
+    for o in &p.obstacles {
+        builtin_call(c, &o.shape, OBSTACLES, "obstacle", fields, diags);
+        // The contact law imposes it on its region: `on REGION`, or `Gamma_C`.
+        match &o.region {
+            Some(r) if !regions.contains(&r.name.as_str()) => {
+                diags.push(unknown_among(r, regions.iter().copied(), "region"))
+            }
+            // The contact law's `Gamma_C` is bound to the obstacle's region: a region of that
+            // name besides would be hidden.
+            Some(r) if r.name != "Gamma_C" && regions.contains(&"Gamma_C") => diags.push(
+                Diagnostic::error("E0103", "two contact regions", r.span, "the contact law's `Gamma_C` is bound here")
+                    .with_label(
+                        p.regions.iter().find(|x| x.name.name == "Gamma_C").map_or(r.span, |x| x.name.span),
+                        "and a region `Gamma_C` is defined here",
+                    )
+                    .with_help("name the obstacle's region `Gamma_C`, or rename the other region"),
+            ),
+            None if !regions.contains(&"Gamma_C") => diags.push(
+                Diagnostic::error("E0101", "an obstacle without its region", o.span, "faces `Gamma_C`, not defined")
+                    .with_help("add `on REGION`, or `region Gamma_C = group \"NAME\"` (or `boundary where ...`)"),
+            ),
+            _ => {}
+        }
+    }
+}
+
+/// Series columns and summary keys, each named once; the columns' and keys' expressions; the
+/// plots' columns.
+fn measures(c: &mut Checker, p: &Problem, constants: &Names, regions: &[&str], diags: &mut Vec<Diagnostic>) {
+    let mut columns: HashMap<&str, Span> = HashMap::new();
+    for d in p.series.iter().map(|(d, _)| d).chain(&p.summary) {
+        if let Some(prev) = columns.insert(&d.name.name, d.name.span) {
+            diags.push(
+                Diagnostic::error("E0102", format!("`{}` is measured twice", d.name.name), d.name.span, "again here")
+                    .with_label(prev, "first here"),
+            );
+        }
+    }
+    // Pointwise expressions see the fields, the problem's coefs and the obstacles' g and nc.
+    let mut pointwise = constants.to_vec();
+    pointwise.extend([("u".to_string(), Vector), ("v".to_string(), Vector)]);
+    for d in &p.coefs {
+        let shape = c.problem_ty(&d.value, constants).map_or(Scalar, |t| t.shape);
+        pointwise.push((d.name.name.clone(), shape));
+    }
+    if !p.obstacles.is_empty() {
+        pointwise.extend([("g".to_string(), Scalar), ("nc".to_string(), Vector)]);
+    }
+    let mut earlier: Vec<&str> = Vec::new();
+    for (d, _) in &p.series {
+        let scope = RowScope { constants, pointwise: &pointwise, regions, earlier: &earlier };
+        row(c, &d.value, &scope, diags);
+        earlier.push(&d.name.name);
+    }
+    // Every row has its time.
+    earlier.push("t");
+    let mut keys: Vec<&str> = Vec::new();
+    for d in &p.summary {
+        let scope = SummaryScope { columns: &earlier, keys: &keys, constants };
+        summary(&d.value, &scope, false, diags);
+        keys.push(&d.name.name);
+    }
+    for pl in &p.plots {
+        for col in &pl.columns {
+            if !p.series.iter().any(|(d, _)| d.name.name == col.name) {
+                diags.push(unknown_among(col, p.series.iter().map(|(d, _)| d.name.name.as_str()), "series column"));
+            }
+        }
+    }
+}
+
+fn settings<'a>(
+    list: &[Defined],
+    known: impl Iterator<Item = &'a str> + Clone,
+    what: &str,
+    c: &mut Checker,
+    names: &[(String, Shape)],
+    diags: &mut Vec<Diagnostic>,
+) {
+    distinct(list.iter().map(|d| &d.name), what, diags);
+    for d in list {
+        if !known.clone().any(|k| k == d.name.name) {
+            diags.push(unknown_among(&d.name, known.clone(), what));
+        }
+        scalar(c, &d.value, names, diags, false);
+    }
+}
+
+/// A Dirichlet condition's component and value: a scalar for `u[k]`, a vector for `u`.
+fn held_value(c: &mut Checker, d: &Dirichlet, fields: &[(String, Shape)], diags: &mut Vec<Diagnostic>) {
+    match &d.component {
+        Some(k) => {
+            if !crate::check::const_value(k).is_some_and(|k| k >= 0.0 && k.fract() == 0.0 && k < 3.0) {
+                diags.push(Diagnostic::error("E0302", "a component index must be 0, 1 or 2", k.span, "not one"));
+            }
+            scalar(c, &d.value, fields, diags, false);
+        }
+        None => vector(c, &d.value, fields, diags),
+    }
+}
+
+fn builtin_call(
+    c: &mut Checker,
+    call: &NamedCall,
+    catalogue: &[Builtin],
+    what: &str,
+    names: &[(String, Shape)],
+    diags: &mut Vec<Diagnostic>,
+) {
+    let Some(b) = catalogue.iter().find(|b| b.name == call.name.name) else {
+        diags.push(unknown_among(&call.name, catalogue.iter().map(|b| b.name), what));
+        return;
+    };
+    distinct(call.args.iter().map(|a| &a.name), "argument", diags);
+    for a in &call.args {
+        match b.args.iter().find(|(n, _, _)| *n == a.name.name) {
+            Some((_, Scalar, _)) => scalar(c, &a.value, names, diags, false),
+            Some(_) => vector(c, &a.value, names, diags),
+            None => diags.push(unknown_among(
+                &a.name,
+                b.args.iter().map(|(n, _, _)| *n),
+                &format!("argument of `{}`", b.name),
+            )),
+        }
+    }
+    for (n, _, optional) in b.args {
+        if !optional && !call.args.iter().any(|a| a.name.name == *n) {
+            diags.push(
+                Diagnostic::error("E0201", format!("`{}` needs `{n}`", b.name), call.span, format!("no `{n} = ...`"))
+                    .with_note(format!("{}: {}", b.name, b.doc)),
+            );
+        }
+    }
+}
+
+fn expression(
+    c: &mut Checker,
+    e: &Expr,
+    names: &[(String, Shape)],
+    diags: &mut Vec<Diagnostic>,
+    facet: bool,
+) -> Option<Shape> {
+    let ty = c.problem_ty(e, names)?;
+    if !facet && let Some(at) = ty.facet {
+        diags.push(Diagnostic::error("E0501", "`n` or `h` outside a region predicate", at, "no facet here").with_help(
+            "a problem's coefs and fields are functions of `x` and `t`; the normal is known in `boundary where ...`",
+        ));
+    }
+    Some(ty.shape)
+}
+
+pub(super) fn scalar(c: &mut Checker, e: &Expr, names: &[(String, Shape)], diags: &mut Vec<Diagnostic>, facet: bool) {
+    if let Some(s) = expression(c, e, names, diags, facet)
+        && s != Scalar
+    {
+        diags.push(Diagnostic::error(
+            "E0301",
+            "shape mismatch",
+            e.span,
+            format!("a scalar is needed here, not a {}", s.name()),
+        ));
+    }
+}
+
+pub(super) fn vector(c: &mut Checker, e: &Expr, names: &[(String, Shape)], diags: &mut Vec<Diagnostic>) {
+    if let Some(s) = expression(c, e, names, diags, false)
+        && s != Vector
+    {
+        diags.push(Diagnostic::error(
+            "E0301",
+            "shape mismatch",
+            e.span,
+            format!("a vector is needed here, not a {}", s.name()),
+        ));
+    }
+}
+
+fn distinct<'a>(names: impl Iterator<Item = &'a Ident>, what: &str, diags: &mut Vec<Diagnostic>) {
+    let mut seen: HashMap<&str, Span> = HashMap::new();
+    for n in names {
+        if let Some(prev) = seen.insert(&n.name, n.span) {
+            diags.push(
+                Diagnostic::error("E0103", format!("duplicate {what} `{}`", n.name), n.span, "repeated here")
+                    .with_label(prev, "first here"),
+            );
+        }
+    }
+}
+
+/// E0101 for `id`, which is none of `known`, with the closest and the list.
+pub fn unknown_among<'a>(id: &Ident, known: impl Iterator<Item = &'a str> + Clone, what: &str) -> Diagnostic {
+    let mut d = Diagnostic::error("E0101", format!("unknown {what} `{}`", id.name), id.span, "not one of them");
+    if let Some(s) = crate::check::suggest_name(&id.name, known.clone()) {
+        d = d.with_help(format!("did you mean `{s}`?"));
+    }
+    let list: Vec<&str> = known.collect();
+    if list.is_empty() {
+        return d.with_note(format!("there is no {what}"));
+    }
+    d.with_note(format!("the {what}s: {}", list.join(", ")))
+}
+
+/// W0004: coef `name` of a problem is read by none of `files` (the files of the run).
+pub fn unread_coef(name: &Ident, files: &[&str]) -> Diagnostic {
+    Diagnostic::warning(
+        "W0004",
+        format!("coef `{}` is set, but no file in use reads it", name.name),
+        name.span,
+        "not read",
+    )
+    .with_note(format!("the files in use: {}", files.join(", ")))
+    .with_help("check its name against the forms' `coef` lines, or add the file that reads it (--forms, --material)")
+}

@@ -1,0 +1,224 @@
+//! Calls: a user's `fn`, inlined with the types of its arguments (memoised, bounded), and the
+//! built-in functions with their arities and shapes.
+
+use super::{Checker, MAX_EXPANSIONS, MAX_INLINE_DEPTH, Ty};
+use crate::check::Global;
+use crate::check::builtins::{self, BUILTIN_FUNCTIONS, BUILTIN_VALUES, NONLINEAR};
+use crate::diagnostic::Diagnostic;
+use crate::syntax::ast::{Expr, Ident, Shape};
+
+impl Checker<'_> {
+    pub(super) fn call_ty(&mut self, e: &Expr, f: &Ident, args: &[Expr]) -> Option<Ty> {
+        if let Some((_, _)) = self.scope.iter().find(|(n, _)| *n == f.name) {
+            self.error(Diagnostic::error(
+                "E0204",
+                format!("`{}` is not a function", f.name),
+                f.span,
+                "a value, not a function",
+            ));
+            return None;
+        }
+        let arg_tys: Vec<Option<Ty>> = args.iter().map(|a| self.ty(a)).collect();
+        match self.prog.globals.get(&f.name) {
+            Some(Global::Fn { params, body, .. }) => self.inline_call(e, f, params, body, arg_tys),
+            Some(g) => {
+                if let Global::Param(i) = g {
+                    self.used_params.insert(*i);
+                }
+                let kind = g.kind();
+                let mut d = Diagnostic::error(
+                    "E0204",
+                    format!("`{}` is a {kind}, not a function", f.name),
+                    f.span,
+                    "cannot be called",
+                );
+                if kind == "form" {
+                    d = d.with_note("forms are applied to time levels in schemes, not called inside expressions");
+                }
+                self.error(d);
+                None
+            }
+            // A problem's numbers round up or down (the lowering checks that they are numbers).
+            None if self.vectors_allowed && builtins::NUMBER_FUNCTIONS.contains(&f.name.as_str()) => {
+                if args.len() != 1 {
+                    self.arity_error(e, f, 1, args.len());
+                    return None;
+                }
+                let ty = arg_tys.into_iter().next().flatten()?;
+                if ty.shape != Shape::Scalar {
+                    self.error(Diagnostic::error(
+                        "E0301",
+                        "shape mismatch",
+                        args[0].span,
+                        format!("`{}` takes a scalar", f.name),
+                    ));
+                    return None;
+                }
+                let round = if f.name == "ceil" { f64::ceil } else { f64::floor };
+                Some(Ty { konst: ty.konst.map(round), ..ty })
+            }
+            None if BUILTIN_FUNCTIONS.contains(&f.name.as_str()) => {
+                let want = builtins::arity(&f.name);
+                if want != args.len() {
+                    self.arity_error(e, f, want, args.len());
+                    return None;
+                }
+                let tys: Vec<Ty> = arg_tys.into_iter().collect::<Option<_>>()?;
+                self.builtin_ty(e, f, args, &tys)
+            }
+            None if BUILTIN_VALUES.contains(&f.name.as_str()) => {
+                self.error(Diagnostic::error(
+                    "E0204",
+                    format!("`{}` is a built-in value, not a function", f.name),
+                    f.span,
+                    "cannot be called",
+                ));
+                None
+            }
+            None => {
+                self.unknown(f);
+                None
+            }
+        }
+    }
+
+    /// A call of the user's `fn` with these parameters and body, inlined: its body checked with
+    /// the argument types (once per distinct types), not recursive, not nested or expanded
+    /// past the limits.
+    fn inline_call(
+        &mut self,
+        e: &Expr,
+        f: &Ident,
+        params: &[Ident],
+        body: &Expr,
+        arg_tys: Vec<Option<Ty>>,
+    ) -> Option<Ty> {
+        if params.len() != arg_tys.len() {
+            self.arity_error(e, f, params.len(), arg_tys.len());
+            return None;
+        }
+        let arg_tys: Vec<Ty> = arg_tys.into_iter().collect::<Option<_>>()?;
+        let key = (f.name.clone(), arg_tys.iter().map(Ty::key).collect::<Vec<_>>());
+        if let Some((ty, used)) = self.memo.get(&key) {
+            self.used_params.extend(used.iter().copied());
+            return *ty;
+        }
+        if self.calls.iter().any(|(n, _)| *n == f.name) {
+            self.error(
+                Diagnostic::error("E0105", format!("`{}` calls itself", f.name), f.span, "recursive call")
+                    .with_note("functions are inlined, so they cannot be recursive"),
+            );
+            return None;
+        }
+        if self.calls.len() >= MAX_INLINE_DEPTH {
+            self.error(Diagnostic::error(
+                "E0105",
+                "functions nested too deeply",
+                f.span,
+                format!("more than {MAX_INLINE_DEPTH} nested calls"),
+            ));
+            return None;
+        }
+        self.expansions += 1;
+        if self.expansions > MAX_EXPANSIONS {
+            if self.expansions == MAX_EXPANSIONS + 1 {
+                self.error(
+                    Diagnostic::error(
+                        "E0002",
+                        "functions expand too far",
+                        e.span,
+                        format!("more than {MAX_EXPANSIONS} inlined calls with distinct arguments"),
+                    )
+                    .with_help("functions are inlined at every call: compute shared values once with `let`"),
+                );
+            }
+            return None;
+        }
+        let scope = params.iter().zip(arg_tys).map(|(p, t)| (p.name.clone(), t)).collect();
+        let saved = std::mem::replace(&mut self.scope, scope);
+        let saved_used = std::mem::take(&mut self.used_params);
+        self.calls.push((f.name.clone(), e.span));
+        let ty = self.ty(body);
+        self.calls.pop();
+        self.scope = saved;
+        let used = std::mem::replace(&mut self.used_params, saved_used);
+        self.used_params.extend(used.iter().copied());
+        self.memo.insert(key, (ty, used));
+        ty
+    }
+
+    pub(super) fn arity_error(&mut self, e: &Expr, f: &Ident, want: usize, got: usize) {
+        let plural = |n: usize| if n == 1 { "argument" } else { "arguments" };
+        let mut d = Diagnostic::error(
+            "E0201",
+            format!(
+                "`{}` takes {want} {}, but {got} {} given",
+                f.name,
+                plural(want),
+                if got == 1 { "was" } else { "were" }
+            ),
+            e.span,
+            format!("{got} {}", plural(got)),
+        );
+        if let Some(Global::Fn { span, .. }) = self.prog.globals.get(&f.name) {
+            d = d.with_label(*span, "defined here");
+        }
+        self.error(d);
+    }
+
+    pub(super) fn builtin_ty(&mut self, e: &Expr, f: &Ident, args: &[Expr], tys: &[Ty]) -> Option<Ty> {
+        let name = f.name.as_str();
+        let shapes: Vec<Shape> = tys.iter().map(|t| t.shape).collect();
+        let shape = match builtins::result_shape(name, &shapes) {
+            Ok(s) => s,
+            Err(msg) => {
+                let mut d = Diagnostic::error("E0301", "shape mismatch", e.span, msg);
+                for (a, t) in args.iter().zip(tys) {
+                    d = d.with_label(a.span, t.shape.name());
+                }
+                self.error(d);
+                return None;
+            }
+        };
+        if NONLINEAR.contains(&name)
+            && let Some((a, _)) = args.iter().zip(tys).find(|(_, t)| t.test)
+        {
+            self.error(
+                Diagnostic::error(
+                    "E0402",
+                    format!("test function inside `{name}`"),
+                    a.span,
+                    "depends on the test function",
+                )
+                .with_note(format!("`{name}` is not linear, and a form must be linear in its test function")),
+            );
+            return None;
+        }
+        if matches!(name, "dot" | "inner" | "outer") && tys[0].test && tys[1].test {
+            self.self_product(e.span, args[0].span, args[1].span);
+            return None;
+        }
+        let mut ty = tys.iter().skip(1).fold(tys[0], |acc, t| Ty::join(&acc, t, shape));
+        ty.shape = shape;
+        ty.konst = None;
+        match name {
+            "grad" | "div" => {
+                if !tys[0].smooth {
+                    let reason = if tys[0].facet.is_some() { "the normal" } else { "case data or a derivative" };
+                    self.error(
+                        Diagnostic::error("E0502", format!("cannot take `{name}` of this expression"), args[0].span, format!("depends on {reason}"))
+                            .with_note("derivatives are available for fields, test functions, x, and smooth functions of them, once"),
+                    );
+                    return None;
+                }
+                ty.smooth = false;
+            }
+            "sqrt" => ty.konst = tys[0].konst.map(f64::sqrt),
+            "abs" => ty.konst = tys[0].konst.map(f64::abs),
+            "min" => ty.konst = tys[0].konst.zip(tys[1].konst).map(|(a, b)| a.min(b)),
+            "max" => ty.konst = tys[0].konst.zip(tys[1].konst).map(|(a, b)| a.max(b)),
+            _ => {}
+        }
+        Some(ty)
+    }
+}

@@ -1,0 +1,154 @@
+//! Pest pairs → a `problem` item: its params and lets, mesh, regions, bindings, reference,
+//! run and quadrature settings, coefs, initial values, Dirichlet conditions, obstacles, and
+//! what it measures and plots.
+
+use pest::iterators::Pair;
+
+use super::Rule;
+use super::build::{Builder, unquote};
+use crate::diagnostic::Diagnostic;
+use crate::source::Span;
+use crate::syntax::ast::*;
+
+impl Builder {
+    pub(super) fn problem(
+        &self,
+        span: Span,
+        name: Pair<Rule>,
+        rest: pest::iterators::Pairs<Rule>,
+    ) -> Result<Problem, Box<Diagnostic>> {
+        let mut pb = Problem {
+            name: self.ident(name),
+            params: Vec::new(),
+            mesh: Vec::new(),
+            regions: Vec::new(),
+            binds: Vec::new(),
+            sets: Vec::new(),
+            coefs: Vec::new(),
+            obstacles: Vec::new(),
+            initial: Vec::new(),
+            dirichlet: Vec::new(),
+            series: Vec::new(),
+            summary: Vec::new(),
+            plots: Vec::new(),
+            run: Vec::new(),
+            run_static: None,
+            quadrature: Vec::new(),
+            reference: None,
+            reference_args: Vec::new(),
+            lets: Vec::new(),
+            span,
+        };
+        for p in rest {
+            let span = self.span(&p);
+            let rule = p.as_rule();
+            let mut it = p.into_inner();
+            let mut next = || it.next().expect("grammar guarantees the child");
+            match rule {
+                Rule::scheme_params => pb.params = self.params(it)?,
+                Rule::mesh_decl => {
+                    let q = next();
+                    pb.mesh.push(match q.as_rule() {
+                        Rule::string => MeshSource::File { path: unquote(q.as_str()), span: self.span(&q) },
+                        _ => MeshSource::Generator(self.named_call(q)?),
+                    });
+                }
+                Rule::region_decl => {
+                    let name = self.ident(next());
+                    let mut sources = Vec::new();
+                    for q in it {
+                        let q = q.into_inner().next().expect("region source");
+                        let qspan = self.span(&q);
+                        sources.push(match q.as_rule() {
+                            Rule::group_source => {
+                                let mut parts = q.into_inner();
+                                let name = unquote(parts.next().expect("group name").as_str());
+                                let conditions = parts.map(|c| self.comparison(c)).collect::<Result<Vec<_>, _>>()?;
+                                RegionSource::Group { name, conditions, span: qspan }
+                            }
+                            _ => {
+                                let conditions =
+                                    q.into_inner().map(|c| self.comparison(c)).collect::<Result<Vec<_>, _>>()?;
+                                RegionSource::Boundary { conditions, span: qspan }
+                            }
+                        });
+                    }
+                    pb.regions.push(RegionDecl { name, sources, span });
+                }
+                Rule::bind_decl => {
+                    for q in it {
+                        let span = self.span(&q);
+                        let mut parts = q.into_inner();
+                        let role = self.ident(parts.next().expect("role"));
+                        let target = parts.next().expect("target");
+                        let is_path = target.as_rule() == Rule::string;
+                        let target = if is_path { unquote(target.as_str()) } else { target.as_str().to_string() };
+                        pb.binds.push(Bind { role, target, is_path, span });
+                    }
+                }
+                Rule::set_decl => pb.sets.extend(self.assignments(next())?),
+                Rule::run_decl => {
+                    let q = next();
+                    if q.as_rule() == Rule::run_static {
+                        pb.run_static = Some(self.span(&q));
+                    } else {
+                        pb.run.extend(self.assignments(q)?);
+                    }
+                }
+                Rule::quadrature_decl => pb.quadrature.extend(self.assignments(next())?),
+                Rule::coef_def => pb.coefs.push(self.defined(span, next(), it.next())?),
+                Rule::initial_field => pb.initial.push(self.defined(span, next(), it.next())?),
+                Rule::series_decl => pb.series.push((self.defined(span, next(), it.next())?, true)),
+                Rule::observe_decl => pb.series.push((self.defined(span, next(), it.next())?, false)),
+                Rule::summary_decl => pb.summary.push(self.defined(span, next(), it.next())?),
+                Rule::let_decl => pb.lets.push(self.defined(span, next(), it.next())?),
+                Rule::obstacle_decl => {
+                    let shape = self.named_call(next())?;
+                    let region = it.next().map(|q| self.ident(q));
+                    pb.obstacles.push(Obstacle { shape, region, span });
+                }
+                Rule::dirichlet_decl => {
+                    let target = next();
+                    let on = if target.as_rule() == Rule::nearest_node {
+                        let span = self.span(&target);
+                        HeldAt::Nearest { point: self.expr(target.into_inner().next().expect("a point"))?, span }
+                    } else {
+                        HeldAt::Region(self.ident(target))
+                    };
+                    let field = self.ident(next());
+                    let mut rest = next();
+                    let mut component = None;
+                    if rest.as_rule() == Rule::index {
+                        component = Some(self.expr(rest.into_inner().next().expect("index expression"))?);
+                        rest = next();
+                    }
+                    let value = self.expr(rest)?;
+                    pb.dirichlet.push(Dirichlet { on, field, component, value, span });
+                }
+                Rule::plot_decl => {
+                    let title = unquote(next().as_str());
+                    let columns = next().into_inner().map(|i| self.ident(i)).collect();
+                    pb.plots.push(Plot { title, columns, span });
+                }
+                Rule::reference_decl => {
+                    let target = next();
+                    let (name, args) = if target.as_rule() == Rule::call_named {
+                        let call = self.named_call(target)?;
+                        (call.name, call.args)
+                    } else {
+                        (self.ident(target), Vec::new())
+                    };
+                    if let Some(prev) = &pb.reference {
+                        let d = Diagnostic::error("E0102", "a problem names one reference", name.span, "second one")
+                            .with_label(prev.span, "first one");
+                        return Err(Box::new(d));
+                    }
+                    pb.reference = Some(name);
+                    pb.reference_args = args;
+                }
+                r => unreachable!("not a problem item: {r:?}"),
+            }
+        }
+        Ok(pb)
+    }
+}
