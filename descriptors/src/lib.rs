@@ -3,6 +3,8 @@
 //! constants; the interpreter builds the same values at run time; the runtime reads them
 //! whichever way they came.
 
+#![forbid(unsafe_code)]
+
 pub mod params;
 pub mod scheme;
 pub mod slots;
