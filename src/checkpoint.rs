@@ -17,8 +17,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::cases::CaseError;
 use crate::driver::Active;
+use crate::error::CaseError;
 use crate::runtime::fem::mesh::Mesh;
 
 /// The files in the output directory.

@@ -103,7 +103,7 @@ fn crank_nicolson_and_midpoint_energy_increments_match_the_formulas() {
 /// standard deviation over τ ∈ (1.2, 1.8) drops by at least 2×.
 #[test]
 fn mass_redistribution_calms_the_contact_stress() {
-    use signorini::cases::bar::MassChoice;
+    use signorini::simulation::MassChoice;
     let std = |r: &bar::Run| {
         let lam: Vec<f64> = r.series.iter().filter(|row| row.t > 1.2 && row.t < 1.8).map(|row| row.lambda).collect();
         let mean = lam.iter().sum::<f64>() / lam.len() as f64;
@@ -130,7 +130,7 @@ fn mass_redistribution_calms_the_contact_stress() {
 /// accurate as the other schemes' (err_λ of HHT and TR-BDF2 with redistribution ≈ 0.37).
 #[test]
 fn midpoint_schemes_measure_contact_at_half_steps() {
-    use signorini::cases::bar::MassChoice;
+    use signorini::simulation::MassChoice;
     for scheme in ["midpoint", "hybrid"] {
         let s = run(|o| {
             o.setup.scheme = scheme.into();
@@ -280,7 +280,7 @@ fn dense_omega_max(lumped: bool) -> f64 {
 /// refused before it steps.
 #[test]
 fn central_differences_know_their_critical_step() {
-    use signorini::cases::CaseError;
+    use signorini::error::CaseError;
     use signorini::simulation::MassChoice;
     for (mass, lumped) in [(MassChoice::Consistent, false), (MassChoice::Lumped, true)] {
         let central = |dt: f64| {

@@ -6,8 +6,9 @@
 //! The blow-ups of issue 32 stop with the cause and exit status 1 (tests/bad_inputs has the
 //! bar's; the disc's are here).
 
-use signorini::cases::{CaseError, bar, disc};
+use signorini::cases::{bar, disc};
 use signorini::driver::{Setup, all_schemes, contact_names};
+use signorini::error::CaseError;
 use signorini::simulation::MassChoice;
 
 /// The scheme whose energy the guard must stop at the library's defaults.

@@ -5,7 +5,7 @@
 
 use signorini::cases::{bar, disc};
 use signorini::driver::{self, Setup};
-use signorini::simulation::Guard;
+use signorini::guard::Guard;
 
 fn copy_outside(dir: &std::path::Path, rel: &str) -> String {
     let to = dir.join(std::path::Path::new(rel).file_name().unwrap());

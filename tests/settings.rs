@@ -1,8 +1,8 @@
 //! forms/library.toml parses, and every scheme, contact law, material and mass matrix it names
 //! exists in the library (verify's reference schemes too).
 
-use signorini::cases::bar::MassChoice;
 use signorini::driver::{self, Setup};
+use signorini::simulation::MassChoice;
 
 #[test]
 fn library_settings_name_library_files() {

@@ -132,7 +132,7 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
 /// translation).
 #[test]
 fn newton_failures_are_typed_errors_with_history() {
-    use signorini::cases::CaseError;
+    use signorini::error::CaseError;
     use signorini::runtime::nonlinear::newton::NewtonError;
     let mut o = block("static_block", "nitsche", 1.0, &[("curvature", 0.5)]);
     o.newton.max_iterations = 2;

@@ -22,9 +22,9 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::median;
-use crate::cases::CaseError;
 use crate::cases::disc::{self, Options};
+use crate::error::CaseError;
+use crate::resources::median;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DiscTiming {

@@ -10,7 +10,7 @@ use std::process::Command;
 
 use serde::{Deserialize, Serialize};
 
-use crate::cases::CaseError;
+use crate::error::CaseError;
 use crate::plot::Curve;
 
 /// Cells per radius of the balls tried, smallest first: 15k, 47k, 108k, 274k, 555k, 985k dofs.

@@ -6,11 +6,11 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use super::CaseError;
 use crate::driver::{ParamValue, Setup};
+use crate::error::CaseError;
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
-pub use crate::simulation::MassChoice;
+use crate::simulation::MassChoice;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {

@@ -9,8 +9,8 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use super::CaseError;
 use crate::driver::{ParamValue, Setup};
+use crate::error::CaseError;
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;

@@ -10,10 +10,11 @@ use clap::ValueEnum;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::CaseError;
 use crate::driver::{self, Setting, Setup};
+use crate::error::CaseError;
+use crate::guard::MAX_STEP_CUTS;
 use crate::runtime::fem::mesh::CellSize;
-use crate::simulation::{MAX_STEP_CUTS, MassChoice};
+use crate::simulation::MassChoice;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -239,7 +240,7 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
         forms: parsed.forms.as_ref().map_or_else(Vec::new, |f| f.get_ref().iter().map(|p| base.join(p)).collect()),
         compiled: Vec::new(),
         params: Vec::new(),
-        guard: crate::simulation::Guard {
+        guard: crate::guard::Guard {
             allow_unstable_dt: parsed.allow_unstable_dt.as_ref().map_or(d.guard.allow_unstable_dt, |b| *b.get_ref()),
             max_step_cuts: match &parsed.max_step_cuts {
                 None => d.guard.max_step_cuts,

@@ -288,7 +288,7 @@ pub struct MethodArgs {
     max_step_cuts: usize,
     /// Stop when E_aug (elastic + kinetic + contact energy) exceeds E_aug(0) + the loads' work
     /// by this fraction of the problem's energy scale (0: never).
-    #[arg(long, default_value_t = crate::simulation::ENERGY_TOLERANCE, value_parser = non_negative)]
+    #[arg(long, default_value_t = crate::guard::ENERGY_TOLERANCE, value_parser = non_negative)]
     energy_tolerance: f64,
     /// Run an explicit scheme (one that claims `cfl`) above its estimated critical step Δt_c.
     #[arg(long)]
@@ -300,7 +300,7 @@ pub struct MethodArgs {
 
 /// `--max-step-cuts`: the range the case files accept too.
 fn step_cuts(s: &str) -> Result<usize, String> {
-    use crate::simulation::MAX_STEP_CUTS;
+    use crate::guard::MAX_STEP_CUTS;
     match s.trim().parse::<i64>() {
         Ok(n) if (0..=MAX_STEP_CUTS as i64).contains(&n) => Ok(n as usize),
         Ok(n) => Err(format!("{n} is not in 0..={MAX_STEP_CUTS}")),
@@ -352,7 +352,7 @@ impl MethodArgs {
             forms: self.forms.clone(),
             compiled: Vec::new(),
             params,
-            guard: crate::simulation::Guard {
+            guard: crate::guard::Guard {
                 max_step_cuts: self.max_step_cuts,
                 energy_tolerance: self.energy_tolerance,
                 allow_unstable_dt: self.allow_unstable_dt,
@@ -870,7 +870,7 @@ fn run_problem_all(base: crate::problem::run::Options, setup: Setup) -> ExitCode
     if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS }
 }
 
-fn finish_problem(result: Result<crate::problem::run::Run, crate::cases::CaseError>) -> ExitCode {
+fn finish_problem(result: Result<crate::problem::run::Run, crate::error::CaseError>) -> ExitCode {
     match result {
         Ok(r) => {
             let s = &r.summary;
@@ -948,9 +948,4 @@ fn interpreted_note(files: &[String]) {
             "note: {f} ran interpreted (compiled at run time, same results as compiled); to compile it, copy it into forms/ (a scheme: forms/schemes/) and rebuild"
         );
     }
-}
-
-/// A metric with `digits` decimals, or "—" where it is undefined.
-pub fn optional(value: Option<f64>, digits: usize) -> String {
-    value.map_or("—".to_string(), |v| format!("{v:.digits$}"))
 }

@@ -9,7 +9,7 @@ pub mod sources;
 
 use std::path::{Path, PathBuf};
 
-use crate::cases::CaseError;
+use crate::error::CaseError;
 use crate::forms::LIBRARY;
 use crate::runtime::descriptors::{ParamInfo, SchemeDesc};
 use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
@@ -40,7 +40,7 @@ pub struct Setup {
     /// Param values set by the user, in order (a later setting of a param wins).
     pub params: Vec<Setting>,
     /// Step cuts and the energy check.
-    pub guard: crate::simulation::Guard,
+    pub guard: crate::guard::Guard,
 }
 
 impl Default for Setup {
@@ -204,7 +204,7 @@ pub struct Active {
     pub scheme: SchemeSource,
     /// The form files and every param's value (the scheme's included).
     pub forms: ActiveForms,
-    pub guard: crate::simulation::Guard,
+    pub guard: crate::guard::Guard,
 }
 
 /// The form files of a run, with the value of every param.

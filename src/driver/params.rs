@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::{FormSource, SchemeSource};
-use crate::cases::CaseError;
+use crate::error::CaseError;
 use crate::runtime::descriptors::ParamInfo;
 
 /// A user's `name = value`, with where it was written (for errors).

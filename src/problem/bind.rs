@@ -6,10 +6,10 @@ use std::path::Path;
 
 use super::ProblemFile;
 use super::expr::{At, Exprs, PointFn};
-use crate::cases::CaseError;
 use crate::compiler::Diagnostic;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, MeshSource, NamedCall, RegionSource};
+use crate::error::CaseError;
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::fem::mesh::{CellSize, Mesh};
 
@@ -42,13 +42,22 @@ pub fn dimension(pf: &ProblemFile, mesh_file: Option<&Path>, params: &[(String, 
 }
 
 fn read(path: &Path) -> Result<Mesh, CaseError> {
-    Ok(crate::cases::read_mesh(path)?)
+    Ok(read_mesh(path)?)
+}
+
+/// Reads a Gmsh file, showing on stderr what the reader skipped (also logged as a warning).
+fn read_mesh(path: &Path) -> Result<Mesh, crate::runtime::fem::mesh::MeshError> {
+    let mesh = crate::runtime::fem::mesh::gmsh::read(path)?;
+    for w in &mesh.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(mesh)
 }
 
 /// The problem's own mesh file, its errors located at the `mesh` line.
 fn read_own(pf: &ProblemFile, path: &str, span: crate::compiler::Span) -> Result<Mesh, CaseError> {
     let full = pf.dir.join(path);
-    crate::cases::read_mesh(&full).map_err(|e| {
+    read_mesh(&full).map_err(|e| {
         pf.render(Diagnostic::error("E0101", format!("cannot read the mesh {}", full.display()), span, e.to_string()))
     })
 }

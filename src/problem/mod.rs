@@ -11,10 +11,10 @@ pub mod run;
 
 use std::path::{Path, PathBuf};
 
-use crate::cases::CaseError;
 use crate::compiler::Program;
 use crate::compiler::syntax::ast;
 use crate::driver::Setting;
+use crate::error::CaseError;
 
 /// A checked problem file.
 pub struct ProblemFile {

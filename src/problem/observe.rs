@@ -6,10 +6,10 @@
 
 use super::ProblemFile;
 use super::expr::{At, Exprs, PointFn};
-use crate::cases::CaseError;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
 use crate::driver::ActiveForms;
+use crate::error::CaseError;
 use crate::runtime::fem::assembly::Assembler;
 use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
 use crate::runtime::fem::evaluate::{FacetSample, facet_samples};

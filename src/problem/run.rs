@@ -13,9 +13,9 @@ use serde::{Deserialize, Serialize};
 use super::ProblemFile;
 use super::expr::Exprs;
 use super::observe::{Observer, State, SummaryKeys};
-use crate::cases::CaseError;
 use crate::checkpoint::Control;
 use crate::driver::{Active, ParamValue, Setup};
+use crate::error::CaseError;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::library::Binding;
@@ -799,7 +799,7 @@ fn simulate(
     put("wall_seconds", json(&wall));
     put("seconds_per_step", json(&(wall / steps.max(1) as f64)));
     put("stepping_seconds", json(&outcome.step_seconds.iter().sum::<f64>()));
-    put("step_median_seconds", json(&crate::bench::median(outcome.step_seconds.clone())));
+    put("step_median_seconds", json(&crate::resources::median(outcome.step_seconds.clone())));
     put("factorizations", counters.numeric.into());
     put("symbolic_factorizations", counters.symbolic.into());
     put("low_rank_updates", counters.updates.into());
@@ -818,7 +818,7 @@ fn simulate(
     }
     put("solver", json(&opts.newton.solver));
     put("krylov_iterations", counters.iterations.into());
-    put("peak_memory_bytes", json(&crate::bench::peak_memory()));
+    put("peak_memory_bytes", json(&crate::resources::peak_memory()));
     put("step_cuts", outcome.cuts.into());
     if !statics {
         put("energy_growth", json(&outcome.energy_growth));

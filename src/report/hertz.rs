@@ -4,8 +4,8 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use crate::cases::CaseError;
 use crate::driver::Setup;
+use crate::error::CaseError;
 use crate::problem::run::{Options, run};
 
 /// The finest level the report solves in 2D and in 3D (level 3 in 3D has 132k unknowns: minutes

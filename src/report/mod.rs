@@ -9,8 +9,9 @@ use std::path::Path;
 use std::time::Instant;
 
 use crate::cases::bar;
-use crate::cases::{CaseError, disc};
+use crate::cases::disc;
 use crate::driver::Setup;
+use crate::error::CaseError;
 use crate::plot::Curve;
 use crate::simulation::MassChoice;
 
@@ -80,8 +81,8 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
             mass.name(),
             guard.map_or(String::new(), |g| format!(" ({g})")),
             s.err_linf_l2_u,
-            crate::cli::optional(s.err_l2_lambda, 4),
-            crate::cli::optional(s.err_l2_lambda_half, 4),
+            optional(s.err_l2_lambda, 4),
+            optional(s.err_l2_lambda_half, 4),
             s.energy_aug_initial,
             s.energy_aug_final,
             s.max_penetration,
@@ -253,4 +254,9 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     let _ = writeln!(md, "_Run time: {:.1} s._", start.elapsed().as_secs_f64());
     crate::output::write_atomic(&out.join("report.md"), md.as_bytes())
         .map_err(|source| CaseError::Write { path: out.join("report.md").display().to_string(), source })
+}
+
+/// A metric with `digits` decimals, or "—" where it is undefined.
+pub fn optional(value: Option<f64>, digits: usize) -> String {
+    value.map_or("—".to_string(), |v| format!("{v:.digits$}"))
 }

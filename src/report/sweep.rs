@@ -9,8 +9,9 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::cases::bar;
-use crate::cases::{CaseError, disc};
+use crate::cases::disc;
 use crate::driver::Setup;
+use crate::error::CaseError;
 use crate::plot::Curve;
 use crate::simulation::MassChoice;
 

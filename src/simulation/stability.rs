@@ -7,7 +7,7 @@
 //! stops a run that is unstable all the same.
 
 use super::Tools;
-use crate::cases::CaseError;
+use crate::error::CaseError;
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::linalg::{Factorization, Structure};
 use crate::runtime::nonlinear::statics::Constraints;

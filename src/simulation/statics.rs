@@ -1,8 +1,8 @@
 //! The static driver every static case shares: the `stiffness`, `load` and `contact` forms of
 //! the files in use, bound by slot name on a mesh, and semi-smooth Newton on K u + C(u) = F.
 
-use crate::cases::CaseError;
 use crate::driver::ActiveForms;
+use crate::error::CaseError;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::bound::BoundFunctional;
 use crate::runtime::fem::kernel::Coef;

@@ -6,8 +6,9 @@
 
 use serde::Serialize;
 
-use crate::cases::{CaseError, disc};
+use crate::cases::disc;
 use crate::driver::Setup;
+use crate::error::CaseError;
 
 const T_END: f64 = 12.0;
 /// Δt refinement: the steps, and the reference's.

@@ -8,8 +8,9 @@
 use serde::Serialize;
 
 use super::oscillator::{oscillator_energies, spectral_radius};
-use crate::cases::{CaseError, bar, disc};
+use crate::cases::{bar, disc};
 use crate::driver::Setup;
+use crate::error::CaseError;
 
 /// How E_aug behaves on one run: on steps whose active set is unchanged, and on the others.
 #[derive(Clone, Debug, Serialize)]

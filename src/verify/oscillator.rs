@@ -1,8 +1,8 @@
 //! The oscillator ü + u = 0 as a one-dof finite-element system, stepped by any scheme: its
 //! error against cos t, and the spectral radius of a scheme's one-step map.
 
-use crate::cases::CaseError;
 use crate::driver::{Active, Setup, Slot};
+use crate::error::CaseError;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::bound::MatrixForm;
 use crate::runtime::fem::kernel::Coef;

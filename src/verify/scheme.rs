@@ -14,9 +14,10 @@ use serde::Serialize;
 
 use super::oscillator::{damped_oscillator_error, oscillator_energies, oscillator_error, spectral_radius, step_map};
 use super::time::{BAR_STEPS, BarOrder, OSCILLATOR_STEPS, bar_orders, last_order};
-use crate::cases::{CaseError, bar, disc};
+use crate::cases::{bar, disc};
 use crate::compiler::scheme::EnergyLaw;
 use crate::driver::{Active, Setup};
+use crate::error::CaseError;
 use crate::plot::Curve;
 
 /// ζ of the damped oscillator ü + 2ζu̇ + u = 0.

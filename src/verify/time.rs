@@ -10,8 +10,9 @@
 use serde::Serialize;
 
 use super::oscillator::{oscillator_error, spectral_radius};
-use crate::cases::{CaseError, bar};
+use crate::cases::bar;
 use crate::driver::Setup;
+use crate::error::CaseError;
 
 /// The oscillator's steps (T = 10).
 pub const OSCILLATOR_STEPS: [f64; 3] = [0.04, 0.02, 0.01];
