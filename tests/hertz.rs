@@ -12,14 +12,14 @@ use signorini::runtime::fem::quadrature::simplex_rule;
 use signorini::runtime::library::Binding;
 
 /// The library's Hertz problem (`hertz_cylinder` or `hertz_ball`) at a mesh level: its summary.
-fn pressed(problem: &str, contact: &str, level: usize) -> signorini::problem::run::Summary {
+fn pressed(problem: &str, contact: &str, level: usize) -> signorini::problem::outputs::Summary {
     let mut o = Options::new(problem);
     o.setup = Setup { contact: contact.into(), ..Setup::default() }.set("level", level as f64);
     o.chosen.contact = true;
     run(&o).unwrap_or_else(|e| panic!("{problem} {contact} level {level}: {e}")).summary
 }
 
-fn number(s: &signorini::problem::run::Summary, key: &str) -> f64 {
+fn number(s: &signorini::problem::outputs::Summary, key: &str) -> f64 {
     s.number(key).unwrap_or_else(|| panic!("no `{key}` in the summary"))
 }
 

@@ -64,7 +64,7 @@ fn interpreted_note(files: &[String]) {
 }
 
 /// The header of the `run --all` table (printed), and the problem's own summary keys it shows.
-pub(super) fn all_header(s: &crate::problem::run::Summary) -> Vec<String> {
+pub(super) fn all_header(s: &crate::problem::outputs::Summary) -> Vec<String> {
     let keys = s.own.clone();
     let names: Vec<String> = keys.iter().map(|k| format!("{k:>w$}", w = k.len().max(11))).collect();
     println!("{:<15} {:<16} {:<13} {} {:>7} {:>4}", "scheme", "contact", "mass", names.join(" "), "Newton", "max");
@@ -73,7 +73,7 @@ pub(super) fn all_header(s: &crate::problem::run::Summary) -> Vec<String> {
 
 /// One line of the `run --all` table: the run's values of `keys`, and its Newton iterations.
 pub(super) fn all_row(
-    s: &crate::problem::run::Summary,
+    s: &crate::problem::outputs::Summary,
     keys: &[String],
     scheme: &str,
     contact: &str,
