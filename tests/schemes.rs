@@ -4,7 +4,7 @@
 //! come from the library's registry; a scheme written only for these tests runs by path
 //! (interpreted) and compiled, with nothing but its file.
 
-use signorini::driver::{self, Setup};
+use signorini::driver::{self, Methods};
 use signorini::runtime::time::scheme::TimeScheme;
 use signorini::runtime::time::stepper::Stepper;
 
@@ -13,23 +13,23 @@ signorini::forms!("tests/wf/newmark_general.wf");
 const TEST_SCHEME: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/wf/newmark_general.wf");
 
 /// Runs `f` on a stepper of the oscillator (`signorini verify`'s), with `scheme` instead of
-/// `setup`'s when given.
-fn with_stepper<R>(setup: &Setup, scheme: Option<Box<dyn TimeScheme>>, f: impl FnOnce(&mut Stepper) -> R) -> R {
-    signorini::verify::with_oscillator_scheme(setup, scheme, f).unwrap()
+/// `methods`'s when given.
+fn with_stepper<R>(methods: &Methods, scheme: Option<Box<dyn TimeScheme>>, f: impl FnOnce(&mut Stepper) -> R) -> R {
+    signorini::verify::with_oscillator_scheme(methods, scheme, f).unwrap()
 }
 
-fn setup(scheme: &str) -> Setup {
-    Setup { scheme: scheme.into(), ..Setup::default() }
+fn methods(scheme: &str) -> Methods {
+    Methods { scheme: scheme.into(), ..Methods::default() }
 }
 
 /// |u(T) − cos T| from u = 1, v = 0 (`signorini verify`'s oscillator).
-fn error(setup: &Setup, dt: f64, t_end: f64) -> f64 {
-    signorini::verify::oscillator_error(setup, dt, t_end).unwrap()
+fn error(methods: &Methods, dt: f64, t_end: f64) -> f64 {
+    signorini::verify::oscillator_error(methods, dt, t_end).unwrap()
 }
 
 /// Spectral radius of the one-step map at step dt (ω = 1).
-fn spectral_radius(setup: &Setup, dt: f64) -> f64 {
-    signorini::verify::spectral_radius(setup, dt).unwrap()
+fn spectral_radius(methods: &Methods, dt: f64) -> f64 {
+    signorini::verify::spectral_radius(methods, dt).unwrap()
 }
 
 /// Every scheme of the library, and the test-only scheme by path.
@@ -42,7 +42,7 @@ fn every_scheme() -> Vec<String> {
 #[test]
 fn every_scheme_is_second_order() {
     for name in every_scheme() {
-        let s = setup(&name);
+        let s = methods(&name);
         let r = error(&s, 0.02, 10.0) / error(&s, 0.01, 10.0);
         if name == TEST_SCHEME {
             // γ = 0.6 ≠ 1/2: first order, by design of the test scheme.
@@ -65,7 +65,7 @@ fn spectral_radius_at_infinite_step() {
             "trbdf2" => 0.0,
             _ => continue,
         };
-        let r = spectral_radius(&setup(&name), 1e6);
+        let r = spectral_radius(&methods(&name), 1e6);
         let tol = if name == "trbdf2" { 1e-5 } else { 1e-6 };
         assert!((r - expected).abs() < tol, "{name}: ρ∞ = {r}, expected {expected}");
         checked += 1;
@@ -73,7 +73,7 @@ fn spectral_radius_at_infinite_step() {
     assert_eq!(checked, 7);
     // At α = 1/3 the two principal roots meet at infinity (a double root), so the radius at
     // finite ωΔt approaches the limit like (ωΔt)^(-1/2): evaluate further out.
-    let third = spectral_radius(&setup("hht").set("alpha", 1.0 / 3.0), 1e12);
+    let third = spectral_radius(&methods("hht").set("alpha", 1.0 / 3.0), 1e12);
     assert!((third - 0.5).abs() < 1e-6, "HHT α = 1/3: ρ∞ = {third}");
 }
 
@@ -81,7 +81,7 @@ fn spectral_radius_at_infinite_step() {
 #[test]
 fn midpoint_and_crank_nicolson_conserve_energy() {
     let drift = |name: &str| {
-        with_stepper(&setup(name), None, |st| {
+        with_stepper(&methods(name), None, |st| {
             let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
             states[0][0] = 1.0;
             st.initialize(&mut states, 0.0).unwrap();
@@ -105,7 +105,7 @@ fn midpoint_and_crank_nicolson_conserve_energy() {
 #[test]
 fn interpreted_and_compiled_schemes_agree() {
     let run = |compiled: bool| {
-        let s = setup(TEST_SCHEME).set("beta", 0.35).set("gam", 0.7);
+        let s = methods(TEST_SCHEME).set("beta", 0.35).set("gam", 0.7);
         let scheme: Option<Box<dyn TimeScheme>> = compiled.then(|| {
             let c = newmark_general::NewmarkGeneral::default();
             Box::new(c.with("beta", 0.35).unwrap().with("gam", 0.7).unwrap()) as Box<dyn TimeScheme>

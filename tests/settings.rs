@@ -1,7 +1,7 @@
 //! forms/library.toml parses, and every scheme, contact law, material and mass matrix it names
 //! exists in the library (verify's reference schemes too).
 
-use signorini::driver::{self, Setup};
+use signorini::driver::{self, Methods};
 use signorini::simulation::MassChoice;
 
 #[test]
@@ -14,7 +14,7 @@ fn library_settings_name_library_files() {
         assert!(laws.contains(&contact), "unknown contact law `{contact}`");
     };
     known(&s.defaults.scheme, &s.defaults.contact);
-    driver::Active::resolve(&Setup::default(), &[]).unwrap();
+    driver::FilesInUse::resolve(&Methods::default(), &[]).unwrap();
     for (scheme, contact, mass) in s.report.bar.iter().flat_map(|b| b.runs.iter()) {
         known(scheme, contact);
         <MassChoice as clap::ValueEnum>::from_str(mass, true).unwrap_or_else(|e| panic!("mass `{mass}`: {e}"));

@@ -185,8 +185,8 @@ fn explicit_timing(opts: &Options, repeats: usize) -> Result<Option<ExplicitTimi
     let (scheme, mass) = &crate::settings::get().bench.disc_explicit;
     let mass = <crate::simulation::MassChoice as clap::ValueEnum>::from_str(mass, true)
         .map_err(|e| CaseError::Option(format!("forms/library.toml [bench]: {e}")))?;
-    let setup = crate::driver::Setup { scheme: scheme.clone(), ..opts.setup.clone() };
-    let mut opts = Options { setup, mass, ..opts.clone() };
+    let methods = crate::driver::Methods { scheme: scheme.clone(), ..opts.methods.clone() };
+    let mut opts = Options { methods, mass, ..opts.clone() };
     // Above its critical step on this mesh: at 0.8 Δt_c (three digits, rounded down), to the
     // same t_end.
     if let Err(CaseError::UnstableStep { stable, .. }) = disc::run(&Options { t_end: opts.dt, ..opts.clone() }) {

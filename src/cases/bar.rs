@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::driver::{ParamValue, Setup};
+use crate::driver::{Methods, ParamValue};
 use crate::error::CaseError;
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
@@ -15,7 +15,7 @@ use crate::simulation::MassChoice;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
     /// Scheme, contact law, extra forms and params.
-    pub setup: Setup,
+    pub methods: Methods,
     /// Elements, Δt and the end time; none: forms/problems/bar.wf's.
     pub elements: Option<usize>,
     pub dt: Option<f64>,
@@ -36,7 +36,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
-            setup: Setup::default(),
+            methods: Methods::default(),
             elements: None,
             dt: None,
             t_end: None,
@@ -135,14 +135,14 @@ pub struct Run {
 
 /// Runs the bar; writes series.csv and summary.json into `opts.out` if set.
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    let mut setup = opts.setup.clone();
+    let mut methods = opts.methods.clone();
     // The problem's mesh param, as the user's setting (before theirs: theirs wins).
     if let Some(ne) = opts.elements {
-        setup.params.insert(0, crate::driver::Setting { name: "ne".into(), value: ne as f64, origin: "--ne".into() });
+        methods.params.insert(0, crate::driver::Setting { name: "ne".into(), value: ne as f64, origin: "--ne".into() });
     }
     let problem = crate::problem::run::Options {
         problem: "bar".to_string(),
-        setup,
+        methods,
         mass: opts.mass,
         cell_size: opts.cell_size,
         dt: opts.dt,

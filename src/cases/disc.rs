@@ -1,15 +1,16 @@
 //! The bouncing disc and sphere as the report, `verify` and the benchmarks read them: the
 //! problems themselves are data (`forms/problems/disc.wf`, `sphere.wf`, run by the one driver,
-//! [`crate::problem::run`]); this module gives their rows and summary typed fields. The series'
-//! vertical columns (the fields `uy_*`, `vy_mean`, `fy_contact` of [`Row`], which hold the
-//! vertical component in both) are named after the axis in the files (`uy_mean`, `fy_contact`
-//! for the disc; `uz_mean`, `fz_contact` for the sphere).
+//! [`crate::problem::run`]); this module gives their rows and summary typed fields. The obstacle's
+//! normal is the vertical axis, y in the disc and z in the sphere: the fields `u_vertical_*`,
+//! `v_vertical_mean` and `f_vertical_contact` of [`Row`] hold that component, read from the
+//! columns the files name after their axis (`uy_mean`, `fy_contact` for the disc; `uz_mean`,
+//! `fz_contact` for the sphere). Both files name their summary key `min_uy_mean`.
 
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::driver::{ParamValue, Setup};
+use crate::driver::{Methods, ParamValue};
 use crate::error::CaseError;
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
@@ -46,7 +47,7 @@ impl Body {
 pub struct Options {
     pub body: Body,
     /// Scheme, contact law, extra forms and params.
-    pub setup: Setup,
+    pub methods: Methods,
     pub mass: MassChoice,
     /// What `h` means in γ = γ0/h.
     pub cell_size: CellSize,
@@ -75,7 +76,7 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             body: Body::Disc,
-            setup: Setup::default(),
+            methods: Methods::default(),
             mass: MassChoice::Consistent,
             cell_size: CellSize::Diameter,
             mesh: None,
@@ -101,14 +102,17 @@ pub struct Row {
     /// ½vᵀMv (with the mass the scheme uses).
     pub kinetic: f64,
     pub energy_aug: f64,
-    /// Mass-weighted mean of u_y (the centre of mass).
-    pub uy_mean: f64,
-    /// Plain mean of the nodal u_y (GetFEM's benchmark reports this one).
-    pub uy_mean_nodal: f64,
-    /// Mass-weighted mean of v_y: the centre of mass's velocity (NaN for a scheme without `v`).
-    pub vy_mean: f64,
-    pub uy_lowest: f64,
-    pub fy_contact: f64,
+    /// Mass-weighted mean of the vertical displacement (the centre of mass's).
+    pub u_vertical_mean: f64,
+    /// Plain mean of the nodes' vertical displacements (GetFEM's benchmark reports this one).
+    pub u_vertical_mean_nodal: f64,
+    /// Mass-weighted mean of the vertical velocity: the centre of mass's (NaN for a scheme
+    /// without `v`).
+    pub v_vertical_mean: f64,
+    /// The vertical displacement of the lowest node.
+    pub u_vertical_lowest: f64,
+    /// The vertical force of the obstacle on the body.
+    pub f_vertical_contact: f64,
     /// The measure of the contact zone's points where the gap is closed (u_N ≥ g): a length
     /// for the disc, an area for the sphere.
     pub contact_area: f64,
@@ -140,7 +144,8 @@ pub struct Summary {
     /// Time of the first step that ends with an active contact point.
     pub first_contact: Option<f64>,
     pub max_penetration: f64,
-    pub min_uy_mean: f64,
+    /// The lowest the centre of mass went (the smallest `u_vertical_mean`).
+    pub min_u_vertical_mean: f64,
     pub energy_aug_initial: f64,
     pub energy_aug_final: f64,
     /// The largest kinetic energy ½vᵀMv over the run (at impact): the disc's energy scale, as
@@ -200,12 +205,12 @@ pub struct StageRow {
 }
 
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    let mut setup = opts.setup.clone();
+    let mut methods = opts.methods.clone();
     // The problem's mesh-size param, as the user's setting (before theirs: theirs wins).
-    setup.params.insert(0, crate::driver::Setting { name: "h".into(), value: opts.h, origin: "--h".into() });
+    methods.params.insert(0, crate::driver::Setting { name: "h".into(), value: opts.h, origin: "--h".into() });
     let problem = crate::problem::run::Options {
         problem: opts.body.name().to_string(),
-        setup,
+        methods,
         mass: opts.mass,
         cell_size: opts.cell_size,
         mesh: opts.mesh.clone(),
@@ -247,11 +252,11 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         energy: v[index[0]],
         kinetic: v[index[1]],
         energy_aug: v[index[2]],
-        uy_mean: v[index[3]],
-        uy_mean_nodal: v[index[4]],
-        vy_mean: v[index[5]],
-        uy_lowest: v[index[6]],
-        fy_contact: v[index[7]],
+        u_vertical_mean: v[index[3]],
+        u_vertical_mean_nodal: v[index[4]],
+        v_vertical_mean: v[index[5]],
+        u_vertical_lowest: v[index[6]],
+        f_vertical_contact: v[index[7]],
         contact_area: v[index[8]],
         active_points: v[index[9]] as usize,
         switches,
@@ -281,7 +286,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         steps: count("steps"),
         first_contact: s.number("first_contact"),
         max_penetration: number("max_penetration"),
-        min_uy_mean: number("min_uy_mean"),
+        min_u_vertical_mean: number("min_uy_mean"),
         energy_aug_initial: number("energy_aug_initial"),
         energy_aug_final: number("energy_aug_final"),
         kinetic_energy_max: number("kinetic_energy_max"),

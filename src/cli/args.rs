@@ -1,12 +1,12 @@
 //! The clap types of the command line: every subcommand with its options and their value
 //! parsers, and what the options of a run make of the files, params and step guard
-//! ([`MethodArgs::setup`]).
+//! ([`MethodArgs::to_methods`]).
 
 use std::path::PathBuf;
 
 use clap::{Subcommand, ValueEnum};
 
-use crate::driver::{Setting, Setup};
+use crate::driver::{Methods, Setting};
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::linalg::Solver;
 use crate::simulation::MassChoice;
@@ -208,7 +208,7 @@ impl MethodArgs {
             || self.line_search
     }
 
-    pub(super) fn setup(&self) -> Result<Setup, String> {
+    pub(super) fn to_methods(&self) -> Result<Methods, String> {
         let mut params = Vec::new();
         for (name, v) in [("alpha", self.alpha), ("theta", self.theta), ("gamma0", self.gamma0)] {
             if let Some(value) = v {
@@ -221,8 +221,8 @@ impl MethodArgs {
                 value.trim().parse().map_err(|_| format!("--param {p}: `{}` is not a number", value.trim()))?;
             params.push(Setting { name: name.trim().into(), value, origin: format!("--param {p}") });
         }
-        let d = Setup::default();
-        Ok(Setup {
+        let d = Methods::default();
+        Ok(Methods {
             scheme: self.scheme.clone().unwrap_or(d.scheme),
             contact: self.contact.clone().unwrap_or(d.contact),
             material: self.material.clone().unwrap_or(d.material),

@@ -7,11 +7,11 @@ use std::process::ExitCode;
 use super::args::ProblemArgs;
 use super::summary::{all_header, all_row, finish};
 use super::{fail, out_dir};
-use crate::driver::{Setting, Setup};
+use crate::driver::{Methods, Setting};
 use crate::simulation::MassChoice;
 
 pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
-    let setup = match a.methods.setup() {
+    let methods = match a.methods.to_methods() {
         Ok(s) => s,
         Err(e) => return fail(e),
     };
@@ -33,11 +33,11 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
             Ok(dir) => dir,
             Err(e) => return fail(e),
         };
-        return all(opts, setup);
+        return all(opts, methods);
     }
     let opts = crate::problem::run::Options {
         problem: problem.to_string(),
-        setup,
+        methods,
         mass: a.mass,
         cell_size: a.methods.cell_size,
         mesh: a.mesh,
@@ -68,11 +68,11 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
 
 /// `run PROBLEM --all`: every scheme × contact law × mass matrix, one line each with the
 /// problem's own summary keys.
-fn all(base: crate::problem::run::Options, setup: Setup) -> ExitCode {
+fn all(base: crate::problem::run::Options, methods: Methods) -> ExitCode {
     // The masses of the implicit schemes' comparison (lumped is for explicit ones).
     let masses = [MassChoice::Consistent, MassChoice::Redistributed].map(|m| (m, m.name()));
     // The problem's own params (`ne`, or `bar.ne`) apply to every run: checked once.
-    let rest = match crate::problem::load(&base.problem).and_then(|pf| crate::problem::params(&pf, &setup.params)) {
+    let rest = match crate::problem::load(&base.problem).and_then(|pf| crate::problem::params(&pf, &methods.params)) {
         Ok((_, rest)) => rest,
         Err(e) => return fail(e),
     };
@@ -83,8 +83,9 @@ fn all(base: crate::problem::run::Options, setup: Setup) -> ExitCode {
         .flat_map(|s| crate::driver::contact_names().into_iter().map(move |c| (s, c)))
         .collect();
     let takes = |scheme: &str, contact: &str, p: &Setting| {
-        let probe = Setup { scheme: scheme.into(), contact: contact.into(), params: vec![p.clone()], ..setup.clone() };
-        crate::driver::Active::resolve(&probe, &[])
+        let probe =
+            Methods { scheme: scheme.into(), contact: contact.into(), params: vec![p.clone()], ..methods.clone() };
+        crate::driver::FilesInUse::resolve(&probe, &[])
     };
     for p in &rest {
         let results: Vec<_> = combinations.iter().map(|(s, c)| takes(s, c, p)).collect();
@@ -99,7 +100,7 @@ fn all(base: crate::problem::run::Options, setup: Setup) -> ExitCode {
     let mut failed = false;
     for (scheme, contact) in combinations.iter().copied() {
         for (mass, mass_name) in masses {
-            let params: Vec<Setting> = setup
+            let params: Vec<Setting> = methods
                 .params
                 .iter()
                 .filter(|p| !rest.contains(p) || takes(scheme, contact, p).is_ok())
@@ -107,7 +108,7 @@ fn all(base: crate::problem::run::Options, setup: Setup) -> ExitCode {
                 .collect();
             let label = format!("{scheme}_{contact}_{mass_name}");
             let opts = crate::problem::run::Options {
-                setup: Setup { scheme: scheme.into(), contact: contact.into(), params, ..setup.clone() },
+                methods: Methods { scheme: scheme.into(), contact: contact.into(), params, ..methods.clone() },
                 mass,
                 out: base.out.as_ref().map(|d| d.join(&label)),
                 chosen: crate::problem::run::Chosen { scheme: true, contact: true, ..base.chosen },

@@ -22,12 +22,12 @@ pub(super) fn library(out: &Path) -> ExitCode {
     }
 }
 
-pub(super) fn scheme(out: &Path, methods: &MethodArgs) -> ExitCode {
-    let setup = match methods.setup() {
+pub(super) fn scheme(out: &Path, args: &MethodArgs) -> ExitCode {
+    let methods = match args.to_methods() {
         Ok(s) => s,
         Err(e) => return fail(e),
     };
-    let v = match crate::verify::scheme::run(&setup, &mut |what| eprintln!("running {what}")) {
+    let v = match crate::verify::scheme::run(&methods, &mut |what| eprintln!("running {what}")) {
         Ok(v) => v,
         Err(e) => return fail(e),
     };

@@ -9,7 +9,7 @@ use super::expr::{At, Exprs, PointFn};
 use crate::compiler::Diagnostic;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, MeshSource, NamedCall, RegionSource};
-use crate::driver::Active;
+use crate::driver::FilesInUse;
 use crate::error::CaseError;
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::fem::mesh::{CellSize, Mesh};
@@ -510,13 +510,13 @@ pub fn coef_lookup(coefs: &[(String, PointFn)]) -> impl Fn(&str) -> Option<Coef>
 /// Every coef the files in use read must be set by the problem (a `coef` line, or an
 /// obstacle's `g` and `nc`): a located error before anything runs. A coef the problem sets that
 /// no file reads is a warning (a misspelt name, or a file left out).
-pub fn unset_coefs(pf: &ProblemFile, active: &Active) -> Result<(), CaseError> {
+pub fn unset_coefs(pf: &ProblemFile, in_use: &FilesInUse) -> Result<(), CaseError> {
     use crate::compiler::Diagnostic;
     let p = pf.problem();
-    let read: Vec<String> = active.forms.units.iter().flat_map(|u| u.coefs()).map(|(n, _)| n).collect();
+    let read: Vec<String> = in_use.forms.units.iter().flat_map(|u| u.coefs()).map(|(n, _)| n).collect();
     for c in &p.coefs {
         if !read.contains(&c.name.name) {
-            let files: Vec<&str> = active.forms.units.iter().map(|u| u.file()).collect();
+            let files: Vec<&str> = in_use.forms.units.iter().map(|u| u.file()).collect();
             let w = crate::compiler::check::problem::unread_coef(&c.name, &files);
             eprintln!("{}", crate::compiler::render_all(&[w], &pf.program.unit.sources).trim_end());
         }
@@ -526,8 +526,8 @@ pub fn unset_coefs(pf: &ProblemFile, active: &Active) -> Result<(), CaseError> {
         set.extend(["g", "nc"]);
     }
     let free = contact_free(pf);
-    for (i, unit) in active.forms.units.iter().enumerate() {
-        if free && i == active.forms.contact {
+    for (i, unit) in in_use.forms.units.iter().enumerate() {
+        if free && i == in_use.forms.contact {
             continue; // integrates over no facet: its coefs are zero
         }
         for (c, _) in unit.coefs() {
@@ -550,9 +550,14 @@ pub fn unset_coefs(pf: &ProblemFile, active: &Active) -> Result<(), CaseError> {
 }
 
 /// Each coef the problem sets has the components the files in use read it with.
-pub fn coef_shapes(pf: &ProblemFile, active: &Active, coefs: &[(String, PointFn)], d: usize) -> Result<(), CaseError> {
+pub fn coef_shapes(
+    pf: &ProblemFile,
+    in_use: &FilesInUse,
+    coefs: &[(String, PointFn)],
+    d: usize,
+) -> Result<(), CaseError> {
     use crate::compiler::Diagnostic;
-    for unit in &active.forms.units {
+    for unit in &in_use.forms.units {
         for (name, rank) in unit.coefs() {
             let Some((_, f)) = coefs.iter().find(|(n, _)| *n == name) else { continue };
             let need = d.pow(rank);

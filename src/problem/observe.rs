@@ -8,14 +8,14 @@ use super::ProblemFile;
 use super::expr::{At, Exprs, PointFn};
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
-use crate::driver::ActiveForms;
+use crate::driver::FormsInUse;
 use crate::error::CaseError;
 use crate::runtime::fem::assembly::Assembler;
 use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
 use crate::runtime::fem::evaluate::{FacetSample, facet_samples};
 use crate::runtime::fem::mesh::Facet;
 use crate::runtime::library::Binding;
-use crate::simulation::{AxisMean, Tools, resultant};
+use crate::simulation::{AxisMean, Operators, resultant};
 
 /// One measured value of a row.
 enum Measure {
@@ -132,8 +132,8 @@ impl<'m> Observer<'m> {
     pub fn new(
         pf: &ProblemFile,
         ex: &mut Exprs,
-        tools: &Tools<'m>,
-        forms: &ActiveForms,
+        ops: &Operators<'m>,
+        forms: &FormsInUse,
         coefs: &dyn Fn(&str) -> Option<crate::runtime::fem::kernel::Coef>,
         binding: &Binding<'m>,
         coef_vals: &[(String, Val)],
@@ -163,7 +163,7 @@ impl<'m> Observer<'m> {
         for (d, written) in &p.series {
             let mut leaves: Vec<(usize, usize)> = Vec::new();
             let rewritten =
-                o.rewrite(pf, ex, tools, &mut inst, &d.value, &mut leaves, &pointwise, &mut region_names, binding)?;
+                o.rewrite(pf, ex, ops, &mut inst, &d.value, &mut leaves, &pointwise, &mut region_names, binding)?;
             let scope: Vec<(String, Val)> =
                 leaves.iter().map(|&(id, comps)| (placeholder(id), ex.measured(id, comps))).collect();
             let val = ex.lower(&rewritten, &scope).map_err(|e| pf.render(*e))?;
@@ -189,7 +189,7 @@ impl<'m> Observer<'m> {
         &mut self,
         pf: &ProblemFile,
         ex: &mut Exprs,
-        tools: &Tools<'m>,
+        ops: &Operators<'m>,
         inst: &mut crate::driver::Instance<'m>,
         e: &Expr,
         leaves: &mut Vec<(usize, usize)>,
@@ -197,7 +197,7 @@ impl<'m> Observer<'m> {
         region_names: &mut Vec<String>,
         binding: &Binding<'m>,
     ) -> Result<Expr, CaseError> {
-        let d = tools.asm.mesh().dim();
+        let d = ops.asm.mesh().dim();
         let mut add = |o: &mut Self, m: Measure, comps: usize, span| {
             o.measures.push(m);
             let id = o.measures.len() - 1;
@@ -237,22 +237,22 @@ impl<'m> Observer<'m> {
                 }
             }
             ExprKind::Neg(a) => {
-                let a = self.rewrite(pf, ex, tools, inst, a, leaves, pointwise, region_names, binding)?;
+                let a = self.rewrite(pf, ex, ops, inst, a, leaves, pointwise, region_names, binding)?;
                 Expr { kind: ExprKind::Neg(Box::new(a)), span: e.span }
             }
             ExprKind::Binary(op, a, b) => {
-                let a = self.rewrite(pf, ex, tools, inst, a, leaves, pointwise, region_names, binding)?;
-                let b = self.rewrite(pf, ex, tools, inst, b, leaves, pointwise, region_names, binding)?;
+                let a = self.rewrite(pf, ex, ops, inst, a, leaves, pointwise, region_names, binding)?;
+                let b = self.rewrite(pf, ex, ops, inst, b, leaves, pointwise, region_names, binding)?;
                 Expr { kind: ExprKind::Binary(*op, Box::new(a), Box::new(b)), span: e.span }
             }
             ExprKind::Index(a, k) => {
-                let a = self.rewrite(pf, ex, tools, inst, a, leaves, pointwise, region_names, binding)?;
+                let a = self.rewrite(pf, ex, ops, inst, a, leaves, pointwise, region_names, binding)?;
                 Expr { kind: ExprKind::Index(Box::new(a), k.clone()), span: e.span }
             }
             ExprKind::Vector(_) => unreachable!("checked: no vector in a column"),
             ExprKind::Call(f, args) => match f.name.as_str() {
                 name if crate::compiler::check::problem::SUMMARY_FUNCTIONS.contains(&name) => {
-                    let a = self.rewrite(pf, ex, tools, inst, &args[0], leaves, pointwise, region_names, binding)?;
+                    let a = self.rewrite(pf, ex, ops, inst, &args[0], leaves, pointwise, region_names, binding)?;
                     Expr { kind: ExprKind::Call(f.clone(), vec![a]), span: e.span }
                 }
                 "mean" | "nodal_mean" | "at_min" => {
@@ -261,12 +261,12 @@ impl<'m> Observer<'m> {
                         return Err(bad_axis(&args[0], axis));
                     }
                     let m = match f.name.as_str() {
-                        "mean" => Measure::Mean { field, weights: tools.axis_mean(axis) },
+                        "mean" => Measure::Mean { field, weights: ops.axis_mean(axis) },
                         "nodal_mean" => Measure::NodalMean { field, axis },
                         _ => {
                             let val = ex.lower(&args[1], &[]).map_err(|e| pf.render(*e))?;
                             let key = ex.function(&val, &args[1]).map_err(|e| pf.render(*e))?;
-                            let mesh = tools.asm.mesh();
+                            let mesh = ops.asm.mesh();
                             let (mut scratch, mut out) = (Vec::new(), [0.0]);
                             let mut at = |i: usize| {
                                 key.eval(&At { x: mesh.node(i), ..At::default() }, &mut scratch, &mut out);
@@ -276,7 +276,7 @@ impl<'m> Observer<'m> {
                             let node = (0..mesh.num_nodes())
                                 .min_by(|&a, &b| values[a].total_cmp(&values[b]))
                                 .ok_or_else(|| CaseError::Option("the mesh has no node".into()))?;
-                            let massless = tools.redistributed && tools.contact_nodes.contains(&(node as u32));
+                            let massless = ops.redistributed && ops.contact_nodes.contains(&(node as u32));
                             Measure::AtMin { field, axis, node, massless }
                         }
                     };
@@ -302,7 +302,7 @@ impl<'m> Observer<'m> {
                     // Over a region: the dofs of its nodes, component by component.
                     let dofs = match args.get(1).map(|a| &a.kind) {
                         Some(ExprKind::Name(region)) => {
-                            let mesh = tools.asm.mesh();
+                            let mesh = ops.asm.mesh();
                             let nodes = mesh.region_nodes(mesh.region(&region.name)?);
                             Some(nodes.iter().flat_map(|&n| (0..d).map(move |k| n as usize * d + k)).collect())
                         }
@@ -338,8 +338,8 @@ impl<'m> Observer<'m> {
                     };
                     // Its integrand must live on facets: a cell functional has none to read.
                     let rule = crate::runtime::fem::quadrature::sampling_rule(d - 1, 1);
-                    let zero = vec![0.0; tools.asm.size()];
-                    if self.functionals[index].1.facet_point_values(tools.asm, &rule, &[&zero], 0.0).is_empty() {
+                    let zero = vec![0.0; ops.asm.size()];
+                    if self.functionals[index].1.facet_point_values(ops.asm, &rule, &[&zero], 0.0).is_empty() {
                         return Err(pf.render(crate::compiler::Diagnostic::error(
                             "E0301",
                             format!("`{}` integrates over no boundary facet", name.name),
@@ -441,17 +441,17 @@ impl<'m> Observer<'m> {
     }
 
     /// The reference's figures of a state into `dir`, if the problem names one.
-    pub fn write_reference(&self, dir: &std::path::Path, tools: &Tools, u: &[f64], t: f64) -> std::io::Result<()> {
+    pub fn write_reference(&self, dir: &std::path::Path, ops: &Operators, u: &[f64], t: f64) -> std::io::Result<()> {
         match &self.reference {
-            Some((_, r)) => r.write(dir, &reference_at(tools, u, t)),
+            Some((_, r)) => r.write(dir, &reference_at(ops, u, t)),
             None => Ok(()),
         }
     }
 
     /// The row at a state: one value per column, and the `contact` slot's switch at each of
     /// its quadrature points (the active set; empty without the slot).
-    pub fn row(&self, tools: &Tools, s: &State) -> (Vec<f64>, Vec<bool>) {
-        let asm: &Assembler = tools.asm;
+    pub fn row(&self, ops: &Operators, s: &State) -> (Vec<f64>, Vec<bool>) {
+        let asm: &Assembler = ops.asm;
         let mesh = asm.mesh();
         let d = mesh.dim();
         let n = asm.size();
@@ -478,9 +478,9 @@ impl<'m> Observer<'m> {
             let (before, dt) = s.before?;
             Some((before.iter().zip(s.u).map(|(a, b)| 0.5 * (a + b)).collect(), s.t - 0.5 * dt))
         };
-        if tools.probe.is_some() {
+        if ops.probe.is_some() {
             // The run's contact slot (the energy guard asked the same step's already).
-            switches = tools.contact_switches(s.u, s.t);
+            switches = ops.contact_switches(s.u, s.t);
         } else if let Some((_, probe)) = self.slots.iter().find(|(n, _)| n == "contact") {
             probe.switches(asm, &[s.u], 0, s.t, &mut switches);
         }
@@ -507,10 +507,10 @@ impl<'m> Observer<'m> {
                 let value: Vec<f64> = match &self.measures[next] {
                     Measure::Time => one(s.t),
                     Measure::Energy => {
-                        let k = *kinetic.get_or_insert_with(|| tools.kinetic(s.v));
-                        one(tools.energy_with_kinetic(s.u, k))
+                        let k = *kinetic.get_or_insert_with(|| ops.kinetic(s.v));
+                        one(ops.energy_with_kinetic(s.u, k))
                     }
-                    Measure::Kinetic => one(*kinetic.get_or_insert_with(|| tools.kinetic(s.v))),
+                    Measure::Kinetic => one(*kinetic.get_or_insert_with(|| ops.kinetic(s.v))),
                     Measure::Newton => one(s.newton as f64),
                     Measure::ActivePoints => one(switches.iter().filter(|b| **b).count() as f64),
                     Measure::Column(i) => one(columns[*i]),
@@ -595,12 +595,12 @@ impl<'m> Observer<'m> {
                     Measure::Reference { which, mid: false } => one(self
                         .reference
                         .as_ref()
-                        .map_or(f64::NAN, |(_, r)| r.value(*which, &reference_at(tools, s.u, s.t)))),
+                        .map_or(f64::NAN, |(_, r)| r.value(*which, &reference_at(ops, s.u, s.t)))),
                     Measure::Reference { which, mid: true } => one(mid
                         .get_or_insert_with(&mut midpoint)
                         .as_ref()
                         .zip(self.reference.as_ref().map(|(_, r)| r))
-                        .map_or(f64::NAN, |((u, t), r)| r.value(*which, &reference_at(tools, u, *t)))),
+                        .map_or(f64::NAN, |((u, t), r)| r.value(*which, &reference_at(ops, u, *t)))),
                     Measure::Density { index, min } => {
                         let rule = crate::runtime::fem::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
                         let points = self.functionals[*index].1.facet_point_values(asm, &rule, &[s.u], s.t);
@@ -621,7 +621,7 @@ impl<'m> Observer<'m> {
                             out
                         };
                         let (a, b) = (nodal(a, &mut *scratch), nodal(b, &mut *scratch));
-                        one(Tools::quad(&tools.scheme_mass, &a, &b))
+                        one(Operators::quad(&ops.scheme_mass, &a, &b))
                     }
                 };
                 measured.push(value);
@@ -642,12 +642,6 @@ impl<'m> Observer<'m> {
 }
 
 /// A state as a reference measures it.
-fn reference_at<'a>(tools: &'a Tools<'_>, u: &'a [f64], t: f64) -> crate::references::At<'a> {
-    crate::references::At {
-        asm: tools.asm,
-        mass: &tools.scheme_mass,
-        pressure: tools.contact_pressure.as_deref(),
-        u,
-        t,
-    }
+fn reference_at<'a>(ops: &'a Operators<'_>, u: &'a [f64], t: f64) -> crate::references::At<'a> {
+    crate::references::At { asm: ops.asm, mass: &ops.scheme_mass, pressure: ops.contact_pressure.as_deref(), u, t }
 }

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use crate::driver::Setup;
+use crate::driver::Methods;
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;
@@ -15,7 +15,7 @@ pub struct Options {
     /// A library problem by name, or a problem file.
     pub problem: String,
     /// Scheme, contact law, extra forms, params (the problem's params among them).
-    pub setup: Setup,
+    pub methods: Methods,
     pub mass: MassChoice,
     pub cell_size: CellSize,
     /// A Gmsh file instead of the problem's mesh.
@@ -35,7 +35,7 @@ pub struct Options {
     pub chosen: Chosen,
 }
 
-/// Which of the setup's files the user chose; a problem's `bind` replaces the library's
+/// Which of the methods' files the user chose; a problem's `bind` replaces the library's
 /// defaults only.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Chosen {
@@ -45,7 +45,7 @@ pub struct Chosen {
 }
 
 impl Chosen {
-    /// Every role chosen: the setup is taken as it is (programs that build their own).
+    /// Every role chosen: the methods are taken as they are (programs that build their own).
     pub fn all() -> Chosen {
         Chosen { scheme: true, contact: true, material: true }
     }
@@ -55,7 +55,7 @@ impl Options {
     pub fn new(problem: &str) -> Options {
         Options {
             problem: problem.to_string(),
-            setup: Setup::default(),
+            methods: Methods::default(),
             mass: MassChoice::Consistent,
             cell_size: CellSize::Diameter,
             mesh: None,

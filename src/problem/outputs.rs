@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::{ProblemFile, ProblemParam};
-use crate::driver::{Active, ParamValue};
+use crate::driver::{FilesInUse, ParamValue};
 use crate::error::CaseError;
 
 /// A finished run: its summary and rows (every column, shown or not).
@@ -89,8 +89,12 @@ pub(super) fn json<T: Serialize + ?Sized>(v: &T) -> serde_json::Value {
 }
 
 /// Every param in effect: the problem's, the scheme's and the form files'.
-pub(super) fn all_params(active: &Active, params: &[ProblemParam], pf: &ProblemFile) -> BTreeMap<String, ParamValue> {
-    let mut out = active.forms.params.values();
+pub(super) fn all_params(
+    in_use: &FilesInUse,
+    params: &[ProblemParam],
+    pf: &ProblemFile,
+) -> BTreeMap<String, ParamValue> {
+    let mut out = in_use.forms.params.values();
     for q in params {
         let declared = pf.problem().params.iter().find(|d| d.name.name == q.name).map(|d| d.span);
         let line = declared.map_or(0, |s| pf.program.unit.sources.line_col(s.file, s.start).0);

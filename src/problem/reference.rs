@@ -4,20 +4,20 @@
 
 use super::ProblemFile;
 use super::expr::Exprs;
-use crate::driver::Active;
+use crate::driver::FilesInUse;
 use crate::error::CaseError;
 
 /// The problem's reference bound to this run, after it checked the run is one it describes.
 pub(super) fn bound_reference(
     pf: &ProblemFile,
     ex: &mut Exprs,
-    active: &Active,
+    in_use: &FilesInUse,
     mesh: &crate::runtime::fem::mesh::Mesh,
     contact: &[crate::runtime::fem::mesh::Facet],
     t_start: f64,
 ) -> Result<Option<crate::references::Bound>, CaseError> {
     let Some(r) = reference(pf, mesh.dim())? else { return Ok(None) };
-    let param = |name: &str| active.forms.params.get(name);
+    let param = |name: &str| in_use.forms.params.get(name);
     let args = reference_args(pf, ex, r)?;
     let facts = crate::references::RunFacts { mesh, param: &param, t_start, args: &args, contact };
     let bound = r.bind(&facts).map_err(|why| {

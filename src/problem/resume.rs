@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::options::{Options, Times};
 use super::{ProblemFile, ProblemParam};
-use crate::driver::Active;
+use crate::driver::FilesInUse;
 
 /// What a checkpoint keeps of the run: what is new since the checkpoint before.
 #[derive(Serialize, Deserialize)]
@@ -22,7 +22,7 @@ pub(super) fn identity(
     opts: &Options,
     pf: &ProblemFile,
     params: &[ProblemParam],
-    active: &Active,
+    in_use: &FilesInUse,
     mesh: &crate::runtime::fem::mesh::Mesh,
     s: &Times,
 ) -> crate::checkpoint::Identity {
@@ -38,5 +38,5 @@ pub(super) fn identity(
     ];
     let problem_params: Vec<String> = params.iter().map(|p| format!("{} = {:?}", p.name, p.value)).collect();
     more.push(("problem params", problem_params.join(", ")));
-    crate::checkpoint::identity(pf.name(), active, mesh, &more)
+    crate::checkpoint::identity(pf.name(), in_use, mesh, &more)
 }

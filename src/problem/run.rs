@@ -19,7 +19,7 @@ use super::reference::{bound_reference, reference};
 use super::resume::{Record, identity};
 use super::summary::SummaryKeys;
 use crate::checkpoint::Control;
-use crate::driver::{Active, Setup};
+use crate::driver::{FilesInUse, Methods};
 use crate::error::CaseError;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::mesh::CellSize;
@@ -46,7 +46,7 @@ pub fn check(problem: &str) -> Result<(), CaseError> {
 }
 
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    bound(opts, |pf, params, ex, active| {
+    bound(opts, |pf, params, ex, in_use| {
         if pf.problem().run_static.is_some() {
             if opts.dt.is_some() || opts.t_end.is_some() || opts.t_start.is_some() {
                 return Err(CaseError::Option(format!(
@@ -55,7 +55,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
                 )));
             }
             let times = Times { dt: f64::NAN, t_start: 0.0, t_end: 0.0 };
-            return simulate(opts, pf, params, ex, active, &times);
+            return simulate(opts, pf, params, ex, in_use, &times);
         }
         let given = super::bind::settings(pf, ex, &pf.problem().run)?;
         let setting = |name: &str, over: Option<f64>, default: f64| {
@@ -76,7 +76,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         if !(times.t_start >= 0.0 && times.t_start < times.t_end) {
             return Err(CaseError::Option(format!("--t-start must be in [0, t_end), not {}", times.t_start)));
         }
-        simulate(opts, pf, params, ex, active, &times)
+        simulate(opts, pf, params, ex, in_use, &times)
     })
 }
 
@@ -85,12 +85,12 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
 /// and hands the bound pieces to `f`.
 fn bound<R>(
     opts: &Options,
-    f: impl FnOnce(&ProblemFile, &[super::ProblemParam], &mut Exprs, &Active) -> Result<R, CaseError>,
+    f: impl FnOnce(&ProblemFile, &[super::ProblemParam], &mut Exprs, &FilesInUse) -> Result<R, CaseError>,
 ) -> Result<R, CaseError> {
     let pf = super::load(&opts.problem)?;
-    let (params, rest) = super::params(&pf, &opts.setup.params)?;
-    let mut setup = Setup { params: rest, ..opts.setup.clone() };
-    bind_files(&pf, &mut setup, opts.chosen);
+    let (params, rest) = super::params(&pf, &opts.methods.params)?;
+    let mut methods = Methods { params: rest, ..opts.methods.clone() };
+    bind_files(&pf, &mut methods, opts.chosen);
     let values: Vec<(String, f64)> = params.iter().map(|p| (p.name.clone(), p.value)).collect();
     let d = super::bind::dimension(&pf, opts.mesh.as_deref(), &values)?;
     let p = pf.problem();
@@ -100,24 +100,24 @@ fn bound<R>(
         sets.push((s.name.name.clone(), ex.scalar(&s.value).map_err(|e| pf.render(*e))?));
     }
     let overrides: Vec<(&str, f64)> = sets.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    let active = Active::resolve(&setup, &overrides)?;
-    unset_coefs(&pf, &active)?;
-    f(&pf, &params, &mut ex, &active)
+    let in_use = FilesInUse::resolve(&methods, &overrides)?;
+    unset_coefs(&pf, &in_use)?;
+    f(&pf, &params, &mut ex, &in_use)
 }
 
 /// The problem's `bind` lines, for the roles the user did not choose; a path is relative to the
 /// problem file.
-fn bind_files(pf: &ProblemFile, setup: &mut Setup, chosen: Chosen) {
+fn bind_files(pf: &ProblemFile, methods: &mut Methods, chosen: Chosen) {
     for b in &pf.problem().binds {
         let target = if b.is_path { pf.dir.join(&b.target).display().to_string() } else { b.target.clone() };
         match b.role.name.as_str() {
-            "scheme" if !chosen.scheme => setup.scheme = target,
-            "contact" if !chosen.contact => setup.contact = target,
-            "material" if !chosen.material => setup.material = target,
+            "scheme" if !chosen.scheme => methods.scheme = target,
+            "contact" if !chosen.contact => methods.contact = target,
+            "material" if !chosen.material => methods.material = target,
             "forms" => {
                 let path = std::path::PathBuf::from(target);
-                if !setup.forms.contains(&path) {
-                    setup.forms.push(path);
+                if !methods.forms.contains(&path) {
+                    methods.forms.push(path);
                 }
             }
             _ => {}
@@ -130,7 +130,7 @@ fn simulate(
     pf: &ProblemFile,
     params: &[super::ProblemParam],
     ex: &mut Exprs,
-    active: &Active,
+    in_use: &FilesInUse,
     times: &Times,
 ) -> Result<Run, CaseError> {
     let start = Instant::now();
@@ -152,11 +152,11 @@ fn simulate(
     };
     let quadrature = Quadrature { cell: degree("cell")?, facet: degree("facet")? };
     let coef_fns = super::bind::coefs(pf, ex)?;
-    coef_shapes(pf, active, &coef_fns, mesh.dim())?;
+    coef_shapes(pf, in_use, &coef_fns, mesh.dim())?;
     let lookup = super::bind::coef_lookup(&coef_fns);
     // Without contact, the coefs only the contact law reads are zero (it integrates over no facet).
     let zeros: Vec<(String, usize)> = if super::bind::contact_free(pf) {
-        let law = &active.forms.units[active.forms.contact];
+        let law = &in_use.forms.units[in_use.forms.contact];
         law.coefs().into_iter().map(|(name, rank)| (name, mesh.dim().pow(rank))).collect()
     } else {
         Vec::new()
@@ -189,11 +189,11 @@ fn simulate(
     let mut control = Control::new(
         opts.checkpoint_every,
         opts.out.clone(),
-        identity(opts, pf, params, active, &mesh, times),
+        identity(opts, pf, params, in_use, &mesh, times),
         opts.resume,
     )?;
     // A static problem is one equilibrium, from u₀ (no initial acceleration to solve for): it
-    // binds the tools, and no stepper.
+    // binds the operators, and no stepper.
     let statics = p.run_static.is_some();
     if statics && held.is_some() {
         return Err(CaseError::Option(format!(
@@ -202,9 +202,9 @@ fn simulate(
         )));
     }
     let mut runner = if statics {
-        Runner::Static(Box::new(crate::simulation::Tools::bind(&asm, problem, active)?))
+        Runner::Static(Box::new(crate::simulation::Operators::bind(&asm, problem, in_use)?))
     } else {
-        Runner::Time(Box::new(Simulation::new(&asm, problem, active)?))
+        Runner::Time(Box::new(Simulation::new(&asm, problem, in_use)?))
     };
     let t0 = times.t_start;
     // The initial fields take the held values on the held dofs.
@@ -215,18 +215,18 @@ fn simulate(
     if let Some(h) = &held {
         h.initial(&mesh, t0, &mut u0, &mut v0);
     }
-    let mut regions = vec![(contact.to_string(), runner.tools().contact_facets)];
+    let mut regions = vec![(contact.to_string(), runner.ops().contact_facets)];
     for name in &others {
         regions.push((name.clone(), asm.region(name)?));
     }
     let binding = Binding { quadrature, regions, dim: mesh.dim() };
     let coef_vals = super::bind::coef_vals(pf, ex)?;
-    let reference = bound_reference(pf, ex, active, &mesh, runner.tools().contact_facets, t0)?;
+    let reference = bound_reference(pf, ex, in_use, &mesh, runner.ops().contact_facets, t0)?;
     let mut observer = Observer::new(
         pf,
         ex,
-        runner.tools(),
-        &active.forms,
+        runner.ops(),
+        &in_use.forms,
         &coefs,
         &binding,
         &coef_vals,
@@ -244,15 +244,15 @@ fn simulate(
             observer.defer(column, by);
         }
     }
-    let row = |tools: &crate::simulation::Tools, state: State| {
+    let row = |ops: &crate::simulation::Operators, state: State| {
         let t = state.t;
-        let (values, switches) = observer.row(tools, &state);
+        let (values, switches) = observer.row(ops, &state);
         ((t, values), switches)
     };
     let name = pf.name().to_string();
     let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, &name);
     let (series, switches, iterations, stage_rows, outcome, counters, steps, last) = match &mut runner {
-        Runner::Static(tools) => {
+        Runner::Static(ops) => {
             // One equilibrium by the static driver: its single row is the solution.
             let contact = contact_region.ok_or_else(|| {
                 CaseError::Option(format!(
@@ -268,12 +268,12 @@ fn simulate(
                 constraints: constraints.clone(),
                 newton: opts.newton,
             };
-            let solution = crate::simulation::statics::solve(&asm, problem, &active.forms, u0)?;
+            let solution = crate::simulation::statics::solve(&asm, problem, &in_use.forms, u0)?;
             let seconds = clock.elapsed().as_secs_f64();
             let newton = solution.newton.iterations();
             let (row, switches) =
-                row(tools, State { t: t0, u: &solution.u, v: None, newton, before: None, stage: false });
-            snapshots.write(tools, 0, t0, &solution.u, &vec![0.0; n])?;
+                row(ops, State { t: t0, u: &solution.u, v: None, newton, before: None, stage: false });
+            snapshots.write(ops, 0, t0, &solution.u, &vec![0.0; n])?;
             let outcome = crate::simulation::Outcome {
                 step_seconds: vec![seconds],
                 cuts: 0,
@@ -287,7 +287,7 @@ fn simulate(
         Runner::Time(sim) => {
             sim.initialize_at(t0, u0, v0)?;
             let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None, stage: false };
-            let (first, first_switches) = row(&sim.tools, first);
+            let (first, first_switches) = row(&sim.ops, first);
             let mut series = vec![first];
             let mut switches = vec![first_switches];
             // Newton iterations of each row's step (0 for the initial state).
@@ -330,7 +330,7 @@ fn simulate(
                         (series.len(), stage_rows.borrow().len(), snapshots.written().len());
                 }
                 None => snapshots.write(
-                    &sim.tools,
+                    &sim.ops,
                     0,
                     t0,
                     &sim.states[0],
@@ -344,15 +344,15 @@ fn simulate(
                 steps,
                 opts.progress,
                 &mut control,
-                &mut |tools, stage, v_index| {
+                &mut |ops, stage, v_index| {
                     if let Some(u) = stage.value_of(names[0]) {
                         let v = v_index.and_then(|i| stage.value_of(names[i]));
                         let ((t, values), _) =
-                            row(tools, State { t: stage.time, u, v, newton: 0, before: None, stage: true });
+                            row(ops, State { t: stage.time, u, v, newton: 0, before: None, stage: true });
                         stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
                     }
                 },
-                &mut |tools, step, record| {
+                &mut |ops, step, record| {
                     let v = v_index.map(|i| step.states[i].as_slice());
                     let state = State {
                         t: step.t,
@@ -362,12 +362,12 @@ fn simulate(
                         before: Some((step.before, step.dt)),
                         stage: false,
                     };
-                    let (values, active) = row(tools, state);
+                    let (values, active) = row(ops, state);
                     series.push(values);
                     switches.push(active);
                     iterations.push(step.report.iterations());
                     snapshots.write(
-                        tools,
+                        ops,
                         step.k,
                         step.t,
                         &step.states[0],
@@ -400,10 +400,10 @@ fn simulate(
     let mut put = |k: &str, v: serde_json::Value| summary.keys.push((k.to_string(), v));
     put("case", name.clone().into());
     put("problem", pf.file.clone().into());
-    put("scheme", if statics { "static".into() } else { active.scheme_name().into() });
-    put("contact", active.forms.contact_name().into());
-    put("interpreted", json(&active.interpreted()));
-    put("params", json(&all_params(active, params, pf)));
+    put("scheme", if statics { "static".into() } else { in_use.scheme_name().into() });
+    put("contact", in_use.forms.contact_name().into());
+    put("interpreted", json(&in_use.interpreted()));
+    put("params", json(&all_params(in_use, params, pf)));
     put("mass", json(&opts.mass));
     put("cell_size", json(&opts.cell_size));
     put("mesh", mesh_label.clone().into());
@@ -471,7 +471,7 @@ fn simulate(
         write_outputs(dir, pf, &run, &shown)?;
         // The reference's figures of the last state (Hertz's pressure profile).
         observer
-            .write_reference(dir, runner.tools(), &last.1, last.0)
+            .write_reference(dir, runner.ops(), &last.1, last.0)
             .map_err(|source| CaseError::Write { path: dir.display().to_string(), source })?;
     }
     if let Some(e) = outcome.stopped {
@@ -480,18 +480,18 @@ fn simulate(
     Ok(run)
 }
 
-/// What runs a problem: the stepper (a time run), or a static problem's tools alone (its one
+/// What runs a problem: the stepper (a time run), or a static problem's operators alone (its one
 /// equilibrium is the static driver's).
 enum Runner<'m> {
     Time(Box<Simulation<'m>>),
-    Static(Box<crate::simulation::Tools<'m>>),
+    Static(Box<crate::simulation::Operators<'m>>),
 }
 
 impl<'m> Runner<'m> {
-    fn tools(&self) -> &crate::simulation::Tools<'m> {
+    fn ops(&self) -> &crate::simulation::Operators<'m> {
         match self {
-            Runner::Time(sim) => &sim.tools,
-            Runner::Static(tools) => tools,
+            Runner::Time(sim) => &sim.ops,
+            Runner::Static(ops) => ops,
         }
     }
 }

@@ -4,7 +4,7 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use crate::driver::Setup;
+use crate::driver::Methods;
 use crate::error::CaseError;
 use crate::problem::run::{Options, run};
 
@@ -42,7 +42,7 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
                 progress(&format!("{problem} {contact} level {level}"));
                 let dir = out.join("hertz").join(format!("static_{dim}d_{contact}_{level}"));
                 let mut opts = Options::new(problem);
-                opts.setup = Setup { contact: contact.clone(), ..Setup::default() }.set("level", level as f64);
+                opts.methods = Methods { contact: contact.clone(), ..Methods::default() }.set("level", level as f64);
                 opts.chosen.contact = true;
                 opts.out = Some(dir);
                 let s = run(&opts)?.summary;
@@ -85,7 +85,7 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         progress(&format!("hertz_impact level {level} v = {speed}"));
         let name = format!("impact_{level}_{speed}");
         let mut opts = Options::new("hertz_impact");
-        opts.setup = Setup::default().set("level", level as f64).set("speed", speed);
+        opts.methods = Methods::default().set("level", level as f64).set("speed", speed);
         opts.out = Some(out.join("hertz").join(&name));
         let s = run(&opts)?.summary;
         let get = |k: &str| s.number(k).unwrap_or(f64::NAN);

@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use crate::cases::bar;
 use crate::cases::disc;
-use crate::driver::Setup;
+use crate::driver::Methods;
 use crate::error::CaseError;
 use crate::plot::Curve;
 use crate::simulation::MassChoice;
@@ -18,16 +18,16 @@ use crate::simulation::MassChoice;
 mod hertz;
 pub mod sweep;
 
-/// Runs `run` with `setup`; a run the energy guard stops (IMEX-HHT: explicit contact is only
+/// Runs `run` with `methods`; a run the energy guard stops (IMEX-HHT: explicit contact is only
 /// conditionally stable) runs again with the guard off, so that the report shows how its
 /// energy grows, and the note says where the guard stopped it.
 fn past_the_guard<R>(
-    setup: Setup,
-    run: impl Fn(Setup) -> Result<R, CaseError>,
+    methods: Methods,
+    run: impl Fn(Methods) -> Result<R, CaseError>,
 ) -> Result<(R, Option<String>), CaseError> {
-    match run(setup.clone()) {
+    match run(methods.clone()) {
         Err(CaseError::BlowUp { t, energy, bound, scale, .. }) => {
-            let mut off = setup;
+            let mut off = methods;
             off.guard.energy_tolerance = 0.0;
             let note = format!(
                 "the energy guard stops it at t = {t:.2}, E_aug {:+.1} % of the energy scale; shown without the guard",
@@ -70,9 +70,9 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         let label = format!("{scheme}-{contact}-{}", mass.name());
         let dir = out.join("bar").join(&label);
         progress(&format!("bar {label}"));
-        let setup = Setup { scheme: scheme.into(), contact: contact.into(), ..Setup::default() };
-        let (r, guard) = past_the_guard(setup, |setup| {
-            bar::run(&bar::Options { setup, mass, out: Some(dir.clone()), ..Default::default() })
+        let methods = Methods { scheme: scheme.into(), contact: contact.into(), ..Methods::default() };
+        let (r, guard) = past_the_guard(methods, |methods| {
+            bar::run(&bar::Options { methods, mass, out: Some(dir.clone()), ..Default::default() })
         })?;
         let s = &r.summary;
         let _ = writeln!(
@@ -112,10 +112,10 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     for scheme in crate::driver::all_schemes() {
         progress(&format!("disc {scheme}"));
         let dir = out.join("disc").join(scheme);
-        let setup = Setup { scheme: scheme.into(), ..Setup::default() };
+        let methods = Methods { scheme: scheme.into(), ..Methods::default() };
         // A scheme that fails here (explicit contact is unstable at this step) is a result.
-        let run = past_the_guard(setup, |setup| {
-            disc::run(&disc::Options { setup, out: Some(dir.clone()), ..Default::default() })
+        let run = past_the_guard(methods, |methods| {
+            disc::run(&disc::Options { methods, out: Some(dir.clone()), ..Default::default() })
         });
         let (r, guard) = match run {
             Ok(r) => r,

@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use crate::cases::bar;
 use crate::cases::disc;
-use crate::driver::Setup;
+use crate::driver::Methods;
 use crate::error::CaseError;
 use crate::plot::Curve;
 use crate::simulation::MassChoice;
@@ -58,15 +58,15 @@ impl Point {
 
 /// The sweep's runs: coarse steps lose accuracy on purpose, and the energy guard stops a run
 /// only where the sweep would not count it as converging.
-fn sweep_setup(scheme: &str) -> Setup {
-    let mut setup = Setup { scheme: scheme.into(), ..Setup::default() };
-    setup.guard.energy_tolerance = BOUNDED;
-    setup
+fn sweep_setup(scheme: &str) -> Methods {
+    let mut methods = Methods { scheme: scheme.into(), ..Methods::default() };
+    methods.guard.energy_tolerance = BOUNDED;
+    methods
 }
 
 fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
-    let setup = sweep_setup(scheme);
-    let r = bar::run(&bar::Options { setup, mass, dt: Some(dt), ..Default::default() })?;
+    let methods = sweep_setup(scheme);
+    let r = bar::run(&bar::Options { methods, mass, dt: Some(dt), ..Default::default() })?;
     let s = &r.summary;
     // The first contact phase of the exact solution is t ∈ [1, 2]: look at [0.5, 2.5].
     let variation = |f: fn(&bar::Row) -> f64| -> f64 {
@@ -84,8 +84,8 @@ fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseEr
 }
 
 fn disc_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
-    let setup = sweep_setup(scheme);
-    let r = disc::run(&disc::Options { setup, mass, dt, ..Default::default() })?;
+    let methods = sweep_setup(scheme);
+    let r = disc::run(&disc::Options { methods, mass, dt, ..Default::default() })?;
     let s = &r.summary;
     // The first contact phase: from the first step with an active point to the next without.
     let start = r.series.iter().position(|row| row.active_points > 0);
@@ -94,7 +94,7 @@ fn disc_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseE
             .iter()
             .enumerate()
             .take_while(|(i, row)| *i < 2 || row.active_points > 0)
-            .map(|(_, row)| row.fy_contact)
+            .map(|(_, row)| row.f_vertical_contact)
             .collect()
     });
     let peak = phase.iter().fold(0.0f64, |m, f| m.max(f.abs()));

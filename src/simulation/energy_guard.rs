@@ -4,7 +4,7 @@
 //! growth beyond the tolerance, a negative potential energy, or a law's own work beyond the
 //! energy from outside stops the run (docs/mathematics.md §5).
 
-use super::Tools;
+use super::Operators;
 use crate::compiler::scheme::EnergyLaw;
 use crate::guard::ENERGY_TOLERANCE;
 use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
@@ -55,11 +55,11 @@ pub(super) enum Cause {
 }
 
 impl EnergyWatch {
-    pub(super) fn new(tools: &Tools, states: &[Vec<f64>], v_index: Option<usize>, t: f64) -> Self {
+    pub(super) fn new(ops: &Operators, states: &[Vec<f64>], v_index: Option<usize>, t: f64) -> Self {
         let u = &states[0];
         let v = v_index.map(|i| states[i].as_slice());
-        let kinetic = tools.kinetic(v);
-        let initial = tools.elastic(u) + kinetic + Self::contact(tools, u, t);
+        let kinetic = ops.kinetic(v);
+        let initial = ops.elastic(u) + kinetic + Self::contact(ops, u, t);
         EnergyWatch {
             initial,
             u0: u.clone(),
@@ -70,24 +70,24 @@ impl EnergyWatch {
             growth: 0.0,
             lowest: initial,
             allowance: 0.0,
-            switches: tools.contact_switches(u, t),
+            switches: ops.contact_switches(u, t),
         }
     }
 
     /// The contact law's energy (0 for a law without `contact_energy`).
-    fn contact(tools: &Tools, u: &[f64], t: f64) -> f64 {
-        Self::value(&tools.contact_energy, tools, u, t)
+    fn contact(ops: &Operators, u: &[f64], t: f64) -> f64 {
+        Self::value(&ops.contact_energy, ops, u, t)
     }
 
     /// A functional of u alone at `u` (0 without it).
-    fn value(f: &Option<Box<dyn BoundFunctional + '_>>, tools: &Tools, u: &[f64], t: f64) -> f64 {
-        f.as_ref().filter(|f| f.fields() == 1).map_or(0.0, |f| f.value(tools.asm, &[u], t))
+    fn value(f: &Option<Box<dyn BoundFunctional + '_>>, ops: &Operators, u: &[f64], t: f64) -> f64 {
+        f.as_ref().filter(|f| f.fields() == 1).map_or(0.0, |f| f.value(ops.asm, &[u], t))
     }
 
     /// Adds the work of a time-dependent load over one step: L(t_mid)·(u − u_before).
-    pub(super) fn step_work(&mut self, tools: &Tools, load: &dyn BoundForm, before: &[f64], u: &[f64], t_mid: f64) {
+    pub(super) fn step_work(&mut self, ops: &Operators, load: &dyn BoundForm, before: &[f64], u: &[f64], t_mid: f64) {
         let mut l = vec![0.0; u.len()];
-        load.residual(tools.asm, &[], t_mid, &mut l);
+        load.residual(ops.asm, &[], t_mid, &mut l);
         self.varying_work += l.iter().zip(u.iter().zip(before)).map(|(l, (a, b))| l * (a - b)).sum::<f64>();
     }
 
@@ -96,7 +96,7 @@ impl EnergyWatch {
     /// a velocity state, its quasi-static part), times their motion.
     pub(super) fn held_work(
         &mut self,
-        tools: &Tools,
+        ops: &Operators,
         before: &[f64],
         u: &[f64],
         v: Option<(&[f64], &[f64])>,
@@ -105,30 +105,30 @@ impl EnergyWatch {
     ) {
         let mid: Vec<f64> = before.iter().zip(u).map(|(a, b)| 0.5 * (a + b)).collect();
         let mut reaction = vec![0.0; u.len()];
-        tools.stiffness.mul_vec(&mid, &mut reaction);
+        ops.stiffness.mul_vec(&mid, &mut reaction);
         if let Some((v0, v1)) = v {
             let dv: Vec<f64> = v1.iter().zip(v0).map(|(a, b)| (a - b) / h).collect();
             let mut inertia = vec![0.0; u.len()];
-            tools.scheme_mass.mul_vec(&dv, &mut inertia);
+            ops.scheme_mass.mul_vec(&dv, &mut inertia);
             reaction.iter_mut().zip(&inertia).for_each(|(r, m)| *r += m);
         }
-        let load = match &tools.varying_load {
+        let load = match &ops.varying_load {
             Some(form) => {
                 let mut l = vec![0.0; u.len()];
-                form.residual(tools.asm, &[], t_mid, &mut l);
+                form.residual(ops.asm, &[], t_mid, &mut l);
                 l
             }
-            None => tools.load.clone(),
+            None => ops.load.clone(),
         };
-        self.varying_work += tools.held.iter().map(|&i| (reaction[i] - load[i]) * (u[i] - before[i])).sum::<f64>();
+        self.varying_work += ops.held.iter().map(|&i| (reaction[i] - load[i]) * (u[i] - before[i])).sum::<f64>();
     }
 
     /// Adds the work of an obstacle that moves (a gap that changes with time) over one step:
     /// the change of the contact energy with time alone, at the step's mid-displacement.
-    pub(super) fn obstacle_work(&mut self, tools: &Tools, before: &[f64], u: &[f64], t: f64, h: f64) {
+    pub(super) fn obstacle_work(&mut self, ops: &Operators, before: &[f64], u: &[f64], t: f64, h: f64) {
         let mid: Vec<f64> = before.iter().zip(u).map(|(a, b)| 0.5 * (a + b)).collect();
         self.varying_work +=
-            Self::value(&tools.contact_energy, tools, &mid, t + h) - Self::value(&tools.contact_energy, tools, &mid, t);
+            Self::value(&ops.contact_energy, ops, &mid, t + h) - Self::value(&ops.contact_energy, ops, &mid, t);
     }
 
     /// After each accepted step: the energy, and whether it grew beyond what `law` allows by
@@ -143,7 +143,7 @@ impl EnergyWatch {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn check(
         &mut self,
-        tools: &Tools,
+        ops: &Operators,
         states: &[Vec<f64>],
         v_index: Option<usize>,
         before: &[f64],
@@ -161,15 +161,15 @@ impl EnergyWatch {
                 &fd
             }
         };
-        let kinetic = tools.kinetic(Some(v));
-        let potential = tools.elastic(u) + Self::contact(tools, u, t);
+        let kinetic = ops.kinetic(Some(v));
+        let potential = ops.elastic(u) + Self::contact(ops, u, t);
         let energy = potential + kinetic;
         // A conserving scheme: the allowance grows on the steps where the active set changes.
         let (switches, allowance) = match law {
             Some(EnergyLaw::Conserving) => {
-                let switches = tools.contact_switches(u, t);
+                let switches = ops.contact_switches(u, t);
                 let jump = if switches != self.switches {
-                    let value = |x: &[f64], at: f64| Self::value(&tools.contact_jump, tools, x, at);
+                    let value = |x: &[f64], at: f64| Self::value(&ops.contact_jump, ops, x, at);
                     value(u, t).max(value(before, t - h))
                 } else {
                     0.0
@@ -180,9 +180,9 @@ impl EnergyWatch {
         };
         // The work summed step by step (a varying load's, the held dofs', a moving obstacle's),
         // a constant load's from u(0), and the law's own.
-        let constant: f64 = match tools.varying_load {
+        let constant: f64 = match ops.varying_load {
             Some(_) => 0.0,
-            None => tools.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum(),
+            None => ops.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum(),
         };
         let external = self.varying_work + constant;
         self.work = self.work.max(external.abs());

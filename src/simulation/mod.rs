@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use crate::checkpoint::Control;
 use crate::compiler::scheme::EnergyLaw;
-use crate::driver::Active;
+use crate::driver::FilesInUse;
 use crate::error::CaseError;
 use crate::guard::{Guard, MAX_STEP_CUTS};
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
@@ -29,7 +29,7 @@ pub mod statics;
 
 use energy_guard::{Cause, EnergyWatch};
 use operators::Parts;
-pub use operators::{AxisMean, Energies, Tools, resultant};
+pub use operators::{AxisMean, Energies, Operators, resultant};
 pub use snapshots::Snapshots;
 
 /// What a case gives the driver.
@@ -72,10 +72,10 @@ impl MassChoice {
     }
 }
 
-/// The stepper, its states and the tools, ready to run.
+/// The stepper, its states and the operators, ready to run.
 pub struct Simulation<'m> {
     pub stepper: Stepper<'m>,
-    pub tools: Tools<'m>,
+    pub ops: Operators<'m>,
     /// One vector per state of the scheme; `states[0]` is the displacement.
     pub states: Vec<Vec<f64>>,
     /// The index of the velocity state `v`, if the scheme has one.
@@ -105,16 +105,16 @@ pub struct Step<'s> {
 impl<'m> Simulation<'m> {
     /// Binds the files in use on `asm`'s mesh, redistributes the mass when asked (the contact
     /// nodes carry none; a⁰ = 0 there), and builds the stepper.
-    pub fn new(asm: &'m Assembler<'m>, mut problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
+    pub fn new(asm: &'m Assembler<'m>, mut problem: Problem<'_>, in_use: &FilesInUse) -> Result<Self, CaseError> {
         let constraints = problem.constraints.clone();
         let held = constraints.clone();
         let coefs = problem.coefs;
         let newton = problem.newton;
         let prescribed = problem.prescribed.take();
-        let Parts { mut tools, forms, inertia } = Parts::build(asm, problem, active)?;
-        tools.held = prescribed.as_ref().map_or_else(Vec::new, |p| p.dofs.clone());
-        let scheme = active.time_scheme()?;
-        if tools.redistributed && scheme.desc().explicit() {
+        let Parts { mut ops, forms, inertia } = Parts::build(asm, problem, in_use)?;
+        ops.held = prescribed.as_ref().map_or_else(Vec::new, |p| p.dofs.clone());
+        let scheme = in_use.time_scheme()?;
+        if ops.redistributed && scheme.desc().explicit() {
             return Err(CaseError::Option(format!(
                 "--mass redistributed: scheme `{}` is explicit (only `mass` acts on its unknown), and the redistributed mass leaves the contact nodes without inertia: their accelerations cannot be solved for at any Δt; use --mass consistent or --mass lumped",
                 scheme.desc().name
@@ -124,22 +124,22 @@ impl<'m> Simulation<'m> {
         if let Some(p) = prescribed {
             stepper.prescribe(p)?;
         }
-        if tools.redistributed {
+        if ops.redistributed {
             let d = asm.mesh().dim();
             let mut initial = constraints;
-            for &c in &tools.contact_nodes {
+            for &c in &ops.contact_nodes {
                 for k in 0..d {
                     initial.fix(d * c as usize + k);
                 }
             }
             stepper.initial_constraints = Some(initial);
         }
-        tools.energies = Energies::new(asm, stepper.half_pattern(), &tools.stiffness, &tools.scheme_mass);
+        ops.energies = Energies::new(asm, stepper.half_pattern(), &ops.stiffness, &ops.scheme_mass);
         let n = asm.size();
         let names = stepper.desc().states;
         let states = names.iter().map(|_| vec![0.0; n]).collect();
         let v_index = names.iter().position(|s| *s == "v");
-        let params = active
+        let params = in_use
             .forms
             .params
             .values()
@@ -148,16 +148,16 @@ impl<'m> Simulation<'m> {
             .collect::<Vec<_>>()
             .join(", ");
         // Without inertia each step is an equilibrium of its own: no energy accumulates to watch.
-        let mut guard = active.guard;
+        let mut guard = in_use.guard;
         if !inertia {
             guard.energy_tolerance = 0.0;
         }
-        let (claims, law) = active.scheme_claims_and_law()?;
+        let (claims, law) = in_use.scheme_claims_and_law()?;
         let stable = match claims.into_iter().find(|(c, _)| c == "cfl") {
-            Some((_, cfl)) => Some(stability::estimate(&tools, coefs, &held, cfl)?),
+            Some((_, cfl)) => Some(stability::estimate(&ops, coefs, &held, cfl)?),
             None => None,
         };
-        Ok(Simulation { stepper, tools, states, v_index, guard, params, law, stable })
+        Ok(Simulation { stepper, ops, states, v_index, guard, params, law, stable })
     }
 
     /// Sets the displacement and solves the scheme's initial problem (the acceleration).
@@ -207,7 +207,7 @@ impl<'m> Simulation<'m> {
         steps: usize,
         progress: bool,
         control: &mut Control,
-        on_stage: &mut dyn FnMut(&Tools, &StageView, Option<usize>),
+        on_stage: &mut dyn FnMut(&Operators, &StageView, Option<usize>),
         on_step: &mut OnStep,
     ) -> Result<Outcome, CaseError> {
         if let Some(stable) = self.stable
@@ -222,7 +222,7 @@ impl<'m> Simulation<'m> {
                 omega_max: stable.omega_max,
                 active: stable.active,
                 points: stable.points,
-                mass: self.tools.mass_choice.name().to_string(),
+                mass: self.ops.mass_choice.name().to_string(),
             });
         }
         let stages = self.stepper.desc().stages;
@@ -236,14 +236,14 @@ impl<'m> Simulation<'m> {
         };
         let mut bar = crate::progress::Progress::new(steps, progress);
         let guard = self.guard;
-        let mut energy = EnergyWatch::new(&self.tools, &self.states, self.v_index, t0);
-        let Simulation { stepper, tools, states, v_index, params, law, .. } = self;
+        let mut energy = EnergyWatch::new(&self.ops, &self.states, self.v_index, t0);
+        let Simulation { stepper, ops, states, v_index, params, law, .. } = self;
         // Progress through a nominal step in units of dt / 2^max_cuts.
         let max_cuts = guard.max_step_cuts.min(MAX_STEP_CUTS);
         let full: u64 = 1 << max_cuts;
         let (mut level, mut streak, mut accepted, mut first) = (0usize, 0usize, 0usize, 0usize);
         if let Some((saved, _)) = &control.resume {
-            if saved.states.len() != states.len() || saved.states.iter().any(|s| s.len() != tools.asm.size()) {
+            if saved.states.len() != states.len() || saved.states.iter().any(|s| s.len() != ops.asm.size()) {
                 return Err(CaseError::Option("the checkpoint's states do not fit this run's scheme and mesh".into()));
             }
             states.clone_from_slice(&saved.states);
@@ -277,14 +277,14 @@ impl<'m> Simulation<'m> {
                 let saved = (max_cuts > 0).then(|| states.to_vec());
                 let before = states[0].clone();
                 // The held dofs' reaction takes the change of velocity over the step.
-                let v_before = v_index.filter(|_| !tools.held.is_empty()).map(|i| states[i].clone());
+                let v_before = v_index.filter(|_| !ops.held.is_empty()).map(|i| states[i].clone());
                 let clock = Instant::now();
                 // The intermediate stages' displacements and velocities, for the held dofs' work.
                 let mut stages_seen: Vec<(f64, Vec<f64>, Option<Vec<f64>>)> = Vec::new();
                 let result = stepper.step_observed(states, t, h, &mut |stage| {
                     if intermediate.contains(&stage.name) {
-                        on_stage(tools, stage, *v_index);
-                        if !tools.held.is_empty()
+                        on_stage(ops, stage, *v_index);
+                        if !ops.held.is_empty()
                             && let Some(u) = stage.value_of("u")
                         {
                             stages_seen.push((stage.time, u.to_vec(), stage.value_of("v").map(<[f64]>::to_vec)));
@@ -330,10 +330,10 @@ impl<'m> Simulation<'m> {
                 // for bit; without, it writes one of its own (which resumes to round-off).
                 let on_interrupt = interrupted && control.every == 0;
                 let mut record = (done == full && (periodic || on_interrupt)).then(Vec::new);
-                if let Some(load) = &tools.varying_load {
-                    energy.step_work(tools, load.as_ref(), &before, &states[0], t + 0.5 * h);
+                if let Some(load) = &ops.varying_load {
+                    energy.step_work(ops, load.as_ref(), &before, &states[0], t + 0.5 * h);
                 }
-                if !tools.held.is_empty() {
+                if !ops.held.is_empty() {
                     // Over each sub-interval between the step's stages.
                     let v = v_index.map(|i| states[i].clone());
                     let mut points = vec![(t, before.clone(), v_before.clone())];
@@ -342,18 +342,18 @@ impl<'m> Simulation<'m> {
                     for w in points.windows(2) {
                         let ((t0, u0, v0), (t1, u1, v1)) = (&w[0], &w[1]);
                         let vs = v0.as_deref().zip(v1.as_deref());
-                        energy.held_work(tools, u0, u1, vs, t1 - t0, 0.5 * (t0 + t1));
+                        energy.held_work(ops, u0, u1, vs, t1 - t0, 0.5 * (t0 + t1));
                     }
                 }
-                if tools.probe.as_ref().is_some_and(|p| p.time_dependent()) {
-                    energy.obstacle_work(tools, &before, &states[0], t, h);
+                if ops.probe.as_ref().is_some_and(|p| p.time_dependent()) {
+                    energy.obstacle_work(ops, &before, &states[0], t, h);
                 }
-                if let Some(work) = &tools.contact_work {
-                    energy.law_work += work.value(tools.asm, &[&states[0], &before], t + 0.5 * h);
+                if let Some(work) = &ops.contact_work {
+                    energy.law_work += work.value(ops.asm, &[&states[0], &before], t + 0.5 * h);
                 }
                 // Checked before the observer sees the step: the outputs end at the last good one.
                 if let Some(grown) =
-                    energy.check(tools, states, *v_index, &before, h, t_end, guard.energy_tolerance, *law)
+                    energy.check(ops, states, *v_index, &before, h, t_end, guard.energy_tolerance, *law)
                 {
                     outcome.stopped = Some(match grown.cause {
                         Cause::Negative(potential) => CaseError::NotCoercive {
@@ -383,7 +383,7 @@ impl<'m> Simulation<'m> {
                 }
                 outcome.energy_growth = energy.growth;
                 let step = Step { k: accepted, t: t_end, dt: h, states, before: &before, report: &report };
-                on_step(tools, &step, record.as_mut())?;
+                on_step(ops, &step, record.as_mut())?;
                 streak += 1;
                 if level > 0 && streak >= 2 && done.is_multiple_of(2 * units) {
                     level -= 1;
@@ -436,7 +436,7 @@ impl<'m> Simulation<'m> {
 
 /// What a case does with each accepted step; when a checkpoint is due, it also writes its
 /// record of the run so far into the buffer.
-pub type OnStep<'a> = dyn FnMut(&Tools, &Step, Option<&mut Vec<u8>>) -> Result<(), CaseError> + 'a;
+pub type OnStep<'a> = dyn FnMut(&Operators, &Step, Option<&mut Vec<u8>>) -> Result<(), CaseError> + 'a;
 
 /// How a run ended.
 pub struct Outcome {

@@ -7,7 +7,7 @@
 use std::sync::Arc;
 
 use super::{MassChoice, Problem, stability};
-use crate::driver::Active;
+use crate::driver::FilesInUse;
 use crate::error::CaseError;
 use crate::runtime::fem::assembly::Assembler;
 use crate::runtime::fem::bound::{BoundForm, BoundFunctional, MatrixForm};
@@ -16,9 +16,10 @@ use crate::runtime::library::Binding;
 use crate::runtime::linalg::Matrix;
 use crate::runtime::linalg::lower_half::{HalfPattern, LowerHalf};
 
-/// What the observers measure with: bound functionals, a fresh contact form, and the linear
-/// operators.
-pub struct Tools<'m> {
+/// A run's operators bound on its mesh, which the observers, the energy guard and the stability
+/// estimate measure with: the matrices (mass, the scheme's mass, stiffness), the load, the
+/// contact form and the contact law's functionals, and the energies they give.
+pub struct Operators<'m> {
     pub asm: &'m Assembler<'m>,
     pub contact_facets: &'m [Facet],
     /// The `contact` slot, for its residual (the contact force) and its switches (the active set).
@@ -103,7 +104,7 @@ impl Energies {
         }
         let half = if which == 0 { &self.stiffness } else { &self.mass };
         let value = match half {
-            None => Tools::quad(a, x, x),
+            None => Operators::quad(a, x, x),
             Some(half) => {
                 let mut y = self.work.lock().unwrap_or_else(|e| e.into_inner());
                 y.resize(x.len(), 0.0);
@@ -123,7 +124,7 @@ impl Energies {
     }
 }
 
-impl Tools<'_> {
+impl Operators<'_> {
     /// xᵀ A y ([`Matrix::quad`]).
     pub fn quad(a: &Matrix, x: &[f64], y: &[f64]) -> f64 {
         a.quad(x, y)
@@ -213,16 +214,16 @@ pub fn resultant(c: &[f64], d: usize) -> Vec<f64> {
     (0..d).map(|k| -c.iter().skip(k).step_by(d).sum::<f64>()).collect()
 }
 
-/// What a run binds before it steps: the tools, the scheme's forms, and whether the scheme
+/// What a run binds before it steps: the operators, the scheme's forms, and whether the scheme
 /// has inertia.
 pub(super) struct Parts<'m> {
-    pub(super) tools: Tools<'m>,
+    pub(super) ops: Operators<'m>,
     pub(super) forms: Vec<(&'static str, Box<dyn BoundForm + 'm>)>,
     pub(super) inertia: bool,
 }
 
 impl<'m> Parts<'m> {
-    pub(super) fn build(asm: &'m Assembler<'m>, problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
+    pub(super) fn build(asm: &'m Assembler<'m>, problem: Problem<'_>, in_use: &FilesInUse) -> Result<Self, CaseError> {
         let mesh: &Mesh = asm.mesh();
         let n = asm.size();
         let contact_facets = match problem.contact {
@@ -234,8 +235,8 @@ impl<'m> Parts<'m> {
             regions.push((name.clone(), asm.region(name)?));
         }
         let binding = Binding { quadrature: problem.quadrature, regions, dim: mesh.dim() };
-        let mut inst = active.forms.instantiate(problem.coefs, &binding)?;
-        let mut forms = active.scheme_forms(&mut inst)?;
+        let mut inst = in_use.forms.instantiate(problem.coefs, &binding)?;
+        let mut forms = in_use.scheme_forms(&mut inst)?;
         let missing = |what: &str| {
             CaseError::Option(format!("the case needs `{what}`, which the form files in use do not provide"))
         };
@@ -250,7 +251,7 @@ impl<'m> Parts<'m> {
         match forms.iter().find(|(s, _)| *s == "mass") {
             Some((_, f)) => f.tangent(asm, &[&zero], 0, 0.0, &mut mass),
             None => {
-                let material = active.forms.instantiate(problem.coefs, &binding)?.take_form("mass");
+                let material = in_use.forms.instantiate(problem.coefs, &binding)?.take_form("mass");
                 material.ok_or_else(|| missing("mass"))?.tangent(asm, &[&zero], 0, 0.0, &mut mass);
             }
         }
@@ -287,10 +288,10 @@ impl<'m> Parts<'m> {
             }
             None => mass.clone(),
         };
-        let mut tools = Tools {
+        let mut ops = Operators {
             asm,
             contact_facets,
-            probe: active.forms.instantiate(problem.coefs, &binding)?.take_form("contact"),
+            probe: in_use.forms.instantiate(problem.coefs, &binding)?.take_form("contact"),
             contact_energy: inst.take_functional("contact_energy"),
             contact_jump: inst.take_functional("contact_jump"),
             contact_work: inst.take_functional("contact_work").filter(|f| f.fields() == 2),
@@ -305,7 +306,7 @@ impl<'m> Parts<'m> {
             scheme_mass,
             stiffness,
             load,
-            varying_load: active
+            varying_load: in_use
                 .forms
                 .instantiate(problem.coefs, &binding)?
                 .take_form("load")
@@ -319,22 +320,22 @@ impl<'m> Parts<'m> {
         // A law that does no work of its own (Nitsche θ = 1: its factor 1 − θ is zero) costs the
         // energy guard nothing per step. Probed from rest to the body pushed into the obstacle
         // and strained every way, where any other law's work is not zero.
-        if let Some(work) = &tools.contact_work {
-            let pushed = stability::pushed_into_obstacle(&tools, problem.coefs);
+        if let Some(work) = &ops.contact_work {
+            let pushed = stability::pushed_into_obstacle(&ops, problem.coefs);
             let size = pushed.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1.0);
             let strained: Vec<f64> =
                 pushed.iter().zip(stability::scattered(n)).map(|(p, r)| p + 1e-3 * size * r).collect();
             if work.value(asm, &[&strained, &vec![0.0; n]], 0.0) == 0.0 {
-                tools.contact_work = None;
+                ops.contact_work = None;
             }
         }
-        Ok(Parts { tools, forms, inertia })
+        Ok(Parts { ops, forms, inertia })
     }
 }
 
-impl<'m> Tools<'m> {
-    /// The tools of a problem solved without a stepper (one equilibrium, `run static`).
-    pub fn bind(asm: &'m Assembler<'m>, problem: Problem<'_>, active: &Active) -> Result<Self, CaseError> {
-        Ok(Parts::build(asm, problem, active)?.tools)
+impl<'m> Operators<'m> {
+    /// The operators of a problem solved without a stepper (one equilibrium, `run static`).
+    pub fn bind(asm: &'m Assembler<'m>, problem: Problem<'_>, in_use: &FilesInUse) -> Result<Self, CaseError> {
+        Ok(Parts::build(asm, problem, in_use)?.ops)
     }
 }

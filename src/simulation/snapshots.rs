@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use super::Tools;
+use super::Operators;
 use crate::error::CaseError;
 
 /// VTU snapshots every `every` steps into `dir`/vtu, and the PVD collection of them.
@@ -22,17 +22,17 @@ impl Snapshots {
 
     /// The displacement and velocity at step `k`, and the cell-mean von Mises stress when the
     /// files in use provide it.
-    pub fn write(&mut self, tools: &Tools, k: usize, t: f64, u: &[f64], v: &[f64]) -> Result<(), CaseError> {
+    pub fn write(&mut self, ops: &Operators, k: usize, t: f64, u: &[f64], v: &[f64]) -> Result<(), CaseError> {
         let Some(dir) = &self.dir else { return Ok(()) };
         if !k.is_multiple_of(self.every) {
             return Ok(());
         }
-        let mesh = tools.asm.mesh();
+        let mesh = ops.asm.mesh();
         let file = format!("{}_{k:06}.vtu", self.name);
-        let vm = match (&tools.von_mises, &tools.cell_measure) {
+        let vm = match (&ops.von_mises, &ops.cell_measure) {
             (Some(vm), Some(measure)) => {
-                let size = measure.cell_values(tools.asm, &[], 0.0);
-                vm.cell_values(tools.asm, &[u], 0.0).iter().zip(&size).map(|(v, a)| v / a).collect()
+                let size = measure.cell_values(ops.asm, &[], 0.0);
+                vm.cell_values(ops.asm, &[u], 0.0).iter().zip(&size).map(|(v, a)| v / a).collect()
             }
             _ => vec![f64::NAN; mesh.num_cells()],
         };

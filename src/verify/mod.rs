@@ -18,9 +18,9 @@ use serde::Serialize;
 
 /// The ωΔt up to which the scheme claims to be stable: its `claim cfl` (an explicit scheme);
 /// none for a scheme that claims no limit.
-pub fn claimed_cfl(setup: &crate::driver::Setup) -> Result<Option<f64>, crate::error::CaseError> {
-    let active = crate::driver::Active::resolve(setup, &[])?;
-    Ok(active.scheme_claims()?.into_iter().find(|(c, _)| c == "cfl").map(|(_, v)| v))
+pub fn claimed_cfl(methods: &crate::driver::Methods) -> Result<Option<f64>, crate::error::CaseError> {
+    let in_use = crate::driver::FilesInUse::resolve(methods, &[])?;
+    Ok(in_use.scheme_claims()?.into_iter().find(|(c, _)| c == "cfl").map(|(_, v)| v))
 }
 
 pub use oscillator::{oscillator_energies, oscillator_error, spectral_radius, with_oscillator, with_oscillator_scheme};
