@@ -26,3 +26,9 @@ impl Default for Guard {
         Guard { max_step_cuts: 6, allow_unstable_dt: false, energy_tolerance: ENERGY_TOLERANCE }
     }
 }
+
+/// A number of step cuts (`--max-step-cuts`, a case file's `max_step_cuts`), checked against
+/// [`MAX_STEP_CUTS`].
+pub fn step_cuts(n: i64) -> Result<usize, String> {
+    usize::try_from(n).ok().filter(|&n| n <= MAX_STEP_CUTS).ok_or_else(|| format!("{n} is not in 0..={MAX_STEP_CUTS}"))
+}

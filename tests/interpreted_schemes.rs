@@ -51,7 +51,13 @@ fn schemes_and_laws_by_path_match_the_compiled_library() {
             }
             // The disc: 100 steps of 0.08 on the coarse built-in mesh (impact at t ≈ 6.3).
             let disc_run = |methods: Methods| {
-                let o = disc::Options { methods, h: 2.0, dt: 0.08, t_end: 8.0, ..disc::Options::default() };
+                let o = disc::Options {
+                    methods,
+                    h: Some(2.0),
+                    dt: Some(0.08),
+                    t_end: Some(8.0),
+                    ..disc::Options::default()
+                };
                 disc::run(&o)
             };
             match (disc_run(compiled), disc_run(by_path)) {

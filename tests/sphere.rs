@@ -7,7 +7,7 @@ use signorini::driver::Methods;
 
 fn sphere(scheme: &str, h: f64, t_end: f64) -> disc::Run {
     let methods = Methods { scheme: scheme.into(), ..Methods::default() };
-    disc::run(&Options { body: Body::Sphere, methods, h, t_end, ..Options::default() }).unwrap()
+    disc::run(&Options { body: Body::Sphere, methods, h: Some(h), t_end: Some(t_end), ..Options::default() }).unwrap()
 }
 
 #[test]
@@ -69,8 +69,15 @@ fn iterative_and_direct_solvers_agree() {
         let run = |solver| {
             let methods = Methods::default().set("theta", theta);
             let newton = NewtonOptions { solver, ..NewtonOptions::default() };
-            disc::run(&Options { body: Body::Sphere, methods, h: 5.0, t_end: 8.0, newton, ..Options::default() })
-                .unwrap()
+            disc::run(&Options {
+                body: Body::Sphere,
+                methods,
+                h: Some(5.0),
+                t_end: Some(8.0),
+                newton,
+                ..Options::default()
+            })
+            .unwrap()
         };
         let (d, i) = (run(Solver::Direct), run(Solver::Iterative));
         assert_eq!(d.summary.krylov_iterations, 0);
@@ -92,7 +99,7 @@ fn the_graded_gmsh_ball_falls_exactly() {
     let m = signorini::runtime::fem::mesh::gmsh::read(&mesh).unwrap();
     let lowest = (0..m.num_nodes()).map(|i| m.node(i)[2]).fold(f64::INFINITY, f64::min);
     assert!((lowest - 2.0).abs() < 1e-9, "the mesh's lowest point is at z = {lowest}");
-    let opts = Options { body: Body::Sphere, mesh: Some(mesh), t_end: 0.4, ..Options::default() };
+    let opts = Options { body: Body::Sphere, mesh: Some(mesh), t_end: Some(0.4), ..Options::default() };
     let r = disc::run(&opts).unwrap();
     assert!(r.summary.dofs > 20_000);
     for row in &r.series {

@@ -33,20 +33,23 @@ pub struct Options {
     pub resume: bool,
 }
 
+/// The bar with the problem file's mesh and times, and a run's defaults
+/// ([`crate::problem::run::Options::new`]).
 impl Default for Options {
     fn default() -> Self {
+        let run = crate::problem::run::Options::new("bar");
         Options {
-            methods: Methods::default(),
+            methods: run.methods,
             elements: None,
-            dt: None,
-            t_end: None,
-            mass: MassChoice::Consistent,
-            cell_size: CellSize::Diameter,
-            newton: NewtonOptions::default(),
-            out: None,
-            checkpoint_every: 0,
-            resume: false,
-            progress: false,
+            dt: run.dt,
+            t_end: run.t_end,
+            mass: run.mass,
+            cell_size: run.cell_size,
+            newton: run.newton,
+            out: run.out,
+            checkpoint_every: run.checkpoint_every,
+            resume: run.resume,
+            progress: run.progress,
         }
     }
 }

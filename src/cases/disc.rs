@@ -53,13 +53,14 @@ pub struct Options {
     pub cell_size: CellSize,
     /// A Gmsh file; the built-in curved disc generator otherwise.
     pub mesh: Option<PathBuf>,
-    /// Mesh size of the built-in generator.
-    pub h: f64,
-    pub dt: f64,
+    /// Mesh size of the built-in generator (none: the problem file's `h`).
+    pub h: Option<f64>,
+    /// The time step, start and end (none: the problem file's `run` line).
+    pub dt: Option<f64>,
     /// Start from the exact free fall at this time (u = −g t²/2, v = −g t, vertically) instead
     /// of rest at t = 0: the first contact at √40 is reached in few steps.
-    pub t_start: f64,
-    pub t_end: f64,
+    pub t_start: Option<f64>,
+    pub t_end: Option<f64>,
     pub newton: NewtonOptions,
     pub out: Option<PathBuf>,
     /// Write a VTU snapshot every this many steps (0: none) into `out`/vtu, with disc.pvd.
@@ -72,24 +73,27 @@ pub struct Options {
     pub resume: bool,
 }
 
+/// The disc with the problem file's mesh size and times, and a run's defaults
+/// ([`crate::problem::run::Options::new`]).
 impl Default for Options {
     fn default() -> Self {
+        let run = crate::problem::run::Options::new(Body::Disc.name());
         Options {
             body: Body::Disc,
-            methods: Methods::default(),
-            mass: MassChoice::Consistent,
-            cell_size: CellSize::Diameter,
-            mesh: None,
-            h: 1.0,
-            dt: 0.02,
-            t_start: 0.0,
-            t_end: 20.0,
-            newton: NewtonOptions::default(),
-            out: None,
-            vtu_every: 0,
-            progress: false,
-            checkpoint_every: 0,
-            resume: false,
+            methods: run.methods,
+            mass: run.mass,
+            cell_size: run.cell_size,
+            mesh: run.mesh,
+            h: None,
+            dt: run.dt,
+            t_start: run.t_start,
+            t_end: run.t_end,
+            newton: run.newton,
+            out: run.out,
+            vtu_every: run.vtu_every,
+            progress: run.progress,
+            checkpoint_every: run.checkpoint_every,
+            resume: run.resume,
         }
     }
 }
@@ -140,6 +144,8 @@ pub struct Summary {
     pub cells: usize,
     pub dofs: usize,
     pub dt: f64,
+    /// The time reached (the end time, or where the run stopped).
+    pub t_end: f64,
     pub steps: usize,
     /// Time of the first step that ends with an active contact point.
     pub first_contact: Option<f64>,
@@ -207,16 +213,18 @@ pub struct StageRow {
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
     let mut methods = opts.methods.clone();
     // The problem's mesh-size param, as the user's setting (before theirs: theirs wins).
-    methods.params.insert(0, crate::driver::Setting { name: "h".into(), value: opts.h, origin: "--h".into() });
+    if let Some(h) = opts.h {
+        methods.params.insert(0, crate::driver::Setting { name: "h".into(), value: h, origin: "--h".into() });
+    }
     let problem = crate::problem::run::Options {
         problem: opts.body.name().to_string(),
         methods,
         mass: opts.mass,
         cell_size: opts.cell_size,
         mesh: opts.mesh.clone(),
-        dt: Some(opts.dt),
-        t_start: Some(opts.t_start),
-        t_end: Some(opts.t_end),
+        dt: opts.dt,
+        t_start: opts.t_start,
+        t_end: opts.t_end,
         newton: opts.newton,
         out: opts.out.clone(),
         vtu_every: opts.vtu_every,
@@ -283,6 +291,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         cells: count("cells"),
         dofs: count("dofs"),
         dt: number("dt"),
+        t_end: number("t_end"),
         steps: count("steps"),
         first_contact: s.number("first_contact"),
         max_penetration: number("max_penetration"),

@@ -1,8 +1,8 @@
 //! Case files: `signorini run case.toml` names a problem (`case = "bar"`, `case =
 //! "my_problem.wf"`) and sets the options of `signorini run` as keys, the problem's params as
 //! keys of their own (`ne = 40`), and the params of the scheme and form files in `[params]`
-//! (`alpha = 0.1`, or per file: `[params.elasticity] rho = 2`). Unknown keys, unknown params and
-//! out-of-range values are refused with the line of the key.
+//! (`alpha = 0.1`, or per file: `[params.elasticity] rho = 2`), the only place they go. Unknown
+//! keys, unknown params and out-of-range values are refused with the line of the key.
 
 use std::path::{Path, PathBuf};
 
@@ -12,7 +12,6 @@ use toml::Spanned;
 
 use crate::driver::{self, Methods, Setting};
 use crate::error::CaseError;
-use crate::guard::MAX_STEP_CUTS;
 use crate::runtime::fem::mesh::CellSize;
 use crate::simulation::MassChoice;
 
@@ -26,10 +25,6 @@ struct CaseFile {
     forms: Option<Spanned<Vec<String>>>,
     /// `name = value`, or `[params.OWNER]` tables of them.
     params: Option<std::collections::BTreeMap<String, Spanned<toml::Value>>>,
-    /// Shorthands for `[params]` entries.
-    alpha: Option<Spanned<f64>>,
-    theta: Option<Spanned<f64>>,
-    gamma0: Option<Spanned<f64>>,
     mass: Option<Spanned<String>>,
     /// `diameter` or `getfem`.
     cell_size: Option<Spanned<String>>,
@@ -179,7 +174,7 @@ pub fn parse(text: &str, path: &Path) -> Result<crate::problem::run::Options, Ca
     })?;
     let problem_settings = keys.map(|k| k.settings).unwrap_or_default();
     let r = Reader { file: &file, text };
-    let mass: MassChoice = r.choice(&parsed.mass, "mass", MassChoice::Consistent)?;
+    let mass: MassChoice = r.choice(&parsed.mass, "mass", MassChoice::default())?;
     let methods = methods(&r, &parsed, &base)?;
     let cell_size = match &parsed.cell_size {
         None => CellSize::default(),
@@ -244,10 +239,7 @@ fn methods(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Methods, CaseEr
             allow_unstable_dt: parsed.allow_unstable_dt.as_ref().map_or(d.guard.allow_unstable_dt, |b| *b.get_ref()),
             max_step_cuts: match &parsed.max_step_cuts {
                 None => d.guard.max_step_cuts,
-                Some(s) if (0..=MAX_STEP_CUTS as i64).contains(s.get_ref()) => *s.get_ref() as usize,
-                Some(s) => {
-                    return Err(r.error(s, "max_step_cuts", format!("{} is not in 0..={MAX_STEP_CUTS}", s.get_ref())));
-                }
+                Some(s) => crate::guard::step_cuts(*s.get_ref()).map_err(|e| r.error(s, "max_step_cuts", e))?,
             },
             energy_tolerance: r.number(
                 &parsed.energy_tolerance,
@@ -259,11 +251,6 @@ fn methods(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Methods, CaseEr
         },
     };
     let at = |span: std::ops::Range<usize>| format!("{}:{}", r.file, r.line(span.start));
-    for (key, v) in [("alpha", &parsed.alpha), ("theta", &parsed.theta), ("gamma0", &parsed.gamma0)] {
-        if let Some(v) = v {
-            methods.params.push(Setting { name: key.into(), value: *v.get_ref(), origin: at(v.span()) });
-        }
-    }
     let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
     for (name, entry) in parsed.params.iter().flatten() {
         let origin = at(entry.span());

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use clap::{Subcommand, ValueEnum};
 
 use crate::driver::{Methods, Setting};
+use crate::guard::Guard;
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::linalg::Solver;
 use crate::simulation::MassChoice;
@@ -98,8 +99,8 @@ pub enum BenchCommand {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
-    /// Time per step of the bouncing disc (Newmark, Nitsche θ = 1, Δt = 0.02, 1000 steps),
-    /// stepper alone, on each Gmsh mesh.
+    /// Time per step of the bouncing disc (the library's default scheme and contact law, the
+    /// disc's own Δt and end time), stepper alone, on each Gmsh mesh.
     Disc {
         #[arg(long = "mesh", required = true, num_args = 1..)]
         meshes: Vec<PathBuf>,
@@ -147,25 +148,16 @@ pub struct MethodArgs {
     /// A param of the scheme or form files: NAME=VALUE, or OWNER.NAME=VALUE (repeatable).
     #[arg(long = "param", value_name = "NAME=VALUE", allow_hyphen_values = true)]
     pub(super) params: Vec<String>,
-    /// Shorthand for --param alpha=VALUE.
-    #[arg(long, allow_hyphen_values = true)]
-    pub(super) alpha: Option<f64>,
-    /// Shorthand for --param theta=VALUE.
-    #[arg(long, allow_hyphen_values = true)]
-    pub(super) theta: Option<f64>,
-    /// Shorthand for --param gamma0=VALUE.
-    #[arg(long, allow_hyphen_values = true)]
-    pub(super) gamma0: Option<f64>,
     /// What h means in γ = γ0/h: diameter (largest vertex distance) or getfem (GetFEM's
     /// element_size: √d · max over the cell's nodes of σ_min of the reference Jacobian).
-    #[arg(long, value_parser = CellSize::parse, default_value = "diameter")]
+    #[arg(long, value_parser = CellSize::parse, default_value = name_of(CellSize::default()))]
     pub(super) cell_size: CellSize,
     /// Halvings of Δt allowed when a step's Newton fails (Δt doubles back after two good steps).
-    #[arg(long, default_value_t = 6, value_parser = step_cuts)]
+    #[arg(long, default_value_t = Guard::default().max_step_cuts, value_parser = step_cuts)]
     pub(super) max_step_cuts: usize,
     /// Stop when E_aug (elastic + kinetic + contact energy) exceeds E_aug(0) + the loads' work
     /// by this fraction of the problem's energy scale (0: never).
-    #[arg(long, default_value_t = crate::guard::ENERGY_TOLERANCE, value_parser = non_negative)]
+    #[arg(long, default_value_t = Guard::default().energy_tolerance, value_parser = non_negative)]
     pub(super) energy_tolerance: f64,
     /// Run an explicit scheme (one that claims `cfl`) above its estimated critical step Δt_c.
     #[arg(long)]
@@ -175,14 +167,17 @@ pub struct MethodArgs {
     pub(super) line_search: bool,
 }
 
-/// `--max-step-cuts`: the range the case files accept too.
+/// `--max-step-cuts`: a whole number in the range the case files accept too.
 fn step_cuts(s: &str) -> Result<usize, String> {
-    use crate::guard::MAX_STEP_CUTS;
-    match s.trim().parse::<i64>() {
-        Ok(n) if (0..=MAX_STEP_CUTS as i64).contains(&n) => Ok(n as usize),
-        Ok(n) => Err(format!("{n} is not in 0..={MAX_STEP_CUTS}")),
-        Err(_) => Err(format!("`{s}` is not a whole number")),
-    }
+    let n = s.trim().parse::<i64>().map_err(|_| format!("`{s}` is not a whole number"))?;
+    crate::guard::step_cuts(n)
+}
+
+/// The command-line name of a runtime type's value (its serde name: `diameter`, `auto`), for
+/// clap's `[default: ...]` of the runtime's own default. clap keeps it for the program's life.
+fn name_of(value: impl serde::Serialize) -> &'static str {
+    let name = serde_json::to_value(value).ok().and_then(|v| v.as_str().map(str::to_string));
+    Box::leak(name.unwrap_or_default().into_boxed_str())
 }
 
 /// `--energy-tolerance` (0: off) and `--tol`: a number ≥ 0.
@@ -202,19 +197,11 @@ impl MethodArgs {
             || self.material.is_some()
             || !self.forms.is_empty()
             || !self.params.is_empty()
-            || self.alpha.is_some()
-            || self.theta.is_some()
-            || self.gamma0.is_some()
             || self.line_search
     }
 
     pub(super) fn to_methods(&self) -> Result<Methods, String> {
         let mut params = Vec::new();
-        for (name, v) in [("alpha", self.alpha), ("theta", self.theta), ("gamma0", self.gamma0)] {
-            if let Some(value) = v {
-                params.push(Setting { name: name.into(), value, origin: format!("--{name}") });
-            }
-        }
         for p in &self.params {
             let (name, value) = p.split_once('=').ok_or_else(|| format!("--param {p}: expected NAME=VALUE"))?;
             let value: f64 =
@@ -229,7 +216,7 @@ impl MethodArgs {
             forms: self.forms.clone(),
             compiled: Vec::new(),
             params,
-            guard: crate::guard::Guard {
+            guard: Guard {
                 max_step_cuts: self.max_step_cuts,
                 energy_tolerance: self.energy_tolerance,
                 allow_unstable_dt: self.allow_unstable_dt,
@@ -244,7 +231,7 @@ impl MethodArgs {
 pub struct ProblemArgs {
     #[command(flatten)]
     pub(super) methods: MethodArgs,
-    #[arg(long, value_enum, default_value_t = MassChoice::Consistent)]
+    #[arg(long, value_enum, default_value_t = MassChoice::default())]
     pub(super) mass: MassChoice,
     /// A Gmsh mesh (MSH 2.2 or 4.1) instead of the problem's.
     #[arg(long)]
@@ -270,7 +257,7 @@ pub struct ProblemArgs {
     /// Linear solver of each step: direct (sparse Cholesky/LU), iterative (Jacobi-preconditioned
     /// CG, or BiCGStab for unsymmetric tangents; memory of the matrix only), or auto (iterative
     /// above 10 000 unknowns in 3D, 100 000 in 2D).
-    #[arg(long, value_parser = Solver::parse, default_value = "auto")]
+    #[arg(long, value_parser = Solver::parse, default_value = name_of(Solver::default()))]
     pub(super) solver: Solver,
     /// Run every scheme × every contact law × {consistent, redistributed} (with the --param
     /// settings that apply) and print one table of the problem's summary (with --out: one

@@ -41,8 +41,8 @@ pub struct Cli {
 }
 
 impl Cli {
-    /// The command line, where every option's value may be negative: `--alpha -0.1` then gets
-    /// the option's own range error instead of clap's "unexpected argument '-0'".
+    /// The command line, where every option's value may be negative: `--t-start -1` then gets
+    /// the option's own range error instead of clap's "unexpected argument '-1'".
     pub fn parse_args() -> Self {
         use clap::{CommandFactory, FromArgMatches};
         let matches = negative_values(Self::command())
@@ -96,9 +96,9 @@ fn dispatch(cli: Cli) -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Verify { out, methods } if methods.scheme.is_some() => verify::scheme(&out, &methods),
-        Command::Verify { methods, .. } if methods.given() => fail(
-            "--contact, --material, --forms, --param, --alpha, --theta, --gamma0 and --line-search apply to `verify --scheme` only",
-        ),
+        Command::Verify { methods, .. } if methods.given() => {
+            fail("--contact, --material, --forms, --param and --line-search apply to `verify --scheme` only")
+        }
         Command::Verify { out, .. } => verify::library(&out),
         Command::Compare { a, b, tol } => compare::command(&a, &b, tol),
         Command::Report { out, quick } => report(out, quick),

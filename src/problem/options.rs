@@ -56,8 +56,8 @@ impl Options {
         Options {
             problem: problem.to_string(),
             methods: Methods::default(),
-            mass: MassChoice::Consistent,
-            cell_size: CellSize::Diameter,
+            mass: MassChoice::default(),
+            cell_size: CellSize::default(),
             mesh: None,
             dt: None,
             t_start: None,

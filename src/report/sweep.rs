@@ -85,7 +85,7 @@ fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseEr
 
 fn disc_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
     let methods = sweep_setup(scheme);
-    let r = disc::run(&disc::Options { methods, mass, dt, ..Default::default() })?;
+    let r = disc::run(&disc::Options { methods, mass, dt: Some(dt), ..Default::default() })?;
     let s = &r.summary;
     // The first contact phase: from the first step with an active point to the next without.
     let start = r.series.iter().position(|row| row.active_points > 0);

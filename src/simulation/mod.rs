@@ -51,9 +51,11 @@ pub struct Problem<'p> {
 }
 
 /// The mass a scheme steps with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum MassChoice {
+    /// The material's mass (the default).
+    #[default]
     Consistent,
     /// Mass redistribution (docs/mathematics.md §4): no inertia at the contact node.
     Redistributed,

@@ -103,13 +103,24 @@ pub fn disc(progress: &mut dyn FnMut(&str)) -> DiscConvergence {
         .map(|scheme| {
             progress(&format!("disc Δt convergence {scheme}"));
             let methods = Methods { scheme: scheme.into(), ..Methods::default() };
-            let runs = |dt| disc::Options { methods: methods.clone(), dt, t_end: T_END, ..disc::Options::default() };
+            let runs = |dt| disc::Options {
+                methods: methods.clone(),
+                dt: Some(dt),
+                t_end: Some(T_END),
+                ..disc::Options::default()
+            };
             study(scheme, runs, &DT_STEPS, DT_REFERENCE)
         })
         .collect();
     progress("disc h convergence");
     let methods = Methods::default();
-    let runs = |h| disc::Options { methods: methods.clone(), h, dt: H_DT, t_end: T_END, ..disc::Options::default() };
+    let runs = |h| disc::Options {
+        methods: methods.clone(),
+        h: Some(h),
+        dt: Some(H_DT),
+        t_end: Some(T_END),
+        ..disc::Options::default()
+    };
     let h = study(&methods.scheme, runs, &H_STEPS, H_REFERENCE);
     DiscConvergence { dt, h }
 }

@@ -176,7 +176,7 @@ pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVe
                 ("Newton".into(), b.newton_total as f64),
             ],
         });
-        let d = disc::run(&disc::Options { methods: s, h: 2.0, ..disc::Options::default() })?.summary;
+        let d = disc::run(&disc::Options { methods: s, h: Some(2.0), ..disc::Options::default() })?.summary;
         disc_rows.push(CaseRow {
             scheme: label,
             values: vec![
