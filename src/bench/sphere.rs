@@ -37,6 +37,18 @@ pub struct SphereTiming {
     pub krylov_iterations: usize,
     pub peak_memory_bytes: Option<u64>,
     pub first_contact: Option<f64>,
+    /// What the run ran with: the scheme, the contact law and its params, Δt and the end time
+    /// (none in older files).
+    #[serde(default)]
+    pub scheme: Option<String>,
+    #[serde(default)]
+    pub contact: Option<String>,
+    #[serde(default)]
+    pub contact_params: Vec<(String, f64)>,
+    #[serde(default)]
+    pub dt: Option<f64>,
+    #[serde(default)]
+    pub t_end: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -67,6 +79,9 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
         serde_json::from_str(&text).map_err(|e| CaseError::Option(format!("{}: {e}", path.display())))?;
     let num = |k: &str| s.get(k).and_then(serde_json::Value::as_f64).unwrap_or(f64::NAN);
     let int = |k: &str| s.get(k).and_then(serde_json::Value::as_u64).unwrap_or(0) as usize;
+    let contact = s.get("contact").and_then(|v| v.as_str()).map(str::to_string);
+    let params: std::collections::BTreeMap<String, crate::driver::ParamValue> =
+        s.get("params").and_then(|p| serde_json::from_value(p.clone()).ok()).unwrap_or_default();
     Ok(SphereTiming {
         dofs: int("dofs"),
         h,
@@ -79,6 +94,11 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
         krylov_iterations: int("krylov_iterations"),
         peak_memory_bytes: s.get("peak_memory_bytes").and_then(serde_json::Value::as_u64),
         first_contact: s.get("first_contact").and_then(serde_json::Value::as_f64),
+        scheme: s.get("scheme").and_then(|v| v.as_str()).map(str::to_string),
+        contact: contact.clone(),
+        contact_params: contact.map_or_else(Vec::new, |c| crate::driver::params::declared_by(&params, &c)),
+        dt: s.get("dt").and_then(serde_json::Value::as_f64),
+        t_end: s.get("t_end").and_then(serde_json::Value::as_f64),
     })
 }
 
