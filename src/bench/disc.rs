@@ -1,6 +1,6 @@
-//! `signorini bench disc`: time per step of the bouncing disc (issue 5), with the library's
-//! default scheme and contact law and the disc's own Δt and end time (forms/problems/disc.wf:
-//! fall, impact, rebound), on each given mesh. The
+//! `signorini bench disc`: time per step of the bouncing disc (issue 5; the problem of
+//! forms/library.toml's `[bench]`), with the library's default scheme and contact law and the
+//! problem's own Δt and end time (fall, impact, rebound), on each given mesh. The
 //! stepper alone is timed (mesh reading, assembly of the linear forms, measurements and output
 //! are not); per run we record the mean and the median over steps, and report the medians of
 //! these over the repeated runs.
@@ -97,7 +97,8 @@ pub struct Report {
 }
 
 pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) -> Result<Report, CaseError> {
-    let base = Options::default();
+    // The problem of forms/library.toml's `[bench]`.
+    let base = Options { problem: crate::settings::get().bench.disc.clone(), ..Options::default() };
     let stream = stream_bandwidth();
     let mut out = Vec::new();
     // The disc's step and end time (its file's) and the methods, as run.

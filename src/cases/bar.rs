@@ -12,6 +12,10 @@ use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;
 
+/// The problem this module reads: the library's compressed bar, whose columns and summary keys
+/// are the fields of [`Row`] and [`Summary`].
+pub const PROBLEM: &str = "bar";
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
     /// Scheme, contact law, extra forms and params.
@@ -37,7 +41,7 @@ pub struct Options {
 /// ([`crate::problem::run::Options::new`]).
 impl Default for Options {
     fn default() -> Self {
-        let run = crate::problem::run::Options::new("bar");
+        let run = crate::problem::run::Options::new(PROBLEM);
         Options {
             methods: run.methods,
             elements: None,
@@ -144,7 +148,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         methods.params.insert(0, crate::driver::Setting { name: "ne".into(), value: ne as f64, origin: "--ne".into() });
     }
     let problem = crate::problem::run::Options {
-        problem: "bar".to_string(),
+        problem: PROBLEM.to_string(),
         methods,
         mass: opts.mass,
         cell_size: opts.cell_size,
@@ -156,14 +160,14 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         checkpoint_every: opts.checkpoint_every,
         resume: opts.resume,
         chosen: crate::problem::run::Chosen::all(),
-        ..crate::problem::run::Options::new("bar")
+        ..crate::problem::run::Options::new(PROBLEM)
     };
     from_problem(opts, &crate::problem::run::run(&problem)?)
 }
 
 fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, CaseError> {
     let names = ["u_c", "v_c", "lambda", "lambda_half", "energy", "energy_aug", "penetration", "newton", "p1"];
-    let index = run.indices(&names, "bar")?;
+    let index = run.indices(&names, PROBLEM)?;
     let series = run
         .rows
         .iter()
@@ -184,10 +188,10 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
     let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
     let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
-    let elements = params.get("bar.ne").map_or(0, |p| p.value as usize);
-    params.retain(|k, _| !k.starts_with("bar."));
+    let elements = params.get(&format!("{PROBLEM}.ne")).map_or(0, |p| p.value as usize);
+    params.retain(|k, _| !k.starts_with(&format!("{PROBLEM}.")));
     let summary = Summary {
-        case: "bar",
+        case: PROBLEM,
         scheme: s.field("scheme")?,
         contact: s.field("contact")?,
         interpreted: s.field("interpreted")?,

@@ -1,10 +1,11 @@
-//! The bouncing disc and sphere as the report, `verify` and the benchmarks read them: the
-//! problems themselves are data (`forms/problems/disc.wf`, `sphere.wf`, run by the one driver,
-//! [`crate::problem::run`]); this module gives their rows and summary typed fields. The obstacle's
-//! normal is the vertical axis, y in the disc and z in the sphere: the fields `u_vertical_*`,
-//! `v_vertical_mean` and `f_vertical_contact` of [`Row`] hold that component, read from the
-//! columns the files name after their axis (`uy_mean`, `fy_contact` for the disc; `uz_mean`,
-//! `fz_contact` for the sphere). Both files name their summary key `min_uy_mean`.
+//! A body falling onto an obstacle, as the report, `verify`, the benchmarks and the tests read
+//! it: the bouncing disc (`forms/problems/disc.wf`, the default), the sphere (`sphere.wf`), or
+//! any problem file with their columns, run by the one driver ([`crate::problem::run`]); this
+//! module gives its rows and summary typed fields. The obstacle's normal is the vertical axis,
+//! y in 2D and z in 3D: the fields `u_vertical_*`, `v_vertical_mean` and `f_vertical_contact`
+//! of [`Row`] hold that component, read from the columns the file names after its axis
+//! (`uy_mean`, `fy_contact` for the disc; `uz_mean`, `fz_contact` for the sphere). Both library
+//! files name their summary key `min_uy_mean`.
 
 use std::path::PathBuf;
 
@@ -18,34 +19,13 @@ use crate::simulation::MassChoice;
 
 /// Gravity of the benchmark (the free fall before the first contact is exact: u = −g t²/2).
 pub const GRAVITY: f64 = 0.1;
-/// The body: the 2D disc or the 3D sphere.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Body {
-    Disc,
-    Sphere,
-}
-
-impl Body {
-    pub fn name(self) -> &'static str {
-        match self {
-            Body::Disc => "disc",
-            Body::Sphere => "sphere",
-        }
-    }
-
-    /// The vertical axis's letter, for column names.
-    pub fn axis(self) -> char {
-        match self {
-            Body::Disc => 'y',
-            Body::Sphere => 'z',
-        }
-    }
-}
+/// The problem these options run unless told otherwise: the library's bouncing disc.
+pub const DISC: &str = "disc";
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
-    pub body: Body,
+    /// The problem: a library problem by name (`disc`, `sphere`) or a problem file.
+    pub problem: String,
     /// Scheme, contact law, extra forms and params.
     pub methods: Methods,
     pub mass: MassChoice,
@@ -77,9 +57,9 @@ pub struct Options {
 /// ([`crate::problem::run::Options::new`]).
 impl Default for Options {
     fn default() -> Self {
-        let run = crate::problem::run::Options::new(Body::Disc.name());
+        let run = crate::problem::run::Options::new(DISC);
         Options {
-            body: Body::Disc,
+            problem: run.problem,
             methods: run.methods,
             mass: run.mass,
             cell_size: run.cell_size,
@@ -130,7 +110,8 @@ pub struct Row {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
-    pub case: &'static str,
+    /// The problem's name.
+    pub case: String,
     pub scheme: String,
     /// The contact law (its file stem).
     pub contact: String,
@@ -217,7 +198,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         methods.params.insert(0, crate::driver::Setting { name: "h".into(), value: h, origin: "--h".into() });
     }
     let problem = crate::problem::run::Options {
-        problem: opts.body.name().to_string(),
+        problem: opts.problem.clone(),
         methods,
         mass: opts.mass,
         cell_size: opts.cell_size,
@@ -239,7 +220,11 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
 
 /// The problem file's run as the disc's rows and summary (its columns by name).
 fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, CaseError> {
-    let a = opts.body.axis();
+    // The vertical axis: the last one whose mean displacement the file measures (z in 3D, y in
+    // 2D).
+    let a = ['z', 'y', 'x'].into_iter().find(|a| run.columns.iter().any(|c| *c == format!("u{a}_mean"))).unwrap_or('y');
+    let s = &run.summary;
+    let name: String = s.field("case")?;
     let names = [
         "energy".to_string(),
         "kinetic".to_string(),
@@ -254,7 +239,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         "penetration".to_string(),
         "newton".to_string(),
     ];
-    let index = run.indices(&names, opts.body.name())?;
+    let index = run.indices(&names, &name)?;
     let row = |t: f64, v: &[f64], switches: Vec<bool>| Row {
         t,
         energy: v[index[0]],
@@ -274,13 +259,12 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     let series: Vec<Row> = run.rows.iter().zip(&run.switches).map(|((t, v), s)| row(*t, v, s.clone())).collect();
     let stages =
         run.stages.iter().map(|(name, t, v)| StageRow { stage: name.clone(), row: row(*t, v, Vec::new()) }).collect();
-    let s = &run.summary;
     let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
     let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
     let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
-    params.retain(|k, _| !k.starts_with(&format!("{}.", opts.body.name())));
+    params.retain(|k, _| !k.starts_with(&format!("{name}.")));
     let summary = Summary {
-        case: opts.body.name(),
+        case: name,
         scheme: s.field("scheme")?,
         contact: s.field("contact")?,
         interpreted: s.field("interpreted")?,

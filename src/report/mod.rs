@@ -71,7 +71,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     let default_contact = &crate::settings::get().defaults.contact;
     for &(scheme, contact, mass) in &runs {
         let label = format!("{scheme}-{contact}-{}", mass.name());
-        let dir = out.join("bar").join(&label);
+        let dir = out.join(bar::PROBLEM).join(&label);
         progress(&format!("bar {label}"));
         let methods = Methods { scheme: scheme.into(), contact: contact.into(), ..Methods::default() };
         let (r, guard) = past_the_guard(methods, |methods| {
@@ -95,7 +95,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         if guard.is_some() {
             stopped.push(label.clone());
         }
-        let _ = writeln!(figures, "**{label}**\n\n![{label}](bar/{label}/bar.png)\n");
+        let _ = writeln!(figures, "**{label}**\n\n![{label}]({p}/{label}/{p}.png)\n", p = bar::PROBLEM);
         laws.add(&s.contact, &s.params);
         // Energies that stay bounded (a run whose energy grows has its own row).
         let bounded = r.summary.energy_aug_drift_max < 1.0;
@@ -139,7 +139,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     let mut disc_newton = Vec::new();
     for scheme in crate::driver::all_schemes() {
         progress(&format!("disc {scheme}"));
-        let dir = out.join("disc").join(scheme);
+        let dir = out.join(disc::DISC).join(scheme);
         let methods = Methods { scheme: scheme.into(), ..Methods::default() };
         // A scheme that fails here (explicit contact is unstable at this step) is a result.
         let run = past_the_guard(methods, |methods| {
@@ -200,7 +200,11 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         ],
     )
     .map_err(|e| CaseError::Write { path: out.display().to_string(), source: std::io::Error::other(e) })?;
-    md.push_str("\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `disc/<scheme>/disc.png` (energies, displacements, contact force, Newton).\n\n");
+    let _ = write!(
+        md,
+        "\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `{p}/<scheme>/{p}.png` (energies, displacements, contact force, Newton).\n\n",
+        p = disc::DISC
+    );
     if !quick {
         md.push_str("## 3. Verification (`signorini verify`)\n\n");
         let verification = crate::verify::run(progress)?;

@@ -135,8 +135,8 @@ pub struct Case {
 
 /// The bar's and the disc's sweeps.
 pub const CASES: [Case; 2] = [
-    Case { name: "bar", steps: &BAR_STEPS, measure: bar_point },
-    Case { name: "disc", steps: &DISC_STEPS, measure: disc_point },
+    Case { name: bar::PROBLEM, steps: &BAR_STEPS, measure: bar_point },
+    Case { name: disc::DISC, steps: &DISC_STEPS, measure: disc_point },
 ];
 
 /// Runs `cases` for every scheme and both masses.

@@ -99,10 +99,10 @@ pub fn contact_laws(progress: &mut dyn FnMut(&str)) -> Result<Vec<EnergyRow>, Ca
             let b = bar::run(&bar::Options { methods: methods.clone(), ..bar::Options::default() })?;
             // The bar's one contact point: its status is the sign of λ.
             let rows: Vec<_> = b.series.iter().map(|r| (vec![r.lambda < 0.0], r.energy_aug, r.energy)).collect();
-            out.push(energy_row("bar", scheme, contact, &rows));
+            out.push(energy_row(bar::PROBLEM, scheme, contact, &rows));
             let d = disc::run(&disc::Options { methods, h: Some(2.0), t_end: Some(16.0), ..disc::Options::default() })?;
             let rows: Vec<_> = d.series.iter().map(|r| (r.switches.clone(), r.energy_aug, r.energy)).collect();
-            out.push(energy_row("disc", scheme, contact, &rows));
+            out.push(energy_row(disc::DISC, scheme, contact, &rows));
         }
     }
     Ok(out)
