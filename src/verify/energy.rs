@@ -32,6 +32,9 @@ pub struct EnergyRow {
     /// Steps on which points only left contact, and the range of ΔE_aug over them.
     pub releasing_steps: usize,
     pub releasing_range: (f64, f64),
+    /// What the run was: the mesh, Δt and T.
+    #[serde(skip)]
+    pub setting: String,
 }
 
 fn energy_row(case: &'static str, scheme: &str, contact: &str, rows: &[(Vec<bool>, f64, f64)]) -> EnergyRow {
@@ -72,6 +75,7 @@ fn energy_row(case: &'static str, scheme: &str, contact: &str, rows: &[(Vec<bool
         entering_range,
         releasing_steps: releasing,
         releasing_range,
+        setting: String::new(),
     }
 }
 
@@ -99,10 +103,12 @@ pub fn contact_laws(progress: &mut dyn FnMut(&str)) -> Result<Vec<EnergyRow>, Ca
             let b = bar::run(&bar::Options { methods: methods.clone(), ..bar::Options::default() })?;
             // The bar's one contact point: its status is the sign of λ.
             let rows: Vec<_> = b.series.iter().map(|r| (vec![r.lambda < 0.0], r.energy_aug, r.energy)).collect();
-            out.push(energy_row(bar::PROBLEM, scheme, contact, &rows));
+            let setting = format!("N = {}, Δt = {}, T = {}", b.summary.elements, b.summary.dt, b.summary.t_end);
+            out.push(EnergyRow { setting, ..energy_row(bar::PROBLEM, scheme, contact, &rows) });
             let d = disc::run(&disc::Options { methods, h: Some(2.0), t_end: Some(16.0), ..disc::Options::default() })?;
             let rows: Vec<_> = d.series.iter().map(|r| (r.switches.clone(), r.energy_aug, r.energy)).collect();
-            out.push(energy_row(disc::DISC, scheme, contact, &rows));
+            let setting = format!("{}, Δt = {}, T = {}", d.summary.mesh, d.summary.dt, d.summary.t_end);
+            out.push(EnergyRow { setting, ..energy_row(disc::DISC, scheme, contact, &rows) });
         }
     }
     Ok(out)
