@@ -17,8 +17,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::cases::CaseError;
-use crate::driver::Active;
+use crate::driver::FilesInUse;
+use crate::error::CaseError;
 use crate::runtime::fem::mesh::Mesh;
 
 /// The files in the output directory.
@@ -200,19 +200,19 @@ pub fn read(dir: &Path, identity: &Identity) -> Result<(DriverState, Vec<Vec<u8>
 
 /// What a resumed run must share with its checkpoint: the case, the scheme, the files and every
 /// param in use, the step guard, the mesh, and the case's own settings (`more`).
-pub fn identity(case: &str, active: &Active, mesh: &Mesh, more: &[(&str, String)]) -> Identity {
+pub fn identity(case: &str, in_use: &FilesInUse, mesh: &Mesh, more: &[(&str, String)]) -> Identity {
     let common = [
         ("case", case.to_string()),
-        ("scheme", active.scheme_name().to_string()),
-        ("contact law", active.forms.contact_name().to_string()),
-        ("files run interpreted", active.interpreted().join(", ")),
-        ("step guard", format!("{:?}", active.guard)),
+        ("scheme", in_use.scheme_name().to_string()),
+        ("contact law", in_use.forms.contact_name().to_string()),
+        ("files run interpreted", in_use.interpreted().join(", ")),
+        ("step guard", format!("{:?}", in_use.guard)),
         ("mesh", mesh_fingerprint(mesh)),
     ];
     let params =
-        active.forms.params.values().into_iter().map(|(name, p)| (format!("param {name}"), format!("{:?}", p.value)));
+        in_use.forms.params.values().into_iter().map(|(name, p)| (format!("param {name}"), format!("{:?}", p.value)));
     // A file run by path may be edited between the stop and the resume: its text counts.
-    let texts = active.interpreted().into_iter().map(|file| {
+    let texts = in_use.interpreted().into_iter().map(|file| {
         let text = std::fs::read(&file).map_or_else(|e| format!("unreadable ({e})"), |b| format!("{:016x}", fnv(&b)));
         (format!("text of {file}"), text)
     });

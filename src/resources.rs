@@ -1,7 +1,27 @@
-//! Memory a run will need, checked before the mesh is built: a mesh size that cannot fit is
-//! an error that says what fits, instead of an allocation failure (an abort) minutes later.
+//! The resources of a run: the memory it will need, checked before the mesh is built (a mesh
+//! size that cannot fit is an error that says what fits, instead of an allocation failure, an
+//! abort, minutes later); the memory it used (its peak) and the median of its timings, which
+//! summaries and benchmarks report.
 
-use crate::cases::CaseError;
+use crate::error::CaseError;
+
+/// The median of some timings (NaN of none).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
+}
+
+/// The process's peak resident memory in bytes (Linux: VmHWM of /proc/self/status).
+pub fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
 
 /// Peak bytes per unknown, measured: the 3D P2 ball with the iterative solver needs 9.6–9.8 kB
 /// per unknown from 108k to 986k unknowns (bench sphere); 2D P2 (about 25 stored entries per

@@ -1,5 +1,6 @@
-//! `forms/library.toml`: the library's defaults and the runs the report and `verify` make, as
-//! data (no scheme or law name is written in Rust).
+//! `forms/library.toml`: the library's defaults and the runs the report, `verify` and the
+//! benchmarks make, as data (no scheme or law name is written in Rust, nor the problems the
+//! benchmarks and the report's Hertz section run).
 
 use std::sync::OnceLock;
 
@@ -17,8 +18,13 @@ pub struct Settings {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Bench {
+    /// `bench disc`: the problem timed.
+    pub disc: String,
     /// `bench disc`: the explicit run timed beside the default one, (scheme, mass matrix).
     pub disc_explicit: (String, String),
+    /// `bench sphere`: the problem timed against its size, and the options of each run.
+    pub sphere: String,
+    pub sphere_options: Vec<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -33,6 +39,19 @@ pub struct Defaults {
 #[serde(deny_unknown_fields)]
 pub struct Report {
     pub bar: Vec<BarRuns>,
+    /// §5: the static Hertz problems and the impact problem.
+    pub hertz: Vec<HertzStatic>,
+    pub hertz_impact: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HertzStatic {
+    pub problem: String,
+    /// The summary key of the contact size (`KEY` and `KEY_error`).
+    pub size: String,
+    /// The finest mesh level solved.
+    pub finest: usize,
 }
 
 #[derive(Debug, Deserialize)]

@@ -19,7 +19,7 @@ fn initial_energy_is_one_eighth() {
 #[test]
 fn nitsche_penetrates_less_than_penalty() {
     let nitsche = run(|_| {}).summary.max_penetration;
-    let penalty = run(|o| o.setup.contact = "penalty".into()).summary.max_penetration;
+    let penalty = run(|o| o.methods.contact = "penalty".into()).summary.max_penetration;
     assert!(nitsche < 0.9 * penalty, "Nitsche {nitsche} vs penalty {penalty}");
 }
 
@@ -41,8 +41,8 @@ fn hht_dissipation_grows_with_alpha() {
         .iter()
         .map(|&a| {
             run(|o| {
-                o.setup.scheme = "hht".into();
-                o.setup = o.setup.clone().set("alpha", a);
+                o.methods.scheme = "hht".into();
+                o.methods = o.methods.clone().set("alpha", a);
             })
             .summary
             .energy_aug_final
@@ -55,7 +55,7 @@ fn hht_dissipation_grows_with_alpha() {
 fn hybrid_never_increases_the_augmented_energy() {
     for dt in [0.01, 0.05, 0.1] {
         let r = run(|o| {
-            o.setup.scheme = "hybrid".into();
+            o.methods.scheme = "hybrid".into();
             o.dt = Some(dt);
         });
         let e0 = r.summary.energy_aug_initial;
@@ -81,7 +81,7 @@ fn crank_nicolson_and_midpoint_energy_increments_match_the_formulas() {
         (neg(p1).powi(2) - neg(p0).powi(2)) / (2.0 * gamma) - neg(0.5 * (p0 + p1)) * (p1 - p0) / gamma
     };
     for (scheme, formula) in [("newmark", &cn as &dyn Fn(f64, f64) -> f64), ("midpoint", &mid)] {
-        let r = run(|o| o.setup.scheme = scheme.into());
+        let r = run(|o| o.methods.scheme = scheme.into());
         let e0 = r.summary.energy_aug_initial;
         let (mut gains, mut losses) = (0, 0);
         for w in r.series.windows(2) {
@@ -103,16 +103,16 @@ fn crank_nicolson_and_midpoint_energy_increments_match_the_formulas() {
 /// standard deviation over τ ∈ (1.2, 1.8) drops by at least 2×.
 #[test]
 fn mass_redistribution_calms_the_contact_stress() {
-    use signorini::cases::bar::MassChoice;
+    use signorini::simulation::MassChoice;
     let std = |r: &bar::Run| {
         let lam: Vec<f64> = r.series.iter().filter(|row| row.t > 1.2 && row.t < 1.8).map(|row| row.lambda).collect();
         let mean = lam.iter().sum::<f64>() / lam.len() as f64;
         (lam.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lam.len() as f64).sqrt()
     };
     for scheme in ["hht", "trbdf2"] {
-        let consistent = run(|o| o.setup.scheme = scheme.into());
+        let consistent = run(|o| o.methods.scheme = scheme.into());
         let redistributed = run(|o| {
-            o.setup.scheme = scheme.into();
+            o.methods.scheme = scheme.into();
             o.mass = MassChoice::Redistributed;
         });
         let (a, b) = (std(&consistent), std(&redistributed));
@@ -130,10 +130,10 @@ fn mass_redistribution_calms_the_contact_stress() {
 /// accurate as the other schemes' (err_λ of HHT and TR-BDF2 with redistribution ≈ 0.37).
 #[test]
 fn midpoint_schemes_measure_contact_at_half_steps() {
-    use signorini::cases::bar::MassChoice;
+    use signorini::simulation::MassChoice;
     for scheme in ["midpoint", "hybrid"] {
         let s = run(|o| {
-            o.setup.scheme = scheme.into();
+            o.methods.scheme = scheme.into();
             o.mass = MassChoice::Redistributed;
         })
         .summary;
@@ -141,7 +141,7 @@ fn midpoint_schemes_measure_contact_at_half_steps() {
         assert!(half < 0.45, "{scheme:?}: err_λ at half steps {half}");
     }
     let midpoint = run(|o| {
-        o.setup.scheme = "midpoint".into();
+        o.methods.scheme = "midpoint".into();
         o.mass = MassChoice::Redistributed;
     })
     .summary;
@@ -154,10 +154,10 @@ fn midpoint_schemes_measure_contact_at_half_steps() {
 #[test]
 fn full_traction_nitsche_is_the_normal_law_in_1d() {
     for theta in [1.0, 0.0, -1.0] {
-        let normal = run(|o| o.setup = o.setup.clone().set("theta", theta));
+        let normal = run(|o| o.methods = o.methods.clone().set("theta", theta));
         let traction = run(|o| {
-            o.setup =
-                signorini::driver::Setup { contact: "nitsche-traction".into(), ..o.setup.clone() }.set("theta", theta);
+            o.methods = signorini::driver::Methods { contact: "nitsche-traction".into(), ..o.methods.clone() }
+                .set("theta", theta);
             o.cell_size = signorini::runtime::fem::mesh::CellSize::GetFem;
         });
         for (a, b) in normal.series.iter().zip(&traction.series) {
@@ -212,7 +212,7 @@ fn time_steps_from_one_to_1e_minus_7_converge_onto_the_space_error() {
 fn an_unstable_run_stops_with_its_cause_and_its_results_so_far() {
     let dir = std::env::temp_dir().join(format!("signorini-blowup-{}", std::process::id()));
     let mut o = Options { out: Some(dir.clone()), ..Options::default() };
-    o.setup = o.setup.clone().set("theta", -1.0).set("gamma0", 1e-6);
+    o.methods = o.methods.clone().set("theta", -1.0).set("gamma0", 1e-6);
     let err = bar::run(&o).err().expect("the run must stop");
     let text = err.to_string();
     assert!(text.contains("drives the motion") && text.contains("gamma0 = 0.000001"), "{text}");
@@ -280,12 +280,12 @@ fn dense_omega_max(lumped: bool) -> f64 {
 /// refused before it steps.
 #[test]
 fn central_differences_know_their_critical_step() {
-    use signorini::cases::CaseError;
+    use signorini::error::CaseError;
     use signorini::simulation::MassChoice;
     for (mass, lumped) in [(MassChoice::Consistent, false), (MassChoice::Lumped, true)] {
         let central = |dt: f64| {
             let mut o = Options { mass, dt: Some(dt), ..Options::default() };
-            o.setup.scheme = "central".into();
+            o.methods.scheme = "central".into();
             bar::run(&o)
         };
         let r = central(0.02).unwrap();

@@ -57,7 +57,7 @@ fn mistakes_are_reported_with_their_line() {
         ("unknown.toml", "case = \"bar\"\nscheme = \"hht\"\nthetta = 1\n", ":3: unknown field `thetta`"),
         (
             "range.toml",
-            "case = \"bar\"\n\ntheta = 2\n",
+            "case = \"bar\"\n[params]\ntheta = 2\n",
             ":3: param `theta` = 2 is outside its range [-1, 1] (declared at contact_nitsche.wf:",
         ),
         (
@@ -73,7 +73,7 @@ fn mistakes_are_reported_with_their_line() {
         (
             "other_case.toml",
             "case = \"disc\"\nne = 5\n",
-            ":2: unknown field `ne`, expected one of `case`, `scheme`, `contact`, `material`, `forms`, `params`, `alpha`, `theta`, `gamma0`, `mass`, `cell_size`, `dt`, `t_end`, `t_start`, `out`, `mesh`, `max_step_cuts`, `energy_tolerance`, `allow_unstable_dt`; nor a param of problem `disc` (its params: h)",
+            ":2: unknown field `ne`, expected one of `case`, `scheme`, `contact`, `material`, `forms`, `params`, `mass`, `cell_size`, `dt`, `t_end`, `t_start`, `out`, `mesh`, `max_step_cuts`, `energy_tolerance`, `allow_unstable_dt`; nor a param of problem `disc` (its params: h)",
         ),
         (
             "name.toml",
@@ -81,7 +81,9 @@ fn mistakes_are_reported_with_their_line() {
             ":2: `scheme`: invalid option: no scheme `rk4` in the library",
         ),
         ("law.toml", "case = \"bar\"\ncontact = \"nitche\"\n", "did you mean `nitsche`?"),
-        ("alpha.toml", "case = \"bar\"\nscheme = \"midpoint\"\nalpha = 0.1\n", ":3: unknown param `alpha`"),
+        ("alpha.toml", "case = \"bar\"\nscheme = \"midpoint\"\n[params]\nalpha = 0.1\n", ":4: unknown param `alpha`"),
+        // A param of the scheme or form files has no key of its own: it goes in [params].
+        ("removed.toml", "case = \"bar\"\nscheme = \"hht\"\nalpha = 0.1\n", ":3: unknown field `alpha`"),
         ("type.toml", "case = \"disc\"\ndt = \"x\"\n", ":2: invalid type"),
         ("case.toml", "case = \"beam\"\n", ":1: `case`: no problem `beam` in the library"),
     ];

@@ -69,7 +69,7 @@ fn mesh_info_prints_json_or_the_error() {
 fn static_block_writes_its_summary() {
     let dir = std::env::temp_dir().join(format!("signorini-cli-{}", std::process::id()));
     let (code, out, err) =
-        signorini(&["run", "static_block", "--cells", "4", "--theta", "-1", "--out", dir.to_str().unwrap()]);
+        signorini(&["run", "static_block", "--cells", "4", "--param", "theta=-1", "--out", dir.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("static_block:"), "{out}");
     let s: serde_json::Value =
@@ -149,9 +149,13 @@ fn bar_writes_series_summary_and_plots() {
     }
     let bytes = std::fs::read(dir.join("bar.png")).unwrap();
     assert!(bytes.starts_with(b"\x89PNG"), "bar.png is not a PNG");
-    let (code, _, err) = signorini(&["run", "bar", "--scheme", "midpoint", "--alpha", "0.1"]);
+    let (code, _, err) = signorini(&["run", "bar", "--scheme", "midpoint", "--param", "alpha=0.1"]);
     assert_eq!(code, 1);
-    assert!(err.contains("--alpha: unknown param `alpha`"), "{err}");
+    assert!(err.contains("--param alpha=0.1: unknown param `alpha`"), "{err}");
+    // A param of the scheme or form files has no option of its own.
+    let (code, _, err) = signorini(&["run", "bar", "--scheme", "hht", "--alpha", "0.1"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("unexpected argument '--alpha'"), "{err}");
 }
 
 #[test]

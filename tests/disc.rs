@@ -2,63 +2,77 @@
 //! exactly, u_y = −½ 0.1 t² and E = 0, and the first contact happens in the step containing t* = √40.
 
 use signorini::cases::disc::{self, GRAVITY, Options};
-use signorini::driver::{self, Setup};
+use signorini::driver::{self, Methods};
 
-fn scheme(name: &str) -> Setup {
-    Setup { scheme: name.into(), ..Setup::default() }
+fn scheme(name: &str) -> Methods {
+    Methods { scheme: name.into(), ..Methods::default() }
 }
 
 #[test]
 fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
     let t_star = (2.0 * 2.0 / GRAVITY).sqrt();
     for scheme in driver::all_schemes() {
-        let opts = Options { setup: self::scheme(scheme), h: 2.0, t_end: 6.5, ..Options::default() };
+        let opts = Options { methods: self::scheme(scheme), h: Some(2.0), t_end: Some(6.5), ..Options::default() };
         let r = disc::run(&opts).unwrap_or_else(|e| panic!("{scheme:?}: {e}"));
         for row in r.series.iter().filter(|row| row.t < t_star - 0.05) {
             let exact = -0.5 * GRAVITY * row.t * row.t;
-            assert!((row.uy_mean - exact).abs() < 1e-12, "{scheme:?} t = {}: mean {} vs {exact}", row.t, row.uy_mean);
+            assert!(
+                (row.u_vertical_mean - exact).abs() < 1e-12,
+                "{scheme:?} t = {}: mean {} vs {exact}",
+                row.t,
+                row.u_vertical_mean
+            );
             // E = 0 exactly. Round-off only (≤ 5e-12 of a kinetic energy ~56 at t = 6): the
             // stepper evaluates every scheme in increments (runtime/src/time/stage.rs). Before, it
             // was 4e-11 (Newmark) to 4e-10 (TR-BDF2).
             assert!(row.energy.abs() < 2e-11, "{scheme:?} t = {}: E = {:e}", row.t, row.energy);
-            assert!((row.uy_mean_nodal - exact).abs() < 1e-10, "{scheme:?} t = {}: nodal mean", row.t);
+            assert!((row.u_vertical_mean_nodal - exact).abs() < 1e-10, "{scheme:?} t = {}: nodal mean", row.t);
             assert!(
-                (row.uy_lowest - exact).abs() < 1e-10,
+                (row.u_vertical_lowest - exact).abs() < 1e-10,
                 "{scheme:?} t = {}: lowest {} vs {exact}",
                 row.t,
-                row.uy_lowest
+                row.u_vertical_lowest
             );
             assert_eq!(row.active_points, 0);
             // The centre of mass falls at v_y = −g t.
-            assert!((row.vy_mean + GRAVITY * row.t).abs() < 1e-10, "{scheme:?} t = {}: v {}", row.t, row.vy_mean);
+            assert!(
+                (row.v_vertical_mean + GRAVITY * row.t).abs() < 1e-10,
+                "{scheme:?} t = {}: v {}",
+                row.t,
+                row.v_vertical_mean
+            );
         }
         // A multi-stage scheme reports each intermediate stage, which is exact in free fall too.
         // TR-BDF2's trapezoidal stage ends at t + (2 − √2)Δt.
         let expected = if scheme == "trbdf2" { r.summary.steps } else { 0 };
         assert_eq!(r.stages.len(), expected, "{scheme:?}");
         for (k, s) in r.stages.iter().enumerate() {
-            let t = (k as f64 + 2.0 - 2f64.sqrt()) * opts.dt;
+            let t = (k as f64 + 2.0 - 2f64.sqrt()) * r.summary.dt;
             assert!((s.row.t - t).abs() < 1e-12, "{scheme:?} stage {k} at t = {}, expected {t}", s.row.t);
         }
         for s in r.stages.iter().filter(|s| s.row.t < t_star - 0.05) {
             let exact = -0.5 * GRAVITY * s.row.t * s.row.t;
-            assert!((s.row.uy_mean - exact).abs() < 1e-10, "{scheme:?} stage {} at t = {}", s.stage, s.row.t);
+            assert!((s.row.u_vertical_mean - exact).abs() < 1e-10, "{scheme:?} stage {} at t = {}", s.stage, s.row.t);
             assert!(
-                (s.row.vy_mean + GRAVITY * s.row.t).abs() < 1e-10,
+                (s.row.v_vertical_mean + GRAVITY * s.row.t).abs() < 1e-10,
                 "{scheme:?} stage {} at t = {}",
                 s.stage,
                 s.row.t
             );
         }
         let first = r.summary.first_contact.expect("the disc reaches the ground");
-        assert!(first - opts.dt < t_star && t_star <= first, "{scheme:?}: first contact at {first}, t* = {t_star}");
+        assert!(
+            first - r.summary.dt < t_star && t_star <= first,
+            "{scheme:?}: first contact at {first}, t* = {t_star}"
+        );
     }
 }
 
 /// Spec §4.5: the hybrid scheme with θ = 1 never increases E_Θ (to 1e-9 of the energy scale).
 #[test]
 fn hybrid_never_increases_the_augmented_energy() {
-    let r = disc::run(&Options { setup: scheme("hybrid"), h: 2.0, t_end: 20.0, ..Options::default() }).unwrap();
+    let r = disc::run(&Options { methods: scheme("hybrid"), h: Some(2.0), t_end: Some(20.0), ..Options::default() })
+        .unwrap();
     let scale = r.series.iter().map(|row| row.energy_aug.abs()).fold(0.0, f64::max);
     assert!(scale > 1e-3);
     // The Jacobian is refactored only when the active set changes: through the whole contact
@@ -89,8 +103,13 @@ fn penetration_decreases_with_the_contact_parameter() {
         let p: Vec<f64> = [1000.0, 3000.0, 10000.0]
             .iter()
             .map(|&gamma0| {
-                let setup = Setup { scheme: "hybrid".into(), contact: contact.into(), ..Setup::default() };
-                let o = Options { setup: setup.set("gamma0", gamma0), h: 2.0, t_end: 12.0, ..Options::default() };
+                let methods = Methods { scheme: "hybrid".into(), contact: contact.into(), ..Methods::default() };
+                let o = Options {
+                    methods: methods.set("gamma0", gamma0),
+                    h: Some(2.0),
+                    t_end: Some(12.0),
+                    ..Options::default()
+                };
                 disc::run(&o).unwrap().summary.max_penetration
             })
             .collect();
@@ -105,11 +124,16 @@ fn gmsh_mesh_and_built_in_generator_agree() {
     let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/disc_r10_h1_v22.msh");
     assert!(shared.exists(), "{} is missing: the reference meshes live in assets/meshes", shared.display());
     let summary = |mesh: Option<std::path::PathBuf>| {
-        let r = disc::run(&Options { setup: scheme("hybrid"), mesh, t_end: 26.0, ..Options::default() }).unwrap();
+        let r =
+            disc::run(&Options { methods: scheme("hybrid"), mesh, t_end: Some(26.0), ..Options::default() }).unwrap();
         let release = r.series.iter().filter(|row| row.active_points > 0).map(|row| row.t).fold(0.0, f64::max);
-        let rebound =
-            r.series.iter().filter(|row| row.t > release).map(|row| row.uy_mean).fold(f64::NEG_INFINITY, f64::max);
-        (r.summary.first_contact.unwrap(), r.summary.min_uy_mean, release, rebound)
+        let rebound = r
+            .series
+            .iter()
+            .filter(|row| row.t > release)
+            .map(|row| row.u_vertical_mean)
+            .fold(f64::NEG_INFINITY, f64::max);
+        (r.summary.first_contact.unwrap(), r.summary.min_u_vertical_mean, release, rebound)
     };
     let (a, b) = (summary(None), summary(Some(shared)));
     assert_eq!(a.0, b.0, "impact");
@@ -123,7 +147,12 @@ fn an_unstable_setting_fails_with_a_clear_error() {
     // Nitsche θ = 1 with γ0 = 2E is not coercive: the free fall already diverges while E_aug
     // is kept, its potential part going negative, and the energy guard stops it within the
     // first second, long before the values overflow.
-    let o = Options { setup: Setup::default().set("gamma0", 100.0), h: 2.0, t_end: 20.0, ..Options::default() };
+    let o = Options {
+        methods: Methods::default().set("gamma0", 100.0),
+        h: Some(2.0),
+        t_end: Some(20.0),
+        ..Options::default()
+    };
     let e = disc::run(&o).err().expect("diverges").to_string();
     assert!(e.contains("not coercive") && e.contains("gamma0 = 100"), "{e}");
     let t: f64 = e.trim_start_matches("stopped at t = ").split(':').next().unwrap().parse().unwrap();
@@ -135,16 +164,16 @@ fn an_unstable_setting_fails_with_a_clear_error() {
 /// t_end on the nominal time levels with the cuts counted.
 #[test]
 fn steps_cut_at_impact_return_to_the_nominal_step() {
-    let mut o = Options { t_end: 9.0, dt: 0.1, ..Options::default() };
+    let mut o = Options { t_end: Some(9.0), dt: Some(0.1), ..Options::default() };
     o.newton.max_iterations = 2;
     let r = disc::run(&o).unwrap();
     let s = &r.summary;
     assert!(s.step_cuts > 0, "no cut at Δt = 0.1");
     let times: Vec<f64> = r.series.iter().map(|row| row.t).collect();
-    let short = times.windows(2).filter(|w| w[1] - w[0] < 0.99 * o.dt).count();
+    let short = times.windows(2).filter(|w| w[1] - w[0] < 0.99 * s.dt).count();
     assert!(short >= 2, "{short} short steps for {} cuts", s.step_cuts);
     assert!((times.last().unwrap() - 9.0).abs() < 1e-12, "ends at {}", times.last().unwrap());
     // After the cuts the steps are whole again.
     let tail = &times[times.len() - 10..];
-    assert!(tail.windows(2).all(|w| (w[1] - w[0] - o.dt).abs() < 1e-9), "{tail:?}");
+    assert!(tail.windows(2).all(|w| (w[1] - w[0] - s.dt).abs() < 1e-9), "{tail:?}");
 }

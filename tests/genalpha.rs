@@ -5,20 +5,20 @@
 
 use nalgebra::{DMatrix, DVector};
 use signorini::cases::bar::{self, Options};
-use signorini::driver::Setup;
+use signorini::driver::Methods;
 use signorini::forms::{contact_nitsche, contact_penalty, elasticity};
 use signorini::runtime::fem::assembly::{Assembler, Quadrature};
 use signorini::runtime::fem::bound::{Bound, BoundForm};
 use signorini::runtime::fem::kernel::Coef;
 use signorini::runtime::fem::mesh::structured;
 
-fn run(setup: Setup, steps: usize) -> bar::Run {
-    let opts = Options { setup, t_end: Some(steps as f64 * 0.01), ..Options::default() };
+fn run(methods: Methods, steps: usize) -> bar::Run {
+    let opts = Options { methods, t_end: Some(steps as f64 * 0.01), ..Options::default() };
     bar::run(&opts).unwrap()
 }
 
-fn genalpha(rho: f64) -> Setup {
-    Setup { scheme: "genalpha".into(), ..Setup::default() }.set("genalpha.rho", rho)
+fn genalpha(rho: f64) -> Methods {
+    Methods { scheme: "genalpha".into(), ..Methods::default() }.set("genalpha.rho", rho)
 }
 
 /// One-step map of the free oscillator ü + u = 0 (one P1 element, E = 1, ρ = 3) at ωΔt = 1e12
@@ -56,8 +56,8 @@ fn spectral_radius_at_infinite_step_is_rho_infinity() {
 #[test]
 fn rho_one_is_newmark_on_the_bar() {
     for contact in ["nitsche", "penalty"] {
-        let a = run(Setup { contact: contact.into(), ..genalpha(1.0) }, 1200);
-        let b = run(Setup { scheme: "newmark".into(), contact: contact.into(), ..Setup::default() }, 1200);
+        let a = run(Methods { contact: contact.into(), ..genalpha(1.0) }, 1200);
+        let b = run(Methods { scheme: "newmark".into(), contact: contact.into(), ..Methods::default() }, 1200);
         let scale = b.series.iter().map(|r| r.u_c.abs()).fold(0.0, f64::max);
         for (x, y) in a.series.iter().zip(&b.series) {
             assert!((x.u_c - y.u_c).abs() < 1e-10 * scale, "{contact} t = {}: {} vs {}", x.t, x.u_c, y.u_c);
@@ -148,12 +148,12 @@ fn by_path_compiled_and_independent_agree() {
     let facets = asm.region("left").unwrap();
     let g = || Coef::function(1, |x, _, out| out[0] = x[0]);
     for (law, theta) in [("penalty", f64::NAN), ("nitsche", 1.0), ("nitsche", -1.0)] {
-        let mut setup = Setup { contact: law.into(), ..genalpha(0.8) };
+        let mut methods = Methods { contact: law.into(), ..genalpha(0.8) };
         if !theta.is_nan() {
-            setup = setup.set("theta", theta);
+            methods = methods.set("theta", theta);
         }
-        let compiled = run(setup.clone(), steps);
-        let by_path = run(Setup { scheme: file.display().to_string(), ..setup }, steps);
+        let compiled = run(methods.clone(), steps);
+        let by_path = run(Methods { scheme: file.display().to_string(), ..methods }, steps);
         assert_eq!(by_path.summary.interpreted, vec![file.display().to_string()]);
         let q = Quadrature::default();
         let regions = vec![("Gamma_C".to_string(), facets)];

@@ -3,7 +3,7 @@
 //! low-velocity impact of a ball. The tolerances are what the committed meshes reach, with a
 //! margin; the report's refinement study shows the rates.
 
-use signorini::driver::Setup;
+use signorini::driver::Methods;
 use signorini::problem::run::{Options, run};
 use signorini::references::hertz::profile;
 use signorini::runtime::fem::assembly::{Assembler, Quadrature};
@@ -12,14 +12,14 @@ use signorini::runtime::fem::quadrature::simplex_rule;
 use signorini::runtime::library::Binding;
 
 /// The library's Hertz problem (`hertz_cylinder` or `hertz_ball`) at a mesh level: its summary.
-fn pressed(problem: &str, contact: &str, level: usize) -> signorini::problem::run::Summary {
+fn pressed(problem: &str, contact: &str, level: usize) -> signorini::problem::outputs::Summary {
     let mut o = Options::new(problem);
-    o.setup = Setup { contact: contact.into(), ..Setup::default() }.set("level", level as f64);
+    o.methods = Methods { contact: contact.into(), ..Methods::default() }.set("level", level as f64);
     o.chosen.contact = true;
     run(&o).unwrap_or_else(|e| panic!("{problem} {contact} level {level}: {e}")).summary
 }
 
-fn number(s: &signorini::problem::run::Summary, key: &str) -> f64 {
+fn number(s: &signorini::problem::outputs::Summary, key: &str) -> f64 {
     s.number(key).unwrap_or_else(|| panic!("no `{key}` in the summary"))
 }
 
@@ -66,7 +66,7 @@ fn the_pressed_ball_has_hertz_contact_radius_and_peak_pressure() {
 fn the_impact_lasts_hertz_contact_time_and_reaches_hertz_peak_force() {
     // 50 steps per contact time (the default is 200; the figures move by < 1 %).
     let mut o = Options::new("hertz_impact");
-    o.setup = Setup::default().set("steps", 50.0);
+    o.methods = Methods::default().set("steps", 50.0);
     let r = run(&o).unwrap();
     let s = &r.summary;
     assert!(number(s, "indentation_ratio") <= 0.02 && number(s, "contact_time_over_wave_time") >= 10.0);
@@ -96,7 +96,7 @@ fn point_values_integrate_to_the_functional() {
     mesh.add_region_where("Gamma_C", |n, _| n[1] < 0.0);
     let asm = Assembler::new(&mesh);
     let material = [("E", 50.0), ("nu", 0.25), ("rho", 1.0), ("gamma0", 5000.0)];
-    let active = signorini::driver::Active::resolve_forms(&Setup::default(), &material).unwrap();
+    let forms = signorini::driver::FilesInUse::resolve_forms(&Methods::default(), &material).unwrap();
     let facets = asm.region("Gamma_C").unwrap();
     let degree = 7;
     let binding = Binding {
@@ -110,7 +110,7 @@ fn point_values_integrate_to_the_functional() {
         "f" => Some(Coef::constant(vec![0.0, 0.0])),
         _ => None,
     };
-    let pressure = active.instantiate(&coefs, &binding).unwrap().take_functional("contact_pressure").unwrap();
+    let pressure = forms.instantiate(&coefs, &binding).unwrap().take_functional("contact_pressure").unwrap();
     // Pushed 0.05 into the plane: a zone of half-width about √(2R·0.05) = 1.
     let u: Vec<f64> = (0..asm.size()).map(|i| if i % 2 == 1 { -0.05 } else { 0.0 }).collect();
     let points = pressure.facet_point_values(&asm, &simplex_rule(1, degree), &[&u], 0.0);
@@ -143,7 +143,7 @@ fn a_column_only_at_max_reads_is_measured_at_the_new_maxima_only() {
     std::fs::write(&file, every_row).unwrap();
     let short = |problem: &str| {
         let mut o = Options::new(problem);
-        o.setup = Setup::default().set("steps", 10.0);
+        o.methods = Methods::default().set("steps", 10.0);
         run(&o).unwrap()
     };
     let (deferred, every) = (short("hertz_impact"), short(file.to_str().unwrap()));

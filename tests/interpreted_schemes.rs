@@ -4,8 +4,8 @@
 //! through impact.
 
 use signorini::cases::{bar, disc};
-use signorini::driver::{self, Setup};
-use signorini::simulation::Guard;
+use signorini::driver::{self, Methods};
+use signorini::guard::Guard;
 
 fn copy_outside(dir: &std::path::Path, rel: &str) -> String {
     let to = dir.join(std::path::Path::new(rel).file_name().unwrap());
@@ -33,11 +33,11 @@ fn schemes_and_laws_by_path_match_the_compiled_library() {
             // The two paths compared step by step, also where a scheme is unstable at these
             // steps (IMEX-HHT; central differences above its critical step): no guard.
             let guard = Guard { energy_tolerance: 0.0, allow_unstable_dt: true, ..Guard::default() };
-            let compiled = Setup { scheme: scheme.into(), contact: (*law).into(), guard, ..Setup::default() };
-            let by_path = Setup { scheme: file.clone(), contact: law_file.clone(), guard, ..Setup::default() };
+            let compiled = Methods { scheme: scheme.into(), contact: (*law).into(), guard, ..Methods::default() };
+            let by_path = Methods { scheme: file.clone(), contact: law_file.clone(), guard, ..Methods::default() };
             // The bar: 100 steps of 0.03 (first impact at t = 1).
-            let bar_run = |setup: Setup| {
-                let o = bar::Options { setup, dt: Some(0.03), t_end: Some(3.0), ..bar::Options::default() };
+            let bar_run = |methods: Methods| {
+                let o = bar::Options { methods, dt: Some(0.03), t_end: Some(3.0), ..bar::Options::default() };
                 bar::run(&o).unwrap_or_else(|e| panic!("{scheme} {law}: {e}"))
             };
             let (a, b) = (bar_run(compiled.clone()), bar_run(by_path.clone()));
@@ -50,14 +50,24 @@ fn schemes_and_laws_by_path_match_the_compiled_library() {
                 largest = largest.max(w);
             }
             // The disc: 100 steps of 0.08 on the coarse built-in mesh (impact at t ≈ 6.3).
-            let disc_run = |setup: Setup| {
-                let o = disc::Options { setup, h: 2.0, dt: 0.08, t_end: 8.0, ..disc::Options::default() };
+            let disc_run = |methods: Methods| {
+                let o = disc::Options {
+                    methods,
+                    h: Some(2.0),
+                    dt: Some(0.08),
+                    t_end: Some(8.0),
+                    ..disc::Options::default()
+                };
                 disc::run(&o)
             };
             match (disc_run(compiled), disc_run(by_path)) {
                 (Ok(a), Ok(b)) => {
                     assert!(a.summary.first_contact.is_some(), "disc {scheme} {law}: no impact");
-                    for f in [|r: &disc::Row| r.uy_mean, |r: &disc::Row| r.fy_contact, |r: &disc::Row| r.energy_aug] {
+                    for f in [
+                        |r: &disc::Row| r.u_vertical_mean,
+                        |r: &disc::Row| r.f_vertical_contact,
+                        |r: &disc::Row| r.energy_aug,
+                    ] {
                         let (x, y): (Vec<f64>, Vec<f64>) =
                             a.series.iter().zip(&b.series).map(|(p, q)| (f(p), f(q))).unzip();
                         let w = worst(&x, &y);

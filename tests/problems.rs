@@ -16,7 +16,7 @@ fn temp_dir(tag: &str) -> PathBuf {
 fn short(problem: &str) -> Options {
     let mut o = Options::new(problem);
     o.t_end = Some(7.0);
-    o.setup.params.push(Setting { name: "h".into(), value: 2.0, origin: "test".into() });
+    o.methods.params.push(Setting { name: "h".into(), value: 2.0, origin: "test".into() });
     o
 }
 
@@ -72,7 +72,7 @@ fn an_interpreted_contact_law_agrees_with_the_compiled_one() {
     std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("forms/contact_nitsche.wf"), &law).unwrap();
     let compiled = run(&short("disc")).unwrap();
     let mut o = short("disc");
-    o.setup.contact = law.display().to_string();
+    o.methods.contact = law.display().to_string();
     let interpreted = run(&o).unwrap();
     let scale = compiled.column("uy_mean").unwrap().iter().fold(0.0f64, |m, x| m.max(x.abs()));
     for name in ["uy_mean", "uy_lowest", "fy_contact", "energy_aug"] {
@@ -92,7 +92,7 @@ fn a_ball_obstacle_tends_to_the_plane_as_its_radius_grows() {
     let plane = run(&short("disc")).unwrap();
     let on_ball = |r: f64| {
         let mut o = short(file.to_str().unwrap());
-        o.setup.params.push(Setting { name: "R".into(), value: r, origin: "test".into() });
+        o.methods.params.push(Setting { name: "R".into(), value: r, origin: "test".into() });
         let b = run(&o).unwrap();
         let (x, y) = (b.column("uy_mean").unwrap(), plane.column("uy_mean").unwrap());
         assert_eq!(x.len(), y.len());
@@ -149,7 +149,7 @@ fn a_traction_on_a_region_of_the_problem_follows_d_alembert() {
     let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems");
     let error = |ne: usize| {
         let mut o = Options::new(here.join("traction_bar.wf").to_str().unwrap());
-        o.setup.params.push(Setting { name: "ne".into(), value: ne as f64, origin: "test".into() });
+        o.methods.params.push(Setting { name: "ne".into(), value: ne as f64, origin: "test".into() });
         o.dt = Some(0.5 / ne as f64);
         let r = run(&o).unwrap();
         assert!(r.column("active_points").unwrap().iter().all(|a| *a == 0.0), "the bar reached the obstacle");
@@ -266,9 +266,9 @@ fn a_moving_held_displacement_pulls_the_bar_as_d_alembert_says() {
     let acceleration = here.join("newmark_acceleration.wf").display().to_string();
     let pulled = |scheme: &str, ne: usize| {
         let mut o = Options::new(here.join("pulled_bar.wf").to_str().unwrap());
-        o.setup.scheme = scheme.to_string();
+        o.methods.scheme = scheme.to_string();
         o.chosen.scheme = true;
-        o.setup.params.push(Setting { name: "ne".into(), value: ne as f64, origin: "test".into() });
+        o.methods.params.push(Setting { name: "ne".into(), value: ne as f64, origin: "test".into() });
         o.dt = Some(1.0 / ne as f64);
         let r = run(&o).unwrap();
         let held = r.column("held").unwrap();
@@ -310,7 +310,7 @@ fn a_static_problem_is_one_equilibrium() {
     let text = std::fs::read_to_string(&file).unwrap().replace("run static", "run dt = 1, t_end = 1");
     std::fs::write(dir.join("resting_block.wf"), text).unwrap();
     let mut o = Options::new(dir.join("resting_block.wf").to_str().unwrap());
-    o.setup.scheme =
+    o.methods.scheme =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/problems/quasistatic.wf").display().to_string();
     o.chosen.scheme = true;
     let q = run(&o).unwrap();

@@ -1,8 +1,9 @@
-//! forms/library.toml parses, and every scheme, contact law, material and mass matrix it names
-//! exists in the library (verify's reference schemes too).
+//! forms/library.toml parses, and every scheme, contact law, material, mass matrix and problem it
+//! names exists in the library (verify's reference schemes, the benchmarks' and the report's
+//! problems too).
 
-use signorini::cases::bar::MassChoice;
-use signorini::driver::{self, Setup};
+use signorini::driver::{self, Methods};
+use signorini::simulation::MassChoice;
 
 #[test]
 fn library_settings_name_library_files() {
@@ -14,7 +15,7 @@ fn library_settings_name_library_files() {
         assert!(laws.contains(&contact), "unknown contact law `{contact}`");
     };
     known(&s.defaults.scheme, &s.defaults.contact);
-    driver::Active::resolve(&Setup::default(), &[]).unwrap();
+    driver::FilesInUse::resolve(&Methods::default(), &[]).unwrap();
     for (scheme, contact, mass) in s.report.bar.iter().flat_map(|b| b.runs.iter()) {
         known(scheme, contact);
         <MassChoice as clap::ValueEnum>::from_str(mass, true).unwrap_or_else(|e| panic!("mass `{mass}`: {e}"));
@@ -26,4 +27,12 @@ fn library_settings_name_library_files() {
     }
     // verify binds the damping slot itself: it must be named.
     assert!(!s.verify.damping_slot.is_empty());
+    let (scheme, mass) = &s.bench.disc_explicit;
+    known(scheme, &s.defaults.contact);
+    <MassChoice as clap::ValueEnum>::from_str(mass, true).unwrap_or_else(|e| panic!("mass `{mass}`: {e}"));
+    let problems = signorini::problem::library_names();
+    let named = [&s.bench.disc, &s.bench.sphere, &s.report.hertz_impact];
+    for problem in named.into_iter().chain(s.report.hertz.iter().map(|h| &h.problem)) {
+        assert!(problems.contains(&problem.as_str()), "unknown problem `{problem}` (known: {problems:?})");
+    }
 }

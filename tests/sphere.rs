@@ -2,12 +2,13 @@
 //! is exact before the first contact, which happens just after t* = √40, and
 //! Crank–Nicolson with Nitsche θ = 1 keeps E_aug on every step whose active set is unchanged.
 
-use signorini::cases::disc::{self, Body, GRAVITY, Options};
-use signorini::driver::Setup;
+use signorini::cases::disc::{self, GRAVITY, Options};
+use signorini::driver::Methods;
 
 fn sphere(scheme: &str, h: f64, t_end: f64) -> disc::Run {
-    let setup = Setup { scheme: scheme.into(), ..Setup::default() };
-    disc::run(&Options { body: Body::Sphere, setup, h, t_end, ..Options::default() }).unwrap()
+    let methods = Methods { scheme: scheme.into(), ..Methods::default() };
+    disc::run(&Options { problem: "sphere".into(), methods, h: Some(h), t_end: Some(t_end), ..Options::default() })
+        .unwrap()
 }
 
 #[test]
@@ -18,9 +19,19 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
         assert_eq!(r.summary.case, "sphere");
         for row in r.series.iter().filter(|row| row.t < t_star - 0.05) {
             let exact = -0.5 * GRAVITY * row.t * row.t;
-            assert!((row.uy_mean - exact).abs() < 1e-10, "{scheme} t = {}: mean u_z {} vs {exact}", row.t, row.uy_mean);
-            assert!((row.uy_lowest - exact).abs() < 1e-10, "{scheme} t = {}: lowest point", row.t);
-            assert!((row.vy_mean + GRAVITY * row.t).abs() < 1e-10, "{scheme} t = {}: v_z {}", row.t, row.vy_mean);
+            assert!(
+                (row.u_vertical_mean - exact).abs() < 1e-10,
+                "{scheme} t = {}: mean u_z {} vs {exact}",
+                row.t,
+                row.u_vertical_mean
+            );
+            assert!((row.u_vertical_lowest - exact).abs() < 1e-10, "{scheme} t = {}: lowest point", row.t);
+            assert!(
+                (row.v_vertical_mean + GRAVITY * row.t).abs() < 1e-10,
+                "{scheme} t = {}: v_z {}",
+                row.t,
+                row.v_vertical_mean
+            );
             assert_eq!(row.active_points, 0);
         }
         // The contact quadrature points nearest the pole sit above it by about (facet size)²/2R
@@ -46,7 +57,7 @@ fn crank_nicolson_keeps_the_augmented_energy_while_the_active_set_is_kept() {
     assert!(kept > 400 && changed > 3, "kept {kept}, changed {changed}");
     assert!(largest < 1e-9, "largest |ΔE_aug| on kept steps: {largest:e}");
     // In contact: a positive contact area and an upward force.
-    assert!(r.series.iter().any(|row| row.contact_area > 0.0 && row.fy_contact > 0.0));
+    assert!(r.series.iter().any(|row| row.contact_area > 0.0 && row.f_vertical_contact > 0.0));
 }
 
 /// The iterative path (CG for θ = 1, BiCGStab for the unsymmetric θ = −1) gives the direct
@@ -57,9 +68,17 @@ fn iterative_and_direct_solvers_agree() {
     use signorini::runtime::nonlinear::newton::NewtonOptions;
     for theta in [1.0, -1.0] {
         let run = |solver| {
-            let setup = Setup::default().set("theta", theta);
+            let methods = Methods::default().set("theta", theta);
             let newton = NewtonOptions { solver, ..NewtonOptions::default() };
-            disc::run(&Options { body: Body::Sphere, setup, h: 5.0, t_end: 8.0, newton, ..Options::default() }).unwrap()
+            disc::run(&Options {
+                problem: "sphere".into(),
+                methods,
+                h: Some(5.0),
+                t_end: Some(8.0),
+                newton,
+                ..Options::default()
+            })
+            .unwrap()
         };
         let (d, i) = (run(Solver::Direct), run(Solver::Iterative));
         assert_eq!(d.summary.krylov_iterations, 0);
@@ -67,7 +86,7 @@ fn iterative_and_direct_solvers_agree() {
         let scale = d.series.iter().map(|r| r.energy.abs()).fold(0.0, f64::max);
         for (a, b) in d.series.iter().zip(&i.series) {
             assert!((a.energy_aug - b.energy_aug).abs() < 1e-6 * scale, "θ = {theta}, t = {}", a.t);
-            assert!((a.uy_mean - b.uy_mean).abs() < 1e-9, "θ = {theta}, t = {}", a.t);
+            assert!((a.u_vertical_mean - b.u_vertical_mean).abs() < 1e-9, "θ = {theta}, t = {}", a.t);
             assert_eq!(a.active_points, b.active_points, "θ = {theta}, t = {}", a.t);
         }
     }
@@ -81,12 +100,17 @@ fn the_graded_gmsh_ball_falls_exactly() {
     let m = signorini::runtime::fem::mesh::gmsh::read(&mesh).unwrap();
     let lowest = (0..m.num_nodes()).map(|i| m.node(i)[2]).fold(f64::INFINITY, f64::min);
     assert!((lowest - 2.0).abs() < 1e-9, "the mesh's lowest point is at z = {lowest}");
-    let opts = Options { body: Body::Sphere, mesh: Some(mesh), t_end: 0.4, ..Options::default() };
+    let opts = Options { problem: "sphere".into(), mesh: Some(mesh), t_end: Some(0.4), ..Options::default() };
     let r = disc::run(&opts).unwrap();
     assert!(r.summary.dofs > 20_000);
     for row in &r.series {
         let exact = -0.5 * GRAVITY * row.t * row.t;
-        assert!((row.uy_mean - exact).abs() < 1e-10, "t = {}: mean u_z {} vs {exact}", row.t, row.uy_mean);
-        assert!((row.uy_lowest - exact).abs() < 1e-10, "t = {}: lowest point", row.t);
+        assert!(
+            (row.u_vertical_mean - exact).abs() < 1e-10,
+            "t = {}: mean u_z {} vs {exact}",
+            row.t,
+            row.u_vertical_mean
+        );
+        assert!((row.u_vertical_lowest - exact).abs() < 1e-10, "t = {}: lowest point", row.t);
     }
 }

@@ -3,7 +3,7 @@
 //! under refinement, Newton iteration counts, and reuse of the factorization when the active
 //! set does not change.
 
-use signorini::driver::{Setting, Setup};
+use signorini::driver::{Methods, Setting};
 use signorini::forms::{contact_nitsche, elasticity};
 use signorini::problem::run::{Options, Run, run as run_problem};
 use signorini::runtime::fem::assembly::{Assembler, Quadrature};
@@ -21,16 +21,16 @@ fn methods() -> Vec<(&'static str, f64)> {
 
 /// The block (`static_block`, or `static_block_3d`) with the contact law, θ and problem params.
 fn block(problem: &str, contact: &str, theta: f64, params: &[(&str, f64)]) -> Options {
-    let mut setup = Setup { contact: contact.into(), ..Setup::default() };
+    let mut methods = Methods { contact: contact.into(), ..Methods::default() };
     if !theta.is_nan() {
-        setup = setup.set("theta", theta);
+        methods = methods.set("theta", theta);
     }
     for (name, value) in params {
-        setup.params.push(Setting { name: name.to_string(), value: *value, origin: "test".into() });
+        methods.params.push(Setting { name: name.to_string(), value: *value, origin: "test".into() });
     }
     let mut o = Options::new(problem);
     o.chosen.contact = true;
-    o.setup = setup;
+    o.methods = methods;
     o
 }
 
@@ -132,7 +132,7 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
 /// translation).
 #[test]
 fn newton_failures_are_typed_errors_with_history() {
-    use signorini::cases::CaseError;
+    use signorini::error::CaseError;
     use signorini::runtime::nonlinear::newton::NewtonError;
     let mut o = block("static_block", "nitsche", 1.0, &[("curvature", 0.5)]);
     o.newton.max_iterations = 2;

@@ -7,8 +7,8 @@ use signorini::report::sweep::{self, Point};
 
 /// A scheme that claims a stability limit (an explicit one).
 fn explicit(scheme: &str) -> bool {
-    let setup = signorini::driver::Setup { scheme: scheme.into(), ..Default::default() };
-    signorini::verify::claimed_cfl(&setup).unwrap().is_some()
+    let methods = signorini::driver::Methods { scheme: scheme.into(), ..Default::default() };
+    signorini::verify::claimed_cfl(&methods).unwrap().is_some()
 }
 
 fn point<'a>(s: &'a sweep::Sweeps, scheme: &str, mass: &str, dt: f64) -> &'a Point {

@@ -79,15 +79,15 @@ fn without_contact_energy_decays_like_the_spectral_radius_squared() {
     let expected: usize = signorini::driver::all_schemes()
         .into_iter()
         .map(|scheme| {
-            let setup = signorini::driver::Setup { scheme: scheme.into(), ..Default::default() };
-            let cfl = verify::claimed_cfl(&setup).unwrap().unwrap_or(f64::INFINITY);
+            let methods = signorini::driver::Methods { scheme: scheme.into(), ..Default::default() };
+            let cfl = verify::claimed_cfl(&methods).unwrap().unwrap_or(f64::INFINITY);
             verify::energy::DISSIPATION_STEPS.iter().filter(|x| **x <= cfl).count()
         })
         .sum();
     assert_eq!(rows.len(), expected);
     for r in &rows {
-        let setup = signorini::driver::Setup { scheme: r.scheme.clone(), ..Default::default() };
-        if verify::claimed_cfl(&setup).unwrap().is_some() {
+        let methods = signorini::driver::Methods { scheme: r.scheme.clone(), ..Default::default() };
+        if verify::claimed_cfl(&methods).unwrap().is_some() {
             // Central differences keep a modified energy, ½v² + ½(1 − (ωΔt)²/4)u²: the
             // physical one oscillates about it by a fraction of order (ωΔt)², without drift.
             assert!((r.final_ratio - 1.0).abs() <= r.omega_dt * r.omega_dt, "{r:?}");

@@ -4,7 +4,7 @@
 //! order 2 on the damped oscillator, and one with an explicit damping term order 1 there
 //! (though 2 without damping).
 
-use signorini::driver::Setup;
+use signorini::driver::Methods;
 use signorini::verify::scheme;
 
 fn write(name: &str, text: &str) -> String {
@@ -52,8 +52,8 @@ scheme euler {
 fn a_users_generalized_alpha_has_order_two_and_its_rho_infinity() {
     let path = write("my_genalpha.wf", GENERALIZED_ALPHA);
     for r in [0.6, 0.3] {
-        let setup = Setup { scheme: path.clone(), ..Setup::default() }.set("r", r);
-        let v = scheme::run(&setup, &mut |_| {}).unwrap();
+        let methods = Methods { scheme: path.clone(), ..Methods::default() }.set("r", r);
+        let v = scheme::run(&methods, &mut |_| {}).unwrap();
         assert!((v.oscillator_order - 2.0).abs() < 0.05, "order {}", v.oscillator_order);
         // Round-off of the step at ωΔt = 1e12 leaves about 1e-6.
         assert!((v.rho_infinity - r).abs() < 1e-4, "ρ∞ {} for r = {r}", v.rho_infinity);
@@ -75,7 +75,7 @@ fn a_users_generalized_alpha_has_order_two_and_its_rho_infinity() {
 #[test]
 fn a_first_order_scheme_that_claims_two_is_contradicted() {
     let path = write("euler.wf", BACKWARD_EULER);
-    let v = scheme::run(&Setup { scheme: path, ..Setup::default() }, &mut |_| {}).unwrap();
+    let v = scheme::run(&Methods { scheme: path, ..Methods::default() }, &mut |_| {}).unwrap();
     assert!((v.oscillator_order - 1.0).abs() < 0.1, "order {}", v.oscillator_order);
     assert!(!v.holds());
     let order = &v.verdicts[0];
@@ -105,8 +105,8 @@ fn damping_applied_explicitly_costs_an_order_on_the_damped_oscillator() {
     let forms = write("damping.wf", DAMPING_FORM);
     let run = |name: &str, level: &str| {
         let path = write(&format!("{name}.wf"), &DAMPED_NEWMARK.replace("NAME", name).replace("LEVEL", level));
-        let setup = Setup { scheme: path, forms: vec![forms.clone().into()], ..Setup::default() };
-        scheme::run(&setup, &mut |_| {}).unwrap()
+        let methods = Methods { scheme: path, forms: vec![forms.clone().into()], ..Methods::default() };
+        scheme::run(&methods, &mut |_| {}).unwrap()
     };
     let implicit = run("newmark_damped", "v'");
     let d = implicit.damped_order.expect("the damping slot is applied");

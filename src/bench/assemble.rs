@@ -10,8 +10,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::median;
 use crate::forms::elasticity::{Coefficients, Mass, Params, Stiffness};
+use crate::resources::median;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::fem::mesh::structured::{self, Diagonal};

@@ -1,5 +1,6 @@
-//! `signorini bench disc`: time per step of the bouncing disc (issue 5), Newmark with Nitsche
-//! θ = 1, Δt = 0.02, 1000 steps (to t = 20: fall, impact, rebound), on each given mesh. The
+//! `signorini bench disc`: time per step of the bouncing disc (issue 5; the problem of
+//! forms/library.toml's `[bench]`), with the library's default scheme and contact law and the
+//! problem's own Δt and end time (fall, impact, rebound), on each given mesh. The
 //! stepper alone is timed (mesh reading, assembly of the linear forms, measurements and output
 //! are not); per run we record the mean and the median over steps, and report the medians of
 //! these over the repeated runs.
@@ -22,9 +23,9 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::median;
-use crate::cases::CaseError;
 use crate::cases::disc::{self, Options};
+use crate::error::CaseError;
+use crate::resources::median;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DiscTiming {
@@ -84,14 +85,25 @@ pub struct ExplicitTiming {
 pub struct Report {
     pub dt: f64,
     pub t_end: f64,
+    /// The scheme and contact law timed, and the law's params as run (none in older files).
+    #[serde(default)]
+    pub scheme: Option<String>,
+    #[serde(default)]
+    pub contact: Option<String>,
+    #[serde(default)]
+    pub contact_params: Vec<(String, f64)>,
     pub repeats: usize,
     pub meshes: Vec<DiscTiming>,
 }
 
 pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) -> Result<Report, CaseError> {
-    let base = Options::default();
+    // The problem of forms/library.toml's `[bench]`.
+    let base = Options { problem: crate::settings::get().bench.disc.clone(), ..Options::default() };
     let stream = stream_bandwidth();
     let mut out = Vec::new();
+    // The disc's step and end time (its file's) and the methods, as run.
+    let (mut dt, mut t_end) = (f64::NAN, f64::NAN);
+    let (mut scheme, mut contact, mut contact_params) = (None, None, Vec::new());
     for path in meshes {
         let opts = Options { mesh: Some(path.clone()), ..base.clone() };
         let (mut mean, mut med, mut whole) = (Vec::new(), Vec::new(), Vec::new());
@@ -105,13 +117,16 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             last = Some(s);
         }
         let s = last.expect("at least one run");
+        (dt, t_end) = (s.dt, s.t_end);
+        contact_params = crate::driver::params::declared_by(&s.params, &s.contact);
+        (scheme, contact) = (Some(s.scheme.clone()), Some(s.contact.clone()));
         let per_1000 = |count: usize| 1000.0 * count as f64 / s.steps.max(1) as f64;
         let median_step_ms = median(med);
         let model_bytes = (16 * s.factor_nnz.unwrap_or(0) + 16 * s.matrix_nnz + 24 * s.dofs) as f64;
         let model_ms = 1e3 * model_bytes / stream;
         let cache = triad_bandwidth(model_bytes as usize);
         let cache_model_ms = 1e3 * model_bytes / cache;
-        let explicit = explicit_timing(&opts, repeats)?;
+        let explicit = explicit_timing(&opts, s.dt, repeats)?;
         let fastest = mean.iter().copied().fold(f64::INFINITY, f64::min);
         let slowest = mean.iter().copied().fold(0.0, f64::max);
         let ms_per_step = median(mean);
@@ -176,23 +191,27 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
         }
         out.push(t);
     }
-    Ok(Report { dt: base.dt, t_end: base.t_end, repeats, meshes: out })
+    Ok(Report { dt, t_end, scheme, contact, contact_params, repeats, meshes: out })
 }
 
-/// The explicit run of forms/library.toml on the same mesh (its summary keys `stable_dt` and
-/// `factorizations`).
-fn explicit_timing(opts: &Options, repeats: usize) -> Result<Option<ExplicitTiming>, CaseError> {
+/// The explicit run of forms/library.toml on the same mesh at the disc's step `dt` (its summary
+/// keys `stable_dt` and `factorizations`).
+fn explicit_timing(opts: &Options, dt: f64, repeats: usize) -> Result<Option<ExplicitTiming>, CaseError> {
     let (scheme, mass) = &crate::settings::get().bench.disc_explicit;
     let mass = <crate::simulation::MassChoice as clap::ValueEnum>::from_str(mass, true)
         .map_err(|e| CaseError::Option(format!("forms/library.toml [bench]: {e}")))?;
-    let setup = crate::driver::Setup { scheme: scheme.clone(), ..opts.setup.clone() };
-    let mut opts = Options { setup, mass, ..opts.clone() };
+    let methods = crate::driver::Methods { scheme: scheme.clone(), ..opts.methods.clone() };
+    let mut opts = Options { methods, mass, ..opts.clone() };
     // Above its critical step on this mesh: at 0.8 Δt_c (three digits, rounded down), to the
     // same t_end.
-    if let Err(CaseError::UnstableStep { stable, .. }) = disc::run(&Options { t_end: opts.dt, ..opts.clone() }) {
+    let mut dt = dt;
+    if let Err(CaseError::UnstableStep { stable, .. }) =
+        disc::run(&Options { dt: Some(dt), t_end: Some(dt), ..opts.clone() })
+    {
         let scale = 10f64.powi(stable.log10().floor() as i32 - 2);
-        opts.dt = (0.8 * stable / scale).floor() * scale;
+        dt = (0.8 * stable / scale).floor() * scale;
     }
+    opts.dt = Some(dt);
     let mut per_step = Vec::new();
     let mut last = None;
     for _ in 0..repeats.max(1) {
@@ -202,7 +221,7 @@ fn explicit_timing(opts: &Options, repeats: usize) -> Result<Option<ExplicitTimi
     }
     let run = last.expect("at least one run");
     Ok(Some(ExplicitTiming {
-        dt: opts.dt,
+        dt,
         scheme: scheme.clone(),
         mass: mass.name().into(),
         ms_per_step: median(per_step),

@@ -1,16 +1,15 @@
 //! `signorini bench sphere`: time per step and peak memory of the bouncing sphere against its
-//! size, for the direct and the iterative solver. Each run is its own process (`run sphere`),
-//! so that its peak memory is its own: 50 steps of Δt = 0.02 from exact free fall at t = 6,
-//! through the first contact at √40 ≈ 6.32 (Newmark, Nitsche θ = 1, `--cell-size getfem`, whose
-//! h keeps θ = 1 stable on the finer built-in balls). Balls of 2·half cells per diameter have
-//! 3(4·half + 1)³ P2 unknowns.
+//! size, for the direct and the iterative solver. Each run is its own process (`run PROBLEM`,
+//! the problem and the options of forms/library.toml's `[bench]`: from just before the first
+//! contact through it), so that its peak memory is its own. Its built-in balls (radius 10) of
+//! 2·half cells per diameter have 3(4·half + 1)³ P2 unknowns.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use serde::{Deserialize, Serialize};
 
-use crate::cases::CaseError;
+use crate::error::CaseError;
 use crate::plot::Curve;
 
 /// Cells per radius of the balls tried, smallest first: 15k, 47k, 108k, 274k, 555k, 985k dofs.
@@ -37,6 +36,18 @@ pub struct SphereTiming {
     pub krylov_iterations: usize,
     pub peak_memory_bytes: Option<u64>,
     pub first_contact: Option<f64>,
+    /// What the run ran with: the scheme, the contact law and its params, Δt and the end time
+    /// (none in older files).
+    #[serde(default)]
+    pub scheme: Option<String>,
+    #[serde(default)]
+    pub contact: Option<String>,
+    #[serde(default)]
+    pub contact_params: Vec<(String, f64)>,
+    #[serde(default)]
+    pub dt: Option<f64>,
+    #[serde(default)]
+    pub t_end: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -47,16 +58,19 @@ pub struct Report {
 
 fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTiming, CaseError> {
     let h = 10.0 / half as f64;
-    let out = dir.join(format!("sphere-{}-{solver}", dofs(half)));
+    let bench = &crate::settings::get().bench;
+    let problem = &bench.sphere;
+    let out = dir.join(format!("{problem}-{}-{solver}", dofs(half)));
     let status = Command::new(exe)
-        .args(["run", "sphere", "--h", &h.to_string(), "--t-start", "6", "--t-end", "7", "--cell-size", "getfem"])
+        .args(["run", problem.as_str(), "--h", &h.to_string()])
+        .args(&bench.sphere_options)
         .args(["--solver", solver, "--out"])
         .arg(&out)
         .output()
         .map_err(|e| CaseError::Option(format!("cannot run {}: {e}", exe.display())))?;
     if !status.status.success() {
         return Err(CaseError::Option(format!(
-            "run sphere --h {h} --solver {solver} failed: {}",
+            "run {problem} --h {h} --solver {solver} failed: {}",
             String::from_utf8_lossy(&status.stderr).trim()
         )));
     }
@@ -67,6 +81,9 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
         serde_json::from_str(&text).map_err(|e| CaseError::Option(format!("{}: {e}", path.display())))?;
     let num = |k: &str| s.get(k).and_then(serde_json::Value::as_f64).unwrap_or(f64::NAN);
     let int = |k: &str| s.get(k).and_then(serde_json::Value::as_u64).unwrap_or(0) as usize;
+    let contact = s.get("contact").and_then(|v| v.as_str()).map(str::to_string);
+    let params: std::collections::BTreeMap<String, crate::driver::ParamValue> =
+        s.get("params").and_then(|p| serde_json::from_value(p.clone()).ok()).unwrap_or_default();
     Ok(SphereTiming {
         dofs: int("dofs"),
         h,
@@ -79,6 +96,11 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
         krylov_iterations: int("krylov_iterations"),
         peak_memory_bytes: s.get("peak_memory_bytes").and_then(serde_json::Value::as_u64),
         first_contact: s.get("first_contact").and_then(serde_json::Value::as_f64),
+        scheme: s.get("scheme").and_then(|v| v.as_str()).map(str::to_string),
+        contact: contact.clone(),
+        contact_params: contact.map_or_else(Vec::new, |c| crate::driver::params::declared_by(&params, &c)),
+        dt: s.get("dt").and_then(serde_json::Value::as_f64),
+        t_end: s.get("t_end").and_then(serde_json::Value::as_f64),
     })
 }
 
@@ -131,13 +153,15 @@ pub fn figure(report: &Report, dir: &Path) -> Result<(), CaseError> {
         ]
     };
     let path = dir.join("bench_sphere.png");
+    let problem = &crate::settings::get().bench.sphere;
+    let title = |what: &str| format!("{problem}: {what}");
     crate::plot::panels(
         &path,
         "log₁₀ unknowns",
         &[
-            ("sphere: time per step (whole run, setup included)", "log₁₀ ms", curves(|r| r.ms_per_step_with_setup)),
-            ("sphere: median step", "log₁₀ ms", curves(|r| r.median_step_ms)),
-            ("sphere: peak memory", "log₁₀ MB", curves(|r| r.peak_memory_bytes.map_or(f64::NAN, |b| b as f64 / 1e6))),
+            (&title("time per step (whole run, setup included)"), "log₁₀ ms", curves(|r| r.ms_per_step_with_setup)),
+            (&title("median step"), "log₁₀ ms", curves(|r| r.median_step_ms)),
+            (&title("peak memory"), "log₁₀ MB", curves(|r| r.peak_memory_bytes.map_or(f64::NAN, |b| b as f64 / 1e6))),
         ],
     )
     .map_err(|e| CaseError::Write { path: path.display().to_string(), source: std::io::Error::other(e) })

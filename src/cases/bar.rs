@@ -6,16 +6,20 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use super::CaseError;
-use crate::driver::{ParamValue, Setup};
+use crate::driver::{Methods, ParamValue};
+use crate::error::CaseError;
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
-pub use crate::simulation::MassChoice;
+use crate::simulation::MassChoice;
+
+/// The problem this module reads: the library's compressed bar, whose columns and summary keys
+/// are the fields of [`Row`] and [`Summary`].
+pub const PROBLEM: &str = "bar";
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
     /// Scheme, contact law, extra forms and params.
-    pub setup: Setup,
+    pub methods: Methods,
     /// Elements, Δt and the end time; none: forms/problems/bar.wf's.
     pub elements: Option<usize>,
     pub dt: Option<f64>,
@@ -33,20 +37,23 @@ pub struct Options {
     pub resume: bool,
 }
 
+/// The bar with the problem file's mesh and times, and a run's defaults
+/// ([`crate::problem::run::Options::new`]).
 impl Default for Options {
     fn default() -> Self {
+        let run = crate::problem::run::Options::new(PROBLEM);
         Options {
-            setup: Setup::default(),
+            methods: run.methods,
             elements: None,
-            dt: None,
-            t_end: None,
-            mass: MassChoice::Consistent,
-            cell_size: CellSize::Diameter,
-            newton: NewtonOptions::default(),
-            out: None,
-            checkpoint_every: 0,
-            resume: false,
-            progress: false,
+            dt: run.dt,
+            t_end: run.t_end,
+            mass: run.mass,
+            cell_size: run.cell_size,
+            newton: run.newton,
+            out: run.out,
+            checkpoint_every: run.checkpoint_every,
+            resume: run.resume,
+            progress: run.progress,
         }
     }
 }
@@ -135,14 +142,14 @@ pub struct Run {
 
 /// Runs the bar; writes series.csv and summary.json into `opts.out` if set.
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    let mut setup = opts.setup.clone();
+    let mut methods = opts.methods.clone();
     // The problem's mesh param, as the user's setting (before theirs: theirs wins).
     if let Some(ne) = opts.elements {
-        setup.params.insert(0, crate::driver::Setting { name: "ne".into(), value: ne as f64, origin: "--ne".into() });
+        methods.params.insert(0, crate::driver::Setting { name: "ne".into(), value: ne as f64, origin: "--ne".into() });
     }
     let problem = crate::problem::run::Options {
-        problem: "bar".to_string(),
-        setup,
+        problem: PROBLEM.to_string(),
+        methods,
         mass: opts.mass,
         cell_size: opts.cell_size,
         dt: opts.dt,
@@ -153,14 +160,14 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         checkpoint_every: opts.checkpoint_every,
         resume: opts.resume,
         chosen: crate::problem::run::Chosen::all(),
-        ..crate::problem::run::Options::new("bar")
+        ..crate::problem::run::Options::new(PROBLEM)
     };
     from_problem(opts, &crate::problem::run::run(&problem)?)
 }
 
 fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, CaseError> {
     let names = ["u_c", "v_c", "lambda", "lambda_half", "energy", "energy_aug", "penetration", "newton", "p1"];
-    let index = run.indices(&names, "bar")?;
+    let index = run.indices(&names, PROBLEM)?;
     let series = run
         .rows
         .iter()
@@ -181,10 +188,10 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
     let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
     let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
-    let elements = params.get("bar.ne").map_or(0, |p| p.value as usize);
-    params.retain(|k, _| !k.starts_with("bar."));
+    let elements = params.get(&format!("{PROBLEM}.ne")).map_or(0, |p| p.value as usize);
+    params.retain(|k, _| !k.starts_with(&format!("{PROBLEM}.")));
     let summary = Summary {
-        case: "bar",
+        case: PROBLEM,
         scheme: s.field("scheme")?,
         contact: s.field("contact")?,
         interpreted: s.field("interpreted")?,

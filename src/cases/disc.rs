@@ -1,64 +1,46 @@
-//! The bouncing disc and sphere as the report, `verify` and the benchmarks read them: the
-//! problems themselves are data (`forms/problems/disc.wf`, `sphere.wf`, run by the one driver,
-//! [`crate::problem::run`]); this module gives their rows and summary typed fields. The series'
-//! vertical columns (the fields `uy_*`, `vy_mean`, `fy_contact` of [`Row`], which hold the
-//! vertical component in both) are named after the axis in the files (`uy_mean`, `fy_contact`
-//! for the disc; `uz_mean`, `fz_contact` for the sphere).
+//! A body falling onto an obstacle, as the report, `verify`, the benchmarks and the tests read
+//! it: the bouncing disc (`forms/problems/disc.wf`, the default), the sphere (`sphere.wf`), or
+//! any problem file with their columns, run by the one driver ([`crate::problem::run`]); this
+//! module gives its rows and summary typed fields. The obstacle's normal is the vertical axis,
+//! y in 2D and z in 3D: the fields `u_vertical_*`, `v_vertical_mean` and `f_vertical_contact`
+//! of [`Row`] hold that component, read from the columns the file names after its axis
+//! (`uy_mean`, `fy_contact` for the disc; `uz_mean`, `fz_contact` for the sphere). Both library
+//! files name their summary key `min_uy_mean`.
 
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use super::CaseError;
-use crate::driver::{ParamValue, Setup};
+use crate::driver::{Methods, ParamValue};
+use crate::error::CaseError;
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;
 
 /// Gravity of the benchmark (the free fall before the first contact is exact: u = −g t²/2).
 pub const GRAVITY: f64 = 0.1;
-/// The body: the 2D disc or the 3D sphere.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Body {
-    Disc,
-    Sphere,
-}
-
-impl Body {
-    pub fn name(self) -> &'static str {
-        match self {
-            Body::Disc => "disc",
-            Body::Sphere => "sphere",
-        }
-    }
-
-    /// The vertical axis's letter, for column names.
-    pub fn axis(self) -> char {
-        match self {
-            Body::Disc => 'y',
-            Body::Sphere => 'z',
-        }
-    }
-}
+/// The problem these options run unless told otherwise: the library's bouncing disc.
+pub const DISC: &str = "disc";
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
-    pub body: Body,
+    /// The problem: a library problem by name (`disc`, `sphere`) or a problem file.
+    pub problem: String,
     /// Scheme, contact law, extra forms and params.
-    pub setup: Setup,
+    pub methods: Methods,
     pub mass: MassChoice,
     /// What `h` means in γ = γ0/h.
     pub cell_size: CellSize,
     /// A Gmsh file; the built-in curved disc generator otherwise.
     pub mesh: Option<PathBuf>,
-    /// Mesh size of the built-in generator.
-    pub h: f64,
-    pub dt: f64,
+    /// Mesh size of the built-in generator (none: the problem file's `h`).
+    pub h: Option<f64>,
+    /// The time step, start and end (none: the problem file's `run` line).
+    pub dt: Option<f64>,
     /// Start from the exact free fall at this time (u = −g t²/2, v = −g t, vertically) instead
     /// of rest at t = 0: the first contact at √40 is reached in few steps.
-    pub t_start: f64,
-    pub t_end: f64,
+    pub t_start: Option<f64>,
+    pub t_end: Option<f64>,
     pub newton: NewtonOptions,
     pub out: Option<PathBuf>,
     /// Write a VTU snapshot every this many steps (0: none) into `out`/vtu, with disc.pvd.
@@ -71,24 +53,27 @@ pub struct Options {
     pub resume: bool,
 }
 
+/// The disc with the problem file's mesh size and times, and a run's defaults
+/// ([`crate::problem::run::Options::new`]).
 impl Default for Options {
     fn default() -> Self {
+        let run = crate::problem::run::Options::new(DISC);
         Options {
-            body: Body::Disc,
-            setup: Setup::default(),
-            mass: MassChoice::Consistent,
-            cell_size: CellSize::Diameter,
-            mesh: None,
-            h: 1.0,
-            dt: 0.02,
-            t_start: 0.0,
-            t_end: 20.0,
-            newton: NewtonOptions::default(),
-            out: None,
-            vtu_every: 0,
-            progress: false,
-            checkpoint_every: 0,
-            resume: false,
+            problem: run.problem,
+            methods: run.methods,
+            mass: run.mass,
+            cell_size: run.cell_size,
+            mesh: run.mesh,
+            h: None,
+            dt: run.dt,
+            t_start: run.t_start,
+            t_end: run.t_end,
+            newton: run.newton,
+            out: run.out,
+            vtu_every: run.vtu_every,
+            progress: run.progress,
+            checkpoint_every: run.checkpoint_every,
+            resume: run.resume,
         }
     }
 }
@@ -101,14 +86,17 @@ pub struct Row {
     /// ½vᵀMv (with the mass the scheme uses).
     pub kinetic: f64,
     pub energy_aug: f64,
-    /// Mass-weighted mean of u_y (the centre of mass).
-    pub uy_mean: f64,
-    /// Plain mean of the nodal u_y (GetFEM's benchmark reports this one).
-    pub uy_mean_nodal: f64,
-    /// Mass-weighted mean of v_y: the centre of mass's velocity (NaN for a scheme without `v`).
-    pub vy_mean: f64,
-    pub uy_lowest: f64,
-    pub fy_contact: f64,
+    /// Mass-weighted mean of the vertical displacement (the centre of mass's).
+    pub u_vertical_mean: f64,
+    /// Plain mean of the nodes' vertical displacements (GetFEM's benchmark reports this one).
+    pub u_vertical_mean_nodal: f64,
+    /// Mass-weighted mean of the vertical velocity: the centre of mass's (NaN for a scheme
+    /// without `v`).
+    pub v_vertical_mean: f64,
+    /// The vertical displacement of the lowest node.
+    pub u_vertical_lowest: f64,
+    /// The vertical force of the obstacle on the body.
+    pub f_vertical_contact: f64,
     /// The measure of the contact zone's points where the gap is closed (u_N ≥ g): a length
     /// for the disc, an area for the sphere.
     pub contact_area: f64,
@@ -122,7 +110,8 @@ pub struct Row {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
-    pub case: &'static str,
+    /// The problem's name.
+    pub case: String,
     pub scheme: String,
     /// The contact law (its file stem).
     pub contact: String,
@@ -136,11 +125,14 @@ pub struct Summary {
     pub cells: usize,
     pub dofs: usize,
     pub dt: f64,
+    /// The time reached (the end time, or where the run stopped).
+    pub t_end: f64,
     pub steps: usize,
     /// Time of the first step that ends with an active contact point.
     pub first_contact: Option<f64>,
     pub max_penetration: f64,
-    pub min_uy_mean: f64,
+    /// The lowest the centre of mass went (the smallest `u_vertical_mean`).
+    pub min_u_vertical_mean: f64,
     pub energy_aug_initial: f64,
     pub energy_aug_final: f64,
     /// The largest kinetic energy ½vᵀMv over the run (at impact): the disc's energy scale, as
@@ -200,18 +192,20 @@ pub struct StageRow {
 }
 
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    let mut setup = opts.setup.clone();
+    let mut methods = opts.methods.clone();
     // The problem's mesh-size param, as the user's setting (before theirs: theirs wins).
-    setup.params.insert(0, crate::driver::Setting { name: "h".into(), value: opts.h, origin: "--h".into() });
+    if let Some(h) = opts.h {
+        methods.params.insert(0, crate::driver::Setting { name: "h".into(), value: h, origin: "--h".into() });
+    }
     let problem = crate::problem::run::Options {
-        problem: opts.body.name().to_string(),
-        setup,
+        problem: opts.problem.clone(),
+        methods,
         mass: opts.mass,
         cell_size: opts.cell_size,
         mesh: opts.mesh.clone(),
-        dt: Some(opts.dt),
-        t_start: Some(opts.t_start),
-        t_end: Some(opts.t_end),
+        dt: opts.dt,
+        t_start: opts.t_start,
+        t_end: opts.t_end,
         newton: opts.newton,
         out: opts.out.clone(),
         vtu_every: opts.vtu_every,
@@ -226,7 +220,11 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
 
 /// The problem file's run as the disc's rows and summary (its columns by name).
 fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, CaseError> {
-    let a = opts.body.axis();
+    // The vertical axis: the last one whose mean displacement the file measures (z in 3D, y in
+    // 2D).
+    let a = ['z', 'y', 'x'].into_iter().find(|a| run.columns.iter().any(|c| *c == format!("u{a}_mean"))).unwrap_or('y');
+    let s = &run.summary;
+    let name: String = s.field("case")?;
     let names = [
         "energy".to_string(),
         "kinetic".to_string(),
@@ -241,17 +239,17 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         "penetration".to_string(),
         "newton".to_string(),
     ];
-    let index = run.indices(&names, opts.body.name())?;
+    let index = run.indices(&names, &name)?;
     let row = |t: f64, v: &[f64], switches: Vec<bool>| Row {
         t,
         energy: v[index[0]],
         kinetic: v[index[1]],
         energy_aug: v[index[2]],
-        uy_mean: v[index[3]],
-        uy_mean_nodal: v[index[4]],
-        vy_mean: v[index[5]],
-        uy_lowest: v[index[6]],
-        fy_contact: v[index[7]],
+        u_vertical_mean: v[index[3]],
+        u_vertical_mean_nodal: v[index[4]],
+        v_vertical_mean: v[index[5]],
+        u_vertical_lowest: v[index[6]],
+        f_vertical_contact: v[index[7]],
         contact_area: v[index[8]],
         active_points: v[index[9]] as usize,
         switches,
@@ -261,13 +259,12 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     let series: Vec<Row> = run.rows.iter().zip(&run.switches).map(|((t, v), s)| row(*t, v, s.clone())).collect();
     let stages =
         run.stages.iter().map(|(name, t, v)| StageRow { stage: name.clone(), row: row(*t, v, Vec::new()) }).collect();
-    let s = &run.summary;
     let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
     let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
     let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
-    params.retain(|k, _| !k.starts_with(&format!("{}.", opts.body.name())));
+    params.retain(|k, _| !k.starts_with(&format!("{name}.")));
     let summary = Summary {
-        case: opts.body.name(),
+        case: name,
         scheme: s.field("scheme")?,
         contact: s.field("contact")?,
         interpreted: s.field("interpreted")?,
@@ -278,10 +275,11 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         cells: count("cells"),
         dofs: count("dofs"),
         dt: number("dt"),
+        t_end: number("t_end"),
         steps: count("steps"),
         first_contact: s.number("first_contact"),
         max_penetration: number("max_penetration"),
-        min_uy_mean: number("min_uy_mean"),
+        min_u_vertical_mean: number("min_uy_mean"),
         energy_aug_initial: number("energy_aug_initial"),
         energy_aug_final: number("energy_aug_final"),
         kinetic_energy_max: number("kinetic_energy_max"),

@@ -1,8 +1,8 @@
 //! Case files: `signorini run case.toml` names a problem (`case = "bar"`, `case =
 //! "my_problem.wf"`) and sets the options of `signorini run` as keys, the problem's params as
 //! keys of their own (`ne = 40`), and the params of the scheme and form files in `[params]`
-//! (`alpha = 0.1`, or per file: `[params.elasticity] rho = 2`). Unknown keys, unknown params and
-//! out-of-range values are refused with the line of the key.
+//! (`alpha = 0.1`, or per file: `[params.elasticity] rho = 2`), the only place they go. Unknown
+//! keys, unknown params and out-of-range values are refused with the line of the key.
 
 use std::path::{Path, PathBuf};
 
@@ -10,10 +10,10 @@ use clap::ValueEnum;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::CaseError;
-use crate::driver::{self, Setting, Setup};
+use crate::driver::{self, Methods, Setting};
+use crate::error::CaseError;
 use crate::runtime::fem::mesh::CellSize;
-use crate::simulation::{MAX_STEP_CUTS, MassChoice};
+use crate::simulation::MassChoice;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -25,10 +25,6 @@ struct CaseFile {
     forms: Option<Spanned<Vec<String>>>,
     /// `name = value`, or `[params.OWNER]` tables of them.
     params: Option<std::collections::BTreeMap<String, Spanned<toml::Value>>>,
-    /// Shorthands for `[params]` entries.
-    alpha: Option<Spanned<f64>>,
-    theta: Option<Spanned<f64>>,
-    gamma0: Option<Spanned<f64>>,
     mass: Option<Spanned<String>>,
     /// `diameter` or `getfem`.
     cell_size: Option<Spanned<String>>,
@@ -178,8 +174,8 @@ pub fn parse(text: &str, path: &Path) -> Result<crate::problem::run::Options, Ca
     })?;
     let problem_settings = keys.map(|k| k.settings).unwrap_or_default();
     let r = Reader { file: &file, text };
-    let mass: MassChoice = r.choice(&parsed.mass, "mass", MassChoice::Consistent)?;
-    let setup = setup(&r, &parsed, &base)?;
+    let mass: MassChoice = r.choice(&parsed.mass, "mass", MassChoice::default())?;
+    let methods = methods(&r, &parsed, &base)?;
     let cell_size = match &parsed.cell_size {
         None => CellSize::default(),
         Some(s) => CellSize::parse(s.get_ref()).map_err(|e| r.error(s, "cell_size", e))?,
@@ -194,9 +190,9 @@ pub fn parse(text: &str, path: &Path) -> Result<crate::problem::run::Options, Ca
     let positive = |v: &Option<Spanned<f64>>, key: &str| -> Result<Option<f64>, CaseError> {
         v.as_ref().map(|_| r.number(v, key, |x| x > 0.0, "positive", 0.0)).transpose()
     };
-    let mut setup = setup;
+    let mut methods = methods;
     for (i, s) in problem_settings.into_iter().enumerate() {
-        setup.params.insert(i, s?);
+        methods.params.insert(i, s?);
     }
     let mut opts = crate::problem::run::Options::new(&problem);
     opts.chosen = crate::problem::run::Chosen {
@@ -204,7 +200,7 @@ pub fn parse(text: &str, path: &Path) -> Result<crate::problem::run::Options, Ca
         contact: parsed.contact.is_some(),
         material: parsed.material.is_some(),
     };
-    opts.setup = setup;
+    opts.methods = methods;
     opts.mass = mass;
     opts.cell_size = cell_size;
     opts.mesh = parsed.mesh.as_ref().map(|m| base.join(m.get_ref()));
@@ -230,23 +226,20 @@ fn name_or_path(value: &str, base: &Path) -> String {
 
 /// The scheme, forms and params of a case file, checked against the library (errors at the
 /// key's line).
-fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError> {
-    let d = Setup::default();
-    let mut setup = Setup {
+fn methods(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Methods, CaseError> {
+    let d = Methods::default();
+    let mut methods = Methods {
         scheme: parsed.scheme.as_ref().map_or(d.scheme, |s| name_or_path(s.get_ref(), base)),
         contact: parsed.contact.as_ref().map_or(d.contact, |s| name_or_path(s.get_ref(), base)),
         material: parsed.material.as_ref().map_or(d.material, |s| name_or_path(s.get_ref(), base)),
         forms: parsed.forms.as_ref().map_or_else(Vec::new, |f| f.get_ref().iter().map(|p| base.join(p)).collect()),
         compiled: Vec::new(),
         params: Vec::new(),
-        guard: crate::simulation::Guard {
+        guard: crate::guard::Guard {
             allow_unstable_dt: parsed.allow_unstable_dt.as_ref().map_or(d.guard.allow_unstable_dt, |b| *b.get_ref()),
             max_step_cuts: match &parsed.max_step_cuts {
                 None => d.guard.max_step_cuts,
-                Some(s) if (0..=MAX_STEP_CUTS as i64).contains(s.get_ref()) => *s.get_ref() as usize,
-                Some(s) => {
-                    return Err(r.error(s, "max_step_cuts", format!("{} is not in 0..={MAX_STEP_CUTS}", s.get_ref())));
-                }
+                Some(s) => crate::guard::step_cuts(*s.get_ref()).map_err(|e| r.error(s, "max_step_cuts", e))?,
             },
             energy_tolerance: r.number(
                 &parsed.energy_tolerance,
@@ -258,11 +251,6 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
         },
     };
     let at = |span: std::ops::Range<usize>| format!("{}:{}", r.file, r.line(span.start));
-    for (key, v) in [("alpha", &parsed.alpha), ("theta", &parsed.theta), ("gamma0", &parsed.gamma0)] {
-        if let Some(v) = v {
-            setup.params.push(Setting { name: key.into(), value: *v.get_ref(), origin: at(v.span()) });
-        }
-    }
     let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
     for (name, entry) in parsed.params.iter().flatten() {
         let origin = at(entry.span());
@@ -284,28 +272,28 @@ fn setup(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Setup, CaseError>
                                 .is_some_and(|t| t.trim_start().starts_with('='))
                         })
                         .map_or(origin.clone(), |i| at(span.start + i..span.start + i));
-                    setup.params.push(Setting { name: format!("{name}.{p}"), value, origin: line });
+                    methods.params.push(Setting { name: format!("{name}.{p}"), value, origin: line });
                 }
             }
             v => {
                 let value = number(v).ok_or_else(|| bad(name))?;
-                setup.params.push(Setting { name: name.clone(), value, origin });
+                methods.params.push(Setting { name: name.clone(), value, origin });
             }
         }
     }
     // Resolve now, so that a bad name is reported at its key.
-    driver::scheme(&setup).map_err(|e| match &parsed.scheme {
+    driver::scheme(&methods).map_err(|e| match &parsed.scheme {
         Some(s) => r.error(s, "scheme", e),
         None => e,
     })?;
-    driver::form_units(&setup).map_err(|e| match (&parsed.contact, &parsed.forms, &parsed.material) {
+    driver::form_units(&methods).map_err(|e| match (&parsed.contact, &parsed.forms, &parsed.material) {
         (Some(s), _, _) if e.to_string().contains(s.get_ref().as_str()) => r.error(s, "contact", e),
         (_, Some(f), _) => r.error(f, "forms", e),
         (_, _, Some(m)) => r.error(m, "material", e),
         (Some(s), _, _) => r.error(s, "contact", e),
         _ => e,
     })?;
-    Ok(setup)
+    Ok(methods)
 }
 
 /// Where a case file's outputs go when it names none.

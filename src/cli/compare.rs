@@ -1,6 +1,23 @@
 //! `signorini compare A B`: column by column, how far two runs' `series.csv` are apart.
 
 use std::path::Path;
+use std::process::ExitCode;
+
+use super::fail;
+
+/// Prints the comparison; fails when `tol` is given and a column differs by more.
+pub(super) fn command(a: &Path, b: &Path, tol: Option<f64>) -> ExitCode {
+    match compare(a, b) {
+        Ok((text, worst)) => {
+            print!("{text}");
+            match tol {
+                Some(t) if worst > t => fail(format!("the runs differ by {worst:e} > {t:e}")),
+                _ => ExitCode::SUCCESS,
+            }
+        }
+        Err(e) => fail(e),
+    }
+}
 
 /// A CSV of numbers with a header line.
 fn read(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {

@@ -9,7 +9,7 @@ pub mod sources;
 
 use std::path::{Path, PathBuf};
 
-use crate::cases::CaseError;
+use crate::error::CaseError;
 use crate::forms::LIBRARY;
 use crate::runtime::descriptors::{ParamInfo, SchemeDesc};
 use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
@@ -23,9 +23,11 @@ pub use sources::FormSource;
 /// A form bound to the slot name a scheme applies it by.
 pub type Slot<'m> = (&'static str, Box<dyn BoundForm + 'm>);
 
-/// What a run is made of, as the user chose it (CLI flags or case-file keys).
+/// The methods of a run as the user named them (CLI flags or case-file keys): the scheme, the
+/// contact law, the material and extra form files, by name or path, the param settings, and the
+/// step guard. [`FilesInUse::resolve`] finds the files and gives every param its value.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Setup {
+pub struct Methods {
     /// A scheme of `forms/schemes/` by name, or a .wf file.
     pub scheme: String,
     /// A contact law of `forms/` by name (`nitsche` for `contact_nitsche`), or a .wf file.
@@ -40,13 +42,13 @@ pub struct Setup {
     /// Param values set by the user, in order (a later setting of a param wins).
     pub params: Vec<Setting>,
     /// Step cuts and the energy check.
-    pub guard: crate::simulation::Guard,
+    pub guard: crate::guard::Guard,
 }
 
-impl Default for Setup {
+impl Default for Methods {
     fn default() -> Self {
         let d = &crate::settings::get().defaults;
-        Setup {
+        Methods {
             scheme: d.scheme.clone(),
             contact: d.contact.clone(),
             material: d.material.clone(),
@@ -58,7 +60,7 @@ impl Default for Setup {
     }
 }
 
-impl Setup {
+impl Methods {
     /// Adds a user setting `name = value` (`name` may be qualified: `unit.name`).
     pub fn set(mut self, name: &str, value: f64) -> Self {
         self.params.push(Setting { name: name.into(), value, origin: "options".into() });
@@ -105,25 +107,25 @@ pub fn library() -> &'static [&'static Unit] {
 }
 
 /// The user's compiled units, then the library's.
-fn units(setup: &Setup) -> impl Iterator<Item = &'static Unit> + '_ {
-    setup.compiled.iter().copied().chain(LIBRARY.iter().copied())
+fn units(methods: &Methods) -> impl Iterator<Item = &'static Unit> + '_ {
+    methods.compiled.iter().copied().chain(LIBRARY.iter().copied())
 }
 
 /// A compiled scheme by name (`hht-imex` finds `hht_imex`).
-fn library_scheme(setup: &Setup) -> Option<&'static crate::runtime::library::SchemeUnit> {
-    let name = setup.scheme.replace('-', "_");
-    units(setup).flat_map(|u| u.schemes.iter()).find(|s| s.name == name)
+fn library_scheme(methods: &Methods) -> Option<&'static crate::runtime::library::SchemeUnit> {
+    let name = methods.scheme.replace('-', "_");
+    units(methods).flat_map(|u| u.schemes.iter()).find(|s| s.name == name)
 }
 
 /// A compiled form file by name; `prefix_name` also matches (`nitsche` → `contact_nitsche`).
-fn library_forms(setup: &Setup, name: &str, prefix: &str) -> Option<&'static Unit> {
+fn library_forms(methods: &Methods, name: &str, prefix: &str) -> Option<&'static Unit> {
     let name = name.replace('-', "_");
-    let found = |n: &str| units(setup).find(|u| u.forms.is_some() && u.name == n);
+    let found = |n: &str| units(methods).find(|u| u.forms.is_some() && u.name == n);
     found(&name).or_else(|| found(&format!("{prefix}{name}")))
 }
 
-fn scheme_names(setup: &Setup) -> Vec<&'static str> {
-    units(setup).flat_map(|u| u.schemes.iter()).map(|s| s.name).collect()
+fn scheme_names(methods: &Methods) -> Vec<&'static str> {
+    units(methods).flat_map(|u| u.schemes.iter()).map(|s| s.name).collect()
 }
 
 /// Names of the library's contact laws (the files providing a `contact` slot), short form.
@@ -137,7 +139,7 @@ pub fn contact_names() -> Vec<&'static str> {
 
 /// Every scheme of the library, by name.
 pub fn all_schemes() -> Vec<&'static str> {
-    scheme_names(&Setup::default())
+    scheme_names(&Methods::default())
 }
 
 fn unknown(what: &str, name: &str, known: &[&str]) -> CaseError {
@@ -149,22 +151,22 @@ fn unknown(what: &str, name: &str, known: &[&str]) -> CaseError {
     ))
 }
 
-/// Resolves the scheme of a setup.
-pub fn scheme(setup: &Setup) -> Result<SchemeSource, CaseError> {
-    if is_path(&setup.scheme) {
-        let path = Path::new(&setup.scheme);
+/// Resolves the scheme of a run's methods.
+pub fn scheme(methods: &Methods) -> Result<SchemeSource, CaseError> {
+    if is_path(&methods.scheme) {
+        let path = Path::new(&methods.scheme);
         return interpreted::load(path, None)
             .map(|i| SchemeSource::Interpreted(Box::new(i)))
             .map_err(CaseError::CaseFile);
     }
-    library_scheme(setup)
+    library_scheme(methods)
         .map(SchemeSource::Compiled)
-        .ok_or_else(|| unknown("scheme", &setup.scheme, &scheme_names(setup)))
+        .ok_or_else(|| unknown("scheme", &methods.scheme, &scheme_names(methods)))
 }
 
-/// The form files of a setup (material, contact law, extras; the contact law's index).
-pub fn form_units(setup: &Setup) -> Result<(Vec<FormSource>, usize), CaseError> {
-    let form_files: Vec<&str> = units(setup).filter(|u| u.forms.is_some()).map(|u| u.name).collect();
+/// The form files of a run's methods (material, contact law, extras; the contact law's index).
+pub fn form_units(methods: &Methods) -> Result<(Vec<FormSource>, usize), CaseError> {
+    let form_files: Vec<&str> = units(methods).filter(|u| u.forms.is_some()).map(|u| u.name).collect();
     let pick = |name: &str, prefix: &str, what: &str, known: &[&str]| -> Result<FormSource, CaseError> {
         if is_path(name) {
             let path = Path::new(name);
@@ -173,16 +175,16 @@ pub fn form_units(setup: &Setup) -> Result<(Vec<FormSource>, usize), CaseError> 
             }
             return sources::interpret(path).map(|i| FormSource::Interpreted(Box::new(i))).map_err(CaseError::CaseFile);
         }
-        library_forms(setup, name, prefix).map(FormSource::Compiled).ok_or_else(|| unknown(what, name, known))
+        library_forms(methods, name, prefix).map(FormSource::Compiled).ok_or_else(|| unknown(what, name, known))
     };
-    let mut units = vec![pick(&setup.material, "", "form file", &form_files)?];
-    let contact = pick(&setup.contact, "contact_", "contact law", &contact_names())?;
+    let mut units = vec![pick(&methods.material, "", "form file", &form_files)?];
+    let contact = pick(&methods.contact, "contact_", "contact law", &contact_names())?;
     let mut contact_index = units.len();
     match units.iter().position(|u| u.name() == contact.name() && u.file() == contact.file()) {
         Some(i) => contact_index = i,
         None => units.push(contact),
     }
-    for f in &setup.forms {
+    for f in &methods.forms {
         let u = pick(&f.display().to_string(), "", "form file", &form_files)?;
         if !units.iter().any(|v| v.name() == u.name() && v.file() == u.file()) {
             units.push(u);
@@ -199,16 +201,18 @@ fn library_file(path: &Path) -> Option<&'static Unit> {
     if same { LIBRARY.iter().copied().find(|u| u.name == stem && u.forms.is_some()) } else { None }
 }
 
-/// A run's scheme and form files with the value of every param.
-pub struct Active {
+/// The files in use of a run: its scheme and form files, found (compiled, or read and
+/// interpreted), with the value of every param; and its step guard.
+pub struct FilesInUse {
     pub scheme: SchemeSource,
     /// The form files and every param's value (the scheme's included).
-    pub forms: ActiveForms,
-    pub guard: crate::simulation::Guard,
+    pub forms: FormsInUse,
+    pub guard: crate::guard::Guard,
 }
 
-/// The form files of a run, with the value of every param.
-pub struct ActiveForms {
+/// The form files in use of a run (material, contact law, extras), with the value of every
+/// param (the scheme's included).
+pub struct FormsInUse {
     /// Material, contact law, extra forms.
     pub units: Vec<FormSource>,
     /// Index of the contact law in `units`.
@@ -216,25 +220,25 @@ pub struct ActiveForms {
     pub params: params::Table,
 }
 
-impl Active {
-    /// Resolves a setup: files, then params (file defaults < `overrides` of the case < the
+impl FilesInUse {
+    /// Resolves a run's methods: files, then params (file defaults < `overrides` of the case < the
     /// user's settings).
-    pub fn resolve(setup: &Setup, overrides: &[(&str, f64)]) -> Result<Active, CaseError> {
-        let scheme = scheme(setup)?;
-        let (units, contact) = form_units(setup)?;
+    pub fn resolve(methods: &Methods, overrides: &[(&str, f64)]) -> Result<FilesInUse, CaseError> {
+        let scheme = scheme(methods)?;
+        let (units, contact) = form_units(methods)?;
         let mut table = params::Table::new(Some(&scheme), &units);
         table.apply_case(overrides)?;
-        table.apply_user(&setup.params)?;
-        Ok(Active { scheme, forms: ActiveForms { units, contact, params: table }, guard: setup.guard })
+        table.apply_user(&methods.params)?;
+        Ok(FilesInUse { scheme, forms: FormsInUse { units, contact, params: table }, guard: methods.guard })
     }
 
-    /// The form files of a setup and their params, without a scheme.
-    pub fn resolve_forms(setup: &Setup, overrides: &[(&str, f64)]) -> Result<ActiveForms, CaseError> {
-        let (units, contact) = form_units(setup)?;
+    /// The form files of a run's methods and their params, without a scheme.
+    pub fn resolve_forms(methods: &Methods, overrides: &[(&str, f64)]) -> Result<FormsInUse, CaseError> {
+        let (units, contact) = form_units(methods)?;
         let mut table = params::Table::new(None, &units);
         table.apply_case(overrides)?;
-        table.apply_user(&setup.params)?;
-        Ok(ActiveForms { units, contact, params: table })
+        table.apply_user(&methods.params)?;
+        Ok(FormsInUse { units, contact, params: table })
     }
 
     /// The scheme with its param values.
@@ -310,7 +314,7 @@ impl Active {
         self.scheme_forms_with(inst, Vec::new())
     }
 
-    /// As [`Active::scheme_forms`], with some slots bound to the given forms instead.
+    /// As [`FilesInUse::scheme_forms`], with some slots bound to the given forms instead.
     pub fn scheme_forms_with<'m>(
         &self,
         inst: &mut Instance<'m>,
@@ -361,7 +365,7 @@ impl Active {
     }
 }
 
-impl ActiveForms {
+impl FormsInUse {
     /// The contact law's name (its file stem).
     pub fn contact_name(&self) -> &'static str {
         self.units[self.contact].name()

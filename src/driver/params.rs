@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::{FormSource, SchemeSource};
-use crate::cases::CaseError;
+use crate::error::CaseError;
 use crate::runtime::descriptors::ParamInfo;
 
 /// A user's `name = value`, with where it was written (for errors).
@@ -39,6 +39,20 @@ pub struct ParamValue {
     pub source: Source,
     /// `file.wf:line`.
     pub declared: String,
+}
+
+/// The params of `params` that file `stem`.wf declares (a contact law's, say), by their names
+/// in the file, with their values.
+pub fn declared_by(params: &BTreeMap<String, ParamValue>, stem: &str) -> Vec<(String, f64)> {
+    let file = format!("{stem}.wf");
+    params
+        .iter()
+        .filter(|(_, p)| {
+            let declared = p.declared.rsplit_once(':').map_or(p.declared.as_str(), |(f, _)| f);
+            std::path::Path::new(declared).file_name().is_some_and(|f| f.to_string_lossy() == file)
+        })
+        .map(|(name, p)| (name.rsplit('.').next().unwrap_or(name).to_string(), p.value))
+        .collect()
 }
 
 struct Entry {

@@ -6,10 +6,11 @@ use std::path::Path;
 
 use super::ProblemFile;
 use super::expr::{At, Exprs, PointFn};
-use crate::cases::CaseError;
 use crate::compiler::Diagnostic;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, MeshSource, NamedCall, RegionSource};
+use crate::driver::FilesInUse;
+use crate::error::CaseError;
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::fem::mesh::{CellSize, Mesh};
 
@@ -42,13 +43,22 @@ pub fn dimension(pf: &ProblemFile, mesh_file: Option<&Path>, params: &[(String, 
 }
 
 fn read(path: &Path) -> Result<Mesh, CaseError> {
-    Ok(crate::cases::read_mesh(path)?)
+    Ok(read_mesh(path)?)
+}
+
+/// Reads a Gmsh file, showing on stderr what the reader skipped (also logged as a warning).
+fn read_mesh(path: &Path) -> Result<Mesh, crate::runtime::fem::mesh::MeshError> {
+    let mesh = crate::runtime::fem::mesh::gmsh::read(path)?;
+    for w in &mesh.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(mesh)
 }
 
 /// The problem's own mesh file, its errors located at the `mesh` line.
 fn read_own(pf: &ProblemFile, path: &str, span: crate::compiler::Span) -> Result<Mesh, CaseError> {
     let full = pf.dir.join(path);
-    crate::cases::read_mesh(&full).map_err(|e| {
+    read_mesh(&full).map_err(|e| {
         pf.render(Diagnostic::error("E0101", format!("cannot read the mesh {}", full.display()), span, e.to_string()))
     })
 }
@@ -495,4 +505,78 @@ pub fn contact_free(pf: &ProblemFile) -> bool {
 
 pub fn coef_lookup(coefs: &[(String, PointFn)]) -> impl Fn(&str) -> Option<Coef> + '_ {
     move |name| coefs.iter().find(|(n, _)| n == name).map(|(_, f)| f.clone().coef())
+}
+
+/// Every coef the files in use read must be set by the problem (a `coef` line, or an
+/// obstacle's `g` and `nc`): a located error before anything runs. A coef the problem sets that
+/// no file reads is a warning (a misspelt name, or a file left out).
+pub fn unset_coefs(pf: &ProblemFile, in_use: &FilesInUse) -> Result<(), CaseError> {
+    use crate::compiler::Diagnostic;
+    let p = pf.problem();
+    let read: Vec<String> = in_use.forms.units.iter().flat_map(|u| u.coefs()).map(|(n, _)| n).collect();
+    for c in &p.coefs {
+        if !read.contains(&c.name.name) {
+            let files: Vec<&str> = in_use.forms.units.iter().map(|u| u.file()).collect();
+            let w = crate::compiler::check::problem::unread_coef(&c.name, &files);
+            eprintln!("{}", crate::compiler::render_all(&[w], &pf.program.unit.sources).trim_end());
+        }
+    }
+    let mut set: Vec<&str> = p.coefs.iter().map(|c| c.name.name.as_str()).collect();
+    if !p.obstacles.is_empty() {
+        set.extend(["g", "nc"]);
+    }
+    let free = contact_free(pf);
+    for (i, unit) in in_use.forms.units.iter().enumerate() {
+        if free && i == in_use.forms.contact {
+            continue; // integrates over no facet: its coefs are zero
+        }
+        for (c, _) in unit.coefs() {
+            if !set.contains(&c.as_str()) {
+                let mut d = Diagnostic::error(
+                    "E0101",
+                    format!("problem `{}` does not set coef `{c}`, which {} reads", pf.name(), unit.file()),
+                    p.name.span,
+                    "no `coef` line for it",
+                )
+                .with_help(format!("add `coef {c} = EXPR` (an expression of x and t) to the problem"));
+                if let Some(close) = crate::compiler::check::suggest_name(&c, set.iter().copied()) {
+                    d = d.with_note(format!("the problem sets `{close}`: a misspelling?"));
+                }
+                return Err(pf.render(d));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Each coef the problem sets has the components the files in use read it with.
+pub fn coef_shapes(
+    pf: &ProblemFile,
+    in_use: &FilesInUse,
+    coefs: &[(String, PointFn)],
+    d: usize,
+) -> Result<(), CaseError> {
+    use crate::compiler::Diagnostic;
+    for unit in &in_use.forms.units {
+        for (name, rank) in unit.coefs() {
+            let Some((_, f)) = coefs.iter().find(|(n, _)| *n == name) else { continue };
+            let need = d.pow(rank);
+            if f.len() != need {
+                let at = pf
+                    .problem()
+                    .coefs
+                    .iter()
+                    .find(|c| c.name.name == name)
+                    .map_or(pf.problem().name.span, |c| c.value.span);
+                let shape = ["a scalar", "a vector", "a tensor"][rank.min(2) as usize];
+                return Err(pf.render(Diagnostic::error(
+                    "E0301",
+                    "shape mismatch",
+                    at,
+                    format!("{} reads `{name}` as {shape} ({need} components in {d}D), not {}", unit.file(), f.len()),
+                )));
+            }
+        }
+    }
+    Ok(())
 }

@@ -1,20 +1,29 @@
 //! Problems posed in `.wf` files (`problem NAME(...) { ... }`): the library's, in
 //! `forms/problems/`, found by name, or a user's file by path. This module loads and checks
 //! the file and resolves its params; [`expr`] evaluates its expressions, [`bind`] builds the
-//! mesh, regions, coefs and initial fields, [`observe`] measures the rows and summaries, and
-//! [`run`] is the one loop that runs every problem.
+//! mesh, regions, coefs and initial fields (and checks the coefs against the files in use),
+//! [`dirichlet`] its held displacements, [`reference`] the analytic reference it names;
+//! [`observe`] measures its series columns at every row and [`summary`] its summary keys over
+//! the rows; [`run`] is the one loop that runs every problem, with [`options`] the choices over
+//! the problem's own, [`outputs`] what a run writes and [`resume`] what its checkpoints keep.
 
 pub mod bind;
+mod dirichlet;
 pub mod expr;
 pub mod observe;
+pub mod options;
+pub mod outputs;
+mod reference;
+mod resume;
 pub mod run;
+pub mod summary;
 
 use std::path::{Path, PathBuf};
 
-use crate::cases::CaseError;
 use crate::compiler::Program;
 use crate::compiler::syntax::ast;
 use crate::driver::Setting;
+use crate::error::CaseError;
 
 /// A checked problem file.
 pub struct ProblemFile {

@@ -6,16 +6,16 @@
 
 use super::ProblemFile;
 use super::expr::{At, Exprs, PointFn};
-use crate::cases::CaseError;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
-use crate::driver::ActiveForms;
+use crate::driver::FormsInUse;
+use crate::error::CaseError;
 use crate::runtime::fem::assembly::Assembler;
 use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
 use crate::runtime::fem::evaluate::{FacetSample, facet_samples};
 use crate::runtime::fem::mesh::Facet;
 use crate::runtime::library::Binding;
-use crate::simulation::{AxisMean, Tools, resultant};
+use crate::simulation::{AxisMean, Operators, resultant};
 
 /// One measured value of a row.
 enum Measure {
@@ -123,7 +123,7 @@ struct Reuse {
 }
 
 /// The placeholder name of measured value `id` in a rewritten expression.
-fn placeholder(id: usize) -> String {
+pub(super) fn placeholder(id: usize) -> String {
     format!("#{id}")
 }
 
@@ -132,8 +132,8 @@ impl<'m> Observer<'m> {
     pub fn new(
         pf: &ProblemFile,
         ex: &mut Exprs,
-        tools: &Tools<'m>,
-        forms: &ActiveForms,
+        ops: &Operators<'m>,
+        forms: &FormsInUse,
         coefs: &dyn Fn(&str) -> Option<crate::runtime::fem::kernel::Coef>,
         binding: &Binding<'m>,
         coef_vals: &[(String, Val)],
@@ -163,7 +163,7 @@ impl<'m> Observer<'m> {
         for (d, written) in &p.series {
             let mut leaves: Vec<(usize, usize)> = Vec::new();
             let rewritten =
-                o.rewrite(pf, ex, tools, &mut inst, &d.value, &mut leaves, &pointwise, &mut region_names, binding)?;
+                o.rewrite(pf, ex, ops, &mut inst, &d.value, &mut leaves, &pointwise, &mut region_names, binding)?;
             let scope: Vec<(String, Val)> =
                 leaves.iter().map(|&(id, comps)| (placeholder(id), ex.measured(id, comps))).collect();
             let val = ex.lower(&rewritten, &scope).map_err(|e| pf.render(*e))?;
@@ -189,7 +189,7 @@ impl<'m> Observer<'m> {
         &mut self,
         pf: &ProblemFile,
         ex: &mut Exprs,
-        tools: &Tools<'m>,
+        ops: &Operators<'m>,
         inst: &mut crate::driver::Instance<'m>,
         e: &Expr,
         leaves: &mut Vec<(usize, usize)>,
@@ -197,7 +197,7 @@ impl<'m> Observer<'m> {
         region_names: &mut Vec<String>,
         binding: &Binding<'m>,
     ) -> Result<Expr, CaseError> {
-        let d = tools.asm.mesh().dim();
+        let d = ops.asm.mesh().dim();
         let mut add = |o: &mut Self, m: Measure, comps: usize, span| {
             o.measures.push(m);
             let id = o.measures.len() - 1;
@@ -237,22 +237,22 @@ impl<'m> Observer<'m> {
                 }
             }
             ExprKind::Neg(a) => {
-                let a = self.rewrite(pf, ex, tools, inst, a, leaves, pointwise, region_names, binding)?;
+                let a = self.rewrite(pf, ex, ops, inst, a, leaves, pointwise, region_names, binding)?;
                 Expr { kind: ExprKind::Neg(Box::new(a)), span: e.span }
             }
             ExprKind::Binary(op, a, b) => {
-                let a = self.rewrite(pf, ex, tools, inst, a, leaves, pointwise, region_names, binding)?;
-                let b = self.rewrite(pf, ex, tools, inst, b, leaves, pointwise, region_names, binding)?;
+                let a = self.rewrite(pf, ex, ops, inst, a, leaves, pointwise, region_names, binding)?;
+                let b = self.rewrite(pf, ex, ops, inst, b, leaves, pointwise, region_names, binding)?;
                 Expr { kind: ExprKind::Binary(*op, Box::new(a), Box::new(b)), span: e.span }
             }
             ExprKind::Index(a, k) => {
-                let a = self.rewrite(pf, ex, tools, inst, a, leaves, pointwise, region_names, binding)?;
+                let a = self.rewrite(pf, ex, ops, inst, a, leaves, pointwise, region_names, binding)?;
                 Expr { kind: ExprKind::Index(Box::new(a), k.clone()), span: e.span }
             }
             ExprKind::Vector(_) => unreachable!("checked: no vector in a column"),
             ExprKind::Call(f, args) => match f.name.as_str() {
                 name if crate::compiler::check::problem::SUMMARY_FUNCTIONS.contains(&name) => {
-                    let a = self.rewrite(pf, ex, tools, inst, &args[0], leaves, pointwise, region_names, binding)?;
+                    let a = self.rewrite(pf, ex, ops, inst, &args[0], leaves, pointwise, region_names, binding)?;
                     Expr { kind: ExprKind::Call(f.clone(), vec![a]), span: e.span }
                 }
                 "mean" | "nodal_mean" | "at_min" => {
@@ -261,12 +261,12 @@ impl<'m> Observer<'m> {
                         return Err(bad_axis(&args[0], axis));
                     }
                     let m = match f.name.as_str() {
-                        "mean" => Measure::Mean { field, weights: tools.axis_mean(axis) },
+                        "mean" => Measure::Mean { field, weights: ops.axis_mean(axis) },
                         "nodal_mean" => Measure::NodalMean { field, axis },
                         _ => {
                             let val = ex.lower(&args[1], &[]).map_err(|e| pf.render(*e))?;
                             let key = ex.function(&val, &args[1]).map_err(|e| pf.render(*e))?;
-                            let mesh = tools.asm.mesh();
+                            let mesh = ops.asm.mesh();
                             let (mut scratch, mut out) = (Vec::new(), [0.0]);
                             let mut at = |i: usize| {
                                 key.eval(&At { x: mesh.node(i), ..At::default() }, &mut scratch, &mut out);
@@ -276,7 +276,7 @@ impl<'m> Observer<'m> {
                             let node = (0..mesh.num_nodes())
                                 .min_by(|&a, &b| values[a].total_cmp(&values[b]))
                                 .ok_or_else(|| CaseError::Option("the mesh has no node".into()))?;
-                            let massless = tools.redistributed && tools.contact_nodes.contains(&(node as u32));
+                            let massless = ops.redistributed && ops.contact_nodes.contains(&(node as u32));
                             Measure::AtMin { field, axis, node, massless }
                         }
                     };
@@ -302,7 +302,7 @@ impl<'m> Observer<'m> {
                     // Over a region: the dofs of its nodes, component by component.
                     let dofs = match args.get(1).map(|a| &a.kind) {
                         Some(ExprKind::Name(region)) => {
-                            let mesh = tools.asm.mesh();
+                            let mesh = ops.asm.mesh();
                             let nodes = mesh.region_nodes(mesh.region(&region.name)?);
                             Some(nodes.iter().flat_map(|&n| (0..d).map(move |k| n as usize * d + k)).collect())
                         }
@@ -338,8 +338,8 @@ impl<'m> Observer<'m> {
                     };
                     // Its integrand must live on facets: a cell functional has none to read.
                     let rule = crate::runtime::fem::quadrature::sampling_rule(d - 1, 1);
-                    let zero = vec![0.0; tools.asm.size()];
-                    if self.functionals[index].1.facet_point_values(tools.asm, &rule, &[&zero], 0.0).is_empty() {
+                    let zero = vec![0.0; ops.asm.size()];
+                    if self.functionals[index].1.facet_point_values(ops.asm, &rule, &[&zero], 0.0).is_empty() {
                         return Err(pf.render(crate::compiler::Diagnostic::error(
                             "E0301",
                             format!("`{}` integrates over no boundary facet", name.name),
@@ -441,17 +441,17 @@ impl<'m> Observer<'m> {
     }
 
     /// The reference's figures of a state into `dir`, if the problem names one.
-    pub fn write_reference(&self, dir: &std::path::Path, tools: &Tools, u: &[f64], t: f64) -> std::io::Result<()> {
+    pub fn write_reference(&self, dir: &std::path::Path, ops: &Operators, u: &[f64], t: f64) -> std::io::Result<()> {
         match &self.reference {
-            Some((_, r)) => r.write(dir, &reference_at(tools, u, t)),
+            Some((_, r)) => r.write(dir, &reference_at(ops, u, t)),
             None => Ok(()),
         }
     }
 
     /// The row at a state: one value per column, and the `contact` slot's switch at each of
     /// its quadrature points (the active set; empty without the slot).
-    pub fn row(&self, tools: &Tools, s: &State) -> (Vec<f64>, Vec<bool>) {
-        let asm: &Assembler = tools.asm;
+    pub fn row(&self, ops: &Operators, s: &State) -> (Vec<f64>, Vec<bool>) {
+        let asm: &Assembler = ops.asm;
         let mesh = asm.mesh();
         let d = mesh.dim();
         let n = asm.size();
@@ -478,9 +478,9 @@ impl<'m> Observer<'m> {
             let (before, dt) = s.before?;
             Some((before.iter().zip(s.u).map(|(a, b)| 0.5 * (a + b)).collect(), s.t - 0.5 * dt))
         };
-        if tools.probe.is_some() {
+        if ops.probe.is_some() {
             // The run's contact slot (the energy guard asked the same step's already).
-            switches = tools.contact_switches(s.u, s.t);
+            switches = ops.contact_switches(s.u, s.t);
         } else if let Some((_, probe)) = self.slots.iter().find(|(n, _)| n == "contact") {
             probe.switches(asm, &[s.u], 0, s.t, &mut switches);
         }
@@ -507,10 +507,10 @@ impl<'m> Observer<'m> {
                 let value: Vec<f64> = match &self.measures[next] {
                     Measure::Time => one(s.t),
                     Measure::Energy => {
-                        let k = *kinetic.get_or_insert_with(|| tools.kinetic(s.v));
-                        one(tools.energy_with_kinetic(s.u, k))
+                        let k = *kinetic.get_or_insert_with(|| ops.kinetic(s.v));
+                        one(ops.energy_with_kinetic(s.u, k))
                     }
-                    Measure::Kinetic => one(*kinetic.get_or_insert_with(|| tools.kinetic(s.v))),
+                    Measure::Kinetic => one(*kinetic.get_or_insert_with(|| ops.kinetic(s.v))),
                     Measure::Newton => one(s.newton as f64),
                     Measure::ActivePoints => one(switches.iter().filter(|b| **b).count() as f64),
                     Measure::Column(i) => one(columns[*i]),
@@ -595,12 +595,12 @@ impl<'m> Observer<'m> {
                     Measure::Reference { which, mid: false } => one(self
                         .reference
                         .as_ref()
-                        .map_or(f64::NAN, |(_, r)| r.value(*which, &reference_at(tools, s.u, s.t)))),
+                        .map_or(f64::NAN, |(_, r)| r.value(*which, &reference_at(ops, s.u, s.t)))),
                     Measure::Reference { which, mid: true } => one(mid
                         .get_or_insert_with(&mut midpoint)
                         .as_ref()
                         .zip(self.reference.as_ref().map(|(_, r)| r))
-                        .map_or(f64::NAN, |((u, t), r)| r.value(*which, &reference_at(tools, u, *t)))),
+                        .map_or(f64::NAN, |((u, t), r)| r.value(*which, &reference_at(ops, u, *t)))),
                     Measure::Density { index, min } => {
                         let rule = crate::runtime::fem::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
                         let points = self.functionals[*index].1.facet_point_values(asm, &rule, &[s.u], s.t);
@@ -621,7 +621,7 @@ impl<'m> Observer<'m> {
                             out
                         };
                         let (a, b) = (nodal(a, &mut *scratch), nodal(b, &mut *scratch));
-                        one(Tools::quad(&tools.scheme_mass, &a, &b))
+                        one(Operators::quad(&ops.scheme_mass, &a, &b))
                     }
                 };
                 measured.push(value);
@@ -641,232 +641,7 @@ impl<'m> Observer<'m> {
     }
 }
 
-/// A summary reducer over the rows.
-#[derive(Clone, Copy)]
-enum Reduce {
-    Initial,
-    Final,
-    Min,
-    Max,
-    Sum,
-    /// The first argument at the first row where the second is positive.
-    First,
-    /// The first argument at the first row where the second is largest (NaN rows left out).
-    AtMax,
-}
-
-/// A reducer's argument: a column as it is (`None`: the row's time), or an expression of the
-/// row (its columns, `t` and the keys before).
-enum Arg {
-    Column(Option<usize>),
-    Expr(PointFn),
-}
-
-/// One summary key: its reducers and its expression of their values and the keys before it.
-struct Key {
-    name: String,
-    reduces: Vec<(Reduce, Vec<Arg>)>,
-    f: PointFn,
-}
-
-/// The problem's summary keys, compiled.
-pub struct SummaryKeys {
-    keys: Vec<Key>,
-    columns: usize,
-    /// The names the reducers' expression arguments read (not plain columns).
-    read_by_expressions: Vec<String>,
-}
-
-impl SummaryKeys {
-    /// `columns`: every column's name, in row order.
-    pub fn new(pf: &ProblemFile, ex: &mut Exprs, columns: &[String]) -> Result<SummaryKeys, CaseError> {
-        let mut keys: Vec<Key> = Vec::new();
-        let mut read_by_expressions = Vec::new();
-        // In a reducer's argument: column i is measured value i, key j is measured value
-        // columns + j.
-        let mut row_scope: Vec<(String, Val)> =
-            columns.iter().enumerate().map(|(i, c)| (c.clone(), ex.measured(i, 1))).collect();
-        for d in &pf.problem().summary {
-            let mut calls = Vec::new();
-            let rewritten = summary_rewrite(&d.value, &mut calls);
-            let mut reduces = Vec::new();
-            for (r, args) in calls {
-                let mut compiled = Vec::new();
-                for a in &args {
-                    compiled.push(match &a.kind {
-                        ExprKind::Name(n) if n.name == "t" => Arg::Column(None),
-                        ExprKind::Name(n) if columns.contains(&n.name) => {
-                            Arg::Column(columns.iter().position(|c| *c == n.name))
-                        }
-                        _ => {
-                            names_in(a, &mut read_by_expressions);
-                            let val = ex.lower(a, &row_scope).map_err(|e| pf.render(*e))?;
-                            Arg::Expr(ex.function(&val, a).map_err(|e| pf.render(*e))?)
-                        }
-                    });
-                }
-                reduces.push((r, compiled));
-            }
-            // Reducer i is measured value i; key j is measured value reducers + j.
-            let mut scope: Vec<(String, Val)> =
-                (0..reduces.len()).map(|i| (placeholder(i), ex.measured(i, 1))).collect();
-            for (j, k) in keys.iter().enumerate() {
-                scope.push((k.name.clone(), ex.measured(reduces.len() + j, 1)));
-            }
-            let val = ex.lower(&rewritten, &scope).map_err(|e| pf.render(*e))?;
-            let f = ex.function(&val, &d.value).map_err(|e| pf.render(*e))?;
-            row_scope.push((d.name.name.clone(), ex.measured(columns.len() + keys.len(), 1)));
-            keys.push(Key { name: d.name.name.clone(), reduces, f });
-        }
-        Ok(SummaryKeys { keys, columns: columns.len(), read_by_expressions })
-    }
-
-    /// The (column, of) pairs of `at_max(column, of)` whose column no other reducer reads: the
-    /// column is needed only at the rows where `of` reaches a new maximum ([`Observer::defer`]).
-    pub fn at_max_columns(&self, names: &[String]) -> Vec<(usize, usize)> {
-        let reads = |c: usize, except: Option<(usize, usize)>| {
-            self.read_by_expressions.contains(&names[c])
-                || self.keys.iter().flat_map(|k| &k.reduces).any(|(r, args)| {
-                    let pair = match (r, &args[..]) {
-                        (Reduce::AtMax, [Arg::Column(Some(e)), Arg::Column(Some(w))]) => Some((*e, *w)),
-                        _ => None,
-                    };
-                    pair != except && args.iter().any(|a| matches!(a, Arg::Column(Some(i)) if *i == c))
-                })
-        };
-        let mut out = Vec::new();
-        for (r, args) in self.keys.iter().flat_map(|k| &k.reduces) {
-            if let (Reduce::AtMax, [Arg::Column(Some(e)), Arg::Column(Some(w))]) = (r, &args[..])
-                && !reads(*e, Some((*e, *w)))
-                && !out.contains(&(*e, *w))
-            {
-                out.push((*e, *w));
-            }
-        }
-        out
-    }
-
-    /// The keys and their values over `rows` (time, values); null where a reducer has none.
-    pub fn values(&self, rows: &[(f64, Vec<f64>)]) -> Vec<(String, Option<f64>)> {
-        let mut out: Vec<(String, Option<f64>)> = Vec::new();
-        // A row as measured values: its columns, then the keys so far.
-        let mut at_row: Vec<Vec<f64>> = vec![vec![0.0]; self.columns + self.keys.len()];
-        let mut scratch = Vec::new();
-        for key in &self.keys {
-            for (j, (_, v)) in out.iter().enumerate() {
-                at_row[self.columns + j][0] = v.unwrap_or(f64::NAN);
-            }
-            let mut arg = |a: &Arg, r: &(f64, Vec<f64>)| -> f64 {
-                match a {
-                    Arg::Column(c) => c.map_or(r.0, |i| r.1[i]),
-                    Arg::Expr(f) => {
-                        for (slot, v) in at_row.iter_mut().zip(&r.1) {
-                            slot[0] = *v;
-                        }
-                        let mut o = [0.0];
-                        f.eval(&At { t: r.0, measured: &at_row, ..At::default() }, &mut scratch, &mut o);
-                        o[0]
-                    }
-                }
-            };
-            let measured: Option<Vec<Vec<f64>>> = key
-                .reduces
-                .iter()
-                .map(|(r, args)| {
-                    let a = &args[0];
-                    Some(vec![match r {
-                        Reduce::Initial => arg(a, rows.first()?),
-                        Reduce::Final => arg(a, rows.last()?),
-                        Reduce::Min => rows.iter().map(|row| arg(a, row)).fold(f64::INFINITY, f64::min),
-                        Reduce::Max => rows.iter().map(|row| arg(a, row)).fold(f64::NEG_INFINITY, f64::max),
-                        Reduce::Sum => {
-                            rows.iter().map(|row| arg(a, row)).filter(|v| !v.is_nan()).fold(0.0, |s, v| s + v)
-                        }
-                        Reduce::First => {
-                            let row = rows.iter().find(|row| arg(&args[1], row) > 0.0)?;
-                            arg(a, row)
-                        }
-                        Reduce::AtMax => {
-                            let mut best: Option<(f64, &(f64, Vec<f64>))> = None;
-                            for row in rows {
-                                let w = arg(&args[1], row);
-                                if !w.is_nan() && best.is_none_or(|(b, _)| w > b) {
-                                    best = Some((w, row));
-                                }
-                            }
-                            arg(a, best?.1)
-                        }
-                    }])
-                })
-                .collect();
-            let value = measured.map(|mut m| {
-                m.extend(out.iter().map(|(_, v)| vec![v.unwrap_or(f64::NAN)]));
-                let mut o = [0.0];
-                key.f.eval(&At { measured: &m, ..At::default() }, &mut scratch, &mut o);
-                o[0]
-            });
-            out.push((key.name.clone(), value));
-        }
-        out
-    }
-}
-
-/// `e` with each reducer call replaced by a placeholder; the calls are collected.
-fn summary_rewrite(e: &Expr, calls: &mut Vec<(Reduce, Vec<Expr>)>) -> Expr {
-    let kind = match &e.kind {
-        ExprKind::Call(f, args) => {
-            let r = match f.name.as_str() {
-                "initial" => Reduce::Initial,
-                "final" => Reduce::Final,
-                "min" => Reduce::Min,
-                "max" => Reduce::Max,
-                "sum" => Reduce::Sum,
-                "first" => Reduce::First,
-                "at_max" => Reduce::AtMax,
-                // A function of a number (`sqrt`): kept, its argument rewritten.
-                _ => {
-                    let args = args.iter().map(|a| summary_rewrite(a, calls)).collect();
-                    return Expr { kind: ExprKind::Call(f.clone(), args), span: e.span };
-                }
-            };
-            calls.push((r, args.clone()));
-            ExprKind::Name(Ident { name: placeholder(calls.len() - 1), span: e.span })
-        }
-        ExprKind::Neg(a) => ExprKind::Neg(Box::new(summary_rewrite(a, calls))),
-        ExprKind::Binary(op, a, b) => {
-            ExprKind::Binary(*op, Box::new(summary_rewrite(a, calls)), Box::new(summary_rewrite(b, calls)))
-        }
-        other => other.clone(),
-    };
-    Expr { kind, span: e.span }
-}
-
-/// Every name an expression reads.
-fn names_in(e: &Expr, out: &mut Vec<String>) {
-    match &e.kind {
-        ExprKind::Name(n) => out.push(n.name.clone()),
-        ExprKind::Neg(a) => names_in(a, out),
-        ExprKind::Binary(_, a, b) => {
-            names_in(a, out);
-            names_in(b, out);
-        }
-        ExprKind::Call(_, args) => args.iter().for_each(|a| names_in(a, out)),
-        ExprKind::Vector(items) => items.iter().for_each(|a| names_in(a, out)),
-        ExprKind::Index(a, i) => {
-            names_in(a, out);
-            names_in(i, out);
-        }
-        _ => {}
-    }
-}
-
 /// A state as a reference measures it.
-fn reference_at<'a>(tools: &'a Tools<'_>, u: &'a [f64], t: f64) -> crate::references::At<'a> {
-    crate::references::At {
-        asm: tools.asm,
-        mass: &tools.scheme_mass,
-        pressure: tools.contact_pressure.as_deref(),
-        u,
-        t,
-    }
+fn reference_at<'a>(ops: &'a Operators<'_>, u: &'a [f64], t: f64) -> crate::references::At<'a> {
+    crate::references::At { asm: ops.asm, mass: &ops.scheme_mass, pressure: ops.contact_pressure.as_deref(), u, t }
 }

@@ -4,29 +4,31 @@
 //! Newton iterations per scheme), `signorini verify`, the Δt sweeps of both cases, the Hertz
 //! cases, and the last `bench sphere` run.
 
+use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
 use std::time::Instant;
 
 use crate::cases::bar;
-use crate::cases::{CaseError, disc};
-use crate::driver::Setup;
+use crate::cases::disc;
+use crate::driver::{Methods, ParamValue};
+use crate::error::CaseError;
 use crate::plot::Curve;
 use crate::simulation::MassChoice;
 
 mod hertz;
 pub mod sweep;
 
-/// Runs `run` with `setup`; a run the energy guard stops (IMEX-HHT: explicit contact is only
+/// Runs `run` with `methods`; a run the energy guard stops (IMEX-HHT: explicit contact is only
 /// conditionally stable) runs again with the guard off, so that the report shows how its
 /// energy grows, and the note says where the guard stopped it.
 fn past_the_guard<R>(
-    setup: Setup,
-    run: impl Fn(Setup) -> Result<R, CaseError>,
+    methods: Methods,
+    run: impl Fn(Methods) -> Result<R, CaseError>,
 ) -> Result<(R, Option<String>), CaseError> {
-    match run(setup.clone()) {
+    match run(methods.clone()) {
         Err(CaseError::BlowUp { t, energy, bound, scale, .. }) => {
-            let mut off = setup;
+            let mut off = methods;
             off.guard.energy_tolerance = 0.0;
             let note = format!(
                 "the energy guard stops it at t = {t:.2}, E_aug {:+.1} % of the energy scale; shown without the guard",
@@ -49,8 +51,6 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     );
 
     // 1. The bar.
-    md.push_str("## 1. Compressed bar (docs/mathematics.md §6)\n\nN = 20 elements, Δt = 0.01, T = 12, γ0 = 5 (θ = 1 for Nitsche). `err_u` = max‖u_h − I_h u‖/max‖I_h u‖ (mass norm), `err_λ` = relative ℓ² error of the contact stress at tⁿ, `err_λ½` the same at t^{n+½} from (uⁿ + uⁿ⁺¹)/2 (where midpoint and hybrid impose contact).\n\n");
-    md.push_str("| run | err_u | err_λ | err_λ½ | E_Θ(0) | E_Θ(12) | max penetration | Newton (max/step) |\n|---|---|---|---|---|---|---|---|\n");
     // The talk's comparisons (forms/library.toml).
     let runs: Vec<(&str, &str, MassChoice)> = crate::settings::get()
         .report
@@ -62,70 +62,99 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
             (s.as_str(), c.as_str(), mass)
         })
         .collect();
+    let mut table = String::new();
     let mut energies: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     let mut figures = String::new();
+    let mut laws = Laws::default();
+    let mut stopped = Vec::new();
+    let mut bar_run: Option<bar::Summary> = None;
     let default_contact = &crate::settings::get().defaults.contact;
     for &(scheme, contact, mass) in &runs {
         let label = format!("{scheme}-{contact}-{}", mass.name());
-        let dir = out.join("bar").join(&label);
+        let dir = out.join(bar::PROBLEM).join(&label);
         progress(&format!("bar {label}"));
-        let setup = Setup { scheme: scheme.into(), contact: contact.into(), ..Setup::default() };
-        let (r, guard) = past_the_guard(setup, |setup| {
-            bar::run(&bar::Options { setup, mass, out: Some(dir.clone()), ..Default::default() })
+        let methods = Methods { scheme: scheme.into(), contact: contact.into(), ..Methods::default() };
+        let (r, guard) = past_the_guard(methods, |methods| {
+            bar::run(&bar::Options { methods, mass, out: Some(dir.clone()), ..Default::default() })
         })?;
         let s = &r.summary;
         let _ = writeln!(
-            md,
+            table,
             "| {scheme} {contact} {}{} | {:.4} | {} | {} | {:.5} | {:.5} | {:.2e} | {}/{} |",
             mass.name(),
-            guard.map_or(String::new(), |g| format!(" ({g})")),
+            guard.as_ref().map_or(String::new(), |g| format!(" ({g})")),
             s.err_linf_l2_u,
-            crate::cli::optional(s.err_l2_lambda, 4),
-            crate::cli::optional(s.err_l2_lambda_half, 4),
+            optional(s.err_l2_lambda, 4),
+            optional(s.err_l2_lambda_half, 4),
             s.energy_aug_initial,
             s.energy_aug_final,
             s.max_penetration,
             s.newton_total,
             s.newton_max
         );
-        let _ = writeln!(figures, "**{label}**\n\n![{label}](bar/{label}/bar.png)\n");
-        // Energies that stay bounded (the explicit-contact variant grows: its own row says so).
+        if guard.is_some() {
+            stopped.push(label.clone());
+        }
+        let _ = writeln!(figures, "**{label}**\n\n![{label}]({p}/{label}/{p}.png)\n", p = bar::PROBLEM);
+        laws.add(&s.contact, &s.params);
+        // Energies that stay bounded (a run whose energy grows has its own row).
         let bounded = r.summary.energy_aug_drift_max < 1.0;
         if mass == MassChoice::Consistent && contact == default_contact && bounded {
             energies.push((scheme.to_string(), r.series.iter().map(|row| (row.t, row.energy_aug)).collect()));
         }
+        bar_run.get_or_insert_with(|| r.summary.clone());
     }
+    let (elements, dt, t_end) = bar_run.as_ref().map_or((0, f64::NAN, f64::NAN), |s| (s.elements, s.dt, s.t_end));
+    let _ = write!(
+        md,
+        "## 1. Compressed bar (docs/mathematics.md §6)\n\nN = {elements} elements, Δt = {dt}, T = {t_end}; {}. `err_u` = max‖u_h − I_h u‖/max‖I_h u‖ (mass norm), `err_λ` = relative ℓ² error of the contact stress at tⁿ, `err_λ½` the same at t^{{n+½}} from (uⁿ + uⁿ⁺¹)/2 (where midpoint and hybrid impose contact).\n\n",
+        laws.text()
+    );
+    let _ = writeln!(
+        md,
+        "| run | err_u | err_λ | err_λ½ | E_Θ(0) | E_Θ({t_end}) | max penetration | Newton (max/step) |\n|---|---|---|---|---|---|---|---|"
+    );
+    md.push_str(&table);
     let curves: Vec<Curve> =
         energies.iter().map(|(name, pts)| Curve { label: name, points: pts.clone(), dashed: false }).collect();
-    crate::plot::panels(&out.join("bar_energies.png"), "t", &[("E_Θ of every scheme (Nitsche θ = 1)", "E_Θ", curves)])
+    let title = format!("E_Θ of every scheme ({})", laws.of(default_contact));
+    crate::plot::panels(&out.join("bar_energies.png"), "t", &[(title.as_str(), "E_Θ", curves)])
         .map_err(|e| CaseError::Write { path: out.display().to_string(), source: std::io::Error::other(e) })?;
-    md.push_str("\nIMEX-HHT (explicit contact) is only conditionally stable: its energy grows, and the energy guard (docs/language.md) stops its runs; they are shown without the guard.\n\n### Energy of every scheme\n\n![energies](bar_energies.png)\n\n");
+    if !stopped.is_empty() {
+        let _ = write!(
+            md,
+            "\nThe energy guard (docs/language.md) stopped these runs, whose energy grows: {}; they are shown without the guard.\n",
+            stopped.join(", ")
+        );
+    }
+    md.push_str("\n### Energy of every scheme\n\n![energies](bar_energies.png)\n\n");
     md.push_str("### Contact displacement and stress against the exact solution\n\n");
     md.push_str(&figures);
 
     // 2. The disc.
-    md.push_str("## 2. Bouncing disc (docs/mathematics.md §6)\n\nBuilt-in curved P2 disc (h = 1), Nitsche θ = 1, γ0 = 1000, Δt = 0.02, T = 20.\n\n");
-    md.push_str("| scheme | first contact | max penetration | E_aug(20) | Newton total | max/step | ms/step |\n|---|---|---|---|---|---|---|\n");
+    let mut table = String::new();
+    let mut laws = Laws::default();
+    let mut disc_run: Option<disc::Summary> = None;
     let mut disc_energies = Vec::new();
     let mut disc_newton = Vec::new();
     for scheme in crate::driver::all_schemes() {
         progress(&format!("disc {scheme}"));
-        let dir = out.join("disc").join(scheme);
-        let setup = Setup { scheme: scheme.into(), ..Setup::default() };
+        let dir = out.join(disc::DISC).join(scheme);
+        let methods = Methods { scheme: scheme.into(), ..Methods::default() };
         // A scheme that fails here (explicit contact is unstable at this step) is a result.
-        let run = past_the_guard(setup, |setup| {
-            disc::run(&disc::Options { setup, out: Some(dir.clone()), ..Default::default() })
+        let run = past_the_guard(methods, |methods| {
+            disc::run(&disc::Options { methods, out: Some(dir.clone()), ..Default::default() })
         });
         let (r, guard) = match run {
             Ok(r) => r,
             Err(e) => {
-                let _ = writeln!(md, "| {scheme} | failed: {} | | | | | |", e.to_string().replace('|', "/"));
+                let _ = writeln!(table, "| {scheme} | failed: {} | | | | | |", e.to_string().replace('|', "/"));
                 continue;
             }
         };
         let s = &r.summary;
         let _ = writeln!(
-            md,
+            table,
             "| {scheme}{} | {} | {:.2e} | {:.5} | {} | {} | {:.2} |",
             guard.map_or(String::new(), |g| format!(" ({g})")),
             s.first_contact.map_or("—".into(), |t| format!("{t:.2}")),
@@ -135,11 +164,25 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
             s.newton_max,
             1e3 * s.seconds_per_step
         );
+        laws.add(&s.contact, &s.params);
+        disc_run.get_or_insert_with(|| s.clone());
         disc_energies
             .push((scheme.to_string(), r.series.iter().map(|row| (row.t, row.energy_aug)).collect::<Vec<_>>()));
         disc_newton
             .push((scheme.to_string(), r.series.iter().map(|row| (row.t, row.newton as f64)).collect::<Vec<_>>()));
     }
+    let (mesh, dt, t_end) =
+        disc_run.as_ref().map_or((String::new(), f64::NAN, f64::NAN), |s| (s.mesh.clone(), s.dt, s.t_end));
+    let _ = write!(
+        md,
+        "## 2. Bouncing disc (docs/mathematics.md §6)\n\nMesh: {mesh}; {}; Δt = {dt}, T = {t_end}.\n\n",
+        laws.text()
+    );
+    let _ = writeln!(
+        md,
+        "| scheme | first contact | max penetration | E_aug({t_end}) | Newton total | max/step | ms/step |\n|---|---|---|---|---|---|---|"
+    );
+    md.push_str(&table);
     crate::plot::panels(
         &out.join("disc_energies.png"),
         "t",
@@ -157,7 +200,11 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         ],
     )
     .map_err(|e| CaseError::Write { path: out.display().to_string(), source: std::io::Error::other(e) })?;
-    md.push_str("\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `disc/<scheme>/disc.png` (energies, displacements, contact force, Newton).\n\n");
+    let _ = write!(
+        md,
+        "\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `{p}/<scheme>/{p}.png` (energies, displacements, contact force, Newton).\n\n",
+        p = disc::DISC
+    );
     if !quick {
         md.push_str("## 3. Verification (`signorini verify`)\n\n");
         let verification = crate::verify::run(progress)?;
@@ -178,7 +225,18 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     md.push_str("## 6. Solvers for size (`signorini bench sphere`)\n\n");
     match crate::bench::sphere::read(out) {
         Some(Ok(bench)) => {
-            md.push_str("Time per step and peak memory of the bouncing sphere against its size (Newmark, Nitsche θ = 1, 50 steps of Δt = 0.02 through the first contact), from `bench_sphere.json` in this directory:\n\n");
+            let first = bench.runs.first();
+            let methods = first.map_or_else(String::new, |r| {
+                bench_methods(r.scheme.as_deref(), r.contact.as_deref(), &r.contact_params)
+            });
+            let steps = first.map_or_else(String::new, |r| match (r.dt, r.t_end) {
+                (Some(dt), Some(t_end)) => format!("{} steps of Δt = {dt} to t = {t_end}", r.steps),
+                _ => format!("{} steps", r.steps),
+            });
+            let _ = writeln!(
+                md,
+                "Time per step and peak memory of the bouncing sphere against its size ({methods}; {steps}), from `bench_sphere.json` in this directory:\n"
+            );
             md.push_str("| unknowns | solver | ms/step, whole run | median step (ms) | Newton | factorizations | Krylov iterations | peak memory (MB) |\n|---|---|---|---|---|---|---|---|\n");
             for r in &bench.runs {
                 let iterations = if r.solver == "direct" { "—".to_string() } else { r.krylov_iterations.to_string() };
@@ -210,8 +268,11 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         Some(Ok(bench)) => {
             let _ = writeln!(
                 md,
-                "Newmark, Nitsche θ = 1, Δt = {}, to t = {}, the stepper alone, medians of {} runs, from `bench_disc.json` in this directory. The model: one residual product and one pair of triangular solves per step, as bytes read at STREAM's triad bandwidth (one thread, arrays out of cache); the in-cache model reads the same bytes at the triad bandwidth of a working set of their size.\n",
-                bench.dt, bench.t_end, bench.repeats
+                "Timed: {}; Δt = {}, to t = {}; the stepper alone, medians of {} runs, from `bench_disc.json` in this directory. The model: one residual product and one pair of triangular solves per step, as bytes read at STREAM's triad bandwidth (one thread, arrays out of cache); the in-cache model reads the same bytes at the triad bandwidth of a working set of their size.\n",
+                bench_methods(bench.scheme.as_deref(), bench.contact.as_deref(), &bench.contact_params),
+                bench.dt,
+                bench.t_end,
+                bench.repeats
             );
             md.push_str("| mesh | unknowns | ms/step (mean) | median step (ms) | factorizations /1000 steps | low-rank updates /1000 steps | nnz(K) | nnz(L) | model (ms) | STREAM GB/s | measured/model | median step/model | in-cache model (ms) | in-cache GB/s | measured/in-cache model |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
             for m in &bench.meshes {
@@ -253,4 +314,73 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     let _ = writeln!(md, "_Run time: {:.1} s._", start.elapsed().as_secs_f64());
     crate::output::write_atomic(&out.join("report.md"), md.as_bytes())
         .map_err(|source| CaseError::Write { path: out.join("report.md").display().to_string(), source })
+}
+
+/// A metric with `digits` decimals, or "—" where it is undefined.
+pub fn optional(value: Option<f64>, digits: usize) -> String {
+    value.map_or("—".to_string(), |v| format!("{v:.digits$}"))
+}
+
+/// The contact laws some runs used, each with the values its params were run with, in the order
+/// first seen: `contact_nitsche (gamma0 = 5, theta = 1)`.
+#[derive(Default)]
+struct Laws(Vec<(String, String)>);
+
+impl Laws {
+    /// A run's law (its file stem) and every param of its run; the law's are those its file
+    /// declares.
+    fn add(&mut self, law: &str, params: &BTreeMap<String, ParamValue>) {
+        let entry = (law.to_string(), values(&crate::driver::params::declared_by(params, law)));
+        if !self.0.contains(&entry) {
+            self.0.push(entry);
+        }
+    }
+
+    /// Every law seen, with its values: `contact laws `a` (...), `b` (...)`.
+    fn text(&self) -> String {
+        let laws: Vec<String> = self.0.iter().map(|(law, values)| format!("`{law}` ({values})")).collect();
+        format!("contact law{} {}", if laws.len() == 1 { "" } else { "s" }, laws.join(", "))
+    }
+
+    /// The values of one law, by its name in the library (`nitsche`) or its file stem.
+    fn of(&self, law: &str) -> String {
+        let found = self.0.iter().find(|(l, _)| l == law || l.strip_prefix("contact_") == Some(law));
+        found.map_or(law.to_string(), |(l, values)| format!("{l}: {values}"))
+    }
+}
+
+/// A run's contact law (its file stem) with the values its params were run with:
+/// `` `contact_nitsche` (gamma0 = 5, theta = 1) ``.
+fn law(law: &str, params: &BTreeMap<String, ParamValue>) -> String {
+    format!("`{law}` ({})", values(&crate::driver::params::declared_by(params, law)))
+}
+
+/// Every param of a run but those named in `skip`, by the file that declares it:
+/// `` `contact_nitsche.wf` (gamma0 = 5000, theta = 1), `elasticity.wf` (E = 50, nu = 0.25, rho = 1) ``.
+fn params_by_file(params: &BTreeMap<String, ParamValue>, skip: &[&str]) -> String {
+    let mut files: BTreeMap<String, Vec<(String, f64)>> = BTreeMap::new();
+    for (name, p) in params {
+        let bare = name.rsplit('.').next().unwrap_or(name);
+        if skip.contains(&bare) {
+            continue;
+        }
+        let declared = p.declared.rsplit_once(':').map_or(p.declared.as_str(), |(f, _)| f);
+        let file = Path::new(declared).file_name().map_or(declared.to_string(), |f| f.to_string_lossy().into_owned());
+        files.entry(file).or_default().push((bare.to_string(), p.value));
+    }
+    files.iter().map(|(file, v)| format!("`{file}` ({})", values(v))).collect::<Vec<_>>().join(", ")
+}
+
+/// `gamma0 = 5, theta = 1`.
+fn values(params: &[(String, f64)]) -> String {
+    params.iter().map(|(n, v)| format!("{n} = {v}")).collect::<Vec<_>>().join(", ")
+}
+
+/// What a benchmark ran: `newmark, contact_nitsche (gamma0 = 1000, theta = 1)`, or what an older
+/// file does not record.
+fn bench_methods(scheme: Option<&str>, law: Option<&str>, params: &[(String, f64)]) -> String {
+    match (scheme, law) {
+        (Some(s), Some(l)) => format!("{s}, {l} ({})", values(params)),
+        _ => "the methods it ran with are not recorded in this file".to_string(),
+    }
 }

@@ -9,8 +9,9 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::cases::bar;
-use crate::cases::{CaseError, disc};
-use crate::driver::Setup;
+use crate::cases::disc;
+use crate::driver::Methods;
+use crate::error::CaseError;
 use crate::plot::Curve;
 use crate::simulation::MassChoice;
 
@@ -20,6 +21,9 @@ const MASSES: [MassChoice; 2] = [MassChoice::Consistent, MassChoice::Redistribut
 /// A run whose |E_aug(T) − E_aug(0)| exceeds this fraction of its energy scale has not converged
 /// to anything physical (explicit contact blows up slowly rather than failing Newton).
 const BOUNDED: f64 = 0.5;
+/// The bar's first contact phase is t ∈ [1, 2] (its exact solution): its pressure is looked at
+/// over this window around it.
+const BAR_PHASE: (f64, f64) = (0.5, 2.5);
 
 /// One run of the sweep.
 #[derive(Clone, Debug, Serialize)]
@@ -47,6 +51,9 @@ pub struct Measures {
     pub newton_mean: f64,
     pub newton_max: usize,
     pub max_penetration: f64,
+    /// What the run was: the mesh, the end time, the contact law and its params.
+    #[serde(skip)]
+    pub setting: String,
 }
 
 impl Point {
@@ -57,19 +64,19 @@ impl Point {
 
 /// The sweep's runs: coarse steps lose accuracy on purpose, and the energy guard stops a run
 /// only where the sweep would not count it as converging.
-fn sweep_setup(scheme: &str) -> Setup {
-    let mut setup = Setup { scheme: scheme.into(), ..Setup::default() };
-    setup.guard.energy_tolerance = BOUNDED;
-    setup
+fn sweep_setup(scheme: &str) -> Methods {
+    let mut methods = Methods { scheme: scheme.into(), ..Methods::default() };
+    methods.guard.energy_tolerance = BOUNDED;
+    methods
 }
 
 fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
-    let setup = sweep_setup(scheme);
-    let r = bar::run(&bar::Options { setup, mass, dt: Some(dt), ..Default::default() })?;
+    let methods = sweep_setup(scheme);
+    let r = bar::run(&bar::Options { methods, mass, dt: Some(dt), ..Default::default() })?;
     let s = &r.summary;
-    // The first contact phase of the exact solution is t ∈ [1, 2]: look at [0.5, 2.5].
     let variation = |f: fn(&bar::Row) -> f64| -> f64 {
-        let phase: Vec<f64> = r.series.iter().filter(|row| (0.5..=2.5).contains(&row.t)).map(f).collect();
+        let phase: Vec<f64> =
+            r.series.iter().filter(|row| (BAR_PHASE.0..=BAR_PHASE.1).contains(&row.t)).map(f).collect();
         phase.windows(2).map(|w| (w[1] - w[0]).abs()).sum()
     };
     Ok(Measures {
@@ -79,12 +86,13 @@ fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseEr
         newton_mean: s.newton_total as f64 / s.steps.max(1) as f64,
         newton_max: s.newton_max,
         max_penetration: s.max_penetration,
+        setting: format!("N = {} elements, T = {}, {}", s.elements, s.t_end, super::law(&s.contact, &s.params)),
     })
 }
 
 fn disc_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
-    let setup = sweep_setup(scheme);
-    let r = disc::run(&disc::Options { setup, mass, dt, ..Default::default() })?;
+    let methods = sweep_setup(scheme);
+    let r = disc::run(&disc::Options { methods, mass, dt: Some(dt), ..Default::default() })?;
     let s = &r.summary;
     // The first contact phase: from the first step with an active point to the next without.
     let start = r.series.iter().position(|row| row.active_points > 0);
@@ -93,7 +101,7 @@ fn disc_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseE
             .iter()
             .enumerate()
             .take_while(|(i, row)| *i < 2 || row.active_points > 0)
-            .map(|(_, row)| row.fy_contact)
+            .map(|(_, row)| row.f_vertical_contact)
             .collect()
     });
     let peak = phase.iter().fold(0.0f64, |m, f| m.max(f.abs()));
@@ -106,6 +114,7 @@ fn disc_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseE
         newton_mean: s.newton_total as f64 / s.steps.max(1) as f64,
         newton_max: s.newton_max,
         max_penetration: s.max_penetration,
+        setting: format!("{}, T = {}, {}", s.mesh, s.t_end, super::law(&s.contact, &s.params)),
     })
 }
 
@@ -126,8 +135,8 @@ pub struct Case {
 
 /// The bar's and the disc's sweeps.
 pub const CASES: [Case; 2] = [
-    Case { name: "bar", steps: &BAR_STEPS, measure: bar_point },
-    Case { name: "disc", steps: &DISC_STEPS, measure: disc_point },
+    Case { name: bar::PROBLEM, steps: &BAR_STEPS, measure: bar_point },
+    Case { name: disc::DISC, steps: &DISC_STEPS, measure: disc_point },
 ];
 
 /// Runs `cases` for every scheme and both masses.
@@ -159,11 +168,22 @@ impl Sweeps {
     }
 
     pub fn markdown(&self) -> String {
-        let mut md = String::from(
-            "Every scheme, consistent and redistributed mass (docs/mathematics.md §5), Nitsche θ = 1. Bar: N = 20, γ0 = 5, T = 12; disc: built-in h = 1 mesh, γ0 = 1000, T = 20. `ΔE_aug` = (E_aug(T) − E_aug(0)) over the energy scale: E_aug(0) on the bar, the largest kinetic energy on the disc (which starts at rest, E_aug(0) = 0). `osc` = total variation of the contact pressure over the first contact phase divided by a clean pulse's (bar: λ over t ∈ [0.5, 2.5] against the exact 1; disc: f_y from first contact to release against 2 max f_y): 1 = no spurious oscillation. `osc½`: the same on the bar from λ at t^{n+½}, computed from (uⁿ + uⁿ⁺¹)/2, where midpoint and hybrid impose contact. A run converges when Newton converges at every step and |ΔE_aug| < 0.5.\n\n### Largest converging Δt\n\n",
-        );
         let mut cases: Vec<&str> = self.points.iter().map(|p| p.case).collect();
         cases.dedup();
+        // What each case ran, from its first run that has measures.
+        let settings: Vec<String> = cases
+            .iter()
+            .filter_map(|&case| {
+                let m = self.points.iter().filter(|p| p.case == case).find_map(|p| p.outcome.as_ref().ok())?;
+                Some(format!("{case}: {}", m.setting))
+            })
+            .collect();
+        let mut md = format!(
+            "Every scheme, consistent and redistributed mass (docs/mathematics.md §5). {}. `ΔE_aug` = (E_aug(T) − E_aug(0)) over the energy scale: E_aug(0) on the bar, the largest kinetic energy on the disc (which starts at rest, E_aug(0) = 0). `osc` = total variation of the contact pressure over the first contact phase divided by a clean pulse's (bar: λ over t ∈ [{}, {}] against the exact 1; disc: f_y from first contact to release against 2 max f_y): 1 = no spurious oscillation. `osc½`: the same on the bar from λ at t^{{n+½}}, computed from (uⁿ + uⁿ⁺¹)/2, where midpoint and hybrid impose contact. A run converges when Newton converges at every step and |ΔE_aug| < {BOUNDED}.\n\n### Largest converging Δt\n\n",
+            settings.join("; "),
+            BAR_PHASE.0,
+            BAR_PHASE.1
+        );
         let columns: Vec<(&str, &str)> =
             cases.iter().flat_map(|&c| MASSES.iter().map(move |&m| (c, m.name()))).collect();
         md.push_str("| scheme |");
@@ -181,8 +201,6 @@ impl Sweeps {
             }
             md.push('\n');
         }
-        let mut cases: Vec<&str> = self.points.iter().map(|p| p.case).collect();
-        cases.dedup();
         for case in cases {
             let _ = write!(
                 md,

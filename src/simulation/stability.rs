@@ -6,8 +6,8 @@
 //! below: the estimated Δt_c is at most a little above the true one, and the energy guard
 //! stops a run that is unstable all the same.
 
-use super::Tools;
-use crate::cases::CaseError;
+use super::Operators;
+use crate::error::CaseError;
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::linalg::{Factorization, Structure};
 use crate::runtime::nonlinear::statics::Constraints;
@@ -31,17 +31,17 @@ const CONVERGED: f64 = 1e-10;
 /// Estimates Δt_c for a scheme claiming `cfl`, with the scheme's mass and the problem's
 /// obstacle (`g`, `nc` of `coefs`).
 pub fn estimate(
-    tools: &Tools,
+    ops: &Operators,
     coefs: &dyn Fn(&str) -> Option<Coef>,
     constraints: &Constraints,
     cfl: f64,
 ) -> Result<StableStep, CaseError> {
-    let asm = tools.asm;
+    let asm = ops.asm;
     let n = asm.size();
-    let mut a = tools.stiffness.clone();
+    let mut a = ops.stiffness.clone();
     let (mut active, mut points) = (0, 0);
-    if let Some(probe) = &tools.probe {
-        let pushed = pushed_into_obstacle(tools, coefs);
+    if let Some(probe) = &ops.probe {
+        let pushed = pushed_into_obstacle(ops, coefs);
         let mut contact = asm.zero_matrix();
         probe.tangent(asm, &[&pushed], 0, 0.0, &mut contact);
         a.add_scaled(1.0, &contact);
@@ -51,7 +51,7 @@ pub fn estimate(
         active = switches.iter().filter(|s| **s).count();
     }
     let mut mass = Factorization::new(Structure::SymmetricPositiveDefinite);
-    mass.factor(&tools.scheme_mass).map_err(|e| CaseError::Option(format!("the scheme's mass: {e}")))?;
+    mass.factor(&ops.scheme_mass).map_err(|e| CaseError::Option(format!("the scheme's mass: {e}")))?;
     let free = |x: &mut [f64]| x.iter_mut().zip(&constraints.fixed).filter(|(_, f)| **f).for_each(|(x, _)| *x = 0.0);
     // A start with every frequency in it.
     let mut x = scattered(n);
@@ -59,7 +59,7 @@ pub fn estimate(
     let (mut ax, mut lambda) = (vec![0.0; n], 0.0f64);
     for _ in 0..ITERATIONS {
         a.mul_vec(&x, &mut ax);
-        let xmx = tools.scheme_mass.quad(&x, &x);
+        let xmx = ops.scheme_mass.quad(&x, &x);
         let rayleigh = x.iter().zip(&ax).map(|(p, q)| p * q).sum::<f64>() / xmx;
         let done = (rayleigh - lambda).abs() <= CONVERGED * rayleigh.abs();
         lambda = rayleigh;
@@ -97,10 +97,10 @@ pub(crate) fn scattered(n: usize) -> Vec<f64> {
 /// contact node is past the obstacle by a thousandth of the body's size: a rigid motion, so
 /// the elastic stress stays zero and a law that compares the stress with the gap (Nitsche's)
 /// sees every point in contact.
-pub(crate) fn pushed_into_obstacle(tools: &Tools, coefs: &dyn Fn(&str) -> Option<Coef>) -> Vec<f64> {
-    let mesh = tools.asm.mesh();
+pub(crate) fn pushed_into_obstacle(ops: &Operators, coefs: &dyn Fn(&str) -> Option<Coef>) -> Vec<f64> {
+    let mesh = ops.asm.mesh();
     let d = mesh.dim();
-    let n = tools.asm.size();
+    let n = ops.asm.size();
     let at = |coef: &Option<Coef>, x: &[f64], components: usize| -> Vec<f64> {
         match coef {
             Some(Coef::Constant(v)) => v.clone(),
@@ -113,7 +113,7 @@ pub(crate) fn pushed_into_obstacle(tools: &Tools, coefs: &dyn Fn(&str) -> Option
         }
     };
     let (g, nc) = (coefs("g"), coefs("nc"));
-    let Some(&first) = tools.contact_nodes.first() else { return vec![0.0; n] };
+    let Some(&first) = ops.contact_nodes.first() else { return vec![0.0; n] };
     let x0 = &mesh.coords[d * first as usize..d * (first as usize + 1)];
     let direction = at(&nc, x0, d);
     let size = (0..d)
@@ -125,7 +125,7 @@ pub(crate) fn pushed_into_obstacle(tools: &Tools, coefs: &dyn Fn(&str) -> Option
     // The translation s along `direction` puts node x past the obstacle when
     // s (direction · nc(x)) − g(x) > 0.
     let mut s = 0.0f64;
-    for &node in &tools.contact_nodes {
+    for &node in &ops.contact_nodes {
         let x = &mesh.coords[d * node as usize..d * (node as usize + 1)];
         let normal = at(&nc, x, d);
         let along: f64 = direction.iter().zip(&normal).map(|(a, b)| a * b).sum();

@@ -1,8 +1,8 @@
 //! The static driver every static case shares: the `stiffness`, `load` and `contact` forms of
 //! the files in use, bound by slot name on a mesh, and semi-smooth Newton on K u + C(u) = F.
 
-use crate::cases::CaseError;
-use crate::driver::ActiveForms;
+use crate::driver::FormsInUse;
+use crate::error::CaseError;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::bound::BoundFunctional;
 use crate::runtime::fem::kernel::Coef;
@@ -45,7 +45,7 @@ pub struct StaticSolution<'m> {
 pub fn solve<'m>(
     asm: &'m Assembler<'m>,
     problem: StaticProblem<'_>,
-    active: &ActiveForms,
+    forms: &FormsInUse,
     initial: Vec<f64>,
 ) -> Result<StaticSolution<'m>, CaseError> {
     let d = asm.mesh().dim();
@@ -57,10 +57,10 @@ pub fn solve<'m>(
     let missing = |what: &str| {
         CaseError::Option(format!("a static case needs a `{what}` form, which the files in use do not provide"))
     };
-    let mut inst = active.instantiate(problem.coefs, &volume)?;
+    let mut inst = forms.instantiate(problem.coefs, &volume)?;
     let stiffness = inst.take_form("stiffness").ok_or_else(|| missing("stiffness"))?;
     let load_form = inst.take_form("load").ok_or_else(|| missing("load"))?;
-    let mut on_boundary = active.instantiate(problem.coefs, &boundary)?;
+    let mut on_boundary = forms.instantiate(problem.coefs, &boundary)?;
     let contact = on_boundary.take_form("contact").ok_or_else(|| missing("contact"))?;
     let mut load = vec![0.0; n];
     load_form.residual(asm, &[], 0.0, &mut load);

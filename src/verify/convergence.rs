@@ -6,8 +6,9 @@
 
 use serde::Serialize;
 
-use crate::cases::{CaseError, disc};
-use crate::driver::Setup;
+use crate::cases::disc;
+use crate::driver::Methods;
+use crate::error::CaseError;
 
 const T_END: f64 = 12.0;
 /// Δt refinement: the steps, and the reference's.
@@ -37,12 +38,12 @@ fn errors(step: f64, run: &[disc::Row], reference: &[disc::Row]) -> Errors {
     // The reference at the run's times (its step divides the run's).
     let stride = ((run[1].t - run[0].t) / (reference[1].t - reference[0].t)).round() as usize;
     let pairs: Vec<(&disc::Row, &disc::Row)> = run.iter().zip(reference.iter().step_by(stride.max(1))).collect();
-    let max_ref = pairs.iter().map(|(_, r)| r.uy_mean.abs()).fold(0.0, f64::max);
-    let uy = pairs.iter().map(|(a, r)| (a.uy_mean - r.uy_mean).abs()).fold(0.0, f64::max) / max_ref;
-    let num: f64 = pairs.iter().map(|(a, r)| (a.fy_contact - r.fy_contact).powi(2)).sum();
-    let den: f64 = pairs.iter().map(|(_, r)| r.fy_contact.powi(2)).sum();
-    let max_v = pairs.iter().map(|(_, r)| r.vy_mean.abs()).fold(0.0, f64::max);
-    let vy = pairs.iter().map(|(a, r)| (a.vy_mean - r.vy_mean).abs()).fold(0.0, f64::max) / max_v;
+    let max_ref = pairs.iter().map(|(_, r)| r.u_vertical_mean.abs()).fold(0.0, f64::max);
+    let uy = pairs.iter().map(|(a, r)| (a.u_vertical_mean - r.u_vertical_mean).abs()).fold(0.0, f64::max) / max_ref;
+    let num: f64 = pairs.iter().map(|(a, r)| (a.f_vertical_contact - r.f_vertical_contact).powi(2)).sum();
+    let den: f64 = pairs.iter().map(|(_, r)| r.f_vertical_contact.powi(2)).sum();
+    let max_v = pairs.iter().map(|(_, r)| r.v_vertical_mean.abs()).fold(0.0, f64::max);
+    let vy = pairs.iter().map(|(a, r)| (a.v_vertical_mean - r.v_vertical_mean).abs()).fold(0.0, f64::max) / max_v;
     Errors { step, uy_mean: uy, fy_contact: (num / den).sqrt(), vy_mean: vy }
 }
 
@@ -101,14 +102,25 @@ pub fn disc(progress: &mut dyn FnMut(&str)) -> DiscConvergence {
         .into_iter()
         .map(|scheme| {
             progress(&format!("disc Δt convergence {scheme}"));
-            let setup = Setup { scheme: scheme.into(), ..Setup::default() };
-            let runs = |dt| disc::Options { setup: setup.clone(), dt, t_end: T_END, ..disc::Options::default() };
+            let methods = Methods { scheme: scheme.into(), ..Methods::default() };
+            let runs = |dt| disc::Options {
+                methods: methods.clone(),
+                dt: Some(dt),
+                t_end: Some(T_END),
+                ..disc::Options::default()
+            };
             study(scheme, runs, &DT_STEPS, DT_REFERENCE)
         })
         .collect();
     progress("disc h convergence");
-    let setup = Setup::default();
-    let runs = |h| disc::Options { setup: setup.clone(), h, dt: H_DT, t_end: T_END, ..disc::Options::default() };
-    let h = study(&setup.scheme, runs, &H_STEPS, H_REFERENCE);
+    let methods = Methods::default();
+    let runs = |h| disc::Options {
+        methods: methods.clone(),
+        h: Some(h),
+        dt: Some(H_DT),
+        t_end: Some(T_END),
+        ..disc::Options::default()
+    };
+    let h = study(&methods.scheme, runs, &H_STEPS, H_REFERENCE);
     DiscConvergence { dt, h }
 }

@@ -8,8 +8,9 @@
 use serde::Serialize;
 
 use super::oscillator::{oscillator_energies, spectral_radius};
-use crate::cases::{CaseError, bar, disc};
-use crate::driver::Setup;
+use crate::cases::{bar, disc};
+use crate::driver::Methods;
+use crate::error::CaseError;
 
 /// How E_aug behaves on one run: on steps whose active set is unchanged, and on the others.
 #[derive(Clone, Debug, Serialize)]
@@ -31,6 +32,9 @@ pub struct EnergyRow {
     /// Steps on which points only left contact, and the range of ΔE_aug over them.
     pub releasing_steps: usize,
     pub releasing_range: (f64, f64),
+    /// What the run was: the mesh, Δt and T.
+    #[serde(skip)]
+    pub setting: String,
 }
 
 fn energy_row(case: &'static str, scheme: &str, contact: &str, rows: &[(Vec<bool>, f64, f64)]) -> EnergyRow {
@@ -71,6 +75,7 @@ fn energy_row(case: &'static str, scheme: &str, contact: &str, rows: &[(Vec<bool
         entering_range,
         releasing_steps: releasing,
         releasing_range,
+        setting: String::new(),
     }
 }
 
@@ -78,8 +83,8 @@ fn energy_row(case: &'static str, scheme: &str, contact: &str, rows: &[(Vec<bool
 pub fn conserving_schemes() -> Result<Vec<&'static str>, CaseError> {
     let mut out = Vec::new();
     for scheme in crate::driver::all_schemes() {
-        let active = crate::driver::Active::resolve(&Setup { scheme: scheme.into(), ..Setup::default() }, &[])?;
-        if active.scheme_energy_law()? == Some(crate::compiler::scheme::EnergyLaw::Conserving) {
+        let in_use = crate::driver::FilesInUse::resolve(&Methods { scheme: scheme.into(), ..Methods::default() }, &[])?;
+        if in_use.scheme_energy_law()? == Some(crate::compiler::scheme::EnergyLaw::Conserving) {
             out.push(scheme);
         }
     }
@@ -94,14 +99,16 @@ pub fn contact_laws(progress: &mut dyn FnMut(&str)) -> Result<Vec<EnergyRow>, Ca
     for scheme in conserving_schemes()? {
         for contact in &v.contacts {
             progress(&format!("energy law {scheme} {contact}"));
-            let setup = Setup { scheme: scheme.into(), contact: contact.clone(), ..Setup::default() };
-            let b = bar::run(&bar::Options { setup: setup.clone(), ..bar::Options::default() })?;
+            let methods = Methods { scheme: scheme.into(), contact: contact.clone(), ..Methods::default() };
+            let b = bar::run(&bar::Options { methods: methods.clone(), ..bar::Options::default() })?;
             // The bar's one contact point: its status is the sign of λ.
             let rows: Vec<_> = b.series.iter().map(|r| (vec![r.lambda < 0.0], r.energy_aug, r.energy)).collect();
-            out.push(energy_row("bar", scheme, contact, &rows));
-            let d = disc::run(&disc::Options { setup, h: 2.0, t_end: 16.0, ..disc::Options::default() })?;
+            let setting = format!("N = {}, Δt = {}, T = {}", b.summary.elements, b.summary.dt, b.summary.t_end);
+            out.push(EnergyRow { setting, ..energy_row(bar::PROBLEM, scheme, contact, &rows) });
+            let d = disc::run(&disc::Options { methods, h: Some(2.0), t_end: Some(16.0), ..disc::Options::default() })?;
             let rows: Vec<_> = d.series.iter().map(|r| (r.switches.clone(), r.energy_aug, r.energy)).collect();
-            out.push(energy_row("disc", scheme, contact, &rows));
+            let setting = format!("{}, Δt = {}, T = {}", d.summary.mesh, d.summary.dt, d.summary.t_end);
+            out.push(EnergyRow { setting, ..energy_row(disc::DISC, scheme, contact, &rows) });
         }
     }
     Ok(out)
@@ -132,18 +139,18 @@ pub fn dissipation(progress: &mut dyn FnMut(&str)) -> Result<Vec<DissipationRow>
     let mut out = Vec::new();
     for scheme in crate::driver::all_schemes() {
         progress(&format!("dissipation {scheme}"));
-        let setup = Setup { scheme: scheme.into(), ..Setup::default() };
+        let methods = Methods { scheme: scheme.into(), ..Methods::default() };
         // An explicit scheme, only where it is stable.
-        let cfl = super::claimed_cfl(&setup)?.unwrap_or(f64::INFINITY);
+        let cfl = super::claimed_cfl(&methods)?.unwrap_or(f64::INFINITY);
         for omega_dt in DISSIPATION_STEPS.into_iter().filter(|x| *x <= cfl) {
-            let e = oscillator_energies(&setup, omega_dt, DISSIPATION_COUNT)?;
+            let e = oscillator_energies(&methods, omega_dt, DISSIPATION_COUNT)?;
             // Strongly damped schemes reach underflow long before N steps: measure up to 1e-200.
             let n = e.iter().rposition(|&x| x > 1e-200 * e[0]).unwrap_or(0).max(1);
             let (e0, en) = (e[0], e[n]);
             out.push(DissipationRow {
                 scheme: scheme.into(),
                 omega_dt,
-                rho: spectral_radius(&setup, omega_dt)?,
+                rho: spectral_radius(&methods, omega_dt)?,
                 measured_rate: (en / e0).powf(0.5 / n as f64),
                 largest_increase: e.windows(2).map(|w| (w[1] - w[0]) / e0).fold(f64::NEG_INFINITY, f64::max),
                 final_ratio: e[DISSIPATION_COUNT] / e0,

@@ -18,14 +18,14 @@ use serde::Serialize;
 
 /// The ωΔt up to which the scheme claims to be stable: its `claim cfl` (an explicit scheme);
 /// none for a scheme that claims no limit.
-pub fn claimed_cfl(setup: &crate::driver::Setup) -> Result<Option<f64>, crate::cases::CaseError> {
-    let active = crate::driver::Active::resolve(setup, &[])?;
-    Ok(active.scheme_claims()?.into_iter().find(|(c, _)| c == "cfl").map(|(_, v)| v))
+pub fn claimed_cfl(methods: &crate::driver::Methods) -> Result<Option<f64>, crate::error::CaseError> {
+    let in_use = crate::driver::FilesInUse::resolve(methods, &[])?;
+    Ok(in_use.scheme_claims()?.into_iter().find(|(c, _)| c == "cfl").map(|(_, v)| v))
 }
 
 pub use oscillator::{oscillator_energies, oscillator_error, spectral_radius, with_oscillator, with_oscillator_scheme};
 
-use crate::cases::CaseError;
+use crate::error::CaseError;
 use crate::plot::Curve;
 
 /// Everything `signorini verify` measures.
@@ -193,7 +193,19 @@ impl Verification {
             );
         }
         md.push_str("\n![space orders](verify/space_orders.png)\n\n");
-        md.push_str("### (c) Energy laws\n\nWith contact: Crank–Nicolson (Newmark β = ¼) and midpoint conserve E_aug on every step whose active set (contact status at the quadrature points) does not change; the other steps carry the jumps D of docs/mathematics.md §5. Relative to the largest |E| of the run. Bar: N = 20, Δt = 0.01, T = 12; disc: built-in h = 2 mesh, Δt = 0.02, T = 16.\n\nOf the changed steps, those on which points only enter contact and those on which they only leave it (Crank–Nicolson: ΔE_aug ≤ 0 entering, ≥ 0 leaving; midpoint: the reverse), with the range of ΔE_aug over them.\n\n| case | scheme | contact | steps, active set kept | max \\|ΔE_aug\\| there | steps, active set changed | total ΔE_aug there | entering: steps, ΔE_aug range | leaving: steps, ΔE_aug range |\n|---|---|---|---|---|---|---|---|---|\n");
+        // What each case ran, from its first row.
+        let mut settings: Vec<String> = Vec::new();
+        for r in &self.energy {
+            let text = format!("{}: {}", r.case, r.setting);
+            if !settings.iter().any(|s| s.starts_with(&format!("{}:", r.case))) {
+                settings.push(text);
+            }
+        }
+        let _ = write!(
+            md,
+            "### (c) Energy laws\n\nWith contact: Crank–Nicolson (Newmark β = ¼) and midpoint conserve E_aug on every step whose active set (contact status at the quadrature points) does not change; the other steps carry the jumps D of docs/mathematics.md §5. Relative to the largest |E| of the run. {}.\n\nOf the changed steps, those on which points only enter contact and those on which they only leave it (Crank–Nicolson: ΔE_aug ≤ 0 entering, ≥ 0 leaving; midpoint: the reverse), with the range of ΔE_aug over them.\n\n| case | scheme | contact | steps, active set kept | max \\|ΔE_aug\\| there | steps, active set changed | total ΔE_aug there | entering: steps, ΔE_aug range | leaving: steps, ΔE_aug range |\n|---|---|---|---|---|---|---|---|---|\n",
+            settings.join("; ")
+        );
         let range =
             |n: usize, r: (f64, f64)| if n == 0 { "0".to_string() } else { format!("{n}: [{:.1e}, {:.1e}]", r.0, r.1) };
         for r in &self.energy {

@@ -1,8 +1,8 @@
 //! The oscillator ü + u = 0 as a one-dof finite-element system, stepped by any scheme: its
 //! error against cos t, and the spectral radius of a scheme's one-step map.
 
-use crate::cases::CaseError;
-use crate::driver::{Active, Setup, Slot};
+use crate::driver::{FilesInUse, Methods, Slot};
+use crate::error::CaseError;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::bound::MatrixForm;
 use crate::runtime::fem::kernel::Coef;
@@ -14,41 +14,41 @@ use crate::runtime::nonlinear::statics::Constraints;
 use crate::runtime::time::scheme::TimeScheme;
 use crate::runtime::time::stepper::Stepper;
 
-/// Runs `f` with a stepper of `setup`'s scheme on the oscillator: one P1 element, E = 1,
+/// Runs `f` with a stepper of `methods`'s scheme on the oscillator: one P1 element, E = 1,
 /// ρ = 3, so M = ρh/3 = 1 and K = E/h = 1 on the free dof; no contact facets.
-pub fn with_oscillator<R>(setup: &Setup, f: impl FnOnce(&mut Stepper) -> R) -> Result<R, CaseError> {
-    with_oscillator_scheme(setup, None, f)
+pub fn with_oscillator<R>(methods: &Methods, f: impl FnOnce(&mut Stepper) -> R) -> Result<R, CaseError> {
+    with_oscillator_scheme(methods, None, f)
 }
 
 /// As [`with_oscillator`], stepping `scheme` (e.g. one compiled by a crate's own `forms!`)
-/// instead of `setup`'s when given; the forms still come from `setup`.
+/// instead of `methods`'s when given; the forms still come from `methods`.
 pub fn with_oscillator_scheme<R>(
-    setup: &Setup,
+    methods: &Methods,
     scheme: Option<Box<dyn TimeScheme>>,
     f: impl FnOnce(&mut Stepper) -> R,
 ) -> Result<R, CaseError> {
-    oscillator(setup, scheme, None, f)
+    oscillator(methods, scheme, None, f)
 }
 
 /// As [`with_oscillator`] on ü + 2ζu̇ + u = 0: the damping slot (forms/library.toml) is bound
 /// to 2ζM. (Without this, a scheme that applies it gets ζ = 0.)
 pub fn with_damped_oscillator<R>(
-    setup: &Setup,
+    methods: &Methods,
     damping: (&'static str, f64),
     f: impl FnOnce(&mut Stepper) -> R,
 ) -> Result<R, CaseError> {
-    oscillator(setup, None, Some(damping), f)
+    oscillator(methods, None, Some(damping), f)
 }
 
 fn oscillator<R>(
-    setup: &Setup,
+    methods: &Methods,
     scheme: Option<Box<dyn TimeScheme>>,
     damping: Option<(&'static str, f64)>,
     f: impl FnOnce(&mut Stepper) -> R,
 ) -> Result<R, CaseError> {
     let mesh = structured::interval(1, 0.0, 1.0);
     let asm = Assembler::new(&mesh);
-    let active = Active::resolve(&setup.clone().set("elasticity.rho", 3.0), &[])?;
+    let in_use = FilesInUse::resolve(&methods.clone().set("elasticity.rho", 3.0), &[])?;
     let coefs = |name: &str| match name {
         "f" => Some(Coef::constant(vec![0.0])),
         "g" => Some(Coef::scalar(0.0)),
@@ -56,14 +56,14 @@ fn oscillator<R>(
         _ => None,
     };
     let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
-    let mut inst = active.forms.instantiate(&coefs, &binding)?;
+    let mut inst = in_use.forms.instantiate(&coefs, &binding)?;
     // A scheme that applies the damping slot gets 2ζM there: ζ = 0 (undamped) unless asked.
     let slot = crate::settings::get().verify.damping_slot.as_str();
-    let damping = damping.or_else(|| active.scheme.desc().uses.iter().any(|s| s.name == slot).then_some((slot, 0.0)));
+    let damping = damping.or_else(|| in_use.scheme.desc().uses.iter().any(|s| s.name == slot).then_some((slot, 0.0)));
     let given: Vec<Slot> = match damping {
         Some((slot, zeta)) => {
             let mut mass = asm.zero_matrix();
-            let mut probe = active.forms.instantiate(&coefs, &binding)?;
+            let mut probe = in_use.forms.instantiate(&coefs, &binding)?;
             let m = probe.take_form("mass").ok_or_else(|| CaseError::Option("the oscillator needs `mass`".into()))?;
             m.tangent(&asm, &[&[0.0, 0.0]], 0, 0.0, &mut mass);
             let mut c = asm.zero_matrix();
@@ -72,26 +72,26 @@ fn oscillator<R>(
         }
         None => Vec::new(),
     };
-    let forms = active.scheme_forms_with(&mut inst, given)?;
+    let forms = in_use.scheme_forms_with(&mut inst, given)?;
     let mut constraints = Constraints::none(asm.size());
     constraints.fix(1);
     let scheme = match scheme {
         Some(s) => s,
-        None => active.time_scheme()?,
+        None => in_use.time_scheme()?,
     };
     let mut stepper = Stepper::new(scheme, &asm, forms, constraints, Structure::General, NewtonOptions::default())?;
     Ok(f(&mut stepper))
 }
 
 /// |u(T) − cos T| from u = 1, v = 0.
-pub fn oscillator_error(setup: &Setup, dt: f64, t_end: f64) -> Result<f64, CaseError> {
-    with_oscillator(setup, |st| final_displacement(st, dt, t_end))?.map(|u| (u - t_end.cos()).abs())
+pub fn oscillator_error(methods: &Methods, dt: f64, t_end: f64) -> Result<f64, CaseError> {
+    with_oscillator(methods, |st| final_displacement(st, dt, t_end))?.map(|u| (u - t_end.cos()).abs())
 }
 
 /// |u(T) − u_exact(T)| on ü + 2ζu̇ + u = 0 from u = 1, v = 0, with `slot` bound to 2ζM:
 /// u = e^{−ζt}(cos ω_d t + ζ/ω_d sin ω_d t), ω_d = √(1 − ζ²).
 pub fn damped_oscillator_error(
-    setup: &Setup,
+    methods: &Methods,
     slot: &'static str,
     zeta: f64,
     dt: f64,
@@ -99,7 +99,7 @@ pub fn damped_oscillator_error(
 ) -> Result<f64, CaseError> {
     let wd = (1.0 - zeta * zeta).sqrt();
     let exact = (-zeta * t_end).exp() * ((wd * t_end).cos() + zeta / wd * (wd * t_end).sin());
-    with_damped_oscillator(setup, (slot, zeta), |st| final_displacement(st, dt, t_end))?.map(|u| (u - exact).abs())
+    with_damped_oscillator(methods, (slot, zeta), |st| final_displacement(st, dt, t_end))?.map(|u| (u - exact).abs())
 }
 
 /// u(T) after steps of `dt` from u = 1, v = 0 and the scheme's initial problem.
@@ -115,14 +115,14 @@ fn final_displacement(st: &mut Stepper, dt: f64, t_end: f64) -> Result<f64, Case
 }
 
 /// Spectral radius of the one-step map of the oscillator's states at step `dt` (ω = 1).
-pub fn spectral_radius(setup: &Setup, dt: f64) -> Result<f64, CaseError> {
-    Ok(spectral_radius_of(&step_map(setup, dt)?))
+pub fn spectral_radius(methods: &Methods, dt: f64) -> Result<f64, CaseError> {
+    Ok(spectral_radius_of(&step_map(methods, dt)?))
 }
 
 /// The matrix of one step of the oscillator on the states (u, v, a, ...): column j is the step
 /// of the j-th unit state.
-pub fn step_map(setup: &Setup, dt: f64) -> Result<Vec<Vec<f64>>, CaseError> {
-    with_oscillator(setup, |st| -> Result<Vec<Vec<f64>>, CaseError> {
+pub fn step_map(methods: &Methods, dt: f64) -> Result<Vec<Vec<f64>>, CaseError> {
+    with_oscillator(methods, |st| -> Result<Vec<Vec<f64>>, CaseError> {
         let m = st.desc().states.len();
         let mut a = vec![vec![0.0; m]; m];
         for j in 0..m {
@@ -164,8 +164,8 @@ fn spectral_radius_of(a: &[Vec<f64>]) -> f64 {
 }
 
 /// E = ½(u² + v²) at every step of `steps` steps of size `dt` from u = 1, v = 0 (M = K = 1).
-pub fn oscillator_energies(setup: &Setup, dt: f64, steps: usize) -> Result<Vec<f64>, CaseError> {
-    with_oscillator(setup, |st| -> Result<Vec<f64>, CaseError> {
+pub fn oscillator_energies(methods: &Methods, dt: f64, steps: usize) -> Result<Vec<f64>, CaseError> {
+    with_oscillator(methods, |st| -> Result<Vec<f64>, CaseError> {
         let v = st.desc().states.iter().position(|s| *s == "v").ok_or_else(|| {
             CaseError::Option(format!("the scheme's states {:?} have no velocity `v`", st.desc().states))
         })?;

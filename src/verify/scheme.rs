@@ -14,9 +14,10 @@ use serde::Serialize;
 
 use super::oscillator::{damped_oscillator_error, oscillator_energies, oscillator_error, spectral_radius, step_map};
 use super::time::{BAR_STEPS, BarOrder, OSCILLATOR_STEPS, bar_orders, last_order};
-use crate::cases::{CaseError, bar, disc};
+use crate::cases::{bar, disc};
 use crate::compiler::scheme::EnergyLaw;
-use crate::driver::{Active, Setup};
+use crate::driver::{FilesInUse, Methods};
+use crate::error::CaseError;
 use crate::plot::Curve;
 
 /// ζ of the damped oscillator ü + 2ζu̇ + u = 0.
@@ -84,10 +85,14 @@ pub struct SchemeVerification {
     /// The oscillator at ωΔt = 0.1 over 1000 steps: max |E_{n+1} − E_n| / E_0 and (E_N − E_0)/E_0.
     pub energy_step_max: Option<f64>,
     pub energy_drift: Option<f64>,
-    /// The bar before impact (t ≤ 0.8, Δt = 0.01): max_n |E_n − E_0| / E_0.
+    /// The bar before impact (t ≤ 0.8, at its file's Δt): max_n |E_n − E_0| / E_0, and that Δt.
     pub bar_energy_drift: f64,
+    pub bar_energy_dt: f64,
     pub bar: Vec<CaseRow>,
     pub disc: Vec<CaseRow>,
+    /// What the bar and disc rows ran: the mesh, Δt and T.
+    pub bar_setting: String,
+    pub disc_setting: String,
     /// The smallest ωΔt with ρ > 1 (none: stable over [1e-2, 1e6]).
     pub stability_limit: Option<f64>,
     /// The energy law the file claims.
@@ -101,47 +106,47 @@ impl SchemeVerification {
     }
 }
 
-/// Measures the scheme of `setup` (its `scheme` and `params`).
-pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerification, CaseError> {
-    let active = Active::resolve(setup, &[])?;
-    let scheme = active.scheme_name().to_string();
-    let params: Vec<(String, f64)> = active
+/// Measures the scheme of `methods` (its `scheme` and `params`).
+pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerification, CaseError> {
+    let in_use = FilesInUse::resolve(methods, &[])?;
+    let scheme = in_use.scheme_name().to_string();
+    let params: Vec<(String, f64)> = in_use
         .scheme
         .params()
         .iter()
-        .zip(active.forms.params.scheme_values(active.scheme.params()))
+        .zip(in_use.forms.params.scheme_values(in_use.scheme.params()))
         .map(|(p, v)| (p.name.to_string(), v))
         .collect();
-    let claims = active.scheme_claims()?;
+    let claims = in_use.scheme_claims()?;
     progress(&format!("{scheme}: oscillator"));
     let oscillator: Vec<(f64, f64)> = OSCILLATOR_STEPS
         .iter()
         .chain(&[0.005])
-        .map(|&dt| Ok((dt, oscillator_error(setup, dt, 10.0)?)))
+        .map(|&dt| Ok((dt, oscillator_error(methods, dt, 10.0)?)))
         .collect::<Result<_, CaseError>>()?;
     let oscillator_order = last_order(&oscillator);
     let settings = &crate::settings::get().verify;
     let damping = settings.damping_slot.as_str();
-    let damped_oscillator: Vec<(f64, f64)> = if active.scheme.desc().uses.iter().any(|s| s.name == damping) {
+    let damped_oscillator: Vec<(f64, f64)> = if in_use.scheme.desc().uses.iter().any(|s| s.name == damping) {
         progress(&format!("{scheme}: damped oscillator"));
         OSCILLATOR_STEPS
             .iter()
             .chain(&[0.005])
-            .map(|&dt| Ok((dt, damped_oscillator_error(setup, damping, ZETA, dt, 10.0)?)))
+            .map(|&dt| Ok((dt, damped_oscillator_error(methods, damping, ZETA, dt, 10.0)?)))
             .collect::<Result<_, CaseError>>()?
     } else {
         Vec::new()
     };
     let damped_order = (!damped_oscillator.is_empty()).then(|| last_order(&damped_oscillator));
-    let rho_infinity = spectral_radius(setup, 1e12)?;
+    let rho_infinity = spectral_radius(methods, 1e12)?;
     progress(&format!("{scheme}: spectrum"));
-    let own = spectrum(setup)?;
+    let own = spectrum(methods)?;
     let others: Vec<&String> = settings.references.iter().filter(|r| **r != scheme).collect();
     let references = others
         .iter()
-        .map(|r| Ok((r.to_string(), spectrum(&reference(setup, r))?)))
+        .map(|r| Ok((r.to_string(), spectrum(&reference(methods, r))?)))
         .collect::<Result<_, CaseError>>()?;
-    let (energy_step_max, energy_drift) = match oscillator_energies(setup, 0.1, 1000) {
+    let (energy_step_max, energy_drift) = match oscillator_energies(methods, 0.1, 1000) {
         Ok(e) => {
             let step = e.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max) / e[0];
             (Some(step), Some((e[e.len() - 1] - e[0]) / e[0]))
@@ -150,21 +155,24 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
         Err(_) => (None, None),
     };
     progress(&format!("{scheme}: bar before impact"));
-    let bar_orders = bar_orders(setup)?;
-    let before = bar::run(&bar::Options { setup: setup.clone(), t_end: Some(0.8), ..bar::Options::default() })?;
+    let bar_orders = bar_orders(methods)?;
+    let before = bar::run(&bar::Options { methods: methods.clone(), t_end: Some(0.8), ..bar::Options::default() })?;
     let e0 = before.series[0].energy;
     let bar_energy_drift = before.series.iter().map(|r| (r.energy - e0).abs()).fold(0.0, f64::max) / e0;
+    let bar_energy_dt = before.summary.dt;
+    let (mut bar_setting, mut disc_setting) = (String::new(), String::new());
     progress(&format!("{scheme}: bar and disc beside the library"));
     let mut bar_rows = Vec::new();
     let mut disc_rows = Vec::new();
     let names = std::iter::once(None).chain(others.iter().map(|r| Some(r.as_str())));
     for name in names {
         let s = match name {
-            None => setup.clone(),
-            Some(r) => reference(setup, r),
+            None => methods.clone(),
+            Some(r) => reference(methods, r),
         };
         let label = name.map_or(scheme.clone(), |r| r.to_string());
-        let b = bar::run(&bar::Options { setup: s.clone(), ..bar::Options::default() })?.summary;
+        let b = bar::run(&bar::Options { methods: s.clone(), ..bar::Options::default() })?.summary;
+        bar_setting = format!("N = {}, Δt = {}, T = {}", b.elements, b.dt, b.t_end);
         bar_rows.push(CaseRow {
             scheme: label.clone(),
             values: vec![
@@ -175,22 +183,23 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
                 ("Newton".into(), b.newton_total as f64),
             ],
         });
-        let d = disc::run(&disc::Options { setup: s, h: 2.0, ..disc::Options::default() })?.summary;
+        let d = disc::run(&disc::Options { methods: s, h: Some(2.0), ..disc::Options::default() })?.summary;
+        disc_setting = format!("{}, Δt = {}, T = {}", d.mesh, d.dt, d.t_end);
         disc_rows.push(CaseRow {
             scheme: label,
             values: vec![
                 ("first contact".into(), d.first_contact.unwrap_or(f64::NAN)),
-                ("min ȳ".into(), d.min_uy_mean),
+                ("min ȳ".into(), d.min_u_vertical_mean),
                 ("penetration".into(), d.max_penetration),
                 ("E_aug(T)".into(), d.energy_aug_final),
                 ("Newton".into(), d.newton_total as f64),
             ],
         });
     }
-    let stability_limit = stability_limit(setup)?;
-    let law = active.scheme_energy_law()?;
+    let stability_limit = stability_limit(methods)?;
+    let law = in_use.scheme_energy_law()?;
     let energy_law = match law {
-        Some(law) => Some((law, energy_law_defect(setup, law)?)),
+        Some(law) => Some((law, energy_law_defect(methods, law)?)),
         None => None,
     };
     let verdicts = verdicts(&claims, oscillator_order, damped_order, rho_infinity, stability_limit, energy_law)?;
@@ -209,8 +218,11 @@ pub fn run(setup: &Setup, progress: &mut dyn FnMut(&str)) -> Result<SchemeVerifi
         energy_step_max,
         energy_drift,
         bar_energy_drift,
+        bar_energy_dt,
         bar: bar_rows,
         disc: disc_rows,
+        bar_setting,
+        disc_setting,
         stability_limit,
         energy_law: law.map(|l| l.name().to_string()),
         verdicts,
@@ -267,8 +279,8 @@ fn figure(x: f64) -> String {
 
 /// The smallest ωΔt at which the oscillator's one-step map has ρ > 1 (to [`RHO_UNSTABLE`]),
 /// scanned over [`omega_dts`] and bisected; none when it is stable over the whole range.
-fn stability_limit(setup: &Setup) -> Result<Option<f64>, CaseError> {
-    let unstable = |x: f64| -> Result<bool, CaseError> { Ok(spectral_radius(setup, x)? > 1.0 + RHO_UNSTABLE) };
+fn stability_limit(methods: &Methods) -> Result<Option<f64>, CaseError> {
+    let unstable = |x: f64| -> Result<bool, CaseError> { Ok(spectral_radius(methods, x)? > 1.0 + RHO_UNSTABLE) };
     let grid = omega_dts();
     let mut first = None;
     for (k, &x) in grid.iter().enumerate() {
@@ -297,10 +309,10 @@ fn stability_limit(setup: &Setup) -> Result<Option<f64>, CaseError> {
 /// ωΔt = 0.1, 1 and 10, relative to E₀: max |Eₙ − E₀| for a conserving scheme, the largest
 /// step increase max (Eₙ₊₁ − Eₙ) for a dissipative one. (With contact, the runs' energy guard
 /// applies the same law.)
-fn energy_law_defect(setup: &Setup, law: EnergyLaw) -> Result<f64, CaseError> {
+fn energy_law_defect(methods: &Methods, law: EnergyLaw) -> Result<f64, CaseError> {
     let mut defect = 0.0f64;
     for dt in [0.1, 1.0, 10.0] {
-        let e = oscillator_energies(setup, dt, 1000)?;
+        let e = oscillator_energies(methods, dt, 1000)?;
         let d = match law {
             EnergyLaw::Conserving => e.iter().map(|x| (x - e[0]).abs()).fold(0.0, f64::max),
             EnergyLaw::Dissipative => e.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max),
@@ -310,28 +322,28 @@ fn energy_law_defect(setup: &Setup, law: EnergyLaw) -> Result<f64, CaseError> {
     Ok(defect)
 }
 
-/// The setup with a reference scheme instead: the settings that apply to it (the form files'
+/// The methods with a reference scheme instead: the settings that apply to it (the form files'
 /// params, and scheme params of the same name) are kept.
-fn reference(setup: &Setup, scheme: &str) -> Setup {
-    let params = setup
+fn reference(methods: &Methods, scheme: &str) -> Methods {
+    let params = methods
         .params
         .iter()
         .filter(|p| {
-            let probe = Setup { scheme: scheme.into(), params: vec![(*p).clone()], ..setup.clone() };
-            Active::resolve(&probe, &[]).is_ok()
+            let probe = Methods { scheme: scheme.into(), params: vec![(*p).clone()], ..methods.clone() };
+            FilesInUse::resolve(&probe, &[]).is_ok()
         })
         .cloned()
         .collect();
-    Setup { scheme: scheme.into(), params, ..setup.clone() }
+    Methods { scheme: scheme.into(), params, ..methods.clone() }
 }
 
 /// The oscillator's one-step map over [`omega_dts`]: its spectral radius and the relative
 /// period error of its principal roots.
-fn spectrum(setup: &Setup) -> Result<Vec<SpectrumPoint>, CaseError> {
+fn spectrum(methods: &Methods) -> Result<Vec<SpectrumPoint>, CaseError> {
     omega_dts()
         .into_iter()
         .map(|dt| {
-            let a = step_map(setup, dt)?;
+            let a = step_map(methods, dt)?;
             let m = a.len();
             let matrix = nalgebra::DMatrix::from_fn(m, m, |i, j| a[i][j]);
             let roots = matrix.complex_eigenvalues();
@@ -474,11 +486,11 @@ impl SchemeVerification {
         }
         let _ = writeln!(
             s,
-            "\nEnergy: max |E_n − E_0| / E_0 = {:.3e} at Δt = 0.01 (steps {:?} for the orders).\n",
-            self.bar_energy_drift, BAR_STEPS
+            "\nEnergy: max |E_n − E_0| / E_0 = {:.3e} at Δt = {} (steps {:?} for the orders).\n",
+            self.bar_energy_drift, self.bar_energy_dt, BAR_STEPS
         );
-        for (title, rows) in [("Bar (Δt = 0.01, T = 12)", &self.bar), ("Disc (h = 2, Δt = 0.02, T = 20)", &self.disc)]
-        {
+        let titles = [format!("Bar ({})", self.bar_setting), format!("Disc ({})", self.disc_setting)];
+        for (title, rows) in titles.iter().zip([&self.bar, &self.disc]) {
             let _ = writeln!(s, "## {title}\n");
             if let Some(first) = rows.first() {
                 let heads: Vec<&str> = first.values.iter().map(|(n, _)| n.as_str()).collect();

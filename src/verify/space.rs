@@ -10,7 +10,7 @@ use std::f64::consts::PI;
 
 use serde::Serialize;
 
-use crate::cases::CaseError;
+use crate::error::CaseError;
 use crate::forms::elasticity;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::evaluate::errors;

@@ -10,8 +10,9 @@
 use serde::Serialize;
 
 use super::oscillator::{oscillator_error, spectral_radius};
-use crate::cases::{CaseError, bar};
-use crate::driver::Setup;
+use crate::cases::bar;
+use crate::driver::Methods;
+use crate::error::CaseError;
 
 /// The oscillator's steps (T = 10).
 pub const OSCILLATOR_STEPS: [f64; 3] = [0.04, 0.02, 0.01];
@@ -58,12 +59,16 @@ fn coarse_difference(a: &[bar::Row], b: &[bar::Row]) -> f64 {
 }
 
 /// The bar before impact: successive differences of the contact point's displacement.
-fn bar_differences(setup: &Setup) -> Result<Vec<(f64, f64)>, CaseError> {
+fn bar_differences(methods: &Methods) -> Result<Vec<(f64, f64)>, CaseError> {
     let runs: Vec<Vec<bar::Row>> = BAR_STEPS
         .iter()
         .map(|&dt| {
-            let opts =
-                bar::Options { setup: setup.clone(), dt: Some(dt), t_end: Some(BAR_END), ..bar::Options::default() };
+            let opts = bar::Options {
+                methods: methods.clone(),
+                dt: Some(dt),
+                t_end: Some(BAR_END),
+                ..bar::Options::default()
+            };
             Ok(bar::run(&opts)?.series)
         })
         .collect::<Result<_, CaseError>>()?;
@@ -71,13 +76,13 @@ fn bar_differences(setup: &Setup) -> Result<Vec<(f64, f64)>, CaseError> {
 }
 
 /// The bar's order before impact with each contact law of verify's list (forms/library.toml).
-pub fn bar_orders(setup: &Setup) -> Result<Vec<BarOrder>, CaseError> {
+pub fn bar_orders(methods: &Methods) -> Result<Vec<BarOrder>, CaseError> {
     crate::settings::get()
         .verify
         .contacts
         .iter()
         .map(|contact| {
-            let differences = bar_differences(&Setup { contact: contact.clone(), ..setup.clone() })?;
+            let differences = bar_differences(&Methods { contact: contact.clone(), ..methods.clone() })?;
             Ok(BarOrder { contact: contact.clone(), order: last_order(&differences), differences })
         })
         .collect()
@@ -89,19 +94,19 @@ pub fn orders(progress: &mut dyn FnMut(&str)) -> Result<Vec<TimeRow>, CaseError>
         .into_iter()
         .map(|scheme| {
             progress(&format!("time order {scheme}"));
-            let setup = Setup { scheme: scheme.into(), ..Setup::default() };
+            let methods = Methods { scheme: scheme.into(), ..Methods::default() };
             let oscillator: Vec<(f64, f64)> = OSCILLATOR_STEPS
                 .iter()
-                .map(|&dt| Ok((dt, oscillator_error(&setup, dt, 10.0)?)))
+                .map(|&dt| Ok((dt, oscillator_error(&methods, dt, 10.0)?)))
                 .collect::<Result<_, CaseError>>()?;
-            let bar = bar_orders(&setup)?;
-            let cfl = super::claimed_cfl(&setup)?;
+            let bar = bar_orders(&methods)?;
+            let cfl = super::claimed_cfl(&methods)?;
             Ok(TimeRow {
                 scheme: scheme.into(),
                 oscillator_order: last_order(&oscillator),
                 oscillator,
                 bar,
-                rho_infinity: spectral_radius(&setup, cfl.unwrap_or(1e12))?,
+                rho_infinity: spectral_radius(&methods, cfl.unwrap_or(1e12))?,
                 cfl,
             })
         })

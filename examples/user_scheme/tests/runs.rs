@@ -2,17 +2,17 @@
 //! same file run by path (interpreted); with αB = 0 WBZ-α is Newmark.
 
 use signorini::cases::bar;
-use signorini::driver::Setup;
+use signorini::driver::Methods;
 
 signorini::forms!(mod wbz = "wbz.wf");
 
-fn series(setup: Setup) -> Vec<f64> {
-    let opts = bar::Options { setup, t_end: Some(3.0), ..bar::Options::default() };
+fn series(methods: Methods) -> Vec<f64> {
+    let opts = bar::Options { methods, t_end: Some(3.0), ..bar::Options::default() };
     bar::run(&opts).unwrap().series.iter().map(|r| r.u_c).collect()
 }
 
-fn compiled() -> Setup {
-    Setup { scheme: "wbz".into(), compiled: vec![&wbz::UNIT], ..Setup::default() }
+fn compiled() -> Methods {
+    Methods { scheme: "wbz".into(), compiled: vec![&wbz::UNIT], ..Methods::default() }
 }
 
 #[test]
@@ -27,10 +27,10 @@ fn the_binary_runs_the_bar_and_a_gmsh_disc() {
 #[test]
 fn compiled_by_path_and_newmark_agree() {
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/wbz.wf");
-    let by_path = Setup { scheme: file.into(), ..Setup::default() };
+    let by_path = Methods { scheme: file.into(), ..Methods::default() };
     let (a, b) = (series(compiled().set("alpha_b", -0.2)), series(by_path.set("alpha_b", -0.2)));
     assert_eq!(a, b, "compiled vs interpreted");
-    let newmark = series(Setup { scheme: "newmark".into(), ..Setup::default() });
+    let newmark = series(Methods { scheme: "newmark".into(), ..Methods::default() });
     let wbz0 = series(compiled().set("alpha_b", 0.0));
     let scale = newmark.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     for (k, (x, y)) in wbz0.iter().zip(&newmark).enumerate() {

@@ -1,0 +1,60 @@
+//! `bench assemble`, `bench disc`, `bench sphere`: the benchmarks run and their JSON written.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use super::fail;
+
+pub(super) fn assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) -> ExitCode {
+    if sizes.iter().any(|&n| n == 0 || n > 2048) {
+        eprintln!("error: --sizes must lie in 1..=2048");
+        return ExitCode::FAILURE;
+    }
+    // The P2 plane-strain unknowns of the N×N mesh, 2 (2N + 1)², against the memory there is,
+    // before anything is allocated.
+    for (what, n) in sizes.iter().map(|&n| ("--sizes", n)).chain((factor > 0).then_some(("--factor", factor))) {
+        let dofs = 2.0 * (2.0 * n as f64 + 1.0).powi(2);
+        if let Err(e) = crate::resources::check(&format!("bench assemble {what} {n}"), dofs, 2, None) {
+            return fail(e);
+        }
+    }
+    let report = crate::bench::assemble(sizes, (factor > 0).then_some(factor), repeats, &mut |line| println!("{line}"));
+    write_bench(&out.join("bench_assemble.json"), &report)
+}
+
+pub(super) fn sphere(max_dofs: usize, out: &Path) -> ExitCode {
+    use crate::bench::sphere;
+    let report = match sphere::sphere(max_dofs, out, &mut |line| println!("{line}")) {
+        Ok(r) => r,
+        Err(e) => return fail(e),
+    };
+    if let Err(e) = sphere::figure(&report, out) {
+        return fail(e);
+    }
+    write_bench(&out.join("bench_sphere.json"), &report)
+}
+
+pub(super) fn disc(meshes: &[PathBuf], repeats: usize, out: &Path) -> ExitCode {
+    let report = match crate::bench::disc::disc(meshes, repeats, &mut |line| println!("{line}")) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    write_bench(&out.join("bench_disc.json"), &report)
+}
+
+/// Writes a benchmark's JSON and says where.
+fn write_bench(path: &Path, report: &impl serde::Serialize) -> ExitCode {
+    match crate::output::write_json(path, report) {
+        Ok(()) => {
+            println!("wrote {}", path.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: cannot write {}: {e}", path.display());
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,65 @@
+//! Why a run did not run or did not finish: the one error type of the facade, from a bad option
+//! or file to a step that failed, an energy that grew, an interrupt. Every layer returns it (the
+//! driver, the simulation, problems, the cases, `verify`, the report); its messages are what the
+//! command line prints.
+
+/// Why a run did not run, or stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    #[error("invalid option: {0}")]
+    Option(String),
+    /// A case file problem, with file and line.
+    #[error("{0}")]
+    CaseFile(String),
+    #[error(transparent)]
+    Mesh(#[from] crate::runtime::fem::mesh::MeshError),
+    #[error(transparent)]
+    Newton(#[from] crate::runtime::nonlinear::newton::NewtonError),
+    #[error("time stepping failed: {0}")]
+    Step(#[from] crate::runtime::time::stepper::StepError),
+    #[error("cannot write {path}: {source}")]
+    Write { path: String, source: std::io::Error },
+    /// Newton failed at a step even after `cuts` halvings of Δt.
+    #[error(
+        "stopped at t = {t} after {cuts} step cuts (Δt = {dt:.3e}): {cause}\n  Newton: {history}\n  results up to the last good step are written; more cuts: --max-step-cuts, or try a smaller Δt"
+    )]
+    Stopped { t: f64, cuts: usize, dt: f64, cause: String, history: String },
+    /// A step failed in a way no smaller Δt mends.
+    #[error("stopped at t = {t}: {cause}\n  results up to the last good step are written")]
+    Failed { t: f64, cause: String },
+    /// The energy grew past what a stable scheme allows.
+    #[error(
+        "stopped at t = {t}: the energy E_aug = ½uᵀKu + ½vᵀMv + contact energy = {energy:.6e} exceeds E_aug(0) + the work of the loads = {bound:.6e} by {:.1} % of the problem's energy scale {scale:.4e} (the largest of |E_aug(0)|, the work and the kinetic energy reached); the tolerance is {:.1} %{law}: the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Δt beyond a conditionally stable scheme's limit (an explicit scheme, an explicit contact term), Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt, a contact parameter so large (γ0 or ε ≳ 1e12 × E) that the contact rows' round-off swamps the solve, or degenerate cells. Results up to the last good step are written; --energy-tolerance sets the tolerance (0 turns this check off)",
+        100.0 * (energy - bound) / scale,
+        100.0 * tolerance
+    )]
+    BlowUp { t: f64, energy: f64, bound: f64, scale: f64, tolerance: f64, law: String, params: String },
+    /// The potential energy went negative: the contact law is not coercive for its params.
+    #[error(
+        "stopped at t = {t}: the potential energy ½uᵀKu + contact energy = {potential:.6e} is negative, beyond {:.1} % of the problem's energy scale {scale:.4e}: the discrete problem is not stable. Most likely the contact law is not coercive for these params (Nitsche θ = 1 or 0 with γ0 too small against the material's stiffness; θ = −1 is coercive for any γ0), and the motion grows without bound while E_aug is kept; otherwise the steps' solutions diverge (an iterative solve that is not accurate enough: try --solver direct).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
+        100.0 * tolerance
+    )]
+    NotCoercive { t: f64, potential: f64, scale: f64, tolerance: f64, params: String },
+    /// The contact law's own work outgrew the energy from outside.
+    #[error(
+        "stopped at t = {t}: the contact law's own work (the part of the law the energy does not keep, `contact_work`: Nitsche with θ ≠ 1) = {work:.6e} exceeds the energy that came from outside, {outside:.6e} (the largest of |E_aug(0)| and the loads' work): the law drives the motion, which grows without bound (γ0 far too small for θ ≠ 1).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off"
+    )]
+    LawWork { t: f64, work: f64, outside: f64, params: String },
+    /// An explicit scheme asked to step beyond its critical step.
+    #[error(
+        "Δt = {dt} is beyond the stable step of scheme `{scheme}`: Δt_c ≈ {stable:.6e} = cfl {cfl} / ω_max {omega_max:.6e}, with ω_max² the largest eigenvalue of M⁻¹(K + the contact stiffness; {active} of {points} contact points active), {mass} mass, estimated by power iteration. Use --dt {stable:.3e} or smaller (a lumped mass raises Δt_c over a consistent one; a smaller γ0 lowers the contact's stiffness), or --allow-unstable-dt to run it anyway (the energy guard still watches)"
+    )]
+    UnstableStep {
+        dt: f64,
+        scheme: String,
+        stable: f64,
+        cfl: f64,
+        omega_max: f64,
+        active: usize,
+        points: usize,
+        mass: String,
+    },
+    /// SIGINT or SIGTERM.
+    #[error("interrupted at t = {t}: results up to there are written")]
+    Interrupted { t: f64 },
+}

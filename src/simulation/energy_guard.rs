@@ -1,0 +1,225 @@
+//! The energy guard: after every step, E_aug = ½uᵀKu + ½vᵀMv + the contact law's energy against
+//! E_aug(0) + the work done on the body so far (the loads', the held dofs' reactions', a moving
+//! obstacle's, the contact law's own), with the allowance the scheme's energy law gives; a
+//! growth beyond the tolerance, a negative potential energy, or a law's own work beyond the
+//! energy from outside stops the run (docs/mathematics.md §5).
+
+use super::Operators;
+use crate::compiler::scheme::EnergyLaw;
+use crate::guard::ENERGY_TOLERANCE;
+use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
+
+/// The energy guard: the growth of E_aug = ½uᵀKu + ½vᵀMv + the contact law's
+/// `contact_energy(u)` beyond E_aug(0) + the work of the loads, over the problem's energy scale
+/// (the largest of |E_aug(0)|, the work's magnitude so far, and the kinetic energy reached).
+pub(super) struct EnergyWatch {
+    pub(super) initial: f64,
+    pub(super) u0: Vec<f64>,
+    /// The largest magnitude of the work of the loads so far.
+    pub(super) work: f64,
+    /// The work summed step by step (midpoint rule): a load that changes with time, the held
+    /// dofs' reactions, a moving obstacle's.
+    pub(super) varying_work: f64,
+    /// The contact law's `contact_work` so far: energy the law itself gives or takes.
+    pub(super) law_work: f64,
+    /// The largest kinetic energy so far.
+    pub(super) kinetic: f64,
+    /// The largest growth over the scale so far (the summary's `energy_growth`).
+    pub(super) growth: f64,
+    /// The lowest E_aug − W so far (a dissipative scheme's bound: what it lost stays lost).
+    pub(super) lowest: f64,
+    /// A conserving scheme's allowance so far: on each step whose active set changed, the
+    /// larger of `contact_jump` before and after it.
+    pub(super) allowance: f64,
+    /// The active set after the previous step (a conserving scheme's).
+    pub(super) switches: Vec<bool>,
+}
+
+/// An energy above what the guard allows.
+pub(super) struct Grown {
+    /// E_aug and E_aug(0) + W.
+    pub(super) energy: f64,
+    pub(super) bound: f64,
+    pub(super) scale: f64,
+    pub(super) cause: Cause,
+}
+
+/// What the guard saw.
+pub(super) enum Cause {
+    /// E_aug beyond its bound.
+    Growth,
+    /// ½uᵀKu + the contact energy negative beyond the tolerance.
+    Negative(f64),
+    /// The law's own work beyond the energy from outside.
+    LawWork { work: f64, outside: f64 },
+}
+
+impl EnergyWatch {
+    pub(super) fn new(ops: &Operators, states: &[Vec<f64>], v_index: Option<usize>, t: f64) -> Self {
+        let u = &states[0];
+        let v = v_index.map(|i| states[i].as_slice());
+        let kinetic = ops.kinetic(v);
+        let initial = ops.elastic(u) + kinetic + Self::contact(ops, u, t);
+        EnergyWatch {
+            initial,
+            u0: u.clone(),
+            work: 0.0,
+            varying_work: 0.0,
+            law_work: 0.0,
+            kinetic,
+            growth: 0.0,
+            lowest: initial,
+            allowance: 0.0,
+            switches: ops.contact_switches(u, t),
+        }
+    }
+
+    /// The contact law's energy (0 for a law without `contact_energy`).
+    fn contact(ops: &Operators, u: &[f64], t: f64) -> f64 {
+        Self::value(&ops.contact_energy, ops, u, t)
+    }
+
+    /// A functional of u alone at `u` (0 without it).
+    fn value(f: &Option<Box<dyn BoundFunctional + '_>>, ops: &Operators, u: &[f64], t: f64) -> f64 {
+        f.as_ref().filter(|f| f.fields() == 1).map_or(0.0, |f| f.value(ops.asm, &[u], t))
+    }
+
+    /// Adds the work of a time-dependent load over one step: L(t_mid)·(u − u_before).
+    pub(super) fn step_work(&mut self, ops: &Operators, load: &dyn BoundForm, before: &[f64], u: &[f64], t_mid: f64) {
+        let mut l = vec![0.0; u.len()];
+        load.residual(ops.asm, &[], t_mid, &mut l);
+        self.varying_work += l.iter().zip(u.iter().zip(before)).map(|(l, (a, b))| l * (a - b)).sum::<f64>();
+    }
+
+    /// Adds the work of the held dofs' reactions over one step: the reaction at the step's
+    /// midpoint, K u_mid − F + M (v' − v)/Δt at the held dofs (exact for Crank–Nicolson; without
+    /// a velocity state, its quasi-static part), times their motion.
+    pub(super) fn held_work(
+        &mut self,
+        ops: &Operators,
+        before: &[f64],
+        u: &[f64],
+        v: Option<(&[f64], &[f64])>,
+        h: f64,
+        t_mid: f64,
+    ) {
+        let mid: Vec<f64> = before.iter().zip(u).map(|(a, b)| 0.5 * (a + b)).collect();
+        let mut reaction = vec![0.0; u.len()];
+        ops.stiffness.mul_vec(&mid, &mut reaction);
+        if let Some((v0, v1)) = v {
+            let dv: Vec<f64> = v1.iter().zip(v0).map(|(a, b)| (a - b) / h).collect();
+            let mut inertia = vec![0.0; u.len()];
+            ops.scheme_mass.mul_vec(&dv, &mut inertia);
+            reaction.iter_mut().zip(&inertia).for_each(|(r, m)| *r += m);
+        }
+        let load = match &ops.varying_load {
+            Some(form) => {
+                let mut l = vec![0.0; u.len()];
+                form.residual(ops.asm, &[], t_mid, &mut l);
+                l
+            }
+            None => ops.load.clone(),
+        };
+        self.varying_work += ops.held.iter().map(|&i| (reaction[i] - load[i]) * (u[i] - before[i])).sum::<f64>();
+    }
+
+    /// Adds the work of an obstacle that moves (a gap that changes with time) over one step:
+    /// the change of the contact energy with time alone, at the step's mid-displacement.
+    pub(super) fn obstacle_work(&mut self, ops: &Operators, before: &[f64], u: &[f64], t: f64, h: f64) {
+        let mid: Vec<f64> = before.iter().zip(u).map(|(a, b)| 0.5 * (a + b)).collect();
+        self.varying_work +=
+            Self::value(&ops.contact_energy, ops, &mid, t + h) - Self::value(&ops.contact_energy, ops, &mid, t);
+    }
+
+    /// After each accepted step: the energy, and whether it grew beyond what `law` allows by
+    /// more than `tolerance` × the scale. Without a law, E_aug − W may not exceed its initial
+    /// value. A conserving scheme's E_aug may also jump on the steps where points enter or leave
+    /// contact, by at most the energy of their contact stress (docs/mathematics.md §5:
+    /// (1/2γ)(pⁿ)² or (1/2γ)(pⁿ⁺¹)²), which the law gives as `contact_jump`: on each such step
+    /// the larger of its values before and after is added to what is allowed. A dissipative scheme's
+    /// E_aug − W may not exceed the lowest value it reached. The kinetic energy of this step
+    /// joins the scale only once the step passes (a blow-up's own motion does not widen its
+    /// bound).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn check(
+        &mut self,
+        ops: &Operators,
+        states: &[Vec<f64>],
+        v_index: Option<usize>,
+        before: &[f64],
+        h: f64,
+        t: f64,
+        tolerance: f64,
+        law: Option<EnergyLaw>,
+    ) -> Option<Grown> {
+        let u = &states[0];
+        let fd: Vec<f64>;
+        let v = match v_index {
+            Some(i) => states[i].as_slice(),
+            None => {
+                fd = u.iter().zip(before).map(|(a, b)| (a - b) / h).collect();
+                &fd
+            }
+        };
+        let kinetic = ops.kinetic(Some(v));
+        let potential = ops.elastic(u) + Self::contact(ops, u, t);
+        let energy = potential + kinetic;
+        // A conserving scheme: the allowance grows on the steps where the active set changes.
+        let (switches, allowance) = match law {
+            Some(EnergyLaw::Conserving) => {
+                let switches = ops.contact_switches(u, t);
+                let jump = if switches != self.switches {
+                    let value = |x: &[f64], at: f64| Self::value(&ops.contact_jump, ops, x, at);
+                    value(u, t).max(value(before, t - h))
+                } else {
+                    0.0
+                };
+                (switches, self.allowance + jump)
+            }
+            _ => (Vec::new(), 0.0),
+        };
+        // The work summed step by step (a varying load's, the held dofs', a moving obstacle's),
+        // a constant load's from u(0), and the law's own.
+        let constant: f64 = match ops.varying_load {
+            Some(_) => 0.0,
+            None => ops.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum(),
+        };
+        let external = self.varying_work + constant;
+        self.work = self.work.max(external.abs());
+        let scale = self.initial.abs().max(self.work).max(self.kinetic).max(f64::MIN_POSITIVE);
+        let work = external + self.law_work;
+        let bound = match law {
+            Some(EnergyLaw::Conserving) => self.initial + work + allowance,
+            Some(EnergyLaw::Dissipative) => self.lowest + work,
+            None => self.initial + work,
+        };
+        // The law's own work (Nitsche θ ≠ 1) is part of the balance, but it may not drive the
+        // motion: beyond the energy that came from outside (initially and by the loads), the
+        // balance would hold while the motion grows without bound.
+        let outside = self.initial.abs().max(self.work).max(f64::MIN_POSITIVE);
+        if tolerance > 0.0 && self.law_work.abs() > outside {
+            return Some(Grown { energy, bound, scale, cause: Cause::LawWork { work: self.law_work, outside } });
+        }
+        let growth = (energy - bound) / scale;
+        // NaN compares false: a non-finite energy is a growth beyond any tolerance.
+        self.growth = if growth.is_finite() { self.growth.max(growth) } else { f64::INFINITY };
+        if tolerance > 0.0 && (growth > tolerance || growth.is_nan()) {
+            return Some(Grown { energy, bound, scale, cause: Cause::Growth });
+        }
+        // The potential energy of a coercive law is not negative: where it is, E_aug may be kept
+        // while the motion grows without bound (Nitsche θ = 1 with γ0 too small).
+        if tolerance > 0.0 && potential < -tolerance * scale {
+            return Some(Grown { energy, bound, scale, cause: Cause::Negative(potential) });
+        }
+        // With the guard off, the default tolerance still decides what joins the scale, so that
+        // the summary's `energy_growth` measures the same thing.
+        let admitted = if tolerance > 0.0 { tolerance } else { ENERGY_TOLERANCE };
+        if growth <= admitted {
+            self.kinetic = self.kinetic.max(kinetic);
+        }
+        self.switches = switches;
+        self.allowance = allowance;
+        self.lowest = self.lowest.min(energy - work);
+        None
+    }
+}

@@ -1,0 +1,69 @@
+//! VTU snapshots of a run (displacement, velocity, the cells' von Mises stress) every K steps,
+//! and their PVD collection for ParaView.
+
+use std::path::PathBuf;
+
+use super::Operators;
+use crate::error::CaseError;
+
+/// VTU snapshots every `every` steps into `dir`/vtu, and the PVD collection of them.
+pub struct Snapshots {
+    dir: Option<PathBuf>,
+    every: usize,
+    name: String,
+    written: Vec<(f64, String)>,
+}
+
+impl Snapshots {
+    /// Writes nothing unless `out` is given and `every` > 0.
+    pub fn new(out: Option<&PathBuf>, every: usize, name: &str) -> Snapshots {
+        Snapshots { dir: out.filter(|_| every > 0).cloned(), every, name: name.to_string(), written: Vec::new() }
+    }
+
+    /// The displacement and velocity at step `k`, and the cell-mean von Mises stress when the
+    /// files in use provide it.
+    pub fn write(&mut self, ops: &Operators, k: usize, t: f64, u: &[f64], v: &[f64]) -> Result<(), CaseError> {
+        let Some(dir) = &self.dir else { return Ok(()) };
+        if !k.is_multiple_of(self.every) {
+            return Ok(());
+        }
+        let mesh = ops.asm.mesh();
+        let file = format!("{}_{k:06}.vtu", self.name);
+        let vm = match (&ops.von_mises, &ops.cell_measure) {
+            (Some(vm), Some(measure)) => {
+                let size = measure.cell_values(ops.asm, &[], 0.0);
+                vm.cell_values(ops.asm, &[u], 0.0).iter().zip(&size).map(|(v, a)| v / a).collect()
+            }
+            _ => vec![f64::NAN; mesh.num_cells()],
+        };
+        let d = mesh.dim();
+        let point = [
+            crate::vtu::Field { name: "displacement", components: d, values: u },
+            crate::vtu::Field { name: "velocity", components: d, values: v },
+        ];
+        let cell = [crate::vtu::Field { name: "von_mises", components: 1, values: &vm }];
+        let path = dir.join("vtu").join(&file);
+        crate::vtu::write(&path, mesh, &point, &cell)
+            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
+        self.written.push((t, format!("vtu/{file}")));
+        Ok(())
+    }
+
+    /// The snapshots written so far: (time, file), for a checkpoint.
+    pub fn written(&self) -> &[(f64, String)] {
+        &self.written
+    }
+
+    /// Adds snapshots an earlier part of the run wrote.
+    pub fn extend_written(&mut self, written: Vec<(f64, String)>) {
+        self.written.extend(written);
+    }
+
+    /// Writes the collection `dir`/NAME.pvd (if any snapshot was written).
+    pub fn finish(self) -> Result<(), CaseError> {
+        let (Some(dir), false) = (&self.dir, self.written.is_empty()) else { return Ok(()) };
+        let path = dir.join(format!("{}.pvd", self.name));
+        crate::vtu::write_collection(&path, &self.written)
+            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })
+    }
+}
