@@ -11,6 +11,8 @@
 //! with [`descriptors`] (what the compiler writes about a file) shared with the compiler, and
 //! [`input`] (bounded reading of files) used by every reader.
 
+#![deny(clippy::undocumented_unsafe_blocks)]
+
 /// Calls `$f::<D, N, ..>(args)` with the D and N of an element kind.
 macro_rules! dispatch {
     ($kind:expr, $f:ident ($($arg:expr),* $(,)?)) => {
