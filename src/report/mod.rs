@@ -58,7 +58,8 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         .iter()
         .flat_map(|b| b.runs.iter())
         .map(|(s, c, m)| {
-            let mass = <MassChoice as clap::ValueEnum>::from_str(m, true).expect("checked by tests/settings.rs");
+            let mass =
+                <MassChoice as clap::ValueEnum>::from_str(m, true).expect("checked by tests/integration/settings.rs");
             (s.as_str(), c.as_str(), mass)
         })
         .collect();

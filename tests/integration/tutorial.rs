@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::process::Command;
 
-const TUTORIAL: &str = include_str!("../docs/tutorial.md");
+const TUTORIAL: &str = include_str!("../../docs/tutorial.md");
 
 /// (info string, body) of every fenced block.
 fn blocks(text: &str) -> Vec<(String, String)> {

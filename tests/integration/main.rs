@@ -1,0 +1,31 @@
+//! The facade's integration tests, in one binary (a binary per file spent most of `cargo
+//! test` linking): the CLI, problems, schemes, references and the report, end to end.
+
+mod assembly;
+mod bad_inputs;
+mod bar;
+mod case_files;
+mod checkpoint;
+mod cli;
+mod convergence;
+mod disc;
+mod elements;
+mod energy_guard;
+mod genalpha;
+mod hertz;
+mod import_circles;
+mod interpreted_forms;
+mod interpreted_schemes;
+mod problems;
+mod redistribution;
+mod schemes;
+mod settings;
+mod sphere;
+mod static_contact;
+mod sweep;
+mod tangents;
+mod time_dependence;
+mod tutorial;
+mod verify;
+mod verify_scheme;
+mod vtu;
