@@ -29,6 +29,23 @@ macro_rules! dispatch {
     };
 }
 
+/// Declares `$name`: a `$per_kind` (a trait generic over an element's D and N) implemented on
+/// every element kind of [`dispatch`]'s catalogue, so that code generic over a form can
+/// dispatch on the kind at run time.
+macro_rules! on_every_element_kind {
+    ($(#[$doc:meta])* $name:ident: $per_kind:ident) => {
+        $(#[$doc])*
+        pub trait $name:
+            Form + $per_kind<1, 2> + $per_kind<2, 3> + $per_kind<2, 6> + $per_kind<3, 4> + $per_kind<3, 10> + Sync
+        {
+        }
+        impl<K> $name for K where
+            K: Form + $per_kind<1, 2> + $per_kind<2, 3> + $per_kind<2, 6> + $per_kind<3, 4> + $per_kind<3, 10> + Sync
+        {
+        }
+    };
+}
+
 /// The descriptions compiled files give of themselves (their own crate: the compiler writes
 /// them too).
 pub use signorini_descriptors as descriptors;

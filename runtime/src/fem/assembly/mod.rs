@@ -31,37 +31,14 @@ use crate::linalg::Matrix;
 use crate::linalg::element_matrices::ElementMatrices;
 pub use crate::linalg::pattern::Pattern;
 
-/// A kernel usable on every element kind of the catalogue (every generated form is).
-pub trait Kernel:
-    Form + FormKernel<1, 2> + FormKernel<2, 3> + FormKernel<2, 6> + FormKernel<3, 4> + FormKernel<3, 10> + Sync
-{
-}
-impl<K> Kernel for K where
-    K: Form + FormKernel<1, 2> + FormKernel<2, 3> + FormKernel<2, 6> + FormKernel<3, 4> + FormKernel<3, 10> + Sync
-{
-}
-
-/// A functional usable on every element kind of the catalogue.
-pub trait Functional:
-    Form
-    + FunctionalKernel<1, 2>
-    + FunctionalKernel<2, 3>
-    + FunctionalKernel<2, 6>
-    + FunctionalKernel<3, 4>
-    + FunctionalKernel<3, 10>
-    + Sync
-{
-}
-impl<K> Functional for K where
-    K: Form
-        + FunctionalKernel<1, 2>
-        + FunctionalKernel<2, 3>
-        + FunctionalKernel<2, 6>
-        + FunctionalKernel<3, 4>
-        + FunctionalKernel<3, 10>
-        + Sync
-{
-}
+on_every_element_kind!(
+    /// A kernel usable on every element kind of the catalogue (every generated form is).
+    Kernel: FormKernel
+);
+on_every_element_kind!(
+    /// A functional usable on every element kind of the catalogue.
+    Functional: FunctionalKernel
+);
 
 /// Quadrature degrees chosen for a form: its suggestion for the element degree unless
 /// overridden.
