@@ -38,7 +38,7 @@ fn generated_rust_snapshots() {
     for f in library() {
         let compiled = compile(&f, &FsLoader).unwrap();
         let code = compiled.print(Stage::Rust, 2).unwrap();
-        insta::with_settings!({ snapshot_path => "snapshots/rust", prepend_module_to_snapshot => false }, {
+        insta::with_settings!({ snapshot_path => "../snapshots/rust", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(stem(&f), code);
         });
     }
@@ -51,7 +51,7 @@ fn ast_ir_and_scheme_snapshots() {
         let ast_text = compiled.print(Stage::Ast, 2).unwrap();
         let ir_text = compiled.print(Stage::Ir, 2).unwrap();
         let schemes = compiled.print(Stage::Scheme, 2).unwrap();
-        insta::with_settings!({ snapshot_path => "snapshots/stages", prepend_module_to_snapshot => false }, {
+        insta::with_settings!({ snapshot_path => "../snapshots/stages", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(format!("{}.ast", stem(&f)), ast_text);
             insta::assert_snapshot!(format!("{}.ir2d", stem(&f)), ir_text);
             if !compiled.schemes().is_empty() {
@@ -77,7 +77,7 @@ fn library_problems_check_clean_and_print() {
         assert!(compiled.warnings.is_empty(), "{}:\n{}", f.display(), compiled.warnings);
         assert!(compiled.program.unit.problems.len() == 1, "{}: one problem per file", f.display());
         let ast = compiled.print(Stage::Ast, 2).unwrap();
-        insta::with_settings!({ snapshot_path => "snapshots/problems", prepend_module_to_snapshot => false }, {
+        insta::with_settings!({ snapshot_path => "../snapshots/problems", prepend_module_to_snapshot => false }, {
             insta::assert_snapshot!(format!("{}.ast", stem(f)), ast);
         });
     }

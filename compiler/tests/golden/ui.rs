@@ -38,7 +38,7 @@ fn bad_files_render_their_diagnostics() {
         assert!(!diags.is_empty(), "{} produced no diagnostic", path.display());
         codes.extend(diags.iter().map(|d| d.code));
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
-        insta::with_settings!({ snapshot_path => "snapshots/ui", prepend_module_to_snapshot => false, description => source_of(path) }, {
+        insta::with_settings!({ snapshot_path => "../snapshots/ui", prepend_module_to_snapshot => false, description => source_of(path) }, {
             insta::assert_snapshot!(name, rendered);
         });
     }
