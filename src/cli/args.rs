@@ -255,10 +255,15 @@ pub struct ProblemArgs {
     #[command(flatten)]
     pub(super) checkpoint: CheckpointArgs,
     /// Linear solver of each step: direct (sparse Cholesky/LU), iterative (Jacobi-preconditioned
-    /// CG, or BiCGStab for unsymmetric tangents; memory of the matrix only), or auto (iterative
-    /// above 10 000 unknowns in 3D, 100 000 in 2D).
+    /// CG, or BiCGStab for unsymmetric tangents; memory of the matrix only), auto (iterative
+    /// above 10 000 unknowns in 3D, 100 000 in 2D), or petsc (CG or GMRES with algebraic
+    /// multigrid; a build with `--features petsc`).
     #[arg(long, value_parser = Solver::parse, default_value = name_of(Solver::default()))]
     pub(super) solver: Solver,
+    /// Options for PETSc's solvers, over the defaults of --solver petsc (`PETSC_OPTIONS` is
+    /// read too): e.g. "-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps".
+    #[arg(long, value_name = "OPTIONS", allow_hyphen_values = true)]
+    pub(super) petsc_options: Option<String>,
     /// Run every scheme × every contact law × {consistent, redistributed} (with the --param
     /// settings that apply) and print one table of the problem's summary (with --out: one
     /// subdirectory per run).

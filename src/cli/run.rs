@@ -11,6 +11,11 @@ use crate::driver::{Methods, Setting};
 use crate::simulation::MassChoice;
 
 pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
+    if let Some(options) = &a.petsc_options
+        && let Err(e) = crate::runtime::linalg::set_petsc_options(options)
+    {
+        return fail(e);
+    }
     let methods = match a.methods.to_methods() {
         Ok(s) => s,
         Err(e) => return fail(e),

@@ -108,7 +108,8 @@ fn diagonal_inverse(a: &Matrix, structure: Structure) -> Result<Option<Vec<f64>>
 
 /// How a `Factorization` solves: a sparse direct factorization, preconditioned Krylov
 /// iterations (conjugate gradients for SPD matrices, BiCGStab otherwise; memory of the matrix
-/// only), or by size: direct in 1D, iterative above [`AUTO_ITERATIVE_DOFS`] unknowns in 2D and 3D.
+/// only), by size: direct in 1D, iterative above [`AUTO_ITERATIVE_DOFS`] unknowns in 2D and 3D;
+/// or PETSc's Krylov solvers with algebraic multigrid (feature `petsc`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Solver {
@@ -116,6 +117,7 @@ pub enum Solver {
     Iterative,
     #[default]
     Auto,
+    Petsc,
 }
 
 /// Above this many unknowns `Solver::Auto` iterates, in 3D and in 2D. Measured with
@@ -131,7 +133,12 @@ impl Solver {
             "direct" => Ok(Solver::Direct),
             "iterative" => Ok(Solver::Iterative),
             "auto" => Ok(Solver::Auto),
-            _ => Err(format!("`{s}`: expected direct, iterative or auto")),
+            "petsc" if cfg!(feature = "petsc") => Ok(Solver::Petsc),
+            "petsc" => Err(
+                "`petsc`: this signorini was built without PETSc (build it with `--features petsc`, README: Large runs)"
+                    .into(),
+            ),
+            _ => Err(format!("`{s}`: expected direct, iterative, auto or petsc")),
         }
     }
 
@@ -139,7 +146,7 @@ impl Solver {
     pub fn iterates(self, n: usize, dim: usize) -> bool {
         match self {
             Solver::Direct => false,
-            Solver::Iterative => true,
+            Solver::Iterative | Solver::Petsc => true,
             // In 1D the matrix is banded: its factor does not fill, and a direct solve is always
             // the cheaper (100 001 unknowns of the bar: 48.8 s for two steps by Jacobi-CG).
             Solver::Auto => dim > 1 && n > AUTO_ITERATIVE_DOFS[if dim >= 3 { 0 } else { 1 }],
@@ -150,6 +157,8 @@ impl Solver {
 enum Factors {
     None,
     Krylov(Box<crate::linalg::krylov::Krylov>),
+    #[cfg(feature = "petsc")]
+    Petsc(Box<crate::linalg::petsc::PetscSolver>),
     /// A diagonal matrix's inverse (a lumped mass: an explicit scheme's step is a division).
     Diagonal(Vec<f64>),
     /// faer's factor, and its copy in node blocks that the solves use (faer's values are then
@@ -178,6 +187,8 @@ pub struct Factorization {
     pub counters: Counters,
     /// The solves' vector in elimination order (kept between solves).
     work: Vec<f64>,
+    /// The nodes' coordinates (`nodes × dim`), for a multigrid's near-null space.
+    coordinates: Option<Arc<[f64]>>,
 }
 
 impl Factorization {
@@ -191,12 +202,21 @@ impl Factorization {
             par: Par::Seq,
             counters: Counters::default(),
             work: Vec::new(),
+            coordinates: None,
         }
     }
 
     /// Solves with `solver` (direct by default).
     pub fn with_solver(mut self, solver: Solver) -> Self {
         self.solver = solver;
+        self
+    }
+
+    /// The nodes' coordinates (`nodes × dim`, row-major) when the unknowns are their
+    /// displacements: algebraic multigrid (PETSc's GAMG) takes their rigid-body modes as its
+    /// near-null space.
+    pub fn with_coordinates(mut self, coordinates: Option<Arc<[f64]>>) -> Self {
+        self.coordinates = coordinates;
         self
     }
 
@@ -218,6 +238,9 @@ impl Factorization {
             self.factors = Factors::Diagonal(inverse);
             self.pattern = None;
             return Ok(());
+        }
+        if self.solver == Solver::Petsc {
+            return self.factor_petsc(a);
         }
         if self.solver.iterates(n, a.pattern.dim()) {
             // Keep the last solution as the next first guess across refactorizations.
@@ -312,9 +335,7 @@ impl Factorization {
                 )?;
                 *factored = true;
             }
-            Factors::None | Factors::Krylov(_) | Factors::Diagonal(_) => {
-                unreachable!("symbolic analysis done above")
-            }
+            _ => unreachable!("symbolic analysis done above"),
         }
         Ok(())
     }
@@ -329,7 +350,7 @@ impl Factorization {
             Factors::Lu { symbolic, .. } => {
                 Factors::Lu { symbolic: symbolic.clone(), numeric: Box::new(NumericLu::new()), factored: false }
             }
-            Factors::None | Factors::Krylov(_) | Factors::Diagonal(_) => Factors::None,
+            _ => Factors::None,
         };
         let pattern = if matches!(factors, Factors::None) { None } else { self.pattern.clone() };
         Factorization {
@@ -340,6 +361,7 @@ impl Factorization {
             par: self.par,
             counters: Counters::default(),
             work: Vec::new(),
+            coordinates: self.coordinates.clone(),
         }
     }
 
@@ -443,7 +465,41 @@ impl Factorization {
             self.counters.solves += 1;
             return result;
         }
+        #[cfg(feature = "petsc")]
+        if let Factors::Petsc(k) = &mut self.factors {
+            let result = k.solve_in_place(b);
+            self.counters.iterations += k.iterations;
+            self.counters.solves += 1;
+            return result;
+        }
         self.solve_many_in_place(b, 1)
+    }
+
+    /// A PETSc solver for `a`: its values into the solver of the same pattern, else a new one.
+    #[cfg(feature = "petsc")]
+    fn factor_petsc(&mut self, a: &Matrix) -> Result<(), LinalgError> {
+        self.counters.numeric += 1;
+        if let Factors::Petsc(k) = &mut self.factors
+            && k.fits(a)
+        {
+            return k.set_values(a);
+        }
+        let symmetric = self.structure == Structure::SymmetricPositiveDefinite;
+        let k = crate::linalg::petsc::PetscSolver::new(
+            a,
+            symmetric,
+            self.coordinates.as_deref(),
+            crate::linalg::krylov::TOLERANCE,
+        )?;
+        self.factors = Factors::Petsc(Box::new(k));
+        self.pattern = Some(a.pattern.clone());
+        self.counters.symbolic += 1;
+        Ok(())
+    }
+
+    #[cfg(not(feature = "petsc"))]
+    fn factor_petsc(&mut self, _a: &Matrix) -> Result<(), LinalgError> {
+        Err(LinalgError::Other("this signorini was built without PETSc (`--features petsc`)".into()))
     }
 }
 

@@ -158,6 +158,8 @@ pub enum LinalgError {
     Singular { index: Option<usize> },
     #[error("the linear solver failed: {0}")]
     Other(String),
+    #[error("PETSc's {function} failed (error {code}): {message}")]
+    Petsc { function: &'static str, code: i32, message: String },
     #[error("solve requested before a successful factorization")]
     NotFactored,
 }

@@ -2,7 +2,8 @@
 //! here): matrices over a sparsity pattern, reusable factorizations (faer's sparse Cholesky and
 //! LU, and a copy of the Cholesky factor in node blocks for the solves), products with a
 //! symmetric matrix's lower half, block-Jacobi Krylov solvers, and low-rank corrections of a
-//! factorization by element matrices kept apart.
+//! factorization by element matrices kept apart; with the feature `petsc`, PETSc's Krylov
+//! solvers and algebraic multigrid behind the same `Factorization`.
 
 pub mod block_factor;
 pub mod element_matrices;
@@ -13,6 +14,20 @@ pub mod lowrank;
 pub mod matrix;
 pub mod norms;
 pub mod pattern;
+#[cfg(feature = "petsc")]
+pub mod petsc;
 
 pub use factorization::{AUTO_ITERATIVE_DOFS, Counters, Factorization, Solver, Structure};
 pub use matrix::{LinalgError, Matrix};
+
+/// Options for every PETSc solver of this process, in PETSc's syntax (`-ksp_type gmres
+/// -pc_type hypre`), applied over their defaults as `PETSC_OPTIONS` is; an error in a build
+/// without the `petsc` feature.
+pub fn set_petsc_options(options: &str) -> Result<(), LinalgError> {
+    #[cfg(feature = "petsc")]
+    return petsc::set_options(options);
+    #[cfg(not(feature = "petsc"))]
+    Err(LinalgError::Other(format!(
+        "PETSc options `{options}` given, but this signorini was built without PETSc (`--features petsc`)"
+    )))
+}

@@ -50,6 +50,12 @@ pub trait NonlinearProblem {
     fn varying_entries(&self) -> Option<&Entries> {
         None
     }
+    /// The coordinates of the nodes whose displacements are the unknowns (`nodes × dim`,
+    /// row-major), if they are: algebraic multigrid builds its near-null space (the rigid-body
+    /// modes) from them.
+    fn node_coordinates(&self) -> Option<std::sync::Arc<[f64]>> {
+        None
+    }
     /// The part of the Jacobian at w that varies with w, as element matrices (always the same
     /// elements), if the problem can give it: corrections then have the rank of the elements'
     /// changes rather than of the dofs they touch.

@@ -312,7 +312,8 @@ impl JacobianReuse {
         let f = match &mut self.factorization {
             Some(f) if f.structure() == want => f,
             slot => {
-                let old = slot.replace(Factorization::new(want).with_solver(solver));
+                let old =
+                    slot.replace(Factorization::new(want).with_solver(solver).with_coordinates(p.node_coordinates()));
                 if let Some(old) = old
                     && let Some(replaced) = self.spare.replace(old)
                 {
@@ -326,7 +327,8 @@ impl JacobianReuse {
                 debug!("Jacobian not positive definite: switching to LU");
                 self.spd_failed = true;
                 let counters = f.counters;
-                let mut lu = Factorization::new(Structure::General).with_solver(solver);
+                let mut lu =
+                    Factorization::new(Structure::General).with_solver(solver).with_coordinates(p.node_coordinates());
                 lu.counters = counters;
                 lu.factor(j)?;
                 *f = lu;

@@ -143,6 +143,9 @@ impl<'m> StaticContact<'m> {
 }
 
 impl NonlinearProblem for StaticContact<'_> {
+    fn node_coordinates(&self) -> Option<std::sync::Arc<[f64]>> {
+        Some(self.asm.mesh().coords.as_slice().into())
+    }
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
         use crate::linalg::norms::norm_inf;
         self.stiffness.mul_vec(u, r);

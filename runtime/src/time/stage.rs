@@ -317,6 +317,9 @@ impl StageProblem<'_, '_> {
 }
 
 impl NonlinearProblem for StageProblem<'_, '_> {
+    fn node_coordinates(&self) -> Option<std::sync::Arc<[f64]>> {
+        Some(self.asm.mesh().coords.as_slice().into())
+    }
     fn residual(&mut self, w: &[f64], r: &mut [f64]) {
         use crate::linalg::norms::norm_inf;
         // Newton starts from δ = 0 unless a constraint moves: no product then.

@@ -7,5 +7,7 @@ mod gmsh;
 mod mesh_integrity;
 mod meshes;
 mod newton;
+#[cfg(feature = "petsc")]
+mod petsc;
 mod solvers;
 mod stepper;

@@ -11,7 +11,7 @@ use signorini_runtime::fem::mesh::structured::{Diagonal, cuboid, interval, recta
 use signorini_runtime::linalg::lowrank::LowRank;
 use signorini_runtime::linalg::{Factorization, Matrix, Solver, Structure};
 
-fn meshes() -> Vec<Mesh> {
+pub(crate) fn meshes() -> Vec<Mesh> {
     let unit = [0.0, 1.0];
     vec![
         interval(40, 0.0, 1.0),
@@ -28,7 +28,7 @@ fn index(m: &Matrix, i: usize, j: usize) -> usize {
 
 /// c·M + K plus, on every third node, the symmetric positive block s·n nᵀ (n a unit vector
 /// mixing the components, as a contact tangent does).
-fn step_matrix(mesh: &Mesh) -> Matrix {
+pub(crate) fn step_matrix(mesh: &Mesh) -> Matrix {
     let asm = Assembler::new(mesh);
     let zero = vec![0.0; asm.size()];
     let mut a = asm.zero_matrix();
@@ -56,7 +56,7 @@ fn solve(a: &Matrix, structure: Structure, solver: Solver, b: &[f64]) -> (Vec<f6
     (x, f.counters.iterations)
 }
 
-fn relative_difference(x: &[f64], y: &[f64]) -> f64 {
+pub(crate) fn relative_difference(x: &[f64], y: &[f64]) -> f64 {
     let diff = x.iter().zip(y).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
     diff / y.iter().map(|v| v * v).sum::<f64>().sqrt()
 }

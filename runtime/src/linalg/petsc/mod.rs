@@ -1,0 +1,332 @@
+//! PETSc as a linear solver (feature `petsc`): Krylov methods with algebraic multigrid
+//! (conjugate gradients for symmetric tangents, GMRES otherwise, preconditioned by GAMG whose
+//! near-null space is the rigid-body modes of the nodes' coordinates), any of which the user's
+//! PETSc options replace (`-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps`).
+//!
+//! Every PETSc call goes through [`call`], which turns an error code into a
+//! [`LinalgError::Petsc`] with PETSc's own message (an error handler records it instead of
+//! printing), so that no PETSc error aborts the process. PETSc is not thread-safe: every
+//! operation holds one process-wide lock ([`lock`]).
+
+mod sys;
+
+use std::cell::{Cell, RefCell};
+use std::ffi::{CStr, CString, c_char, c_int, c_void};
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use crate::linalg::pattern::Pattern;
+use crate::linalg::{LinalgError, Matrix};
+
+thread_local! {
+    /// The message of the last error PETSc raised on this thread.
+    static LAST_ERROR: RefCell<String> = const { RefCell::new(String::new()) };
+}
+
+/// Records the first report of an error (PETSc calls the handler again for each function the
+/// error passes through on its way up).
+unsafe extern "C" fn record_error(
+    _comm: sys::MPI_Comm,
+    _line: c_int,
+    function: *const c_char,
+    _file: *const c_char,
+    code: sys::PetscErrorCode,
+    kind: c_int,
+    message: *const c_char,
+    _context: *mut c_void,
+) -> sys::PetscErrorCode {
+    let text = |p: *const c_char| {
+        if p.is_null() {
+            String::new()
+        } else {
+            // SAFETY: PETSc passes NUL-terminated strings that live for the call.
+            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+        }
+    };
+    const PETSC_ERROR_INITIAL: c_int = 0;
+    if kind == PETSC_ERROR_INITIAL {
+        let what = format!("{}: {}", text(function), text(message).trim());
+        LAST_ERROR.with(|e| *e.borrow_mut() = what);
+    }
+    code
+}
+
+/// `Ok` for PETSc's success code; otherwise the error with the message PETSc recorded.
+fn call(function: &'static str, code: sys::PetscErrorCode) -> Result<(), LinalgError> {
+    if code == 0 {
+        return Ok(());
+    }
+    let message = LAST_ERROR.with(|e| std::mem::take(&mut *e.borrow_mut()));
+    Err(LinalgError::Petsc { function, code, message })
+}
+
+/// Options given before PETSc starts (`--petsc-options`), and whether it has started.
+struct State {
+    options: Option<String>,
+    started: bool,
+}
+
+static STATE: Mutex<State> = Mutex::new(State { options: None, started: false });
+
+thread_local! {
+    /// Whether this thread holds [`STATE`]'s lock (objects dropped under it must not take it
+    /// again).
+    static HOLDING: Cell<bool> = const { Cell::new(false) };
+}
+
+/// The process-wide lock, held.
+struct Held(MutexGuard<'static, State>);
+
+impl Drop for Held {
+    fn drop(&mut self) {
+        HOLDING.set(false);
+    }
+}
+
+/// The lock every use of PETSc holds, with PETSc started (once per process, reading
+/// `PETSC_OPTIONS`, errors recorded rather than printed).
+fn lock() -> Result<Held, LinalgError> {
+    // A panic while holding the lock leaves PETSc's objects as they were: still usable.
+    let mut state = Held(STATE.lock().unwrap_or_else(|poisoned| poisoned.into_inner()));
+    HOLDING.set(true);
+    if !state.0.started {
+        let mut done: sys::PetscBool = 0;
+        // SAFETY: PetscInitialized only writes the flag.
+        call("PetscInitialized", unsafe { sys::PetscInitialized(&mut done) })?;
+        if done == 0 {
+            // SAFETY: called once, under the lock, before any other PETSc object exists.
+            call("PetscInitializeNoArguments", unsafe { sys::PetscInitializeNoArguments() })?;
+        }
+        // SAFETY: the handler has PETSc's handler signature and keeps no context.
+        call("PetscPushErrorHandler", unsafe { sys::PetscPushErrorHandler(record_error, std::ptr::null_mut()) })?;
+        state.0.started = true;
+        if let Some(options) = state.0.options.take() {
+            insert_options(&options)?;
+        }
+    }
+    Ok(state)
+}
+
+/// Options for every PETSc solver of this process, in PETSc's syntax (`-ksp_rtol 1e-8
+/// -pc_type hypre`); they are applied over the solver's defaults, as `PETSC_OPTIONS` is.
+pub fn set_options(options: &str) -> Result<(), LinalgError> {
+    let _petsc = lock()?;
+    insert_options(options)
+}
+
+fn insert_options(options: &str) -> Result<(), LinalgError> {
+    let text = CString::new(options).map_err(|_| LinalgError::Other("PETSc options contain a NUL byte".into()))?;
+    // SAFETY: a NUL-terminated string; a null options database means the global one.
+    call("PetscOptionsInsertString", unsafe { sys::PetscOptionsInsertString(std::ptr::null_mut(), text.as_ptr()) })
+}
+
+/// Each process solves its own systems: the solver lives on `MPI_COMM_SELF`.
+fn comm_self() -> sys::MPI_Comm {
+    // Only the address of Open MPI's predefined communicator is taken (no read of the static).
+    (&raw const sys::ompi_mpi_comm_self).cast_mut().cast()
+}
+
+/// An index as PETSc's 32-bit `PetscInt`.
+fn petsc_int(i: usize) -> Result<sys::PetscInt, LinalgError> {
+    sys::PetscInt::try_from(i).map_err(|_| {
+        LinalgError::Other(format!(
+            "{i} does not fit PETSc's 32-bit indices (a PETSc built with 64-bit indices is needed)"
+        ))
+    })
+}
+
+macro_rules! handle {
+    ($name:ident, $raw:ty, $destroy:ident) => {
+        /// Owns a PETSc object, destroyed when dropped.
+        struct $name($raw);
+        impl Drop for $name {
+            fn drop(&mut self) {
+                if !self.0.is_null() {
+                    // SAFETY: the object was created by PETSc and is destroyed once, here.
+                    unsafe { sys::$destroy(&mut self.0) };
+                }
+            }
+        }
+    };
+}
+handle!(OwnedMat, sys::Mat, MatDestroy);
+handle!(OwnedVec, sys::Vec, VecDestroy);
+handle!(OwnedKsp, sys::KSP, KSPDestroy);
+handle!(OwnedNullSpace, sys::MatNullSpace, MatNullSpaceDestroy);
+
+impl OwnedVec {
+    /// Runs `f` on the vector's values.
+    fn with_values<T>(&mut self, n: usize, f: impl FnOnce(&mut [f64]) -> T) -> Result<T, LinalgError> {
+        let mut array: *mut f64 = std::ptr::null_mut();
+        // SAFETY: the vector is valid; PETSc hands out its local array until restored.
+        call("VecGetArray", unsafe { sys::VecGetArray(self.0, &mut array) })?;
+        // SAFETY: a local array of `n` values (the caller's size of this vector), restored below.
+        let out = f(unsafe { std::slice::from_raw_parts_mut(array, n) });
+        // SAFETY: the array obtained above.
+        call("VecRestoreArray", unsafe { sys::VecRestoreArray(self.0, &mut array) })?;
+        Ok(out)
+    }
+}
+
+/// A Krylov solver of PETSc for one matrix pattern, whose values change between solves.
+pub struct PetscSolver {
+    ksp: OwnedKsp,
+    matrix: OwnedMat,
+    rhs: OwnedVec,
+    solution: OwnedVec,
+    pattern: Arc<Pattern>,
+    /// Krylov iterations of the last solve.
+    pub iterations: usize,
+}
+
+// SAFETY: the PETSc objects are owned by this value alone, and every PETSc call holds the
+// process-wide lock, so PETSc is never entered from two threads at once.
+unsafe impl Send for PetscSolver {}
+
+impl PetscSolver {
+    /// A solver for `a`'s pattern with `a`'s values: CG (`symmetric`) or GMRES, preconditioned
+    /// by GAMG with the rigid-body modes of `coordinates` (`nodes × dim`, row-major, when the
+    /// unknowns are the nodes' displacements), stopping at a relative residual `rtol`; the
+    /// user's options then apply.
+    pub fn new(a: &Matrix, symmetric: bool, coordinates: Option<&[f64]>, rtol: f64) -> Result<Self, LinalgError> {
+        let _petsc = lock()?;
+        let n = a.size();
+        let size = petsc_int(n)?;
+        let comm = comm_self();
+        let mut matrix = OwnedMat(std::ptr::null_mut());
+        // SAFETY: PETSc is initialized; each call gets valid handles and writes only its out
+        // parameters.
+        unsafe {
+            call("MatCreate", sys::MatCreate(comm, &mut matrix.0))?;
+            call("MatSetSizes", sys::MatSetSizes(matrix.0, size, size, size, size))?;
+            call("MatSetType", sys::MatSetType(matrix.0, c"aij".as_ptr()))?;
+            call("MatSetBlockSize", sys::MatSetBlockSize(matrix.0, petsc_int(a.pattern.dim())?))?;
+        }
+        let p = &a.pattern;
+        let mut rows = Vec::with_capacity(p.nnz());
+        let mut cols = Vec::with_capacity(p.nnz());
+        for j in 0..n {
+            for &i in &p.row_idx[p.col_ptr[j]..p.col_ptr[j + 1]] {
+                rows.push(petsc_int(i)?);
+                cols.push(petsc_int(j)?);
+            }
+        }
+        // SAFETY: `rows` and `cols` hold nnz indices each (PETSc copies them).
+        unsafe {
+            call(
+                "MatSetPreallocationCOO",
+                sys::MatSetPreallocationCOO(
+                    matrix.0,
+                    rows.len() as sys::PetscCount,
+                    rows.as_mut_ptr(),
+                    cols.as_mut_ptr(),
+                ),
+            )?;
+            if symmetric {
+                for option in [sys::MAT_SYMMETRIC, sys::MAT_SYMMETRY_ETERNAL, sys::MAT_SPD] {
+                    call("MatSetOption", sys::MatSetOption(matrix.0, option, sys::PETSC_TRUE))?;
+                }
+            }
+        }
+        let dim = p.dim();
+        if let Some(coords) = coordinates.filter(|c| c.len() == n) {
+            let mut vec = OwnedVec(std::ptr::null_mut());
+            // SAFETY: a vector of the coordinates' length with block size `dim`.
+            unsafe {
+                call("VecCreate", sys::VecCreate(comm, &mut vec.0))?;
+                call("VecSetSizes", sys::VecSetSizes(vec.0, size, size))?;
+                call("VecSetBlockSize", sys::VecSetBlockSize(vec.0, petsc_int(dim)?))?;
+                call("VecSetFromOptions", sys::VecSetFromOptions(vec.0))?;
+            }
+            vec.with_values(n, |v| v.copy_from_slice(coords))?;
+            let mut space = OwnedNullSpace(std::ptr::null_mut());
+            // SAFETY: the matrix keeps its own reference to the null space.
+            unsafe {
+                call("MatNullSpaceCreateRigidBody", sys::MatNullSpaceCreateRigidBody(vec.0, &mut space.0))?;
+                call("MatSetNearNullSpace", sys::MatSetNearNullSpace(matrix.0, space.0))?;
+            }
+        }
+        let (mut solution, mut rhs) = (OwnedVec(std::ptr::null_mut()), OwnedVec(std::ptr::null_mut()));
+        // SAFETY: vectors compatible with the matrix.
+        call("MatCreateVecs", unsafe { sys::MatCreateVecs(matrix.0, &mut solution.0, &mut rhs.0) })?;
+        let mut ksp = OwnedKsp(std::ptr::null_mut());
+        let mut pc: sys::PC = std::ptr::null_mut();
+        // SAFETY: a KSP on the matrix; the PC handle is borrowed from it.
+        unsafe {
+            call("KSPCreate", sys::KSPCreate(comm, &mut ksp.0))?;
+            call("KSPSetType", sys::KSPSetType(ksp.0, if symmetric { c"cg" } else { c"gmres" }.as_ptr()))?;
+            call("KSPGetPC", sys::KSPGetPC(ksp.0, &mut pc))?;
+            call("PCSetType", sys::PCSetType(pc, c"gamg".as_ptr()))?;
+            // The tolerance bounds the true residual ‖b − A x‖ / ‖b‖, as the other solvers':
+            // GMRES then preconditions on the right.
+            call("KSPSetNormType", sys::KSPSetNormType(ksp.0, sys::KSP_NORM_UNPRECONDITIONED))?;
+            if !symmetric {
+                call("KSPSetPCSide", sys::KSPSetPCSide(ksp.0, sys::PC_RIGHT))?;
+            }
+            call("KSPSetTolerances", sys::KSPSetTolerances(ksp.0, rtol, 0.0, sys::PETSC_DEFAULT, 10_000))?;
+            call("KSPSetFromOptions", sys::KSPSetFromOptions(ksp.0))?;
+        }
+        let mut solver = PetscSolver { ksp, matrix, rhs, solution, pattern: a.pattern.clone(), iterations: 0 };
+        solver.take_values(a)?;
+        Ok(solver)
+    }
+
+    /// Whether `a` has the pattern this solver was built for.
+    pub fn fits(&self, a: &Matrix) -> bool {
+        Arc::ptr_eq(&self.pattern, &a.pattern)
+    }
+
+    /// Takes `a`'s values (same pattern); the preconditioner is rebuilt at the next solve.
+    pub fn set_values(&mut self, a: &Matrix) -> Result<(), LinalgError> {
+        let _petsc = lock()?;
+        self.take_values(a)
+    }
+
+    fn take_values(&mut self, a: &Matrix) -> Result<(), LinalgError> {
+        debug_assert!(self.fits(a));
+        // SAFETY: the values are in the order of the COO indices given at creation (column by
+        // column of the same pattern), nnz of them.
+        unsafe {
+            call("MatSetValuesCOO", sys::MatSetValuesCOO(self.matrix.0, a.values.as_ptr(), sys::INSERT_VALUES))?;
+            call("KSPSetOperators", sys::KSPSetOperators(self.ksp.0, self.matrix.0, self.matrix.0))?;
+        }
+        Ok(())
+    }
+
+    /// Solves `A x = b` in place, from x = 0 (Newton's corrections shrink from one solve to the
+    /// next: the last one is a worse first guess than none).
+    pub fn solve_in_place(&mut self, b: &mut [f64]) -> Result<(), LinalgError> {
+        let _petsc = lock()?;
+        let n = b.len();
+        self.rhs.with_values(n, |v| v.copy_from_slice(b))?;
+        let (mut its, mut reason): (sys::PetscInt, c_int) = (0, 0);
+        // SAFETY: vectors and KSP created together for this size.
+        unsafe {
+            call("KSPSolve", sys::KSPSolve(self.ksp.0, self.rhs.0, self.solution.0))?;
+            call("KSPGetIterationNumber", sys::KSPGetIterationNumber(self.ksp.0, &mut its))?;
+            call("KSPGetConvergedReason", sys::KSPGetConvergedReason(self.ksp.0, &mut reason))?;
+        }
+        self.iterations = its.max(0) as usize;
+        if reason <= 0 {
+            return Err(diverged(reason, self.iterations));
+        }
+        self.solution.with_values(n, |x| b.copy_from_slice(x))?;
+        if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(LinalgError::Singular { index: None }) }
+    }
+}
+
+/// The error of a Krylov solve that stopped without converging.
+fn diverged(reason: c_int, iterations: usize) -> LinalgError {
+    const DIVERGED_INDEFINITE_PC: c_int = -8;
+    const DIVERGED_INDEFINITE_MAT: c_int = -10;
+    if reason == DIVERGED_INDEFINITE_MAT || reason == DIVERGED_INDEFINITE_PC {
+        return LinalgError::NotPositiveDefinite { index: 0 };
+    }
+    // SAFETY: PETSc's table of reason names covers every reason a solve returns.
+    let name = unsafe {
+        let entry = *sys::KSPConvergedReasons.offset(reason as isize);
+        if entry.is_null() { format!("reason {reason}") } else { CStr::from_ptr(entry).to_string_lossy().into_owned() }
+    };
+    LinalgError::Other(format!(
+        "PETSc's Krylov solve did not converge ({name} after {iterations} iterations); other options may help, e.g. --petsc-options \"-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps\""
+    ))
+}

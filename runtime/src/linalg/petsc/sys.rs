@@ -1,0 +1,114 @@
+//! The part of PETSc's C API the solver calls, declared by hand for the PETSc this feature
+//! builds against (Debian's libpetsc-real3.18-dev): real double scalars, 32-bit `PetscInt`,
+//! Open MPI (whose `MPI_Comm` is a pointer). `build.rs` checks the version through pkg-config.
+
+// Names as in C.
+#![allow(non_camel_case_types, non_upper_case_globals, clippy::upper_case_acronyms)]
+
+use std::ffi::{c_char, c_int, c_void};
+
+pub type PetscErrorCode = c_int;
+pub type PetscInt = i32;
+pub type PetscCount = isize;
+pub type PetscScalar = f64;
+pub type PetscReal = f64;
+/// `PetscBool` is a C enum: `PETSC_FALSE` = 0, `PETSC_TRUE` = 1.
+pub type PetscBool = c_int;
+pub const PETSC_TRUE: PetscBool = 1;
+/// Open MPI's communicator handle.
+pub type MPI_Comm = *mut c_void;
+
+macro_rules! opaque {
+    ($($name:ident => $handle:ident),* $(,)?) => {$(
+        #[repr(C)]
+        pub struct $name {
+            _private: [u8; 0],
+        }
+        pub type $handle = *mut $name;
+    )*};
+}
+opaque!(_p_Mat => Mat, _p_Vec => Vec, _p_KSP => KSP, _p_PC => PC, _p_MatNullSpace => MatNullSpace);
+
+/// `InsertMode::INSERT_VALUES`.
+pub const INSERT_VALUES: c_int = 1;
+/// `MatOption` values (petscmat.h).
+pub const MAT_SYMMETRIC: c_int = 1;
+pub const MAT_SYMMETRY_ETERNAL: c_int = 10;
+pub const MAT_SPD: c_int = 15;
+/// `KSPNormType::KSP_NORM_UNPRECONDITIONED`, `PCSide::PC_RIGHT`.
+pub const KSP_NORM_UNPRECONDITIONED: c_int = 2;
+pub const PC_RIGHT: c_int = 1;
+/// `PETSC_DEFAULT` for tolerances.
+pub const PETSC_DEFAULT: PetscReal = -2.0;
+
+/// An error handler: PETSc calls it with the error's origin and message.
+pub type ErrorHandler = unsafe extern "C" fn(
+    comm: MPI_Comm,
+    line: c_int,
+    function: *const c_char,
+    file: *const c_char,
+    code: PetscErrorCode,
+    kind: c_int,
+    message: *const c_char,
+    context: *mut c_void,
+) -> PetscErrorCode;
+
+/// Open MPI's communicator object.
+#[repr(C)]
+pub struct ompi_communicator_t {
+    _private: [u8; 0],
+}
+
+unsafe extern "C" {
+    /// Open MPI's `MPI_COMM_SELF` is the address of this object.
+    pub static ompi_mpi_comm_self: ompi_communicator_t;
+    /// Indexed by a `KSPConvergedReason` (negative ones too: it points inside its table).
+    pub static KSPConvergedReasons: *const *const c_char;
+
+    pub fn PetscInitializeNoArguments() -> PetscErrorCode;
+    pub fn PetscInitialized(done: *mut PetscBool) -> PetscErrorCode;
+    pub fn PetscOptionsInsertString(options: *mut c_void, text: *const c_char) -> PetscErrorCode;
+    pub fn PetscPushErrorHandler(handler: ErrorHandler, context: *mut c_void) -> PetscErrorCode;
+
+    pub fn MatCreate(comm: MPI_Comm, mat: *mut Mat) -> PetscErrorCode;
+    pub fn MatSetSizes(mat: Mat, m: PetscInt, n: PetscInt, big_m: PetscInt, big_n: PetscInt) -> PetscErrorCode;
+    pub fn MatSetType(mat: Mat, kind: *const c_char) -> PetscErrorCode;
+    pub fn MatSetBlockSize(mat: Mat, bs: PetscInt) -> PetscErrorCode;
+    pub fn MatSetOption(mat: Mat, option: c_int, flag: PetscBool) -> PetscErrorCode;
+    pub fn MatSetPreallocationCOO(mat: Mat, n: PetscCount, i: *mut PetscInt, j: *mut PetscInt) -> PetscErrorCode;
+    pub fn MatSetValuesCOO(mat: Mat, values: *const PetscScalar, mode: c_int) -> PetscErrorCode;
+    pub fn MatSetNearNullSpace(mat: Mat, space: MatNullSpace) -> PetscErrorCode;
+    pub fn MatCreateVecs(mat: Mat, right: *mut Vec, left: *mut Vec) -> PetscErrorCode;
+    pub fn MatDestroy(mat: *mut Mat) -> PetscErrorCode;
+
+    pub fn MatNullSpaceCreateRigidBody(coords: Vec, space: *mut MatNullSpace) -> PetscErrorCode;
+    pub fn MatNullSpaceDestroy(space: *mut MatNullSpace) -> PetscErrorCode;
+
+    pub fn VecCreate(comm: MPI_Comm, vec: *mut Vec) -> PetscErrorCode;
+    pub fn VecSetSizes(vec: Vec, n: PetscInt, big_n: PetscInt) -> PetscErrorCode;
+    pub fn VecSetBlockSize(vec: Vec, bs: PetscInt) -> PetscErrorCode;
+    pub fn VecSetFromOptions(vec: Vec) -> PetscErrorCode;
+    pub fn VecGetArray(vec: Vec, array: *mut *mut PetscScalar) -> PetscErrorCode;
+    pub fn VecRestoreArray(vec: Vec, array: *mut *mut PetscScalar) -> PetscErrorCode;
+    pub fn VecDestroy(vec: *mut Vec) -> PetscErrorCode;
+
+    pub fn KSPCreate(comm: MPI_Comm, ksp: *mut KSP) -> PetscErrorCode;
+    pub fn KSPSetOperators(ksp: KSP, a: Mat, p: Mat) -> PetscErrorCode;
+    pub fn KSPSetType(ksp: KSP, kind: *const c_char) -> PetscErrorCode;
+    pub fn KSPGetPC(ksp: KSP, pc: *mut PC) -> PetscErrorCode;
+    pub fn PCSetType(pc: PC, kind: *const c_char) -> PetscErrorCode;
+    pub fn KSPSetTolerances(
+        ksp: KSP,
+        rtol: PetscReal,
+        abstol: PetscReal,
+        dtol: PetscReal,
+        maxits: PetscInt,
+    ) -> PetscErrorCode;
+    pub fn KSPSetNormType(ksp: KSP, norm: c_int) -> PetscErrorCode;
+    pub fn KSPSetPCSide(ksp: KSP, side: c_int) -> PetscErrorCode;
+    pub fn KSPSetFromOptions(ksp: KSP) -> PetscErrorCode;
+    pub fn KSPSolve(ksp: KSP, b: Vec, x: Vec) -> PetscErrorCode;
+    pub fn KSPGetIterationNumber(ksp: KSP, its: *mut PetscInt) -> PetscErrorCode;
+    pub fn KSPGetConvergedReason(ksp: KSP, reason: *mut c_int) -> PetscErrorCode;
+    pub fn KSPDestroy(ksp: *mut KSP) -> PetscErrorCode;
+}

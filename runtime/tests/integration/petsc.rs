@@ -1,0 +1,86 @@
+//! PETSc's solvers (feature `petsc`) against a plain factorization of the same matrix: CG with
+//! algebraic multigrid on a symmetric step matrix, GMRES on one whose contact blocks are
+//! unsymmetric, on every element kind; new values of the same pattern reuse the solver; a failure is an error.
+
+use crate::common::pseudo_random;
+use crate::solvers::{meshes, relative_difference, step_matrix};
+use signorini_runtime::linalg::{Factorization, LinalgError, Matrix, Solver, Structure};
+
+fn petsc(structure: Structure, mesh: &signorini_runtime::fem::mesh::Mesh) -> Factorization {
+    Factorization::new(structure).with_solver(Solver::Petsc).with_coordinates(Some(mesh.coords.as_slice().into()))
+}
+
+fn solve(f: &mut Factorization, a: &Matrix, b: &[f64]) -> Result<Vec<f64>, LinalgError> {
+    f.factor(a)?;
+    let mut x = b.to_vec();
+    f.solve_in_place(&mut x)?;
+    Ok(x)
+}
+
+fn direct(a: &Matrix, structure: Structure, b: &[f64]) -> Vec<f64> {
+    solve(&mut Factorization::new(structure), a, b).expect("a direct solve")
+}
+
+#[test]
+fn conjugate_gradients_with_multigrid_match_the_cholesky_solution() {
+    for mesh in meshes() {
+        let a = step_matrix(&mesh);
+        let b = pseudo_random(a.size(), 3);
+        let mut f = petsc(Structure::SymmetricPositiveDefinite, &mesh);
+        let x = solve(&mut f, &a, &b).expect("PETSc solves");
+        let err = relative_difference(&x, &direct(&a, Structure::SymmetricPositiveDefinite, &b));
+        let iterations = f.counters.iterations;
+        assert!(err < 1e-10, "{}: differs by {err:.1e} after {iterations} iterations", mesh.kind.name());
+        assert!(iterations > 1, "a real iteration");
+    }
+}
+
+#[test]
+fn gmres_matches_the_lu_solution_of_a_nonsymmetric_matrix() {
+    for mesh in meshes() {
+        // The contact blocks of the first tenth of the nodes (a "contact surface") made
+        // unsymmetric, as Nitsche's θ ≠ 1 makes a contact tangent.
+        let mut a = step_matrix(&mesh);
+        let d = mesh.dim();
+        for j in 0..a.size() {
+            for k in a.pattern.col_ptr[j]..a.pattern.col_ptr[j + 1] {
+                let i = a.pattern.row_idx[k];
+                if i < j && i / d == j / d && (j / d) % 3 == 0 && j < a.size() / 10 {
+                    a.values[k] *= 1.3;
+                }
+            }
+        }
+        assert!(d == 1 || !a.is_symmetric(1e-3));
+        let b = pseudo_random(a.size(), 5);
+        let x = solve(&mut petsc(Structure::General, &mesh), &a, &b).expect("PETSc solves");
+        let err = relative_difference(&x, &direct(&a, Structure::General, &b));
+        assert!(err < 1e-10, "{}: GMRES differs by {err:.1e}", mesh.kind.name());
+    }
+}
+
+#[test]
+fn new_values_of_the_same_pattern_reuse_the_solver() {
+    let mesh = &meshes()[1];
+    let mut a = step_matrix(mesh);
+    let b = pseudo_random(a.size(), 7);
+    let mut f = petsc(Structure::SymmetricPositiveDefinite, mesh);
+    solve(&mut f, &a, &b).expect("first solve");
+    a.values.iter_mut().for_each(|v| *v *= 2.0);
+    let x = solve(&mut f, &a, &b).expect("second solve");
+    assert_eq!((f.counters.symbolic, f.counters.numeric), (1, 2), "one solver set up, its values set twice");
+    let err = relative_difference(&x, &direct(&a, Structure::SymmetricPositiveDefinite, &b));
+    assert!(err < 1e-10, "the second solve is of the new matrix: differs by {err:.1e}");
+}
+
+#[test]
+fn a_matrix_petsc_cannot_solve_is_an_error_with_its_reason() {
+    let mesh = &meshes()[1];
+    let mut a = step_matrix(mesh);
+    a.values.iter_mut().for_each(|v| *v = 0.0);
+    let b = pseudo_random(a.size(), 9);
+    let err = solve(&mut petsc(Structure::SymmetricPositiveDefinite, mesh), &a, &b).expect_err("no solution");
+    assert!(!err.to_string().is_empty());
+    // PETSc still works after the failure.
+    let a = step_matrix(mesh);
+    assert!(solve(&mut petsc(Structure::SymmetricPositiveDefinite, mesh), &a, &b).is_ok());
+}
