@@ -12,5 +12,10 @@ fn main() -> std::process::ExitCode {
         .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
         .with_writer(std::io::stderr)
         .init();
-    signorini::cli::run(signorini::cli::Cli::parse_args())
+    let code = signorini::cli::run(signorini::cli::Cli::parse_args());
+    if let Err(e) = signorini::runtime::linalg::finalize_petsc() {
+        eprintln!("error: {e}");
+        return std::process::ExitCode::FAILURE;
+    }
+    code
 }

@@ -31,3 +31,12 @@ pub fn set_petsc_options(options: &str) -> Result<(), LinalgError> {
         "PETSc options `{options}` given, but this signorini was built without PETSc (`--features petsc`)"
     )))
 }
+
+/// Ends PETSc if it was used (it then writes what options like `-log_view` asked for); a
+/// no-op without the `petsc` feature. Call it last: no PETSc solver may be used afterwards.
+pub fn finalize_petsc() -> Result<(), LinalgError> {
+    #[cfg(feature = "petsc")]
+    return petsc::finalize();
+    #[cfg(not(feature = "petsc"))]
+    Ok(())
+}

@@ -119,6 +119,23 @@ fn insert_options(options: &str) -> Result<(), LinalgError> {
     call("PetscOptionsInsertString", unsafe { sys::PetscOptionsInsertString(std::ptr::null_mut(), text.as_ptr()) })
 }
 
+/// Ends PETSc (writing what `-log_view` and the like asked for), if it started; no PETSc
+/// solver may be used afterwards.
+pub fn finalize() -> Result<(), LinalgError> {
+    let mut state = lock_if_started()?;
+    if let Some(state) = state.as_mut() {
+        // SAFETY: PETSc started and, the caller says, none of its objects is used again.
+        call("PetscFinalize", unsafe { sys::PetscFinalize() })?;
+        state.0.started = false;
+    }
+    Ok(())
+}
+
+fn lock_if_started() -> Result<Option<Held>, LinalgError> {
+    let started = STATE.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).started;
+    if started { lock().map(Some) } else { Ok(None) }
+}
+
 /// Each process solves its own systems: the solver lives on `MPI_COMM_SELF`.
 fn comm_self() -> sys::MPI_Comm {
     // Only the address of Open MPI's predefined communicator is taken (no read of the static).
@@ -174,6 +191,9 @@ pub struct PetscSolver {
     rhs: OwnedVec,
     solution: OwnedVec,
     pattern: Arc<Pattern>,
+    /// The values PETSc holds: the same values again keep the preconditioner (whose setup,
+    /// GAMG's, costs many solves).
+    values: Vec<f64>,
     /// Krylov iterations of the last solve.
     pub iterations: usize,
 }
@@ -265,7 +285,8 @@ impl PetscSolver {
             call("KSPSetTolerances", sys::KSPSetTolerances(ksp.0, rtol, 0.0, sys::PETSC_DEFAULT, 10_000))?;
             call("KSPSetFromOptions", sys::KSPSetFromOptions(ksp.0))?;
         }
-        let mut solver = PetscSolver { ksp, matrix, rhs, solution, pattern: a.pattern.clone(), iterations: 0 };
+        let mut solver =
+            PetscSolver { ksp, matrix, rhs, solution, pattern: a.pattern.clone(), values: Vec::new(), iterations: 0 };
         solver.take_values(a)?;
         Ok(solver)
     }
@@ -283,6 +304,10 @@ impl PetscSolver {
 
     fn take_values(&mut self, a: &Matrix) -> Result<(), LinalgError> {
         debug_assert!(self.fits(a));
+        if self.values == a.values {
+            return Ok(());
+        }
+        self.values.clone_from(&a.values);
         // SAFETY: the values are in the order of the COO indices given at creation (column by
         // column of the same pattern), nnz of them.
         unsafe {

@@ -67,6 +67,7 @@ unsafe extern "C" {
 
     pub fn PetscInitializeNoArguments() -> PetscErrorCode;
     pub fn PetscInitialized(done: *mut PetscBool) -> PetscErrorCode;
+    pub fn PetscFinalize() -> PetscErrorCode;
     pub fn PetscOptionsInsertString(options: *mut c_void, text: *const c_char) -> PetscErrorCode;
     pub fn PetscPushErrorHandler(handler: ErrorHandler, context: *mut c_void) -> PetscErrorCode;
 
