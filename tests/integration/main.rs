@@ -16,6 +16,8 @@ mod hertz;
 mod import_circles;
 mod interpreted_forms;
 mod interpreted_schemes;
+#[cfg(feature = "petsc")]
+mod petsc;
 mod problems;
 mod redistribution;
 mod schemes;

@@ -1,0 +1,67 @@
+//! `--solver petsc` (feature `petsc`) against the direct solver: the disc through its first
+//! impact, with Nitsche's θ = 1 (symmetric tangents: CG) and θ = −1 (GMRES), and the sphere;
+//! every column of the series agrees to 1e-8 of its scale. Bad PETSc options are an error with
+//! PETSc's message.
+
+use std::path::Path;
+use std::process::Command;
+
+const BIN: &str = env!("CARGO_BIN_EXE_signorini");
+
+/// The series of `run ARGS --solver SOLVER`, as its header and rows.
+fn series(args: &[&str], solver: &str, dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let out = Command::new(BIN)
+        .args(["run"])
+        .args(args)
+        .args(["--solver", solver, "--force", "--out"])
+        .arg(dir)
+        .output()
+        .expect("the binary runs");
+    assert!(out.status.success(), "{args:?} --solver {solver}: {}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(dir.join("series.csv")).expect("a series");
+    let mut lines = text.lines();
+    let header = lines.next().expect("a header").split(',').map(str::to_string).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect()).collect();
+    (header, rows)
+}
+
+fn agree(args: &[&str], name: &str) {
+    let tmp = std::env::temp_dir().join(format!("signorini-petsc-{name}-{}", std::process::id()));
+    let (header, direct) = series(args, "direct", &tmp.join("direct"));
+    let (_, petsc) = series(args, "petsc", &tmp.join("petsc"));
+    assert_eq!(direct.len(), petsc.len(), "{name}: as many steps");
+    for (c, column) in header.iter().enumerate() {
+        let scale = direct.iter().map(|r| r[c].abs()).filter(|v| v.is_finite()).fold(0.0, f64::max);
+        for (d, p) in direct.iter().zip(&petsc) {
+            let (d, p) = (d[c], p[c]);
+            assert!(
+                (d.is_nan() && p.is_nan()) || (d - p).abs() <= 1e-8 * scale.max(f64::MIN_POSITIVE),
+                "{name}: {column} {p} against {d} (scale {scale:e})"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}
+
+#[test]
+fn the_disc_through_impact_agrees_with_the_direct_solver() {
+    agree(&["disc", "--t-start", "6", "--t-end", "8"], "disc");
+    agree(&["disc", "--t-start", "6", "--t-end", "8", "--param", "theta=-1"], "disc-unsymmetric");
+}
+
+#[test]
+fn the_sphere_through_impact_agrees_with_the_direct_solver() {
+    agree(&["sphere", "--t-start", "6.3", "--t-end", "6.45"], "sphere");
+}
+
+#[test]
+fn bad_petsc_options_are_an_error_with_petscs_message() {
+    let out = Command::new(BIN)
+        .args(["run", "disc", "--t-start", "6", "--t-end", "6.2", "--solver", "petsc"])
+        .args(["--petsc-options", "-ksp_type no_such_method"])
+        .output()
+        .expect("the binary runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("PETSc") && stderr.contains("no_such_method"), "{stderr}");
+}
