@@ -1,5 +1,5 @@
 //! `signorini bench sphere`: time per step and peak memory of the bouncing sphere against its
-//! size, for the direct and the iterative solver. Each run is its own process (`run PROBLEM`,
+//! size, for each solver (direct, block-Jacobi Krylov, PETSc). Each run is its own process (`run PROBLEM`,
 //! the problem and the options of forms/library.toml's `[bench]`: from just before the first
 //! contact through it), so that its peak memory is its own. Its built-in balls (radius 10) of
 //! 2·half cells per diameter have 3(4·half + 1)³ P2 unknowns.
@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::CaseError;
 use crate::plot::Curve;
+use crate::runtime::linalg::Solver;
 
 /// Cells per radius of the balls tried, smallest first: 15k, 47k, 108k, 274k, 555k, 985k dofs.
 const HALVES: [usize; 6] = [4, 6, 8, 11, 14, 17];
@@ -34,6 +35,12 @@ pub struct SphereTiming {
     pub newton_total: usize,
     pub factorizations: usize,
     pub krylov_iterations: usize,
+    /// Krylov iterations per linear solve (NaN for a direct solver; none in older files).
+    #[serde(default)]
+    pub iterations_per_solve: Option<f64>,
+    /// MPI ranks the run used.
+    #[serde(default = "one")]
+    pub ranks: usize,
     pub peak_memory_bytes: Option<u64>,
     pub first_contact: Option<f64>,
     /// What the run ran with: the scheme, the contact law and its params, Δt and the end time
@@ -48,6 +55,10 @@ pub struct SphereTiming {
     pub dt: Option<f64>,
     #[serde(default)]
     pub t_end: Option<f64>,
+}
+
+fn one() -> usize {
+    1
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -94,6 +105,9 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
         newton_total: int("newton_total"),
         factorizations: int("factorizations"),
         krylov_iterations: int("krylov_iterations"),
+        iterations_per_solve: (solver != "direct" && int("linear_solves") > 0)
+            .then(|| int("krylov_iterations") as f64 / int("linear_solves") as f64),
+        ranks: 1,
         peak_memory_bytes: s.get("peak_memory_bytes").and_then(serde_json::Value::as_u64),
         first_contact: s.get("first_contact").and_then(serde_json::Value::as_f64),
         scheme: s.get("scheme").and_then(|v| v.as_str()).map(str::to_string),
@@ -104,21 +118,39 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
     })
 }
 
-/// Every ball up to `max_dofs` unknowns, with both solvers where the direct one fits.
-pub fn sphere(max_dofs: usize, dir: &Path, progress: &mut dyn FnMut(&str)) -> Result<Report, CaseError> {
+/// Every ball up to `max_dofs` unknowns with each of `solvers` (none: direct, iterative, and
+/// PETSc when built with it), the direct one where it fits.
+pub fn sphere(
+    max_dofs: usize,
+    solvers: &[Solver],
+    dir: &Path,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Report, CaseError> {
     let exe: PathBuf = std::env::current_exe().map_err(|e| CaseError::Option(format!("cannot find myself: {e}")))?;
+    let mut chosen = solvers.to_vec();
+    if chosen.is_empty() {
+        chosen = vec![Solver::Direct, Solver::Iterative];
+        if cfg!(feature = "petsc") {
+            chosen.push(Solver::Petsc);
+        }
+    }
+    let names: Vec<String> = chosen
+        .iter()
+        .map(|s| serde_json::to_value(s).ok().and_then(|v| v.as_str().map(str::to_string)).unwrap_or_default())
+        .collect();
     let mut runs = Vec::new();
     for half in HALVES.into_iter().filter(|&h| dofs(h) <= max_dofs) {
-        for solver in ["direct", "iterative"] {
+        for solver in names.iter().map(String::as_str) {
             if solver == "direct" && dofs(half) > DIRECT_LIMIT {
                 continue;
             }
             let r = run_one(&exe, half, solver, &dir.join("bench_sphere_runs"))?;
             progress(&format!(
-                "{} dofs, {solver}: {:.1} ms/step (median), {:.1} ms/step with setup, peak {:.0} MB",
+                "{} dofs, {solver}: {:.1} ms/step (median), {:.1} ms/step with setup, {:.1} iterations per solve, peak {:.0} MB",
                 r.dofs,
                 r.median_step_ms,
                 r.ms_per_step_with_setup,
+                r.iterations_per_solve.unwrap_or(f64::NAN),
                 r.peak_memory_bytes.map_or(f64::NAN, |b| b as f64 / 1e6)
             ));
             runs.push(r);
@@ -150,6 +182,7 @@ pub fn figure(report: &Report, dir: &Path) -> Result<(), CaseError> {
         vec![
             Curve { label: "direct", points: series("direct", f), dashed: false },
             Curve { label: "iterative", points: series("iterative", f), dashed: true },
+            Curve { label: "petsc", points: series("petsc", f), dashed: true },
         ]
     };
     let path = dir.join("bench_sphere.png");

@@ -112,11 +112,15 @@ pub enum BenchCommand {
     },
     /// Time per step and peak memory of the bouncing sphere against its size (built-in balls
     /// of 15k, 47k, 108k, 274k, 556k and 986k unknowns up to --max-dofs; 50 steps through the
-    /// first contact), direct and iterative solvers, each run in its own process. Up to 120k:
-    /// a few minutes; the 986k ball alone takes about half an hour and 10 GB.
+    /// first contact), each solver in its own process. Up to 120k: a few minutes; the 986k
+    /// ball alone takes about half an hour and 10 GB.
     Sphere {
         #[arg(long, default_value_t = 120_000)]
         max_dofs: usize,
+        /// The solvers timed, side by side at each size (the direct one up to 60 000
+        /// unknowns); default: direct, iterative, and petsc in a build with PETSc.
+        #[arg(long, value_delimiter = ',', value_parser = Solver::parse)]
+        solvers: Vec<Solver>,
         /// Directory for bench_sphere.json, bench_sphere.png and the runs.
         #[arg(long, default_value = "results")]
         out: PathBuf,

@@ -22,9 +22,9 @@ pub(super) fn assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Pat
     write_bench(&out.join("bench_assemble.json"), &report)
 }
 
-pub(super) fn sphere(max_dofs: usize, out: &Path) -> ExitCode {
+pub(super) fn sphere(max_dofs: usize, solvers: &[crate::runtime::linalg::Solver], out: &Path) -> ExitCode {
     use crate::bench::sphere;
-    let report = match sphere::sphere(max_dofs, out, &mut |line| println!("{line}")) {
+    let report = match sphere::sphere(max_dofs, solvers, out, &mut |line| println!("{line}")) {
         Ok(r) => r,
         Err(e) => return fail(e),
     };

@@ -114,7 +114,9 @@ fn dispatch(cli: Cli) -> ExitCode {
             bench::assemble(&sizes, factor, repeats, &out)
         }
         Command::Bench { what: BenchCommand::Disc { meshes, repeats, out } } => bench::disc(&meshes, repeats, &out),
-        Command::Bench { what: BenchCommand::Sphere { max_dofs, out } } => bench::sphere(max_dofs, &out),
+        Command::Bench { what: BenchCommand::Sphere { max_dofs, solvers, out } } => {
+            bench::sphere(max_dofs, &solvers, &out)
+        }
     }
 }
 

@@ -441,6 +441,7 @@ fn simulate(
     }
     put("solver", json(&opts.newton.solver));
     put("krylov_iterations", counters.iterations.into());
+    put("linear_solves", counters.solves.into());
     put("peak_memory_bytes", json(&crate::resources::peak_memory()));
     put("step_cuts", outcome.cuts.into());
     if !statics {

@@ -215,7 +215,16 @@ fn bench_disc_times_the_stepper_and_reports_missing_meshes() {
 fn bench_sphere_runs_each_size_in_its_own_process() {
     let dir = std::env::temp_dir().join(format!("signorini-bench-sphere-{}", std::process::id()));
     // The smallest ball only (14 739 unknowns), with both solvers.
-    let (code, out, err) = signorini(&["bench", "sphere", "--max-dofs", "20000", "--out", dir.to_str().unwrap()]);
+    let (code, out, err) = signorini(&[
+        "bench",
+        "sphere",
+        "--max-dofs",
+        "20000",
+        "--solvers",
+        "direct,iterative",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("14739 dofs, direct") && out.contains("14739 dofs, iterative"), "{out}");
     let json: serde_json::Value =
@@ -229,6 +238,15 @@ fn bench_sphere_runs_each_size_in_its_own_process() {
         assert!(r["peak_memory_bytes"].as_u64().is_some_and(|b| b > 1_000_000), "{r}");
     }
     assert!(runs.iter().any(|r| r["solver"] == "iterative" && r["krylov_iterations"].as_u64() > Some(0)));
+    // Iterations per solve for the iterative run only: at least one, at most the stall limit.
+    for r in runs {
+        let per_solve = r["iterations_per_solve"].as_f64();
+        match r["solver"].as_str() {
+            Some("iterative") => assert!(per_solve.is_some_and(|i| (1.0..250.0).contains(&i)), "{r}"),
+            _ => assert!(per_solve.is_none(), "{r}"),
+        }
+        assert_eq!(r["ranks"], 1);
+    }
     assert!(std::fs::read(dir.join("bench_sphere.png")).unwrap().starts_with(b"\x89PNG"));
 }
 
