@@ -17,8 +17,6 @@ use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;
 
-/// Gravity of the benchmark (the free fall before the first contact is exact: u = −g t²/2).
-pub const GRAVITY: f64 = 0.1;
 /// The problem these options run unless told otherwise: the library's bouncing disc.
 pub const DISC: &str = "disc";
 
