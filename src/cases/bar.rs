@@ -12,10 +12,6 @@ use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;
 
-/// The problem this module reads: the library's compressed bar, whose columns and summary keys
-/// are the fields of [`Row`] and [`Summary`].
-pub const PROBLEM: &str = "bar";
-
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
     /// Scheme, contact law, extra forms and params.
@@ -37,11 +33,11 @@ pub struct Options {
     pub resume: bool,
 }
 
-/// The bar with the problem file's mesh and times, and a run's defaults
-/// ([`crate::problem::run::Options::new`]).
+/// The bar (forms/library.toml's `cases.bar`) with the problem file's mesh and times, and a
+/// run's defaults ([`crate::problem::run::Options::new`]).
 impl Default for Options {
     fn default() -> Self {
-        let run = crate::problem::run::Options::new(PROBLEM);
+        let run = crate::problem::run::Options::new(&crate::settings::get().cases.bar);
         Options {
             methods: run.methods,
             elements: None,
@@ -80,7 +76,8 @@ pub struct Row {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
-    pub case: &'static str,
+    /// The problem's name.
+    pub case: String,
     pub scheme: String,
     /// The contact law (its file stem).
     pub contact: String,
@@ -147,8 +144,9 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     if let Some(ne) = opts.elements {
         methods.params.insert(0, crate::driver::Setting { name: "ne".into(), value: ne as f64, origin: "--ne".into() });
     }
+    let name = &crate::settings::get().cases.bar;
     let problem = crate::problem::run::Options {
-        problem: PROBLEM.to_string(),
+        problem: name.clone(),
         methods,
         mass: opts.mass,
         cell_size: opts.cell_size,
@@ -160,14 +158,16 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         checkpoint_every: opts.checkpoint_every,
         resume: opts.resume,
         chosen: crate::problem::run::Chosen::all(),
-        ..crate::problem::run::Options::new(PROBLEM)
+        ..crate::problem::run::Options::new(name)
     };
     from_problem(opts, &crate::problem::run::run(&problem)?)
 }
 
 fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, CaseError> {
+    let s = &run.summary;
+    let name: String = s.field("case")?;
     let names = ["u_c", "v_c", "lambda", "lambda_half", "energy", "energy_aug", "penetration", "newton", "p1"];
-    let index = run.indices(&names, PROBLEM)?;
+    let index = run.indices(&names, &name)?;
     let series = run
         .rows
         .iter()
@@ -184,14 +184,13 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
             p1: v[index[8]],
         })
         .collect::<Vec<_>>();
-    let s = &run.summary;
     let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
     let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
     let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
-    let elements = params.get(&format!("{PROBLEM}.ne")).map_or(0, |p| p.value as usize);
-    params.retain(|k, _| !k.starts_with(&format!("{PROBLEM}.")));
+    let elements = params.get(&format!("{name}.ne")).map_or(0, |p| p.value as usize);
+    params.retain(|k, _| !k.starts_with(&format!("{name}.")));
     let summary = Summary {
-        case: PROBLEM,
+        case: name,
         scheme: s.field("scheme")?,
         contact: s.field("contact")?,
         interpreted: s.field("interpreted")?,

@@ -17,9 +17,6 @@ use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;
 
-/// The problem these options run unless told otherwise: the library's bouncing disc.
-pub const DISC: &str = "disc";
-
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
     /// The problem: a library problem by name (`disc`, `sphere`) or a problem file.
@@ -51,11 +48,11 @@ pub struct Options {
     pub resume: bool,
 }
 
-/// The disc with the problem file's mesh size and times, and a run's defaults
-/// ([`crate::problem::run::Options::new`]).
+/// The disc (forms/library.toml's `cases.disc`) with the problem file's mesh size and times,
+/// and a run's defaults ([`crate::problem::run::Options::new`]).
 impl Default for Options {
     fn default() -> Self {
-        let run = crate::problem::run::Options::new(DISC);
+        let run = crate::problem::run::Options::new(&crate::settings::get().cases.disc);
         Options {
             problem: run.problem,
             methods: run.methods,

@@ -133,11 +133,14 @@ pub struct Case {
     pub measure: Measure,
 }
 
-/// The bar's and the disc's sweeps.
-pub const CASES: [Case; 2] = [
-    Case { name: bar::PROBLEM, steps: &BAR_STEPS, measure: bar_point },
-    Case { name: disc::DISC, steps: &DISC_STEPS, measure: disc_point },
-];
+/// The bar's and the disc's sweeps (their problems: forms/library.toml's `cases`).
+pub fn cases() -> [Case; 2] {
+    let names = &crate::settings::get().cases;
+    [
+        Case { name: &names.bar, steps: &BAR_STEPS, measure: bar_point },
+        Case { name: &names.disc, steps: &DISC_STEPS, measure: disc_point },
+    ]
+}
 
 /// Runs `cases` for every scheme and both masses.
 pub fn run(progress: &mut dyn FnMut(&str), cases: &[Case]) -> Sweeps {

@@ -96,6 +96,7 @@ pub fn conserving_schemes() -> Result<Vec<&'static str>, CaseError> {
 pub fn contact_laws(progress: &mut dyn FnMut(&str)) -> Result<Vec<EnergyRow>, CaseError> {
     let mut out = Vec::new();
     let v = &crate::settings::get().verify;
+    let cases = &crate::settings::get().cases;
     for scheme in conserving_schemes()? {
         for contact in &v.contacts {
             progress(&format!("energy law {scheme} {contact}"));
@@ -104,11 +105,11 @@ pub fn contact_laws(progress: &mut dyn FnMut(&str)) -> Result<Vec<EnergyRow>, Ca
             // The bar's one contact point: its status is the sign of λ.
             let rows: Vec<_> = b.series.iter().map(|r| (vec![r.lambda < 0.0], r.energy_aug, r.energy)).collect();
             let setting = format!("N = {}, Δt = {}, T = {}", b.summary.elements, b.summary.dt, b.summary.t_end);
-            out.push(EnergyRow { setting, ..energy_row(bar::PROBLEM, scheme, contact, &rows) });
+            out.push(EnergyRow { setting, ..energy_row(&cases.bar, scheme, contact, &rows) });
             let d = disc::run(&disc::Options { methods, h: Some(2.0), t_end: Some(16.0), ..disc::Options::default() })?;
             let rows: Vec<_> = d.series.iter().map(|r| (r.switches.clone(), r.energy_aug, r.energy)).collect();
             let setting = format!("{}, Δt = {}, T = {}", d.summary.mesh, d.summary.dt, d.summary.t_end);
-            out.push(EnergyRow { setting, ..energy_row(disc::DISC, scheme, contact, &rows) });
+            out.push(EnergyRow { setting, ..energy_row(&cases.disc, scheme, contact, &rows) });
         }
     }
     Ok(out)
