@@ -1,57 +1,20 @@
 //! The compressed bar as the report, `verify` and the tests read it: the problem itself is data
 //! (`forms/problems/bar.wf`, run by the one driver, [`crate::problem::run`], against the
 //! reference [`crate::references::bar`]); this module gives its rows and summary typed fields.
-
-use std::path::PathBuf;
+//! Its runs take the driver's [`Options`]; the number of elements is the problem's param `ne`.
 
 use serde::{Deserialize, Serialize};
 
-use crate::driver::{Methods, ParamValue};
+use crate::driver::ParamValue;
 use crate::error::CaseError;
+use crate::problem::run::{Chosen, Options};
 use crate::runtime::fem::mesh::CellSize;
-use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;
 
-#[derive(Clone, Debug, PartialEq)]
-pub struct Options {
-    /// Scheme, contact law, extra forms and params.
-    pub methods: Methods,
-    /// Elements, Δt and the end time; none: forms/problems/bar.wf's.
-    pub elements: Option<usize>,
-    pub dt: Option<f64>,
-    pub t_end: Option<f64>,
-    pub mass: MassChoice,
-    /// What `h` means in γ = γ0/h.
-    pub cell_size: CellSize,
-    pub newton: NewtonOptions,
-    pub out: Option<PathBuf>,
-    /// Show a progress bar on long runs (when stdout is a terminal).
-    pub progress: bool,
-    /// Write `out`/checkpoint.bin after every this many steps (0: only on an interrupt).
-    pub checkpoint_every: usize,
-    /// Continue from `out`/checkpoint.bin.
-    pub resume: bool,
-}
-
-/// The bar (forms/library.toml's `cases.bar`) with the problem file's mesh and times, and a
-/// run's defaults ([`crate::problem::run::Options::new`]).
-impl Default for Options {
-    fn default() -> Self {
-        let run = crate::problem::run::Options::new(&crate::settings::get().cases.bar);
-        Options {
-            methods: run.methods,
-            elements: None,
-            dt: run.dt,
-            t_end: run.t_end,
-            mass: run.mass,
-            cell_size: run.cell_size,
-            newton: run.newton,
-            out: run.out,
-            checkpoint_every: run.checkpoint_every,
-            resume: run.resume,
-            progress: run.progress,
-        }
-    }
+/// The bar's run with its file's mesh and times and a run's defaults: the problem of
+/// forms/library.toml's `cases.bar`, with the methods as given (no `bind` line replaces them).
+pub fn options() -> Options {
+    Options { chosen: Chosen::all(), ..Options::new(&crate::settings::get().cases.bar) }
 }
 
 /// One row of `series.csv`.
@@ -139,28 +102,7 @@ pub struct Run {
 
 /// Runs the bar; writes series.csv and summary.json into `opts.out` if set.
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    let mut methods = opts.methods.clone();
-    // The problem's mesh param, as the user's setting (before theirs: theirs wins).
-    if let Some(ne) = opts.elements {
-        methods.params.insert(0, crate::driver::Setting { name: "ne".into(), value: ne as f64, origin: "--ne".into() });
-    }
-    let name = &crate::settings::get().cases.bar;
-    let problem = crate::problem::run::Options {
-        problem: name.clone(),
-        methods,
-        mass: opts.mass,
-        cell_size: opts.cell_size,
-        dt: opts.dt,
-        t_end: opts.t_end,
-        newton: opts.newton,
-        out: opts.out.clone(),
-        progress: opts.progress,
-        checkpoint_every: opts.checkpoint_every,
-        resume: opts.resume,
-        chosen: crate::problem::run::Chosen::all(),
-        ..crate::problem::run::Options::new(name)
-    };
-    from_problem(opts, &crate::problem::run::run(&problem)?)
+    from_problem(opts, &crate::problem::run::run(opts)?)
 }
 
 fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, CaseError> {

@@ -5,72 +5,22 @@
 //! y in 2D and z in 3D: the fields `u_vertical_*`, `v_vertical_mean` and `f_vertical_contact`
 //! of [`Row`] hold that component, read from the columns the file names after its axis
 //! (`uy_mean`, `fy_contact` for the disc; `uz_mean`, `fz_contact` for the sphere). Both library
-//! files name their summary key `min_uy_mean`.
-
-use std::path::PathBuf;
+//! files name their summary key `min_uy_mean`. Its runs take the driver's [`Options`]; the mesh
+//! size of the built-in generator is the problem's param `h`.
 
 use serde::{Deserialize, Serialize};
 
-use crate::driver::{Methods, ParamValue};
+use crate::driver::ParamValue;
 use crate::error::CaseError;
+use crate::problem::run::{Chosen, Options};
 use crate::runtime::fem::mesh::CellSize;
-use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::simulation::MassChoice;
 
-#[derive(Clone, Debug, PartialEq)]
-pub struct Options {
-    /// The problem: a library problem by name (`disc`, `sphere`) or a problem file.
-    pub problem: String,
-    /// Scheme, contact law, extra forms and params.
-    pub methods: Methods,
-    pub mass: MassChoice,
-    /// What `h` means in γ = γ0/h.
-    pub cell_size: CellSize,
-    /// A Gmsh file; the built-in curved disc generator otherwise.
-    pub mesh: Option<PathBuf>,
-    /// Mesh size of the built-in generator (none: the problem file's `h`).
-    pub h: Option<f64>,
-    /// The time step, start and end (none: the problem file's `run` line).
-    pub dt: Option<f64>,
-    /// Start from the exact free fall at this time (u = −g t²/2, v = −g t, vertically) instead
-    /// of rest at t = 0: the first contact at √40 is reached in few steps.
-    pub t_start: Option<f64>,
-    pub t_end: Option<f64>,
-    pub newton: NewtonOptions,
-    pub out: Option<PathBuf>,
-    /// Write a VTU snapshot every this many steps (0: none) into `out`/vtu, with disc.pvd.
-    pub vtu_every: usize,
-    /// Show a progress bar on long runs (when stdout is a terminal).
-    pub progress: bool,
-    /// Write `out`/checkpoint.bin after every this many steps (0: only on an interrupt).
-    pub checkpoint_every: usize,
-    /// Continue from `out`/checkpoint.bin.
-    pub resume: bool,
-}
-
-/// The disc (forms/library.toml's `cases.disc`) with the problem file's mesh size and times,
-/// and a run's defaults ([`crate::problem::run::Options::new`]).
-impl Default for Options {
-    fn default() -> Self {
-        let run = crate::problem::run::Options::new(&crate::settings::get().cases.disc);
-        Options {
-            problem: run.problem,
-            methods: run.methods,
-            mass: run.mass,
-            cell_size: run.cell_size,
-            mesh: run.mesh,
-            h: None,
-            dt: run.dt,
-            t_start: run.t_start,
-            t_end: run.t_end,
-            newton: run.newton,
-            out: run.out,
-            vtu_every: run.vtu_every,
-            progress: run.progress,
-            checkpoint_every: run.checkpoint_every,
-            resume: run.resume,
-        }
-    }
+/// The disc's run with its file's mesh and times and a run's defaults: the problem of
+/// forms/library.toml's `cases.disc`, with the methods as given (no `bind` line replaces them).
+/// Another problem with the disc's columns runs with `problem` set (`sphere`).
+pub fn options() -> Options {
+    Options { chosen: Chosen::all(), ..Options::new(&crate::settings::get().cases.disc) }
 }
 
 /// One row of `series.csv`.
@@ -186,31 +136,9 @@ pub struct StageRow {
     pub row: Row,
 }
 
+/// Runs the problem; writes its outputs into `opts.out` if set.
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    let mut methods = opts.methods.clone();
-    // The problem's mesh-size param, as the user's setting (before theirs: theirs wins).
-    if let Some(h) = opts.h {
-        methods.params.insert(0, crate::driver::Setting { name: "h".into(), value: h, origin: "--h".into() });
-    }
-    let problem = crate::problem::run::Options {
-        problem: opts.problem.clone(),
-        methods,
-        mass: opts.mass,
-        cell_size: opts.cell_size,
-        mesh: opts.mesh.clone(),
-        dt: opts.dt,
-        t_start: opts.t_start,
-        t_end: opts.t_end,
-        newton: opts.newton,
-        out: opts.out.clone(),
-        vtu_every: opts.vtu_every,
-        progress: opts.progress,
-        checkpoint_every: opts.checkpoint_every,
-        resume: opts.resume,
-        chosen: crate::problem::run::Chosen::all(),
-    };
-    let run = crate::problem::run::run(&problem)?;
-    from_problem(opts, &run)
+    from_problem(opts, &crate::problem::run::run(opts)?)
 }
 
 /// The problem file's run as the disc's rows and summary (its columns by name).

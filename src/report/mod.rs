@@ -14,6 +14,7 @@ use crate::cases::disc;
 use crate::driver::{Methods, ParamValue};
 use crate::error::CaseError;
 use crate::plot::Curve;
+use crate::problem::run::Options;
 use crate::simulation::MassChoice;
 
 mod hertz;
@@ -77,7 +78,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         progress(&format!("bar {label}"));
         let methods = Methods { scheme: scheme.into(), contact: contact.into(), ..Methods::default() };
         let (r, guard) = past_the_guard(methods, |methods| {
-            bar::run(&bar::Options { methods, mass, out: Some(dir.clone()), ..Default::default() })
+            bar::run(&Options { methods, mass, out: Some(dir.clone()), ..bar::options() })
         })?;
         let s = &r.summary;
         let _ = writeln!(
@@ -145,7 +146,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         let methods = Methods { scheme: scheme.into(), ..Methods::default() };
         // A scheme that fails here (explicit contact is unstable at this step) is a result.
         let run = past_the_guard(methods, |methods| {
-            disc::run(&disc::Options { methods, out: Some(dir.clone()), ..Default::default() })
+            disc::run(&Options { methods, out: Some(dir.clone()), ..disc::options() })
         });
         let (r, guard) = match run {
             Ok(r) => r,

@@ -1,8 +1,9 @@
 //! The bouncing disc (spec §6.2): before the first contact every scheme reproduces free fall
 //! exactly, u_y = −½ 0.1 t² and E = 0, and the first contact happens in the step containing t* = √40.
 
-use signorini::cases::disc::{self, Options};
+use signorini::cases::disc;
 use signorini::driver::{self, Methods};
+use signorini::problem::run::Options;
 
 fn scheme(name: &str) -> Methods {
     Methods { scheme: name.into(), ..Methods::default() }
@@ -30,7 +31,7 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
     let g = gravity("disc");
     let t_star = (2.0 * 2.0 / g).sqrt();
     for scheme in driver::all_schemes() {
-        let opts = Options { methods: self::scheme(scheme), h: Some(2.0), t_end: Some(6.5), ..Options::default() };
+        let opts = Options { methods: self::scheme(scheme).set("h", 2.0), t_end: Some(6.5), ..disc::options() };
         let r = disc::run(&opts).unwrap_or_else(|e| panic!("{scheme:?}: {e}"));
         for row in r.series.iter().filter(|row| row.t < t_star - 0.05) {
             let exact = -0.5 * g * row.t * row.t;
@@ -89,8 +90,8 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
 /// Spec §4.5: the hybrid scheme with θ = 1 never increases E_Θ (to 1e-9 of the energy scale).
 #[test]
 fn hybrid_never_increases_the_augmented_energy() {
-    let r = disc::run(&Options { methods: scheme("hybrid"), h: Some(2.0), t_end: Some(20.0), ..Options::default() })
-        .unwrap();
+    let r =
+        disc::run(&Options { methods: scheme("hybrid").set("h", 2.0), t_end: Some(20.0), ..disc::options() }).unwrap();
     let scale = r.series.iter().map(|row| row.energy_aug.abs()).fold(0.0, f64::max);
     assert!(scale > 1e-3);
     // The Jacobian is refactored only when the active set changes: through the whole contact
@@ -122,12 +123,8 @@ fn penetration_decreases_with_the_contact_parameter() {
             .iter()
             .map(|&gamma0| {
                 let methods = Methods { scheme: "hybrid".into(), contact: contact.into(), ..Methods::default() };
-                let o = Options {
-                    methods: methods.set("gamma0", gamma0),
-                    h: Some(2.0),
-                    t_end: Some(12.0),
-                    ..Options::default()
-                };
+                let methods = methods.set("gamma0", gamma0).set("h", 2.0);
+                let o = Options { methods, t_end: Some(12.0), ..disc::options() };
                 disc::run(&o).unwrap().summary.max_penetration
             })
             .collect();
@@ -142,8 +139,7 @@ fn gmsh_mesh_and_built_in_generator_agree() {
     let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/disc_r10_h1_v22.msh");
     assert!(shared.exists(), "{} is missing: the reference meshes live in assets/meshes", shared.display());
     let summary = |mesh: Option<std::path::PathBuf>| {
-        let r =
-            disc::run(&Options { methods: scheme("hybrid"), mesh, t_end: Some(26.0), ..Options::default() }).unwrap();
+        let r = disc::run(&Options { methods: scheme("hybrid"), mesh, t_end: Some(26.0), ..disc::options() }).unwrap();
         let release = r.series.iter().filter(|row| row.active_points > 0).map(|row| row.t).fold(0.0, f64::max);
         let rebound = r
             .series
@@ -165,12 +161,8 @@ fn an_unstable_setting_fails_with_a_clear_error() {
     // Nitsche θ = 1 with γ0 = 2E is not coercive: the free fall already diverges while E_aug
     // is kept, its potential part going negative, and the energy guard stops it within the
     // first second, long before the values overflow.
-    let o = Options {
-        methods: Methods::default().set("gamma0", 100.0),
-        h: Some(2.0),
-        t_end: Some(20.0),
-        ..Options::default()
-    };
+    let methods = Methods::default().set("gamma0", 100.0).set("h", 2.0);
+    let o = Options { methods, t_end: Some(20.0), ..disc::options() };
     let e = disc::run(&o).err().expect("diverges").to_string();
     assert!(e.contains("not coercive") && e.contains("gamma0 = 100"), "{e}");
     let t: f64 = e.trim_start_matches("stopped at t = ").split(':').next().unwrap().parse().unwrap();
@@ -182,7 +174,7 @@ fn an_unstable_setting_fails_with_a_clear_error() {
 /// t_end on the nominal time levels with the cuts counted.
 #[test]
 fn steps_cut_at_impact_return_to_the_nominal_step() {
-    let mut o = Options { t_end: Some(9.0), dt: Some(0.1), ..Options::default() };
+    let mut o = Options { t_end: Some(9.0), dt: Some(0.1), ..disc::options() };
     o.newton.max_iterations = 2;
     let r = disc::run(&o).unwrap();
     let s = &r.summary;

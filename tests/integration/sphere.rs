@@ -2,15 +2,16 @@
 //! is exact before the first contact, which happens just after t* = √40, and
 //! Crank–Nicolson with Nitsche θ = 1 keeps E_aug on every step whose active set is unchanged.
 
-use signorini::cases::disc::{self, Options};
+use signorini::cases::disc;
 use signorini::driver::Methods;
+use signorini::problem::run::Options;
 
 use super::disc::gravity;
 
 fn sphere(scheme: &str, h: f64, t_end: f64) -> disc::Run {
     let methods = Methods { scheme: scheme.into(), ..Methods::default() };
-    disc::run(&Options { problem: "sphere".into(), methods, h: Some(h), t_end: Some(t_end), ..Options::default() })
-        .unwrap()
+    let methods = methods.set("h", h);
+    disc::run(&Options { problem: "sphere".into(), methods, t_end: Some(t_end), ..disc::options() }).unwrap()
 }
 
 #[test]
@@ -75,11 +76,10 @@ fn iterative_and_direct_solvers_agree() {
             let newton = NewtonOptions { solver, ..NewtonOptions::default() };
             disc::run(&Options {
                 problem: "sphere".into(),
-                methods,
-                h: Some(5.0),
+                methods: methods.set("h", 5.0),
                 t_end: Some(8.0),
                 newton,
-                ..Options::default()
+                ..disc::options()
             })
             .unwrap()
         };
@@ -103,7 +103,7 @@ fn the_graded_gmsh_ball_falls_exactly() {
     let m = signorini::runtime::fem::mesh::gmsh::read(&mesh).unwrap();
     let lowest = (0..m.num_nodes()).map(|i| m.node(i)[2]).fold(f64::INFINITY, f64::min);
     assert!((lowest - 2.0).abs() < 1e-9, "the mesh's lowest point is at z = {lowest}");
-    let opts = Options { problem: "sphere".into(), mesh: Some(mesh), t_end: Some(0.4), ..Options::default() };
+    let opts = Options { problem: "sphere".into(), mesh: Some(mesh), t_end: Some(0.4), ..disc::options() };
     let g = gravity("sphere");
     let r = disc::run(&opts).unwrap();
     assert!(r.summary.dofs > 20_000);
