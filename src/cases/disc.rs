@@ -10,11 +10,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::driver::ParamValue;
+use super::{Common, count, number};
 use crate::error::CaseError;
 use crate::problem::run::{Chosen, Options};
-use crate::runtime::fem::mesh::CellSize;
-use crate::simulation::MassChoice;
 
 /// The disc's run with its file's mesh and times and a run's defaults: the problem of
 /// forms/library.toml's `cases.disc`, with the methods as given (no `bind` line replaces them).
@@ -53,26 +51,14 @@ pub struct Row {
     pub newton: usize,
 }
 
+/// The disc's summary: the keys of every run ([`Common`], read through `Deref`) and the disc's
+/// own.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
-    /// The problem's name.
-    pub case: String,
-    pub scheme: String,
-    /// The contact law (its file stem).
-    pub contact: String,
-    /// Files of the run compiled at run time (given by path, not in the library).
-    pub interpreted: Vec<String>,
-    /// Every param of the scheme and form files, with its value and where it comes from.
-    pub params: std::collections::BTreeMap<String, ParamValue>,
-    pub mass: MassChoice,
-    pub cell_size: CellSize,
+    #[serde(flatten)]
+    pub common: Common,
     pub mesh: String,
     pub cells: usize,
-    pub dofs: usize,
-    pub dt: f64,
-    /// The time reached (the end time, or where the run stopped).
-    pub t_end: f64,
-    pub steps: usize,
     /// Time of the first step that ends with an active contact point.
     pub first_contact: Option<f64>,
     pub max_penetration: f64,
@@ -83,9 +69,6 @@ pub struct Summary {
     /// The largest kinetic energy ½vᵀMv over the run (at impact): the disc's energy scale, as
     /// E_aug(0) = 0.
     pub kinetic_energy_max: f64,
-    pub newton_total: usize,
-    pub newton_max: usize,
-    pub wall_seconds: f64,
     pub seconds_per_step: f64,
     /// Time inside the time stepper alone (no setup, measurements or output), in total and
     /// the median over steps.
@@ -105,19 +88,13 @@ pub struct Summary {
     pub krylov_iterations: usize,
     /// The process's peak resident memory at the end of the run (Linux), in bytes.
     pub peak_memory_bytes: Option<u64>,
-    /// Halvings of Δt after a failed Newton (the series has the actual time levels).
-    pub step_cuts: usize,
-    /// The energy guard's largest growth of E_aug over the energy scale.
-    pub energy_growth: f64,
-    /// An explicit scheme's estimated critical step.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stable_dt: Option<f64>,
-    /// Why the run ended before t_end, if it did (the series stops at the last good step).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stopped: Option<String>,
-    /// The checkpoint this run resumed from (its counters and wall time cover the rest only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub resumed: Option<crate::simulation::Resumed>,
+}
+
+impl std::ops::Deref for Summary {
+    type Target = Common;
+    fn deref(&self) -> &Common {
+        &self.common
+    }
 }
 
 pub struct Run {
@@ -147,7 +124,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     // 2D).
     let a = ['z', 'y', 'x'].into_iter().find(|a| run.columns.iter().any(|c| *c == format!("u{a}_mean"))).unwrap_or('y');
     let s = &run.summary;
-    let name: String = s.field("case")?;
+    let (common, _) = Common::read(opts, s)?;
     let names = [
         "energy".to_string(),
         "kinetic".to_string(),
@@ -162,7 +139,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         "penetration".to_string(),
         "newton".to_string(),
     ];
-    let index = run.indices(&names, &name)?;
+    let index = run.indices(&names, &common.case)?;
     let row = |t: f64, v: &[f64], switches: Vec<bool>| Row {
         t,
         energy: v[index[0]],
@@ -182,48 +159,26 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     let series: Vec<Row> = run.rows.iter().zip(&run.switches).map(|((t, v), s)| row(*t, v, s.clone())).collect();
     let stages =
         run.stages.iter().map(|(name, t, v)| StageRow { stage: name.clone(), row: row(*t, v, Vec::new()) }).collect();
-    let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
-    let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
-    let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
-    params.retain(|k, _| !k.starts_with(&format!("{name}.")));
     let summary = Summary {
-        case: name,
-        scheme: s.field("scheme")?,
-        contact: s.field("contact")?,
-        interpreted: s.field("interpreted")?,
-        params,
-        mass: opts.mass,
-        cell_size: opts.cell_size,
         mesh: s.field("mesh")?,
-        cells: count("cells"),
-        dofs: count("dofs"),
-        dt: number("dt"),
-        t_end: number("t_end"),
-        steps: count("steps"),
+        cells: count(s, "cells"),
         first_contact: s.number("first_contact"),
-        max_penetration: number("max_penetration"),
-        min_u_vertical_mean: number("min_uy_mean"),
-        energy_aug_initial: number("energy_aug_initial"),
-        energy_aug_final: number("energy_aug_final"),
-        kinetic_energy_max: number("kinetic_energy_max"),
-        newton_total: count("newton_total"),
-        newton_max: count("newton_max"),
-        wall_seconds: number("wall_seconds"),
-        seconds_per_step: number("seconds_per_step"),
-        stepping_seconds: number("stepping_seconds"),
-        step_median_seconds: number("step_median_seconds"),
-        factorizations: count("factorizations"),
-        low_rank_updates: count("low_rank_updates"),
-        matrix_nnz: count("matrix_nnz"),
+        max_penetration: number(s, "max_penetration"),
+        min_u_vertical_mean: number(s, "min_uy_mean"),
+        energy_aug_initial: number(s, "energy_aug_initial"),
+        energy_aug_final: number(s, "energy_aug_final"),
+        kinetic_energy_max: number(s, "kinetic_energy_max"),
+        seconds_per_step: number(s, "seconds_per_step"),
+        stepping_seconds: number(s, "stepping_seconds"),
+        step_median_seconds: number(s, "step_median_seconds"),
+        factorizations: count(s, "factorizations"),
+        low_rank_updates: count(s, "low_rank_updates"),
+        matrix_nnz: count(s, "matrix_nnz"),
         factor_nnz: s.get("factor_nnz").and_then(|v| v.as_u64()).map(|v| v as usize),
         solver: opts.newton.solver,
-        krylov_iterations: count("krylov_iterations"),
+        krylov_iterations: count(s, "krylov_iterations"),
         peak_memory_bytes: s.get("peak_memory_bytes").and_then(|v| v.as_u64()),
-        step_cuts: count("step_cuts"),
-        energy_growth: number("energy_growth"),
-        stable_dt: s.get("stable_dt").and_then(|v| v.as_f64()),
-        stopped: s.get("stopped").and_then(|v| v.as_str()).map(str::to_string),
-        resumed: s.field("resumed")?,
+        common,
     };
     Ok(Run { summary, series, stages })
 }
