@@ -64,12 +64,7 @@ pub struct Summary {
     pub max_penetration: f64,
 }
 
-impl std::ops::Deref for Summary {
-    type Target = Common;
-    fn deref(&self) -> &Common {
-        &self.common
-    }
-}
+deref_to_common!(Summary);
 
 pub struct Run {
     pub summary: Summary,

@@ -90,12 +90,7 @@ pub struct Summary {
     pub peak_memory_bytes: Option<u64>,
 }
 
-impl std::ops::Deref for Summary {
-    type Target = Common;
-    fn deref(&self) -> &Common {
-        &self.common
-    }
-}
+deref_to_common!(Summary);
 
 pub struct Run {
     pub summary: Summary,

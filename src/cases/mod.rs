@@ -3,6 +3,19 @@
 //! and case files (`signorini run case.toml`). A view's summary is the keys every run has
 //! ([`Common`]) and its problem's own.
 
+/// A view's summary reads the common keys as its own fields (`summary.dt`): `Deref` to its
+/// field `common`.
+macro_rules! deref_to_common {
+    ($summary:ty) => {
+        impl std::ops::Deref for $summary {
+            type Target = $crate::cases::Common;
+            fn deref(&self) -> &$crate::cases::Common {
+                &self.common
+            }
+        }
+    };
+}
+
 pub mod bar;
 pub mod disc;
 pub mod file;
