@@ -1,6 +1,5 @@
 //! `forms/library.toml`: the library's defaults and the runs the report, `verify` and the
-//! benchmarks make, as data (no scheme or law name is written in Rust, nor the problems the
-//! benchmarks and the report's Hertz section run).
+//! benchmarks make, as data (no scheme, law or problem name is written in Rust).
 
 use std::sync::OnceLock;
 
@@ -10,6 +9,7 @@ use serde::Deserialize;
 #[serde(deny_unknown_fields)]
 pub struct Settings {
     pub defaults: Defaults,
+    pub cases: Cases,
     pub report: Report,
     pub verify: Verify,
     pub bench: Bench,
@@ -33,6 +33,14 @@ pub struct Defaults {
     pub scheme: String,
     pub contact: String,
     pub material: String,
+}
+
+/// The problems `cases::bar` and `cases::disc` run unless told otherwise.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cases {
+    pub bar: String,
+    pub disc: String,
 }
 
 #[derive(Debug, Deserialize)]

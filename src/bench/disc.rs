@@ -23,8 +23,9 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::cases::disc::{self, Options};
+use crate::cases::disc;
 use crate::error::CaseError;
+use crate::problem::run::Options;
 use crate::resources::median;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -98,7 +99,7 @@ pub struct Report {
 
 pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) -> Result<Report, CaseError> {
     // The problem of forms/library.toml's `[bench]`.
-    let base = Options { problem: crate::settings::get().bench.disc.clone(), ..Options::default() };
+    let base = Options { problem: crate::settings::get().bench.disc.clone(), ..disc::options() };
     let stream = stream_bandwidth();
     let mut out = Vec::new();
     // The disc's step and end time (its file's) and the methods, as run.

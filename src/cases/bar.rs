@@ -1,61 +1,18 @@
 //! The compressed bar as the report, `verify` and the tests read it: the problem itself is data
 //! (`forms/problems/bar.wf`, run by the one driver, [`crate::problem::run`], against the
 //! reference [`crate::references::bar`]); this module gives its rows and summary typed fields.
-
-use std::path::PathBuf;
+//! Its runs take the driver's [`Options`]; the number of elements is the problem's param `ne`.
 
 use serde::{Deserialize, Serialize};
 
-use crate::driver::{Methods, ParamValue};
+use super::{Common, number};
 use crate::error::CaseError;
-use crate::runtime::fem::mesh::CellSize;
-use crate::runtime::nonlinear::newton::NewtonOptions;
-use crate::simulation::MassChoice;
+use crate::problem::run::{Chosen, Options};
 
-/// The problem this module reads: the library's compressed bar, whose columns and summary keys
-/// are the fields of [`Row`] and [`Summary`].
-pub const PROBLEM: &str = "bar";
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct Options {
-    /// Scheme, contact law, extra forms and params.
-    pub methods: Methods,
-    /// Elements, Δt and the end time; none: forms/problems/bar.wf's.
-    pub elements: Option<usize>,
-    pub dt: Option<f64>,
-    pub t_end: Option<f64>,
-    pub mass: MassChoice,
-    /// What `h` means in γ = γ0/h.
-    pub cell_size: CellSize,
-    pub newton: NewtonOptions,
-    pub out: Option<PathBuf>,
-    /// Show a progress bar on long runs (when stdout is a terminal).
-    pub progress: bool,
-    /// Write `out`/checkpoint.bin after every this many steps (0: only on an interrupt).
-    pub checkpoint_every: usize,
-    /// Continue from `out`/checkpoint.bin.
-    pub resume: bool,
-}
-
-/// The bar with the problem file's mesh and times, and a run's defaults
-/// ([`crate::problem::run::Options::new`]).
-impl Default for Options {
-    fn default() -> Self {
-        let run = crate::problem::run::Options::new(PROBLEM);
-        Options {
-            methods: run.methods,
-            elements: None,
-            dt: run.dt,
-            t_end: run.t_end,
-            mass: run.mass,
-            cell_size: run.cell_size,
-            newton: run.newton,
-            out: run.out,
-            checkpoint_every: run.checkpoint_every,
-            resume: run.resume,
-            progress: run.progress,
-        }
-    }
+/// The bar's run with its file's mesh and times and a run's defaults: the problem of
+/// forms/library.toml's `cases.bar`, with the methods as given (no `bind` line replaces them).
+pub fn options() -> Options {
+    Options { chosen: Chosen::all(), ..Options::new(&crate::settings::get().cases.bar) }
 }
 
 /// One row of `series.csv`.
@@ -78,23 +35,13 @@ pub struct Row {
     pub p1: f64,
 }
 
+/// The bar's summary: the keys of every run ([`Common`], read through `Deref`) and the bar's own.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
-    pub case: &'static str,
-    pub scheme: String,
-    /// The contact law (its file stem).
-    pub contact: String,
-    /// Files of the run compiled at run time (given by path, not in the library).
-    pub interpreted: Vec<String>,
-    /// Every param of the scheme and form files, with its value and where it comes from.
-    pub params: std::collections::BTreeMap<String, ParamValue>,
-    pub mass: MassChoice,
-    pub cell_size: CellSize,
+    #[serde(flatten)]
+    pub common: Common,
+    /// The number of elements (the problem's param `ne`).
     pub elements: usize,
-    pub dt: f64,
-    pub t_end: f64,
-    pub dofs: usize,
-    pub steps: usize,
     /// max_n ‖u_h − I_h u‖_M / max_n ‖I_h u‖_M.
     pub err_linf_l2_u: f64,
     /// (Σ (λⁿ − σ_ex(0, tⁿ))²)^½ / (Σ σ_ex(0, tⁿ)²)^½; absent (see `notes`) when the exact
@@ -115,25 +62,9 @@ pub struct Summary {
     /// max_n |E_Θⁿ − E_Θ(0)| / E_Θ(0).
     pub energy_aug_drift_max: f64,
     pub max_penetration: f64,
-    pub newton_total: usize,
-    pub newton_max: usize,
-    pub wall_seconds: f64,
-    /// Halvings of Δt after a failed Newton (the series has the actual time levels).
-    pub step_cuts: usize,
-    /// The energy guard's largest growth of E_aug over the energy scale.
-    pub energy_growth: f64,
-    /// An explicit scheme's estimated critical step.
-    pub stable_dt: Option<f64>,
-    /// Why the run ended before t_end, if it did (the series stops at the last good step).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub stopped: Option<String>,
-    /// The checkpoint this run resumed from (its counters and wall time cover the rest only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub resumed: Option<crate::simulation::Resumed>,
-    /// Why a metric is absent.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub notes: Vec<String>,
 }
+
+deref_to_common!(Summary);
 
 pub struct Run {
     pub summary: Summary,
@@ -142,32 +73,14 @@ pub struct Run {
 
 /// Runs the bar; writes series.csv and summary.json into `opts.out` if set.
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    let mut methods = opts.methods.clone();
-    // The problem's mesh param, as the user's setting (before theirs: theirs wins).
-    if let Some(ne) = opts.elements {
-        methods.params.insert(0, crate::driver::Setting { name: "ne".into(), value: ne as f64, origin: "--ne".into() });
-    }
-    let problem = crate::problem::run::Options {
-        problem: PROBLEM.to_string(),
-        methods,
-        mass: opts.mass,
-        cell_size: opts.cell_size,
-        dt: opts.dt,
-        t_end: opts.t_end,
-        newton: opts.newton,
-        out: opts.out.clone(),
-        progress: opts.progress,
-        checkpoint_every: opts.checkpoint_every,
-        resume: opts.resume,
-        chosen: crate::problem::run::Chosen::all(),
-        ..crate::problem::run::Options::new(PROBLEM)
-    };
-    from_problem(opts, &crate::problem::run::run(&problem)?)
+    from_problem(opts, &crate::problem::run::run(opts)?)
 }
 
 fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, CaseError> {
+    let s = &run.summary;
+    let (common, own) = Common::read(opts, s)?;
     let names = ["u_c", "v_c", "lambda", "lambda_half", "energy", "energy_aug", "penetration", "newton", "p1"];
-    let index = run.indices(&names, PROBLEM)?;
+    let index = run.indices(&names, &common.case)?;
     let series = run
         .rows
         .iter()
@@ -184,44 +97,19 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
             p1: v[index[8]],
         })
         .collect::<Vec<_>>();
-    let s = &run.summary;
-    let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
-    let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
-    let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
-    let elements = params.get(&format!("{PROBLEM}.ne")).map_or(0, |p| p.value as usize);
-    params.retain(|k, _| !k.starts_with(&format!("{PROBLEM}.")));
     let summary = Summary {
-        case: PROBLEM,
-        scheme: s.field("scheme")?,
-        contact: s.field("contact")?,
-        interpreted: s.field("interpreted")?,
-        params,
-        mass: opts.mass,
-        cell_size: opts.cell_size,
-        elements,
-        dt: number("dt"),
-        t_end: number("t_end"),
-        dofs: count("dofs"),
-        steps: count("steps"),
-        err_linf_l2_u: number("err_linf_l2_u"),
+        elements: own.get(&format!("{}.ne", common.case)).map_or(0, |p| p.value as usize),
+        err_linf_l2_u: number(s, "err_linf_l2_u"),
         err_l2_lambda: s.number("err_l2_lambda"),
         err_l2_lambda_half: s.number("err_l2_lambda_half"),
-        energy_initial: number("energy_initial"),
-        energy_final: number("energy_final"),
-        energy_aug_initial: number("energy_aug_initial"),
-        energy_aug_final: number("energy_aug_final"),
-        energy_aug_drift_final: number("energy_aug_drift_final"),
-        energy_aug_drift_max: number("energy_aug_drift_max"),
-        max_penetration: number("max_penetration"),
-        newton_total: count("newton_total"),
-        newton_max: count("newton_max"),
-        wall_seconds: number("wall_seconds"),
-        step_cuts: count("step_cuts"),
-        energy_growth: number("energy_growth"),
-        stable_dt: s.get("stable_dt").and_then(|v| v.as_f64()),
-        stopped: s.get("stopped").and_then(|v| v.as_str()).map(str::to_string),
-        resumed: s.field("resumed")?,
-        notes: s.field::<Option<Vec<String>>>("notes")?.unwrap_or_default(),
+        energy_initial: number(s, "energy_initial"),
+        energy_final: number(s, "energy_final"),
+        energy_aug_initial: number(s, "energy_aug_initial"),
+        energy_aug_final: number(s, "energy_aug_final"),
+        energy_aug_drift_final: number(s, "energy_aug_drift_final"),
+        energy_aug_drift_max: number(s, "energy_aug_drift_max"),
+        max_penetration: number(s, "max_penetration"),
+        common,
     };
     Ok(Run { summary, series })
 }

@@ -5,77 +5,20 @@
 //! y in 2D and z in 3D: the fields `u_vertical_*`, `v_vertical_mean` and `f_vertical_contact`
 //! of [`Row`] hold that component, read from the columns the file names after its axis
 //! (`uy_mean`, `fy_contact` for the disc; `uz_mean`, `fz_contact` for the sphere). Both library
-//! files name their summary key `min_uy_mean`.
-
-use std::path::PathBuf;
+//! files name their summary key `min_uy_mean`. Its runs take the driver's [`Options`]; the mesh
+//! size of the built-in generator is the problem's param `h`.
 
 use serde::{Deserialize, Serialize};
 
-use crate::driver::{Methods, ParamValue};
+use super::{Common, count, number};
 use crate::error::CaseError;
-use crate::runtime::fem::mesh::CellSize;
-use crate::runtime::nonlinear::newton::NewtonOptions;
-use crate::simulation::MassChoice;
+use crate::problem::run::{Chosen, Options};
 
-/// Gravity of the benchmark (the free fall before the first contact is exact: u = −g t²/2).
-pub const GRAVITY: f64 = 0.1;
-/// The problem these options run unless told otherwise: the library's bouncing disc.
-pub const DISC: &str = "disc";
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct Options {
-    /// The problem: a library problem by name (`disc`, `sphere`) or a problem file.
-    pub problem: String,
-    /// Scheme, contact law, extra forms and params.
-    pub methods: Methods,
-    pub mass: MassChoice,
-    /// What `h` means in γ = γ0/h.
-    pub cell_size: CellSize,
-    /// A Gmsh file; the built-in curved disc generator otherwise.
-    pub mesh: Option<PathBuf>,
-    /// Mesh size of the built-in generator (none: the problem file's `h`).
-    pub h: Option<f64>,
-    /// The time step, start and end (none: the problem file's `run` line).
-    pub dt: Option<f64>,
-    /// Start from the exact free fall at this time (u = −g t²/2, v = −g t, vertically) instead
-    /// of rest at t = 0: the first contact at √40 is reached in few steps.
-    pub t_start: Option<f64>,
-    pub t_end: Option<f64>,
-    pub newton: NewtonOptions,
-    pub out: Option<PathBuf>,
-    /// Write a VTU snapshot every this many steps (0: none) into `out`/vtu, with disc.pvd.
-    pub vtu_every: usize,
-    /// Show a progress bar on long runs (when stdout is a terminal).
-    pub progress: bool,
-    /// Write `out`/checkpoint.bin after every this many steps (0: only on an interrupt).
-    pub checkpoint_every: usize,
-    /// Continue from `out`/checkpoint.bin.
-    pub resume: bool,
-}
-
-/// The disc with the problem file's mesh size and times, and a run's defaults
-/// ([`crate::problem::run::Options::new`]).
-impl Default for Options {
-    fn default() -> Self {
-        let run = crate::problem::run::Options::new(DISC);
-        Options {
-            problem: run.problem,
-            methods: run.methods,
-            mass: run.mass,
-            cell_size: run.cell_size,
-            mesh: run.mesh,
-            h: None,
-            dt: run.dt,
-            t_start: run.t_start,
-            t_end: run.t_end,
-            newton: run.newton,
-            out: run.out,
-            vtu_every: run.vtu_every,
-            progress: run.progress,
-            checkpoint_every: run.checkpoint_every,
-            resume: run.resume,
-        }
-    }
+/// The disc's run with its file's mesh and times and a run's defaults: the problem of
+/// forms/library.toml's `cases.disc`, with the methods as given (no `bind` line replaces them).
+/// Another problem with the disc's columns runs with `problem` set (`sphere`).
+pub fn options() -> Options {
+    Options { chosen: Chosen::all(), ..Options::new(&crate::settings::get().cases.disc) }
 }
 
 /// One row of `series.csv`.
@@ -108,26 +51,14 @@ pub struct Row {
     pub newton: usize,
 }
 
+/// The disc's summary: the keys of every run ([`Common`], read through `Deref`) and the disc's
+/// own.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
-    /// The problem's name.
-    pub case: String,
-    pub scheme: String,
-    /// The contact law (its file stem).
-    pub contact: String,
-    /// Files of the run compiled at run time (given by path, not in the library).
-    pub interpreted: Vec<String>,
-    /// Every param of the scheme and form files, with its value and where it comes from.
-    pub params: std::collections::BTreeMap<String, ParamValue>,
-    pub mass: MassChoice,
-    pub cell_size: CellSize,
+    #[serde(flatten)]
+    pub common: Common,
     pub mesh: String,
     pub cells: usize,
-    pub dofs: usize,
-    pub dt: f64,
-    /// The time reached (the end time, or where the run stopped).
-    pub t_end: f64,
-    pub steps: usize,
     /// Time of the first step that ends with an active contact point.
     pub first_contact: Option<f64>,
     pub max_penetration: f64,
@@ -138,9 +69,6 @@ pub struct Summary {
     /// The largest kinetic energy ½vᵀMv over the run (at impact): the disc's energy scale, as
     /// E_aug(0) = 0.
     pub kinetic_energy_max: f64,
-    pub newton_total: usize,
-    pub newton_max: usize,
-    pub wall_seconds: f64,
     pub seconds_per_step: f64,
     /// Time inside the time stepper alone (no setup, measurements or output), in total and
     /// the median over steps.
@@ -160,20 +88,9 @@ pub struct Summary {
     pub krylov_iterations: usize,
     /// The process's peak resident memory at the end of the run (Linux), in bytes.
     pub peak_memory_bytes: Option<u64>,
-    /// Halvings of Δt after a failed Newton (the series has the actual time levels).
-    pub step_cuts: usize,
-    /// The energy guard's largest growth of E_aug over the energy scale.
-    pub energy_growth: f64,
-    /// An explicit scheme's estimated critical step.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stable_dt: Option<f64>,
-    /// Why the run ended before t_end, if it did (the series stops at the last good step).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stopped: Option<String>,
-    /// The checkpoint this run resumed from (its counters and wall time cover the rest only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub resumed: Option<crate::simulation::Resumed>,
 }
+
+deref_to_common!(Summary);
 
 pub struct Run {
     pub summary: Summary,
@@ -191,31 +108,9 @@ pub struct StageRow {
     pub row: Row,
 }
 
+/// Runs the problem; writes its outputs into `opts.out` if set.
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
-    let mut methods = opts.methods.clone();
-    // The problem's mesh-size param, as the user's setting (before theirs: theirs wins).
-    if let Some(h) = opts.h {
-        methods.params.insert(0, crate::driver::Setting { name: "h".into(), value: h, origin: "--h".into() });
-    }
-    let problem = crate::problem::run::Options {
-        problem: opts.problem.clone(),
-        methods,
-        mass: opts.mass,
-        cell_size: opts.cell_size,
-        mesh: opts.mesh.clone(),
-        dt: opts.dt,
-        t_start: opts.t_start,
-        t_end: opts.t_end,
-        newton: opts.newton,
-        out: opts.out.clone(),
-        vtu_every: opts.vtu_every,
-        progress: opts.progress,
-        checkpoint_every: opts.checkpoint_every,
-        resume: opts.resume,
-        chosen: crate::problem::run::Chosen::all(),
-    };
-    let run = crate::problem::run::run(&problem)?;
-    from_problem(opts, &run)
+    from_problem(opts, &crate::problem::run::run(opts)?)
 }
 
 /// The problem file's run as the disc's rows and summary (its columns by name).
@@ -224,7 +119,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     // 2D).
     let a = ['z', 'y', 'x'].into_iter().find(|a| run.columns.iter().any(|c| *c == format!("u{a}_mean"))).unwrap_or('y');
     let s = &run.summary;
-    let name: String = s.field("case")?;
+    let (common, _) = Common::read(opts, s)?;
     let names = [
         "energy".to_string(),
         "kinetic".to_string(),
@@ -239,7 +134,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         "penetration".to_string(),
         "newton".to_string(),
     ];
-    let index = run.indices(&names, &name)?;
+    let index = run.indices(&names, &common.case)?;
     let row = |t: f64, v: &[f64], switches: Vec<bool>| Row {
         t,
         energy: v[index[0]],
@@ -259,48 +154,26 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
     let series: Vec<Row> = run.rows.iter().zip(&run.switches).map(|((t, v), s)| row(*t, v, s.clone())).collect();
     let stages =
         run.stages.iter().map(|(name, t, v)| StageRow { stage: name.clone(), row: row(*t, v, Vec::new()) }).collect();
-    let number = |k: &str| s.number(k).unwrap_or(f64::NAN);
-    let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
-    let mut params: std::collections::BTreeMap<String, ParamValue> = s.field("params")?;
-    params.retain(|k, _| !k.starts_with(&format!("{name}.")));
     let summary = Summary {
-        case: name,
-        scheme: s.field("scheme")?,
-        contact: s.field("contact")?,
-        interpreted: s.field("interpreted")?,
-        params,
-        mass: opts.mass,
-        cell_size: opts.cell_size,
         mesh: s.field("mesh")?,
-        cells: count("cells"),
-        dofs: count("dofs"),
-        dt: number("dt"),
-        t_end: number("t_end"),
-        steps: count("steps"),
+        cells: count(s, "cells"),
         first_contact: s.number("first_contact"),
-        max_penetration: number("max_penetration"),
-        min_u_vertical_mean: number("min_uy_mean"),
-        energy_aug_initial: number("energy_aug_initial"),
-        energy_aug_final: number("energy_aug_final"),
-        kinetic_energy_max: number("kinetic_energy_max"),
-        newton_total: count("newton_total"),
-        newton_max: count("newton_max"),
-        wall_seconds: number("wall_seconds"),
-        seconds_per_step: number("seconds_per_step"),
-        stepping_seconds: number("stepping_seconds"),
-        step_median_seconds: number("step_median_seconds"),
-        factorizations: count("factorizations"),
-        low_rank_updates: count("low_rank_updates"),
-        matrix_nnz: count("matrix_nnz"),
+        max_penetration: number(s, "max_penetration"),
+        min_u_vertical_mean: number(s, "min_uy_mean"),
+        energy_aug_initial: number(s, "energy_aug_initial"),
+        energy_aug_final: number(s, "energy_aug_final"),
+        kinetic_energy_max: number(s, "kinetic_energy_max"),
+        seconds_per_step: number(s, "seconds_per_step"),
+        stepping_seconds: number(s, "stepping_seconds"),
+        step_median_seconds: number(s, "step_median_seconds"),
+        factorizations: count(s, "factorizations"),
+        low_rank_updates: count(s, "low_rank_updates"),
+        matrix_nnz: count(s, "matrix_nnz"),
         factor_nnz: s.get("factor_nnz").and_then(|v| v.as_u64()).map(|v| v as usize),
         solver: opts.newton.solver,
-        krylov_iterations: count("krylov_iterations"),
+        krylov_iterations: count(s, "krylov_iterations"),
         peak_memory_bytes: s.get("peak_memory_bytes").and_then(|v| v.as_u64()),
-        step_cuts: count("step_cuts"),
-        energy_growth: number("energy_growth"),
-        stable_dt: s.get("stable_dt").and_then(|v| v.as_f64()),
-        stopped: s.get("stopped").and_then(|v| v.as_str()).map(str::to_string),
-        resumed: s.field("resumed")?,
+        common,
     };
     Ok(Run { summary, series, stages })
 }

@@ -14,6 +14,7 @@ use crate::cases::disc;
 use crate::driver::{Methods, ParamValue};
 use crate::error::CaseError;
 use crate::plot::Curve;
+use crate::problem::run::Options;
 use crate::simulation::MassChoice;
 
 mod hertz;
@@ -70,13 +71,14 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     let mut stopped = Vec::new();
     let mut bar_run: Option<bar::Summary> = None;
     let default_contact = &crate::settings::get().defaults.contact;
+    let cases = &crate::settings::get().cases;
     for &(scheme, contact, mass) in &runs {
         let label = format!("{scheme}-{contact}-{}", mass.name());
-        let dir = out.join(bar::PROBLEM).join(&label);
+        let dir = out.join(&cases.bar).join(&label);
         progress(&format!("bar {label}"));
         let methods = Methods { scheme: scheme.into(), contact: contact.into(), ..Methods::default() };
         let (r, guard) = past_the_guard(methods, |methods| {
-            bar::run(&bar::Options { methods, mass, out: Some(dir.clone()), ..Default::default() })
+            bar::run(&Options { methods, mass, out: Some(dir.clone()), ..bar::options() })
         })?;
         let s = &r.summary;
         let _ = writeln!(
@@ -96,7 +98,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         if guard.is_some() {
             stopped.push(label.clone());
         }
-        let _ = writeln!(figures, "**{label}**\n\n![{label}]({p}/{label}/{p}.png)\n", p = bar::PROBLEM);
+        let _ = writeln!(figures, "**{label}**\n\n![{label}]({p}/{label}/{p}.png)\n", p = cases.bar);
         laws.add(&s.contact, &s.params);
         // Energies that stay bounded (a run whose energy grows has its own row).
         let bounded = r.summary.energy_aug_drift_max < 1.0;
@@ -140,11 +142,11 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     let mut disc_newton = Vec::new();
     for scheme in crate::driver::all_schemes() {
         progress(&format!("disc {scheme}"));
-        let dir = out.join(disc::DISC).join(scheme);
+        let dir = out.join(&cases.disc).join(scheme);
         let methods = Methods { scheme: scheme.into(), ..Methods::default() };
         // A scheme that fails here (explicit contact is unstable at this step) is a result.
         let run = past_the_guard(methods, |methods| {
-            disc::run(&disc::Options { methods, out: Some(dir.clone()), ..Default::default() })
+            disc::run(&Options { methods, out: Some(dir.clone()), ..disc::options() })
         });
         let (r, guard) = match run {
             Ok(r) => r,
@@ -204,7 +206,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
     let _ = write!(
         md,
         "\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `{p}/<scheme>/{p}.png` (energies, displacements, contact force, Newton).\n\n",
-        p = disc::DISC
+        p = cases.disc
     );
     if !quick {
         md.push_str("## 3. Verification (`signorini verify`)\n\n");
@@ -213,7 +215,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         md.push_str(&verification.markdown());
         md.push('\n');
         md.push_str("## 4. The talk's conclusions: Δt sweeps\n\n");
-        let sweeps = sweep::run(progress, &sweep::CASES);
+        let sweeps = sweep::run(progress, &sweep::cases());
         sweeps.figures(out)?;
         let json = out.join("dt_sweep.json");
         crate::output::write_json(&json, &sweeps)

@@ -13,6 +13,7 @@ use crate::cases::disc;
 use crate::driver::Methods;
 use crate::error::CaseError;
 use crate::plot::Curve;
+use crate::problem::run::Options;
 use crate::simulation::MassChoice;
 
 const BAR_STEPS: [f64; 7] = [0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5];
@@ -72,7 +73,7 @@ fn sweep_setup(scheme: &str) -> Methods {
 
 fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
     let methods = sweep_setup(scheme);
-    let r = bar::run(&bar::Options { methods, mass, dt: Some(dt), ..Default::default() })?;
+    let r = bar::run(&Options { methods, mass, dt: Some(dt), ..bar::options() })?;
     let s = &r.summary;
     let variation = |f: fn(&bar::Row) -> f64| -> f64 {
         let phase: Vec<f64> =
@@ -92,7 +93,7 @@ fn bar_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseEr
 
 fn disc_point(scheme: &str, mass: MassChoice, dt: f64) -> Result<Measures, CaseError> {
     let methods = sweep_setup(scheme);
-    let r = disc::run(&disc::Options { methods, mass, dt: Some(dt), ..Default::default() })?;
+    let r = disc::run(&Options { methods, mass, dt: Some(dt), ..disc::options() })?;
     let s = &r.summary;
     // The first contact phase: from the first step with an active point to the next without.
     let start = r.series.iter().position(|row| row.active_points > 0);
@@ -133,11 +134,14 @@ pub struct Case {
     pub measure: Measure,
 }
 
-/// The bar's and the disc's sweeps.
-pub const CASES: [Case; 2] = [
-    Case { name: bar::PROBLEM, steps: &BAR_STEPS, measure: bar_point },
-    Case { name: disc::DISC, steps: &DISC_STEPS, measure: disc_point },
-];
+/// The bar's and the disc's sweeps (their problems: forms/library.toml's `cases`).
+pub fn cases() -> [Case; 2] {
+    let names = &crate::settings::get().cases;
+    [
+        Case { name: &names.bar, steps: &BAR_STEPS, measure: bar_point },
+        Case { name: &names.disc, steps: &DISC_STEPS, measure: disc_point },
+    ]
+}
 
 /// Runs `cases` for every scheme and both masses.
 pub fn run(progress: &mut dyn FnMut(&str), cases: &[Case]) -> Sweeps {

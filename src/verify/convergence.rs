@@ -9,6 +9,7 @@ use serde::Serialize;
 use crate::cases::disc;
 use crate::driver::Methods;
 use crate::error::CaseError;
+use crate::problem::run::Options;
 
 const T_END: f64 = 12.0;
 /// Δt refinement: the steps, and the reference's.
@@ -59,7 +60,7 @@ pub struct Study {
     pub failure: Option<String>,
 }
 
-fn study(scheme: &str, runs: impl Fn(f64) -> disc::Options, steps: &[f64], reference: f64) -> Study {
+fn study(scheme: &str, runs: impl Fn(f64) -> Options, steps: &[f64], reference: f64) -> Study {
     let go = || -> Result<Vec<Errors>, CaseError> {
         let reference = disc::run(&runs(reference))?.series;
         steps.iter().map(|&s| Ok(errors(s, &disc::run(&runs(s))?.series, &reference))).collect()
@@ -103,24 +104,14 @@ pub fn disc(progress: &mut dyn FnMut(&str)) -> DiscConvergence {
         .map(|scheme| {
             progress(&format!("disc Δt convergence {scheme}"));
             let methods = Methods { scheme: scheme.into(), ..Methods::default() };
-            let runs = |dt| disc::Options {
-                methods: methods.clone(),
-                dt: Some(dt),
-                t_end: Some(T_END),
-                ..disc::Options::default()
-            };
+            let runs = |dt| Options { methods: methods.clone(), dt: Some(dt), t_end: Some(T_END), ..disc::options() };
             study(scheme, runs, &DT_STEPS, DT_REFERENCE)
         })
         .collect();
     progress("disc h convergence");
     let methods = Methods::default();
-    let runs = |h| disc::Options {
-        methods: methods.clone(),
-        h: Some(h),
-        dt: Some(H_DT),
-        t_end: Some(T_END),
-        ..disc::Options::default()
-    };
+    let runs =
+        |h| Options { methods: methods.clone().set("h", h), dt: Some(H_DT), t_end: Some(T_END), ..disc::options() };
     let h = study(&methods.scheme, runs, &H_STEPS, H_REFERENCE);
     DiscConvergence { dt, h }
 }

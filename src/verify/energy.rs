@@ -11,6 +11,7 @@ use super::oscillator::{oscillator_energies, spectral_radius};
 use crate::cases::{bar, disc};
 use crate::driver::Methods;
 use crate::error::CaseError;
+use crate::problem::run::Options;
 
 /// How E_aug behaves on one run: on steps whose active set is unchanged, and on the others.
 #[derive(Clone, Debug, Serialize)]
@@ -96,19 +97,20 @@ pub fn conserving_schemes() -> Result<Vec<&'static str>, CaseError> {
 pub fn contact_laws(progress: &mut dyn FnMut(&str)) -> Result<Vec<EnergyRow>, CaseError> {
     let mut out = Vec::new();
     let v = &crate::settings::get().verify;
+    let cases = &crate::settings::get().cases;
     for scheme in conserving_schemes()? {
         for contact in &v.contacts {
             progress(&format!("energy law {scheme} {contact}"));
             let methods = Methods { scheme: scheme.into(), contact: contact.clone(), ..Methods::default() };
-            let b = bar::run(&bar::Options { methods: methods.clone(), ..bar::Options::default() })?;
+            let b = bar::run(&Options { methods: methods.clone(), ..bar::options() })?;
             // The bar's one contact point: its status is the sign of λ.
             let rows: Vec<_> = b.series.iter().map(|r| (vec![r.lambda < 0.0], r.energy_aug, r.energy)).collect();
             let setting = format!("N = {}, Δt = {}, T = {}", b.summary.elements, b.summary.dt, b.summary.t_end);
-            out.push(EnergyRow { setting, ..energy_row(bar::PROBLEM, scheme, contact, &rows) });
-            let d = disc::run(&disc::Options { methods, h: Some(2.0), t_end: Some(16.0), ..disc::Options::default() })?;
+            out.push(EnergyRow { setting, ..energy_row(&cases.bar, scheme, contact, &rows) });
+            let d = disc::run(&Options { methods: methods.set("h", 2.0), t_end: Some(16.0), ..disc::options() })?;
             let rows: Vec<_> = d.series.iter().map(|r| (r.switches.clone(), r.energy_aug, r.energy)).collect();
             let setting = format!("{}, Δt = {}, T = {}", d.summary.mesh, d.summary.dt, d.summary.t_end);
-            out.push(EnergyRow { setting, ..energy_row(disc::DISC, scheme, contact, &rows) });
+            out.push(EnergyRow { setting, ..energy_row(&cases.disc, scheme, contact, &rows) });
         }
     }
     Ok(out)

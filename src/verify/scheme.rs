@@ -19,6 +19,7 @@ use crate::compiler::scheme::EnergyLaw;
 use crate::driver::{FilesInUse, Methods};
 use crate::error::CaseError;
 use crate::plot::Curve;
+use crate::problem::run::Options;
 
 /// ζ of the damped oscillator ü + 2ζu̇ + u = 0.
 const ZETA: f64 = 0.1;
@@ -156,7 +157,7 @@ pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVe
     };
     progress(&format!("{scheme}: bar before impact"));
     let bar_orders = bar_orders(methods)?;
-    let before = bar::run(&bar::Options { methods: methods.clone(), t_end: Some(0.8), ..bar::Options::default() })?;
+    let before = bar::run(&Options { methods: methods.clone(), t_end: Some(0.8), ..bar::options() })?;
     let e0 = before.series[0].energy;
     let bar_energy_drift = before.series.iter().map(|r| (r.energy - e0).abs()).fold(0.0, f64::max) / e0;
     let bar_energy_dt = before.summary.dt;
@@ -171,7 +172,7 @@ pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVe
             Some(r) => reference(methods, r),
         };
         let label = name.map_or(scheme.clone(), |r| r.to_string());
-        let b = bar::run(&bar::Options { methods: s.clone(), ..bar::Options::default() })?.summary;
+        let b = bar::run(&Options { methods: s.clone(), ..bar::options() })?.summary;
         bar_setting = format!("N = {}, Δt = {}, T = {}", b.elements, b.dt, b.t_end);
         bar_rows.push(CaseRow {
             scheme: label.clone(),
@@ -183,7 +184,7 @@ pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVe
                 ("Newton".into(), b.newton_total as f64),
             ],
         });
-        let d = disc::run(&disc::Options { methods: s, h: Some(2.0), ..disc::Options::default() })?.summary;
+        let d = disc::run(&Options { methods: s.set("h", 2.0), ..disc::options() })?.summary;
         disc_setting = format!("{}, Δt = {}, T = {}", d.mesh, d.dt, d.t_end);
         disc_rows.push(CaseRow {
             scheme: label,

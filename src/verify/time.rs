@@ -13,6 +13,7 @@ use super::oscillator::{oscillator_error, spectral_radius};
 use crate::cases::bar;
 use crate::driver::Methods;
 use crate::error::CaseError;
+use crate::problem::run::Options;
 
 /// The oscillator's steps (T = 10).
 pub const OSCILLATOR_STEPS: [f64; 3] = [0.04, 0.02, 0.01];
@@ -63,12 +64,7 @@ fn bar_differences(methods: &Methods) -> Result<Vec<(f64, f64)>, CaseError> {
     let runs: Vec<Vec<bar::Row>> = BAR_STEPS
         .iter()
         .map(|&dt| {
-            let opts = bar::Options {
-                methods: methods.clone(),
-                dt: Some(dt),
-                t_end: Some(BAR_END),
-                ..bar::Options::default()
-            };
+            let opts = Options { methods: methods.clone(), dt: Some(dt), t_end: Some(BAR_END), ..bar::options() };
             Ok(bar::run(&opts)?.series)
         })
         .collect::<Result<_, CaseError>>()?;

@@ -2,10 +2,11 @@
 //! HHT dissipation, the hybrid scheme's energy decay, and the exact energy identities of
 //! Crank–Nicolson and midpoint with contact.
 
-use signorini::cases::bar::{self, Options};
+use signorini::cases::bar;
+use signorini::problem::run::Options;
 
 fn run(f: impl FnOnce(&mut Options)) -> bar::Run {
-    let mut o = Options::default();
+    let mut o = bar::options();
     f(&mut o);
     bar::run(&o).unwrap()
 }
@@ -27,7 +28,7 @@ fn nitsche_penetrates_less_than_penalty() {
 fn displacement_error_decreases_under_refinement() {
     let coarse = run(|_| {}).summary.err_linf_l2_u;
     let fine = run(|o| {
-        o.elements = Some(100);
+        o.methods = o.methods.clone().set("ne", 100.0);
         o.dt = Some(0.002);
     })
     .summary
@@ -211,7 +212,7 @@ fn time_steps_from_one_to_1e_minus_7_converge_onto_the_space_error() {
 #[test]
 fn an_unstable_run_stops_with_its_cause_and_its_results_so_far() {
     let dir = std::env::temp_dir().join(format!("signorini-blowup-{}", std::process::id()));
-    let mut o = Options { out: Some(dir.clone()), ..Options::default() };
+    let mut o = Options { out: Some(dir.clone()), ..bar::options() };
     o.methods = o.methods.clone().set("theta", -1.0).set("gamma0", 1e-6);
     let err = bar::run(&o).err().expect("the run must stop");
     let text = err.to_string();
@@ -231,7 +232,7 @@ fn an_unstable_run_stops_with_its_cause_and_its_results_so_far() {
 #[test]
 fn a_step_that_fails_at_every_cut_stops_the_run_with_its_history() {
     let dir = std::env::temp_dir().join(format!("signorini-cuts-{}", std::process::id()));
-    let mut o = Options { t_end: Some(2.0), out: Some(dir.clone()), ..Options::default() };
+    let mut o = Options { t_end: Some(2.0), out: Some(dir.clone()), ..bar::options() };
     o.newton.max_iterations = 1;
     let text = bar::run(&o).err().expect("no step converges in one iteration at contact").to_string();
     assert!(text.contains("after 6 step cuts") && text.contains("Newton: residual"), "{text}");
@@ -284,7 +285,7 @@ fn central_differences_know_their_critical_step() {
     use signorini::simulation::MassChoice;
     for (mass, lumped) in [(MassChoice::Consistent, false), (MassChoice::Lumped, true)] {
         let central = |dt: f64| {
-            let mut o = Options { mass, dt: Some(dt), ..Options::default() };
+            let mut o = Options { mass, dt: Some(dt), ..bar::options() };
             o.methods.scheme = "central".into();
             bar::run(&o)
         };

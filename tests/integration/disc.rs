@@ -1,21 +1,40 @@
 //! The bouncing disc (spec §6.2): before the first contact every scheme reproduces free fall
 //! exactly, u_y = −½ 0.1 t² and E = 0, and the first contact happens in the step containing t* = √40.
 
-use signorini::cases::disc::{self, GRAVITY, Options};
+use signorini::cases::disc;
 use signorini::driver::{self, Methods};
+use signorini::problem::run::Options;
 
 fn scheme(name: &str) -> Methods {
     Methods { scheme: name.into(), ..Methods::default() }
 }
 
+/// The gravity of a library problem, read from its file: its body force `coef f` (a force
+/// density) over the density `rho` it sets, vertically. Until the first contact the body falls
+/// freely, u = −g t²/2.
+pub(crate) fn gravity(problem: &str) -> f64 {
+    use signorini::compiler::check::const_value;
+    use signorini::compiler::syntax::ast::{Defined, ExprKind};
+    let pf = signorini::problem::load(problem).unwrap();
+    let p = pf.problem();
+    let value = |items: &[Defined], name: &str| {
+        let d = items.iter().find(|d| d.name.name == name).unwrap_or_else(|| panic!("{problem} sets no `{name}`"));
+        d.value.clone()
+    };
+    let ExprKind::Vector(f) = value(&p.coefs, "f").kind else { panic!("{problem}: `coef f` is not a vector") };
+    let rho = const_value(&value(&p.sets, "rho")).expect("a constant ρ");
+    -const_value(f.last().expect("a component")).expect("a constant force") / rho
+}
+
 #[test]
 fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
-    let t_star = (2.0 * 2.0 / GRAVITY).sqrt();
+    let g = gravity("disc");
+    let t_star = (2.0 * 2.0 / g).sqrt();
     for scheme in driver::all_schemes() {
-        let opts = Options { methods: self::scheme(scheme), h: Some(2.0), t_end: Some(6.5), ..Options::default() };
+        let opts = Options { methods: self::scheme(scheme).set("h", 2.0), t_end: Some(6.5), ..disc::options() };
         let r = disc::run(&opts).unwrap_or_else(|e| panic!("{scheme:?}: {e}"));
         for row in r.series.iter().filter(|row| row.t < t_star - 0.05) {
-            let exact = -0.5 * GRAVITY * row.t * row.t;
+            let exact = -0.5 * g * row.t * row.t;
             assert!(
                 (row.u_vertical_mean - exact).abs() < 1e-12,
                 "{scheme:?} t = {}: mean {} vs {exact}",
@@ -36,7 +55,7 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
             assert_eq!(row.active_points, 0);
             // The centre of mass falls at v_y = −g t.
             assert!(
-                (row.v_vertical_mean + GRAVITY * row.t).abs() < 1e-10,
+                (row.v_vertical_mean + g * row.t).abs() < 1e-10,
                 "{scheme:?} t = {}: v {}",
                 row.t,
                 row.v_vertical_mean
@@ -51,10 +70,10 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
             assert!((s.row.t - t).abs() < 1e-12, "{scheme:?} stage {k} at t = {}, expected {t}", s.row.t);
         }
         for s in r.stages.iter().filter(|s| s.row.t < t_star - 0.05) {
-            let exact = -0.5 * GRAVITY * s.row.t * s.row.t;
+            let exact = -0.5 * g * s.row.t * s.row.t;
             assert!((s.row.u_vertical_mean - exact).abs() < 1e-10, "{scheme:?} stage {} at t = {}", s.stage, s.row.t);
             assert!(
-                (s.row.v_vertical_mean + GRAVITY * s.row.t).abs() < 1e-10,
+                (s.row.v_vertical_mean + g * s.row.t).abs() < 1e-10,
                 "{scheme:?} stage {} at t = {}",
                 s.stage,
                 s.row.t
@@ -71,8 +90,8 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
 /// Spec §4.5: the hybrid scheme with θ = 1 never increases E_Θ (to 1e-9 of the energy scale).
 #[test]
 fn hybrid_never_increases_the_augmented_energy() {
-    let r = disc::run(&Options { methods: scheme("hybrid"), h: Some(2.0), t_end: Some(20.0), ..Options::default() })
-        .unwrap();
+    let r =
+        disc::run(&Options { methods: scheme("hybrid").set("h", 2.0), t_end: Some(20.0), ..disc::options() }).unwrap();
     let scale = r.series.iter().map(|row| row.energy_aug.abs()).fold(0.0, f64::max);
     assert!(scale > 1e-3);
     // The Jacobian is refactored only when the active set changes: through the whole contact
@@ -104,12 +123,8 @@ fn penetration_decreases_with_the_contact_parameter() {
             .iter()
             .map(|&gamma0| {
                 let methods = Methods { scheme: "hybrid".into(), contact: contact.into(), ..Methods::default() };
-                let o = Options {
-                    methods: methods.set("gamma0", gamma0),
-                    h: Some(2.0),
-                    t_end: Some(12.0),
-                    ..Options::default()
-                };
+                let methods = methods.set("gamma0", gamma0).set("h", 2.0);
+                let o = Options { methods, t_end: Some(12.0), ..disc::options() };
                 disc::run(&o).unwrap().summary.max_penetration
             })
             .collect();
@@ -124,8 +139,7 @@ fn gmsh_mesh_and_built_in_generator_agree() {
     let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/disc_r10_h1_v22.msh");
     assert!(shared.exists(), "{} is missing: the reference meshes live in assets/meshes", shared.display());
     let summary = |mesh: Option<std::path::PathBuf>| {
-        let r =
-            disc::run(&Options { methods: scheme("hybrid"), mesh, t_end: Some(26.0), ..Options::default() }).unwrap();
+        let r = disc::run(&Options { methods: scheme("hybrid"), mesh, t_end: Some(26.0), ..disc::options() }).unwrap();
         let release = r.series.iter().filter(|row| row.active_points > 0).map(|row| row.t).fold(0.0, f64::max);
         let rebound = r
             .series
@@ -147,12 +161,8 @@ fn an_unstable_setting_fails_with_a_clear_error() {
     // Nitsche θ = 1 with γ0 = 2E is not coercive: the free fall already diverges while E_aug
     // is kept, its potential part going negative, and the energy guard stops it within the
     // first second, long before the values overflow.
-    let o = Options {
-        methods: Methods::default().set("gamma0", 100.0),
-        h: Some(2.0),
-        t_end: Some(20.0),
-        ..Options::default()
-    };
+    let methods = Methods::default().set("gamma0", 100.0).set("h", 2.0);
+    let o = Options { methods, t_end: Some(20.0), ..disc::options() };
     let e = disc::run(&o).err().expect("diverges").to_string();
     assert!(e.contains("not coercive") && e.contains("gamma0 = 100"), "{e}");
     let t: f64 = e.trim_start_matches("stopped at t = ").split(':').next().unwrap().parse().unwrap();
@@ -164,7 +174,7 @@ fn an_unstable_setting_fails_with_a_clear_error() {
 /// t_end on the nominal time levels with the cuts counted.
 #[test]
 fn steps_cut_at_impact_return_to_the_nominal_step() {
-    let mut o = Options { t_end: Some(9.0), dt: Some(0.1), ..Options::default() };
+    let mut o = Options { t_end: Some(9.0), dt: Some(0.1), ..disc::options() };
     o.newton.max_iterations = 2;
     let r = disc::run(&o).unwrap();
     let s = &r.summary;

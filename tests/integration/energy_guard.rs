@@ -9,6 +9,7 @@
 use signorini::cases::{bar, disc};
 use signorini::driver::{Methods, all_schemes, contact_names};
 use signorini::error::CaseError;
+use signorini::problem::run::Options;
 use signorini::simulation::MassChoice;
 
 /// The scheme whose energy the guard must stop at the library's defaults.
@@ -53,9 +54,9 @@ fn no_library_run_trips_the_guard_but_the_unstable_scheme() {
                 s.spawn(move || {
                     let mut out = Vec::new();
                     for &(scheme, contact, mass) in chunk {
-                        let o = bar::Options { methods: methods(scheme, contact), mass, ..Default::default() };
+                        let o = Options { methods: methods(scheme, contact), mass, ..bar::options() };
                         out.push(judge("bar", scheme, contact, mass, bar::run(&o).map(|r| r.summary.energy_growth)));
-                        let o = disc::Options { methods: methods(scheme, contact), mass, ..Default::default() };
+                        let o = Options { methods: methods(scheme, contact), mass, ..disc::options() };
                         out.push(judge("disc", scheme, contact, mass, disc::run(&o).map(|r| r.summary.energy_growth)));
                     }
                     out
@@ -72,18 +73,17 @@ fn no_library_run_trips_the_guard_but_the_unstable_scheme() {
 /// the series ends at the last good step, below the tolerance.
 #[test]
 fn the_discs_blow_ups_stop() {
-    let stiff =
-        disc::Options { methods: Methods::default().set("gamma0", 1e12), t_end: Some(8.0), ..Default::default() };
-    let imex = disc::Options {
+    let stiff = Options { methods: Methods::default().set("gamma0", 1e12), t_end: Some(8.0), ..disc::options() };
+    let imex = Options {
         methods: methods(UNSTABLE, "nitsche"),
         mass: MassChoice::Redistributed,
         t_end: Some(20.0),
-        ..Default::default()
+        ..disc::options()
     };
     for (k, opts) in [stiff, imex].into_iter().enumerate() {
         let dir = std::env::temp_dir().join(format!("signorini-guard-{}-{k}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let opts = disc::Options { out: Some(dir.clone()), ..opts };
+        let opts = Options { out: Some(dir.clone()), ..opts };
         match disc::run(&opts) {
             Err(CaseError::BlowUp { t, energy, bound, scale, tolerance, .. }) => {
                 assert!(energy - bound > tolerance * scale, "{t}: {energy} {bound} {scale}");

@@ -4,16 +4,17 @@
 //! and those of an independent implementation written here with dense matrices.
 
 use nalgebra::{DMatrix, DVector};
-use signorini::cases::bar::{self, Options};
+use signorini::cases::bar;
 use signorini::driver::Methods;
 use signorini::forms::{contact_nitsche, contact_penalty, elasticity};
+use signorini::problem::run::Options;
 use signorini::runtime::fem::assembly::{Assembler, Quadrature};
 use signorini::runtime::fem::bound::{Bound, BoundForm};
 use signorini::runtime::fem::kernel::Coef;
 use signorini::runtime::fem::mesh::structured;
 
 fn run(methods: Methods, steps: usize) -> bar::Run {
-    let opts = Options { methods, t_end: Some(steps as f64 * 0.01), ..Options::default() };
+    let opts = Options { methods, t_end: Some(steps as f64 * 0.01), ..bar::options() };
     bar::run(&opts).unwrap()
 }
 

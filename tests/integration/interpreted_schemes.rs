@@ -6,6 +6,7 @@
 use signorini::cases::{bar, disc};
 use signorini::driver::{self, Methods};
 use signorini::guard::Guard;
+use signorini::problem::run::Options;
 
 fn copy_outside(dir: &std::path::Path, rel: &str) -> String {
     let to = dir.join(std::path::Path::new(rel).file_name().unwrap());
@@ -37,7 +38,7 @@ fn schemes_and_laws_by_path_match_the_compiled_library() {
             let by_path = Methods { scheme: file.clone(), contact: law_file.clone(), guard, ..Methods::default() };
             // The bar: 100 steps of 0.03 (first impact at t = 1).
             let bar_run = |methods: Methods| {
-                let o = bar::Options { methods, dt: Some(0.03), t_end: Some(3.0), ..bar::Options::default() };
+                let o = Options { methods, dt: Some(0.03), t_end: Some(3.0), ..bar::options() };
                 bar::run(&o).unwrap_or_else(|e| panic!("{scheme} {law}: {e}"))
             };
             let (a, b) = (bar_run(compiled.clone()), bar_run(by_path.clone()));
@@ -51,13 +52,7 @@ fn schemes_and_laws_by_path_match_the_compiled_library() {
             }
             // The disc: 100 steps of 0.08 on the coarse built-in mesh (impact at t ≈ 6.3).
             let disc_run = |methods: Methods| {
-                let o = disc::Options {
-                    methods,
-                    h: Some(2.0),
-                    dt: Some(0.08),
-                    t_end: Some(8.0),
-                    ..disc::Options::default()
-                };
+                let o = Options { methods: methods.set("h", 2.0), dt: Some(0.08), t_end: Some(8.0), ..disc::options() };
                 disc::run(&o)
             };
             match (disc_run(compiled), disc_run(by_path)) {

@@ -116,7 +116,7 @@ fn the_bar_posed_with_a_dirichlet_condition_is_the_built_in_bar() {
     let mut o = Options::new(file.to_str().unwrap());
     o.t_end = Some(3.0);
     let posed = run(&o).unwrap();
-    let built_in = bar::run(&bar::Options { t_end: Some(3.0), ..bar::Options::default() }).unwrap();
+    let built_in = bar::run(&Options { t_end: Some(3.0), ..bar::options() }).unwrap();
     assert_eq!(posed.rows.len(), built_in.series.len());
     let col = |name: &str| posed.column(name).unwrap();
     type Of = fn(&bar::Row) -> f64;

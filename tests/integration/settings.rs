@@ -1,6 +1,6 @@
 //! forms/library.toml parses, and every scheme, contact law, material, mass matrix and problem it
-//! names exists in the library (verify's reference schemes, the benchmarks' and the report's
-//! problems too).
+//! names exists in the library (verify's reference schemes, the cases', the benchmarks' and the
+//! report's problems too).
 
 use signorini::driver::{self, Methods};
 use signorini::simulation::MassChoice;
@@ -31,7 +31,7 @@ fn library_settings_name_library_files() {
     known(scheme, &s.defaults.contact);
     <MassChoice as clap::ValueEnum>::from_str(mass, true).unwrap_or_else(|e| panic!("mass `{mass}`: {e}"));
     let problems = signorini::problem::library_names();
-    let named = [&s.bench.disc, &s.bench.sphere, &s.report.hertz_impact];
+    let named = [&s.cases.bar, &s.cases.disc, &s.bench.disc, &s.bench.sphere, &s.report.hertz_impact];
     for problem in named.into_iter().chain(s.report.hertz.iter().map(|h| &h.problem)) {
         assert!(problems.contains(&problem.as_str()), "unknown problem `{problem}` (known: {problems:?})");
     }

@@ -2,23 +2,27 @@
 //! is exact before the first contact, which happens just after t* = √40, and
 //! Crank–Nicolson with Nitsche θ = 1 keeps E_aug on every step whose active set is unchanged.
 
-use signorini::cases::disc::{self, GRAVITY, Options};
+use signorini::cases::disc;
 use signorini::driver::Methods;
+use signorini::problem::run::Options;
+
+use super::disc::gravity;
 
 fn sphere(scheme: &str, h: f64, t_end: f64) -> disc::Run {
     let methods = Methods { scheme: scheme.into(), ..Methods::default() };
-    disc::run(&Options { problem: "sphere".into(), methods, h: Some(h), t_end: Some(t_end), ..Options::default() })
-        .unwrap()
+    let methods = methods.set("h", h);
+    disc::run(&Options { problem: "sphere".into(), methods, t_end: Some(t_end), ..disc::options() }).unwrap()
 }
 
 #[test]
 fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
-    let t_star = (2.0 * 2.0 / GRAVITY).sqrt();
+    let g = gravity("sphere");
+    let t_star = (2.0 * 2.0 / g).sqrt();
     for scheme in ["newmark", "trbdf2", "hybrid"] {
         let r = sphere(scheme, 5.0, 6.5);
         assert_eq!(r.summary.case, "sphere");
         for row in r.series.iter().filter(|row| row.t < t_star - 0.05) {
-            let exact = -0.5 * GRAVITY * row.t * row.t;
+            let exact = -0.5 * g * row.t * row.t;
             assert!(
                 (row.u_vertical_mean - exact).abs() < 1e-10,
                 "{scheme} t = {}: mean u_z {} vs {exact}",
@@ -27,7 +31,7 @@ fn free_fall_is_exact_and_contact_starts_in_the_right_step() {
             );
             assert!((row.u_vertical_lowest - exact).abs() < 1e-10, "{scheme} t = {}: lowest point", row.t);
             assert!(
-                (row.v_vertical_mean + GRAVITY * row.t).abs() < 1e-10,
+                (row.v_vertical_mean + g * row.t).abs() < 1e-10,
                 "{scheme} t = {}: v_z {}",
                 row.t,
                 row.v_vertical_mean
@@ -72,11 +76,10 @@ fn iterative_and_direct_solvers_agree() {
             let newton = NewtonOptions { solver, ..NewtonOptions::default() };
             disc::run(&Options {
                 problem: "sphere".into(),
-                methods,
-                h: Some(5.0),
+                methods: methods.set("h", 5.0),
                 t_end: Some(8.0),
                 newton,
-                ..Options::default()
+                ..disc::options()
             })
             .unwrap()
         };
@@ -100,11 +103,12 @@ fn the_graded_gmsh_ball_falls_exactly() {
     let m = signorini::runtime::fem::mesh::gmsh::read(&mesh).unwrap();
     let lowest = (0..m.num_nodes()).map(|i| m.node(i)[2]).fold(f64::INFINITY, f64::min);
     assert!((lowest - 2.0).abs() < 1e-9, "the mesh's lowest point is at z = {lowest}");
-    let opts = Options { problem: "sphere".into(), mesh: Some(mesh), t_end: Some(0.4), ..Options::default() };
+    let opts = Options { problem: "sphere".into(), mesh: Some(mesh), t_end: Some(0.4), ..disc::options() };
+    let g = gravity("sphere");
     let r = disc::run(&opts).unwrap();
     assert!(r.summary.dofs > 20_000);
     for row in &r.series {
-        let exact = -0.5 * GRAVITY * row.t * row.t;
+        let exact = -0.5 * g * row.t * row.t;
         assert!(
             (row.u_vertical_mean - exact).abs() < 1e-10,
             "t = {}: mean u_z {} vs {exact}",

@@ -1,13 +1,15 @@
 //! VTU and PVD output of the disc, read back by an independent reader (vtkio): cell types,
 //! point and cell counts, data arrays and the collection's times.
 
-use signorini::cases::disc::{self, Options};
+use signorini::cases::disc;
+use signorini::problem::run::Options;
 use vtkio::model::{Attribute, CellType, DataSet, Piece, VertexNumbers};
 
 #[test]
 fn snapshots_read_back_with_vtkio() {
     let out = std::env::temp_dir().join(format!("signorini-vtu-{}", std::process::id()));
-    let opts = Options { h: Some(2.0), t_end: Some(1.0), vtu_every: 25, out: Some(out.clone()), ..Options::default() };
+    let methods = disc::options().methods.set("h", 2.0);
+    let opts = Options { methods, t_end: Some(1.0), vtu_every: 25, out: Some(out.clone()), ..disc::options() };
     let run = disc::run(&opts).unwrap();
     // The problem's mesh at h = 2: the built-in curved disc of radius 10 about (0, 12).
     let mesh = signorini::runtime::fem::mesh::disc::disc(10.0, [0.0, 12.0], 2.0);

@@ -3,11 +3,12 @@
 
 use signorini::cases::bar;
 use signorini::driver::Methods;
+use signorini::problem::run::Options;
 
 signorini::forms!(mod wbz = "wbz.wf");
 
 fn series(methods: Methods) -> Vec<f64> {
-    let opts = bar::Options { methods, t_end: Some(3.0), ..bar::Options::default() };
+    let opts = Options { methods, t_end: Some(3.0), ..bar::options() };
     bar::run(&opts).unwrap().series.iter().map(|r| r.u_c).collect()
 }
 
