@@ -66,6 +66,13 @@ impl Methods {
         self.params.push(Setting { name: name.into(), value, origin: "options".into() });
         self
     }
+
+    /// Adds `name = value` before the settings already made, which override it: a caller's
+    /// default (`verify` runs the disc at h = 2 unless the user's `--param h=…` says otherwise).
+    pub fn set_default(mut self, name: &str, value: f64) -> Self {
+        self.params.insert(0, Setting { name: name.into(), value, origin: "options".into() });
+        self
+    }
 }
 
 /// A scheme file's numeric claims at the params in use, and its energy law.

@@ -107,7 +107,8 @@ pub fn contact_laws(progress: &mut dyn FnMut(&str)) -> Result<Vec<EnergyRow>, Ca
             let rows: Vec<_> = b.series.iter().map(|r| (vec![r.lambda < 0.0], r.energy_aug, r.energy)).collect();
             let setting = format!("N = {}, Δt = {}, T = {}", b.summary.elements, b.summary.dt, b.summary.t_end);
             out.push(EnergyRow { setting, ..energy_row(&cases.bar, scheme, contact, &rows) });
-            let d = disc::run(&Options { methods: methods.set("h", 2.0), t_end: Some(16.0), ..disc::options() })?;
+            let d =
+                disc::run(&Options { methods: methods.set_default("h", 2.0), t_end: Some(16.0), ..disc::options() })?;
             let rows: Vec<_> = d.series.iter().map(|r| (r.switches.clone(), r.energy_aug, r.energy)).collect();
             let setting = format!("{}, Δt = {}, T = {}", d.summary.mesh, d.summary.dt, d.summary.t_end);
             out.push(EnergyRow { setting, ..energy_row(&cases.disc, scheme, contact, &rows) });

@@ -184,7 +184,7 @@ pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVe
                 ("Newton".into(), b.newton_total as f64),
             ],
         });
-        let d = disc::run(&Options { methods: s.set("h", 2.0), ..disc::options() })?.summary;
+        let d = disc::run(&Options { methods: s.set_default("h", 2.0), ..disc::options() })?.summary;
         disc_setting = format!("{}, Δt = {}, T = {}", d.mesh, d.dt, d.t_end);
         disc_rows.push(CaseRow {
             scheme: label,
