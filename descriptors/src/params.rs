@@ -29,11 +29,19 @@ pub struct CoefInfo {
     pub declared: &'static str,
 }
 
-/// A parameter value refused by a generated `Params`.
+/// A parameter value refused: by a generated `Params`, or by a scheme or form file loaded at
+/// run time.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ParamError {
-    Unknown { name: String, known: &'static [&'static str] },
-    OutOfRange { name: &'static str, value: f64, range: String },
+    Unknown { name: String, known: Vec<String> },
+    OutOfRange { name: String, value: f64, range: String },
+}
+
+impl ParamError {
+    /// `name` is none of `known`.
+    pub fn unknown(name: &str, known: &[&str]) -> ParamError {
+        ParamError::Unknown { name: name.to_string(), known: known.iter().map(|k| k.to_string()).collect() }
+    }
 }
 
 impl fmt::Display for ParamError {
@@ -51,10 +59,10 @@ impl fmt::Display for ParamError {
 
 impl std::error::Error for ParamError {}
 
-/// The declared range of a parameter (unbounded sides are infinite and open).
+/// The declared range of a parameter (unbounded sides are infinite and open). The compiler's
+/// checks, generated `Params` and the interpreter all decide with [`ParamRange::contains`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParamRange {
-    pub name: &'static str,
     pub lo: f64,
     pub lo_closed: bool,
     pub hi: f64,
@@ -62,6 +70,11 @@ pub struct ParamRange {
 }
 
 impl ParamRange {
+    /// The range of a param declared without one: every finite value.
+    pub const UNBOUNDED: ParamRange =
+        ParamRange { lo: f64::NEG_INFINITY, lo_closed: false, hi: f64::INFINITY, hi_closed: false };
+
+    /// Whether `v` is finite and in the range (a closed infinite bound admits no infinity).
     pub fn contains(&self, v: f64) -> bool {
         let above = if self.lo_closed { v >= self.lo } else { v > self.lo };
         let below = if self.hi_closed { v <= self.hi } else { v < self.hi };
@@ -85,11 +98,12 @@ impl fmt::Display for ParamRange {
     }
 }
 
-/// Range check used by generated `Params::set`: the value if it lies in the range.
-pub fn check_param(range: &ParamRange, value: f64) -> Result<f64, ParamError> {
+/// The range check of param `name` (generated `Params::set`, the interpreter): the value if it
+/// lies in the range.
+pub fn check_param(name: &str, range: &ParamRange, value: f64) -> Result<f64, ParamError> {
     if range.contains(value) {
         Ok(value)
     } else {
-        Err(ParamError::OutOfRange { name: range.name, value, range: range.to_string() })
+        Err(ParamError::OutOfRange { name: name.to_string(), value, range: range.to_string() })
     }
 }

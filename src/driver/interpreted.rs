@@ -142,7 +142,7 @@ impl Interpreted {
     /// An instance with param values in declaration order (range-checked).
     pub fn instance(&self, values: &[f64]) -> Result<Box<dyn TimeScheme>, LibraryError> {
         for (p, v) in self.params.iter().zip(values) {
-            rs::check_param(&p.range, *v)?;
+            rs::check_param(p.name, &p.range, *v)?;
         }
         Ok(Box::new(Running {
             desc: self.desc,

@@ -69,7 +69,7 @@ pub(super) fn param_info(
     src: &SourceMap,
     name: &str,
     default: f64,
-    range: Option<crate::compiler::check::ParamRange>,
+    range: Option<ParamRange>,
     span: Span,
     owner: &'static str,
 ) -> ParamInfo {
@@ -77,13 +77,7 @@ pub(super) fn param_info(
     ParamInfo {
         name,
         default,
-        range: ParamRange {
-            name,
-            lo: range.map_or(f64::NEG_INFINITY, |r| r.lo),
-            lo_closed: range.is_some_and(|r| r.lo_closed),
-            hi: range.map_or(f64::INFINITY, |r| r.hi),
-            hi_closed: range.is_some_and(|r| r.hi_closed),
-        },
+        range: range.unwrap_or(ParamRange::UNBOUNDED),
         doc: leak(docs::declaration(src, span)),
         declared: leak(docs::location(src, span)),
         written: leak(docs::written(src, span)),

@@ -26,9 +26,9 @@ mod kernels;
 use std::path::Path;
 use std::sync::Arc;
 
-use signorini_compiler::check::ParamRange;
 use signorini_compiler::ir::DimIr;
 use signorini_compiler::{FsLoader, Program, Span};
+use signorini_runtime::descriptors::ParamRange;
 use signorini_runtime::fem::kernel::{Coef, FormMeta};
 
 pub use form::InterpretedForm;
@@ -92,14 +92,14 @@ struct ParamDecl {
 impl ParamDecl {
     /// The value if it is accepted, as generated `Params::set` decides (finite, in range).
     fn check(&self, value: f64) -> Result<f64, InterpretError> {
-        if value.is_finite() && self.range.is_none_or(|r| r.contains(value)) {
+        let range = self.range.unwrap_or(ParamRange::UNBOUNDED);
+        if range.contains(value) {
             return Ok(value);
         }
-        let all = ParamRange { lo: f64::NEG_INFINITY, lo_closed: false, hi: f64::INFINITY, hi_closed: false };
         Err(InterpretError::OutOfRange {
             name: self.name.clone(),
             value,
-            range: self.range.unwrap_or(all).describe(),
+            range: range.to_string(),
             at: self.at.clone(),
         })
     }

@@ -133,16 +133,12 @@ pub fn params(pf: &ProblemFile, settings: &[Setting]) -> Result<(Vec<ProblemPara
         if let Some(r) = &q.range {
             let lo = const_value(&r.lo).unwrap_or(f64::NEG_INFINITY);
             let hi = const_value(&r.hi).unwrap_or(f64::INFINITY);
-            let range = crate::compiler::check::ParamRange { lo, lo_closed: r.lo_closed, hi, hi_closed: r.hi_closed };
+            let range =
+                crate::runtime::descriptors::ParamRange { lo, lo_closed: r.lo_closed, hi, hi_closed: r.hi_closed };
             if !range.contains(s.value) {
                 return Err(CaseError::Option(format!(
                     "{}: param {} of problem `{}` must be in {}, not {} ({})",
-                    s.origin,
-                    q.name.name,
-                    p.name.name,
-                    range.describe(),
-                    s.value,
-                    pf.file
+                    s.origin, q.name.name, p.name.name, range, s.value, pf.file
                 )));
             }
         } else if !s.value.is_finite() {

@@ -11,10 +11,13 @@ pub mod problem;
 pub mod schemes;
 mod types;
 
+use std::collections::{BTreeSet, HashMap, HashSet};
+
+use signorini_descriptors::ParamRange;
+
 use crate::diagnostic::Diagnostic;
 use crate::source::{FileId, SourceMap, Span};
 use crate::syntax::ast::{self, Expr, Ident, Shape};
-use std::collections::{BTreeSet, HashMap, HashSet};
 
 pub use builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES, NUMBER_FUNCTIONS};
 pub use schemes::{CLAIMS, EnergyLaw, SchemeDef, SchemeParamInfo};
@@ -52,42 +55,6 @@ pub struct Param {
     /// The default and range as written; `default` and `range` are their values.
     pub default_expr: Expr,
     pub range_expr: Option<ast::Range>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ParamRange {
-    pub lo: f64,
-    pub lo_closed: bool,
-    pub hi: f64,
-    pub hi_closed: bool,
-}
-
-impl ParamRange {
-    pub fn contains(&self, v: f64) -> bool {
-        let above = if self.lo_closed { v >= self.lo } else { v > self.lo };
-        let below = if self.hi_closed { v <= self.hi } else { v < self.hi };
-        above && below
-    }
-
-    pub fn describe(&self) -> String {
-        format!(
-            "{}{}, {}{}",
-            if self.lo_closed { "[" } else { "(" },
-            fmt_bound(self.lo),
-            fmt_bound(self.hi),
-            if self.hi_closed { "]" } else { ")" }
-        )
-    }
-}
-
-fn fmt_bound(v: f64) -> String {
-    if v == f64::INFINITY {
-        "inf".into()
-    } else if v == f64::NEG_INFINITY {
-        "-inf".into()
-    } else {
-        format!("{v}")
-    }
 }
 
 #[derive(Clone, Debug)]

@@ -4,7 +4,9 @@
 //! it reads a scheme, so that a scheme whose declarations are wrong stops before its stages;
 //! nothing here builds coefficients.
 
-use super::{Global, ParamRange, Unit, const_eval, suggest_name};
+use signorini_descriptors::ParamRange;
+
+use super::{Global, Unit, const_eval, suggest_name};
 use crate::diagnostic::Diagnostic;
 use crate::source::Span;
 use crate::syntax::ast::{self, Expr, ExprKind, Ident};

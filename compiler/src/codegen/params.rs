@@ -3,9 +3,10 @@
 
 use std::fmt::Write;
 
+use signorini_descriptors::ParamRange;
+
 use super::emit::{ADD, ATOM, MUL, UNARY, literal};
 use super::names::{case_allowance, ident};
-use crate::check::ParamRange;
 use crate::program::Program;
 use crate::syntax::ast::{self, BinOp, ExprKind};
 
@@ -85,14 +86,10 @@ pub fn params_struct(name: &str, doc: &str, params: &[ParamDecl]) -> String {
 /// `ParamRange { ... }` of a parameter, its bounds as written where they are numbers and
 /// arithmetic of them (evaluated by Rust as by the checker: the same operations on f64).
 fn range_text(p: &ParamDecl) -> String {
-    let r =
-        p.range.unwrap_or(ParamRange { lo: f64::NEG_INFINITY, lo_closed: false, hi: f64::INFINITY, hi_closed: false });
+    let r = p.range.unwrap_or(ParamRange::UNBOUNDED);
     let bound = |e: Option<&ast::Expr>, v: f64| e.and_then(as_rust).map_or_else(|| literal(v).0, |(t, _)| t);
     let (lo, hi) = (bound(p.range_expr.map(|r| &r.lo), r.lo), bound(p.range_expr.map(|r| &r.hi), r.hi));
-    format!(
-        "ParamRange {{ name: {:?}, lo: {lo}, lo_closed: {}, hi: {hi}, hi_closed: {} }},\n",
-        p.name, r.lo_closed, r.hi_closed
-    )
+    format!("ParamRange {{ lo: {lo}, lo_closed: {}, hi: {hi}, hi_closed: {} }},\n", r.lo_closed, r.hi_closed)
 }
 
 /// A constant expression of the source as Rust, with its precedence: numbers, `inf`, `pi`,
@@ -133,15 +130,14 @@ fn get_and_set(params: &[ParamDecl]) -> String {
     }
     s.push_str("/// Sets a parameter by name, refusing unknown names and values outside the declared range.\n");
     if params.is_empty() {
-        s.push_str("pub fn set(&mut self, name: &str, _value: f64) -> Result<(), ParamError> { Err(ParamError::Unknown { name: name.to_string(), known: Self::NAMES }) }\n");
+        s.push_str("pub fn set(&mut self, name: &str, _value: f64) -> Result<(), ParamError> { Err(ParamError::unknown(name, Self::NAMES)) }\n");
     } else {
         s.push_str("pub fn set(&mut self, name: &str, value: f64) -> Result<(), ParamError> { match name {\n");
         for (i, p) in params.iter().enumerate() {
-            let _ = writeln!(s, "{:?} => self.{} = check_param(&Self::RANGES[{i}], value)?,", p.name, ident(p.name));
+            let _ =
+                writeln!(s, "{:?} => self.{} = check_param(name, &Self::RANGES[{i}], value)?,", p.name, ident(p.name));
         }
-        s.push_str(
-            "_ => return Err(ParamError::Unknown { name: name.to_string(), known: Self::NAMES }),\n} Ok(()) }\n",
-        );
+        s.push_str("_ => return Err(ParamError::unknown(name, Self::NAMES)),\n} Ok(()) }\n");
     }
     s
 }

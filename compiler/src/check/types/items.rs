@@ -1,9 +1,11 @@
 //! The unit's declarations checked: param defaults and ranges, lets (once, whether used or
 //! not), fns (on their own, by names only), forms' integrands, and a problem's expressions.
 
+use signorini_descriptors::ParamRange;
+
 use super::{Checker, LetState, Ty};
 use crate::check::builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES};
-use crate::check::{CELL_REGION, Global, ParamRange, const_eval, range_written};
+use crate::check::{CELL_REGION, Global, const_eval, range_written};
 use crate::diagnostic::Diagnostic;
 use crate::source::Span;
 use crate::syntax::ast::{Expr, ExprKind, Ident, Shape};
