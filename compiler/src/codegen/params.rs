@@ -8,6 +8,7 @@ use signorini_descriptors::ParamRange;
 use super::emit::{ADD, ATOM, MUL, UNARY, literal};
 use super::names::{case_allowance, ident};
 use crate::program::Program;
+use crate::source::{SourceMap, Span};
 use crate::syntax::ast::{self, BinOp, ExprKind};
 
 /// A parameter as a generated struct declares it.
@@ -21,18 +22,26 @@ pub struct ParamDecl<'a> {
     pub written: String,
 }
 
+impl<'a> ParamDecl<'a> {
+    /// A file's or a scheme's param, declared at `span`.
+    pub fn new(
+        sources: &SourceMap,
+        name: &'a str,
+        default: f64,
+        range: Option<ParamRange>,
+        range_expr: Option<&'a ast::Range>,
+        span: Span,
+    ) -> Self {
+        ParamDecl { name, default, range, range_expr, written: crate::docs::written(sources, span) }
+    }
+}
+
 /// The file's `Params`.
 pub fn params_text(prog: &Program) -> String {
     let list: Vec<ParamDecl> = prog
         .params
         .iter()
-        .map(|p| ParamDecl {
-            name: &p.name,
-            default: p.default,
-            range: p.range,
-            range_expr: p.range_expr.as_ref(),
-            written: crate::docs::written(&prog.sources, p.span),
-        })
+        .map(|p| ParamDecl::new(&prog.sources, &p.name, p.default, p.range, p.range_expr.as_ref(), p.span))
         .collect();
     let doc = "/// Parameters, with the defaults and ranges declared in the source. Values are range-checked\n/// when set.\n";
     params_struct("Params", doc, &list)

@@ -17,13 +17,7 @@ pub fn scheme_text(prog: &Program, s: &SchemeIr, struct_name: &str) -> String {
     let params: Vec<ParamDecl> = s
         .params
         .iter()
-        .map(|p| ParamDecl {
-            name: &p.name,
-            default: p.default,
-            range: p.range,
-            range_expr: p.range_expr.as_ref(),
-            written: crate::docs::written(&prog.sources, p.span),
-        })
+        .map(|p| ParamDecl::new(&prog.sources, &p.name, p.default, p.range, p.range_expr.as_ref(), p.span))
         .collect();
     let sig: Vec<String> = params.iter().map(|p| format!("{} = {}", p.name, p.written)).collect();
     let doc = format!("/// `scheme {}({})`: its parameters; it implements `TimeScheme`.\n", s.name, sig.join(", "));
