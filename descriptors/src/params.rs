@@ -3,30 +3,32 @@
 
 use std::fmt;
 
+use crate::Text;
+
 /// A param of a form file or a scheme.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ParamInfo {
-    pub name: &'static str,
+    pub name: Text,
     pub default: f64,
     pub range: ParamRange,
     /// The comment on the declaration's line (or the line above), if any.
-    pub doc: &'static str,
+    pub doc: Text,
     /// `file.wf:line`.
-    pub declared: &'static str,
+    pub declared: Text,
     /// The default and range as written in the file (`0.05 in [0, 1/3]`).
-    pub written: &'static str,
+    pub written: Text,
     /// The file stem or scheme that declares it: `owner.name` is its qualified name.
-    pub owner: &'static str,
+    pub owner: Text,
 }
 
 /// A `coef` (case data) of a form file.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct CoefInfo {
-    pub name: &'static str,
+    pub name: Text,
     /// 0 scalar, 1 vector, 2 tensor.
     pub rank: u32,
-    pub doc: &'static str,
-    pub declared: &'static str,
+    pub doc: Text,
+    pub declared: Text,
 }
 
 /// A parameter value refused: by a generated `Params`, or by a scheme or form file loaded at

@@ -3,6 +3,7 @@
 //! one array of coefficients the scheme evaluates per step.
 
 use crate::slots::SlotUse;
+use crate::{List, Text};
 
 /// A vector known when a stage starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -14,47 +15,47 @@ pub enum Level {
 }
 
 /// `c[unknown]·w + Σ c[k]·level` (indices into the coefficient array; `None`: no unknown).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Combination {
     pub unknown: Option<usize>,
-    pub known: &'static [(Level, usize)],
+    pub known: List<(Level, usize)>,
 }
 
 /// `c[coef] · form(args)` at time `c[time]`.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct TermDesc {
     pub coef: usize,
-    pub form: &'static str,
-    pub args: &'static [Combination],
+    pub form: Text,
+    pub args: List<Combination>,
     pub time: usize,
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct StageDesc {
-    pub name: &'static str,
+    pub name: Text,
     pub time: usize,
     /// New quantities, the unknown first.
-    pub quantities: &'static [&'static str],
-    pub values: &'static [Combination],
-    pub terms: &'static [TermDesc],
+    pub quantities: List<Text>,
+    pub values: List<Combination>,
+    pub terms: List<TermDesc>,
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct InitialDesc {
     pub state: usize,
-    pub terms: &'static [TermDesc],
+    pub terms: List<TermDesc>,
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SchemeDesc {
-    pub name: &'static str,
+    pub name: Text,
     /// The slots it applies (`uses`), with where they are declared.
-    pub uses: &'static [SlotUse],
-    pub states: &'static [&'static str],
+    pub uses: List<SlotUse>,
+    pub states: List<Text>,
     pub initial: Option<InitialDesc>,
-    pub stages: &'static [StageDesc],
+    pub stages: List<StageDesc>,
     /// The level each state takes at the end of a step.
-    pub updates: &'static [Level],
+    pub updates: List<Level>,
     /// Length of the coefficient array.
     pub coefficients: usize,
 }

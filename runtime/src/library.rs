@@ -29,11 +29,13 @@ pub enum SlotForm<'m> {
     Functional(Box<dyn BoundFunctional + 'm>),
 }
 
-/// The forms of a file, instantiated: (slot name, bound form).
-pub type Made<'m> = Vec<(&'static str, SlotForm<'m>)>;
+/// The forms of a file, instantiated: (slot name, bound form). Generated code names them with
+/// `'static` text; a file interpreted at run time, with its own slots' names.
+pub type Made<'s, 'm> = Vec<(&'s str, SlotForm<'m>)>;
 
 /// Instantiates a file's forms: values of `params` in order, coefs by name.
-pub type MakeForms = for<'m> fn(&[f64], &dyn Fn(&str) -> Option<Coef>, &Binding<'m>) -> Result<Made<'m>, LibraryError>;
+pub type MakeForms =
+    for<'m> fn(&[f64], &dyn Fn(&str) -> Option<Coef>, &Binding<'m>) -> Result<Made<'static, 'm>, LibraryError>;
 
 /// Instantiates a scheme with the values of its params, in order.
 pub type MakeScheme = fn(&[f64]) -> Result<Box<dyn TimeScheme>, LibraryError>;
@@ -93,7 +95,7 @@ pub enum LibraryError {
     #[error("{0}")]
     Param(#[from] ParamError),
     #[error("the case provides no `{name}` (`coef {name}` declared at {declared})")]
-    MissingCoef { name: &'static str, declared: &'static str },
+    MissingCoef { name: String, declared: String },
     #[error("{0}")]
     Coef(String),
     #[error(
@@ -149,7 +151,8 @@ impl<'m> Binding<'m> {
 
 /// The coef `name` from the case, or an error naming its declaration.
 pub fn need_coef(coefs: &dyn Fn(&str) -> Option<Coef>, info: &CoefInfo) -> Result<Coef, LibraryError> {
-    coefs(info.name).ok_or(LibraryError::MissingCoef { name: info.name, declared: info.declared })
+    coefs(&info.name)
+        .ok_or_else(|| LibraryError::MissingCoef { name: info.name.to_string(), declared: info.declared.to_string() })
 }
 
 #[cfg(test)]

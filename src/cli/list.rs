@@ -8,7 +8,7 @@ use crate::runtime::library::Unit;
 
 fn params(out: &mut String, params: &[ParamInfo]) {
     for p in params {
-        let doc = if p.doc.is_empty() { String::new() } else { format!("  {}", first_sentence(p.doc)) };
+        let doc = if p.doc.is_empty() { String::new() } else { format!("  {}", first_sentence(&p.doc)) };
         let _ = writeln!(out, "    {:<8} = {:<22} {:<22}{doc}", p.name, p.written, p.declared);
     }
 }
@@ -23,7 +23,7 @@ pub fn text() -> String {
     let mut out = String::from("Schemes (--scheme NAME, or a .wf file):\n");
     for u in lib {
         for s in u.schemes {
-            let slots: Vec<&str> = s.desc.uses.iter().map(|u| u.name).collect();
+            let slots: Vec<&str> = s.desc.uses.iter().map(|u| &*u.name).collect();
             let _ = writeln!(out, "  {:<16} {}", s.name, first_sentence(s.doc));
             let _ = writeln!(out, "    uses {}   ({})", slots.join(", "), u.file);
             params(&mut out, s.params);
@@ -90,6 +90,6 @@ fn print_forms(out: &mut String, u: &Unit, own_params_only: bool) {
         .map(|s| if s.functional { format!("{} (functional)", s.name) } else { s.name.to_string() })
         .collect();
     let _ = writeln!(out, "    provides {}   ({})", slots.join(", "), u.file);
-    let shown: Vec<ParamInfo> = f.params.iter().filter(|p| !own_params_only || p.owner == u.name).copied().collect();
+    let shown: Vec<ParamInfo> = f.params.iter().filter(|p| !own_params_only || p.owner == u.name).cloned().collect();
     params(out, &shown);
 }

@@ -3,6 +3,7 @@
 //! expression DAG.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use crate::compiler::ir::eval::Program;
 use crate::compiler::ir::graph::{Graph, NodeId};
@@ -17,7 +18,7 @@ use crate::runtime::time::scheme::TimeScheme;
 /// A scheme compiled at run time.
 pub struct Interpreted {
     pub file: String,
-    pub desc: &'static SchemeDesc,
+    pub desc: Arc<SchemeDesc>,
     pub params: Vec<ParamInfo>,
     pub doc: String,
     graph: Graph,
@@ -26,29 +27,19 @@ pub struct Interpreted {
 
 /// Its instance with param values: the coefficients as one program of the IR evaluator.
 struct Running {
-    desc: &'static SchemeDesc,
+    desc: Arc<SchemeDesc>,
     program: Program,
     values: Vec<f64>,
 }
 
 impl TimeScheme for Running {
     fn desc(&self) -> &SchemeDesc {
-        self.desc
+        &self.desc
     }
     fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]) {
         let leaves: Vec<f64> = self.program.syms().iter().map(|&s| scheme_leaf(s, &self.values, dt, t)).collect();
         self.program.run(&leaves, &mut Vec::new(), out);
     }
-}
-
-// The runtime's scheme description borrows `'static` data, as generated code does; a scheme
-// loaded at run time leaks its (small) description once per load.
-fn leak<T>(v: Vec<T>) -> &'static [T] {
-    Vec::leak(v)
-}
-
-fn leak_str(s: &str) -> &'static str {
-    String::leak(s.to_string())
 }
 
 fn level(q: Quantity) -> rs::Level {
@@ -59,20 +50,18 @@ fn level(q: Quantity) -> rs::Level {
 }
 
 fn combination(c: &Combination) -> rs::Combination {
-    rs::Combination { unknown: c.unknown, known: leak(c.known.iter().map(|(q, k)| (level(*q), *k)).collect()) }
+    rs::Combination { unknown: c.unknown, known: c.known.iter().map(|(q, k)| (level(*q), *k)).collect() }
 }
 
-fn terms(ts: &[TermLayout]) -> &'static [rs::TermDesc] {
-    leak(
-        ts.iter()
-            .map(|t| rs::TermDesc {
-                coef: t.coef,
-                form: leak_str(&t.slot),
-                args: leak(t.args.iter().map(combination).collect()),
-                time: t.time,
-            })
-            .collect(),
-    )
+fn terms(ts: &[TermLayout]) -> rs::List<rs::TermDesc> {
+    ts.iter()
+        .map(|t| rs::TermDesc {
+            coef: t.coef,
+            form: t.slot.clone().into(),
+            args: t.args.iter().map(combination).collect(),
+            time: t.time,
+        })
+        .collect()
 }
 
 /// Compiles the scheme file at `path` (its only scheme, or the one named `name`).
@@ -98,39 +87,39 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
         .slots
         .iter()
         .map(|u| SlotUse {
-            name: leak_str(&u.name),
+            name: u.name.clone().into(),
             fields: u.fields,
-            declared: leak_str(&docs::location_col(&prog.sources, u.span)),
+            declared: docs::location_col(&prog.sources, u.span).into(),
         })
         .collect();
     let stages = lay
         .stages
         .iter()
         .map(|st| rs::StageDesc {
-            name: leak_str(&st.name),
+            name: st.name.clone().into(),
             time: st.time,
-            quantities: leak(st.quantities.iter().map(|q| leak_str(q)).collect()),
-            values: leak(st.values.iter().map(combination).collect()),
+            quantities: st.quantities.iter().map(|q| q.clone().into()).collect(),
+            values: st.values.iter().map(combination).collect(),
             terms: terms(&st.terms),
         })
         .collect();
     let desc = SchemeDesc {
-        name: leak_str(&s.name),
-        uses: leak(uses),
-        states: leak(s.states.iter().map(|q| leak_str(q)).collect()),
+        name: s.name.clone().into(),
+        uses,
+        states: s.states.iter().map(|q| q.clone().into()).collect(),
         initial: lay.initial.as_ref().map(|(state, ts)| rs::InitialDesc { state: *state, terms: terms(ts) }),
-        stages: leak(stages),
-        updates: leak(s.updates.iter().map(|q| level(*q)).collect()),
+        stages,
+        updates: s.updates.iter().map(|q| level(*q)).collect(),
         coefficients: lay.coefficients.len(),
     };
     let params = s
         .params
         .iter()
-        .map(|p| super::sources::param_info(&prog.sources, &p.name, p.default, p.range, p.span, desc.name))
+        .map(|p| super::sources::param_info(&prog.sources, &p.name, p.default, p.range, p.span, &s.name))
         .collect();
     Ok(Interpreted {
         file: path.display().to_string(),
-        desc: Box::leak(Box::new(desc)),
+        desc: Arc::new(desc),
         params,
         doc: docs::declaration(&prog.sources, s.span),
         graph: s.graph.clone(),
@@ -142,10 +131,10 @@ impl Interpreted {
     /// An instance with param values in declaration order (range-checked).
     pub fn instance(&self, values: &[f64]) -> Result<Box<dyn TimeScheme>, LibraryError> {
         for (p, v) in self.params.iter().zip(values) {
-            rs::check_param(p.name, &p.range, *v)?;
+            rs::check_param(&p.name, &p.range, *v)?;
         }
         Ok(Box::new(Running {
-            desc: self.desc,
+            desc: Arc::clone(&self.desc),
             program: Program::new(&self.graph, &self.coefficients),
             values: values.to_vec(),
         }))

@@ -21,7 +21,7 @@ pub use params::{ParamValue, Setting};
 pub use sources::FormSource;
 
 /// A form bound to the slot name a scheme applies it by.
-pub type Slot<'m> = (&'static str, Box<dyn BoundForm + 'm>);
+pub type Slot<'s, 'm> = (&'s str, Box<dyn BoundForm + 'm>);
 
 /// The methods of a run as the user named them (CLI flags or case-file keys): the scheme, the
 /// contact law, the material and extra form files, by name or path, the param settings, and the
@@ -85,10 +85,10 @@ pub enum SchemeSource {
 }
 
 impl SchemeSource {
-    pub fn desc(&self) -> &'static SchemeDesc {
+    pub fn desc(&self) -> &SchemeDesc {
         match self {
             SchemeSource::Compiled(u) => u.desc,
-            SchemeSource::Interpreted(i) => i.desc,
+            SchemeSource::Interpreted(i) => &i.desc,
         }
     }
 
@@ -268,8 +268,8 @@ impl FilesInUse {
         scheme.into_iter().chain(forms).collect()
     }
 
-    pub fn scheme_name(&self) -> &'static str {
-        self.scheme.desc().name
+    pub fn scheme_name(&self) -> &str {
+        &self.scheme.desc().name
     }
 
     /// What the scheme's file claims (`claim order = 2`, `claim rho_inf = rho`), at the param
@@ -317,19 +317,19 @@ impl FilesInUse {
     }
 
     /// The forms the scheme applies, bound; errors name the slot's declaration.
-    pub fn scheme_forms<'m>(&self, inst: &mut Instance<'m>) -> Result<Vec<Slot<'m>>, CaseError> {
+    pub fn scheme_forms<'m>(&self, inst: &mut Instance<'m>) -> Result<Vec<Slot<'_, 'm>>, CaseError> {
         self.scheme_forms_with(inst, Vec::new())
     }
 
     /// As [`FilesInUse::scheme_forms`], with some slots bound to the given forms instead.
-    pub fn scheme_forms_with<'m>(
-        &self,
+    pub fn scheme_forms_with<'s, 'm>(
+        &'s self,
         inst: &mut Instance<'m>,
-        mut given: Vec<Slot<'m>>,
-    ) -> Result<Vec<Slot<'m>>, CaseError> {
+        mut given: Vec<Slot<'s, 'm>>,
+    ) -> Result<Vec<Slot<'s, 'm>>, CaseError> {
         let desc = self.scheme.desc();
         let mut out = Vec::new();
-        for slot in desc.uses {
+        for slot in desc.uses.iter() {
             if let Some(i) = given.iter().position(|(name, _)| *name == slot.name) {
                 out.push(given.swap_remove(i));
                 continue;
@@ -340,13 +340,13 @@ impl FilesInUse {
                     .units
                     .iter()
                     .map(|u| {
-                        let names: Vec<&str> = u.slots().iter().map(|s| s.name).collect();
+                        let names: Vec<&str> = u.slots().iter().map(|s| &*s.name).collect();
                         format!("{}: {}", u.file(), names.join(", "))
                     })
                     .collect();
                 list.join("; ")
             };
-            let Some(form) = inst.take_form(slot.name) else {
+            let Some(form) = inst.take_form(&slot.name) else {
                 return Err(CaseError::Option(format!(
                     "scheme `{}` applies slot `{}` ({}), which none of the form files in use provides ({}); add one with --forms FILE.wf",
                     desc.name,
@@ -366,7 +366,7 @@ impl FilesInUse {
                     form.fields()
                 )));
             }
-            out.push((slot.name, form));
+            out.push((&*slot.name, form));
         }
         Ok(out)
     }
@@ -374,7 +374,7 @@ impl FilesInUse {
 
 impl FormsInUse {
     /// The contact law's name (its file stem).
-    pub fn contact_name(&self) -> &'static str {
+    pub fn contact_name(&self) -> &str {
         self.units[self.contact].name()
     }
 
@@ -384,7 +384,7 @@ impl FormsInUse {
         coefs: &dyn Fn(&str) -> Option<Coef>,
         binding: &Binding<'m>,
     ) -> Result<Instance<'m>, CaseError> {
-        let mut slots: Vec<(&'static str, SlotForm<'m>, &'static str)> = Vec::new();
+        let mut slots: Vec<(String, SlotForm<'m>, String)> = Vec::new();
         for unit in &self.units {
             let values = self.params.unit_values(unit.params());
             let made = unit.make(&values, coefs, binding).map_err(|e| {
@@ -401,7 +401,7 @@ impl FormsInUse {
                         unit.file()
                     )));
                 }
-                slots.push((name, form, unit.file()));
+                slots.push((name.to_string(), form, unit.file().to_string()));
             }
         }
         Ok(Instance { slots })
@@ -412,7 +412,7 @@ impl FormsInUse {
 /// `missing`: "; the case provides f, g, nc; did you mean `g`?".
 fn provided_coefs(coefs: &dyn Fn(&str) -> Option<Coef>, missing: &str) -> String {
     let mut names: Vec<&str> =
-        LIBRARY.iter().filter_map(|u| u.forms).flat_map(|f| f.coefs.iter().map(|c| c.name)).collect();
+        LIBRARY.iter().filter_map(|u| u.forms).flat_map(|f| f.coefs.iter().map(|c| &*c.name)).collect();
     names.sort_unstable();
     names.dedup();
     names.retain(|n| coefs(n).is_some());
@@ -424,9 +424,9 @@ fn provided_coefs(coefs: &dyn Fn(&str) -> Option<Coef>, missing: &str) -> String
     format!("; the case provides {}{hint}", names.join(", "))
 }
 
-/// The bound forms of a run, taken by slot name.
+/// The bound forms of a run, taken by slot name (and the file that provides each).
 pub struct Instance<'m> {
-    slots: Vec<(&'static str, SlotForm<'m>, &'static str)>,
+    slots: Vec<(String, SlotForm<'m>, String)>,
 }
 
 impl<'m> Instance<'m> {

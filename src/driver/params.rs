@@ -76,11 +76,11 @@ impl Table {
         let mut entries: Vec<Entry> = scheme
             .map_or(&[][..], |s| s.params())
             .iter()
-            .map(|p| Entry { info: *p, scheme: true, value: p.default, source: Source::File })
+            .map(|p| Entry { info: p.clone(), scheme: true, value: p.default, source: Source::File })
             .collect();
         for p in units.iter().flat_map(|u| u.params().iter()) {
             if !entries.iter().any(|e| same(&e.info, p)) {
-                entries.push(Entry { info: *p, scheme: false, value: p.default, source: Source::File });
+                entries.push(Entry { info: p.clone(), scheme: false, value: p.default, source: Source::File });
             }
         }
         Table { entries }

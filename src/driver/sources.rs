@@ -18,17 +18,11 @@ pub enum FormSource {
 
 /// A form file compiled at run time.
 pub struct Interpreted {
-    pub name: &'static str,
-    pub file: &'static str,
+    pub name: String,
+    pub file: String,
     pub params: Vec<ParamInfo>,
     pub slots: Vec<SlotInfo>,
     lib: Library,
-}
-
-// Param and slot data hold `'static` strings, as generated constants do; a file loaded at run
-// time leaks its (few) names once per load.
-pub(super) fn leak(s: String) -> &'static str {
-    String::leak(s)
 }
 
 /// Checks and lowers a form file given by path.
@@ -41,23 +35,23 @@ pub fn interpret(path: &Path) -> Result<Interpreted, String> {
     let params = prog
         .params
         .iter()
-        .map(|p| param_info(src, &p.name, p.default, p.range, p.span, leak(module_name(src.path(p.span.file)))))
+        .map(|p| param_info(src, &p.name, p.default, p.range, p.span, &module_name(src.path(p.span.file))))
         .collect();
     let slots = prog
         .forms
         .iter()
         .filter(|f| f.span.file == prog.root)
         .map(|f| SlotInfo {
-            name: leak(f.name.clone()),
+            name: f.name.clone().into(),
             fields: f.fields.len(),
             functional: f.test.is_none(),
-            doc: leak(docs::declaration(src, f.span)),
-            declared: leak(docs::location(src, f.span)),
+            doc: docs::declaration(src, f.span).into(),
+            declared: docs::location(src, f.span).into(),
         })
         .collect();
     Ok(Interpreted {
-        name: leak(module_name(path)),
-        file: leak(path.display().to_string()),
+        name: module_name(path),
+        file: path.display().to_string(),
         params,
         slots,
         lib: Library::new(&prog),
@@ -71,17 +65,16 @@ pub(super) fn param_info(
     default: f64,
     range: Option<ParamRange>,
     span: Span,
-    owner: &'static str,
+    owner: &str,
 ) -> ParamInfo {
-    let name = leak(name.to_string());
     ParamInfo {
-        name,
+        name: name.to_string().into(),
         default,
         range: range.unwrap_or(ParamRange::UNBOUNDED),
-        doc: leak(docs::declaration(src, span)),
-        declared: leak(docs::location(src, span)),
-        written: leak(docs::written(src, span)),
-        owner,
+        doc: docs::declaration(src, span).into(),
+        declared: docs::location(src, span).into(),
+        written: docs::written(src, span).into(),
+        owner: owner.to_string().into(),
     }
 }
 
@@ -91,37 +84,39 @@ impl Interpreted {
         values: &[f64],
         coefs: &dyn Fn(&str) -> Option<Coef>,
         binding: &Binding<'m>,
-    ) -> Result<Made<'m>, LibraryError> {
-        let params: Vec<(&str, f64)> = self.params.iter().map(|p| p.name).zip(values.iter().copied()).collect();
+    ) -> Result<Made<'_, 'm>, LibraryError> {
+        let params: Vec<(&str, f64)> = self.params.iter().map(|p| &*p.name).zip(values.iter().copied()).collect();
         let mut data = Vec::new();
         for name in self.lib.coefs() {
             let c = coefs(name)
-                .ok_or_else(|| LibraryError::MissingCoef { name: leak(name.to_string()), declared: self.file })?;
+                .ok_or_else(|| LibraryError::MissingCoef { name: name.to_string(), declared: self.file.clone() })?;
             data.push((name, c));
         }
         let mut made = Vec::new();
         for slot in &self.slots {
-            let form =
-                self.lib.form(slot.name, binding.dim, &params, &data).map_err(|e| LibraryError::Coef(e.to_string()))?;
+            let form = self
+                .lib
+                .form(&slot.name, binding.dim, &params, &data)
+                .map_err(|e| LibraryError::Coef(e.to_string()))?;
             let bound = if slot.functional { binding.functional(form)? } else { binding.form(form)? };
-            made.push((slot.name, bound));
+            made.push((&*slot.name, bound));
         }
         Ok(made)
     }
 }
 
 impl FormSource {
-    pub fn name(&self) -> &'static str {
+    pub fn name(&self) -> &str {
         match self {
             FormSource::Compiled(u) => u.name,
-            FormSource::Interpreted(i) => i.name,
+            FormSource::Interpreted(i) => &i.name,
         }
     }
 
-    pub fn file(&self) -> &'static str {
+    pub fn file(&self) -> &str {
         match self {
             FormSource::Compiled(u) => u.file,
-            FormSource::Interpreted(i) => i.file,
+            FormSource::Interpreted(i) => &i.file,
         }
     }
 
@@ -159,7 +154,7 @@ impl FormSource {
         values: &[f64],
         coefs: &dyn Fn(&str) -> Option<Coef>,
         binding: &Binding<'m>,
-    ) -> Result<Made<'m>, LibraryError> {
+    ) -> Result<Made<'_, 'm>, LibraryError> {
         match self {
             FormSource::Compiled(u) => match u.forms {
                 Some(f) => (f.make)(values, coefs, binding),

@@ -305,7 +305,7 @@ fn simulate(
             let (mut saved_rows, mut saved_stages, mut saved_snapshots) = (0, 0, 0);
             match control.observer() {
                 Some(records) => {
-                    let stages = sim.stepper.desc().stages;
+                    let stages = &sim.stepper.desc().stages;
                     series.clear();
                     iterations.clear();
                     switches.clear();
@@ -337,7 +337,7 @@ fn simulate(
                     &velocity(&sim.states, v_index, &sim.states[0], times.dt),
                 )?,
             }
-            let names = sim.stepper.desc().states;
+            let names = sim.stepper.desc().states.clone();
             let outcome = sim.run(
                 t0,
                 times.dt,
@@ -345,8 +345,8 @@ fn simulate(
                 opts.progress,
                 &mut control,
                 &mut |ops, stage, v_index| {
-                    if let Some(u) = stage.value_of(names[0]) {
-                        let v = v_index.and_then(|i| stage.value_of(names[i]));
+                    if let Some(u) = stage.value_of(&names[0]) {
+                        let v = v_index.and_then(|i| stage.value_of(&names[i]));
                         let ((t, values), _) =
                             row(ops, State { t: stage.time, u, v, newton: 0, before: None, stage: true });
                         stage_rows.borrow_mut().push((stage.name.to_string(), t, values));

@@ -138,7 +138,7 @@ impl<'m> Simulation<'m> {
         }
         ops.energies = Energies::new(asm, stepper.half_pattern(), &ops.stiffness, &ops.scheme_mass);
         let n = asm.size();
-        let names = stepper.desc().states;
+        let names = &stepper.desc().states;
         let states = names.iter().map(|_| vec![0.0; n]).collect();
         let v_index = names.iter().position(|s| *s == "v");
         let params = in_use
@@ -227,8 +227,8 @@ impl<'m> Simulation<'m> {
                 mass: self.ops.mass_choice.name().to_string(),
             });
         }
-        let stages = self.stepper.desc().stages;
-        let intermediate: Vec<&str> = stages.iter().rev().skip(1).map(|s| s.name).collect();
+        let intermediate: Vec<String> =
+            self.stepper.desc().stages.iter().rev().skip(1).map(|s| s.name.to_string()).collect();
         let mut outcome = Outcome {
             step_seconds: Vec::with_capacity(steps),
             cuts: 0,
@@ -284,7 +284,7 @@ impl<'m> Simulation<'m> {
                 // The intermediate stages' displacements and velocities, for the held dofs' work.
                 let mut stages_seen: Vec<(f64, Vec<f64>, Option<Vec<f64>>)> = Vec::new();
                 let result = stepper.step_observed(states, t, h, &mut |stage| {
-                    if intermediate.contains(&stage.name) {
+                    if intermediate.iter().any(|name| name == stage.name) {
                         on_stage(ops, stage, *v_index);
                         if !ops.held.is_empty()
                             && let Some(u) = stage.value_of("u")

@@ -218,7 +218,7 @@ pub fn resultant(c: &[f64], d: usize) -> Vec<f64> {
 /// has inertia.
 pub(super) struct Parts<'m> {
     pub(super) ops: Operators<'m>,
-    pub(super) forms: Vec<(&'static str, Box<dyn BoundForm + 'm>)>,
+    pub(super) forms: Vec<(String, Box<dyn BoundForm + 'm>)>,
     pub(super) inertia: bool,
 }
 
@@ -236,19 +236,20 @@ impl<'m> Parts<'m> {
         }
         let binding = Binding { quadrature: problem.quadrature, regions, dim: mesh.dim() };
         let mut inst = in_use.forms.instantiate(problem.coefs, &binding)?;
-        let mut forms = in_use.scheme_forms(&mut inst)?;
+        let mut forms: Vec<(String, Box<dyn BoundForm + 'm>)> =
+            in_use.scheme_forms(&mut inst)?.into_iter().map(|(slot, f)| (slot.to_string(), f)).collect();
         let missing = |what: &str| {
             CaseError::Option(format!("the case needs `{what}`, which the form files in use do not provide"))
         };
-        let slot = |forms: &[(&str, Box<dyn BoundForm + 'm>)], name: &str| {
-            forms.iter().position(|(s, _)| *s == name).ok_or_else(|| missing(name))
+        let slot = |forms: &[(String, Box<dyn BoundForm + 'm>)], name: &str| {
+            forms.iter().position(|(s, _)| s == name).ok_or_else(|| missing(name))
         };
         let zero = vec![0.0; n];
         let mut mass = asm.zero_matrix();
         // A scheme without inertia (quasi-static: equilibrium at every step) does not apply the
         // mass; the material's still weighs the means and the figures.
-        let inertia = forms.iter().any(|(s, _)| *s == "mass");
-        match forms.iter().find(|(s, _)| *s == "mass") {
+        let inertia = forms.iter().any(|(s, _)| s == "mass");
+        match forms.iter().find(|(s, _)| s == "mass") {
             Some((_, f)) => f.tangent(asm, &[&zero], 0, 0.0, &mut mass),
             None => {
                 let material = in_use.forms.instantiate(problem.coefs, &binding)?.take_form("mass");
@@ -283,7 +284,7 @@ impl<'m> Parts<'m> {
         let scheme_mass = match scheme_mass {
             Some(matrix) => {
                 let i = slot(&forms, "mass")?;
-                forms[i] = ("mass", Box::new(MatrixForm { name: "mass".into(), matrix: matrix.clone() }));
+                forms[i] = ("mass".into(), Box::new(MatrixForm { name: "mass".into(), matrix: matrix.clone() }));
                 matrix
             }
             None => mass.clone(),

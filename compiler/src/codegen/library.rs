@@ -20,7 +20,7 @@ fn param_info(prog: &Program, name: &str, default: f64, range: &str, span: Span,
         docs::written(&prog.sources, span),
     );
     format!(
-        "ParamInfo {{ name: {name:?}, default: {default:?}, range: {range}, doc: {doc:?}, declared: {declared:?}, written: {written:?}, owner: {owner:?} }}"
+        "ParamInfo {{ name: Borrowed({name:?}), default: {default:?}, range: {range}, doc: Borrowed({doc:?}), declared: Borrowed({declared:?}), written: Borrowed({written:?}), owner: Borrowed({owner:?}) }}"
     )
 }
 
@@ -48,7 +48,7 @@ pub fn forms_items(prog: &Program, own: &[(usize, &str)]) -> String {
         .map(|c| {
             let rank = c.shape.rank();
             format!(
-                "CoefInfo {{ name: {:?}, rank: {rank}, doc: {:?}, declared: {:?} }}",
+                "CoefInfo {{ name: Borrowed({:?}), rank: {rank}, doc: Borrowed({:?}), declared: Borrowed({:?}) }}",
                 c.name,
                 docs::declaration(src, c.span),
                 docs::location(src, c.span)
@@ -61,7 +61,7 @@ pub fn forms_items(prog: &Program, own: &[(usize, &str)]) -> String {
         .map(|&(fi, _)| {
             let f = &prog.forms[fi];
             format!(
-                "SlotInfo {{ name: {:?}, fields: {}, functional: {}, doc: {:?}, declared: {:?} }}",
+                "SlotInfo {{ name: Borrowed({:?}), fields: {}, functional: {}, doc: Borrowed({:?}), declared: Borrowed({:?}) }}",
                 f.name,
                 f.fields.len(),
                 f.test.is_none(),
@@ -79,7 +79,7 @@ pub fn forms_items(prog: &Program, own: &[(usize, &str)]) -> String {
     let coefs = if prog.coefs.is_empty() { "_coefs" } else { "coefs" };
     let _ = writeln!(
         s,
-        "pub fn make<'m>(values: &[f64], {coefs}: &dyn Fn(&str) -> Option<Coef>, bind: &Binding<'m>) -> Result<Made<'m>, LibraryError> {{"
+        "pub fn make<'m>(values: &[f64], {coefs}: &dyn Fn(&str) -> Option<Coef>, bind: &Binding<'m>) -> Result<Made<'static, 'm>, LibraryError> {{"
     );
     s.push_str("let mut params = Params::default();\n");
     s.push_str("for (name, value) in Params::NAMES.iter().zip(values) { params.set(name, *value)?; }\n");

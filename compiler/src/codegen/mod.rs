@@ -44,6 +44,7 @@ const IMPORTS: &[(&str, &[&str])] = &[
     (
         "descriptors",
         &[
+            "Borrowed",
             "CoefInfo",
             "Combination",
             "InitialDesc",

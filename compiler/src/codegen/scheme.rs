@@ -78,7 +78,7 @@ fn level(q: Quantity) -> String {
 fn combination(c: &Combination) -> String {
     let unknown = c.unknown.map_or("None".to_string(), |k| format!("Some({k})"));
     let known: Vec<String> = c.known.iter().map(|(q, k)| format!("({}, {k})", level(*q))).collect();
-    format!("Combination {{ unknown: {unknown}, known: &[{}] }}", known.join(", "))
+    format!("Combination {{ unknown: {unknown}, known: Borrowed(&[{}]) }}", known.join(", "))
 }
 
 fn terms(ts: &[TermLayout]) -> String {
@@ -87,7 +87,7 @@ fn terms(ts: &[TermLayout]) -> String {
         .map(|t| {
             let args: Vec<String> = t.args.iter().map(combination).collect();
             format!(
-                "TermDesc {{ coef: {}, form: {:?}, args: &[{}], time: {} }}",
+                "TermDesc {{ coef: {}, form: Borrowed({:?}), args: Borrowed(&[{}]), time: {} }}",
                 t.coef,
                 t.slot,
                 args.join(", "),
@@ -95,7 +95,7 @@ fn terms(ts: &[TermLayout]) -> String {
             )
         })
         .collect();
-    format!("&[{}]", list.join(", "))
+    format!("Borrowed(&[{}])", list.join(", "))
 }
 
 fn describe(prog: &Program, s: &SchemeIr, layout: &Layout) -> String {
@@ -104,14 +104,14 @@ fn describe(prog: &Program, s: &SchemeIr, layout: &Layout) -> String {
         .iter()
         .map(|u| {
             format!(
-                "SlotUse {{ name: {:?}, fields: {}, declared: {:?} }}",
+                "SlotUse {{ name: Borrowed({:?}), fields: {}, declared: Borrowed({:?}) }}",
                 u.name,
                 u.fields,
                 crate::docs::location_col(&prog.sources, u.span)
             )
         })
         .collect();
-    let states: Vec<String> = s.states.iter().map(|x| format!("{x:?}")).collect();
+    let states: Vec<String> = s.states.iter().map(|x| format!("Borrowed({x:?})")).collect();
     let initial = match &layout.initial {
         Some((state, ts)) => format!("Some(InitialDesc {{ state: {state}, terms: {} }})", terms(ts)),
         None => "None".into(),
@@ -120,10 +120,10 @@ fn describe(prog: &Program, s: &SchemeIr, layout: &Layout) -> String {
         .stages
         .iter()
         .map(|st| {
-            let quantities: Vec<String> = st.quantities.iter().map(|q| format!("{q:?}")).collect();
+            let quantities: Vec<String> = st.quantities.iter().map(|q| format!("Borrowed({q:?})")).collect();
             let values: Vec<String> = st.values.iter().map(combination).collect();
             format!(
-                "StageDesc {{ name: {:?}, time: {}, quantities: &[{}], values: &[{}], terms: {} }}",
+                "StageDesc {{ name: Borrowed({:?}), time: {}, quantities: Borrowed(&[{}]), values: Borrowed(&[{}]), terms: {} }}",
                 st.name,
                 st.time,
                 quantities.join(", "),
@@ -134,7 +134,7 @@ fn describe(prog: &Program, s: &SchemeIr, layout: &Layout) -> String {
         .collect();
     let updates: Vec<String> = s.updates.iter().map(|q| level(*q)).collect();
     format!(
-        "SchemeDesc {{ name: {:?}, uses: &[{}], states: &[{}], initial: {initial}, stages: &[{}], updates: &[{}], coefficients: {} }}",
+        "SchemeDesc {{ name: Borrowed({:?}), uses: Borrowed(&[{}]), states: Borrowed(&[{}]), initial: {initial}, stages: Borrowed(&[{}]), updates: Borrowed(&[{}]), coefficients: {} }}",
         s.name,
         uses.join(", "),
         states.join(", "),

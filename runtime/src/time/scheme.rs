@@ -1,14 +1,14 @@
 //! What the stepper asks of a time scheme: its description (laid out by the compiler) and its
 //! coefficients for a step size; and the view of a solved stage that observers read.
 
-use signorini_descriptors::SchemeDesc;
+use signorini_descriptors::{SchemeDesc, Text};
 
 /// A solved stage: its name, its time and its quantities (the unknown first), named as in the
 /// scheme's file.
 pub struct StageView<'v> {
-    pub name: &'static str,
+    pub name: &'v str,
     pub time: f64,
-    pub quantities: &'static [&'static str],
+    pub quantities: &'v [Text],
     pub values: &'v [Vec<f64>],
 }
 

@@ -46,7 +46,7 @@ pub(super) fn locate_non_finite(
 pub(super) struct SwitchMemo {
     /// The forms, then per term its time, the arguments it is differentiated by, and its
     /// arguments at the support's dofs, as bits.
-    pub(super) forms: Vec<&'static str>,
+    pub(super) forms: Vec<String>,
     pub(super) key: Vec<u64>,
     pub(super) set: Vec<bool>,
     /// Scratch for the key being compared.
@@ -156,15 +156,15 @@ impl Linear {
 pub(super) type Part<'v> = (f64, &'v [f64], Option<&'v [f64]>);
 
 /// A nonlinear term of a stage: coef·form(α₁w + b₁, ...).
-pub(super) struct ActiveTerm {
-    pub(super) form: &'static str,
+pub(super) struct ActiveTerm<'d> {
+    pub(super) form: &'d str,
     pub(super) coef: f64,
     pub(super) alphas: Vec<f64>,
     pub(super) bases: Vec<Vec<f64>>,
     pub(super) t: f64,
 }
 
-impl ActiveTerm {
+impl ActiveTerm<'_> {
     /// Writes the arguments α w + b into `out` (resized, reused across calls): at `dofs` only,
     /// if given (the rest is never read).
     pub(super) fn args_into(&self, w: &[f64], out: &mut Vec<Vec<f64>>, dofs: Option<&[usize]>) {
@@ -189,7 +189,7 @@ pub(super) struct StageProblem<'p, 'a> {
     pub(super) forms: &'p HashMap<String, Box<dyn BoundForm + 'a>>,
     pub(super) constant: &'p Linear,
     pub(super) rhs: Vec<f64>,
-    pub(super) terms: Vec<ActiveTerm>,
+    pub(super) terms: Vec<ActiveTerm<'p>>,
     pub(super) constraints: &'p Constraints,
     pub(super) structure: Structure,
     pub(super) piecewise: bool,
@@ -392,7 +392,7 @@ impl NonlinearProblem for StageProblem<'_, '_> {
                 memo.next.extend(term.alphas.iter().map(|a| u64::from(*a != 0.0)));
                 push_key(&self.args, Some(dofs), &mut memo.next);
             }
-            if memo.key == memo.next && memo.forms.iter().eq(self.terms.iter().map(|t| &t.form)) {
+            if memo.key == memo.next && memo.forms.iter().map(String::as_str).eq(self.terms.iter().map(|t| t.form)) {
                 out.extend_from_slice(&memo.set);
                 return self.piecewise;
             }
@@ -409,8 +409,9 @@ impl NonlinearProblem for StageProblem<'_, '_> {
         }
         if dofs.is_some() {
             std::mem::swap(&mut memo.key, &mut memo.next);
-            memo.forms.clear();
-            memo.forms.extend(self.terms.iter().map(|t| t.form));
+            if !memo.forms.iter().map(String::as_str).eq(self.terms.iter().map(|t| t.form)) {
+                memo.forms = self.terms.iter().map(|t| t.form.to_string()).collect();
+            }
             memo.set.clear();
             memo.set.extend_from_slice(&out[start..]);
         }

@@ -18,7 +18,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use signorini_descriptors::{Combination, Level, SchemeDesc, StageDesc};
+use signorini_descriptors::{Borrowed, Combination, Level, SchemeDesc, StageDesc};
 
 use crate::fem::assembly::Assembler;
 use crate::fem::bound::BoundForm;
@@ -35,7 +35,7 @@ use crate::time::stage::{
 #[derive(Debug, thiserror::Error)]
 pub enum StepError {
     #[error("scheme `{scheme}` applies slot `{form}` ({declared}), which no form file in use provides")]
-    MissingForm { scheme: &'static str, form: String, declared: &'static str },
+    MissingForm { scheme: String, form: String, declared: String },
     #[error("form `{form}` takes {expected} field(s), but the scheme applies it to {given}")]
     Arity { form: String, expected: usize, given: usize },
     #[error(
@@ -43,15 +43,15 @@ pub enum StepError {
     )]
     NonFinite { t: f64 },
     #[error("stage `{stage}` at t = {t}: {source}")]
-    Newton { stage: &'static str, t: f64, source: NewtonError },
+    Newton { stage: String, t: f64, source: NewtonError },
     #[error(
         "stage `{stage}` at t = {t}: {at}: its derivative divides by zero there (0/0 where a `pos`/`neg` clips an expression under a `sqrt` or a negative power; `check` warns of it as W0006): write the power directly, `d^(3/2)` rather than `d*sqrt(d)`"
     )]
-    NonFiniteTangent { stage: &'static str, t: f64, at: NonFiniteTangent },
+    NonFiniteTangent { stage: String, t: f64, at: NonFiniteTangent },
     #[error(
         "stage `{stage}` of scheme `{scheme}` has no displacement quantity (u', um, ...) that depends on its unknown (a nonzero coefficient at this Δt): a moving held displacement cannot be imposed there"
     )]
-    NoDisplacement { scheme: &'static str, stage: &'static str },
+    NoDisplacement { scheme: String, stage: String },
 }
 
 /// Displacements held at values that change with time (a moving Dirichlet condition): the
@@ -86,7 +86,9 @@ impl StepReport {
 /// Steps a scheme on a mesh with bound forms.
 pub struct Stepper<'a> {
     pub scheme: Box<dyn TimeScheme + 'a>,
-    desc: SchemeDesc,
+    /// The scheme's description, shared with the step being taken (which iterates its stages
+    /// while it updates the stepper).
+    desc: Arc<SchemeDesc>,
     asm: &'a Assembler<'a>,
     forms: HashMap<String, Box<dyn BoundForm + 'a>>,
     pub constraints: Constraints,
@@ -104,7 +106,7 @@ pub struct Stepper<'a> {
     /// The pattern's lower half, when the stage matrices are symmetric.
     half_pattern: Option<Arc<HalfPattern>>,
     /// Recently assembled loads, by (form, time).
-    loads: Vec<((&'static str, u64), Vec<f64>)>,
+    loads: Vec<((String, u64), Vec<f64>)>,
     coefs: Vec<f64>,
     /// Vectors of the problem's size no longer in use (states replaced, bases, products), for
     /// the next step: a step allocates none once the first has run.
@@ -150,12 +152,12 @@ struct StageCache {
     dt: f64,
     constant: Option<Linear>,
     /// The nonlinear terms' forms, and the entries their tangents add to (None: anywhere).
-    support: Option<(Vec<&'static str>, Option<Support>)>,
+    support: Option<(Vec<String>, Option<Support>)>,
     /// Scratch for the nonlinear terms' tangents: zero outside `support`.
     scratch: Option<Matrix>,
     /// The linear terms' forms, and their matrices' lower halves fused for one product (in
     /// groups of at most [`MAX_FUSED`]), when the matrices are symmetric.
-    linear: Option<(Vec<&'static str>, Vec<LowerHalf>)>,
+    linear: Option<(Vec<String>, Vec<LowerHalf>)>,
     /// The nonlinear terms' arguments and residual, kept from one step to the next.
     args: Vec<Vec<f64>>,
     term: Vec<f64>,
@@ -169,24 +171,28 @@ impl<'a> Stepper<'a> {
     /// `forms` binds the form names the scheme uses to bound kernels (a slot may hold any form
     /// of the right arity: `contact` is Nitsche's or the penalty's). `structure`: Cholesky for
     /// symmetric positive definite stage Jacobians, LU otherwise.
-    pub fn new(
+    pub fn new<S: Into<String>>(
         scheme: Box<dyn TimeScheme + 'a>,
         asm: &'a Assembler<'a>,
-        forms: Vec<(&'static str, Box<dyn BoundForm + 'a>)>,
+        forms: Vec<(S, Box<dyn BoundForm + 'a>)>,
         constraints: Constraints,
         structure: Structure,
         newton_options: NewtonOptions,
     ) -> Result<Self, StepError> {
         let forms: HashMap<String, Box<dyn BoundForm + 'a>> =
-            forms.into_iter().map(|(slot, f)| (slot.to_string(), f)).collect();
-        let desc = *scheme.desc();
+            forms.into_iter().map(|(slot, f)| (slot.into(), f)).collect();
+        let desc = Arc::new(scheme.desc().clone());
         let all_terms =
             desc.stages.iter().flat_map(|s| s.terms.iter()).chain(desc.initial.iter().flat_map(|i| i.terms.iter()));
         for term in all_terms {
-            let form = forms.get(term.form).ok_or_else(|| StepError::MissingForm {
-                scheme: desc.name,
+            let form = forms.get(&*term.form).ok_or_else(|| StepError::MissingForm {
+                scheme: desc.name.to_string(),
                 form: term.form.to_string(),
-                declared: desc.uses.iter().find(|u| u.name == term.form).map_or("", |u| u.declared),
+                declared: desc
+                    .uses
+                    .iter()
+                    .find(|u| u.name == term.form)
+                    .map_or_else(String::new, |u| u.declared.to_string()),
             })?;
             if form.fields() != term.args.len() {
                 return Err(StepError::Arity {
@@ -225,6 +231,7 @@ impl<'a> Stepper<'a> {
                 recorded: RecordedTangent::default(),
             })
             .collect();
+        let coefs = vec![0.0; desc.coefficients];
         Ok(Stepper {
             scheme,
             desc,
@@ -239,7 +246,7 @@ impl<'a> Stepper<'a> {
             matrices,
             half_pattern,
             loads: Vec::new(),
-            coefs: vec![0.0; desc.coefficients],
+            coefs,
             pool: Pool::default(),
         })
     }
@@ -275,19 +282,23 @@ impl<'a> Stepper<'a> {
     /// stage has no displacement quantity depending on its unknown. The initial problem keeps
     /// its held values (zero: the held motion's acceleration at the start is taken as zero).
     pub fn prescribe(&mut self, p: Prescribed) -> Result<(), StepError> {
-        for stage in self.desc.stages {
+        for stage in self.desc.stages.iter() {
             if self.displacement(stage).is_none() {
-                return Err(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name });
+                return Err(self.no_displacement(stage));
             }
         }
         self.prescribed = Some(p);
         Ok(())
     }
 
+    fn no_displacement(&self, stage: &StageDesc) -> StepError {
+        StepError::NoDisplacement { scheme: self.desc.name.to_string(), stage: stage.name.to_string() }
+    }
+
     /// The stage's displacement quantity (named after the first state with a suffix: `u'`,
     /// `um`) when it depends on the unknown.
     fn displacement(&self, stage: &StageDesc) -> Option<usize> {
-        let u = self.desc.states.first()?;
+        let u: &str = self.desc.states.first()?;
         let q = stage.quantities.iter().position(|q| q.starts_with(u) && q.len() > u.len())?;
         stage.values.get(q).filter(|c| c.unknown.is_some()).map(|_| q)
     }
@@ -303,12 +314,11 @@ impl<'a> Stepper<'a> {
         time: f64,
     ) -> Result<(), StepError> {
         let Some(p) = &self.prescribed else { return Ok(()) };
-        let q =
-            self.displacement(stage).ok_or(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name })?;
+        let q = self.displacement(stage).ok_or_else(|| self.no_displacement(stage))?;
         let c = &stage.values[q];
         let cw = c.unknown.map_or(0.0, |k| self.coefs[k]);
         if cw == 0.0 || !cw.is_finite() {
-            return Err(StepError::NoDisplacement { scheme: self.desc.name, stage: stage.name });
+            return Err(self.no_displacement(stage));
         }
         let mut g = vec![0.0; p.dofs.len()];
         (p.values)(time, &mut g);
@@ -326,15 +336,22 @@ impl<'a> Stepper<'a> {
 
     /// Solves the initial problem (e.g. M a⁰ = L⁰ − B(u⁰)) for its state, if the scheme has one.
     pub fn initialize(&mut self, states: &mut [Vec<f64>], t: f64) -> Result<Option<NewtonReport>, StepError> {
-        let Some(init) = self.desc.initial else { return Ok(None) };
+        let Some(init) = &self.desc.initial else { return Ok(None) };
+        let state = init.state;
+        let stage = StageDesc {
+            name: Borrowed("initial"),
+            time: 0,
+            quantities: Borrowed(&[]),
+            values: Borrowed(&[]),
+            terms: init.terms.clone(),
+        };
         self.scheme.coefficients(1.0, t, &mut self.coefs);
-        let reference = Level::State(init.state);
-        let stage = StageDesc { name: "initial", time: 0, quantities: &[], values: &[], terms: init.terms };
+        let reference = Level::State(state);
         let cache = self.stages.len() - 1;
         let saved = self.initial_constraints.as_ref().map(|c| std::mem::replace(&mut self.constraints, c.clone()));
         let result = self.solve_stage(&stage, cache, states, &[], reference, 1.0, t);
         let result = result.map(|(delta, report)| {
-            let mut w: Vec<f64> = states[init.state].iter().zip(&delta).map(|(r, d)| r + d).collect();
+            let mut w: Vec<f64> = states[state].iter().zip(&delta).map(|(r, d)| r + d).collect();
             self.constraints.impose(&mut w);
             (w, report)
         });
@@ -342,7 +359,7 @@ impl<'a> Stepper<'a> {
             self.constraints = c;
         }
         let (w, report) = result?;
-        states[init.state] = w;
+        states[state] = w;
         // The stages' Jacobians have the initial problem's pattern: one ordering and symbolic
         // analysis serves all, and the first stage factors into the initial problem's storage.
         if let Some((initial, stages)) = self.stages.split_last_mut()
@@ -378,16 +395,16 @@ impl<'a> Stepper<'a> {
         dt: f64,
         observe: &mut dyn FnMut(&StageView),
     ) -> Result<StepReport, StepError> {
-        let desc = self.desc;
+        let desc = Arc::clone(&self.desc);
         let n = self.asm.size();
         self.scheme.coefficients(dt, t, &mut self.coefs);
         let mut quantities: Vec<Vec<Vec<f64>>> = Vec::with_capacity(desc.stages.len());
         let mut report = StepReport::default();
         for (s, stage) in desc.stages.iter().enumerate() {
             // Newton starts from the state the unknown updates (u for u'), else the first state.
-            let name = stage.quantities[0];
+            let name = &stage.quantities[0];
             let reference =
-                Level::State(desc.states.iter().position(|st| name.trim_end_matches('\'') == *st).unwrap_or(0));
+                Level::State(desc.states.iter().position(|st| name.trim_end_matches('\'') == st).unwrap_or(0));
             if self.prescribed.is_some() {
                 let time = self.coefs.get(stage.time).copied().unwrap_or(t + dt);
                 self.hold(stage, reference, states, &quantities, time)?;
@@ -395,14 +412,14 @@ impl<'a> Stepper<'a> {
             let (delta, r) = self.solve_stage(stage, s, states, &quantities, reference, dt, t)?;
             report.stages.push(r);
             let mut values: Vec<Vec<f64>> = Vec::with_capacity(stage.values.len());
-            for c in stage.values {
+            for c in stage.values.iter() {
                 let mut v = self.pool.take(n);
                 self.combine(c, reference, Some(&delta), states, &quantities, &mut v);
                 values.push(v);
             }
             self.pool.give(delta);
             let time = self.coefs.get(stage.time).copied().unwrap_or(t + dt);
-            observe(&StageView { name: stage.name, time, quantities: stage.quantities, values: &values });
+            observe(&StageView { name: &stage.name, time, quantities: &stage.quantities, values: &values });
             quantities.push(values);
         }
         // A stage quantity that becomes one state only is moved there, not copied.
@@ -459,7 +476,7 @@ impl<'a> Stepper<'a> {
             }
             add(reference, a);
         }
-        for &(l, k) in c.known {
+        for &(l, k) in c.known.iter() {
             add(l, self.coefs[k]);
         }
         terms.retain(|(_, a)| *a != 0.0);
@@ -500,7 +517,7 @@ impl<'a> Stepper<'a> {
     fn add_linear(
         &mut self,
         cache: usize,
-        (forms, coefs, bases): &(Vec<&'static str>, Vec<f64>, Vec<Vec<f64>>),
+        (forms, coefs, bases): &(Vec<&str>, Vec<f64>, Vec<Vec<f64>>),
         rhs: &mut [f64],
     ) {
         if forms.is_empty() {
@@ -516,10 +533,11 @@ impl<'a> Stepper<'a> {
             return;
         };
         let entry = &mut self.stages[cache];
-        if entry.linear.as_ref().is_none_or(|(cached, _)| cached != forms) {
+        if entry.linear.as_ref().is_none_or(|(cached, _)| !cached.iter().map(String::as_str).eq(forms.iter().copied()))
+        {
             let matrices: Vec<&Matrix> = forms.iter().map(|f| &self.matrices[*f]).collect();
             let groups = matrices.chunks(MAX_FUSED).map(|g| LowerHalf::fused(g, half)).collect();
-            entry.linear = Some((forms.clone(), groups));
+            entry.linear = Some((forms.iter().map(|f| f.to_string()).collect(), groups));
         }
         let (_, groups) = entry.linear.as_ref().expect("built above");
         let terms: Vec<(f64, &[f64])> = coefs.iter().zip(bases).map(|(c, b)| (*c, b.as_slice())).collect();
@@ -547,18 +565,18 @@ impl<'a> Stepper<'a> {
         let mut constant_rhs = self.pool.zeros(n);
         let mut nonlinear: Vec<ActiveTerm> = Vec::new();
         // Linear terms coef·K·(α w + base): their forms, coefficients and bases.
-        let mut linear: (Vec<&'static str>, Vec<f64>, Vec<Vec<f64>>) = Default::default();
+        let mut linear: (Vec<&str>, Vec<f64>, Vec<Vec<f64>>) = Default::default();
         let rebuild = self.stages[cache].dt != dt || self.stages[cache].constant.is_none();
         let mut constant = if rebuild { Some(self.asm.zero_matrix()) } else { None };
-        for term in stage.terms {
+        for term in stage.terms.iter() {
             let coef = self.coefs[term.coef];
-            let form = &self.forms[term.form];
+            let form = &self.forms[&*term.form];
             let term_t = self.coefs[term.time];
             if term.args.is_empty() {
                 // Loads depend on time only: the one at t + dt this step is the one at t next step,
                 // and a steady one is the same at every time.
-                let key = (term.form, if form.time_dependent() { term_t.to_bits() } else { u64::MAX });
-                let b = match self.loads.iter().position(|(k, _)| *k == key) {
+                let bits = if form.time_dependent() { term_t.to_bits() } else { u64::MAX };
+                let b = match self.loads.iter().position(|((f, t), _)| *f == term.form && *t == bits) {
                     Some(i) => &self.loads[i].1,
                     None => {
                         let mut b = vec![0.0; n];
@@ -566,7 +584,7 @@ impl<'a> Stepper<'a> {
                         if self.loads.len() == LOAD_CACHE {
                             self.loads.remove(0);
                         }
-                        self.loads.push((key, b));
+                        self.loads.push(((term.form.to_string(), bits), b));
                         &self.loads.last().expect("just pushed").1
                     }
                 };
@@ -574,18 +592,18 @@ impl<'a> Stepper<'a> {
                 continue;
             }
             let mut bases: Vec<Vec<f64>> = Vec::with_capacity(term.args.len());
-            for c in term.args {
+            for c in term.args.iter() {
                 let mut b = self.pool.take(n);
                 self.combine(c, reference, None, states, quantities, &mut b);
                 bases.push(b);
             }
             let alphas: Vec<f64> = term.args.iter().map(|c| c.unknown.map_or(0.0, |k| self.coefs[k])).collect();
-            match self.matrices.get(term.form) {
+            match self.matrices.get(&*term.form) {
                 Some(k) if alphas.len() == 1 => {
                     if let Some(c) = constant.as_mut() {
                         c.add_scaled(coef * alphas[0], k);
                     }
-                    linear.0.push(term.form);
+                    linear.0.push(&term.form);
                     linear.1.push(coef);
                     linear.2.extend(bases);
                 }
@@ -597,7 +615,7 @@ impl<'a> Stepper<'a> {
                     self.pool.give(b);
                     bases.into_iter().for_each(|b| self.pool.give(b));
                 }
-                _ => nonlinear.push(ActiveTerm { form: term.form, coef, alphas, bases, t: term_t }),
+                _ => nonlinear.push(ActiveTerm { form: &term.form, coef, alphas, bases, t: term_t }),
             }
         }
         self.add_linear(cache, &linear, &mut constant_rhs);
@@ -613,8 +631,11 @@ impl<'a> Stepper<'a> {
             &mut self.stages[cache];
         // The same forms at every step in practice; should they change, so may the entries where
         // J varies, and the references compared there only are dropped.
-        if support.as_ref().is_none_or(|(forms, _)| !forms.iter().eq(nonlinear.iter().map(|a| &a.form))) {
-            let forms = nonlinear.iter().map(|a| a.form).collect();
+        if support
+            .as_ref()
+            .is_none_or(|(forms, _)| !forms.iter().map(String::as_str).eq(nonlinear.iter().map(|a| a.form)))
+        {
+            let forms = nonlinear.iter().map(|a| a.form.to_string()).collect();
             *support = Some((forms, tangent_support(self.asm, &self.forms, &nonlinear)));
             *scratch = None;
             newton.invalidate();
@@ -654,12 +675,13 @@ impl<'a> Stepper<'a> {
         if report.is_err()
             && let Some(at) = problem.non_finite.take()
         {
-            return Err(StepError::NonFiniteTangent { stage: stage.name, t: stage_t, at });
+            return Err(StepError::NonFiniteTangent { stage: stage.name.to_string(), t: stage_t, at });
         }
         (*args, *term, *recorded) = (problem.args, problem.term, problem.recorded);
         self.pool.give(problem.rhs);
         problem.terms.into_iter().flat_map(|t| t.bases).for_each(|b| self.pool.give(b));
-        let report = report.map_err(|source| StepError::Newton { stage: stage.name, t: stage_t, source })?;
+        let report =
+            report.map_err(|source| StepError::Newton { stage: stage.name.to_string(), t: stage_t, source })?;
         Ok((delta, report))
     }
 }

@@ -12,7 +12,9 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use crate::common::MassStiffness;
-use signorini_runtime::descriptors::{Combination, InitialDesc, Level, SchemeDesc, SlotUse, StageDesc, TermDesc};
+use signorini_runtime::descriptors::{
+    Borrowed, Combination, InitialDesc, Level, List, SchemeDesc, SlotUse, StageDesc, TermDesc, Text,
+};
 use signorini_runtime::fem::assembly::{Assembler, Quadrature};
 use signorini_runtime::fem::bound::{Bound, BoundForm};
 use signorini_runtime::fem::mesh::structured::interval;
@@ -61,46 +63,54 @@ static ALLOCATOR: Counting = Counting;
 
 struct CrankNicolson;
 
-const A_NEW: Combination =
-    Combination { unknown: Some(8), known: &[(Level::State(0), 9), (Level::State(1), 10), (Level::State(2), 11)] };
+const U_NEW: Combination = Combination { unknown: Some(0), known: Borrowed(&[]) };
+const A_NEW: Combination = Combination {
+    unknown: Some(8),
+    known: Borrowed(&[(Level::State(0), 9), (Level::State(1), 10), (Level::State(2), 11)]),
+};
+
+const MASS: SlotUse = SlotUse { name: Borrowed("mass"), fields: 1, declared: Borrowed("test:1:1") };
+const STIFFNESS: SlotUse = SlotUse { name: Borrowed("stiffness"), fields: 1, declared: Borrowed("test:1:6") };
+
+// The stage's parts the obstacle's scheme shares.
+const STAGE_NAME: Text = Borrowed("stage1");
+const QUANTITIES: List<Text> = Borrowed(&[Borrowed("u'"), Borrowed("v'"), Borrowed("a'")]);
+const VALUES: List<Combination> = Borrowed(&[
+    U_NEW,
+    Combination {
+        unknown: Some(4),
+        known: Borrowed(&[(Level::State(0), 5), (Level::State(1), 6), (Level::State(2), 7)]),
+    },
+    A_NEW,
+]);
 
 const DESC: SchemeDesc = SchemeDesc {
-    name: "crank_nicolson",
-    uses: &[
-        SlotUse { name: "mass", fields: 1, declared: "test:1:1" },
-        SlotUse { name: "stiffness", fields: 1, declared: "test:1:6" },
-    ],
-    states: &["u", "v", "a"],
+    name: Borrowed("crank_nicolson"),
+    uses: Borrowed(&[MASS, STIFFNESS]),
+    states: Borrowed(&[Borrowed("u"), Borrowed("v"), Borrowed("a")]),
     initial: Some(InitialDesc {
         state: 2,
-        terms: &[
-            TermDesc { coef: 0, form: "mass", args: &[Combination { unknown: Some(0), known: &[] }], time: 1 },
+        terms: Borrowed(&[
+            TermDesc { coef: 0, form: Borrowed("mass"), args: Borrowed(&[U_NEW]), time: 1 },
             TermDesc {
                 coef: 0,
-                form: "stiffness",
-                args: &[Combination { unknown: None, known: &[(Level::State(0), 0)] }],
+                form: Borrowed("stiffness"),
+                args: Borrowed(&[Combination { unknown: None, known: Borrowed(&[(Level::State(0), 0)]) }]),
                 time: 1,
             },
-        ],
+        ]),
     }),
-    stages: &[StageDesc {
-        name: "stage1",
+    stages: Borrowed(&[StageDesc {
+        name: STAGE_NAME,
         time: 3,
-        quantities: &["u'", "v'", "a'"],
-        values: &[
-            Combination { unknown: Some(0), known: &[] },
-            Combination {
-                unknown: Some(4),
-                known: &[(Level::State(0), 5), (Level::State(1), 6), (Level::State(2), 7)],
-            },
-            A_NEW,
-        ],
-        terms: &[
-            TermDesc { coef: 0, form: "mass", args: &[A_NEW], time: 3 },
-            TermDesc { coef: 0, form: "stiffness", args: &[Combination { unknown: Some(0), known: &[] }], time: 3 },
-        ],
-    }],
-    updates: &[Level::Stage(0, 0), Level::Stage(0, 1), Level::Stage(0, 2)],
+        quantities: QUANTITIES,
+        values: VALUES,
+        terms: Borrowed(&[
+            TermDesc { coef: 0, form: Borrowed("mass"), args: Borrowed(&[A_NEW]), time: 3 },
+            TermDesc { coef: 0, form: Borrowed("stiffness"), args: Borrowed(&[U_NEW]), time: 3 },
+        ]),
+    }]),
+    updates: Borrowed(&[Level::Stage(0, 0), Level::Stage(0, 1), Level::Stage(0, 2)]),
     coefficients: 12,
 };
 
@@ -282,23 +292,24 @@ impl BoundForm for Obstacle {
     }
 }
 
-const U_NEW: Combination = Combination { unknown: Some(0), known: &[] };
-
 const OBSTACLE_DESC: SchemeDesc = SchemeDesc {
-    name: "crank_nicolson_obstacle",
-    uses: &[
-        SlotUse { name: "mass", fields: 1, declared: "test:1:1" },
-        SlotUse { name: "stiffness", fields: 1, declared: "test:1:6" },
-        SlotUse { name: "obstacle", fields: 1, declared: "test:1:17" },
-    ],
-    stages: &[StageDesc {
-        terms: &[
-            TermDesc { coef: 0, form: "mass", args: &[A_NEW], time: 3 },
-            TermDesc { coef: 0, form: "stiffness", args: &[U_NEW], time: 3 },
-            TermDesc { coef: 0, form: "obstacle", args: &[U_NEW], time: 3 },
-        ],
-        ..DESC.stages[0]
-    }],
+    name: Borrowed("crank_nicolson_obstacle"),
+    uses: Borrowed(&[
+        MASS,
+        STIFFNESS,
+        SlotUse { name: Borrowed("obstacle"), fields: 1, declared: Borrowed("test:1:17") },
+    ]),
+    stages: Borrowed(&[StageDesc {
+        name: STAGE_NAME,
+        time: 3,
+        quantities: QUANTITIES,
+        values: VALUES,
+        terms: Borrowed(&[
+            TermDesc { coef: 0, form: Borrowed("mass"), args: Borrowed(&[A_NEW]), time: 3 },
+            TermDesc { coef: 0, form: Borrowed("stiffness"), args: Borrowed(&[U_NEW]), time: 3 },
+            TermDesc { coef: 0, form: Borrowed("obstacle"), args: Borrowed(&[U_NEW]), time: 3 },
+        ]),
+    }]),
     ..DESC
 };
 
