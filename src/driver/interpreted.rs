@@ -1,17 +1,16 @@
-//! Scheme files given by path, run at once: compiled at run time to the same description the
-//! macro generates (`compiler::scheme::layout`), their coefficients evaluated from the
-//! expression DAG.
+//! Scheme files given by path, run at once: compiled at run time to the description the macro
+//! prints (`compiler::scheme::layout`), their coefficients evaluated from the expression DAG.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use crate::compiler::ir::eval::Program;
 use crate::compiler::ir::graph::{Graph, NodeId};
-use crate::compiler::scheme::layout::{self, Combination, TermLayout};
-use crate::compiler::scheme::{Quantity, SchemeIr, scheme_leaf};
+use crate::compiler::scheme::layout::{Layout, layout};
+use crate::compiler::scheme::{SchemeIr, scheme_leaf};
 use crate::compiler::{check_path, docs};
 use crate::driver::sources::LibraryLoader;
-use crate::runtime::descriptors::{self as rs, ParamInfo, SchemeDesc, SlotUse};
+use crate::runtime::descriptors::{ParamInfo, SchemeDesc, check_param};
 use crate::runtime::library::LibraryError;
 use crate::runtime::time::scheme::TimeScheme;
 
@@ -42,28 +41,6 @@ impl TimeScheme for Running {
     }
 }
 
-fn level(q: Quantity) -> rs::Level {
-    match q {
-        Quantity::State(i) => rs::Level::State(i),
-        Quantity::Stage { stage, index } => rs::Level::Stage(stage, index),
-    }
-}
-
-fn combination(c: &Combination) -> rs::Combination {
-    rs::Combination { unknown: c.unknown, known: c.known.iter().map(|(q, k)| (level(*q), *k)).collect() }
-}
-
-fn terms(ts: &[TermLayout]) -> rs::List<rs::TermDesc> {
-    ts.iter()
-        .map(|t| rs::TermDesc {
-            coef: t.coef,
-            form: t.slot.clone().into(),
-            args: t.args.iter().map(combination).collect(),
-            time: t.time,
-        })
-        .collect()
-}
-
 /// Compiles the scheme file at `path` (its only scheme, or the one named `name`).
 pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
     let (prog, warnings) = check_path(path, &LibraryLoader).map_err(|f| f.rendered)?;
@@ -82,36 +59,7 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
             return Err(format!("{} declares several schemes ({}): name one", path.display(), names.join(", ")));
         }
     };
-    let lay = layout::layout(s);
-    let uses = s
-        .slots
-        .iter()
-        .map(|u| SlotUse {
-            name: u.name.clone().into(),
-            fields: u.fields,
-            declared: docs::location_col(&prog.sources, u.span).into(),
-        })
-        .collect();
-    let stages = lay
-        .stages
-        .iter()
-        .map(|st| rs::StageDesc {
-            name: st.name.clone().into(),
-            time: st.time,
-            quantities: st.quantities.iter().map(|q| q.clone().into()).collect(),
-            values: st.values.iter().map(combination).collect(),
-            terms: terms(&st.terms),
-        })
-        .collect();
-    let desc = SchemeDesc {
-        name: s.name.clone().into(),
-        uses,
-        states: s.states.iter().map(|q| q.clone().into()).collect(),
-        initial: lay.initial.as_ref().map(|(state, ts)| rs::InitialDesc { state: *state, terms: terms(ts) }),
-        stages,
-        updates: s.updates.iter().map(|q| level(*q)).collect(),
-        coefficients: lay.coefficients.len(),
-    };
+    let Layout { desc, coefficients } = layout(s, &prog.sources);
     let params = s
         .params
         .iter()
@@ -123,7 +71,7 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
         params,
         doc: docs::declaration(&prog.sources, s.span),
         graph: s.graph.clone(),
-        coefficients: lay.coefficients,
+        coefficients,
     })
 }
 
@@ -131,7 +79,7 @@ impl Interpreted {
     /// An instance with param values in declaration order (range-checked).
     pub fn instance(&self, values: &[f64]) -> Result<Box<dyn TimeScheme>, LibraryError> {
         for (p, v) in self.params.iter().zip(values) {
-            rs::check_param(&p.name, &p.range, *v)?;
+            check_param(&p.name, &p.range, *v)?;
         }
         Ok(Box::new(Running {
             desc: Arc::clone(&self.desc),

@@ -49,7 +49,9 @@ mod tests {
                 let path = library().join("schemes").join(unit.file);
                 let compiled = compile(&path, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", path.display()));
                 let ir = compiled.schemes().iter().find(|i| i.name == s.name).expect("the scheme compiles");
-                let order = layout::layout(ir).coefficients;
+                let layout = layout::layout(ir, &compiled.program.sources);
+                assert_eq!(&layout.desc, s.desc, "{}: the generated description is the layout's", s.name);
+                let order = layout.coefficients;
                 let defaults: Vec<f64> = s.params.iter().map(|p| p.default).collect();
                 let scheme = (s.make)(&defaults).expect("the defaults are in range");
                 for (dt, t) in [(1e-3, 0.0), (0.05, 0.7), (2.0, 3.0)] {

@@ -10,8 +10,10 @@
 //!
 //! Modules: `emit` writes expressions (kernels and scheme coefficients alike), `kernel` the
 //! element kernels, `forms` the form structs, `params` the parameter and coefficient structs,
-//! `scheme` the schemes, `library` the registry entry, `names` the identifiers.
+//! `scheme` the schemes, `library` the registry entry, `descriptors` the runtime's descriptions
+//! of them, `names` the identifiers.
 
+mod descriptors;
 mod emit;
 mod forms;
 mod kernel;

@@ -1,6 +1,6 @@
 //! Rust for a compiled scheme: a parameter struct named after the scheme, and its
-//! `TimeScheme` implementation: the static description of stages, terms and updates, and the
-//! evaluation of every coefficient for a step size (written by `emit`, as the kernels are).
+//! `TimeScheme` implementation: its description (the layout's, printed by `descriptors`), and
+//! the evaluation of every coefficient for a step size (written by `emit`, as the kernels are).
 
 use std::collections::HashMap;
 use std::fmt::Write;
@@ -10,8 +10,8 @@ use super::names::{Namer, case_allowance, ident};
 use super::params::{ParamDecl, params_struct};
 use crate::ir::graph::{Node, NodeId, Sym};
 use crate::program::Program;
-use crate::scheme::layout::{self, Combination, Layout, TermLayout};
-use crate::scheme::{Quantity, SchemeIr};
+use crate::scheme::SchemeIr;
+use crate::scheme::layout;
 
 pub fn scheme_text(prog: &Program, s: &SchemeIr, struct_name: &str) -> String {
     let params: Vec<ParamDecl> = s
@@ -22,8 +22,8 @@ pub fn scheme_text(prog: &Program, s: &SchemeIr, struct_name: &str) -> String {
     let sig: Vec<String> = params.iter().map(|p| format!("{} = {}", p.name, p.written)).collect();
     let doc = format!("/// `scheme {}({})`: its parameters; it implements `TimeScheme`.\n", s.name, sig.join(", "));
     let mut out = params_struct(struct_name, &doc, &params);
-    let layout = layout::layout(s);
-    let desc = describe(prog, s, &layout);
+    let layout = layout::layout(s, &prog.sources);
+    let desc = super::descriptors::scheme(&layout.desc);
     let _ = writeln!(out, "impl {struct_name} {{ pub const DESC: SchemeDesc = {desc}; }}");
     let coefficients = coefficients_fn(&layout.coefficients, s);
     out.push_str(case_allowance(super::names::locals(&coefficients)));
@@ -66,80 +66,4 @@ fn coefficients_fn(order: &[NodeId], s: &SchemeIr) -> String {
     let words = super::names::words(&body);
     let arg = |name: &str| if words.contains(name) { name.to_string() } else { format!("_{name}") };
     format!("fn coefficients(&self, {}: f64, {}: f64, out: &mut [f64]) {{\n{body}}}\n", arg("dt"), arg("t"))
-}
-
-fn level(q: Quantity) -> String {
-    match q {
-        Quantity::State(i) => format!("Level::State({i})"),
-        Quantity::Stage { stage, index } => format!("Level::Stage({stage}, {index})"),
-    }
-}
-
-fn combination(c: &Combination) -> String {
-    let unknown = c.unknown.map_or("None".to_string(), |k| format!("Some({k})"));
-    let known: Vec<String> = c.known.iter().map(|(q, k)| format!("({}, {k})", level(*q))).collect();
-    format!("Combination {{ unknown: {unknown}, known: Borrowed(&[{}]) }}", known.join(", "))
-}
-
-fn terms(ts: &[TermLayout]) -> String {
-    let list: Vec<String> = ts
-        .iter()
-        .map(|t| {
-            let args: Vec<String> = t.args.iter().map(combination).collect();
-            format!(
-                "TermDesc {{ coef: {}, form: Borrowed({:?}), args: Borrowed(&[{}]), time: {} }}",
-                t.coef,
-                t.slot,
-                args.join(", "),
-                t.time
-            )
-        })
-        .collect();
-    format!("Borrowed(&[{}])", list.join(", "))
-}
-
-fn describe(prog: &Program, s: &SchemeIr, layout: &Layout) -> String {
-    let uses: Vec<String> = s
-        .slots
-        .iter()
-        .map(|u| {
-            format!(
-                "SlotUse {{ name: Borrowed({:?}), fields: {}, declared: Borrowed({:?}) }}",
-                u.name,
-                u.fields,
-                crate::docs::location_col(&prog.sources, u.span)
-            )
-        })
-        .collect();
-    let states: Vec<String> = s.states.iter().map(|x| format!("Borrowed({x:?})")).collect();
-    let initial = match &layout.initial {
-        Some((state, ts)) => format!("Some(InitialDesc {{ state: {state}, terms: {} }})", terms(ts)),
-        None => "None".into(),
-    };
-    let stages: Vec<String> = layout
-        .stages
-        .iter()
-        .map(|st| {
-            let quantities: Vec<String> = st.quantities.iter().map(|q| format!("Borrowed({q:?})")).collect();
-            let values: Vec<String> = st.values.iter().map(combination).collect();
-            format!(
-                "StageDesc {{ name: Borrowed({:?}), time: {}, quantities: Borrowed(&[{}]), values: Borrowed(&[{}]), terms: {} }}",
-                st.name,
-                st.time,
-                quantities.join(", "),
-                values.join(", "),
-                terms(&st.terms)
-            )
-        })
-        .collect();
-    let updates: Vec<String> = s.updates.iter().map(|q| level(*q)).collect();
-    format!(
-        "SchemeDesc {{ name: Borrowed({:?}), uses: Borrowed(&[{}]), states: Borrowed(&[{}]), initial: {initial}, stages: Borrowed(&[{}]), updates: Borrowed(&[{}]), coefficients: {} }}",
-        s.name,
-        uses.join(", "),
-        states.join(", "),
-        stages.join(", "),
-        updates.join(", "),
-        layout.coefficients.len()
-    )
 }

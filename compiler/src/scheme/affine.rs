@@ -2,6 +2,8 @@
 
 use std::collections::BTreeMap;
 
+use signorini_descriptors::Level;
+
 use crate::ir::graph::{Graph, NodeId, Sym};
 
 /// A vector known when a stage starts, or one of its new quantities.
@@ -11,6 +13,16 @@ pub enum Quantity {
     State(usize),
     /// New quantity `index` of stage `stage`.
     Stage { stage: usize, index: usize },
+}
+
+/// The runtime's name for the same level.
+impl From<Quantity> for Level {
+    fn from(q: Quantity) -> Level {
+        match q {
+            Quantity::State(i) => Level::State(i),
+            Quantity::Stage { stage, index } => Level::Stage(stage, index),
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]

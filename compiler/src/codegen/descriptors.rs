@@ -1,0 +1,68 @@
+//! Descriptor values (`signorini_descriptors`) as Rust constant expressions: their text and
+//! lists `Borrowed` by the constant. Each printer names every field of what it prints, so a
+//! field added to a descriptor is a compile error here until it is printed.
+
+use signorini_descriptors::{Combination, InitialDesc, Level, SchemeDesc, SlotUse, StageDesc, TermDesc};
+
+fn text(s: &str) -> String {
+    format!("Borrowed({s:?})")
+}
+
+fn list<T>(items: &[T], item: impl Fn(&T) -> String) -> String {
+    let items: Vec<String> = items.iter().map(item).collect();
+    format!("Borrowed(&[{}])", items.join(", "))
+}
+
+fn level(l: &Level) -> String {
+    match l {
+        Level::State(i) => format!("Level::State({i})"),
+        Level::Stage(stage, index) => format!("Level::Stage({stage}, {index})"),
+    }
+}
+
+fn combination(c: &Combination) -> String {
+    let Combination { unknown, known } = c;
+    let unknown = unknown.map_or("None".to_string(), |k| format!("Some({k})"));
+    let known = list(known, |(l, k)| format!("({}, {k})", level(l)));
+    format!("Combination {{ unknown: {unknown}, known: {known} }}")
+}
+
+fn term(t: &TermDesc) -> String {
+    let TermDesc { coef, form, args, time } = t;
+    format!("TermDesc {{ coef: {coef}, form: {}, args: {}, time: {time} }}", text(form), list(args, combination))
+}
+
+fn stage(s: &StageDesc) -> String {
+    let StageDesc { name, time, quantities, values, terms } = s;
+    format!(
+        "StageDesc {{ name: {}, time: {time}, quantities: {}, values: {}, terms: {} }}",
+        text(name),
+        list(quantities, |q| text(q)),
+        list(values, combination),
+        list(terms, term)
+    )
+}
+
+fn slot_use(u: &SlotUse) -> String {
+    let SlotUse { name, fields, declared } = u;
+    format!("SlotUse {{ name: {}, fields: {fields}, declared: {} }}", text(name), text(declared))
+}
+
+/// `SchemeDesc { ... }`.
+pub fn scheme(d: &SchemeDesc) -> String {
+    let SchemeDesc { name, uses, states, initial, stages, updates, coefficients } = d;
+    let initial = match initial {
+        Some(InitialDesc { state, terms }) => {
+            format!("Some(InitialDesc {{ state: {state}, terms: {} }})", list(terms, term))
+        }
+        None => "None".into(),
+    };
+    format!(
+        "SchemeDesc {{ name: {}, uses: {}, states: {}, initial: {initial}, stages: {}, updates: {}, coefficients: {coefficients} }}",
+        text(name),
+        list(uses, slot_use),
+        list(states, |s| text(s)),
+        list(stages, stage),
+        list(updates, level)
+    )
+}
