@@ -3,12 +3,13 @@
 //!
 //! [`compile`] runs the whole pipeline and returns every stage ([`Compiled`]); the CLI, the
 //! `forms!` macro and the helpers here all use it. Modules, lowest first: `syntax`, `check`,
-//! `ir`, `scheme`, `program`, `codegen`, `pipeline`.
+//! `ir`, `scheme`, `program`, `describe`, `codegen`, `pipeline`.
 
 #![forbid(unsafe_code)]
 
 pub mod check;
 pub mod codegen;
+pub mod describe;
 pub mod diagnostic;
 pub mod docs;
 pub mod ir;

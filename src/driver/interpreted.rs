@@ -8,7 +8,7 @@ use crate::compiler::ir::eval::Program;
 use crate::compiler::ir::graph::{Graph, NodeId};
 use crate::compiler::scheme::layout::{Layout, layout};
 use crate::compiler::scheme::{SchemeIr, scheme_leaf};
-use crate::compiler::{check_path, docs};
+use crate::compiler::{check_path, describe, docs};
 use crate::driver::sources::LibraryLoader;
 use crate::runtime::descriptors::{ParamInfo, SchemeDesc, check_param};
 use crate::runtime::library::LibraryError;
@@ -60,15 +60,10 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
         }
     };
     let Layout { desc, coefficients } = layout(s, &prog.sources);
-    let params = s
-        .params
-        .iter()
-        .map(|p| super::sources::param_info(&prog.sources, &p.name, p.default, p.range, p.span, &s.name))
-        .collect();
     Ok(Interpreted {
         file: path.display().to_string(),
         desc: Arc::new(desc),
-        params,
+        params: describe::scheme_params(&prog, s),
         doc: docs::declaration(&prog.sources, s.span),
         graph: s.graph.clone(),
         coefficients,

@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use crate::compiler::{SourceMap, Span, check_path, docs, module_name};
+use crate::compiler::{check_path, describe, module_name};
 use crate::interpret::Library;
-use crate::runtime::descriptors::{ParamInfo, ParamRange, SlotInfo};
+use crate::runtime::descriptors::{ParamInfo, SlotInfo};
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::library::{Binding, LibraryError, Made, Unit};
 
@@ -31,51 +31,13 @@ pub fn interpret(path: &Path) -> Result<Interpreted, String> {
     if !warnings.is_empty() {
         eprint!("{warnings}");
     }
-    let src = &prog.sources;
-    let params = prog
-        .params
-        .iter()
-        .map(|p| param_info(src, &p.name, p.default, p.range, p.span, &module_name(src.path(p.span.file))))
-        .collect();
-    let slots = prog
-        .forms
-        .iter()
-        .filter(|f| f.span.file == prog.root)
-        .map(|f| SlotInfo {
-            name: f.name.clone().into(),
-            fields: f.fields.len(),
-            functional: f.test.is_none(),
-            doc: docs::declaration(src, f.span).into(),
-            declared: docs::location(src, f.span).into(),
-        })
-        .collect();
     Ok(Interpreted {
         name: module_name(path),
         file: path.display().to_string(),
-        params,
-        slots,
+        params: describe::params(&prog),
+        slots: describe::slots(&prog),
         lib: Library::new(&prog),
     })
-}
-
-/// A param of a file loaded at run time, described as generated code describes it.
-pub(super) fn param_info(
-    src: &SourceMap,
-    name: &str,
-    default: f64,
-    range: Option<ParamRange>,
-    span: Span,
-    owner: &str,
-) -> ParamInfo {
-    ParamInfo {
-        name: name.to_string().into(),
-        default,
-        range: range.unwrap_or(ParamRange::UNBOUNDED),
-        doc: docs::declaration(src, span).into(),
-        declared: docs::location(src, span).into(),
-        written: docs::written(src, span).into(),
-        owner: owner.to_string().into(),
-    }
 }
 
 impl Interpreted {

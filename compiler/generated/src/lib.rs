@@ -12,7 +12,7 @@ mod tests {
     use std::path::{Path, PathBuf};
 
     use signorini_compiler::scheme::{eval_all, layout};
-    use signorini_compiler::{FsLoader, compile};
+    use signorini_compiler::{FsLoader, compile, describe};
 
     fn library() -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../forms")
@@ -36,6 +36,28 @@ mod tests {
         let mut compiled: Vec<&str> = super::UNITS.iter().map(|u| u.name).collect();
         compiled.sort();
         assert_eq!(compiled, expected);
+    }
+
+    /// The params, coefs and slots the generated code describes are those the compiler
+    /// describes to a file interpreted at run time (ranges to the bit: Rust evaluates the
+    /// bounds as written as the checker does).
+    #[test]
+    fn generated_descriptions_are_the_compilers() {
+        for unit in super::UNITS {
+            let dir = if unit.schemes.is_empty() { library() } else { library().join("schemes") };
+            let path = dir.join(unit.file);
+            let compiled = compile(&path, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", path.display()));
+            let prog = &compiled.program;
+            if let Some(forms) = unit.forms {
+                assert_eq!(describe::params(prog), forms.params, "{}", unit.name);
+                assert_eq!(describe::coefs(prog), forms.coefs, "{}", unit.name);
+                assert_eq!(describe::slots(prog), forms.slots, "{}", unit.name);
+            }
+            for s in unit.schemes {
+                let ir = prog.schemes.iter().find(|i| i.name == s.name).expect("the scheme compiles");
+                assert_eq!(describe::scheme_params(prog, ir), s.params, "{}", s.name);
+            }
+        }
     }
 
     /// A scheme's generated `coefficients` computes what the IR evaluator computes from the

@@ -2,7 +2,9 @@
 //! lists `Borrowed` by the constant. Each printer names every field of what it prints, so a
 //! field added to a descriptor is a compile error here until it is printed.
 
-use signorini_descriptors::{Combination, InitialDesc, Level, SchemeDesc, SlotUse, StageDesc, TermDesc};
+use signorini_descriptors::{
+    CoefInfo, Combination, InitialDesc, Level, ParamInfo, SchemeDesc, SlotInfo, SlotUse, StageDesc, TermDesc,
+};
 
 fn text(s: &str) -> String {
     format!("Borrowed({s:?})")
@@ -11,6 +13,37 @@ fn text(s: &str) -> String {
 fn list<T>(items: &[T], item: impl Fn(&T) -> String) -> String {
     let items: Vec<String> = items.iter().map(item).collect();
     format!("Borrowed(&[{}])", items.join(", "))
+}
+
+/// `ParamInfo { ... }`, its range the expression `range` (an entry of the struct's `RANGES`,
+/// whose bounds are written as in the source).
+pub fn param(p: &ParamInfo, range: &str) -> String {
+    let ParamInfo { name, default, range: _, doc, declared, written, owner } = p;
+    format!(
+        "ParamInfo {{ name: {}, default: {default:?}, range: {range}, doc: {}, declared: {}, written: {}, owner: {} }}",
+        text(name),
+        text(doc),
+        text(declared),
+        text(written),
+        text(owner)
+    )
+}
+
+/// `CoefInfo { ... }`.
+pub fn coef(c: &CoefInfo) -> String {
+    let CoefInfo { name, rank, doc, declared } = c;
+    format!("CoefInfo {{ name: {}, rank: {rank}, doc: {}, declared: {} }}", text(name), text(doc), text(declared))
+}
+
+/// `SlotInfo { ... }`.
+pub fn slot(s: &SlotInfo) -> String {
+    let SlotInfo { name, fields, functional, doc, declared } = s;
+    format!(
+        "SlotInfo {{ name: {}, fields: {fields}, functional: {functional}, doc: {}, declared: {} }}",
+        text(name),
+        text(doc),
+        text(declared)
+    )
 }
 
 fn level(l: &Level) -> String {

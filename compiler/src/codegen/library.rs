@@ -1,75 +1,32 @@
 //! The registry entry of a generated module: its params (with docs and declaration sites), coefs
-//! and slots as data, and the functions that instantiate its forms and schemes by slot name.
+//! and slots as data (as `describe` builds them), and the functions that instantiate its forms
+//! and schemes by slot name.
 
 use std::fmt::Write;
 
+use super::descriptors;
 use super::names::{case_allowance, ident};
 use crate::docs;
 use crate::program::Program;
 use crate::scheme::SchemeIr;
-use crate::source::Span;
-
-fn owner(prog: &Program, span: Span) -> String {
-    crate::module_name(prog.sources.path(span.file))
-}
-
-fn param_info(prog: &Program, name: &str, default: f64, range: &str, span: Span, owner: &str) -> String {
-    let (doc, declared, written) = (
-        docs::declaration(&prog.sources, span),
-        docs::location(&prog.sources, span),
-        docs::written(&prog.sources, span),
-    );
-    format!(
-        "ParamInfo {{ name: Borrowed({name:?}), default: {default:?}, range: {range}, doc: Borrowed({doc:?}), declared: Borrowed({declared:?}), written: Borrowed({written:?}), owner: Borrowed({owner:?}) }}"
-    )
-}
 
 /// `PARAMS`, `COEFS`, `SLOTS` and `make` for the forms declared in the file (`own`: form index
 /// and struct name).
 pub fn forms_items(prog: &Program, own: &[(usize, &str)]) -> String {
-    let src = &prog.sources;
     let mut s = String::new();
-    let params: Vec<String> = prog
-        .params
+    let params: Vec<String> = crate::describe::params(prog)
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            param_info(prog, &p.name, p.default, &format!("Params::RANGES[{i}]"), p.span, &owner(prog, p.span))
-        })
+        .map(|(i, p)| descriptors::param(p, &format!("Params::RANGES[{i}]")))
         .collect();
     let _ = writeln!(
         s,
         "/// Every param the forms read (imports included), in `Params` order.\npub const PARAMS: &[ParamInfo] = &[{}];",
         params.join(", ")
     );
-    let coefs: Vec<String> = prog
-        .coefs
-        .iter()
-        .map(|c| {
-            let rank = c.shape.rank();
-            format!(
-                "CoefInfo {{ name: Borrowed({:?}), rank: {rank}, doc: Borrowed({:?}), declared: Borrowed({:?}) }}",
-                c.name,
-                docs::declaration(src, c.span),
-                docs::location(src, c.span)
-            )
-        })
-        .collect();
+    let coefs: Vec<String> = crate::describe::coefs(prog).iter().map(descriptors::coef).collect();
     let _ = writeln!(s, "/// The case data the forms read.\npub const COEFS: &[CoefInfo] = &[{}];", coefs.join(", "));
-    let slots: Vec<String> = own
-        .iter()
-        .map(|&(fi, _)| {
-            let f = &prog.forms[fi];
-            format!(
-                "SlotInfo {{ name: Borrowed({:?}), fields: {}, functional: {}, doc: Borrowed({:?}), declared: Borrowed({:?}) }}",
-                f.name,
-                f.fields.len(),
-                f.test.is_none(),
-                docs::declaration(src, f.span),
-                docs::location(src, f.span)
-            )
-        })
-        .collect();
+    let slots: Vec<String> = crate::describe::slots(prog).iter().map(descriptors::slot).collect();
     let _ = writeln!(
         s,
         "/// The forms and functionals of this file.\npub const SLOTS: &[SlotInfo] = &[{}];",
@@ -114,11 +71,10 @@ pub fn scheme_unit(prog: &Program, sch: &SchemeIr, struct_name: &str) -> (String
         sch.name,
         case_allowance([make.as_str()])
     );
-    let params: Vec<String> = sch
-        .params
+    let params: Vec<String> = crate::describe::scheme_params(prog, sch)
         .iter()
         .enumerate()
-        .map(|(i, p)| param_info(prog, &p.name, p.default, &format!("{struct_name}::RANGES[{i}]"), p.span, &sch.name))
+        .map(|(i, p)| descriptors::param(p, &format!("{struct_name}::RANGES[{i}]")))
         .collect();
     let unit = format!(
         "SchemeUnit {{ name: {:?}, doc: {:?}, params: &[{}], desc: &{struct_name}::DESC, make: {make} }}",
