@@ -178,10 +178,10 @@ fn step_cuts(s: &str) -> Result<usize, String> {
 }
 
 /// The command-line name of a runtime type's value (its serde name: `diameter`, `auto`), for
-/// clap's `[default: ...]` of the runtime's own default. clap keeps it for the program's life.
-fn name_of(value: impl serde::Serialize) -> &'static str {
+/// clap's `[default: ...]` of the runtime's own default.
+fn name_of(value: impl serde::Serialize) -> String {
     let name = serde_json::to_value(value).ok().and_then(|v| v.as_str().map(str::to_string));
-    Box::leak(name.unwrap_or_default().into_boxed_str())
+    name.unwrap_or_default()
 }
 
 /// `--energy-tolerance` (0: off) and `--tol`: a number ≥ 0.
