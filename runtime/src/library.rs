@@ -101,20 +101,23 @@ pub enum LibraryError {
     #[error(
         "{at}: form `{form}` integrates over `{region}`, which the case does not define (it defines: {defined}){hint}"
     )]
-    MissingRegion { form: &'static str, region: &'static str, at: &'static str, defined: String, hint: String },
+    MissingRegion { form: String, region: String, at: String, defined: String, hint: String },
 }
 
 impl<'m> Binding<'m> {
+    /// The facets of each of a form's boundary regions (`names`, named in the source at
+    /// `sites`).
     fn regions_of(
         &self,
-        form: &'static str,
-        names: &[(&'static str, [u32; 2])],
-        sites: &[&'static str],
+        form: &str,
+        names: &[(impl AsRef<str>, [u32; 2])],
+        sites: &[impl AsRef<str>],
     ) -> Result<Vec<(String, &'m [Facet])>, LibraryError> {
         names
             .iter()
             .enumerate()
             .map(|(k, (region, _))| {
+                let region = region.as_ref();
                 self.regions.iter().find(|(n, _)| n == region).map(|(n, f)| (n.clone(), *f)).ok_or_else(|| {
                     let defined: Vec<&str> = self.regions.iter().map(|(n, _)| n.as_str()).collect();
                     let close = defined
@@ -123,9 +126,9 @@ impl<'m> Binding<'m> {
                         .filter(|(dist, d)| *dist <= 1.max(region.len() / 3) && *dist < d.len())
                         .min();
                     LibraryError::MissingRegion {
-                        form,
-                        region,
-                        at: sites.get(k).copied().unwrap_or("(source unknown)"),
+                        form: form.to_string(),
+                        region: region.to_string(),
+                        at: sites.get(k).map_or("(source unknown)", AsRef::as_ref).to_string(),
                         defined: if defined.is_empty() { "none".into() } else { defined.join(", ") },
                         hint: close.map_or_else(String::new, |(_, d)| format!("; did you mean `{d}`?")),
                     }
@@ -136,15 +139,15 @@ impl<'m> Binding<'m> {
 
     /// A form kernel bound to this mesh.
     pub fn form<K: Kernel + 'm>(&self, kernel: K) -> Result<SlotForm<'m>, LibraryError> {
-        let meta = *kernel.meta();
-        let regions = self.regions_of(meta.name, meta.facets, meta.facet_sites)?;
+        let meta = kernel.meta();
+        let regions = self.regions_of(&meta.name, &meta.facets, &meta.facet_sites)?;
         Ok(SlotForm::Form(Box::new(Bound { kernel, quadrature: self.quadrature, regions })))
     }
 
     /// A functional kernel bound to this mesh.
     pub fn functional<K: Functional + 'm>(&self, kernel: K) -> Result<SlotForm<'m>, LibraryError> {
-        let meta = *kernel.meta();
-        let regions = self.regions_of(meta.name, meta.facets, meta.facet_sites)?;
+        let meta = kernel.meta();
+        let regions = self.regions_of(&meta.name, &meta.facets, &meta.facet_sites)?;
         Ok(SlotForm::Functional(Box::new(BoundValue { kernel, quadrature: self.quadrature, regions })))
     }
 }

@@ -167,8 +167,8 @@ impl Library {
     }
 
     /// Names of the forms and functionals, in declaration order.
-    pub fn forms(&self) -> Vec<&'static str> {
-        self.unit.forms.iter().map(|f| f.meta.name).collect()
+    pub fn forms(&self) -> Vec<&str> {
+        self.unit.forms.iter().map(|f| &*f.meta.name).collect()
     }
 
     /// The metadata of a form, as a generated form's `META`.
@@ -206,28 +206,18 @@ impl Library {
 }
 
 /// `FormMeta` as codegen builds `META`: degrees from the 2D lowering, `linear` and
-/// `piecewise` over every dimension. Its strings are leaked, once per loaded form, because
-/// `FormMeta` holds `&'static` data (it is a constant in generated code).
+/// `piecewise` over every dimension.
 fn meta(prog: &Program, irs: &[DimIr], fi: usize) -> FormMeta {
-    let leak = |s: &str| -> &'static str { Box::leak(s.to_string().into_boxed_str()) };
     let f2 = &irs[1].forms[fi];
-    let fields: Vec<&'static str> = f2.fields.iter().map(|f| leak(f)).collect();
-    let facets: Vec<(&'static str, [u32; 2])> =
-        f2.integrals.iter().filter(|i| !i.cell).map(|i| (leak(&i.region), i.degree)).collect();
-    let sites: Vec<&'static str> = f2
-        .integrals
-        .iter()
-        .filter(|i| !i.cell)
-        .map(|i| leak(&signorini_compiler::docs::region_site(prog, &f2.name, &i.region)))
-        .collect();
+    let facets = f2.integrals.iter().filter(|i| !i.cell);
     FormMeta {
-        name: leak(&f2.name),
-        fields: Box::leak(fields.into_boxed_slice()),
-        test: f2.test.as_deref().map_or("", leak),
+        name: f2.name.clone().into(),
+        fields: f2.fields.iter().map(|f| f.clone().into()).collect(),
+        test: f2.test.clone().unwrap_or_default().into(),
         linear: irs.iter().all(|ir| ir.forms[fi].linear),
         piecewise: irs.iter().all(|ir| ir.forms[fi].integrals.iter().all(|i| i.tangents.iter().all(|t| t.piecewise))),
         cell_degree: f2.integrals.iter().find(|i| i.cell).map(|i| i.degree),
-        facets: Box::leak(facets.into_boxed_slice()),
-        facet_sites: Box::leak(sites.into_boxed_slice()),
+        facets: facets.clone().map(|i| (i.region.clone().into(), i.degree)).collect(),
+        facet_sites: facets.map(|i| signorini_compiler::docs::region_site(prog, &f2.name, &i.region).into()).collect(),
     }
 }

@@ -128,7 +128,7 @@ fn compare_form_on<const D: usize, const N: usize, K: FormKernel<D, N>>(
     rng: &mut Rng,
     stats: &mut Stats,
 ) {
-    let meta = *compiled.meta();
+    let meta = compiled.meta();
     let p = kind.degree() as usize - 1;
     for trial in 0..3 {
         let x: [[f64; D]; N] = cell(kind, rng);
@@ -151,7 +151,7 @@ fn compare_form_on<const D: usize, const N: usize, K: FormKernel<D, N>>(
                 assert_eq!(c, i, "{}", what("cell switches"));
             }
         }
-        for (region, &(name, deg)) in meta.facets.iter().enumerate() {
+        for (region, (name, deg)) in meta.facets.iter().enumerate() {
             let tab = FacetTabulation::<D, N>::new(kind, deg[p]).unwrap();
             for facet in 0..tab.facets.len() {
                 let at = |part: &str| what(&format!("{part} on {name}, local facet {facet}"));
@@ -185,7 +185,7 @@ fn compare_functional_on<const D: usize, const N: usize, K: FunctionalKernel<D, 
     rng: &mut Rng,
     stats: &mut Stats,
 ) {
-    let meta = *compiled.meta();
+    let meta = compiled.meta();
     let p = kind.degree() as usize - 1;
     for trial in 0..3 {
         let x: [[f64; D]; N] = cell(kind, rng);
@@ -202,7 +202,7 @@ fn compare_functional_on<const D: usize, const N: usize, K: FunctionalKernel<D, 
                 &[interp.cell_value(&ctx, &fields)],
             );
         }
-        for (region, &(name, deg)) in meta.facets.iter().enumerate() {
+        for (region, (name, deg)) in meta.facets.iter().enumerate() {
             let tab = FacetTabulation::<D, N>::new(kind, deg[p]).unwrap();
             for (facet, (ftab, normal)) in tab.facets.iter().enumerate() {
                 let ctx = FacetCtx { tab: ftab, ref_normal: normal, coords: &x, h, t: T };
@@ -275,15 +275,15 @@ macro_rules! unit_test {
                 let c = make(&data);
                 $(
                     let compiled = $m::$F::new(&p, &c);
-                    let name = compiled.meta().name;
-                    let interp = lib.form(name, d, &values, &data.list(&lib)).unwrap();
+                    let name = compiled.meta().name.to_string();
+                    let interp = lib.form(&name, d, &values, &data.list(&lib)).unwrap();
                     compare_form(&compiled, &interp, &mut rng, &mut stats);
                     seen.push(name);
                 )*
                 $(
                     let compiled = $m::$G::new(&p, &c);
-                    let name = compiled.meta().name;
-                    let interp = lib.form(name, d, &values, &data.list(&lib)).unwrap();
+                    let name = compiled.meta().name.to_string();
+                    let interp = lib.form(&name, d, &values, &data.list(&lib)).unwrap();
                     compare_functional(&compiled, &interp, &mut rng, &mut stats);
                     seen.push(name);
                 )*

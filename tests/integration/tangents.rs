@@ -240,7 +240,7 @@ fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
     let p = contact_nitsche::Params::default().with("gamma0", 5.0).and_then(|p| p.with("nu", 0.3)).unwrap();
     let c = contact_nitsche::Coefficients { f: Coef::constant(vec![0.0; 2]), g: gap(2), nc: down(2) };
     let k = contact_nitsche::HybridContact::new(&p, &c);
-    assert_eq!(contact_nitsche::HybridContact::META.fields, &["u0", "u1"]);
+    assert_eq!(*contact_nitsche::HybridContact::META.fields, ["u0", "u1"]);
     const { assert!(!contact_nitsche::HybridContact::META.linear) };
     let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 7).unwrap();
     let x = cell_2d();

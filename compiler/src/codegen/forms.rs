@@ -15,7 +15,7 @@ pub fn form_items(prog: &Program, irs: &[&DimIr], fi: usize, sname: &str) -> Str
     let mut s = String::new();
     let form = &prog.forms[fi];
     let ir2 = &irs[1].forms[fi];
-    let fields: Vec<String> = form.fields.iter().map(|f| format!("{:?}", f.name)).collect();
+    let fields: Vec<String> = form.fields.iter().map(|f| format!("Borrowed({:?})", f.name)).collect();
     let sig = format!(
         "{} {}({}{})",
         if form.test.is_some() { "form" } else { "functional" },
@@ -45,17 +45,17 @@ pub fn form_items(prog: &Program, irs: &[&DimIr], fi: usize, sname: &str) -> Str
         .integrals
         .iter()
         .filter(|i| !i.cell)
-        .map(|i| format!("({:?}, [{}, {}])", i.region, i.degree[0], i.degree[1]))
+        .map(|i| format!("(Borrowed({:?}), [{}, {}])", i.region, i.degree[0], i.degree[1]))
         .collect();
     let sites: Vec<String> = ir2
         .integrals
         .iter()
         .filter(|i| !i.cell)
-        .map(|i| format!("{:?}", crate::docs::region_site(prog, &form.name, &i.region)))
+        .map(|i| format!("Borrowed({:?})", crate::docs::region_site(prog, &form.name, &i.region)))
         .collect();
     let _ = writeln!(
         s,
-        "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: {:?}, fields: &[{}], test: {:?}, linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: &[{}], facet_sites: &[{}] }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }}\n{} }}",
+        "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: Borrowed({:?}), fields: Borrowed(&[{}]), test: Borrowed({:?}), linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: Borrowed(&[{}]), facet_sites: Borrowed(&[{}]) }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }}\n{} }}",
         form.name,
         fields.join(", "),
         form.test.as_ref().map_or("", |t| t.name.as_str()),

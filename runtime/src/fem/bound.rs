@@ -60,7 +60,7 @@ impl<K: Kernel> Bound<'_, K> {
 
 impl<K: Kernel> BoundForm for Bound<'_, K> {
     fn name(&self) -> &str {
-        self.kernel.meta().name
+        &self.kernel.meta().name
     }
     fn fields(&self) -> usize {
         self.kernel.meta().fields.len()
@@ -175,7 +175,7 @@ pub struct BoundValue<'m, K: Functional> {
 
 impl<K: Functional> BoundFunctional for BoundValue<'_, K> {
     fn name(&self) -> &str {
-        self.kernel.meta().name
+        &self.kernel.meta().name
     }
     fn fields(&self) -> usize {
         self.kernel.meta().fields.len()

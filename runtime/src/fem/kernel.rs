@@ -9,6 +9,8 @@
 use std::fmt;
 use std::sync::Arc;
 
+use signorini_descriptors::{List, Text};
+
 use crate::fem::element::ElementKind;
 use crate::fem::quadrature::{Rule, simplex_rule};
 
@@ -236,12 +238,13 @@ pub fn check_coef(name: &str, coef: &Coef, shape_rank: u32, dim: usize) -> Resul
     Ok(())
 }
 
-/// Static description of a compiled form.
-#[derive(Debug, Clone, Copy)]
+/// Static description of a compiled form: constant in generated code, built by a form
+/// interpreted at run time.
+#[derive(Debug, Clone, PartialEq)]
 pub struct FormMeta {
-    pub name: &'static str,
-    pub fields: &'static [&'static str],
-    pub test: &'static str,
+    pub name: Text,
+    pub fields: List<Text>,
+    pub test: Text,
     /// The tangent does not depend on the fields: assemble it once.
     pub linear: bool,
     /// The tangent depends on the fields only through the switches (the active set).
@@ -249,10 +252,10 @@ pub struct FormMeta {
     /// Suggested cell quadrature degree for P1 and P2, if the form has a volume integral.
     pub cell_degree: Option<[u32; 2]>,
     /// Boundary regions with suggested facet quadrature degrees for P1 and P2.
-    pub facets: &'static [(&'static str, [u32; 2])],
+    pub facets: List<(Text, [u32; 2])>,
     /// Where each of `facets` is named in the source (`file.wf:line:col` of `int(NAME)`), for
     /// errors when a case does not define the region.
-    pub facet_sites: &'static [&'static str],
+    pub facet_sites: List<Text>,
 }
 
 /// Implemented by every generated form.

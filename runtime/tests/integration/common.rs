@@ -1,6 +1,7 @@
 //! A form written by hand against the kernel interface, so the runtime is tested without the
 //! compiler: ∫ ρ u·v + k ∇u : ∇v (vector-valued, every component alike).
 
+use signorini_runtime::descriptors::Borrowed;
 use signorini_runtime::fem::geometry::{gradient, interpolate, jacobian, physical_gradients};
 use signorini_runtime::fem::kernel::{CellCtx, Form, FormKernel, FormMeta, LocalMatrix, LocalVector};
 
@@ -10,14 +11,14 @@ pub struct MassStiffness {
 }
 
 const META: FormMeta = FormMeta {
-    name: "mass_stiffness",
-    fields: &["u"],
-    test: "v",
+    name: Borrowed("mass_stiffness"),
+    fields: Borrowed(&[Borrowed("u")]),
+    test: Borrowed("v"),
     linear: true,
     piecewise: false,
     cell_degree: Some([2, 4]),
-    facets: &[],
-    facet_sites: &[],
+    facets: Borrowed(&[]),
+    facet_sites: Borrowed(&[]),
 };
 
 impl Form for MassStiffness {
