@@ -4,8 +4,8 @@
 //! module gives its rows and summary typed fields. The obstacle's normal is the vertical axis,
 //! y in 2D and z in 3D: the fields `u_vertical_*`, `v_vertical_mean` and `f_vertical_contact`
 //! of [`Row`] hold that component, read from the columns the file names after its axis
-//! (`uy_mean`, `fy_contact` for the disc; `uz_mean`, `fz_contact` for the sphere). Both library
-//! files name their summary key `min_uy_mean`. Its runs take the driver's [`Options`]; the mesh
+//! (`uy_mean`, `fy_contact` and the summary key `min_uy_mean` for the disc; `uz_mean`,
+//! `fz_contact` and `min_uz_mean` for the sphere). Its runs take the driver's [`Options`]; the mesh
 //! size of the built-in generator is the problem's param `h`.
 
 use serde::{Deserialize, Serialize};
@@ -159,7 +159,7 @@ fn from_problem(opts: &Options, run: &crate::problem::run::Run) -> Result<Run, C
         cells: count(s, "cells"),
         first_contact: s.number("first_contact"),
         max_penetration: number(s, "max_penetration"),
-        min_u_vertical_mean: number(s, "min_uy_mean"),
+        min_u_vertical_mean: number(s, &format!("min_u{a}_mean")),
         energy_aug_initial: number(s, "energy_aug_initial"),
         energy_aug_final: number(s, "energy_aug_final"),
         kinetic_energy_max: number(s, "kinetic_energy_max"),
