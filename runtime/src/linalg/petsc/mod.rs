@@ -59,13 +59,13 @@ fn call(function: &'static str, code: sys::PetscErrorCode) -> Result<(), LinalgE
     Err(LinalgError::Petsc { function, code, message })
 }
 
-/// Options given before PETSc starts (`--petsc-options`), and whether it has started.
+/// Whether PETSc has started, and whether it has ended (it cannot start again).
 struct State {
-    options: Option<String>,
     started: bool,
+    finished: bool,
 }
 
-static STATE: Mutex<State> = Mutex::new(State { options: None, started: false });
+static STATE: Mutex<State> = Mutex::new(State { started: false, finished: false });
 
 thread_local! {
     /// Whether this thread holds [`STATE`]'s lock (objects dropped under it must not take it
@@ -88,6 +88,9 @@ fn lock() -> Result<Held, LinalgError> {
     // A panic while holding the lock leaves PETSc's objects as they were: still usable.
     let mut state = Held(STATE.lock().unwrap_or_else(|poisoned| poisoned.into_inner()));
     HOLDING.set(true);
+    if state.0.finished {
+        return Err(LinalgError::Other("PETSc was used after it ended (finalize_petsc)".into()));
+    }
     if !state.0.started {
         let mut done: sys::PetscBool = 0;
         // SAFETY: PetscInitialized only writes the flag.
@@ -99,9 +102,6 @@ fn lock() -> Result<Held, LinalgError> {
         // SAFETY: the handler has PETSc's handler signature and keeps no context.
         call("PetscPushErrorHandler", unsafe { sys::PetscPushErrorHandler(record_error, std::ptr::null_mut()) })?;
         state.0.started = true;
-        if let Some(options) = state.0.options.take() {
-            insert_options(&options)?;
-        }
     }
     Ok(state)
 }
@@ -126,14 +126,16 @@ pub fn finalize() -> Result<(), LinalgError> {
     if let Some(state) = state.as_mut() {
         // SAFETY: PETSc started and, the caller says, none of its objects is used again.
         call("PetscFinalize", unsafe { sys::PetscFinalize() })?;
-        state.0.started = false;
+        state.0.finished = true;
     }
     Ok(())
 }
 
 fn lock_if_started() -> Result<Option<Held>, LinalgError> {
-    let started = STATE.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).started;
-    if started { lock().map(Some) } else { Ok(None) }
+    let state = STATE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let (started, finished) = (state.started, state.finished);
+    drop(state);
+    if started && !finished { lock().map(Some) } else { Ok(None) }
 }
 
 /// Each process solves its own systems: the solver lives on `MPI_COMM_SELF`.
