@@ -30,3 +30,13 @@ pub fn install() {
 pub fn requested() -> bool {
     REQUESTED.load(Ordering::SeqCst)
 }
+
+/// Whether a stop was asked for on any process of the run (collective: the processes of an MPI
+/// run stop after the same step, though the signal may reach them one by one).
+pub fn agreed() -> Result<bool, crate::runtime::linalg::LinalgError> {
+    let any = crate::runtime::linalg::ranks::any(requested())?;
+    if any {
+        REQUESTED.store(true, Ordering::SeqCst);
+    }
+    Ok(any)
+}

@@ -7,7 +7,7 @@ use super::fail;
 
 pub(super) fn assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) -> ExitCode {
     if sizes.iter().any(|&n| n == 0 || n > 2048) {
-        eprintln!("error: --sizes must lie in 1..=2048");
+        eprintln!("{}: --sizes must lie in 1..=2048", super::error_prefix());
         return ExitCode::FAILURE;
     }
     // The P2 plane-strain unknowns of the N×N mesh, 2 (2N + 1)², against the memory there is,
@@ -38,7 +38,7 @@ pub(super) fn disc(meshes: &[PathBuf], repeats: usize, out: &Path) -> ExitCode {
     let report = match crate::bench::disc::disc(meshes, repeats, &mut |line| println!("{line}")) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("{}: {e}", super::error_prefix());
             return ExitCode::FAILURE;
         }
     };
@@ -53,7 +53,7 @@ fn write_bench(path: &Path, report: &impl serde::Serialize) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: cannot write {}: {e}", path.display());
+            eprintln!("{}: cannot write {}: {e}", super::error_prefix(), path.display());
             ExitCode::FAILURE
         }
     }

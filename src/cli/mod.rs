@@ -62,6 +62,11 @@ static FORCE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 /// The directory a run writes to (see `output::prepare`), announced when it is not `--out`.
 pub(super) fn out_dir(out: Option<PathBuf>) -> Result<Option<PathBuf>, String> {
     let Some(dir) = out else { return Ok(None) };
+    // In a run of several processes, rank 0 writes the results (and alone prepares their
+    // directory).
+    if !crate::runtime::linalg::ranks::writes() {
+        return Ok(None);
+    }
     let (dir, note) = crate::output::prepare(&dir, FORCE.get().copied().unwrap_or(false))?;
     if let Some(note) = note {
         eprintln!("note: {note}");
@@ -69,9 +74,25 @@ pub(super) fn out_dir(out: Option<PathBuf>) -> Result<Option<PathBuf>, String> {
     Ok(Some(dir))
 }
 
+/// How an error line starts: `error`, and which process saw it in a run of several.
+pub fn error_prefix() -> String {
+    match crate::runtime::linalg::ranks::world() {
+        (_, 1) => "error".into(),
+        (rank, size) => format!("error (rank {rank} of {size})"),
+    }
+}
+
+/// Under mpirun, the threads of each process: the cores shared among the node's processes
+/// (`--threads` chooses otherwise).
+fn threads_per_rank() -> Option<usize> {
+    let local: usize = std::env::var("OMPI_COMM_WORLD_LOCAL_SIZE").ok()?.parse().ok()?;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    (local > 1).then(|| (cores / local).max(1))
+}
+
 /// Prints an error and fails.
 pub(super) fn fail(e: impl std::fmt::Display) -> ExitCode {
-    eprintln!("error: {e}");
+    eprintln!("{}: {e}", error_prefix());
     ExitCode::FAILURE
 }
 
@@ -82,10 +103,10 @@ pub fn run(cli: Cli) -> ExitCode {
 }
 
 fn dispatch(cli: Cli) -> ExitCode {
-    if let Some(n) = cli.threads
-        && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n as usize).build_global()
+    if let Some(n) = cli.threads.map(|n| n as usize).or_else(threads_per_rank)
+        && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global()
     {
-        eprintln!("error: cannot start {n} threads: {e}");
+        eprintln!("{}: cannot start {n} threads: {e}", error_prefix());
         return ExitCode::FAILURE;
     }
     match cli.command {
@@ -106,7 +127,7 @@ fn dispatch(cli: Cli) -> ExitCode {
         Command::Run { file: Some(problem), args } => run::problem(&problem.to_string_lossy(), *args),
         Command::Run { file: None, .. } => {
             let names = crate::problem::library_names().join(", ");
-            eprintln!("error: name a problem ({names}), a problem file or a case file");
+            eprintln!("{}: name a problem ({names}), a problem file or a case file", error_prefix());
             ExitCode::FAILURE
         }
         Command::Mesh { command: MeshCommand::Info { file } } => files::mesh_info(&file),
@@ -132,7 +153,7 @@ fn report(out: PathBuf, quick: bool) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("{}: {e}", error_prefix());
             ExitCode::FAILURE
         }
     }

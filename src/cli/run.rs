@@ -149,7 +149,7 @@ pub(super) fn case_file(file: &Path) -> ExitCode {
             finish(crate::problem::run::run(&opts))
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("{}: {e}", super::error_prefix());
             ExitCode::FAILURE
         }
     }

@@ -192,6 +192,14 @@ fn simulate(
         identity(opts, pf, params, in_use, &mesh, times),
         opts.resume,
     )?;
+    // In a run of several processes each holds the whole state and takes the same steps; rank 0
+    // writes the results and checkpoints (which any number of processes resumes), the others
+    // only read a checkpoint they resume.
+    let writes = crate::runtime::linalg::ranks::writes();
+    let out = if writes { opts.out.clone() } else { None };
+    if !writes {
+        control.dir = None;
+    }
     // A static problem is one equilibrium, from u₀ (no initial acceleration to solve for): it
     // binds the operators, and no stepper.
     let statics = p.run_static.is_some();
@@ -250,7 +258,7 @@ fn simulate(
         ((t, values), switches)
     };
     let name = pf.name().to_string();
-    let mut snapshots = Snapshots::new(opts.out.as_ref(), opts.vtu_every, &name);
+    let mut snapshots = Snapshots::new(out.as_ref(), opts.vtu_every, &name);
     let (series, switches, iterations, stage_rows, outcome, counters, steps, last) = match &mut runner {
         Runner::Static(ops) => {
             // One equilibrium by the static driver: its single row is the solution.
@@ -342,7 +350,7 @@ fn simulate(
                 t0,
                 times.dt,
                 steps,
-                opts.progress,
+                opts.progress && writes,
                 &mut control,
                 &mut |ops, stage, v_index| {
                     if let Some(u) = stage.value_of(&names[0]) {
@@ -468,7 +476,7 @@ fn simulate(
     }
     summary.own = own.into_iter().map(|(k, _)| k).collect();
     let run = Run { summary, columns, rows: series, switches, stages: stage_rows };
-    if let Some(dir) = &opts.out {
+    if let Some(dir) = &out {
         write_outputs(dir, pf, &run, &shown)?;
         // The reference's figures of the last state (Hertz's pressure profile).
         observer

@@ -327,7 +327,7 @@ impl<'m> Simulation<'m> {
                 let t_end = if done == full { t0 + (k + 1) as f64 * dt } else { t + h };
                 // A checkpoint after the last step would resume nothing.
                 let periodic = control.every > 0 && (k + 1).is_multiple_of(control.every) && k + 1 < steps;
-                let interrupted = crate::interrupt::requested();
+                let interrupted = crate::interrupt::agreed().map_err(|e| CaseError::Option(format!("MPI: {e}")))?;
                 // With periodic checkpoints an interrupt keeps the last one, which resumes bit
                 // for bit; without, it writes one of its own (which resumes to round-off).
                 let on_interrupt = interrupted && control.every == 0;

@@ -74,7 +74,7 @@ pub fn solve<'m>(
     // `--solver auto` factorizes here: without a mass term, Jacobi-CG on the stiffness alone
     // converges slowly (the threshold of `auto` is measured on time steps).
     let mut options = problem.newton;
-    if options.solver == crate::runtime::linalg::Solver::Auto {
+    if options.solver == crate::runtime::linalg::Solver::Auto && !options.solver.petsc() {
         options.solver = crate::runtime::linalg::Solver::Direct;
     }
     let mut newton = Newton::new(options);

@@ -17,6 +17,8 @@ mod import_circles;
 mod interpreted_forms;
 mod interpreted_schemes;
 #[cfg(feature = "petsc")]
+mod mpi;
+#[cfg(feature = "petsc")]
 mod petsc;
 mod problems;
 mod redistribution;

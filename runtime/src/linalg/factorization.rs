@@ -108,8 +108,9 @@ fn diagonal_inverse(a: &Matrix, structure: Structure) -> Result<Option<Vec<f64>>
 
 /// How a `Factorization` solves: a sparse direct factorization, preconditioned Krylov
 /// iterations (conjugate gradients for SPD matrices, BiCGStab otherwise; memory of the matrix
-/// only), by size: direct in 1D, iterative above [`AUTO_ITERATIVE_DOFS`] unknowns in 2D and 3D;
-/// or PETSc's Krylov solvers with algebraic multigrid (feature `petsc`).
+/// only), by size: direct in 1D, iterative above [`AUTO_ITERATIVE_DOFS`] unknowns in 2D and 3D
+/// (PETSc in a run of several processes); or PETSc's Krylov solvers with algebraic multigrid
+/// (feature `petsc`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Solver {
@@ -142,6 +143,12 @@ impl Solver {
         }
     }
 
+    /// Whether PETSc solves: when chosen, and by default in a run of several processes (which
+    /// PETSc solves together).
+    pub fn petsc(self) -> bool {
+        self == Solver::Petsc || (self == Solver::Auto && crate::linalg::ranks::world().1 > 1)
+    }
+
     /// Whether a system of `n` unknowns in dimension `dim` is solved iteratively.
     pub fn iterates(self, n: usize, dim: usize) -> bool {
         match self {
@@ -149,7 +156,7 @@ impl Solver {
             Solver::Iterative | Solver::Petsc => true,
             // In 1D the matrix is banded: its factor does not fill, and a direct solve is always
             // the cheaper (100 001 unknowns of the bar: 48.8 s for two steps by Jacobi-CG).
-            Solver::Auto => dim > 1 && n > AUTO_ITERATIVE_DOFS[if dim >= 3 { 0 } else { 1 }],
+            Solver::Auto => self.petsc() || (dim > 1 && n > AUTO_ITERATIVE_DOFS[if dim >= 3 { 0 } else { 1 }]),
         }
     }
 }
@@ -239,7 +246,7 @@ impl Factorization {
             self.pattern = None;
             return Ok(());
         }
-        if self.solver == Solver::Petsc {
+        if self.solver.petsc() {
             return self.factor_petsc(a);
         }
         if self.solver.iterates(n, a.pattern.dim()) {

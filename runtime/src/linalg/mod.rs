@@ -16,6 +16,7 @@ pub mod norms;
 pub mod pattern;
 #[cfg(feature = "petsc")]
 pub mod petsc;
+pub mod ranks;
 
 pub use factorization::{AUTO_ITERATIVE_DOFS, Counters, Factorization, Solver, Structure};
 pub use matrix::{LinalgError, Matrix};

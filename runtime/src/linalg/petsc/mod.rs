@@ -8,6 +8,7 @@
 //! printing), so that no PETSc error aborts the process. PETSc is not thread-safe: every
 //! operation holds one process-wide lock ([`lock`]).
 
+pub mod ranks;
 mod sys;
 
 use std::cell::{Cell, RefCell};
@@ -138,7 +139,11 @@ fn lock_if_started() -> Result<Option<Held>, LinalgError> {
     if started && !finished { lock().map(Some) } else { Ok(None) }
 }
 
-/// Each process solves its own systems: the solver lives on `MPI_COMM_SELF`.
+/// The processes that solve a system together: all of an `mpirun` launch, or this one alone.
+fn comm() -> sys::MPI_Comm {
+    if ranks::distributed() { ranks::comm_world() } else { comm_self() }
+}
+
 fn comm_self() -> sys::MPI_Comm {
     // Only the address of Open MPI's predefined communicator is taken (no read of the static).
     (&raw const sys::ompi_mpi_comm_self).cast_mut().cast()
@@ -171,6 +176,10 @@ handle!(OwnedMat, sys::Mat, MatDestroy);
 handle!(OwnedVec, sys::Vec, VecDestroy);
 handle!(OwnedKsp, sys::KSP, KSPDestroy);
 handle!(OwnedNullSpace, sys::MatNullSpace, MatNullSpaceDestroy);
+handle!(OwnedScatter, sys::VecScatter, VecScatterDestroy);
+
+mod layout;
+use layout::Layout;
 
 impl OwnedVec {
     /// Runs `f` on the vector's values.
@@ -196,8 +205,24 @@ pub struct PetscSolver {
     /// The values PETSc holds: the same values again keep the preconditioner (whose setup,
     /// GAMG's, costs many solves).
     values: Vec<f64>,
+    /// Across processes: the split, and what gathers the solution on every process.
+    split: Option<Split>,
     /// Krylov iterations of the last solve.
     pub iterations: usize,
+}
+
+/// A system solved across processes. Every process holds the whole matrix and right-hand side
+/// (it assembled them); it gives PETSc its own rows, and receives the whole solution.
+struct Split {
+    layout: Arc<Layout>,
+    /// The indices in the matrix's values of this process's entries, in the order PETSc was
+    /// given them.
+    picked: Vec<usize>,
+    /// Their values.
+    buffer: Vec<f64>,
+    gather: OwnedScatter,
+    /// The whole solution, in PETSc's numbering.
+    all: OwnedVec,
 }
 
 // SAFETY: the PETSc objects are owned by this value alone, and every PETSc call holds the
@@ -213,23 +238,47 @@ impl PetscSolver {
         let _petsc = lock()?;
         let n = a.size();
         let size = petsc_int(n)?;
-        let comm = comm_self();
+        let comm = comm();
+        let layout = match ranks::distributed() {
+            true => {
+                let (rank, count) = ranks::world();
+                Some(Layout::of(&a.pattern, rank, count)?)
+            }
+            false => None,
+        };
+        let local_n = layout.as_ref().map_or(n, |l| l.mine.len());
+        let local = petsc_int(local_n)?;
         let mut matrix = OwnedMat(std::ptr::null_mut());
         // SAFETY: PETSc is initialized; each call gets valid handles and writes only its out
         // parameters.
         unsafe {
             call("MatCreate", sys::MatCreate(comm, &mut matrix.0))?;
-            call("MatSetSizes", sys::MatSetSizes(matrix.0, size, size, size, size))?;
+            call("MatSetSizes", sys::MatSetSizes(matrix.0, local, local, size, size))?;
             call("MatSetType", sys::MatSetType(matrix.0, c"aij".as_ptr()))?;
             call("MatSetBlockSize", sys::MatSetBlockSize(matrix.0, petsc_int(a.pattern.dim())?))?;
         }
         let p = &a.pattern;
         let mut rows = Vec::with_capacity(p.nnz());
         let mut cols = Vec::with_capacity(p.nnz());
+        let mut picked = Vec::new();
         for j in 0..n {
-            for &i in &p.row_idx[p.col_ptr[j]..p.col_ptr[j + 1]] {
-                rows.push(petsc_int(i)?);
-                cols.push(petsc_int(j)?);
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[k];
+                match &layout {
+                    // This process's rows only, in PETSc's numbering.
+                    Some(l) => {
+                        let row = l.to_petsc[i] as usize;
+                        if (l.first..l.first + local_n).contains(&row) {
+                            rows.push(l.to_petsc[i]);
+                            cols.push(l.to_petsc[j]);
+                            picked.push(k);
+                        }
+                    }
+                    None => {
+                        rows.push(petsc_int(i)?);
+                        cols.push(petsc_int(j)?);
+                    }
+                }
             }
         }
         // SAFETY: `rows` and `cols` hold nnz indices each (PETSc copies them).
@@ -255,11 +304,14 @@ impl PetscSolver {
             // SAFETY: a vector of the coordinates' length with block size `dim`.
             unsafe {
                 call("VecCreate", sys::VecCreate(comm, &mut vec.0))?;
-                call("VecSetSizes", sys::VecSetSizes(vec.0, size, size))?;
+                call("VecSetSizes", sys::VecSetSizes(vec.0, local, size))?;
                 call("VecSetBlockSize", sys::VecSetBlockSize(vec.0, petsc_int(dim)?))?;
                 call("VecSetFromOptions", sys::VecSetFromOptions(vec.0))?;
             }
-            vec.with_values(n, |v| v.copy_from_slice(coords))?;
+            vec.with_values(local_n, |v| match &layout {
+                Some(l) => v.iter_mut().zip(&l.mine).for_each(|(x, &dof)| *x = coords[dof]),
+                None => v.copy_from_slice(coords),
+            })?;
             let mut space = OwnedNullSpace(std::ptr::null_mut());
             // SAFETY: the matrix keeps its own reference to the null space.
             unsafe {
@@ -287,8 +339,28 @@ impl PetscSolver {
             call("KSPSetTolerances", sys::KSPSetTolerances(ksp.0, rtol, 0.0, sys::PETSC_DEFAULT, 10_000))?;
             call("KSPSetFromOptions", sys::KSPSetFromOptions(ksp.0))?;
         }
-        let mut solver =
-            PetscSolver { ksp, matrix, rhs, solution, pattern: a.pattern.clone(), values: Vec::new(), iterations: 0 };
+        let split = match layout {
+            Some(layout) => {
+                let (mut gather, mut all) = (OwnedScatter(std::ptr::null_mut()), OwnedVec(std::ptr::null_mut()));
+                // SAFETY: a scatter from the distributed solution to a whole copy on each process.
+                call("VecScatterCreateToAll", unsafe {
+                    sys::VecScatterCreateToAll(solution.0, &mut gather.0, &mut all.0)
+                })?;
+                let buffer = vec![0.0; picked.len()];
+                Some(Split { layout, picked, buffer, gather, all })
+            }
+            None => None,
+        };
+        let mut solver = PetscSolver {
+            ksp,
+            matrix,
+            rhs,
+            solution,
+            pattern: a.pattern.clone(),
+            values: Vec::new(),
+            split,
+            iterations: 0,
+        };
         solver.take_values(a)?;
         Ok(solver)
     }
@@ -310,10 +382,17 @@ impl PetscSolver {
             return Ok(());
         }
         self.values.clone_from(&a.values);
+        let values = match &mut self.split {
+            Some(s) => {
+                s.buffer.iter_mut().zip(&s.picked).for_each(|(v, &k)| *v = a.values[k]);
+                s.buffer.as_ptr()
+            }
+            None => a.values.as_ptr(),
+        };
         // SAFETY: the values are in the order of the COO indices given at creation (column by
-        // column of the same pattern), nnz of them.
+        // column of the same pattern: all of them, or this process's rows), as many.
         unsafe {
-            call("MatSetValuesCOO", sys::MatSetValuesCOO(self.matrix.0, a.values.as_ptr(), sys::INSERT_VALUES))?;
+            call("MatSetValuesCOO", sys::MatSetValuesCOO(self.matrix.0, values, sys::INSERT_VALUES))?;
             call("KSPSetOperators", sys::KSPSetOperators(self.ksp.0, self.matrix.0, self.matrix.0))?;
         }
         Ok(())
@@ -324,7 +403,11 @@ impl PetscSolver {
     pub fn solve_in_place(&mut self, b: &mut [f64]) -> Result<(), LinalgError> {
         let _petsc = lock()?;
         let n = b.len();
-        self.rhs.with_values(n, |v| v.copy_from_slice(b))?;
+        let local = self.split.as_ref().map_or(n, |s| s.layout.mine.len());
+        self.rhs.with_values(local, |v| match &self.split {
+            Some(s) => v.iter_mut().zip(&s.layout.mine).for_each(|(x, &dof)| *x = b[dof]),
+            None => v.copy_from_slice(b),
+        })?;
         let (mut its, mut reason): (sys::PetscInt, c_int) = (0, 0);
         // SAFETY: vectors and KSP created together for this size.
         unsafe {
@@ -336,7 +419,25 @@ impl PetscSolver {
         if reason <= 0 {
             return Err(diverged(reason, self.iterations));
         }
-        self.solution.with_values(n, |x| b.copy_from_slice(x))?;
+        match &mut self.split {
+            Some(s) => {
+                // SAFETY: the scatter was created from this solution vector to `all`.
+                unsafe {
+                    let (from, to) = (self.solution.0, s.all.0);
+                    call(
+                        "VecScatterBegin",
+                        sys::VecScatterBegin(s.gather.0, from, to, sys::INSERT_VALUES, sys::SCATTER_FORWARD),
+                    )?;
+                    call(
+                        "VecScatterEnd",
+                        sys::VecScatterEnd(s.gather.0, from, to, sys::INSERT_VALUES, sys::SCATTER_FORWARD),
+                    )?;
+                }
+                let to_petsc = &s.layout.to_petsc;
+                s.all.with_values(n, |x| b.iter_mut().zip(to_petsc).for_each(|(v, &p)| *v = x[p as usize]))?;
+            }
+            None => self.solution.with_values(n, |x| b.copy_from_slice(x))?,
+        }
         if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(LinalgError::Singular { index: None }) }
     }
 }

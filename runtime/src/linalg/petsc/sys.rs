@@ -1,6 +1,7 @@
 //! The part of PETSc's C API the solver calls, declared by hand for the PETSc this feature
 //! builds against (Debian's libpetsc-real3.18-dev): real double scalars, 32-bit `PetscInt`,
-//! Open MPI (whose `MPI_Comm` is a pointer). `build.rs` checks the version through pkg-config.
+//! Open MPI (whose handles are pointers to its predefined objects), and the few MPI calls the
+//! runs across processes make. `build.rs` checks the version through pkg-config.
 
 // Names as in C.
 #![allow(non_camel_case_types, non_upper_case_globals, clippy::upper_case_acronyms)]
@@ -27,7 +28,16 @@ macro_rules! opaque {
         pub type $handle = *mut $name;
     )*};
 }
-opaque!(_p_Mat => Mat, _p_Vec => Vec, _p_KSP => KSP, _p_PC => PC, _p_MatNullSpace => MatNullSpace);
+opaque!(
+    _p_Mat => Mat,
+    _p_Vec => Vec,
+    _p_KSP => KSP,
+    _p_PC => PC,
+    _p_MatNullSpace => MatNullSpace,
+    _p_PetscSF => VecScatter,
+    ompi_predefined_datatype_t => MPI_Datatype,
+    ompi_predefined_op_t => MPI_Op,
+);
 
 /// `InsertMode::INSERT_VALUES`.
 pub const INSERT_VALUES: c_int = 1;
@@ -38,6 +48,8 @@ pub const MAT_SPD: c_int = 15;
 /// `KSPNormType::KSP_NORM_UNPRECONDITIONED`, `PCSide::PC_RIGHT`.
 pub const KSP_NORM_UNPRECONDITIONED: c_int = 2;
 pub const PC_RIGHT: c_int = 1;
+/// `ScatterMode::SCATTER_FORWARD`.
+pub const SCATTER_FORWARD: c_int = 0;
 /// `PETSC_DEFAULT` for tolerances.
 pub const PETSC_DEFAULT: PetscReal = -2.0;
 
@@ -60,8 +72,24 @@ pub struct ompi_communicator_t {
 }
 
 unsafe extern "C" {
-    /// Open MPI's `MPI_COMM_SELF` is the address of this object.
+    /// Open MPI's `MPI_COMM_SELF`, `MPI_COMM_WORLD`, `MPI_INT` and `MPI_LOR` are the
+    /// addresses of these objects.
     pub static ompi_mpi_comm_self: ompi_communicator_t;
+    pub static ompi_mpi_comm_world: ompi_communicator_t;
+    pub static ompi_mpi_int: ompi_predefined_datatype_t;
+    pub static ompi_mpi_op_lor: ompi_predefined_op_t;
+
+    pub fn MPI_Comm_rank(comm: MPI_Comm, rank: *mut c_int) -> c_int;
+    pub fn MPI_Comm_size(comm: MPI_Comm, size: *mut c_int) -> c_int;
+    pub fn MPI_Allreduce(
+        send: *const c_void,
+        recv: *mut c_void,
+        count: c_int,
+        datatype: MPI_Datatype,
+        op: MPI_Op,
+        comm: MPI_Comm,
+    ) -> c_int;
+    pub fn MPI_Abort(comm: MPI_Comm, code: c_int) -> c_int;
     /// Indexed by a `KSPConvergedReason` (negative ones too: it points inside its table).
     pub static KSPConvergedReasons: *const *const c_char;
 
@@ -92,6 +120,10 @@ unsafe extern "C" {
     pub fn VecGetArray(vec: Vec, array: *mut *mut PetscScalar) -> PetscErrorCode;
     pub fn VecRestoreArray(vec: Vec, array: *mut *mut PetscScalar) -> PetscErrorCode;
     pub fn VecDestroy(vec: *mut Vec) -> PetscErrorCode;
+    pub fn VecScatterCreateToAll(vec: Vec, scatter: *mut VecScatter, all: *mut Vec) -> PetscErrorCode;
+    pub fn VecScatterBegin(scatter: VecScatter, x: Vec, y: Vec, insert: c_int, mode: c_int) -> PetscErrorCode;
+    pub fn VecScatterEnd(scatter: VecScatter, x: Vec, y: Vec, insert: c_int, mode: c_int) -> PetscErrorCode;
+    pub fn VecScatterDestroy(scatter: *mut VecScatter) -> PetscErrorCode;
 
     pub fn KSPCreate(comm: MPI_Comm, ksp: *mut KSP) -> PetscErrorCode;
     pub fn KSPSetOperators(ksp: KSP, a: Mat, p: Mat) -> PetscErrorCode;

@@ -1,0 +1,100 @@
+//! How a system is split across processes: its nodes are partitioned (METIS, on the graph of
+//! the matrix's node blocks) and renumbered so that each process owns a contiguous range of
+//! PETSc's rows, a node's dofs staying together.
+
+use std::sync::{Arc, Mutex, Weak};
+
+use super::{petsc_int, sys};
+use crate::linalg::LinalgError;
+use crate::linalg::pattern::Pattern;
+
+pub(super) struct Layout {
+    /// PETSc's index of each dof.
+    pub(super) to_petsc: Vec<sys::PetscInt>,
+    /// The dofs this process owns, in PETSc's order: PETSc's rows `first..first + mine.len()`.
+    pub(super) mine: Vec<usize>,
+    pub(super) first: usize,
+}
+
+/// The last pattern split and its layout: a solver built again for the same matrix (a new
+/// time step, a run resumed from a checkpoint) splits it as before, as the partitioner may not
+/// give the same parts twice.
+static LAST: Mutex<Option<(Weak<Pattern>, Arc<Layout>)>> = Mutex::new(None);
+
+impl Layout {
+    /// The layout of `pattern`: the last one, if it was for this pattern, or a new one.
+    pub(super) fn of(pattern: &Arc<Pattern>, rank: usize, size: usize) -> Result<Arc<Self>, LinalgError> {
+        let mut last = LAST.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if let Some((p, layout)) = last.as_ref()
+            && p.upgrade().is_some_and(|p| Arc::ptr_eq(&p, pattern))
+        {
+            return Ok(layout.clone());
+        }
+        let layout = Arc::new(Layout::new(pattern, rank, size)?);
+        *last = Some((Arc::downgrade(pattern), layout.clone()));
+        Ok(layout)
+    }
+
+    /// Partitions the nodes of `pattern` (blocks of `pattern.dim()` dofs) over the `size`
+    /// processes; every process calls it with the same pattern and gets the same
+    /// numbering.
+    fn new(pattern: &Pattern, rank: usize, size: usize) -> Result<Self, LinalgError> {
+        let dim = pattern.dim().max(1);
+        let n = pattern.col_ptr.len() - 1;
+        if !n.is_multiple_of(dim) {
+            return Err(LinalgError::Other(format!("{n} unknowns are not blocks of {dim}: cannot split them by node")));
+        }
+        let nodes = n / dim;
+        let owner = partition(pattern, dim, nodes, size)?;
+        let mut to_petsc = vec![0; n];
+        let (mut next, mut mine, mut first) = (0usize, Vec::new(), 0);
+        for r in 0..size {
+            if r == rank {
+                first = next * dim;
+            }
+            for node in (0..nodes).filter(|&node| owner[node] == r) {
+                for c in 0..dim {
+                    to_petsc[node * dim + c] = petsc_int(next * dim + c)?;
+                    if r == rank {
+                        mine.push(node * dim + c);
+                    }
+                }
+                next += 1;
+            }
+        }
+        Ok(Layout { to_petsc, mine, first })
+    }
+}
+
+/// The process that owns each node: METIS's partition into `size` parts of the graph whose
+/// edges join nodes coupled in the matrix. Every process computes it alone, from its own copy of
+/// the pattern: METIS's seed is fixed, so each gets the same parts on every run (PT-Scotch's
+/// partition across processes, PETSc's, changed from run to run, and with it the bits).
+fn partition(pattern: &Pattern, dim: usize, nodes: usize, size: usize) -> Result<Vec<usize>, LinalgError> {
+    let index = |i: usize| {
+        metis::Idx::try_from(i).map_err(|_| LinalgError::Other(format!("{i} nodes are too many for METIS's indices")))
+    };
+    let mut offsets = Vec::with_capacity(nodes + 1);
+    let mut neighbours = Vec::new();
+    offsets.push(0);
+    for node in 0..nodes {
+        let col = node * dim;
+        let rows = &pattern.row_idx[pattern.col_ptr[col]..pattern.col_ptr[col + 1]];
+        let mut last = usize::MAX;
+        // Rows are sorted: their nodes come in order, each kept once.
+        for other in rows.iter().map(|&i| i / dim) {
+            if other != node && other != last {
+                neighbours.push(index(other)?);
+            }
+            last = other;
+        }
+        offsets.push(index(neighbours.len())?);
+    }
+    let failed = |e: &dyn std::fmt::Display| LinalgError::Other(format!("METIS cannot split the matrix's graph: {e}"));
+    let mut part = vec![0; nodes];
+    metis::Graph::new(1, index(size)?, &offsets, &neighbours)
+        .map_err(|e| failed(&e))?
+        .part_kway(&mut part)
+        .map_err(|e| failed(&e))?;
+    Ok(part.into_iter().map(|p| p.max(0) as usize).collect())
+}

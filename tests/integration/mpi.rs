@@ -1,0 +1,142 @@
+//! Runs under `mpirun` (feature `petsc`): the disc and the sphere through their first impact on
+//! 1, 2 and 3 processes agree with the serial direct run to 1e-8 of each column's scale; a run
+//! resumed from its checkpoint on the same 2 processes has the bits of the uninterrupted one; a
+//! process that fails, alone or with the others, ends them all with its message.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_signorini");
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("signorini-mpi-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// `mpirun` with `ranks` processes of `signorini ARGS` (several programs: `ARGS : ARGS`), its exit
+/// status and stderr; killed (and failed) if it has not ended after `limit`.
+fn mpirun(ranks: usize, args: &[&str], limit: Duration) -> (bool, String) {
+    let mut command = Command::new("mpirun");
+    command.args(["--allow-run-as-root", "--oversubscribe", "-n", &ranks.to_string(), BIN]);
+    for a in args {
+        // A second program of the launch: `: -n 1 signorini ...`.
+        if *a == ":" {
+            command.args([":", "-n", "1", BIN]);
+        } else {
+            command.arg(a);
+        }
+    }
+    let stderr = std::env::temp_dir().join(format!("signorini-mpi-{}-{ranks}.err", std::process::id()));
+    let file = std::fs::File::create(&stderr).expect("a file for stderr");
+    let mut child =
+        command.stdout(Stdio::null()).stderr(file).spawn().expect("mpirun runs (apt-get install openmpi-bin)");
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("mpirun's status") {
+            break status;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!(
+                "mpirun -n {ranks} {args:?} still ran after {limit:?}: {}",
+                std::fs::read_to_string(&stderr).unwrap_or_default()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let text = std::fs::read_to_string(&stderr).unwrap_or_default();
+    let _ = std::fs::remove_file(&stderr);
+    (status.success(), text)
+}
+
+fn series(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(dir.join("series.csv")).expect("a series");
+    let mut lines = text.lines();
+    let header = lines.next().expect("a header").split(',').map(str::to_string).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect()).collect();
+    (header, rows)
+}
+
+/// Every column of `run ARGS` on 1, 2 and 3 processes (PETSc's solvers) against the serial direct
+/// run, to 1e-8 of the column's largest value.
+fn agree(args: &[&str], name: &str) {
+    let root = scratch(name);
+    let direct = root.join("direct");
+    let out = Command::new(BIN)
+        .args(["run"])
+        .args(args)
+        .args(["--solver", "direct", "--out"])
+        .arg(&direct)
+        .output()
+        .expect("the binary runs");
+    assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+    let (header, reference) = series(&direct);
+    for ranks in 1..=3 {
+        let dir = root.join(format!("ranks-{ranks}"));
+        let run: Vec<&str> = [&["run"], args, &["--solver", "petsc", "--out", dir.to_str().unwrap()]].concat();
+        let (ok, err) = mpirun(ranks, &run, Duration::from_secs(600));
+        assert!(ok, "{name} on {ranks} processes: {err}");
+        let (_, rows) = series(&dir);
+        assert_eq!(rows.len(), reference.len(), "{name} on {ranks}: as many rows");
+        for (c, column) in header.iter().enumerate() {
+            let scale = reference.iter().map(|r| r[c].abs()).filter(|v| v.is_finite()).fold(0.0, f64::max);
+            for (d, p) in reference.iter().zip(&rows) {
+                let (d, p) = (d[c], p[c]);
+                assert!(
+                    (d.is_nan() && p.is_nan()) || (d - p).abs() <= 1e-8 * scale.max(f64::MIN_POSITIVE),
+                    "{name} on {ranks} processes: {column} {p} against {d} (scale {scale:e})"
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn the_disc_on_one_two_and_three_processes_agrees_with_the_serial_run() {
+    agree(&["disc", "--t-start", "6", "--t-end", "8"], "disc");
+}
+
+#[test]
+fn the_sphere_on_one_two_and_three_processes_agrees_with_the_serial_run() {
+    agree(&["sphere", "--t-start", "6.3", "--t-end", "6.45"], "sphere");
+}
+
+#[test]
+fn a_run_resumed_on_the_same_two_processes_has_the_bits_of_an_uninterrupted_one() {
+    let root = scratch("resume");
+    let dir = root.join("run");
+    let d = dir.to_str().unwrap();
+    let run = ["run", "disc", "--t-start", "6", "--t-end", "8", "--checkpoint-every", "40"];
+    let (ok, err) = mpirun(2, &[&run[..], &["--out", d]].concat(), Duration::from_secs(300));
+    assert!(ok, "{err}");
+    let full = std::fs::read(dir.join("series.csv")).expect("a series");
+    assert!(dir.join("checkpoint.bin").is_file(), "a checkpoint after step 80");
+    // From the checkpoint after step 80: the last 20 steps again, on every process.
+    let (ok, err) = mpirun(2, &[&run[..], &["--resume", d]].concat(), Duration::from_secs(300));
+    assert!(ok, "{err}");
+    assert!(std::fs::read(dir.join("series.csv")).expect("a series") == full, "the resumed series differs");
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn a_process_that_fails_alone_ends_every_process_with_its_message() {
+    // The second process is given a problem that does not exist; the first runs on into its
+    // first solve, where it would wait for the second forever.
+    let args = ["run", "disc", "--t-start", "6", "--t-end", "8", ":", "run", "no_such_problem"];
+    let (ok, err) = mpirun(1, &args, Duration::from_secs(120));
+    assert!(!ok, "the launch failed");
+    assert!(err.contains("error (rank 1 of 2)") && err.contains("no_such_problem"), "{err}");
+}
+
+#[test]
+fn a_failure_on_every_process_ends_them_all_with_the_message() {
+    // Two Krylov iterations cannot solve a step: Newton fails at every halving of the step.
+    let args = ["run", "disc", "--t-start", "6", "--t-end", "6.2", "--petsc-options", "-ksp_max_it 2"];
+    let (ok, err) = mpirun(2, &args, Duration::from_secs(300));
+    assert!(!ok, "the run failed");
+    assert!(err.contains("error (rank 0 of 2)") && err.contains("did not converge"), "{err}");
+}
