@@ -32,7 +32,7 @@ fn main() -> std::process::ExitCode {
         ranks::abort(1);
     }
     if let Err(e) = signorini::runtime::linalg::finalize_petsc() {
-        eprintln!("{}: {e}", signorini::cli::error_prefix());
+        signorini::cli::print_error(e);
         return std::process::ExitCode::FAILURE;
     }
     code

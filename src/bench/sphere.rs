@@ -55,6 +55,43 @@ pub struct SphereTiming {
     pub dt: Option<f64>,
     #[serde(default)]
     pub t_end: Option<f64>,
+    /// PETSc's runs: the cost model of a step's Krylov solves (see [`Model`]).
+    #[serde(default)]
+    pub model: Option<Model>,
+}
+
+/// Fine-level matrix products per Krylov iteration of CG with GAMG at PETSc's defaults: CG's
+/// own, the residual restricted to the next level, and the Chebyshev smoother before and after
+/// (2 iterations from a nonzero guess: 3 products each). `-log_view -pc_mg_log` on the 47k
+/// sphere agrees: the finest level's smoothing takes 3 times its residual's time per call.
+pub const PRODUCTS_PER_ITERATION: f64 = 8.0;
+
+/// A step's Krylov solves as memory traffic: each fine-level product reads the matrix (AIJ:
+/// 8-byte values, 4-byte column indices and row offsets) once, at the triad's bandwidth of as
+/// many threads as there are processes.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Model {
+    pub matrix_bytes: f64,
+    pub products_per_step: f64,
+    pub bandwidth_gb_s: f64,
+    pub model_ms_per_step: f64,
+    /// The median step over the model: what the step spends beyond reading the matrix.
+    pub measured_over_model: f64,
+}
+
+impl Model {
+    fn new(dofs: usize, nnz: usize, iterations_per_step: f64, bandwidth: f64, median_ms: f64) -> Model {
+        let matrix_bytes = 12.0 * nnz as f64 + 4.0 * (dofs + 1) as f64;
+        let products_per_step = PRODUCTS_PER_ITERATION * iterations_per_step;
+        let model_ms_per_step = 1e3 * products_per_step * matrix_bytes / bandwidth;
+        Model {
+            matrix_bytes,
+            products_per_step,
+            bandwidth_gb_s: bandwidth / 1e9,
+            model_ms_per_step,
+            measured_over_model: median_ms / model_ms_per_step,
+        }
+    }
 }
 
 fn one() -> usize {
@@ -67,12 +104,36 @@ pub struct Report {
     pub runs: Vec<SphereTiming>,
 }
 
-fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTiming, CaseError> {
+/// The command that runs `exe` on `ranks` MPI processes (itself, for one).
+fn launch(exe: &Path, ranks: usize) -> Command {
+    if ranks == 1 {
+        return Command::new(exe);
+    }
+    let mut command = Command::new("mpirun");
+    command.args(["-n", &ranks.to_string()]).arg(exe);
+    // Open MPI refuses to run as root unless told that it is meant.
+    #[cfg(unix)]
+    // SAFETY: getuid has no preconditions.
+    if unsafe { libc::getuid() } == 0 {
+        command.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+    }
+    command
+}
+
+fn run_one(
+    exe: &Path,
+    half: usize,
+    solver: &str,
+    ranks: usize,
+    bandwidth: &mut dyn FnMut(usize) -> f64,
+    dir: &Path,
+) -> Result<SphereTiming, CaseError> {
     let h = 10.0 / half as f64;
     let bench = &crate::settings::get().bench;
     let problem = &bench.sphere;
-    let out = dir.join(format!("{problem}-{}-{solver}", dofs(half)));
-    let status = Command::new(exe)
+    let label = if ranks == 1 { solver.to_string() } else { format!("{solver}-{ranks}ranks") };
+    let out = dir.join(format!("{problem}-{}-{label}", dofs(half)));
+    let status = launch(exe, ranks)
         .args(["run", problem.as_str(), "--h", &h.to_string()])
         .args(&bench.sphere_options)
         .args(["--solver", solver, "--out"])
@@ -81,7 +142,7 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
         .map_err(|e| CaseError::Option(format!("cannot run {}: {e}", exe.display())))?;
     if !status.status.success() {
         return Err(CaseError::Option(format!(
-            "run {problem} --h {h} --solver {solver} failed: {}",
+            "run {problem} --h {h} --solver {solver} on {ranks} process(es) failed: {}",
             String::from_utf8_lossy(&status.stderr).trim()
         )));
     }
@@ -95,7 +156,13 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
     let contact = s.get("contact").and_then(|v| v.as_str()).map(str::to_string);
     let params: std::collections::BTreeMap<String, crate::driver::ParamValue> =
         s.get("params").and_then(|p| serde_json::from_value(p.clone()).ok()).unwrap_or_default();
+    let steps = int("steps").max(1);
+    let model = (solver == "petsc").then(|| {
+        let per_step = int("krylov_iterations") as f64 / steps as f64;
+        Model::new(int("dofs"), int("matrix_nnz"), per_step, bandwidth(ranks), 1e3 * num("step_median_seconds"))
+    });
     Ok(SphereTiming {
+        model,
         dofs: int("dofs"),
         h,
         solver: solver.into(),
@@ -107,7 +174,7 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
         krylov_iterations: int("krylov_iterations"),
         iterations_per_solve: (solver != "direct" && int("linear_solves") > 0)
             .then(|| int("krylov_iterations") as f64 / int("linear_solves") as f64),
-        ranks: 1,
+        ranks,
         peak_memory_bytes: s.get("peak_memory_bytes").and_then(serde_json::Value::as_u64),
         first_contact: s.get("first_contact").and_then(serde_json::Value::as_f64),
         scheme: s.get("scheme").and_then(|v| v.as_str()).map(str::to_string),
@@ -119,10 +186,12 @@ fn run_one(exe: &Path, half: usize, solver: &str, dir: &Path) -> Result<SphereTi
 }
 
 /// Every ball up to `max_dofs` unknowns with each of `solvers` (none: direct, iterative, and
-/// PETSc when built with it), the direct one where it fits.
+/// PETSc when built with it), the direct one where it fits; PETSc's on each number of MPI
+/// processes of `ranks` (the others on one).
 pub fn sphere(
     max_dofs: usize,
     solvers: &[Solver],
+    ranks: &[usize],
     dir: &Path,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Report, CaseError> {
@@ -139,21 +208,44 @@ pub fn sphere(
         .map(|s| serde_json::to_value(s).ok().and_then(|v| v.as_str().map(str::to_string)).unwrap_or_default())
         .collect();
     let mut runs = Vec::new();
+    // The triad's bandwidth on n threads, measured once each.
+    let mut measured: Vec<(usize, f64)> = Vec::new();
+    let mut bandwidth = |n: usize| match measured.iter().find(|(m, _)| *m == n) {
+        Some((_, b)) => *b,
+        None => {
+            let b = super::bandwidth::triad(n);
+            measured.push((n, b));
+            b
+        }
+    };
     for half in HALVES.into_iter().filter(|&h| dofs(h) <= max_dofs) {
         for solver in names.iter().map(String::as_str) {
             if solver == "direct" && dofs(half) > DIRECT_LIMIT {
                 continue;
             }
-            let r = run_one(&exe, half, solver, &dir.join("bench_sphere_runs"))?;
-            progress(&format!(
-                "{} dofs, {solver}: {:.1} ms/step (median), {:.1} ms/step with setup, {:.1} iterations per solve, peak {:.0} MB",
-                r.dofs,
-                r.median_step_ms,
-                r.ms_per_step_with_setup,
-                r.iterations_per_solve.unwrap_or(f64::NAN),
-                r.peak_memory_bytes.map_or(f64::NAN, |b| b as f64 / 1e6)
-            ));
-            runs.push(r);
+            let counts: &[usize] = if solver == "petsc" { ranks } else { &[1] };
+            for &n in counts {
+                let r = run_one(&exe, half, solver, n, &mut bandwidth, &dir.join("bench_sphere_runs"))?;
+                progress(&format!(
+                    "{} dofs, {solver} on {n}: {:.1} ms/step (median), {:.1} ms/step with setup, {:.1} iterations per solve, peak {:.0} MB",
+                    r.dofs,
+                    r.median_step_ms,
+                    r.ms_per_step_with_setup,
+                    r.iterations_per_solve.unwrap_or(f64::NAN),
+                    r.peak_memory_bytes.map_or(f64::NAN, |b| b as f64 / 1e6)
+                ));
+                if let Some(m) = &r.model {
+                    progress(&format!(
+                        "    model: {:.1} products of {:.0} MB per step at {:.1} GB/s = {:.1} ms; measured {:.2}× that",
+                        m.products_per_step,
+                        m.matrix_bytes / 1e6,
+                        m.bandwidth_gb_s,
+                        m.model_ms_per_step,
+                        m.measured_over_model
+                    ));
+                }
+                runs.push(r);
+            }
         }
     }
     Ok(Report { max_dofs, runs })

@@ -40,6 +40,9 @@ struct CaseFile {
     energy_tolerance: Option<Spanned<f64>>,
     /// `--allow-unstable-dt`.
     allow_unstable_dt: Option<Spanned<bool>>,
+    /// The linear solver (`--solver`) and PETSc's options (`--petsc-options`).
+    solver: Option<Spanned<String>>,
+    petsc_options: Option<Spanned<String>>,
 }
 
 struct Reader<'a> {
@@ -211,6 +214,10 @@ pub fn parse(text: &str, path: &Path) -> Result<crate::problem::run::Options, Ca
         .as_ref()
         .map(|_| r.number(&parsed.t_start, "t_start", |x| x >= 0.0, "0 or positive", 0.0))
         .transpose()?;
+    if let Some(s) = &parsed.solver {
+        opts.newton.solver = crate::runtime::linalg::Solver::parse(s.get_ref()).map_err(|e| r.error(s, "solver", e))?;
+    }
+    opts.petsc_options = parsed.petsc_options.as_ref().map(|o| o.get_ref().clone());
     opts.out = out;
     Ok(opts)
 }

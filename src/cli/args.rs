@@ -121,6 +121,10 @@ pub enum BenchCommand {
         /// unknowns); default: direct, iterative, and petsc in a build with PETSc.
         #[arg(long, value_delimiter = ',', value_parser = Solver::parse)]
         solvers: Vec<Solver>,
+        /// The numbers of MPI processes PETSc's runs are timed on, each under `mpirun -n N`
+        /// (Open MPI's; a build with PETSc).
+        #[arg(long, value_delimiter = ',', default_value = "1", value_parser = clap::value_parser!(u32).range(1..=1024))]
+        ranks: Vec<u32>,
         /// Directory for bench_sphere.json, bench_sphere.png and the runs.
         #[arg(long, default_value = "results")]
         out: PathBuf,

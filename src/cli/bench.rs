@@ -7,7 +7,7 @@ use super::fail;
 
 pub(super) fn assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Path) -> ExitCode {
     if sizes.iter().any(|&n| n == 0 || n > 2048) {
-        eprintln!("{}: --sizes must lie in 1..=2048", super::error_prefix());
+        super::print_error("--sizes must lie in 1..=2048");
         return ExitCode::FAILURE;
     }
     // The P2 plane-strain unknowns of the N×N mesh, 2 (2N + 1)², against the memory there is,
@@ -22,9 +22,14 @@ pub(super) fn assemble(sizes: &[usize], factor: usize, repeats: usize, out: &Pat
     write_bench(&out.join("bench_assemble.json"), &report)
 }
 
-pub(super) fn sphere(max_dofs: usize, solvers: &[crate::runtime::linalg::Solver], out: &Path) -> ExitCode {
+pub(super) fn sphere(
+    max_dofs: usize,
+    solvers: &[crate::runtime::linalg::Solver],
+    ranks: &[usize],
+    out: &Path,
+) -> ExitCode {
     use crate::bench::sphere;
-    let report = match sphere::sphere(max_dofs, solvers, out, &mut |line| println!("{line}")) {
+    let report = match sphere::sphere(max_dofs, solvers, ranks, out, &mut |line| println!("{line}")) {
         Ok(r) => r,
         Err(e) => return fail(e),
     };
@@ -38,7 +43,7 @@ pub(super) fn disc(meshes: &[PathBuf], repeats: usize, out: &Path) -> ExitCode {
     let report = match crate::bench::disc::disc(meshes, repeats, &mut |line| println!("{line}")) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("{}: {e}", super::error_prefix());
+            super::print_error(e);
             return ExitCode::FAILURE;
         }
     };
@@ -53,7 +58,7 @@ fn write_bench(path: &Path, report: &impl serde::Serialize) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("{}: cannot write {}: {e}", super::error_prefix(), path.display());
+            super::print_error(format_args!("cannot write {}: {e}", path.display()));
             ExitCode::FAILURE
         }
     }

@@ -113,7 +113,7 @@ pub(super) fn mesh_info(file: &Path) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("{}: {e}", super::error_prefix());
+            super::print_error(e);
             ExitCode::FAILURE
         }
     }

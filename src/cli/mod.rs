@@ -75,11 +75,19 @@ pub(super) fn out_dir(out: Option<PathBuf>) -> Result<Option<PathBuf>, String> {
 }
 
 /// How an error line starts: `error`, and which process saw it in a run of several.
-pub fn error_prefix() -> String {
+fn error_prefix() -> String {
     match crate::runtime::linalg::ranks::world() {
         (_, 1) => "error".into(),
         (rank, size) => format!("error (rank {rank} of {size})"),
     }
+}
+
+/// Prints an error line (see [`error_prefix`]) in one write: the processes of an MPI run share
+/// stderr, and their lines must not interleave.
+pub fn print_error(message: impl std::fmt::Display) {
+    use std::io::Write;
+    let line = format!("{}: {message}\n", error_prefix());
+    let _ = std::io::stderr().lock().write_all(line.as_bytes());
 }
 
 /// Under mpirun, the threads of each process: the cores shared among the node's processes
@@ -92,7 +100,7 @@ fn threads_per_rank() -> Option<usize> {
 
 /// Prints an error and fails.
 pub(super) fn fail(e: impl std::fmt::Display) -> ExitCode {
-    eprintln!("{}: {e}", error_prefix());
+    print_error(e);
     ExitCode::FAILURE
 }
 
@@ -106,7 +114,7 @@ fn dispatch(cli: Cli) -> ExitCode {
     if let Some(n) = cli.threads.map(|n| n as usize).or_else(threads_per_rank)
         && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global()
     {
-        eprintln!("{}: cannot start {n} threads: {e}", error_prefix());
+        print_error(format_args!("cannot start {n} threads: {e}"));
         return ExitCode::FAILURE;
     }
     match cli.command {
@@ -127,7 +135,7 @@ fn dispatch(cli: Cli) -> ExitCode {
         Command::Run { file: Some(problem), args } => run::problem(&problem.to_string_lossy(), *args),
         Command::Run { file: None, .. } => {
             let names = crate::problem::library_names().join(", ");
-            eprintln!("{}: name a problem ({names}), a problem file or a case file", error_prefix());
+            print_error(format_args!("name a problem ({names}), a problem file or a case file"));
             ExitCode::FAILURE
         }
         Command::Mesh { command: MeshCommand::Info { file } } => files::mesh_info(&file),
@@ -135,8 +143,8 @@ fn dispatch(cli: Cli) -> ExitCode {
             bench::assemble(&sizes, factor, repeats, &out)
         }
         Command::Bench { what: BenchCommand::Disc { meshes, repeats, out } } => bench::disc(&meshes, repeats, &out),
-        Command::Bench { what: BenchCommand::Sphere { max_dofs, solvers, out } } => {
-            bench::sphere(max_dofs, &solvers, &out)
+        Command::Bench { what: BenchCommand::Sphere { max_dofs, solvers, ranks, out } } => {
+            bench::sphere(max_dofs, &solvers, &ranks.iter().map(|&r| r as usize).collect::<Vec<_>>(), &out)
         }
     }
 }
@@ -153,7 +161,7 @@ fn report(out: PathBuf, quick: bool) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("{}: {e}", error_prefix());
+            print_error(e);
             ExitCode::FAILURE
         }
     }

@@ -11,11 +11,6 @@ use crate::driver::{Methods, Setting};
 use crate::simulation::MassChoice;
 
 pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
-    if let Some(options) = &a.petsc_options
-        && let Err(e) = crate::runtime::linalg::set_petsc_options(options)
-    {
-        return fail(e);
-    }
     let methods = match a.methods.to_methods() {
         Ok(s) => s,
         Err(e) => return fail(e),
@@ -31,6 +26,7 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
         opts.t_end = a.t_end;
         opts.cell_size = a.methods.cell_size;
         opts.newton.solver = a.solver;
+        opts.petsc_options = a.petsc_options;
         opts.newton.line_search = a.methods.line_search;
         opts.vtu_every = a.vtu_every;
         opts.chosen.material = a.methods.material.is_some();
@@ -54,6 +50,7 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
             line_search: a.methods.line_search,
             ..Default::default()
         },
+        petsc_options: a.petsc_options,
         out: match a.checkpoint.out(a.out) {
             Ok(dir) => dir,
             Err(e) => return fail(e),
@@ -149,7 +146,7 @@ pub(super) fn case_file(file: &Path) -> ExitCode {
             finish(crate::problem::run::run(&opts))
         }
         Err(e) => {
-            eprintln!("{}: {e}", super::error_prefix());
+            super::print_error(e);
             ExitCode::FAILURE
         }
     }

@@ -48,7 +48,7 @@ pub(super) fn finish(result: Result<crate::problem::run::Run, crate::error::Case
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("{}: {e}", super::error_prefix());
+            super::print_error(e);
             ExitCode::FAILURE
         }
     }

@@ -25,6 +25,9 @@ pub struct Options {
     pub t_start: Option<f64>,
     pub t_end: Option<f64>,
     pub newton: NewtonOptions,
+    /// Options for PETSc's solvers (`-ksp_rtol 1e-8 -pc_type hypre`), over the defaults of the
+    /// `petsc` solver.
+    pub petsc_options: Option<String>,
     pub out: Option<PathBuf>,
     pub vtu_every: usize,
     pub progress: bool,
@@ -63,6 +66,7 @@ impl Options {
             t_start: None,
             t_end: None,
             newton: NewtonOptions::default(),
+            petsc_options: None,
             out: None,
             vtu_every: 0,
             progress: false,

@@ -46,6 +46,9 @@ pub fn check(problem: &str) -> Result<(), CaseError> {
 }
 
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
+    if let Some(options) = &opts.petsc_options {
+        crate::runtime::linalg::set_petsc_options(options).map_err(|e| CaseError::Option(e.to_string()))?;
+    }
     bound(opts, |pf, params, ex, in_use| {
         if pf.problem().run_static.is_some() {
             if opts.dt.is_some() || opts.t_end.is_some() || opts.t_start.is_some() {

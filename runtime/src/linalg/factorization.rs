@@ -474,7 +474,10 @@ impl Factorization {
         }
         #[cfg(feature = "petsc")]
         if let Factors::Petsc(k) = &mut self.factors {
+            let setups = k.setups;
             let result = k.solve_in_place(b);
+            // A PETSc solver's factorizations are its preconditioner's setups.
+            self.counters.numeric += k.setups - setups;
             self.counters.iterations += k.iterations;
             self.counters.solves += 1;
             return result;
@@ -485,7 +488,6 @@ impl Factorization {
     /// A PETSc solver for `a`: its values into the solver of the same pattern, else a new one.
     #[cfg(feature = "petsc")]
     fn factor_petsc(&mut self, a: &Matrix) -> Result<(), LinalgError> {
-        self.counters.numeric += 1;
         if let Factors::Petsc(k) = &mut self.factors
             && k.fits(a)
         {

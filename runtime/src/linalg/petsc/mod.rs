@@ -117,7 +117,14 @@ pub fn set_options(options: &str) -> Result<(), LinalgError> {
 fn insert_options(options: &str) -> Result<(), LinalgError> {
     let text = CString::new(options).map_err(|_| LinalgError::Other("PETSc options contain a NUL byte".into()))?;
     // SAFETY: a NUL-terminated string; a null options database means the global one.
-    call("PetscOptionsInsertString", unsafe { sys::PetscOptionsInsertString(std::ptr::null_mut(), text.as_ptr()) })
+    call("PetscOptionsInsertString", unsafe { sys::PetscOptionsInsertString(std::ptr::null_mut(), text.as_ptr()) })?;
+    // PETSc reads -log_view when it starts, before these options: its log is started here
+    // (PetscFinalize fails otherwise).
+    if options.split_whitespace().any(|o| o.starts_with("-log_view")) {
+        // SAFETY: PETSc is initialized; starting its default log twice is harmless.
+        call("PetscLogDefaultBegin", unsafe { sys::PetscLogDefaultBegin() })?;
+    }
+    Ok(())
 }
 
 /// Ends PETSc (writing what `-log_view` and the like asked for), if it started; no PETSc
@@ -207,9 +214,22 @@ pub struct PetscSolver {
     values: Vec<f64>,
     /// Across processes: the split, and what gathers the solution on every process.
     split: Option<Split>,
+    /// Iterations of the first solve with the preconditioner in use; none when the next solve
+    /// sets one up.
+    baseline: Option<usize>,
+    /// The Krylov method's tolerances (ours, or the user's options): a solve with a kept
+    /// preconditioner stops earlier and sets one up again.
+    tolerances: (f64, f64, f64, sys::PetscInt),
     /// Krylov iterations of the last solve.
     pub iterations: usize,
+    /// Preconditioners set up so far.
+    pub setups: usize,
 }
+
+/// A preconditioner is kept for new values (Newton's next tangent, the contact terms changed)
+/// until a solve takes more than this many times the iterations of its first solve: a GAMG
+/// setup costs tens of iterations, while the preconditioner of a nearby matrix costs a few.
+const LAG_GROWTH: usize = 2;
 
 /// A system solved across processes. Every process holds the whole matrix and right-hand side
 /// (it assembled them); it gives PETSc its own rows, and receives the whole solution.
@@ -339,6 +359,11 @@ impl PetscSolver {
             call("KSPSetTolerances", sys::KSPSetTolerances(ksp.0, rtol, 0.0, sys::PETSC_DEFAULT, 10_000))?;
             call("KSPSetFromOptions", sys::KSPSetFromOptions(ksp.0))?;
         }
+        let mut tolerances = (0.0, 0.0, 0.0, 0);
+        // SAFETY: a valid KSP writing its four tolerances.
+        call("KSPGetTolerances", unsafe {
+            sys::KSPGetTolerances(ksp.0, &mut tolerances.0, &mut tolerances.1, &mut tolerances.2, &mut tolerances.3)
+        })?;
         let split = match layout {
             Some(layout) => {
                 let (mut gather, mut all) = (OwnedScatter(std::ptr::null_mut()), OwnedVec(std::ptr::null_mut()));
@@ -359,7 +384,10 @@ impl PetscSolver {
             pattern: a.pattern.clone(),
             values: Vec::new(),
             split,
+            baseline: None,
+            tolerances,
             iterations: 0,
+            setups: 0,
         };
         solver.take_values(a)?;
         Ok(solver)
@@ -370,7 +398,8 @@ impl PetscSolver {
         Arc::ptr_eq(&self.pattern, &a.pattern)
     }
 
-    /// Takes `a`'s values (same pattern); the preconditioner is rebuilt at the next solve.
+    /// Takes `a`'s values (same pattern); the preconditioner of the last values is kept while it
+    /// serves (see [`LAG_GROWTH`]), and rebuilt at the next solve otherwise.
     pub fn set_values(&mut self, a: &Matrix) -> Result<(), LinalgError> {
         let _petsc = lock()?;
         self.take_values(a)
@@ -395,7 +424,37 @@ impl PetscSolver {
             call("MatSetValuesCOO", sys::MatSetValuesCOO(self.matrix.0, values, sys::INSERT_VALUES))?;
             call("KSPSetOperators", sys::KSPSetOperators(self.ksp.0, self.matrix.0, self.matrix.0))?;
         }
-        Ok(())
+        self.reuse(self.baseline.is_some())
+    }
+
+    /// Whether the next solve keeps the preconditioner it has (the Krylov method always applies
+    /// the matrix's current values).
+    fn reuse(&mut self, keep: bool) -> Result<(), LinalgError> {
+        if !keep {
+            self.baseline = None;
+        }
+        // SAFETY: a valid KSP; the flag only decides whether KSPSolve sets the PC up again.
+        call("KSPSetReusePreconditioner", unsafe { sys::KSPSetReusePreconditioner(self.ksp.0, keep.into()) })
+    }
+
+    /// One Krylov solve of the right-hand side in place: its iterations and PETSc's reason.
+    fn krylov(&mut self) -> Result<(usize, c_int), LinalgError> {
+        let (rtol, abstol, dtol, most) = self.tolerances;
+        // With a kept preconditioner, past a few times its first solve's iterations a new one
+        // is cheaper.
+        let limit = match self.baseline {
+            Some(first) => most.min(sys::PetscInt::try_from(4 * first + 20).unwrap_or(most)),
+            None => most,
+        };
+        let (mut its, mut reason): (sys::PetscInt, c_int) = (0, 0);
+        // SAFETY: vectors and KSP created together for this size.
+        unsafe {
+            call("KSPSetTolerances", sys::KSPSetTolerances(self.ksp.0, rtol, abstol, dtol, limit))?;
+            call("KSPSolve", sys::KSPSolve(self.ksp.0, self.rhs.0, self.solution.0))?;
+            call("KSPGetIterationNumber", sys::KSPGetIterationNumber(self.ksp.0, &mut its))?;
+            call("KSPGetConvergedReason", sys::KSPGetConvergedReason(self.ksp.0, &mut reason))?;
+        }
+        Ok((its.max(0) as usize, reason))
     }
 
     /// Solves `A x = b` in place, from x = 0 (Newton's corrections shrink from one solve to the
@@ -408,16 +467,23 @@ impl PetscSolver {
             Some(s) => v.iter_mut().zip(&s.layout.mine).for_each(|(x, &dof)| *x = b[dof]),
             None => v.copy_from_slice(b),
         })?;
-        let (mut its, mut reason): (sys::PetscInt, c_int) = (0, 0);
-        // SAFETY: vectors and KSP created together for this size.
-        unsafe {
-            call("KSPSolve", sys::KSPSolve(self.ksp.0, self.rhs.0, self.solution.0))?;
-            call("KSPGetIterationNumber", sys::KSPGetIterationNumber(self.ksp.0, &mut its))?;
-            call("KSPGetConvergedReason", sys::KSPGetConvergedReason(self.ksp.0, &mut reason))?;
+        let (mut its, mut reason) = self.krylov()?;
+        if reason <= 0 && self.baseline.is_some() {
+            // A kept preconditioner that no longer serves: set up for these values, again.
+            self.reuse(false)?;
+            (its, reason) = self.krylov()?;
         }
-        self.iterations = its.max(0) as usize;
+        self.iterations = its;
         if reason <= 0 {
             return Err(diverged(reason, self.iterations));
+        }
+        match self.baseline {
+            None => {
+                self.baseline = Some(its);
+                self.setups += 1;
+            }
+            Some(first) if its > LAG_GROWTH * first.max(1) => self.reuse(false)?,
+            Some(_) => {}
         }
         match &mut self.split {
             Some(s) => {

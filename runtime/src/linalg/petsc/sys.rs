@@ -97,6 +97,7 @@ unsafe extern "C" {
     pub fn PetscInitialized(done: *mut PetscBool) -> PetscErrorCode;
     pub fn PetscFinalize() -> PetscErrorCode;
     pub fn PetscOptionsInsertString(options: *mut c_void, text: *const c_char) -> PetscErrorCode;
+    pub fn PetscLogDefaultBegin() -> PetscErrorCode;
     pub fn PetscPushErrorHandler(handler: ErrorHandler, context: *mut c_void) -> PetscErrorCode;
 
     pub fn MatCreate(comm: MPI_Comm, mat: *mut Mat) -> PetscErrorCode;
@@ -137,9 +138,17 @@ unsafe extern "C" {
         dtol: PetscReal,
         maxits: PetscInt,
     ) -> PetscErrorCode;
+    pub fn KSPGetTolerances(
+        ksp: KSP,
+        rtol: *mut PetscReal,
+        abstol: *mut PetscReal,
+        dtol: *mut PetscReal,
+        maxits: *mut PetscInt,
+    ) -> PetscErrorCode;
     pub fn KSPSetNormType(ksp: KSP, norm: c_int) -> PetscErrorCode;
     pub fn KSPSetPCSide(ksp: KSP, side: c_int) -> PetscErrorCode;
     pub fn KSPSetFromOptions(ksp: KSP) -> PetscErrorCode;
+    pub fn KSPSetReusePreconditioner(ksp: KSP, reuse: PetscBool) -> PetscErrorCode;
     pub fn KSPSolve(ksp: KSP, b: Vec, x: Vec) -> PetscErrorCode;
     pub fn KSPGetIterationNumber(ksp: KSP, its: *mut PetscInt) -> PetscErrorCode;
     pub fn KSPGetConvergedReason(ksp: KSP, reason: *mut c_int) -> PetscErrorCode;
