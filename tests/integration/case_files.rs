@@ -20,7 +20,7 @@ fn write(name: &str, text: &str) -> std::path::PathBuf {
 fn a_valid_file_runs_and_writes_its_results() {
     let path = write(
         "bar.toml",
-        "case = \"bar\"\nscheme = \"trbdf2\"\nmass = \"redistributed\"\nt_end = 1.5\nout = \"bar-out\"\n",
+        "case = \"bar\"\nscheme = \"trbdf2\"\nmass = \"redistributed\"\nt_end = 1.5\nout = \"bar-out\"\nsolver = \"iterative\"\n",
     );
     let (code, err) = signorini(&["run", path.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
@@ -30,6 +30,7 @@ fn a_valid_file_runs_and_writes_its_results() {
     assert_eq!(s["scheme"], "trbdf2");
     assert_eq!(s["mass"], "redistributed");
     assert_eq!(s["steps"], 150);
+    assert_eq!(s["solver"], "iterative");
 }
 
 /// `[params]` reaches every param of the files in use, qualified by file when asked.
@@ -73,7 +74,7 @@ fn mistakes_are_reported_with_their_line() {
         (
             "other_case.toml",
             "case = \"disc\"\nne = 5\n",
-            ":2: unknown field `ne`, expected one of `case`, `scheme`, `contact`, `material`, `forms`, `params`, `mass`, `cell_size`, `dt`, `t_end`, `t_start`, `out`, `mesh`, `max_step_cuts`, `energy_tolerance`, `allow_unstable_dt`; nor a param of problem `disc` (its params: h)",
+            ":2: unknown field `ne`, expected one of `case`, `scheme`, `contact`, `material`, `forms`, `params`, `mass`, `cell_size`, `dt`, `t_end`, `t_start`, `out`, `mesh`, `max_step_cuts`, `energy_tolerance`, `allow_unstable_dt`, `solver`, `petsc_options`; nor a param of problem `disc` (its params: h)",
         ),
         (
             "name.toml",
@@ -86,6 +87,7 @@ fn mistakes_are_reported_with_their_line() {
         ("removed.toml", "case = \"bar\"\nscheme = \"hht\"\nalpha = 0.1\n", ":3: unknown field `alpha`"),
         ("type.toml", "case = \"disc\"\ndt = \"x\"\n", ":2: invalid type"),
         ("case.toml", "case = \"beam\"\n", ":1: `case`: no problem `beam` in the library"),
+        ("solver.toml", "case = \"bar\"\nsolver = \"cholmod\"\n", ":2: `solver`: `cholmod`: expected direct"),
     ];
     for (name, text, want) in cases {
         let path = write(name, text);

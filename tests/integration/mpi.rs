@@ -28,7 +28,10 @@ fn mpirun(ranks: usize, args: &[&str], limit: Duration) -> (bool, String) {
             command.arg(a);
         }
     }
-    let stderr = std::env::temp_dir().join(format!("signorini-mpi-{}-{ranks}.err", std::process::id()));
+    // One file per launch: the tests run at once.
+    static LAUNCHES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let launch = LAUNCHES.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    let stderr = std::env::temp_dir().join(format!("signorini-mpi-{}-{launch}.err", std::process::id()));
     let file = std::fs::File::create(&stderr).expect("a file for stderr");
     let mut child =
         command.stdout(Stdio::null()).stderr(file).spawn().expect("mpirun runs (apt-get install openmpi-bin)");
