@@ -17,8 +17,7 @@ pub(super) struct Layout {
 }
 
 /// The last pattern split and its layout: a solver built again for the same matrix (a new
-/// time step, a run resumed from a checkpoint) splits it as before, as the partitioner may not
-/// give the same parts twice.
+/// time step, a cut step) does not partition it again.
 static LAST: Mutex<Option<(Weak<Pattern>, Arc<Layout>)>> = Mutex::new(None);
 
 impl Layout {
@@ -46,21 +45,25 @@ impl Layout {
         }
         let nodes = n / dim;
         let owner = partition(pattern, dim, nodes, size)?;
-        let mut to_petsc = vec![0; n];
-        let (mut next, mut mine, mut first) = (0usize, Vec::new(), 0);
-        for r in 0..size {
-            if r == rank {
-                first = next * dim;
-            }
-            for node in (0..nodes).filter(|&node| owner[node] == r) {
-                for c in 0..dim {
-                    to_petsc[node * dim + c] = petsc_int(next * dim + c)?;
-                    if r == rank {
-                        mine.push(node * dim + c);
-                    }
+        // Each process's nodes in their own order, after those of the processes before it.
+        let mut next = vec![0usize; size];
+        for &r in &owner {
+            next[r] += 1;
+        }
+        let mut start = 0;
+        for count in &mut next {
+            (*count, start) = (start, start + *count);
+        }
+        let first = next[rank] * dim;
+        let (mut to_petsc, mut mine) = (vec![0; n], Vec::new());
+        for (node, &r) in owner.iter().enumerate() {
+            for c in 0..dim {
+                to_petsc[node * dim + c] = petsc_int(next[r] * dim + c)?;
+                if r == rank {
+                    mine.push(node * dim + c);
                 }
-                next += 1;
             }
+            next[r] += 1;
         }
         Ok(Layout { to_petsc, mine, first })
     }
