@@ -117,6 +117,22 @@ fn dispatch(cli: Cli) -> ExitCode {
         print_error(format_args!("cannot start {n} threads: {e}"));
         return ExitCode::FAILURE;
     }
+    // The commands that run many cases and write their own files (verify, report, bench,
+    // compare) run as one process; under mpirun they would repeat each other's work.
+    let alone = match &cli.command {
+        Command::Verify { .. } => Some("verify"),
+        Command::Report { .. } => Some("report"),
+        Command::Bench { .. } => Some("bench"),
+        Command::Compare { .. } => Some("compare"),
+        _ => None,
+    };
+    if let Some(name) = alone
+        && crate::runtime::linalg::ranks::world().1 > 1
+    {
+        return fail(format!(
+            "`{name}` runs as one process: under mpirun only `run` is shared among the processes (`bench sphere --ranks` launches mpirun itself)"
+        ));
+    }
     match cli.command {
         Command::Check { files } => files::check(&files),
         Command::Emit { file, stage, dim } => files::emit(&file, stage, dim as usize),

@@ -1,7 +1,8 @@
 //! Runs under `mpirun` (feature `petsc`): the disc and the sphere through their first impact on
 //! 1, 2 and 3 processes agree with the serial direct run to 1e-8 of each column's scale; a run
 //! resumed from its checkpoint on the same 2 processes has the bits of the uninterrupted one; a
-//! process that fails, alone or with the others, ends them all with its message.
+//! process that fails, alone or with the others, ends them all with its message; the commands
+//! that run as one process refuse mpirun.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -142,4 +143,13 @@ fn a_failure_on_every_process_ends_them_all_with_the_message() {
     let (ok, err) = mpirun(2, &args, Duration::from_secs(300));
     assert!(!ok, "the run failed");
     assert!(err.contains("error (rank 0 of 2)") && err.contains("did not converge"), "{err}");
+}
+
+#[test]
+fn commands_that_run_as_one_process_refuse_mpirun() {
+    let dir = scratch("report");
+    let (ok, err) = mpirun(2, &["report", "--quick", "--out", dir.to_str().unwrap()], Duration::from_secs(120));
+    assert!(!ok, "report under mpirun failed");
+    assert!(err.contains("`report` runs as one process"), "{err}");
+    assert!(!dir.exists(), "nothing written");
 }
