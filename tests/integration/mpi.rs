@@ -4,9 +4,11 @@
 //! process that fails, alone or with the others, ends them all with its message; the commands
 //! that run as one process refuse mpirun.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+
+use super::petsc::{assert_agree, read_series};
 
 const BIN: &str = env!("CARGO_BIN_EXE_signorini");
 
@@ -56,14 +58,6 @@ fn mpirun(ranks: usize, args: &[&str], limit: Duration) -> (bool, String) {
     (status.success(), text)
 }
 
-fn series(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(dir.join("series.csv")).expect("a series");
-    let mut lines = text.lines();
-    let header = lines.next().expect("a header").split(',').map(str::to_string).collect();
-    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect()).collect();
-    (header, rows)
-}
-
 /// Every column of `run ARGS` on 1, 2 and 3 processes (PETSc's solvers) against the serial direct
 /// run, to 1e-8 of the column's largest value.
 fn agree(args: &[&str], name: &str) {
@@ -77,24 +71,14 @@ fn agree(args: &[&str], name: &str) {
         .output()
         .expect("the binary runs");
     assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
-    let (header, reference) = series(&direct);
+    let (header, reference) = read_series(&direct);
     for ranks in 1..=3 {
         let dir = root.join(format!("ranks-{ranks}"));
         let run: Vec<&str> = [&["run"], args, &["--solver", "petsc", "--out", dir.to_str().unwrap()]].concat();
         let (ok, err) = mpirun(ranks, &run, Duration::from_secs(600));
         assert!(ok, "{name} on {ranks} processes: {err}");
-        let (_, rows) = series(&dir);
-        assert_eq!(rows.len(), reference.len(), "{name} on {ranks}: as many rows");
-        for (c, column) in header.iter().enumerate() {
-            let scale = reference.iter().map(|r| r[c].abs()).filter(|v| v.is_finite()).fold(0.0, f64::max);
-            for (d, p) in reference.iter().zip(&rows) {
-                let (d, p) = (d[c], p[c]);
-                assert!(
-                    (d.is_nan() && p.is_nan()) || (d - p).abs() <= 1e-8 * scale.max(f64::MIN_POSITIVE),
-                    "{name} on {ranks} processes: {column} {p} against {d} (scale {scale:e})"
-                );
-            }
-        }
+        let (_, rows) = read_series(&dir);
+        assert_agree(&format!("{name} on {ranks} processes"), &header, &reference, &rows);
     }
     let _ = std::fs::remove_dir_all(&root);
 }

@@ -18,6 +18,11 @@ fn series(args: &[&str], solver: &str, dir: &Path) -> (Vec<String>, Vec<Vec<f64>
         .output()
         .expect("the binary runs");
     assert!(out.status.success(), "{args:?} --solver {solver}: {}", String::from_utf8_lossy(&out.stderr));
+    read_series(dir)
+}
+
+/// `dir/series.csv` as its header and rows (NaN where a value is empty).
+pub(super) fn read_series(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(dir.join("series.csv")).expect("a series");
     let mut lines = text.lines();
     let header = lines.next().expect("a header").split(',').map(str::to_string).collect();
@@ -25,21 +30,27 @@ fn series(args: &[&str], solver: &str, dir: &Path) -> (Vec<String>, Vec<Vec<f64>
     (header, rows)
 }
 
+/// Every column of `rows` equals `reference`'s to 1e-8 of the column's largest value (NaN where
+/// it is NaN), as many rows.
+pub(super) fn assert_agree(what: &str, header: &[String], reference: &[Vec<f64>], rows: &[Vec<f64>]) {
+    assert_eq!(reference.len(), rows.len(), "{what}: as many rows");
+    for (c, column) in header.iter().enumerate() {
+        let scale = reference.iter().map(|r| r[c].abs()).filter(|v| v.is_finite()).fold(0.0, f64::max);
+        for (d, p) in reference.iter().zip(rows) {
+            let (d, p) = (d[c], p[c]);
+            assert!(
+                (d.is_nan() && p.is_nan()) || (d - p).abs() <= 1e-8 * scale.max(f64::MIN_POSITIVE),
+                "{what}: {column} {p} against {d} (scale {scale:e})"
+            );
+        }
+    }
+}
+
 fn agree(args: &[&str], name: &str) {
     let tmp = std::env::temp_dir().join(format!("signorini-petsc-{name}-{}", std::process::id()));
     let (header, direct) = series(args, "direct", &tmp.join("direct"));
     let (_, petsc) = series(args, "petsc", &tmp.join("petsc"));
-    assert_eq!(direct.len(), petsc.len(), "{name}: as many steps");
-    for (c, column) in header.iter().enumerate() {
-        let scale = direct.iter().map(|r| r[c].abs()).filter(|v| v.is_finite()).fold(0.0, f64::max);
-        for (d, p) in direct.iter().zip(&petsc) {
-            let (d, p) = (d[c], p[c]);
-            assert!(
-                (d.is_nan() && p.is_nan()) || (d - p).abs() <= 1e-8 * scale.max(f64::MIN_POSITIVE),
-                "{name}: {column} {p} against {d} (scale {scale:e})"
-            );
-        }
-    }
+    assert_agree(name, &header, &direct, &petsc);
     let _ = std::fs::remove_dir_all(&tmp);
 }
 

@@ -217,6 +217,9 @@ pub struct PetscSolver {
     /// Iterations of the first solve with the preconditioner in use; none when the next solve
     /// sets one up.
     baseline: Option<usize>,
+    /// Whether the preconditioner in use has stopped serving (a solve took more than
+    /// [`LAG_GROWTH`] times the first's iterations): the next new values get one of their own.
+    stale: bool,
     /// The Krylov method's tolerances (ours, or the user's options): a solve with a kept
     /// preconditioner stops earlier and sets one up again.
     tolerances: (f64, f64, f64, sys::PetscInt),
@@ -385,6 +388,7 @@ impl PetscSolver {
             values: Vec::new(),
             split,
             baseline: None,
+            stale: false,
             tolerances,
             iterations: 0,
             setups: 0,
@@ -424,14 +428,14 @@ impl PetscSolver {
             call("MatSetValuesCOO", sys::MatSetValuesCOO(self.matrix.0, values, sys::INSERT_VALUES))?;
             call("KSPSetOperators", sys::KSPSetOperators(self.ksp.0, self.matrix.0, self.matrix.0))?;
         }
-        self.reuse(self.baseline.is_some())
+        self.reuse(self.baseline.is_some() && !self.stale)
     }
 
     /// Whether the next solve keeps the preconditioner it has (the Krylov method always applies
     /// the matrix's current values).
     fn reuse(&mut self, keep: bool) -> Result<(), LinalgError> {
         if !keep {
-            self.baseline = None;
+            (self.baseline, self.stale) = (None, false);
         }
         // SAFETY: a valid KSP; the flag only decides whether KSPSolve sets the PC up again.
         call("KSPSetReusePreconditioner", unsafe { sys::KSPSetReusePreconditioner(self.ksp.0, keep.into()) })
@@ -482,8 +486,7 @@ impl PetscSolver {
                 self.baseline = Some(its);
                 self.setups += 1;
             }
-            Some(first) if its > LAG_GROWTH * first.max(1) => self.reuse(false)?,
-            Some(_) => {}
+            Some(first) => self.stale |= its > LAG_GROWTH * first.max(1),
         }
         match &mut self.split {
             Some(s) => {
