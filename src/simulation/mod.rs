@@ -475,7 +475,10 @@ fn history(e: &crate::runtime::time::stepper::StepError) -> String {
     };
     let mut text = format!("residual {:.3e}", report.initial_residual);
     for it in &report.history {
-        text.push_str(&format!(" → {:.3e} ({} active)", it.residual, it.active));
+        match it.tolerance {
+            Some(eta) => text.push_str(&format!(" → {:.3e} ({} active, solved to {eta:.0e})", it.residual, it.active)),
+            None => text.push_str(&format!(" → {:.3e} ({} active)", it.residual, it.active)),
+        }
     }
     text
 }

@@ -31,10 +31,11 @@ pub(super) fn read_series(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 }
 
 /// Every column of `rows` equals `reference`'s to 1e-8 of the column's largest value (NaN where
-/// it is NaN), as many rows.
+/// it is NaN), as many rows; but `newton`, the count of Newton's iterations, which an iterative
+/// solver's loose solves raise by design (inexact Newton) where the direct solver's need none.
 pub(super) fn assert_agree(what: &str, header: &[String], reference: &[Vec<f64>], rows: &[Vec<f64>]) {
     assert_eq!(reference.len(), rows.len(), "{what}: as many rows");
-    for (c, column) in header.iter().enumerate() {
+    for (c, column) in header.iter().enumerate().filter(|(_, name)| *name != "newton") {
         let scale = reference.iter().map(|r| r[c].abs()).filter(|v| v.is_finite()).fold(0.0, f64::max);
         for (d, p) in reference.iter().zip(rows) {
             let (d, p) = (d[c], p[c]);

@@ -196,6 +196,8 @@ pub struct Factorization {
     work: Vec<f64>,
     /// The nodes' coordinates (`nodes × dim`), for a multigrid's near-null space.
     coordinates: Option<Arc<[f64]>>,
+    /// Relative residual ‖b − A x‖₂ ≤ tolerance·‖b‖₂ at which iterative solves stop.
+    tolerance: f64,
 }
 
 impl Factorization {
@@ -210,6 +212,7 @@ impl Factorization {
             counters: Counters::default(),
             work: Vec::new(),
             coordinates: None,
+            tolerance: crate::linalg::krylov::TOLERANCE,
         }
     }
 
@@ -237,6 +240,23 @@ impl Factorization {
         self.structure
     }
 
+    /// Iterative solves from now on stop at ‖b − A x‖₂ ≤ `rtol`·‖b‖₂ (default
+    /// [`TOLERANCE`](crate::linalg::krylov::TOLERANCE)): Newton asks each solve for the accuracy
+    /// its iteration needs. Direct solves are unaffected.
+    pub fn set_tolerance(&mut self, rtol: f64) {
+        self.tolerance = rtol;
+    }
+
+    /// Whether solves stop at a tolerance (Krylov methods, ours or PETSc's).
+    pub fn iterates(&self) -> bool {
+        match &self.factors {
+            Factors::Krylov(_) => true,
+            #[cfg(feature = "petsc")]
+            Factors::Petsc(_) => true,
+            _ => false,
+        }
+    }
+
     /// Factors `a`: the symbolic analysis if `a`'s pattern is new, the numeric factorization
     /// always.
     pub fn factor(&mut self, a: &Matrix) -> Result<(), LinalgError> {
@@ -250,16 +270,8 @@ impl Factorization {
             return self.factor_petsc(a);
         }
         if self.solver.iterates(n, a.pattern.dim()) {
-            // Keep the last solution as the next first guess across refactorizations.
-            let last = match std::mem::replace(&mut self.factors, Factors::None) {
-                Factors::Krylov(k) => Some(k),
-                _ => None,
-            };
-            let mut k =
+            let k =
                 crate::linalg::krylov::Krylov::new(a.clone(), self.structure == Structure::SymmetricPositiveDefinite)?;
-            if let Some(old) = last {
-                k.inherit(&old);
-            }
             self.factors = Factors::Krylov(Box::new(k));
             self.pattern = Some(a.pattern.clone());
             self.counters.numeric += 1;
@@ -369,6 +381,7 @@ impl Factorization {
             counters: Counters::default(),
             work: Vec::new(),
             coordinates: self.coordinates.clone(),
+            tolerance: self.tolerance,
         }
     }
 
@@ -467,7 +480,7 @@ impl Factorization {
             return Ok(());
         }
         if let Factors::Krylov(k) = &mut self.factors {
-            let result = k.solve_in_place(b);
+            let result = k.solve_in_place(b, self.tolerance);
             self.counters.iterations += k.iterations;
             self.counters.solves += 1;
             return result;
@@ -475,7 +488,7 @@ impl Factorization {
         #[cfg(feature = "petsc")]
         if let Factors::Petsc(k) = &mut self.factors {
             let setups = k.setups;
-            let result = k.solve_in_place(b);
+            let result = k.solve_in_place(b, self.tolerance);
             // A PETSc solver's factorizations are its preconditioner's setups.
             self.counters.numeric += k.setups - setups;
             self.counters.iterations += k.iterations;

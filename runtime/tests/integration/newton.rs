@@ -288,3 +288,43 @@ fn a_residual_on_the_contact_dofs_alone_gives_the_same_answer() {
 fn norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
+
+/// Inexact Newton: under loads growing step by step, as in a run through an impact, each solve's
+/// active set grows from the last one's. The iterative solves whose iteration is expected to
+/// change the set are loose, the ones that end Newton tight; the answers still meet Newton's
+/// tolerance and agree with the direct solver's.
+#[test]
+fn iterative_solves_are_as_loose_as_their_newton_iteration_allows() {
+    let run = |solver| {
+        let options = NewtonOptions { solver, ..NewtonOptions::default() };
+        let (_, _, mut problem, _) = solve_on(true, options, Some(16..49), false);
+        let full = problem.f.clone();
+        let mut u = vec![0.0; full.len()];
+        let mut newton = Newton::new(options);
+        let mut out = Vec::new();
+        for scale in [0.5, 0.7, 0.9, 1.1, 1.3] {
+            problem.f.iter_mut().zip(&full).for_each(|(f, g)| *f = scale * g);
+            let mut r0 = vec![0.0; u.len()];
+            problem.residual(&u, &mut r0);
+            let report = newton.solve(&mut problem, &mut u).unwrap();
+            let mut r = vec![0.0; u.len()];
+            problem.residual(&u, &mut r);
+            assert!(norm(&r) <= options.tol * norm(&r0), "‖R‖ = {:.1e} from {:.1e}", norm(&r), norm(&r0));
+            out.push((u.clone(), report));
+        }
+        out
+    };
+    let (direct, iterative) = (run(Solver::Direct), run(Solver::Iterative));
+    let mut loose = 0;
+    for ((a, d), (b, i)) in direct.iter().zip(&iterative) {
+        assert!(d.history.iter().all(|it| it.tolerance.is_none()), "direct solves have no tolerance");
+        let tolerances: Vec<f64> = i.history.iter().map(|it| it.tolerance.expect("an iterative solve")).collect();
+        assert!(*tolerances.last().unwrap() <= 1e-8, "the last solve is tight: {tolerances:?}");
+        loose += tolerances.iter().filter(|t| **t >= 1e-4).count();
+        assert!(a.iter().any(|x| *x < PSI), "in contact");
+        let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let diff = a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        assert!(diff < 1e-9 * scale, "the answers differ by {diff:.1e} of {scale:.1e}");
+    }
+    assert!(loose > 0, "solves expected to change the active set are loose");
+}

@@ -223,6 +223,8 @@ pub struct PetscSolver {
     /// The Krylov method's tolerances (ours, or the user's options): a solve with a kept
     /// preconditioner stops earlier and sets one up again.
     tolerances: (f64, f64, f64, sys::PetscInt),
+    /// The relative tolerance is the user's (`-ksp_rtol`), not the caller's.
+    user_rtol: bool,
     /// Krylov iterations of the last solve.
     pub iterations: usize,
     /// Preconditioners set up so far.
@@ -367,6 +369,8 @@ impl PetscSolver {
         call("KSPGetTolerances", unsafe {
             sys::KSPGetTolerances(ksp.0, &mut tolerances.0, &mut tolerances.1, &mut tolerances.2, &mut tolerances.3)
         })?;
+        // `-ksp_rtol` given by the user stands; otherwise each solve's is Newton's.
+        let user_rtol = tolerances.0 != rtol;
         let split = match layout {
             Some(layout) => {
                 let (mut gather, mut all) = (OwnedScatter(std::ptr::null_mut()), OwnedVec(std::ptr::null_mut()));
@@ -390,6 +394,7 @@ impl PetscSolver {
             baseline: None,
             stale: false,
             tolerances,
+            user_rtol,
             iterations: 0,
             setups: 0,
         };
@@ -463,8 +468,11 @@ impl PetscSolver {
 
     /// Solves `A x = b` in place, from x = 0 (Newton's corrections shrink from one solve to the
     /// next: the last one is a worse first guess than none).
-    pub fn solve_in_place(&mut self, b: &mut [f64]) -> Result<(), LinalgError> {
+    pub fn solve_in_place(&mut self, b: &mut [f64], rtol: f64) -> Result<(), LinalgError> {
         let _petsc = lock()?;
+        if !self.user_rtol {
+            self.tolerances.0 = rtol;
+        }
         let n = b.len();
         let local = self.split.as_ref().map_or(n, |s| s.layout.mine.len());
         self.rhs.with_values(local, |v| match &self.split {
