@@ -60,11 +60,13 @@ pub struct SphereTiming {
     pub model: Option<Model>,
 }
 
-/// Fine-level matrix products per Krylov iteration of CG with GAMG at PETSc's defaults: CG's
-/// own, the residual restricted to the next level, and the Chebyshev smoother before and after
-/// (2 iterations from a nonzero guess: 3 products each). `-log_view -pc_mg_log` on the 47k
-/// sphere agrees: the finest level's smoothing takes 3 times its residual's time per call.
-pub const PRODUCTS_PER_ITERATION: f64 = 8.0;
+/// Matrix reads per Krylov iteration of CG with PETSc's block Jacobi, the sphere's
+/// preconditioner: CG's product, and ILU(0)'s two triangular solves, whose factors L and U
+/// have the matrix's pattern and so read its entries once more. (GAMG, were it chosen, reads
+/// the finest matrix about 8 times: CG's product, the residual restricted to the next level,
+/// and Chebyshev's two smoothings of 3 products, as `-log_view -pc_mg_log` on the 47k sphere
+/// showed.)
+pub const PRODUCTS_PER_ITERATION: f64 = 2.0;
 
 /// A step's Krylov solves as memory traffic: each fine-level product reads the matrix (AIJ:
 /// 8-byte values, 4-byte column indices and row offsets) once, at the triad's bandwidth of as

@@ -131,6 +131,13 @@ unsafe extern "C" {
     pub fn KSPSetType(ksp: KSP, kind: *const c_char) -> PetscErrorCode;
     pub fn KSPGetPC(ksp: KSP, pc: *mut PC) -> PetscErrorCode;
     pub fn PCSetType(pc: PC, kind: *const c_char) -> PetscErrorCode;
+    pub fn PCSetFromOptions(pc: PC) -> PetscErrorCode;
+    pub fn PetscOptionsHasName(
+        options: *mut c_void,
+        pre: *const c_char,
+        name: *const c_char,
+        set: *mut PetscBool,
+    ) -> PetscErrorCode;
     pub fn KSPSetTolerances(
         ksp: KSP,
         rtol: PetscReal,
