@@ -264,8 +264,8 @@ pub struct ProblemArgs {
     pub(super) checkpoint: CheckpointArgs,
     /// Linear solver of each step: direct (sparse Cholesky/LU), iterative (Jacobi-preconditioned
     /// CG, or BiCGStab for unsymmetric tangents; memory of the matrix only), auto (iterative
-    /// above 10 000 unknowns in 3D, 100 000 in 2D), or petsc (CG or GMRES with algebraic
-    /// multigrid; a build with `--features petsc`).
+    /// above 10 000 unknowns in 3D, 100 000 in 2D), or petsc (CG or GMRES with block Jacobi, or
+    /// algebraic multigrid where that does not serve; a build with `--features petsc`).
     #[arg(long, value_parser = Solver::parse, default_value = name_of(Solver::default()))]
     pub(super) solver: Solver,
     /// Options for PETSc's solvers, over the defaults of --solver petsc (`PETSC_OPTIONS` is

@@ -109,8 +109,8 @@ fn diagonal_inverse(a: &Matrix, structure: Structure) -> Result<Option<Vec<f64>>
 /// How a `Factorization` solves: a sparse direct factorization, preconditioned Krylov
 /// iterations (conjugate gradients for SPD matrices, BiCGStab otherwise; memory of the matrix
 /// only), by size: direct in 1D, iterative above [`AUTO_ITERATIVE_DOFS`] unknowns in 2D and 3D
-/// (PETSc in a run of several processes); or PETSc's Krylov solvers with algebraic multigrid
-/// (feature `petsc`).
+/// (PETSc in a run of several processes); or PETSc's Krylov solvers with block Jacobi or
+/// algebraic multigrid (feature `petsc`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Solver {
@@ -242,9 +242,15 @@ impl Factorization {
 
     /// Iterative solves from now on stop at ‖b − A x‖₂ ≤ `rtol`·‖b‖₂ (default
     /// [`TOLERANCE`](crate::linalg::krylov::TOLERANCE)): Newton asks each solve for the accuracy
-    /// its iteration needs. Direct solves are unaffected.
-    pub fn set_tolerance(&mut self, rtol: f64) {
+    /// its iteration needs. Returns the tolerance they will stop at (a user's PETSc `-ksp_rtol`
+    /// stands). Direct solves are unaffected.
+    pub fn set_tolerance(&mut self, rtol: f64) -> f64 {
         self.tolerance = rtol;
+        #[cfg(feature = "petsc")]
+        if let Factors::Petsc(k) = &self.factors {
+            return k.tolerance(rtol);
+        }
+        rtol
     }
 
     /// Whether solves stop at a tolerance (Krylov methods, ours or PETSc's).
@@ -381,7 +387,7 @@ impl Factorization {
             counters: Counters::default(),
             work: Vec::new(),
             coordinates: self.coordinates.clone(),
-            tolerance: self.tolerance,
+            tolerance: crate::linalg::krylov::TOLERANCE,
         }
     }
 

@@ -119,14 +119,6 @@ impl Krylov {
         if self.symmetric { self.matrix.mul_vec_transposed(x, y) } else { self.matrix.mul_vec(x, y) }
     }
 
-    /// b − A x.
-    fn residual(&self, b: &[f64], x: &[f64]) -> Vec<f64> {
-        let mut r = vec![0.0; b.len()];
-        self.mul(x, &mut r);
-        update(&mut r, b, |ax, bi| bi - ax);
-        r
-    }
-
     /// Whether `method` has converged with residual `r`; an error once it never will: past the
     /// iteration limit, or stalled ([`STALL`] iterations without halving its best residual).
     fn converged(&mut self, method: &str, r: &[f64], norm_b: f64) -> Result<bool, LinalgError> {
@@ -192,7 +184,8 @@ impl Krylov {
 
     fn cg(&mut self, b: &[f64], x: &mut [f64], norm_b: f64) -> Result<(), LinalgError> {
         let n = b.len();
-        let mut r = self.residual(b, x);
+        // x = 0: the residual is b.
+        let mut r = b.to_vec();
         let mut z = vec![0.0; n];
         self.precondition(&r, &mut z);
         let mut p = z.clone();
@@ -220,7 +213,7 @@ impl Krylov {
 
     fn bicgstab(&mut self, b: &[f64], x: &mut [f64], norm_b: f64) -> Result<(), LinalgError> {
         let n = b.len();
-        let mut r = self.residual(b, x);
+        let mut r = b.to_vec();
         let r0 = r.clone();
         let (mut rho, mut alpha, mut omega) = (1.0, 1.0, 1.0);
         let [mut v, mut p, mut t, mut y, mut s, mut zs] = std::array::from_fn(|_| vec![0.0; n]);

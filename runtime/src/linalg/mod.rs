@@ -3,7 +3,7 @@
 //! LU, and a copy of the Cholesky factor in node blocks for the solves), products with a
 //! symmetric matrix's lower half, block-Jacobi Krylov solvers, and low-rank corrections of a
 //! factorization by element matrices kept apart; with the feature `petsc`, PETSc's Krylov
-//! solvers and algebraic multigrid behind the same `Factorization`.
+//! solvers (block Jacobi or algebraic multigrid) behind the same `Factorization`.
 
 pub mod block_factor;
 pub mod element_matrices;

@@ -263,11 +263,9 @@ impl Newton {
             let f = self.reuse.factorization.as_mut().expect("factored above");
             let iterative = f.iterates();
             let norm2_r = if iterative { norm2(r) } else { 0.0 };
-            let loose = iterative && piecewise && report.history.is_empty() && self.first_changed;
-            let eta = iterative.then(|| forcing(norm2_r, threshold, loose));
-            if let Some(eta) = eta {
-                f.set_tolerance(eta);
-            }
+            let loose =
+                iterative && piecewise && !self.options.line_search && report.history.is_empty() && self.first_changed;
+            let eta = iterative.then(|| f.set_tolerance(forcing(norm2_r, threshold, loose)));
             let trusted = if piecewise && !self.options.line_search { self.reuse.solve_accuracy } else { None };
             // A correction of a reference whose solves are trusted reports the residual it
             // leaves itself (`LowRank::solve`): its first solve needs no product J δ then.
@@ -455,11 +453,18 @@ impl Newton {
 /// solve's error anyway; otherwise what brings R below Newton's threshold (the 2-norm bounds
 /// the ∞-norm the threshold is in), never tighter than the solvers' default.
 fn forcing(norm2_r: f64, threshold: f64, loose: bool) -> f64 {
-    if loose { LOOSE } else { (FINISH * threshold / norm2_r).max(crate::linalg::krylov::TOLERANCE) }
+    let tight = crate::linalg::krylov::TOLERANCE;
+    // The clamp also catches a zero or infinite ‖R‖₂ (NaN falls to the tight end).
+    if loose { LOOSE } else { (FINISH * threshold / norm2_r).clamp(tight, LOOSE).max(tight) }
 }
 
+/// ‖v‖₂, scaled by ‖v‖∞ so that neither tiny nor huge entries under- or overflow.
 fn norm2(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+    let scale = norm_inf(v);
+    if scale == 0.0 || !scale.is_finite() {
+        return scale;
+    }
+    scale * v.iter().map(|x| (x / scale) * (x / scale)).sum::<f64>().sqrt()
 }
 
 #[cfg(test)]

@@ -215,9 +215,9 @@ pub struct PetscSolver {
     values: Vec<f64>,
     /// Across processes: the split, and what gathers the solution on every process.
     split: Option<Split>,
-    /// Iterations of the first solve with the preconditioner in use; none when the next solve
-    /// sets one up.
-    baseline: Option<usize>,
+    /// Iterations per digit gained (see [`digits`]) of the first solve with the preconditioner in
+    /// use; none when the next solve sets one up.
+    baseline: Option<f64>,
     /// Whether the preconditioner in use has stopped serving (a solve took more than
     /// [`LAG_GROWTH`] times the first's iterations): the next new values get one of their own.
     stale: bool,
@@ -239,16 +239,24 @@ pub struct PetscSolver {
 /// until a solve takes more than this many times the iterations of its first solve: a GAMG
 /// setup costs tens of iterations (an ILU(0) a few), while the preconditioner of a nearby
 /// matrix costs a few.
-const LAG_GROWTH: usize = 2;
+const LAG_GROWTH: f64 = 2.0;
 
-/// Iterations above which the first solve with a new block-Jacobi preconditioner makes the
-/// solver switch to GAMG for good. A time step's matrix c·M + K + J_C, c ∝ 1/Δt², is
-/// conditioned by its mass term: on the sphere through impact (Newmark, Δt = 0.02) block Jacobi
-/// with ILU(0) per process took 15 iterations per solve at 108k unknowns and 22 at 274k, GAMG
-/// 16 and 25, each of GAMG's costing 3.1 of block Jacobi's (3.4 against 12.5 s per step at
-/// 274k). A stiffness alone is not: the static Hertz ball at 51k unknowns took 212 iterations
-/// per solve against GAMG's 39 (36.5 against 27.3 s). The limit sits between.
-const ONE_LEVEL_LIMIT: usize = 100;
+/// The decimal digits a solve to the relative tolerance `rtol` gains (at least one): the solves'
+/// tolerances vary (inexact Newton), so iterations are compared per digit.
+fn digits(rtol: f64) -> f64 {
+    (-rtol.log10()).max(1.0)
+}
+
+/// Iterations per digit gained above which a solve with a new block-Jacobi preconditioner
+/// gives up, and the solver turns to GAMG and solves again (until its next checkpoint, which
+/// starts every solver afresh). A time step's matrix c·M + K + J_C, c ∝ 1/Δt², is conditioned
+/// by its mass term: on the sphere through impact (Newmark, Δt = 0.02) block Jacobi with ILU(0)
+/// per process took 15 iterations per solve at 108k unknowns and 22 at 274k, GAMG 16 and 25,
+/// each of GAMG's costing 3.1 of block Jacobi's (3.4 against 12.5 s per step at 274k); under
+/// 2 per digit. A stiffness alone is not: the static Hertz ball at 51k unknowns took 212
+/// iterations per solve to 1e-12 (18 per digit) against GAMG's 39 (36.5 against 27.3 s). The
+/// limit sits between.
+const ONE_LEVEL_LIMIT: f64 = 8.0;
 
 /// A system solved across processes. Every process holds the whole matrix and right-hand side
 /// (it assembled them); it gives PETSc its own rows, and receives the whole solution.
@@ -383,13 +391,9 @@ impl PetscSolver {
         call("KSPGetTolerances", unsafe {
             sys::KSPGetTolerances(ksp.0, &mut tolerances.0, &mut tolerances.1, &mut tolerances.2, &mut tolerances.3)
         })?;
-        // `-ksp_rtol` given by the user stands; otherwise each solve's is Newton's.
-        let user_rtol = tolerances.0 != rtol;
-        let mut user_pc = 0;
-        // SAFETY: the global options database, a NUL-terminated name, one flag written.
-        call("PetscOptionsHasName", unsafe {
-            sys::PetscOptionsHasName(std::ptr::null_mut(), std::ptr::null(), c"-pc_type".as_ptr(), &mut user_pc)
-        })?;
+        // `-ksp_rtol` given by the user stands, otherwise each solve's is Newton's; `-pc_type`
+        // given by the user is kept.
+        let (user_rtol, user_pc) = (given(c"-ksp_rtol")?, given(c"-pc_type")?);
         let split = match layout {
             Some(layout) => {
                 let (mut gather, mut all) = (OwnedScatter(std::ptr::null_mut()), OwnedVec(std::ptr::null_mut()));
@@ -414,7 +418,7 @@ impl PetscSolver {
             stale: false,
             tolerances,
             user_rtol,
-            adaptive: user_pc == 0,
+            adaptive: !user_pc,
             iterations: 0,
             setups: 0,
         };
@@ -469,10 +473,14 @@ impl PetscSolver {
     /// One Krylov solve of the right-hand side in place: its iterations and PETSc's reason.
     fn krylov(&mut self) -> Result<(usize, c_int), LinalgError> {
         let (rtol, abstol, dtol, most) = self.tolerances;
-        // With a kept preconditioner, past a few times its first solve's iterations a new one
-        // is cheaper.
+        let digits = digits(rtol);
+        let cap = |its: f64| most.min(its.ceil() as sys::PetscInt);
         let limit = match self.baseline {
-            Some(first) => most.min(sys::PetscInt::try_from(4 * first + 20).unwrap_or(most)),
+            // With a kept preconditioner, past a few times its first solve's iterations (per
+            // digit gained) a new one is cheaper.
+            Some(rate) => cap(4.0 * rate * digits + 20.0),
+            // A new block-Jacobi preconditioner that needs more than this is replaced by GAMG.
+            None if self.adaptive => cap(ONE_LEVEL_LIMIT * digits),
             None => most,
         };
         let (mut its, mut reason): (sys::PetscInt, c_int) = (0, 0);
@@ -486,8 +494,14 @@ impl PetscSolver {
         Ok((its.max(0) as usize, reason))
     }
 
-    /// Solves `A x = b` in place, from x = 0 (Newton's corrections shrink from one solve to the
-    /// next: the last one is a worse first guess than none).
+    /// The relative tolerance a solve asked for `rtol` stops at: the user's `-ksp_rtol` if given.
+    pub fn tolerance(&self, rtol: f64) -> f64 {
+        if self.user_rtol { self.tolerances.0 } else { rtol }
+    }
+
+    /// Solves `A x = b` in place to the relative tolerance `rtol` (see [`Self::tolerance`]), from
+    /// x = 0 (Newton's corrections shrink from one solve to the next: the last one is a worse
+    /// first guess than none).
     pub fn solve_in_place(&mut self, b: &mut [f64], rtol: f64) -> Result<(), LinalgError> {
         let _petsc = lock()?;
         if !self.user_rtol {
@@ -499,36 +513,43 @@ impl PetscSolver {
             Some(s) => v.iter_mut().zip(&s.layout.mine).for_each(|(x, &dof)| *x = b[dof]),
             None => v.copy_from_slice(b),
         })?;
+        let digits = digits(self.tolerances.0);
         let (mut its, mut reason) = self.krylov()?;
+        let mut total = its;
         if reason <= 0 && self.baseline.is_some() {
             // A kept preconditioner that no longer serves: set up for these values, again.
             self.reuse(false)?;
             (its, reason) = self.krylov()?;
+            total += its;
         }
-        self.iterations = its;
+        if reason <= 0 && self.adaptive {
+            // A new block-Jacobi preconditioner that failed or reached its limit: too hard for
+            // one level, multigrid from now on.
+            tracing::info!(iterations = its, "block Jacobi does not serve this matrix: PETSc's GAMG from now on");
+            let mut pc: sys::PC = std::ptr::null_mut();
+            // SAFETY: the KSP's own PC; the user's -pc_gamg_* options apply to it.
+            unsafe {
+                call("KSPGetPC", sys::KSPGetPC(self.ksp.0, &mut pc))?;
+                call("PCSetType", sys::PCSetType(pc, c"gamg".as_ptr()))?;
+                call("PCSetFromOptions", sys::PCSetFromOptions(pc))?;
+            }
+            self.adaptive = false;
+            self.setups += 1;
+            self.reuse(false)?;
+            (its, reason) = self.krylov()?;
+            total += its;
+        }
+        self.iterations = total;
         if reason <= 0 {
-            return Err(diverged(reason, self.iterations));
+            return Err(diverged(reason, total));
         }
         match self.baseline {
-            None if self.adaptive && its > ONE_LEVEL_LIMIT => {
-                // Too hard for one level: multigrid from the next solve on.
-                tracing::info!(iterations = its, "block Jacobi needed too many iterations: PETSc's GAMG from now on");
-                let mut pc: sys::PC = std::ptr::null_mut();
-                // SAFETY: the KSP's own PC; the user's -pc_gamg_* options apply to it.
-                unsafe {
-                    call("KSPGetPC", sys::KSPGetPC(self.ksp.0, &mut pc))?;
-                    call("PCSetType", sys::PCSetType(pc, c"gamg".as_ptr()))?;
-                    call("PCSetFromOptions", sys::PCSetFromOptions(pc))?;
-                }
-                self.adaptive = false;
-                self.setups += 1;
-                self.reuse(false)?;
-            }
             None => {
-                self.baseline = Some(its);
+                self.baseline = Some(its as f64 / digits);
                 self.setups += 1;
             }
-            Some(first) => self.stale |= its > LAG_GROWTH * first.max(1),
+            // Tolerances differ from solve to solve (inexact Newton): iterations per digit.
+            Some(rate) => self.stale |= its as f64 > LAG_GROWTH * rate * digits + 2.0,
         }
         match &mut self.split {
             Some(s) => {
@@ -551,6 +572,16 @@ impl PetscSolver {
         }
         if b.iter().all(|v| v.is_finite()) { Ok(()) } else { Err(LinalgError::Singular { index: None }) }
     }
+}
+
+/// Whether the user's options (`--petsc-options`, `PETSC_OPTIONS`) name `option`.
+fn given(option: &CStr) -> Result<bool, LinalgError> {
+    let mut set = 0;
+    // SAFETY: the global options database, a NUL-terminated name, one flag written.
+    call("PetscOptionsHasName", unsafe {
+        sys::PetscOptionsHasName(std::ptr::null_mut(), std::ptr::null(), option.as_ptr(), &mut set)
+    })?;
+    Ok(set != 0)
 }
 
 /// The error of a Krylov solve that stopped without converging.
