@@ -1,7 +1,8 @@
 //! `--solver petsc` (feature `petsc`) against the direct solver: the disc through its first
 //! impact, with Nitsche's θ = 1 (symmetric tangents: CG) and θ = −1 (GMRES), and the sphere;
-//! every column of the series agrees to 1e-8 of its scale (`assert_agree`). Bad PETSc options
-//! are an error with PETSc's message.
+//! every column of the series agrees to 1e-8 of its scale (`assert_agree`). The user's
+//! `-ksp_rtol` and `-pc_type` stand; a static stiffness turns block Jacobi into GAMG. Bad PETSc
+//! options are an error with PETSc's message.
 
 use std::path::Path;
 use std::process::Command;
@@ -97,6 +98,39 @@ fn the_users_ksp_rtol_stands() {
     let iterations = |rows: &[Vec<f64>]| rows.iter().map(|r| r[newton]).collect::<Vec<_>>();
     assert_eq!(iterations(&petsc), iterations(&direct), "Newton's iterations, step by step");
     assert_agree("disc with -ksp_rtol", &header, &direct, &petsc, energy_scale(&tmp.join("direct")));
+    let _ = std::fs::remove_dir_all(&tmp);
+}
+
+/// The static block: block Jacobi does not serve a stiffness alone, so the solver turns to
+/// GAMG (and logs it); a user's `-pc_type` is kept as given. Both agree with the direct solver.
+#[test]
+fn a_static_stiffness_turns_to_multigrid_unless_the_user_chose() {
+    let tmp = std::env::temp_dir().join(format!("signorini-petsc-static-{}", std::process::id()));
+    series(&["static_block"], "direct", &tmp.join("direct"));
+    let summary = |dir: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).expect("a summary")).expect("JSON")
+    };
+    let direct = summary(&tmp.join("direct"));
+    let run = |options: &[&str], name: &str| {
+        let dir = tmp.join(name);
+        let out = Command::new(BIN)
+            .args(["run", "static_block", "--solver", "petsc", "--force", "--out"])
+            .arg(&dir)
+            .args(options)
+            .env("RUST_LOG", "signorini_runtime=info")
+            .output()
+            .expect("the binary runs");
+        let log = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(out.status.success(), "{name}: {log}");
+        let answer = summary(&dir);
+        for key in ["contact_force", "max_penetration", "active_points"] {
+            let (d, p) = (direct[key].as_f64().expect(key), answer[key].as_f64().expect(key));
+            assert!((d - p).abs() <= 1e-8 * d.abs(), "{name}: {key} {p} against {d}");
+        }
+        log.contains("GAMG from now on")
+    };
+    assert!(run(&[], "switched"), "block Jacobi gave way to GAMG");
+    assert!(!run(&["--petsc-options", "-pc_type bjacobi"], "chosen"), "the user's block Jacobi stays");
     let _ = std::fs::remove_dir_all(&tmp);
 }
 
