@@ -46,7 +46,7 @@ const TRUSTED_ACCURACY: f64 = 1e-12;
 const LOOSE: f64 = 1e-3;
 
 /// The fraction of Newton's threshold a solve that may end Newton leaves in ‖J δ + R‖₂. The
-/// energy columns are differences of energies 10⁴–10⁵ times larger, so they are the first to
+/// energy columns are differences of energies 10³–10⁵ times larger, so they are the first to
 /// show a solve's error: on the same run, 0.5 left 3.7e-8 of their scale between block-Jacobi
 /// CG and the direct path, 0.01 left 2.9e-8 with PETSc's GAMG, and 1e-3 leaves 1.9e-9 and
 /// 5.4e-9 (with 4772 → 3232 and 1260 → 926 Krylov iterations against a fixed 1e-12).
