@@ -34,9 +34,12 @@ pub(super) fn read_series(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 /// The energy scale of the run in `dir`: its summary's `kinetic_energy_max` (the disc's and the
 /// sphere's problem files declare it so; their energy is 0 at the start).
 pub(super) fn energy_scale(dir: &Path) -> f64 {
-    let text = std::fs::read_to_string(dir.join("summary.json")).expect("a summary");
-    let summary: serde_json::Value = serde_json::from_str(&text).expect("JSON");
-    summary["kinetic_energy_max"].as_f64().expect("kinetic_energy_max in the summary")
+    read_summary(dir)["kinetic_energy_max"].as_f64().expect("kinetic_energy_max in the summary")
+}
+
+/// `dir/summary.json`.
+fn read_summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).expect("a summary")).expect("JSON")
 }
 
 /// Every column of `rows` equals `reference`'s to 1e-8 of the column's largest value (NaN where
@@ -107,10 +110,7 @@ fn the_users_ksp_rtol_stands() {
 fn a_static_stiffness_turns_to_multigrid_unless_the_user_chose() {
     let tmp = std::env::temp_dir().join(format!("signorini-petsc-static-{}", std::process::id()));
     series(&["static_block"], "direct", &tmp.join("direct"));
-    let summary = |dir: &Path| -> serde_json::Value {
-        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).expect("a summary")).expect("JSON")
-    };
-    let direct = summary(&tmp.join("direct"));
+    let direct = read_summary(&tmp.join("direct"));
     let run = |options: &[&str], name: &str| {
         let dir = tmp.join(name);
         let out = Command::new(BIN)
@@ -122,7 +122,7 @@ fn a_static_stiffness_turns_to_multigrid_unless_the_user_chose() {
             .expect("the binary runs");
         let log = String::from_utf8_lossy(&out.stderr).to_string();
         assert!(out.status.success(), "{name}: {log}");
-        let answer = summary(&dir);
+        let answer = read_summary(&dir);
         for key in ["contact_force", "max_penetration", "active_points"] {
             let (d, p) = (direct[key].as_f64().expect(key), answer[key].as_f64().expect(key));
             assert!((d - p).abs() <= 1e-8 * d.abs(), "{name}: {key} {p} against {d}");
