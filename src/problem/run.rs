@@ -24,6 +24,7 @@ use crate::error::CaseError;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::library::Binding;
+use crate::runtime::linalg::pattern::Owners;
 use crate::simulation::{Problem, Simulation, Snapshots};
 
 /// Binds a problem with the library's defaults without running it: its params, the files in use
@@ -139,7 +140,19 @@ fn simulate(
     let start = Instant::now();
     let p = pf.problem();
     let (mesh, mesh_label) = super::bind::mesh(pf, ex, opts.mesh.as_deref(), opts.cell_size)?;
-    let asm = Assembler::new(&mesh);
+    // Under mpirun each process assembles the cells around the nodes it owns, where it can.
+    let ownership = match split(opts, pf, in_use)? {
+        true => crate::runtime::linalg::ownership::Ownership::of(&mesh).map_err(mpi)?,
+        false => None,
+    };
+    // Every process integrates over the problem's regions whole (the contact law's among them).
+    let whole: Vec<&str> =
+        pf.problem().regions.iter().map(|r| r.name.name.as_str()).chain(contact_region(pf)).collect();
+    let part = ownership.as_ref().map(|o| mesh.part(o.owners(), o.rank() as u32, &whole));
+    let asm = match (&part, &ownership) {
+        (Some((local, owned)), Some(o)) => Assembler::split(local, o.clone(), *owned),
+        _ => Assembler::new(&mesh),
+    };
     let n = asm.size();
     let quad = super::bind::settings(pf, ex, &p.quadrature)?;
     let max = crate::compiler::ir::MAX_DEGREE as f64;
@@ -170,13 +183,8 @@ fn simulate(
             Some(crate::runtime::fem::kernel::Coef::constant(vec![0.0; *len]))
         })
     };
-    // The contact law's `Gamma_C` is the obstacle's region (`on REGION`, or `Gamma_C`); none
-    // without an obstacle or a region `Gamma_C`.
     let contact = super::bind::CONTACT;
-    let contact_region: Option<&str> = match p.obstacles.first() {
-        Some(o) => Some(o.region.as_ref().map_or(contact, |r| r.name.as_str())),
-        None => p.regions.iter().any(|r| r.name.name == contact).then_some(contact),
-    };
+    let contact_region = contact_region(pf);
     let others: Vec<String> = p.regions.iter().map(|r| r.name.name.clone()).filter(|r| r != contact).collect();
     let (constraints, held) = dirichlet(pf, ex, &mesh)?;
     let problem = Problem {
@@ -232,7 +240,7 @@ fn simulate(
     }
     let binding = Binding { quadrature, regions, dim: mesh.dim() };
     let coef_vals = super::bind::coef_vals(pf, ex)?;
-    let reference = bound_reference(pf, ex, in_use, &mesh, runner.ops().contact_facets, t0)?;
+    let reference = bound_reference(pf, ex, in_use, asm.mesh(), runner.ops().contact_facets, t0)?;
     let mut observer = Observer::new(
         pf,
         ex,
@@ -261,7 +269,12 @@ fn simulate(
         ((t, values), switches)
     };
     let name = pf.name().to_string();
-    let mut snapshots = Snapshots::new(out.as_ref(), opts.vtu_every, &name);
+    // Every process of a split run writes its piece of each snapshot, into rank 0's directory.
+    let pieces = match &ownership {
+        Some(_) => shared_dir(out.as_ref())?,
+        None => out.clone(),
+    };
+    let mut snapshots = Snapshots::new(pieces.as_ref(), opts.vtu_every, &name);
     let (series, switches, iterations, stage_rows, outcome, counters, steps, last) = match &mut runner {
         Runner::Static(ops) => {
             // One equilibrium by the static driver: its single row is the solution.
@@ -437,7 +450,7 @@ fn simulate(
     put("factorizations", counters.numeric.into());
     put("symbolic_factorizations", counters.symbolic.into());
     put("low_rank_updates", counters.updates.into());
-    put("matrix_nnz", asm.pattern().nnz().into());
+    put("matrix_nnz", matrix_nnz(&asm)?.into());
     let factor_nnz = match &runner {
         Runner::Time(sim) => sim.stepper.factor_nnz(),
         Runner::Static(_) => None,
@@ -490,6 +503,56 @@ fn simulate(
         return Err(e);
     }
     Ok(run)
+}
+
+/// The contact law's `Gamma_C`: the obstacle's region (`on REGION`, or `Gamma_C`); none without
+/// an obstacle or a region `Gamma_C`.
+fn contact_region(pf: &ProblemFile) -> Option<&str> {
+    let (p, contact) = (pf.problem(), super::bind::CONTACT);
+    match p.obstacles.first() {
+        Some(o) => Some(o.region.as_ref().map_or(contact, |r| r.name.as_str())),
+        None => p.regions.iter().any(|r| r.name.name == contact).then_some(contact),
+    }
+}
+
+/// Whether a run under mpirun is split across its processes (each assembling the cells around
+/// the nodes it owns, `Mesh::part`), rather than repeated whole by each: a time run with PETSc's
+/// solvers and the material's mass. A static problem, another solver (which factors or iterates
+/// on the whole matrix), the redistributed or lumped mass and a scheme that estimates its
+/// critical step (both factor the whole mass) are repeated whole by every process.
+fn split(opts: &Options, pf: &ProblemFile, in_use: &FilesInUse) -> Result<bool, CaseError> {
+    use crate::runtime::linalg::{Solver, ranks};
+    if ranks::world().1 == 1
+        || pf.problem().run_static.is_some()
+        || opts.newton.solver != Solver::Petsc
+        || opts.mass != crate::simulation::MassChoice::Consistent
+    {
+        return Ok(false);
+    }
+    let (claims, _) = in_use.scheme_claims_and_law()?;
+    Ok(!claims.iter().any(|(c, _)| c == "cfl"))
+}
+
+fn mpi(e: crate::runtime::linalg::LinalgError) -> CaseError {
+    CaseError::Option(format!("MPI: {e}"))
+}
+
+/// Rank 0's output directory, on every process (collective).
+fn shared_dir(out: Option<&std::path::PathBuf>) -> Result<Option<std::path::PathBuf>, CaseError> {
+    let mut bytes = out.map(|d| d.to_string_lossy().into_owned().into_bytes()).unwrap_or_default();
+    crate::runtime::linalg::ranks::broadcast(&mut bytes).map_err(mpi)?;
+    let dir = String::from_utf8(bytes).map_err(|e| CaseError::Option(format!("rank 0's output directory: {e}")))?;
+    Ok((!dir.is_empty()).then(|| dir.into()))
+}
+
+/// The stored entries of the run's matrices: in a split run, every process's own rows (each
+/// holds those whole).
+fn matrix_nnz(asm: &Assembler) -> Result<u64, CaseError> {
+    let p = asm.pattern();
+    let Some(o) = p.ownership() else { return Ok(p.nnz() as u64) };
+    let d = p.dim() as u64;
+    let mine: u64 = (0..p.num_nodes()).filter(|&i| o.owns(i)).map(|i| p.neighbours(i).len() as u64 * d * d).sum();
+    crate::runtime::linalg::ranks::total(mine).map_err(mpi)
 }
 
 /// What runs a problem: the stepper (a time run), or a static problem's operators alone (its one

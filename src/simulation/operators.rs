@@ -89,7 +89,7 @@ impl Energies {
     /// With the stepper's lower-half pattern when it has one (the same pattern).
     pub fn new(asm: &Assembler, half: Option<&Arc<HalfPattern>>, stiffness: &Matrix, mass: &Matrix) -> Energies {
         let half = half.cloned().unwrap_or_else(|| Arc::new(HalfPattern::new(asm.pattern())));
-        let lower = |a: &Matrix| a.is_symmetric(1e-12).then(|| LowerHalf::new(a, &half));
+        let lower = |a: &Matrix| a.is_symmetric_everywhere(1e-12).then(|| LowerHalf::new(a, &half));
         Energies { stiffness: lower(stiffness), mass: lower(mass), work: Default::default(), last: Default::default() }
     }
 

@@ -1,5 +1,6 @@
 //! VTU snapshots of a run (displacement, velocity, the cells' von Mises stress) every K steps,
-//! and their PVD collection for ParaView.
+//! and their PVD collection for ParaView; a run split across processes writes one piece per
+//! process and a PVTU file per snapshot.
 
 use std::path::PathBuf;
 
@@ -21,14 +22,14 @@ impl Snapshots {
     }
 
     /// The displacement and velocity at step `k`, and the cell-mean von Mises stress when the
-    /// files in use provide it.
+    /// files in use provide it. In a run split across processes each writes a piece (its cells),
+    /// and rank 0 the PVTU file of the pieces: every process calls it, with the directory.
     pub fn write(&mut self, ops: &Operators, k: usize, t: f64, u: &[f64], v: &[f64]) -> Result<(), CaseError> {
         let Some(dir) = &self.dir else { return Ok(()) };
         if !k.is_multiple_of(self.every) {
             return Ok(());
         }
         let mesh = ops.asm.mesh();
-        let file = format!("{}_{k:06}.vtu", self.name);
         let vm = match (&ops.von_mises, &ops.cell_measure) {
             (Some(vm), Some(measure)) => {
                 let size = measure.cell_values(ops.asm, &[], 0.0);
@@ -41,10 +42,36 @@ impl Snapshots {
             crate::vtu::Field { name: "displacement", components: d, values: u },
             crate::vtu::Field { name: "velocity", components: d, values: v },
         ];
-        let cell = [crate::vtu::Field { name: "von_mises", components: 1, values: &vm }];
-        let path = dir.join("vtu").join(&file);
-        crate::vtu::write(&path, mesh, &point, &cell)
-            .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
+        let owned = ops.asm.owned_cells();
+        let cell = [crate::vtu::Field { name: "von_mises", components: 1, values: &vm[..owned] }];
+        let base = format!("{}_{k:06}", self.name);
+        let written = |path: &std::path::Path| {
+            let path = path.display().to_string();
+            move |source| CaseError::Write { path, source }
+        };
+        let file = match ops.asm.pattern().ownership() {
+            None => {
+                let file = format!("{base}.vtu");
+                let path = dir.join("vtu").join(&file);
+                crate::vtu::write(&path, mesh, &point, &cell).map_err(written(&path))?;
+                file
+            }
+            // A split run: each process writes the cells it owns, rank 0 the file that joins them.
+            Some(o) => {
+                let piece = |rank: usize| format!("{base}_{rank}.vtu");
+                let path = dir.join("vtu").join(piece(o.rank()));
+                let cells: Vec<usize> = (0..owned).collect();
+                crate::vtu::write_piece(&path, mesh, &cells, &point, &cell).map_err(written(&path))?;
+                if o.rank() != 0 {
+                    return Ok(());
+                }
+                let file = format!("{base}.pvtu");
+                let path = dir.join("vtu").join(&file);
+                let pieces: Vec<String> = (0..o.size()).map(piece).collect();
+                crate::vtu::write_parallel(&path, d, &pieces, &point, &cell).map_err(written(&path))?;
+                file
+            }
+        };
         self.written.push((t, format!("vtu/{file}")));
         Ok(())
     }

@@ -1,7 +1,8 @@
 //! Runs under `mpirun` (feature `petsc`): the disc and the sphere through their first impact on
 //! 1, 2 and 3 processes agree with the serial direct run to 1e-8 of each column's scale; a run
 //! resumed from its checkpoint on the same 2 processes has the bits of the uninterrupted one; a
-//! process that fails, alone or with the others, ends them all with its message; the commands
+//! split run's snapshots are pieces, one per process, that cover the mesh once; a process that
+//! fails, alone or with the others, ends them all with its message; the commands
 //! that run as one process refuse mpirun.
 
 use std::path::PathBuf;
@@ -136,4 +137,67 @@ fn commands_that_run_as_one_process_refuse_mpirun() {
     assert!(!ok, "report under mpirun failed");
     assert!(err.contains("`report` runs as one process"), "{err}");
     assert!(!dir.exists(), "nothing written");
+}
+
+/// The numbers of a VTU file's data array: `<Points>`'s with `name` "Points", else the one named.
+fn vtu_array(text: &str, name: &str) -> Vec<Vec<f64>> {
+    let start = match name {
+        "Points" => text.find("<Points>").expect("points"),
+        _ => text.find(&format!("Name=\"{name}\"")).unwrap_or_else(|| panic!("an array {name}")),
+    };
+    let body = &text[start..];
+    let body = &body[body.find(">\n").expect("an opening tag") + 2..];
+    let body = &body[body.find('\n').map_or(0, |i| if name == "Points" { i + 1 } else { 0 })..];
+    let body = &body[..body.find("</DataArray>").expect("a closing tag")];
+    body.lines().map(|l| l.split_whitespace().map(|x| x.parse().expect("a number")).collect()).collect()
+}
+
+#[test]
+fn a_split_run_writes_snapshots_as_pieces_that_cover_the_mesh_once() {
+    let root = scratch("pieces");
+    let (serial, split) = (root.join("serial"), root.join("split"));
+    let run = ["run", "disc", "--t-start", "6.3", "--t-end", "6.5", "--vtu-every", "5"];
+    let out = Command::new(BIN)
+        .args(run)
+        .args(["--solver", "direct", "--out"])
+        .arg(&serial)
+        .output()
+        .expect("the binary runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (ok, err) = mpirun(
+        3,
+        &[&run[..], &["--solver", "petsc", "--out", split.to_str().unwrap()]].concat(),
+        Duration::from_secs(300),
+    );
+    assert!(ok, "{err}");
+    let pvd = std::fs::read_to_string(split.join("disc.pvd")).expect("a collection");
+    for k in [0, 5, 10] {
+        let file = format!("vtu/disc_{k:06}.pvtu");
+        assert!(pvd.contains(&format!("file=\"{file}\"")), "the collection lists {file}: {pvd}");
+        let pvtu = std::fs::read_to_string(split.join(&file)).expect("a parallel file");
+        let whole = std::fs::read_to_string(serial.join(format!("vtu/disc_{k:06}.vtu"))).expect("a serial snapshot");
+        // Each node of the mesh, by its position, with its displacement.
+        let key = |x: &[f64]| format!("{:.9} {:.9}", x[0], x[1]);
+        let by_node = |text: &str| -> std::collections::HashMap<String, Vec<f64>> {
+            vtu_array(text, "Points").iter().map(|x| key(x)).zip(vtu_array(text, "displacement")).collect()
+        };
+        let expected = by_node(&whole);
+        let cells = |text: &str| vtu_array(text, "von_mises").len();
+        let (mut seen, mut cells_seen) = (std::collections::HashMap::new(), 0);
+        for rank in 0..3 {
+            let piece = format!("disc_{k:06}_{rank}.vtu");
+            assert!(pvtu.contains(&format!("Source=\"{piece}\"")), "{file} lists {piece}");
+            let text = std::fs::read_to_string(split.join("vtu").join(&piece)).expect("a piece");
+            cells_seen += cells(&text);
+            seen.extend(by_node(&text));
+        }
+        assert_eq!(cells_seen, cells(&whole), "snapshot {k}: the pieces' cells are the mesh's, each once");
+        assert_eq!(seen.len(), expected.len(), "snapshot {k}: every node in some piece");
+        let scale = expected.values().flatten().fold(1e-300f64, |m, x| m.max(x.abs()));
+        for (at, u) in &expected {
+            let v = &seen[at];
+            assert!(u.iter().zip(v).all(|(a, b)| (a - b).abs() <= 1e-8 * scale), "snapshot {k} at {at}: {u:?} {v:?}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&root);
 }

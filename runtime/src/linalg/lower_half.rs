@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 use rayon::prelude::*;
 
 use crate::linalg::matrix::Matrix;
-use crate::linalg::pattern::Pattern;
+use crate::linalg::pattern::{Owners, Pattern};
 
 /// Columns (nodes) per task: fixed, so the sums do not depend on the number of threads.
 const NODES_PER_TASK: usize = 512;
@@ -35,6 +35,8 @@ pub struct HalfPattern {
     /// node `order[p]`'s columns.
     source: Vec<usize>,
     tasks: Vec<Task>,
+    /// The pattern's owners of rows, in a run split across processes.
+    ownership: Option<Arc<dyn Owners>>,
 }
 
 /// Columns `start..end`; the task's buffer covers positions `start..reach`.
@@ -75,7 +77,7 @@ impl HalfPattern {
                 Task { start, end, reach }
             })
             .collect();
-        HalfPattern { d, order, ptr, rows, source, tasks }
+        HalfPattern { d, order, ptr, rows, source, tasks, ownership: p.ownership().cloned() }
     }
 
     fn nodes(&self) -> usize {
@@ -189,6 +191,9 @@ impl LowerHalf {
             (3, 1, 0), (3, 2, 0), (3, 3, 0), (3, 4, 0), (3, 1, 1), (3, 2, 1), (3, 3, 1), (3, 4, 1),
             (3, 2, 2), (3, 3, 2), (3, 4, 2), (3, 3, 3), (3, 4, 3), (3, 4, 4)
         );
+        if let Some(o) = &self.pattern.ownership {
+            o.complete(y);
+        }
     }
 
     /// The product for d = D, M matrices of which the first S (in storage order) are scalar.

@@ -25,7 +25,7 @@ impl Matrix {
         self.pattern.size()
     }
 
-    /// `y = A x`.
+    /// `y = A x` (whole in a split run: collective there, as every product).
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         y.iter_mut().for_each(|v| *v = 0.0);
         let p = &self.pattern;
@@ -34,6 +34,7 @@ impl Matrix {
                 y[p.row_idx[k]] += self.values[k] * xj;
             }
         }
+        p.complete(y);
     }
 
     /// xᵀ A y, as (Aᵀ x)ᵀ y: the column-gathering product reads half the bytes.
@@ -52,6 +53,8 @@ impl Matrix {
             2 => self.gather::<2>(x, y),
             _ => self.gather::<3>(x, y),
         }
+        // An owned node's columns are whole, as its rows are.
+        self.pattern.complete(y);
     }
 
     fn gather<const D: usize>(&self, x: &[f64], y: &mut [f64]) {
@@ -112,6 +115,16 @@ impl Matrix {
             rows[i] += v.abs();
         }
         rows.into_iter().fold(0.0, f64::max)
+    }
+
+    /// [`Matrix::is_symmetric`] on every process of a split run (collective there): each
+    /// holds a part of the matrix.
+    pub fn is_symmetric_everywhere(&self, tol: f64) -> bool {
+        let here = self.is_symmetric(tol);
+        match self.pattern.ownership() {
+            Some(o) => !o.any(!here),
+            None => here,
+        }
     }
 
     /// Whether |a_ij − a_ji| ≤ tol·max|a| for every stored entry.

@@ -13,6 +13,7 @@ pub mod lower_half;
 pub mod lowrank;
 pub mod matrix;
 pub mod norms;
+pub mod ownership;
 pub mod pattern;
 #[cfg(feature = "petsc")]
 pub mod petsc;

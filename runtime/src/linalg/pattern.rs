@@ -4,6 +4,8 @@
 //! For each cell it stores, for every pair of its nodes (i, j), the offset of node i's first
 //! row inside node j's columns, so element matrices are added in place without searching.
 
+use std::sync::Arc;
+
 /// Element matrix: `[test node][test component][trial node][trial component]`, the same
 /// memory as a row-major (N·D)×(N·D) matrix.
 pub type LocalMatrix<const D: usize, const N: usize> = [[[[f64; D]; N]; D]; N];
@@ -28,6 +30,30 @@ impl Connectivity<'_> {
     }
 }
 
+/// Who owns the rows of a pattern that holds one process's part of a system, in a run split
+/// across processes (`linalg::ownership::Ownership`, which exchanges over MPI). Every method
+/// but the first four is collective.
+pub trait Owners: std::fmt::Debug + Send + Sync {
+    /// This process.
+    fn rank(&self) -> usize;
+    /// The number of processes.
+    fn size(&self) -> usize;
+    /// Dofs per node.
+    fn dim(&self) -> usize;
+    /// Per node, the process that owns it.
+    fn owners(&self) -> &[u32];
+    /// Whether this process owns `node`.
+    fn owns(&self, node: usize) -> bool {
+        self.owners()[node] as usize == self.rank()
+    }
+    /// Makes `y`, right at this process's dofs, whole: every dof takes its owner's value.
+    fn complete(&self, y: &mut [f64]);
+    /// Whether `flag` holds on any process.
+    fn any(&self, flag: bool) -> bool;
+    /// The sum of every process's `x`, added in rank order (the same bits everywhere).
+    fn sum(&self, x: f64) -> f64;
+}
+
 /// The sparsity pattern of a vector field on a mesh (CSC, rows sorted in each column).
 #[derive(Debug)]
 pub struct Pattern {
@@ -40,6 +66,9 @@ pub struct Pattern {
     node_adj: Vec<u32>,
     /// Per cell, `[j][i]`: offset of node i's first row within the columns of node j.
     cell_offsets: Vec<u32>,
+    /// In a run split across processes, who owns which rows: this process's rows are complete,
+    /// the others partial, and products make their result whole ([`Owners::complete`]).
+    ownership: Option<Arc<dyn Owners>>,
 }
 
 /// Some entries of a pattern: their indices among the stored values, and their columns.
@@ -47,6 +76,30 @@ pub struct Pattern {
 pub struct Entries {
     pub indices: Vec<usize>,
     pub columns: Vec<u32>,
+}
+
+/// Each node's neighbours (the nodes it shares a cell with, and itself), sorted: node
+/// i's are `adj[ptr[i]..ptr[i + 1]]`.
+pub fn node_adjacency(mesh: &Connectivity) -> (Vec<usize>, Vec<u32>) {
+    let (inc_ptr, inc) = cells_of_nodes(mesh);
+    let mut adj_ptr = Vec::with_capacity(mesh.num_nodes + 1);
+    adj_ptr.push(0usize);
+    let mut adj: Vec<u32> = Vec::with_capacity(mesh.num_nodes * 2 * mesh.nodes_per_cell);
+    let mut scratch: Vec<u32> = Vec::new();
+    for n in 0..mesh.num_nodes {
+        scratch.clear();
+        // A node of no cell (in one process's part of a mesh, a node it neither owns nor
+        // touches) still has its diagonal block: every node neighbours itself.
+        scratch.push(n as u32);
+        for &c in &inc[inc_ptr[n]..inc_ptr[n + 1]] {
+            scratch.extend_from_slice(mesh.cell(c as usize));
+        }
+        scratch.sort_unstable();
+        scratch.dedup();
+        adj.extend_from_slice(&scratch);
+        adj_ptr.push(adj.len());
+    }
+    (adj_ptr, adj)
 }
 
 /// The cells of each node: node i's are `cells[ptr[i]..ptr[i + 1]]`, in increasing order.
@@ -77,22 +130,7 @@ impl Pattern {
         let npc = mesh.nodes_per_cell;
         let nodes = mesh.num_nodes;
         let cells = mesh.num_cells();
-        let (inc_ptr, inc) = cells_of_nodes(mesh);
-        // Node adjacency, sorted.
-        let mut adj_ptr = Vec::with_capacity(nodes + 1);
-        adj_ptr.push(0usize);
-        let mut adj: Vec<u32> = Vec::with_capacity(nodes * 2 * npc);
-        let mut scratch: Vec<u32> = Vec::new();
-        for n in 0..nodes {
-            scratch.clear();
-            for &c in &inc[inc_ptr[n]..inc_ptr[n + 1]] {
-                scratch.extend_from_slice(mesh.cell(c as usize));
-            }
-            scratch.sort_unstable();
-            scratch.dedup();
-            adj.extend_from_slice(&scratch);
-            adj_ptr.push(adj.len());
-        }
+        let (adj_ptr, adj) = node_adjacency(mesh);
         // Columns: node j's d columns each hold rows (i, k) for i adjacent to j.
         let size = nodes * d;
         let mut col_ptr = Vec::with_capacity(size + 1);
@@ -120,7 +158,26 @@ impl Pattern {
                 }
             }
         }
-        Pattern { dim: d, col_ptr, row_idx, node_ptr: adj_ptr, node_adj: adj, cell_offsets }
+        Pattern { dim: d, col_ptr, row_idx, node_ptr: adj_ptr, node_adj: adj, cell_offsets, ownership: None }
+    }
+
+    /// This pattern, of one process's cells in a run split across processes.
+    pub fn owned_by(mut self, ownership: Arc<dyn Owners>) -> Pattern {
+        self.ownership = Some(ownership);
+        self
+    }
+
+    /// Who owns the rows, in a run split across processes.
+    pub fn ownership(&self) -> Option<&Arc<dyn Owners>> {
+        self.ownership.as_ref()
+    }
+
+    /// Makes a vector that is right at this process's rows whole (nothing to do in a run of
+    /// one process). Collective in a split run.
+    pub fn complete(&self, y: &mut [f64]) {
+        if let Some(o) = &self.ownership {
+            o.complete(y);
+        }
     }
 
     /// Number of rows (= columns).

@@ -302,7 +302,7 @@ impl JacobianReuse {
         }
         self.jacobian_current = true;
         let want = match p.structure() {
-            Structure::Auto if self.spd_failed || !j.is_symmetric(1e-12) => Structure::General,
+            Structure::Auto if self.spd_failed || !j.is_symmetric_everywhere(1e-12) => Structure::General,
             Structure::Auto => Structure::SymmetricPositiveDefinite,
             s => s,
         };

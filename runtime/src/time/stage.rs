@@ -87,8 +87,22 @@ pub(super) fn zero_sum_groups(coefs: &[f64]) -> Vec<Vec<usize>> {
 
 /// Cholesky if every form's tangent is symmetric, LU otherwise. Nonlinear tangents are probed at
 /// pseudo-random states ±s, larger than the mesh, so that a switched term (a contact law's
-/// active set) is active at each point in one of them.
+/// active set) is active at each point in one of them. In a split run every process probes its
+/// cells, and one nonsymmetric part decides for all.
 pub(super) fn probe_structure(
+    asm: &Assembler,
+    forms: &HashMap<String, Box<dyn BoundForm + '_>>,
+    matrices: &HashMap<String, Matrix>,
+) -> Structure {
+    let here = probe_here(asm, forms, matrices);
+    match asm.pattern().ownership() {
+        Some(o) if o.any(here == Structure::General) => Structure::General,
+        Some(_) => Structure::SymmetricPositiveDefinite,
+        None => here,
+    }
+}
+
+fn probe_here(
     asm: &Assembler,
     forms: &HashMap<String, Box<dyn BoundForm + '_>>,
     matrices: &HashMap<String, Matrix>,
@@ -343,7 +357,6 @@ impl NonlinearProblem for StageProblem<'_, '_> {
         let a = &self.constant.matrix;
         let p = &a.pattern;
         r.fill(0.0);
-        let mut largest = 0.0f64;
         for (&i, left) in support.dofs.iter().zip(&support.lower_rows) {
             let below = p.col_ptr[i]..p.col_ptr[i + 1];
             let mut aw: f64 = left.iter().map(|&(k, j)| a.values[k] * w[j]).sum();
@@ -352,8 +365,14 @@ impl NonlinearProblem for StageProblem<'_, '_> {
                     aw += v * w[j];
                 }
             }
-            largest = largest.max(aw.abs());
-            r[i] = aw + self.rhs[i];
+            r[i] = aw;
+        }
+        // A split run's other rows are partial here: their owners' values replace them.
+        p.complete(r);
+        let mut largest = 0.0f64;
+        for &i in &support.dofs {
+            largest = largest.max(r[i].abs());
+            r[i] += self.rhs[i];
         }
         self.magnitude = self.magnitude.max(largest);
         self.add_terms(w, r);

@@ -672,10 +672,21 @@ impl<'a> Stepper<'a> {
         let report = newton.solve(&mut problem, &mut delta);
         // A NaN or infinite tangent (0/0 in a law's derivative) is said as such, not as the
         // singular matrix it makes.
-        if report.is_err()
-            && let Some(at) = problem.non_finite.take()
-        {
-            return Err(StepError::NonFiniteTangent { stage: stage.name.to_string(), t: stage_t, at });
+        // In a split run every process says so when one saw it (each decides alike what follows).
+        if report.is_err() {
+            let here = problem.non_finite.take();
+            let anywhere = match self.asm.pattern().ownership() {
+                Some(o) => o.any(here.is_some()),
+                None => here.is_some(),
+            };
+            if anywhere {
+                let at = here.unwrap_or_else(|| NonFiniteTangent {
+                    form: "(seen by another process)".into(),
+                    level: 0,
+                    nodes: Vec::new(),
+                });
+                return Err(StepError::NonFiniteTangent { stage: stage.name.to_string(), t: stage_t, at });
+            }
         }
         (*args, *term, *recorded) = (problem.args, problem.term, problem.recorded);
         self.pool.give(problem.rhs);

@@ -1,7 +1,8 @@
 //! Assembly through the runtime alone (a hand-written form, no compiler), on every element kind
 //! of the catalogue: the mass matrix integrates to ρ|Ω| per component, the stiffness gives
 //! ∫|∇x₁|² = |Ω| for the interpolated linear field x₁ and annihilates constants, matrices are
-//! symmetric, and the residual of a linear form is its tangent times the field.
+//! symmetric, and the residual of a linear form is its tangent times the field; a process's part
+//! of a mesh (a run split across processes) assembles its rows whole.
 
 use crate::common::{MassStiffness, pseudo_random};
 use signorini_runtime::fem::assembly::{Assembler, CellOrder, Quadrature};
@@ -132,4 +133,74 @@ fn threaded_assembly_has_the_same_bits_on_one_and_two_threads() {
     assert!(colours.iter().any(|c| c.len() > 2), "several blocks in a colour: {colours:?}");
     assert!(m1.iter().zip(&m2).all(|(a, b)| a.to_bits() == b.to_bits()), "matrix bits");
     assert!(r1.iter().zip(&r2).all(|(a, b)| a.to_bits() == b.to_bits()), "residual bits");
+}
+
+#[test]
+fn each_process_part_holds_its_rows_whole_and_the_parts_own_every_cell_once() {
+    // Three processes, owning slabs of nodes along x (an uneven split, as a partitioner's).
+    for mesh in [ball(1.0, [0.0, 0.0, 0.0], 0.3), cuboid([3, 2, 2], [0.0, 1.0], [0.0, 1.0], [0.0, 1.0], 2)] {
+        let name = mesh.kind.name();
+        let owner: Vec<u32> = (0..mesh.num_nodes())
+            .map(|i| {
+                let x = mesh.node(i)[0];
+                if x < -0.2 || (x < 0.3 && mesh.node(i)[1] > 0.5) {
+                    0
+                } else if x < 0.55 {
+                    1
+                } else {
+                    2
+                }
+            })
+            .collect();
+        let whole = Assembler::new(&mesh);
+        let n = whole.size();
+        let form = MassStiffness { rho: 1.5, k: 0.7 };
+        let u = pseudo_random(n, 11);
+        let (mut m, mut r) = (whole.zero_matrix(), vec![0.0; n]);
+        whole.cell_tangent(&form, Quadrature::default(), &[&u], 0, 0.0, &mut m);
+        whole.cell_residual(&form, Quadrature::default(), &[&u], 0.0, &mut r);
+        let mut mu = vec![0.0; n];
+        m.mul_vec(&u, &mut mu);
+        let scale = r.iter().chain(&mu).fold(0.0f64, |s, x| s.max(x.abs()));
+        let mut owned_cells: Vec<Vec<u32>> = Vec::new();
+        for rank in 0..3u32 {
+            let regions: Vec<&str> = mesh.regions.iter().map(|r| r.name.as_str()).collect();
+            let (part, owned) = mesh.part(&owner, rank, &regions[1..]);
+            // The cells it owns are those whose first node it owns.
+            for c in 0..part.num_cells() {
+                assert_eq!(c < owned, owner[part.cell(c)[0] as usize] == rank, "{name}: owned cells first");
+            }
+            owned_cells.extend((0..owned).map(|c| part.cell(c).to_vec()));
+            // Every region named keeps its facets, in order, on the same cells; the others are
+            // left out.
+            assert_eq!(part.regions.len(), mesh.regions.len() - 1, "{name}: the first region left out");
+            for (a, b) in mesh.regions[1..].iter().zip(&part.regions) {
+                assert_eq!(a.facets.len(), b.facets.len(), "{name}: region {}", a.name);
+                for (f, g) in a.facets.iter().zip(&b.facets) {
+                    assert_eq!((mesh.cell(f.cell as usize), f.local), (part.cell(g.cell as usize), g.local));
+                }
+            }
+            // Assembled on the part alone, the rows of its nodes are the whole mesh's.
+            let asm = Assembler::new(&part);
+            let (mut mp, mut rp) = (asm.zero_matrix(), vec![0.0; n]);
+            asm.cell_tangent(&form, Quadrature::default(), &[&u], 0, 0.0, &mut mp);
+            asm.cell_residual(&form, Quadrature::default(), &[&u], 0.0, &mut rp);
+            let mut mpu = vec![0.0; n];
+            mp.mul_vec(&u, &mut mpu);
+            let d = mesh.dim();
+            let mine: Vec<usize> = (0..n).filter(|&i| owner[i / d] == rank).collect();
+            assert!(!mine.is_empty() && mine.len() < n, "{name}: rank {rank} owns some rows");
+            for &i in &mine {
+                assert!((rp[i] - r[i]).abs() <= 1e-13 * scale, "{name}: rank {rank}, residual row {i}");
+                assert!((mpu[i] - mu[i]).abs() <= 1e-13 * scale, "{name}: rank {rank}, matrix row {i}");
+            }
+            // And some other row is not (the part does not hold every cell).
+            assert!((0..n).any(|i| (mpu[i] - mu[i]).abs() > 1e-8 * scale), "{name}: rank {rank} holds a part");
+        }
+        // The owned cells of the three parts are the mesh's cells, each once.
+        let mut all: Vec<Vec<u32>> = (0..mesh.num_cells()).map(|c| mesh.cell(c).to_vec()).collect();
+        all.sort();
+        owned_cells.sort();
+        assert_eq!(owned_cells, all, "{name}: every cell owned once");
+    }
 }

@@ -29,6 +29,7 @@ use crate::fem::mesh::{Facet, Mesh, MeshError};
 use crate::fem::quadrature::Rule;
 use crate::linalg::Matrix;
 use crate::linalg::element_matrices::ElementMatrices;
+use crate::linalg::pattern::Owners;
 pub use crate::linalg::pattern::Pattern;
 
 on_every_element_kind!(
@@ -80,6 +81,9 @@ pub struct Assembler<'m> {
     pattern: Arc<Pattern>,
     /// The blocks of cells and their colours (computed on first use).
     order: OnceLock<CellOrder>,
+    /// The cells this process counts in volume integrals: the mesh's first `owned` (all of them
+    /// unless the run is split across processes, `Mesh::part`).
+    owned: usize,
 }
 
 /// What a loop over cells or facets evaluates: a kernel at some fields and a time, with a
@@ -94,7 +98,22 @@ pub(crate) struct Job<'a, K> {
 
 impl<'m> Assembler<'m> {
     pub fn new(mesh: &'m Mesh) -> Self {
-        Assembler { mesh, pattern: Arc::new(Pattern::new(&mesh.connectivity())), order: OnceLock::new() }
+        let pattern = Arc::new(Pattern::new(&mesh.connectivity()));
+        Assembler { mesh, pattern, order: OnceLock::new(), owned: mesh.num_cells() }
+    }
+
+    /// One process's assembler in a run split across processes: `mesh` is its part of the
+    /// whole (`Mesh::part`), whose first `owned` cells it owns. Residuals and products are then
+    /// whole on every process (`Owners::complete`), volume integrals sum the owned cells of
+    /// every process, and facet integrals are computed whole by each.
+    pub fn split(mesh: &'m Mesh, ownership: Arc<dyn Owners>, owned: usize) -> Self {
+        let pattern = Arc::new(Pattern::new(&mesh.connectivity()).owned_by(ownership));
+        Assembler { mesh, pattern, order: OnceLock::new(), owned }
+    }
+
+    /// The cells whose volume integrals this process counts: the mesh's first `owned_cells()`.
+    pub fn owned_cells(&self) -> usize {
+        self.owned
     }
 
     /// The order of the cell loops: blocks of consecutive cells, coloured so that no two blocks
@@ -141,7 +160,8 @@ impl<'m> Assembler<'m> {
     /// Adds the volume part of `k`'s residual at `fields` to `out`.
     pub fn cell_residual<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64, out: &mut [f64]) {
         let job = self.cell_job(k, q, fields, t);
-        dispatch!(self.mesh.kind, cell_residual::<K>(&job, self.cell_order(), out))
+        dispatch!(self.mesh.kind, cell_residual::<K>(&job, self.cell_order(), out));
+        self.pattern.complete(out);
     }
 
     /// Adds the volume part of `k`'s tangent with respect to field `wrt` to `m`.
@@ -199,12 +219,17 @@ impl<'m> Assembler<'m> {
         dispatch!(self.mesh.kind, facet_switches::<K>(&job, wrt, out))
     }
 
-    /// The volume integral of a functional at `fields`.
+    /// The volume integral of a functional at `fields` (collective in a split run).
     pub fn cell_value<K: Functional>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64) -> f64 {
-        self.cell_values(k, q, fields, t).iter().sum()
+        let mine: f64 = self.cell_values(k, q, fields, t)[..self.owned].iter().sum();
+        match self.pattern.ownership() {
+            Some(o) => o.sum(mine),
+            None => mine,
+        }
     }
 
-    /// The volume integral of a functional on each cell.
+    /// The volume integral of a functional on each cell (of this process's part, in a split
+    /// run).
     pub fn cell_values<K: Functional>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64) -> Vec<f64> {
         let job = self.cell_job(k, q, fields, t);
         dispatch!(self.mesh.kind, cell_values::<K>(&job))

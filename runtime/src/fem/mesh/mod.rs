@@ -8,6 +8,7 @@ mod boundary;
 pub mod disc;
 pub mod gmsh;
 mod integrity;
+mod part;
 pub mod structured;
 mod validate;
 

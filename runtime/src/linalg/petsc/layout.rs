@@ -1,5 +1,5 @@
 //! How a system is split across processes: its nodes are partitioned (METIS, on the graph of
-//! the matrix's node blocks) and renumbered so that each process owns a contiguous range of
+//! the nodes that share a cell: the run's partition, or the matrix's) and renumbered so that each process owns a contiguous range of
 //! PETSc's rows, a node's dofs staying together.
 
 use std::sync::{Arc, Mutex, Weak};
@@ -44,11 +44,15 @@ impl Layout {
             return Err(LinalgError::Other(format!("{n} unknowns are not blocks of {dim}: cannot split them by node")));
         }
         let nodes = n / dim;
-        let owner = partition(pattern, dim, nodes, size)?;
+        // A split run's pattern carries its partition; otherwise the matrix's graph is split.
+        let owner: Vec<u32> = match pattern.ownership() {
+            Some(o) => o.owners().to_vec(),
+            None => partition(nodes, |node| pattern.neighbours(node), size)?,
+        };
         // Each process's nodes in their own order, after those of the processes before it.
         let mut next = vec![0usize; size];
         for &r in &owner {
-            next[r] += 1;
+            next[r as usize] += 1;
         }
         let mut start = 0;
         for count in &mut next {
@@ -57,6 +61,7 @@ impl Layout {
         let first = next[rank] * dim;
         let (mut to_petsc, mut mine) = (vec![0; n], Vec::new());
         for (node, &r) in owner.iter().enumerate() {
+            let r = r as usize;
             for c in 0..dim {
                 to_petsc[node * dim + c] = petsc_int(next[r] * dim + c)?;
                 if r == rank {
@@ -69,39 +74,42 @@ impl Layout {
     }
 }
 
+/// The process that owns each node of `mesh` among `size`: see [`partition`]. Every process
+/// computes it alone, and gets the same.
+pub fn partition_mesh(mesh: &crate::fem::mesh::Mesh, size: usize) -> Result<Vec<u32>, LinalgError> {
+    let (ptr, adj) = crate::linalg::pattern::node_adjacency(&mesh.connectivity());
+    partition(mesh.num_nodes(), |node| &adj[ptr[node]..ptr[node + 1]], size)
+}
+
 /// The process that owns each node: METIS's partition into `size` parts of the graph whose
-/// edges join nodes coupled in the matrix. Every process computes it alone, from its own copy of
-/// the pattern: METIS's seed is fixed, so each gets the same parts on every run (PT-Scotch's
-/// partition across processes, PETSc's, changed from run to run, and with it the bits).
-fn partition(pattern: &Pattern, dim: usize, nodes: usize, size: usize) -> Result<Vec<usize>, LinalgError> {
+/// edges join the nodes that share a cell (`neighbours`, sorted, the node itself among them).
+/// Every process computes it alone, from its own copy of the graph: METIS's seed is fixed, so
+/// each gets the same parts on every run (PT-Scotch's partition across processes, PETSc's,
+/// changed from run to run, and with it the bits).
+fn partition<'g>(nodes: usize, neighbours: impl Fn(usize) -> &'g [u32], size: usize) -> Result<Vec<u32>, LinalgError> {
     let index = |i: usize| {
         metis::Idx::try_from(i).map_err(|_| LinalgError::Other(format!("{i} nodes are too many for METIS's indices")))
     };
     let mut offsets = Vec::with_capacity(nodes + 1);
-    let mut neighbours = Vec::new();
+    let mut adjacent = Vec::new();
     offsets.push(0);
     for node in 0..nodes {
-        let col = node * dim;
-        let rows = &pattern.row_idx[pattern.col_ptr[col]..pattern.col_ptr[col + 1]];
-        let mut last = usize::MAX;
-        // Rows are sorted: their nodes come in order, each kept once.
-        for other in rows.iter().map(|&i| i / dim) {
-            if other != node && other != last {
-                neighbours.push(index(other)?);
+        for &other in neighbours(node) {
+            if other as usize != node {
+                adjacent.push(index(other as usize)?);
             }
-            last = other;
         }
-        offsets.push(index(neighbours.len())?);
+        offsets.push(index(adjacent.len())?);
     }
-    let failed = |e: &dyn std::fmt::Display| LinalgError::Other(format!("METIS cannot split the matrix's graph: {e}"));
+    let failed = |e: &dyn std::fmt::Display| LinalgError::Other(format!("METIS cannot split the mesh's graph: {e}"));
     let mut part = vec![0; nodes];
     let clock = std::time::Instant::now();
-    let cut = metis::Graph::new(1, index(size)?, &offsets, &neighbours)
+    let cut = metis::Graph::new(1, index(size)?, &offsets, &adjacent)
         .map_err(|e| failed(&e))?
         .part_kway(&mut part)
         .map_err(|e| failed(&e))?;
     // Partition quality: the edges cut among all (each edge is listed from both ends).
-    let edges = neighbours.len() / 2;
+    let edges = adjacent.len() / 2;
     tracing::info!(nodes, parts = size, cut, edges, seconds = clock.elapsed().as_secs_f64(), "METIS partition");
-    Ok(part.into_iter().map(|p| p.max(0) as usize).collect())
+    Ok(part.into_iter().map(|p| p.max(0) as u32).collect())
 }

@@ -188,6 +188,7 @@ handle!(OwnedScatter, sys::VecScatter, VecScatterDestroy);
 
 mod layout;
 use layout::Layout;
+pub use layout::partition_mesh;
 
 impl OwnedVec {
     /// Runs `f` on the vector's values.
@@ -434,15 +435,21 @@ impl PetscSolver {
     /// Takes `a`'s values (same pattern); the preconditioner of the last values is kept while it
     /// serves (see [`LAG_GROWTH`]), and rebuilt at the next solve otherwise.
     pub fn set_values(&mut self, a: &Matrix) -> Result<(), LinalgError> {
+        // Setting values is collective: in a split run every process sets them when any
+        // process's part changed (asked before PETSc's lock, which the exchange takes).
+        let same = self.values == a.values;
+        if match a.pattern.ownership() {
+            Some(o) => !o.any(!same),
+            None => same,
+        } {
+            return Ok(());
+        }
         let _petsc = lock()?;
         self.take_values(a)
     }
 
     fn take_values(&mut self, a: &Matrix) -> Result<(), LinalgError> {
         debug_assert!(self.fits(a));
-        if self.values == a.values {
-            return Ok(());
-        }
         self.values.clone_from(&a.values);
         let values = match &mut self.split {
             Some(s) => {

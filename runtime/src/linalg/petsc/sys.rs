@@ -72,12 +72,17 @@ pub struct ompi_communicator_t {
 }
 
 unsafe extern "C" {
-    /// Open MPI's `MPI_COMM_SELF`, `MPI_COMM_WORLD`, `MPI_INT` and `MPI_LOR` are the
-    /// addresses of these objects.
+    /// Open MPI's `MPI_COMM_SELF`, `MPI_COMM_WORLD`, `MPI_INT`, `MPI_BYTE`, `MPI_DOUBLE`,
+    /// `MPI_UNSIGNED_LONG_LONG`, `MPI_LOR` and `MPI_SUM` are the addresses of these
+    /// objects.
     pub static ompi_mpi_comm_self: ompi_communicator_t;
     pub static ompi_mpi_comm_world: ompi_communicator_t;
     pub static ompi_mpi_int: ompi_predefined_datatype_t;
+    pub static ompi_mpi_byte: ompi_predefined_datatype_t;
+    pub static ompi_mpi_double: ompi_predefined_datatype_t;
+    pub static ompi_mpi_unsigned_long_long: ompi_predefined_datatype_t;
     pub static ompi_mpi_op_lor: ompi_predefined_op_t;
+    pub static ompi_mpi_op_sum: ompi_predefined_op_t;
 
     pub fn MPI_Comm_rank(comm: MPI_Comm, rank: *mut c_int) -> c_int;
     pub fn MPI_Comm_size(comm: MPI_Comm, size: *mut c_int) -> c_int;
@@ -89,6 +94,26 @@ unsafe extern "C" {
         op: MPI_Op,
         comm: MPI_Comm,
     ) -> c_int;
+    pub fn MPI_Allgather(
+        send: *const c_void,
+        send_count: c_int,
+        send_type: MPI_Datatype,
+        recv: *mut c_void,
+        recv_count: c_int,
+        recv_type: MPI_Datatype,
+        comm: MPI_Comm,
+    ) -> c_int;
+    pub fn MPI_Allgatherv(
+        send: *const c_void,
+        send_count: c_int,
+        send_type: MPI_Datatype,
+        recv: *mut c_void,
+        recv_counts: *const c_int,
+        displacements: *const c_int,
+        recv_type: MPI_Datatype,
+        comm: MPI_Comm,
+    ) -> c_int;
+    pub fn MPI_Bcast(buffer: *mut c_void, count: c_int, datatype: MPI_Datatype, root: c_int, comm: MPI_Comm) -> c_int;
     pub fn MPI_Abort(comm: MPI_Comm, code: c_int) -> c_int;
     /// Indexed by a `KSPConvergedReason` (negative ones too: it points inside its table).
     pub static KSPConvergedReasons: *const *const c_char;

@@ -1,0 +1,130 @@
+//! Which process owns each node of a run split across processes (`mpirun`), and the exchange
+//! that keeps every process's vectors whole.
+//!
+//! Each process assembles the cells that touch a node it owns (`Mesh::part`), so its rows of
+//! those nodes are complete; its other rows hold only part of their sums. A product or an
+//! assembly on such a pattern is right at the owned rows, and [`Ownership::complete`] then
+//! copies every process's owned rows to all the others: values are copied, never added, so
+//! every process holds the same whole vector, bit for bit, and takes the same decisions from it
+//! (Newton's norms, step cuts, the energy guard) without a reduction.
+
+use std::sync::{Arc, Mutex};
+
+use crate::linalg::pattern::Owners;
+use crate::linalg::{LinalgError, ranks};
+
+#[derive(Debug)]
+pub struct Ownership {
+    rank: usize,
+    dim: usize,
+    /// Per node, the process that owns it.
+    owner: Vec<u32>,
+    /// Every process's dofs, increasing, process by process: process p's are
+    /// `dofs[offsets[p]..offsets[p + 1]]`.
+    dofs: Vec<u32>,
+    offsets: Vec<usize>,
+    /// Scratch for `complete`: this process's values, and everyone's.
+    work: Mutex<(Vec<f64>, Vec<f64>)>,
+}
+
+impl Ownership {
+    /// The nodes of `mesh` split among the processes of this run (METIS's partition of the
+    /// graph of nodes that share a cell, the same on every process); None in a run of one.
+    pub fn of(mesh: &crate::fem::mesh::Mesh) -> Result<Option<Arc<Ownership>>, LinalgError> {
+        let (rank, size) = ranks::world();
+        if size == 1 {
+            return Ok(None);
+        }
+        #[cfg(feature = "petsc")]
+        return Ok(Some(Arc::new(Ownership::new(
+            crate::linalg::petsc::partition_mesh(mesh, size)?,
+            mesh.dim(),
+            rank,
+            size,
+        ))));
+        #[cfg(not(feature = "petsc"))]
+        Err(LinalgError::Other(format!(
+            "{size} processes, in a build without MPI (rank {rank}, {} nodes)",
+            mesh.num_nodes()
+        )))
+    }
+
+    /// The ownership of nodes by `owner` (node → process, `size` processes), seen from process
+    /// `rank`, for `dim` dofs per node.
+    pub fn new(owner: Vec<u32>, dim: usize, rank: usize, size: usize) -> Ownership {
+        let mut offsets = vec![0usize; size + 1];
+        for &p in &owner {
+            offsets[p as usize + 1] += dim;
+        }
+        for p in 0..size {
+            offsets[p + 1] += offsets[p];
+        }
+        let mut next = offsets.clone();
+        let mut dofs = vec![0u32; owner.len() * dim];
+        for (node, &p) in owner.iter().enumerate() {
+            for c in 0..dim {
+                dofs[next[p as usize]] = (node * dim + c) as u32;
+                next[p as usize] += 1;
+            }
+        }
+        Ownership { rank, dim, owner, dofs, offsets, work: Mutex::new((Vec::new(), Vec::new())) }
+    }
+
+    /// This process's dofs, increasing.
+    pub fn mine(&self) -> &[u32] {
+        &self.dofs[self.offsets[self.rank]..self.offsets[self.rank + 1]]
+    }
+}
+
+impl Owners for Ownership {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+
+    fn size(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    fn dim(&self) -> usize {
+        self.dim
+    }
+
+    fn owners(&self) -> &[u32] {
+        &self.owner
+    }
+
+    /// Whether `flag` holds on any process. Collective; an MPI failure ends every process.
+    fn any(&self, flag: bool) -> bool {
+        ranks::any(flag).unwrap_or_else(|e| {
+            eprintln!("error (rank {} of {}): {e}", self.rank, self.size());
+            ranks::abort(1)
+        })
+    }
+
+    /// The sum of every process's `x`, added in rank order (the same bits on every process).
+    /// Collective; an MPI failure ends every process.
+    fn sum(&self, x: f64) -> f64 {
+        ranks::sum(x).unwrap_or_else(|e| {
+            eprintln!("error (rank {} of {}): {e}", self.rank, self.size());
+            ranks::abort(1)
+        })
+    }
+
+    /// Makes `y`, right at this process's dofs, whole: every process's dofs take their owner's
+    /// values. Collective: every process calls it at the same point. An MPI failure ends every
+    /// process (there is no state to go on from).
+    fn complete(&self, y: &mut [f64]) {
+        let mut work = self.work.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let (mine, all) = &mut *work;
+        mine.clear();
+        mine.extend(self.mine().iter().map(|&i| y[i as usize]));
+        all.resize(self.dofs.len(), 0.0);
+        if let Err(e) = ranks::gather_parts(mine, &self.offsets, all) {
+            eprintln!("error (rank {} of {}): {e}", self.rank, self.size());
+            ranks::abort(1);
+        }
+        for (&i, &v) in self.dofs.iter().zip(all.iter()) {
+            y[i as usize] = v;
+        }
+    }
+}
