@@ -621,7 +621,7 @@ impl<'m> Observer<'m> {
                             out
                         };
                         let (a, b) = (nodal(a, &mut *scratch), nodal(b, &mut *scratch));
-                        one(Operators::quad(&ops.scheme_mass, &a, &b))
+                        one(Operators::quad(ops.scheme_mass(), &a, &b))
                     }
                 };
                 measured.push(value);
@@ -643,5 +643,5 @@ impl<'m> Observer<'m> {
 
 /// A state as a reference measures it.
 fn reference_at<'a>(ops: &'a Operators<'_>, u: &'a [f64], t: f64) -> crate::references::At<'a> {
-    crate::references::At { asm: ops.asm, mass: &ops.scheme_mass, pressure: ops.contact_pressure.as_deref(), u, t }
+    crate::references::At { asm: ops.asm, mass: ops.scheme_mass(), pressure: ops.contact_pressure.as_deref(), u, t }
 }

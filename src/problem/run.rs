@@ -150,7 +150,11 @@ fn simulate(
         pf.problem().regions.iter().map(|r| r.name.name.as_str()).chain(contact_region(pf)).collect();
     let part = ownership.as_ref().map(|o| mesh.part(o.owners(), o.rank() as u32, &whole));
     let asm = match (&part, &ownership) {
-        (Some((local, owned)), Some(o)) => Assembler::split(local, o.clone(), *owned),
+        (Some((local, owned)), Some(o)) => {
+            let (cells, rank) = (local.num_cells(), o.rank());
+            tracing::info!(rank, owned, cells, whole = mesh.num_cells(), "this process's part of the mesh");
+            Assembler::split(local, o.clone(), *owned)
+        }
         _ => Assembler::new(&mesh),
     };
     let n = asm.size();
@@ -494,7 +498,9 @@ fn simulate(
     let run = Run { summary, columns, rows: series, switches, stages: stage_rows };
     if let Some(dir) = &out {
         write_outputs(dir, pf, &run, &shown)?;
-        // The reference's figures of the last state (Hertz's pressure profile).
+        // The reference's figures of the last state (Hertz's pressure profile): rank 0 alone
+        // draws them, so they read the state's facet samples, never a product (collective in a
+        // split run).
         observer
             .write_reference(dir, runner.ops(), &last.1, last.0)
             .map_err(|source| CaseError::Write { path: dir.display().to_string(), source })?;

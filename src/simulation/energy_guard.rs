@@ -109,7 +109,7 @@ impl EnergyWatch {
         if let Some((v0, v1)) = v {
             let dv: Vec<f64> = v1.iter().zip(v0).map(|(a, b)| (a - b) / h).collect();
             let mut inertia = vec![0.0; u.len()];
-            ops.scheme_mass.mul_vec(&dv, &mut inertia);
+            ops.scheme_mass().mul_vec(&dv, &mut inertia);
             reaction.iter_mut().zip(&inertia).for_each(|(r, m)| *r += m);
         }
         let load = match &ops.varying_load {

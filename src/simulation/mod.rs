@@ -136,7 +136,7 @@ impl<'m> Simulation<'m> {
             }
             stepper.initial_constraints = Some(initial);
         }
-        ops.energies = Energies::new(asm, stepper.half_pattern(), &ops.stiffness, &ops.scheme_mass);
+        ops.energies = Energies::new(asm, stepper.half_pattern(), &ops.stiffness, ops.scheme_mass());
         let n = asm.size();
         let names = &stepper.desc().states;
         let states = names.iter().map(|_| vec![0.0; n]).collect();

@@ -35,10 +35,10 @@ pub struct Operators<'m> {
     pub contact_trial: Option<Box<dyn BoundFunctional + 'm>>,
     pub von_mises: Option<Box<dyn BoundFunctional + 'm>>,
     pub cell_measure: Option<Box<dyn BoundFunctional + 'm>>,
-    /// The consistent mass, the mass the scheme steps with (redistributed or not), the
-    /// stiffness and the load vector at t = 0.
+    /// The consistent mass, the mass the scheme steps with when it is another (redistributed or
+    /// lumped: [`Operators::scheme_mass`]), the stiffness and the load vector at t = 0.
     pub mass: Matrix,
-    pub scheme_mass: Matrix,
+    pub other_mass: Option<Matrix>,
     pub stiffness: Matrix,
     pub load: Vec<f64>,
     /// The `load` slot when it changes with time (a traction p(t)): the energy check then sums
@@ -130,9 +130,14 @@ impl Operators<'_> {
         a.quad(x, y)
     }
 
+    /// The mass the scheme steps with: the material's, or the one that replaces it.
+    pub fn scheme_mass(&self) -> &Matrix {
+        self.other_mass.as_ref().unwrap_or(&self.mass)
+    }
+
     /// ½vᵀMv with the scheme's mass (0 without a velocity).
     pub fn kinetic(&self, v: Option<&[f64]>) -> f64 {
-        v.map_or(0.0, |v| 0.5 * self.energies.quad(1, &self.scheme_mass, v))
+        v.map_or(0.0, |v| 0.5 * self.energies.quad(1, self.scheme_mass(), v))
     }
 
     /// E = ½uᵀKu + ½vᵀMv − Fᵀu.
@@ -281,14 +286,10 @@ impl<'m> Parts<'m> {
             ),
             MassChoice::Lumped => Some(crate::runtime::fem::lumping::lumped(&mass, mesh.kind.degree(), mesh.dim())),
         };
-        let scheme_mass = match scheme_mass {
-            Some(matrix) => {
-                let i = slot(&forms, "mass")?;
-                forms[i] = ("mass".into(), Box::new(MatrixForm { name: "mass".into(), matrix: matrix.clone() }));
-                matrix
-            }
-            None => mass.clone(),
-        };
+        if let Some(matrix) = &scheme_mass {
+            let i = slot(&forms, "mass")?;
+            forms[i] = ("mass".into(), Box::new(MatrixForm { name: "mass".into(), matrix: matrix.clone() }));
+        }
         let mut ops = Operators {
             asm,
             contact_facets,
@@ -304,7 +305,7 @@ impl<'m> Parts<'m> {
             energies: Energies::full(),
             last_switches: Default::default(),
             mass,
-            scheme_mass,
+            other_mass: scheme_mass,
             stiffness,
             load,
             varying_load: in_use

@@ -51,7 +51,7 @@ pub fn estimate(
         active = switches.iter().filter(|s| **s).count();
     }
     let mut mass = Factorization::new(Structure::SymmetricPositiveDefinite);
-    mass.factor(&ops.scheme_mass).map_err(|e| CaseError::Option(format!("the scheme's mass: {e}")))?;
+    mass.factor(ops.scheme_mass()).map_err(|e| CaseError::Option(format!("the scheme's mass: {e}")))?;
     let free = |x: &mut [f64]| x.iter_mut().zip(&constraints.fixed).filter(|(_, f)| **f).for_each(|(x, _)| *x = 0.0);
     // A start with every frequency in it.
     let mut x = scattered(n);
@@ -59,7 +59,7 @@ pub fn estimate(
     let (mut ax, mut lambda) = (vec![0.0; n], 0.0f64);
     for _ in 0..ITERATIONS {
         a.mul_vec(&x, &mut ax);
-        let xmx = ops.scheme_mass.quad(&x, &x);
+        let xmx = ops.scheme_mass().quad(&x, &x);
         let rayleigh = x.iter().zip(&ax).map(|(p, q)| p * q).sum::<f64>() / xmx;
         let done = (rayleigh - lambda).abs() <= CONVERGED * rayleigh.abs();
         lambda = rayleigh;

@@ -367,6 +367,9 @@ impl<'a> Stepper<'a> {
         {
             rest.iter_mut().for_each(|s| s.newton.share_analysis(&initial.newton));
             first.newton.inherit(&mut initial.newton);
+            // The initial problem is solved once: its operators need not stay (a matrix's worth
+            // each, rebuilt if it is solved again).
+            (initial.constant, initial.linear, initial.scratch) = (None, None, None);
         }
         Ok(Some(report))
     }

@@ -211,8 +211,10 @@ pub struct PetscSolver {
     rhs: OwnedVec,
     solution: OwnedVec,
     pattern: Arc<Pattern>,
-    /// The values PETSc holds: the same values again keep the preconditioner (whose setup,
-    /// GAMG's above all, costs solves).
+    /// The values PETSc holds, when each process holds the whole matrix: the same values again
+    /// keep the preconditioner (whose setup, GAMG's above all, costs solves). In a split run
+    /// (each process holding its part, `Pattern::ownership`) each compares its own rows, which
+    /// are what PETSc holds of it (`Split::buffer`).
     values: Vec<f64>,
     /// Across processes: the split, and what gathers the solution on every process.
     split: Option<Split>,
@@ -437,11 +439,11 @@ impl PetscSolver {
     pub fn set_values(&mut self, a: &Matrix) -> Result<(), LinalgError> {
         // Setting values is collective: in a split run every process sets them when any
         // process's part changed (asked before PETSc's lock, which the exchange takes).
-        let same = self.values == a.values;
-        if match a.pattern.ownership() {
-            Some(o) => !o.any(!same),
-            None => same,
-        } {
+        let same = match (a.pattern.ownership(), &self.split) {
+            (Some(o), Some(s)) => !o.any(s.picked.iter().zip(&s.buffer).any(|(&k, v)| a.values[k] != *v)),
+            _ => self.values == a.values,
+        };
+        if same {
             return Ok(());
         }
         let _petsc = lock()?;
@@ -450,7 +452,9 @@ impl PetscSolver {
 
     fn take_values(&mut self, a: &Matrix) -> Result<(), LinalgError> {
         debug_assert!(self.fits(a));
-        self.values.clone_from(&a.values);
+        if a.pattern.ownership().is_none() {
+            self.values.clone_from(&a.values);
+        }
         let values = match &mut self.split {
             Some(s) => {
                 s.buffer.iter_mut().zip(&s.picked).for_each(|(v, &k)| *v = a.values[k]);
