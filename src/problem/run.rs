@@ -158,6 +158,9 @@ fn simulate(
         _ => Assembler::new(&mesh),
     };
     let n = asm.size();
+    // Collective in a split run: counted now, while every process runs the same code (rank 0
+    // alone may stop early, on a failed write).
+    let matrix_nnz = matrix_nnz(&asm)?;
     let quad = super::bind::settings(pf, ex, &p.quadrature)?;
     let max = crate::compiler::ir::MAX_DEGREE as f64;
     let degree = |name: &str| -> Result<Option<u32>, CaseError> {
@@ -422,7 +425,10 @@ fn simulate(
             (series, switches, iterations, stage_rows, outcome, sim.stepper.counters(), steps, last)
         }
     };
-    snapshots.finish()?;
+    // Rank 0 writes the collection (every process of a split run holds the directory).
+    if writes {
+        snapshots.finish()?;
+    }
     let wall = start.elapsed().as_secs_f64();
     let mut summary = Summary::default();
     let mut put = |k: &str, v: serde_json::Value| summary.keys.push((k.to_string(), v));
@@ -454,7 +460,7 @@ fn simulate(
     put("factorizations", counters.numeric.into());
     put("symbolic_factorizations", counters.symbolic.into());
     put("low_rank_updates", counters.updates.into());
-    put("matrix_nnz", matrix_nnz(&asm)?.into());
+    put("matrix_nnz", matrix_nnz.into());
     let factor_nnz = match &runner {
         Runner::Time(sim) => sim.stepper.factor_nnz(),
         Runner::Static(_) => None,
@@ -523,14 +529,14 @@ fn contact_region(pf: &ProblemFile) -> Option<&str> {
 
 /// Whether a run under mpirun is split across its processes (each assembling the cells around
 /// the nodes it owns, `Mesh::part`), rather than repeated whole by each: a time run with PETSc's
-/// solvers and the material's mass. A static problem, another solver (which factors or iterates
+/// solvers (`--solver petsc`, or the default) and the material's mass. A static problem, another solver (which factors or iterates
 /// on the whole matrix), the redistributed or lumped mass and a scheme that estimates its
 /// critical step (both factor the whole mass) are repeated whole by every process.
 fn split(opts: &Options, pf: &ProblemFile, in_use: &FilesInUse) -> Result<bool, CaseError> {
-    use crate::runtime::linalg::{Solver, ranks};
+    use crate::runtime::linalg::ranks;
     if ranks::world().1 == 1
         || pf.problem().run_static.is_some()
-        || opts.newton.solver != Solver::Petsc
+        || !opts.newton.solver.petsc()
         || opts.mass != crate::simulation::MassChoice::Consistent
     {
         return Ok(false);

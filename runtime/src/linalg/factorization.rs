@@ -267,7 +267,10 @@ impl Factorization {
     /// always.
     pub fn factor(&mut self, a: &Matrix) -> Result<(), LinalgError> {
         let n = a.size();
-        if let Some(inverse) = diagonal_inverse(a, self.structure)? {
+        // A process's part of a matrix (a split run) is not the matrix: PETSc solves it.
+        if a.pattern.ownership().is_none()
+            && let Some(inverse) = diagonal_inverse(a, self.structure)?
+        {
             self.factors = Factors::Diagonal(inverse);
             self.pattern = None;
             return Ok(());

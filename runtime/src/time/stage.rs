@@ -473,6 +473,9 @@ impl NonlinearProblem for StageProblem<'_, '_> {
         for (&k, &col) in s.entries.indices.iter().zip(&s.entries.columns) {
             y[rows[k]] += (j.values[k] - a[k]) * x_free[col as usize];
         }
+        // In a split run J − A is exact only at this process's rows (elsewhere both are partial,
+        // and their difference rounds otherwise): the owners' rows replace the others.
+        j.pattern.complete(y);
         if constrained {
             y.iter_mut().zip(x).zip(&self.constraints.fixed).filter(|(_, f)| **f).for_each(|((y, x), _)| *y = *x);
         }

@@ -107,6 +107,10 @@ pub fn broadcast(bytes: &mut Vec<u8>) -> Result<(), LinalgError> {
         let count =
             c_int::try_from(len).map_err(|_| LinalgError::Other(format!("{len} bytes are too many for MPI")))?;
         bytes.resize(count as usize, 0);
+        // Nothing to send: an empty vector's pointer is not one MPI accepts.
+        if count == 0 {
+            return Ok(());
+        }
         checked(
             "MPI_Bcast",
             sys::MPI_Bcast(bytes.as_mut_ptr().cast(), count, datatype(&sys::ompi_mpi_byte), 0, comm_world()),
