@@ -59,19 +59,19 @@ fn mpirun(ranks: usize, args: &[&str], limit: Duration) -> (bool, String) {
     (status.success(), text)
 }
 
+/// `signorini ARGS --solver direct --out DIR`, one process, which must succeed.
+fn serial_direct(args: &[&str], dir: &std::path::Path) {
+    let out =
+        Command::new(BIN).args(args).args(["--solver", "direct", "--out"]).arg(dir).output().expect("the binary runs");
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+}
+
 /// Every column of `run ARGS` on 1, 2 and 3 processes (PETSc's solvers) against the serial direct
 /// run, to 1e-8 of the column's scale (`assert_agree`).
 fn agree(args: &[&str], name: &str) {
     let root = scratch(name);
     let direct = root.join("direct");
-    let out = Command::new(BIN)
-        .args(["run"])
-        .args(args)
-        .args(["--solver", "direct", "--out"])
-        .arg(&direct)
-        .output()
-        .expect("the binary runs");
-    assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+    serial_direct(&[&["run"], args].concat(), &direct);
     let (header, reference) = read_series(&direct);
     for ranks in 1..=3 {
         let dir = root.join(format!("ranks-{ranks}"));
@@ -139,17 +139,19 @@ fn commands_that_run_as_one_process_refuse_mpirun() {
     assert!(!dir.exists(), "nothing written");
 }
 
-/// The numbers of a VTU file's data array: `<Points>`'s with `name` "Points", else the one named.
-fn vtu_array(text: &str, name: &str) -> Vec<Vec<f64>> {
-    let start = match name {
-        "Points" => text.find("<Points>").expect("points"),
-        _ => text.find(&format!("Name=\"{name}\"")).unwrap_or_else(|| panic!("an array {name}")),
-    };
-    let body = &text[start..];
-    let body = &body[body.find(">\n").expect("an opening tag") + 2..];
-    let body = &body[body.find('\n').map_or(0, |i| if name == "Points" { i + 1 } else { 0 })..];
-    let body = &body[..body.find("</DataArray>").expect("a closing tag")];
-    body.lines().map(|l| l.split_whitespace().map(|x| x.parse().expect("a number")).collect()).collect()
+/// A VTU file read back by an independent reader (vtkio): its points' coordinates and
+/// displacements (3 per point), and its number of cells.
+fn read_vtu(path: &std::path::Path) -> (Vec<f64>, Vec<f64>, usize) {
+    use vtkio::model::{Attribute, DataSet, Piece};
+    let vtk = vtkio::Vtk::import(path).unwrap_or_else(|e| panic!("{}: {e:?}", path.display()));
+    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else { panic!("not an unstructured grid") };
+    let Piece::Inline(piece) = &pieces[0] else { panic!("piece not inline") };
+    let points: Vec<f64> = piece.points.clone().cast_into().expect("points");
+    let u = piece.data.point.iter().find_map(|a| match a {
+        Attribute::DataArray(d) if d.name == "displacement" => d.data.clone().cast_into::<f64>(),
+        _ => None,
+    });
+    (points, u.expect("a displacement"), piece.cells.types.len())
 }
 
 #[test]
@@ -157,13 +159,7 @@ fn a_split_run_writes_snapshots_as_pieces_that_cover_the_mesh_once() {
     let root = scratch("pieces");
     let (serial, split) = (root.join("serial"), root.join("split"));
     let run = ["run", "disc", "--t-start", "6.3", "--t-end", "6.5", "--vtu-every", "5"];
-    let out = Command::new(BIN)
-        .args(run)
-        .args(["--solver", "direct", "--out"])
-        .arg(&serial)
-        .output()
-        .expect("the binary runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serial_direct(&run, &serial);
     let (ok, err) = mpirun(
         3,
         &[&run[..], &["--solver", "petsc", "--out", split.to_str().unwrap()]].concat(),
@@ -175,23 +171,24 @@ fn a_split_run_writes_snapshots_as_pieces_that_cover_the_mesh_once() {
         let file = format!("vtu/disc_{k:06}.pvtu");
         assert!(pvd.contains(&format!("file=\"{file}\"")), "the collection lists {file}: {pvd}");
         let pvtu = std::fs::read_to_string(split.join(&file)).expect("a parallel file");
-        let whole = std::fs::read_to_string(serial.join(format!("vtu/disc_{k:06}.vtu"))).expect("a serial snapshot");
         // Each node of the mesh, by its position, with its displacement.
-        let key = |x: &[f64]| format!("{:.9} {:.9}", x[0], x[1]);
-        let by_node = |text: &str| -> std::collections::HashMap<String, Vec<f64>> {
-            vtu_array(text, "Points").iter().map(|x| key(x)).zip(vtu_array(text, "displacement")).collect()
+        let by_node = |path: &std::path::Path| {
+            let (points, u, cells) = read_vtu(path);
+            let key = |x: &[f64]| format!("{:.9} {:.9}", x[0], x[1]);
+            let nodes: std::collections::HashMap<String, Vec<f64>> =
+                points.chunks(3).map(key).zip(u.chunks(3).map(<[f64]>::to_vec)).collect();
+            (nodes, cells)
         };
-        let expected = by_node(&whole);
-        let cells = |text: &str| vtu_array(text, "von_mises").len();
+        let (expected, whole_cells) = by_node(&serial.join(format!("vtu/disc_{k:06}.vtu")));
         let (mut seen, mut cells_seen) = (std::collections::HashMap::new(), 0);
         for rank in 0..3 {
             let piece = format!("disc_{k:06}_{rank}.vtu");
             assert!(pvtu.contains(&format!("Source=\"{piece}\"")), "{file} lists {piece}");
-            let text = std::fs::read_to_string(split.join("vtu").join(&piece)).expect("a piece");
-            cells_seen += cells(&text);
-            seen.extend(by_node(&text));
+            let (nodes, cells) = by_node(&split.join("vtu").join(&piece));
+            cells_seen += cells;
+            seen.extend(nodes);
         }
-        assert_eq!(cells_seen, cells(&whole), "snapshot {k}: the pieces' cells are the mesh's, each once");
+        assert_eq!(cells_seen, whole_cells, "snapshot {k}: the pieces' cells are the mesh's, each once");
         assert_eq!(seen.len(), expected.len(), "snapshot {k}: every node in some piece");
         let scale = expected.values().flatten().fold(1e-300f64, |m, x| m.max(x.abs()));
         for (at, u) in &expected {

@@ -78,6 +78,15 @@ impl Ownership {
         Ownership { rank, dim, owner, dofs, offsets, work: Mutex::new((Vec::new(), Vec::new())) }
     }
 
+    /// The value of an exchange, or the end of every process with its error: the exchanges sit
+    /// inside products and sums, which cannot fail, and there is no state to go on from.
+    fn or_end<T>(&self, result: Result<T, LinalgError>) -> T {
+        result.unwrap_or_else(|e| {
+            eprintln!("error (rank {} of {}): {e}", self.rank, self.offsets.len() - 1);
+            ranks::abort(1)
+        })
+    }
+
     /// This process's dofs, increasing.
     pub fn mine(&self) -> &[u32] {
         &self.dofs[self.offsets[self.rank]..self.offsets[self.rank + 1]]
@@ -103,19 +112,13 @@ impl Owners for Ownership {
 
     /// Whether `flag` holds on any process. Collective; an MPI failure ends every process.
     fn any(&self, flag: bool) -> bool {
-        ranks::any(flag).unwrap_or_else(|e| {
-            eprintln!("error (rank {} of {}): {e}", self.rank, self.size());
-            ranks::abort(1)
-        })
+        self.or_end(ranks::any(flag))
     }
 
     /// The sum of every process's `x`, added in rank order (the same bits on every process).
     /// Collective; an MPI failure ends every process.
     fn sum(&self, x: f64) -> f64 {
-        ranks::sum(x).unwrap_or_else(|e| {
-            eprintln!("error (rank {} of {}): {e}", self.rank, self.size());
-            ranks::abort(1)
-        })
+        self.or_end(ranks::sum(x))
     }
 
     /// Makes `y`, right at this process's dofs, whole: every process's dofs take their owner's
@@ -127,10 +130,7 @@ impl Owners for Ownership {
         mine.clear();
         mine.extend(self.mine().iter().map(|&i| y[i as usize]));
         all.resize(self.dofs.len(), 0.0);
-        if let Err(e) = ranks::gather_parts(mine, &self.offsets, all) {
-            eprintln!("error (rank {} of {}): {e}", self.rank, self.size());
-            ranks::abort(1);
-        }
+        self.or_end(ranks::gather_parts(mine, &self.offsets, all));
         for (&i, &v) in self.dofs.iter().zip(all.iter()) {
             y[i as usize] = v;
         }
