@@ -204,20 +204,19 @@ fn simulate(
         mass: opts.mass,
         newton: opts.newton,
     };
+    // In a run of several processes each holds the whole state and takes the same steps; rank 0
+    // writes the results, and the checkpoints with the others' parts in a split run (any
+    // number of processes resumes them). Collective.
+    let shared = shared_dir(opts.out.as_ref())?;
     let mut control = Control::new(
         opts.checkpoint_every,
-        opts.out.clone(),
+        shared.clone(),
         identity(opts, pf, params, in_use, &mesh, times),
         opts.resume,
+        ownership.clone(),
     )?;
-    // In a run of several processes each holds the whole state and takes the same steps; rank 0
-    // writes the results and checkpoints (which any number of processes resumes), the others
-    // only read a checkpoint they resume.
     let writes = crate::runtime::linalg::ranks::writes();
     let out = if writes { opts.out.clone() } else { None };
-    if !writes {
-        control.dir = None;
-    }
     // A static problem is one equilibrium, from u₀ (no initial acceleration to solve for): it
     // binds the operators, and no stepper.
     let statics = p.run_static.is_some();
@@ -278,7 +277,7 @@ fn simulate(
     let name = pf.name().to_string();
     // Every process of a split run writes its piece of each snapshot, into rank 0's directory.
     let pieces = match &ownership {
-        Some(_) => shared_dir(out.as_ref())?,
+        Some(_) => shared.clone(),
         None => out.clone(),
     };
     let mut snapshots = Snapshots::new(pieces.as_ref(), opts.vtu_every, &name);

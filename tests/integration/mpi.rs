@@ -1,6 +1,7 @@
 //! Runs under `mpirun` (feature `petsc`): the disc and the sphere through their first impact on
 //! 1, 2 and 3 processes agree with the serial direct run to 1e-8 of each column's scale; a run
-//! resumed from its checkpoint on the same 2 processes has the bits of the uninterrupted one; a
+//! resumed from its checkpoint (one part per process) on the same 2 processes has the bits of
+//! the uninterrupted one, and on 3 or 1 agrees with it; a
 //! split run's snapshots are pieces, one per process, that cover the mesh once; a process that
 //! fails, alone or with the others, ends them all with its message; the commands
 //! that run as one process refuse mpirun.
@@ -103,11 +104,25 @@ fn a_run_resumed_on_the_same_two_processes_has_the_bits_of_an_uninterrupted_one(
     let (ok, err) = mpirun(2, &[&run[..], &["--out", d]].concat(), Duration::from_secs(300));
     assert!(ok, "{err}");
     let full = std::fs::read(dir.join("series.csv")).expect("a series");
+    // The checkpoint after step 80, the second: rank 0's manifest, and each process's rows in
+    // the second slot of its own part.
     assert!(dir.join("checkpoint.bin").is_file(), "a checkpoint after step 80");
+    for rank in 0..2 {
+        assert!(dir.join(format!("checkpoint.{rank}.0.bin")).is_file(), "rank {rank}'s part of it");
+    }
+    let (_, reference) = read_series(&dir);
     // From the checkpoint after step 80: the last 20 steps again, on every process.
     let (ok, err) = mpirun(2, &[&run[..], &["--resume", d]].concat(), Duration::from_secs(300));
     assert!(ok, "{err}");
     assert!(std::fs::read(dir.join("series.csv")).expect("a series") == full, "the resumed series differs");
+    // Three processes, split otherwise, and one read every part: the same run to round-off.
+    for ranks in [3, 1] {
+        let (ok, err) = mpirun(ranks, &[&run[..], &["--resume", d]].concat(), Duration::from_secs(300));
+        assert!(ok, "resumed on {ranks}: {err}");
+        let (header, rows) = read_series(&dir);
+        let name = format!("the disc resumed on {ranks} processes");
+        assert_agree(&name, &header, &reference, &rows, energy_scale(&dir));
+    }
     let _ = std::fs::remove_dir_all(&root);
 }
 

@@ -40,15 +40,16 @@ impl Ownership {
             let owner = crate::linalg::petsc::partition_mesh(mesh, size)?;
             // Each process partitioned alone: a process whose METIS (another build, another
             // machine of a cluster) split otherwise would exchange the wrong rows, silently.
-            let mut first = fingerprint(&owner).to_le_bytes().to_vec();
+            let ownership = Ownership::new(owner, mesh.dim(), rank, size);
+            let mut first = ownership.fingerprint().to_le_bytes().to_vec();
             ranks::broadcast(&mut first)?;
-            if ranks::any(first != fingerprint(&owner).to_le_bytes())? {
+            if ranks::any(first != ownership.fingerprint().to_le_bytes())? {
                 return Err(LinalgError::Other(format!(
                     "the processes split the mesh's {} nodes differently (METIS gave rank {rank} other parts than rank 0): every process must run the same build",
                     mesh.num_nodes()
                 )));
             }
-            Ok(Some(Arc::new(Ownership::new(owner, mesh.dim(), rank, size))))
+            Ok(Some(Arc::new(ownership)))
         }
         #[cfg(not(feature = "petsc"))]
         Err(LinalgError::Other(format!(
@@ -90,6 +91,15 @@ impl Ownership {
     /// This process's dofs, increasing.
     pub fn mine(&self) -> &[u32] {
         &self.dofs[self.offsets[self.rank]..self.offsets[self.rank + 1]]
+    }
+
+    /// A 64-bit FNV-1a hash of the partition (node → process): the same on every process of a
+    /// run, and in every run on as many processes of the same mesh and build.
+    pub fn fingerprint(&self) -> u64 {
+        self.owner
+            .iter()
+            .flat_map(|p| p.to_le_bytes())
+            .fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
     }
 }
 
@@ -135,13 +145,4 @@ impl Owners for Ownership {
             y[i as usize] = v;
         }
     }
-}
-
-/// A 64-bit FNV-1a hash of a partition, to compare it across processes.
-#[cfg(feature = "petsc")]
-fn fingerprint(owner: &[u32]) -> u64 {
-    owner
-        .iter()
-        .flat_map(|p| p.to_le_bytes())
-        .fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
 }
