@@ -22,6 +22,7 @@ signorini::forms!("forms/elasticity.wf");
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
 signorini::forms!("tests/problems/power_law_penalty.wf");
+signorini::forms!("tests/problems/coulomb_penalty.wf");
 signorini::forms!("forms/contact_nitsche_traction.wf");
 
 const TOL: f64 = 1e-12;
@@ -46,6 +47,7 @@ fn params(names: &[&'static str]) -> Vec<(&'static str, f64)> {
         "rho" => 1.7,
         "gamma0" => 7.5,
         "theta" => 0.5,
+        "F" => 0.8,
         _ => panic!("no test value for parameter `{n}`"),
     };
     names.iter().map(|&n| (n, value(n))).collect()
@@ -58,6 +60,8 @@ struct Data {
     f: Coef,
     g: Coef,
     nc: Coef,
+    /// The displacement a frictional law measures slip from.
+    w: Coef,
 }
 
 impl Data {
@@ -70,12 +74,17 @@ impl Data {
             }),
             g: Coef::function(1, |x, t, out| out[0] = 0.5 * (x[0] - 0.3) + 0.01 * t),
             nc: Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>()),
+            w: Coef::function(d, |x, _, out| {
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o = 0.04 * (2.1 * x[0] + k as f64).sin();
+                }
+            }),
         }
     }
 
     /// The coefs a library declares, by name.
     fn list(&self, lib: &Library) -> Vec<(&'static str, Coef)> {
-        let all = [("f", &self.f), ("g", &self.g), ("nc", &self.nc)];
+        let all = [("f", &self.f), ("g", &self.g), ("nc", &self.nc), ("w", &self.w)];
         let names = lib.coefs();
         all.into_iter().filter(|(n, _)| names.contains(n)).map(|(n, c)| (n, c.clone())).collect()
     }
@@ -348,6 +357,15 @@ unit_test!(
     |d| contact_penalty::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact, HybridContact],
     functionals: [ContactEnergy, ContactJump, ContactPressure, ContactTrial]
+);
+
+unit_test!(
+    coulomb_interpreted_matches_compiled,
+    coulomb_penalty,
+    "tests/problems/coulomb_penalty.wf",
+    |d| coulomb_penalty::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone(), w: d.w.clone() },
+    forms: [Contact],
+    functionals: [FrictionForce, Slip]
 );
 
 fn bound<'m, K: Kernel + 'm>(kernel: K, contact: &'m [Facet]) -> Box<dyn BoundForm + 'm> {

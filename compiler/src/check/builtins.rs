@@ -6,18 +6,36 @@ use crate::syntax::ast::Shape;
 pub const BUILTIN_VALUES: &[&str] = &["I", "n", "h", "x", "t", "pi", "inf"];
 
 /// Built-in functions.
-pub const BUILTIN_FUNCTIONS: &[&str] =
-    &["grad", "div", "sym", "tr", "transpose", "dot", "inner", "outer", "pos", "neg", "H", "min", "max", "abs", "sqrt"];
+pub const BUILTIN_FUNCTIONS: &[&str] = &[
+    "grad",
+    "div",
+    "sym",
+    "tr",
+    "transpose",
+    "dot",
+    "inner",
+    "outer",
+    "pos",
+    "neg",
+    "H",
+    "min",
+    "max",
+    "abs",
+    "sqrt",
+    "norm",
+    "proj_ball",
+    "tangential",
+];
 
 /// Functions of a problem's numbers (params, `let`s of them), not of values that vary.
 pub const NUMBER_FUNCTIONS: &[&str] = &["ceil", "floor"];
 
 /// Functions of one scalar that are not linear, so a test function must not appear inside.
-pub const NONLINEAR: &[&str] = &["pos", "neg", "H", "min", "max", "abs", "sqrt"];
+pub const NONLINEAR: &[&str] = &["pos", "neg", "H", "min", "max", "abs", "sqrt", "norm", "proj_ball"];
 
 pub fn arity(name: &str) -> usize {
     match name {
-        "dot" | "inner" | "outer" | "min" | "max" => 2,
+        "dot" | "inner" | "outer" | "min" | "max" | "proj_ball" | "tangential" => 2,
         _ => 1,
     }
 }
@@ -47,6 +65,18 @@ pub fn result_shape(name: &str, args: &[Shape]) -> Result<Shape, String> {
         ("outer", [Vector, Vector]) => Ok(Tensor),
         ("outer", [a, b]) => Err(format!("outer takes two vectors, not a {} and a {}", a.name(), b.name())),
         ("pos" | "neg" | "H" | "abs" | "sqrt", [Scalar]) => Ok(Scalar),
+        ("norm", [Vector | Tensor]) => Ok(Scalar),
+        ("norm", [Scalar]) => Err("norm takes a vector or a tensor; the size of a scalar is `abs`".into()),
+        ("proj_ball", [a @ (Scalar | Vector), Scalar]) => Ok(*a),
+        ("proj_ball", [a, b]) => Err(format!(
+            "proj_ball takes a vector (or a scalar) and a scalar radius, not a {} and a {}",
+            a.name(),
+            b.name()
+        )),
+        ("tangential", [Vector, Vector]) => Ok(Vector),
+        ("tangential", [a, b]) => {
+            Err(format!("tangential takes a vector and a unit normal, not a {} and a {}", a.name(), b.name()))
+        }
         ("min" | "max", [Scalar, Scalar]) => Ok(Scalar),
         (_, shapes) => {
             let got: Vec<_> = shapes.iter().map(|s| s.name()).collect();

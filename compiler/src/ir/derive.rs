@@ -83,13 +83,22 @@ impl Derivative {
                 g.mul(cq, da)
             }
             Node::Sqrt(a) => {
+                // da / (2√a) where a > 0, and 0 at a = 0 (where √ has no derivative): written
+                // da·H(a) / (2√a + (1 − H(a))), which has the bits of da / (2√a) where a > 0.
+                // The size |x| = √(x·x) then has the generalised derivative 0 at x = 0, an
+                // element of its Clarke Jacobian (the unit ball), rather than 0/0.
                 let da = d(a);
                 if g.is_zero(da) {
                     return g.zero();
                 }
                 let two = g.constant(2.0);
                 let den = g.mul(two, id);
-                g.div(da, den)
+                let on = g.heaviside(a);
+                let one = g.one();
+                let off = g.sub(one, on);
+                let den = g.add(den, off);
+                let num = g.mul(da, on);
+                g.div(num, den)
             }
         }
     }

@@ -488,6 +488,57 @@ impl<'p> Lowerer<'p> {
                 let a = next().c.remove(0);
                 Self::scalar(self.jsqrt(&a))
             }
+            "norm" => {
+                let a = next();
+                Self::scalar(self.jnorm(&a))
+            }
+            "tangential" => {
+                // a − (a·nc) nc
+                let (a, nc) = (next(), next());
+                let mut an = self.constant(0.0);
+                for (x, y) in a.c.iter().zip(&nc.c) {
+                    let p = self.jmul(x, y);
+                    an = self.jadd(&an, &p);
+                }
+                let c =
+                    a.c.iter()
+                        .zip(&nc.c)
+                        .map(|(x, y)| {
+                            let p = self.jmul(&an, y);
+                            self.jsub(x, &p)
+                        })
+                        .collect();
+                Val { shape: Shape::Vector, c }
+            }
+            "proj_ball" => {
+                // With ρ = [r]_+, |a| and the stick indicator k = H(ρ − |a|):
+                // k·a + (1 − k)·ρ·a/D, D = |a| + (1 − H(|a|)). D is |a| where a ≠ 0 and 1 at
+                // a = 0, so that neither branch divides by zero, nor does their tangent (see the
+                // derivative of sqrt): the value is a inside the ball, ρ·a/|a| outside, 0 for
+                // ρ = 0; the tangent I inside, ρ/|a| (I − â âᵀ) outside, 0 for ρ = 0.
+                let (a, r) = (next(), next().c.remove(0));
+                let hr = self.jheaviside(&r);
+                let rho = self.jmul(&r, &hr);
+                let size = self.jnorm(&a);
+                let gap = self.jsub(&rho, &size);
+                let k = self.jheaviside(&gap);
+                let one = self.constant(1.0);
+                let slip = self.jsub(&one, &k);
+                let nonzero = self.jheaviside(&size);
+                let guard = self.jsub(&one, &nonzero);
+                let den = self.jadd(&size, &guard);
+                let scale = self.jdiv(&rho, &den);
+                let outer = self.jmul(&slip, &scale);
+                let c =
+                    a.c.iter()
+                        .map(|x| {
+                            let inside = self.jmul(&k, x);
+                            let outside = self.jmul(&outer, x);
+                            self.jadd(&inside, &outside)
+                        })
+                        .collect();
+                Val { shape: a.shape, c }
+            }
             _ => unreachable!("checked built-in `{f}`"),
         }
     }
@@ -646,6 +697,16 @@ impl<'p> Lowerer<'p> {
             ga.iter().map(|&x| if self.g.is_zero(x) { x } else { self.g.div(x, den) }).collect()
         });
         Jet { v, g }
+    }
+
+    /// The Euclidean (Frobenius) size of a vector (tensor).
+    fn jnorm(&mut self, a: &Val) -> Jet {
+        let mut acc = self.constant(0.0);
+        for x in &a.c {
+            let p = self.jmul(x, x);
+            acc = self.jadd(&acc, &p);
+        }
+        self.jsqrt(&acc)
     }
 
     fn jheaviside(&mut self, a: &Jet) -> Jet {

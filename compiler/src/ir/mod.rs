@@ -165,17 +165,11 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
 
 /// W0006: a form whose tangent divides by (or takes a negative power of) an expression of the
 /// fields that a `pos`/`neg` clips to zero on a whole part of its region: the derivative of
-/// `d*sqrt(d)` with d = pos(u_N − g) is 0/0 wherever the body is out of contact, and the first
+/// `d*d^(1/3)` with d = pos(u_N − g) is 0/0 wherever the body is out of contact, and the first
 /// Jacobian is NaN. One warning per integral.
 pub fn vanishing_denominators(prog: &Unit, ir: &DimIr) -> Vec<Diagnostic> {
     let g = &ir.graph;
-    // A node that is zero wherever a clip of a field-dependent expression is: it contains
-    // H(a) with `a` depending on the fields.
-    let clipped = |den: NodeId| {
-        g.reachable([den]).into_iter().any(|n| {
-            matches!(g.node(n), Node::Heaviside(a) if g.reachable([a]).into_iter().any(|m| matches!(g.node(m), Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. }))))
-        })
-    };
+    let clipped = |den: NodeId| vanishes_with_a_clip(g, den);
     let mut out = Vec::new();
     for form in ir.forms.iter().filter(|f| f.test.is_some()) {
         let Some(def) = prog.forms.iter().find(|f| f.name == form.name) else { continue };
@@ -199,7 +193,7 @@ pub fn vanishing_denominators(prog: &Unit, ir: &DimIr) -> Vec<Diagnostic> {
                     "its derivative is 0/0 (NaN) there",
                 )
                 .with_note("Newton's first Jacobian is then NaN wherever the clip is active (out of contact), and the solve fails as singular")
-                .with_help("write the power directly: `d^(3/2)` rather than `d*sqrt(d)` differentiates to (3/2) d^(1/2), which is 0 at d = 0"),
+                .with_help("write the power directly: `d^(4/3)` rather than `d*d^(1/3)` differentiates to (4/3) d^(1/3), which is 0 at d = 0"),
             );
         }
     }
@@ -284,6 +278,29 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> Ta
         }
     }
     t
+}
+
+/// Whether `id` is zero wherever some H(a), `a` depending on the fields, is (a clip by `pos` or
+/// `neg` out of contact): H(a) itself, a product with such a factor, a sum of two such terms,
+/// a positive power or root of one. A sum with a term that stays (`|a| + (1 − H(|a|))`, the
+/// guard `proj_ball` and the derivative of `sqrt` write) does not vanish.
+fn vanishes_with_a_clip(g: &Graph, id: NodeId) -> bool {
+    let field = |s: Sym| matches!(s, Sym::Field { .. } | Sym::FieldGrad { .. });
+    let mut vanishes: std::collections::HashMap<NodeId, bool> = std::collections::HashMap::new();
+    for n in g.reachable([id]) {
+        let v = |m: NodeId| vanishes[&m];
+        let here = match g.node(n) {
+            Node::Heaviside(a) => g.depends_on(a, field),
+            Node::Mul(a, b) => v(a) || v(b),
+            Node::Add(a, b) => v(a) && v(b),
+            Node::Neg(a) | Node::Div(a, _) | Node::Sqrt(a) => v(a),
+            Node::Powi(a, k) => k > 0 && v(a),
+            Node::Powf(a, p) => f64::from_bits(p) > 0.0 && v(a),
+            Node::Const(_) | Node::Sym(_) => false,
+        };
+        vanishes.insert(n, here);
+    }
+    vanishes[&id]
 }
 
 /// Polynomial degree estimate of each node for Lagrange elements of degree p on affine cells

@@ -194,6 +194,13 @@ impl Checker<'_> {
             );
             return None;
         }
+        if name == "tangential" && tys[1].test {
+            self.error(
+                Diagnostic::error("E0402", "test function in the normal of `tangential`", args[1].span, "depends on the test function")
+                    .with_note("`tangential(a, nc)` = a − (a·nc) nc is linear in `a` only, and a form must be linear in its test function"),
+            );
+            return None;
+        }
         if matches!(name, "dot" | "inner" | "outer") && tys[0].test && tys[1].test {
             self.self_product(e.span, args[0].span, args[1].span);
             return None;
