@@ -37,6 +37,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0403", "test function in a denominator"),
     ("E0404", "test function multiplied by itself"),
     ("E0405", "form not linear in the test function (a term without it)"),
+    ("E0406", "`prev` outside a form (a functional or a problem's expression has no previous time level)"),
     ("E0501", "`n` or `h` in a volume integral"),
     ("E0502", "derivative of something that has none"),
     ("E0503", "form needs a quadrature degree above the cap (20)"),

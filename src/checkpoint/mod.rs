@@ -70,6 +70,7 @@ pub struct DriverState {
     /// A conserving scheme's allowance so far, and its active set after the last step.
     pub energy_allowance: f64,
     pub energy_switches: Vec<bool>,
+    /// The scheme's states, then the previous time level when a law reads it (`prev`).
     pub states: Vec<Vec<f64>>,
     /// Written every N steps (resumes bit for bit), or on an interrupt (to round-off).
     pub periodic: bool,

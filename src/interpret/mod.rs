@@ -216,6 +216,7 @@ fn meta(prog: &Program, irs: &[DimIr], fi: usize) -> FormMeta {
         test: f2.test.clone().unwrap_or_default().into(),
         linear: irs.iter().all(|ir| ir.forms[fi].linear),
         piecewise: irs.iter().all(|ir| ir.forms[fi].integrals.iter().all(|i| i.tangents.iter().all(|t| t.piecewise))),
+        previous: irs.iter().any(|ir| ir.forms[fi].previous),
         cell_degree: f2.integrals.iter().find(|i| i.cell).map(|i| i.degree),
         facets: facets.clone().map(|i| (i.region.clone().into(), i.degree)).collect(),
         facet_sites: facets.map(|i| signorini_compiler::docs::region_site(prog, &f2.name, &i.region).into()).collect(),

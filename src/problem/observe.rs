@@ -11,7 +11,7 @@ use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
 use crate::driver::FormsInUse;
 use crate::error::CaseError;
 use crate::runtime::fem::assembly::Assembler;
-use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
+use crate::runtime::fem::bound::{BoundForm, BoundFunctional, with_previous};
 use crate::runtime::fem::evaluate::{FacetSample, facet_samples};
 use crate::runtime::fem::mesh::Facet;
 use crate::runtime::library::Binding;
@@ -88,6 +88,9 @@ pub struct State<'a> {
     /// The displacement at the start of the step and the step (none at the initial row and at
     /// stages).
     pub before: Option<(&'a [f64], f64)>,
+    /// The level a contact law's `prev` reads at this row: the step's start (at a stage too),
+    /// the initial state at the first row and in a static problem.
+    pub previous: &'a [f64],
     /// An intermediate stage's row (not a row of the series).
     pub stage: bool,
 }
@@ -480,9 +483,9 @@ impl<'m> Observer<'m> {
         };
         if ops.probe.is_some() {
             // The run's contact slot (the energy guard asked the same step's already).
-            switches = ops.contact_switches(s.u, s.t);
+            switches = ops.contact_switches(s.u, s.previous, s.t);
         } else if let Some((_, probe)) = self.slots.iter().find(|(n, _)| n == "contact") {
-            probe.switches(asm, &[s.u], 0, s.t, &mut switches);
+            probe.switches(asm, &with_previous(probe.previous(), &[s.u], s.previous), 0, s.t, &mut switches);
         }
         let mut next = 0;
         for (c, (_, _, f)) in self.columns.iter().enumerate() {
@@ -529,7 +532,8 @@ impl<'m> Observer<'m> {
                     }
                     Measure::Force { slot, dofs } => {
                         let mut r = vec![0.0; n];
-                        self.slots[*slot].1.residual(asm, &[s.u], s.t, &mut r);
+                        let form = &self.slots[*slot].1;
+                        form.residual(asm, &with_previous(form.previous(), &[s.u], s.previous), s.t, &mut r);
                         match dofs {
                             None => resultant(&r, d),
                             Some(dofs) => (0..d)

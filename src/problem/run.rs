@@ -298,11 +298,15 @@ fn simulate(
                 constraints: constraints.clone(),
                 newton: opts.newton,
             };
+            // The level a law's `prev` reads: the state the equilibrium is sought from.
+            let initial = u0.clone();
             let solution = crate::simulation::statics::solve(&asm, problem, &in_use.forms, u0)?;
             let seconds = clock.elapsed().as_secs_f64();
             let newton = solution.newton.iterations();
-            let (row, switches) =
-                row(ops, State { t: t0, u: &solution.u, v: None, newton, before: None, stage: false });
+            let (row, switches) = row(
+                ops,
+                State { t: t0, u: &solution.u, v: None, newton, before: None, previous: &initial, stage: false },
+            );
             snapshots.write(ops, 0, t0, &solution.u, &vec![0.0; n])?;
             let outcome = crate::simulation::Outcome {
                 step_seconds: vec![seconds],
@@ -316,7 +320,8 @@ fn simulate(
         }
         Runner::Time(sim) => {
             sim.initialize_at(t0, u0, v0)?;
-            let first = State { t: t0, u: &sim.states[0], v: sim.velocity(), newton: 0, before: None, stage: false };
+            let u0 = &sim.states[0];
+            let first = State { t: t0, u: u0, v: sim.velocity(), newton: 0, before: None, previous: u0, stage: false };
             let (first, first_switches) = row(&sim.ops, first);
             let mut series = vec![first];
             let mut switches = vec![first_switches];
@@ -374,11 +379,12 @@ fn simulate(
                 steps,
                 opts.progress && writes,
                 &mut control,
-                &mut |ops, stage, v_index| {
+                &mut |ops, stage, v_index, start| {
                     if let Some(u) = stage.value_of(&names[0]) {
                         let v = v_index.and_then(|i| stage.value_of(&names[i]));
-                        let ((t, values), _) =
-                            row(ops, State { t: stage.time, u, v, newton: 0, before: None, stage: true });
+                        let state =
+                            State { t: stage.time, u, v, newton: 0, before: None, previous: start, stage: true };
+                        let ((t, values), _) = row(ops, state);
                         stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
                     }
                 },
@@ -390,6 +396,7 @@ fn simulate(
                         v,
                         newton: step.report.iterations(),
                         before: Some((step.before, step.dt)),
+                        previous: step.before,
                         stage: false,
                     };
                     let (values, active) = row(ops, state);

@@ -70,7 +70,8 @@ impl EnergyWatch {
             growth: 0.0,
             lowest: initial,
             allowance: 0.0,
-            switches: ops.contact_switches(u, t),
+            // The first level's previous level is itself (as the stepper's is).
+            switches: ops.contact_switches(u, u, t),
         }
     }
 
@@ -167,7 +168,7 @@ impl EnergyWatch {
         // A conserving scheme: the allowance grows on the steps where the active set changes.
         let (switches, allowance) = match law {
             Some(EnergyLaw::Conserving) => {
-                let switches = ops.contact_switches(u, t);
+                let switches = ops.contact_switches(u, before, t);
                 let jump = if switches != self.switches {
                     let value = |x: &[f64], at: f64| Self::value(&ops.contact_jump, ops, x, at);
                     value(u, t).max(value(before, t - h))

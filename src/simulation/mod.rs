@@ -209,7 +209,7 @@ impl<'m> Simulation<'m> {
         steps: usize,
         progress: bool,
         control: &mut Control,
-        on_stage: &mut dyn FnMut(&Operators, &StageView, Option<usize>),
+        on_stage: &mut OnStage,
         on_step: &mut OnStep,
     ) -> Result<Outcome, CaseError> {
         if let Some(stable) = self.stable
@@ -245,10 +245,16 @@ impl<'m> Simulation<'m> {
         let full: u64 = 1 << max_cuts;
         let (mut level, mut streak, mut accepted, mut first) = (0usize, 0usize, 0usize, 0usize);
         if let Some((saved, _)) = &control.resume {
-            if saved.states.len() != states.len() || saved.states.iter().any(|s| s.len() != ops.asm.size()) {
+            // The scheme's states, then the previous level when a law reads it (`prev`).
+            let count = states.len() + usize::from(stepper.reads_previous());
+            if saved.states.len() != count || saved.states.iter().any(|s| s.len() != ops.asm.size()) {
                 return Err(CaseError::Option("the checkpoint's states do not fit this run's scheme and mesh".into()));
             }
-            states.clone_from_slice(&saved.states);
+            let scheme_states = states.len();
+            states.clone_from_slice(&saved.states[..scheme_states]);
+            if let Some(previous) = saved.states.get(scheme_states) {
+                stepper.set_previous(previous.clone());
+            }
             (first, accepted, level, streak) = (saved.steps_done, saved.accepted, saved.level, saved.streak);
             outcome.cuts = saved.cuts;
             energy = EnergyWatch {
@@ -285,7 +291,7 @@ impl<'m> Simulation<'m> {
                 let mut stages_seen: Vec<(f64, Vec<f64>, Option<Vec<f64>>)> = Vec::new();
                 let result = stepper.step_observed(states, t, h, &mut |stage| {
                     if intermediate.iter().any(|name| name == stage.name) {
-                        on_stage(ops, stage, *v_index);
+                        on_stage(ops, stage, *v_index, &before);
                         if !ops.held.is_empty()
                             && let Some(u) = stage.value_of("u")
                         {
@@ -408,7 +414,12 @@ impl<'m> Simulation<'m> {
                         energy_lowest: energy.lowest,
                         energy_allowance: energy.allowance,
                         energy_switches: energy.switches.clone(),
-                        states: states.to_vec(),
+                        states: states
+                            .iter()
+                            .map(Vec::as_slice)
+                            .chain(stepper.previous())
+                            .map(<[f64]>::to_vec)
+                            .collect(),
                         periodic: !interrupted,
                     };
                     if let Err(e) = control.write(driver, record) {
@@ -435,6 +446,11 @@ impl<'m> Simulation<'m> {
         Ok(outcome)
     }
 }
+
+/// What a case does with each intermediate stage: the operators, the stage's quantities, the
+/// index of the velocity state (if any), and the displacement at the step's start (what a
+/// contact law's `prev` reads there).
+pub type OnStage<'a> = dyn FnMut(&Operators, &StageView, Option<usize>, &[f64]) + 'a;
 
 /// What a case does with each accepted step; when a checkpoint is due, it also writes its
 /// record of the run so far into the buffer.

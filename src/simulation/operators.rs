@@ -10,7 +10,7 @@ use super::{MassChoice, Problem, stability};
 use crate::driver::FilesInUse;
 use crate::error::CaseError;
 use crate::runtime::fem::assembly::Assembler;
-use crate::runtime::fem::bound::{BoundForm, BoundFunctional, MatrixForm};
+use crate::runtime::fem::bound::{BoundForm, BoundFunctional, MatrixForm, with_previous};
 use crate::runtime::fem::mesh::{Facet, Mesh};
 use crate::runtime::library::Binding;
 use crate::runtime::linalg::Matrix;
@@ -56,11 +56,12 @@ pub struct Operators<'m> {
     /// step by the observers.
     pub energies: Energies,
     /// The last `contact_switches` asked for: u, t's bits and the answer.
-    last_switches: std::sync::Mutex<Option<Kept<Vec<bool>>>>,
+    last_switches: std::sync::Mutex<Option<KeptSwitches>>,
 }
 
-/// A value kept for the vector and the time (its bits) it was computed at.
-type Kept<T> = (Vec<f64>, u64, T);
+/// Switches kept for the u, the previous level (empty when the law does not read it) and the
+/// time (its bits) they were computed at.
+type KeptSwitches = (Vec<f64>, Vec<f64>, u64, Vec<bool>);
 
 /// The last vector and value of each energy form (stiffness, mass).
 type LastQuads = [Option<(Vec<f64>, f64)>; 2];
@@ -156,32 +157,36 @@ impl Operators<'_> {
     }
 
     /// The resultant of the contact term on the body along each axis (zeros without a
-    /// `contact` slot).
-    pub fn contact_force(&self, u: &[f64], t: f64) -> Vec<f64> {
+    /// `contact` slot), at u with `previous` the level before it (what a law's `prev` reads).
+    pub fn contact_force(&self, u: &[f64], previous: &[f64], t: f64) -> Vec<f64> {
         let mut c = vec![0.0; u.len()];
         if let Some(probe) = &self.probe {
-            probe.residual(self.asm, &[u], t, &mut c);
+            probe.residual(self.asm, &with_previous(probe.previous(), &[u], previous), t, &mut c);
         }
         resultant(&c, self.asm.mesh().dim())
     }
 
-    /// The contact slot's switch at each of its quadrature points (none without the slot).
+    /// The contact slot's switch at each of its quadrature points (none without the slot), at
+    /// u with `previous` the level before it.
     ///
     /// The energy guard and the observers ask for the same step's: the last answer is kept and
-    /// reused for the same u and t.
-    pub fn contact_switches(&self, u: &[f64], t: f64) -> Vec<bool> {
+    /// reused for the same u, previous level and t.
+    pub fn contact_switches(&self, u: &[f64], previous: &[f64], t: f64) -> Vec<bool> {
         let mut last = self.last_switches.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((kept, at, switches)) = &*last
+        let reads = self.probe.as_ref().is_some_and(|p| p.previous());
+        if let Some((kept, kept_previous, at, switches)) = &*last
             && *at == t.to_bits()
             && kept.as_slice() == u
+            && (!reads || kept_previous.as_slice() == previous)
         {
             return switches.clone();
         }
         let mut switches = Vec::new();
         if let Some(probe) = &self.probe {
-            probe.switches(self.asm, &[u], 0, t, &mut switches);
+            probe.switches(self.asm, &with_previous(reads, &[u], previous), 0, t, &mut switches);
         }
-        *last = Some((u.to_vec(), t.to_bits(), switches.clone()));
+        let kept_previous = if reads { previous.to_vec() } else { Vec::new() };
+        *last = Some((u.to_vec(), kept_previous, t.to_bits(), switches.clone()));
         switches
     }
 

@@ -43,10 +43,12 @@ pub fn estimate(
     if let Some(probe) = &ops.probe {
         let pushed = pushed_into_obstacle(ops, coefs);
         let mut contact = asm.zero_matrix();
-        probe.tangent(asm, &[&pushed], 0, 0.0, &mut contact);
+        // Pushed from where it was: a frictional law sticks there, its stiffest state.
+        let args = crate::runtime::fem::bound::with_previous(probe.previous(), &[&pushed], &pushed);
+        probe.tangent(asm, &args, 0, 0.0, &mut contact);
         a.add_scaled(1.0, &contact);
         let mut switches = Vec::new();
-        probe.switches(asm, &[&pushed], 0, 0.0, &mut switches);
+        probe.switches(asm, &args, 0, 0.0, &mut switches);
         points = switches.len();
         active = switches.iter().filter(|s| **s).count();
     }

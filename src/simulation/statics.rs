@@ -71,6 +71,8 @@ pub fn solve<'m>(
         return Err(CaseError::Option(format!("the initial state has {} values, the mesh {n} unknowns", u.len())));
     }
     static_problem.constraints.zero(&mut u);
+    // A law's `prev` (a frictional slip) is measured from the initial state.
+    static_problem.previous.clone_from(&u);
     // `--solver auto` factorizes here: without a mass term, Jacobi-CG on the stiffness alone
     // converges slowly (the threshold of `auto` is measured on time steps).
     let mut options = problem.newton;

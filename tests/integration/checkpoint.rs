@@ -3,7 +3,8 @@
 //! as an uninterrupted run with the same checkpoint period; an interrupted run writes complete
 //! outputs and exits with 130, keeping its last periodic checkpoint (bit for bit) or, without
 //! periodic ones, writing one that resumes to round-off; a checkpoint of other options is
-//! refused.
+//! refused. A frictional law, whose previous level the checkpoint keeps, resumes bit for bit
+//! too.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -52,6 +53,18 @@ fn killed_and_resumed_discs_have_the_bits_of_an_uninterrupted_one() {
 #[test]
 fn killed_and_resumed_bars_have_the_bits_of_an_uninterrupted_one() {
     kill_and_resume("bar", &["run", "bar", "--ne", "100", "--dt", "0.002", "--checkpoint-every", "37"]);
+}
+
+/// A frictional law (`prev`: the slip since the previous level, which the checkpoint keeps),
+/// run by path, under HHT, whose accepted level reads the level before it, and TR-BDF2.
+#[test]
+fn killed_and_resumed_frictional_discs_have_the_bits_of_an_uninterrupted_one() {
+    let law = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/problems/coulomb_penalty.wf");
+    for scheme in ["hht", "trbdf2"] {
+        let mut args = RUN.to_vec();
+        args.extend_from_slice(&["--contact", law, "--scheme", scheme]);
+        kill_and_resume(&format!("coulomb-{scheme}"), &args);
+    }
 }
 
 /// Runs `run` to the end; then again, killed at arbitrary moments and resumed from its

@@ -60,8 +60,6 @@ struct Data {
     f: Coef,
     g: Coef,
     nc: Coef,
-    /// The displacement a frictional law measures slip from.
-    w: Coef,
 }
 
 impl Data {
@@ -74,17 +72,12 @@ impl Data {
             }),
             g: Coef::function(1, |x, t, out| out[0] = 0.5 * (x[0] - 0.3) + 0.01 * t),
             nc: Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>()),
-            w: Coef::function(d, |x, _, out| {
-                for (k, o) in out.iter_mut().enumerate() {
-                    *o = 0.04 * (2.1 * x[0] + k as f64).sin();
-                }
-            }),
         }
     }
 
     /// The coefs a library declares, by name.
     fn list(&self, lib: &Library) -> Vec<(&'static str, Coef)> {
-        let all = [("f", &self.f), ("g", &self.g), ("nc", &self.nc), ("w", &self.w)];
+        let all = [("f", &self.f), ("g", &self.g), ("nc", &self.nc)];
         let names = lib.coefs();
         all.into_iter().filter(|(n, _)| names.contains(n)).map(|(n, c)| (n, c.clone())).collect()
     }
@@ -142,14 +135,16 @@ fn compare_form_on<const D: usize, const N: usize, K: FormKernel<D, N>>(
     for trial in 0..3 {
         let x: [[f64; D]; N] = cell(kind, rng);
         let h = geometry::diameter(&x, D + 1);
-        let states: Vec<LocalVector<D, N>> = meta.fields.iter().map(|_| state(rng)).collect();
+        // The fields, then the previous level when the form reads it (`prev`).
+        let count = meta.fields.len() + usize::from(meta.previous);
+        let states: Vec<LocalVector<D, N>> = (0..count).map(|_| state(rng)).collect();
         let fields: Vec<&LocalVector<D, N>> = states.iter().collect();
         let what = |part: &str| format!("{} on a {} (trial {trial}): {part}", meta.name, kind.name());
         if let Some(deg) = meta.cell_degree {
             let tab = Tabulation::<D, N>::cell(kind, deg[p]).unwrap();
             let (c, i) = (cell_vector(compiled, &tab, &x, &fields, T), cell_vector(interp, &tab, &x, &fields, T));
             stats.close(&what("cell residual"), &flat(&c), &flat(&i));
-            for wrt in 0..fields.len() {
+            for wrt in 0..meta.fields.len() {
                 let c = cell_matrix(compiled, &tab, &x, &fields, wrt, T);
                 let i = cell_matrix(interp, &tab, &x, &fields, wrt, T);
                 stats.close(&what(&format!("cell tangent d/d{}", meta.fields[wrt])), &c.concat(), &i.concat());
@@ -167,7 +162,7 @@ fn compare_form_on<const D: usize, const N: usize, K: FormKernel<D, N>>(
                 let c = facet_vector(compiled, region, &tab, facet, &x, h, &fields, T);
                 let i = facet_vector(interp, region, &tab, facet, &x, h, &fields, T);
                 stats.close(&at("facet residual"), &flat(&c), &flat(&i));
-                for wrt in 0..fields.len() {
+                for wrt in 0..meta.fields.len() {
                     let c = facet_matrix(compiled, region, &tab, facet, &x, h, &fields, wrt, T);
                     let i = facet_matrix(interp, region, &tab, facet, &x, h, &fields, wrt, T);
                     stats.close(&at(&format!("facet tangent d/d{}", meta.fields[wrt])), &c.concat(), &i.concat());
@@ -199,7 +194,9 @@ fn compare_functional_on<const D: usize, const N: usize, K: FunctionalKernel<D, 
     for trial in 0..3 {
         let x: [[f64; D]; N] = cell(kind, rng);
         let h = geometry::diameter(&x, D + 1);
-        let states: Vec<LocalVector<D, N>> = meta.fields.iter().map(|_| state(rng)).collect();
+        // The fields, then the previous level when the form reads it (`prev`).
+        let count = meta.fields.len() + usize::from(meta.previous);
+        let states: Vec<LocalVector<D, N>> = (0..count).map(|_| state(rng)).collect();
         let fields: Vec<&LocalVector<D, N>> = states.iter().collect();
         let what = |part: &str| format!("{} on a {} (trial {trial}): {part}", meta.name, kind.name());
         if let Some(deg) = meta.cell_degree {
@@ -363,9 +360,9 @@ unit_test!(
     coulomb_interpreted_matches_compiled,
     coulomb_penalty,
     "tests/problems/coulomb_penalty.wf",
-    |d| coulomb_penalty::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone(), w: d.w.clone() },
+    |d| coulomb_penalty::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact],
-    functionals: [FrictionForce, Slip]
+    functionals: [ContactEnergy, ContactPressure, FrictionForce, Slip]
 );
 
 fn bound<'m, K: Kernel + 'm>(kernel: K, contact: &'m [Facet]) -> Box<dyn BoundForm + 'm> {

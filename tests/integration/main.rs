@@ -20,6 +20,7 @@ mod interpreted_schemes;
 mod mpi;
 #[cfg(feature = "petsc")]
 mod petsc;
+mod previous_level;
 mod problems;
 mod redistribution;
 mod schemes;

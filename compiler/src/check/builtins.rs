@@ -25,6 +25,7 @@ pub const BUILTIN_FUNCTIONS: &[&str] = &[
     "norm",
     "proj_ball",
     "tangential",
+    "prev",
 ];
 
 /// Functions of a problem's numbers (params, `let`s of them), not of values that vary.
@@ -74,6 +75,7 @@ pub fn result_shape(name: &str, args: &[Shape]) -> Result<Shape, String> {
             b.name()
         )),
         ("tangential", [Vector, Vector]) => Ok(Vector),
+        ("prev", [a]) => Ok(*a),
         ("tangential", [a, b]) => {
             Err(format!("tangential takes a vector and a unit normal, not a {} and a {}", a.name(), b.name()))
         }

@@ -55,12 +55,13 @@ pub fn form_items(prog: &Program, irs: &[&DimIr], fi: usize, sname: &str) -> Str
         .collect();
     let _ = writeln!(
         s,
-        "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: Borrowed({:?}), fields: Borrowed(&[{}]), test: Borrowed({:?}), linear: {}, piecewise: {}, cell_degree: {cell_degree}, facets: Borrowed(&[{}]), facet_sites: Borrowed(&[{}]) }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }}\n{} }}",
+        "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: Borrowed({:?}), fields: Borrowed(&[{}]), test: Borrowed({:?}), linear: {}, piecewise: {}, previous: {}, cell_degree: {cell_degree}, facets: Borrowed(&[{}]), facet_sites: Borrowed(&[{}]) }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }}\n{} }}",
         form.name,
         fields.join(", "),
         form.test.as_ref().map_or("", |t| t.name.as_str()),
         irs.iter().all(|ir| ir.forms[fi].linear),
         irs.iter().all(|ir| ir.forms[fi].integrals.iter().all(|i| i.tangents.iter().all(|t| t.piecewise))),
+        irs.iter().any(|ir| ir.forms[fi].previous),
         facets.join(", "),
         sites.join(", "),
         time_dependence(prog, irs, fi)

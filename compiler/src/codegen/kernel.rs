@@ -355,14 +355,15 @@ impl Body<'_> {
             let _ = writeln!(prologue, "let {local} = self.params.{};", ident(pname));
             leaf.insert(Sym::Param(i), local);
         }
-        let nfields = self.form.fields.len();
+        // The previous time level (`prev`), when read, is one more field after the arguments.
+        let nfields = self.form.fields.len() + usize::from(self.form.previous);
         let mut field_val = vec![None; nfields];
         let mut field_grad = vec![None; nfields];
         for a in 0..nfields {
             let uses_val = syms.iter().any(|s| matches!(s, Sym::Field { arg, .. } if *arg as usize == a));
             let uses_grad = syms.iter().any(|s| matches!(s, Sym::FieldGrad { arg, .. } if *arg as usize == a));
             if uses_val || uses_grad {
-                let fname = &self.form.fields[a];
+                let fname = self.form.fields.get(a).map_or("previous", String::as_str);
                 let dofs = namer.fresh(fname);
                 let _ = writeln!(prologue, "let {dofs} = fields[{a}];");
                 if uses_val {

@@ -306,6 +306,29 @@ impl Graph {
         out
     }
 
+    /// `root` with every leaf `s` for which `map(s)` is some other leaf replaced by it, rebuilt
+    /// through the constructors (children first: ids are a topological order).
+    pub fn substitute(&mut self, root: NodeId, map: &impl Fn(Sym) -> Option<Sym>) -> NodeId {
+        let mut new: HashMap<NodeId, NodeId> = HashMap::new();
+        for id in self.reachable([root]) {
+            let c = |x: NodeId| new[&x];
+            let rebuilt = match self.node(id) {
+                Node::Const(_) => id,
+                Node::Sym(s) => map(s).map_or(id, |t| self.sym(t)),
+                Node::Add(a, b) => self.add(c(a), c(b)),
+                Node::Mul(a, b) => self.mul(c(a), c(b)),
+                Node::Div(a, b) => self.div(c(a), c(b)),
+                Node::Neg(a) => self.neg(c(a)),
+                Node::Powi(a, k) => self.powi(c(a), k),
+                Node::Powf(a, p) => self.powf(c(a), f64::from_bits(p)),
+                Node::Sqrt(a) => self.sqrt(c(a)),
+                Node::Heaviside(a) => self.heaviside(c(a)),
+            };
+            new.insert(id, rebuilt);
+        }
+        new[&root]
+    }
+
     /// Whether `id` depends on any symbol accepted by `pred`.
     pub fn depends_on(&self, id: NodeId, pred: impl Fn(Sym) -> bool) -> bool {
         self.reachable([id]).into_iter().any(|n| matches!(self.node(n), Node::Sym(s) if pred(s)))

@@ -63,6 +63,10 @@ pub struct Lowerer<'p> {
     /// Graph size when the current form began, for [`MAX_FORM_NODES`], and its name.
     form_start: usize,
     form_name: String,
+    /// In a form of n field arguments, n: `prev(u)` reads the previous time level's
+    /// displacement as an n+1-th field, which no tangent differentiates. None outside forms
+    /// (functionals, a problem's expressions).
+    previous: Option<u8>,
 }
 
 impl<'p> Lowerer<'p> {
@@ -76,6 +80,7 @@ impl<'p> Lowerer<'p> {
             calls: HashMap::new(),
             form_start: 0,
             form_name: String::new(),
+            previous: None,
         }
     }
 
@@ -104,6 +109,9 @@ impl<'p> Lowerer<'p> {
         let form = &self.prog.forms[index];
         self.form_start = self.g.len();
         self.form_name.clone_from(&form.name);
+        // A functional is evaluated at levels the driver names (`contact_work(u, w)`): the
+        // previous one is an argument there, not `prev`.
+        self.previous = form.test.is_some().then_some(form.fields.len() as u8);
         let d = self.d;
         let mut scope = Vec::new();
         for (a, f) in form.fields.iter().enumerate() {
@@ -373,7 +381,35 @@ impl<'p> Lowerer<'p> {
             };
             return Ok(self.constant_val(if f == "ceil" { x.ceil() } else { x.floor() }));
         }
+        if f == "prev" {
+            let Some(previous) = self.previous else {
+                return Err(Box::new(
+                    Diagnostic::error("E0406", "`prev` outside a form", span, "no previous time level here")
+                        .with_note("`prev(e)` is `e` at the previous time level, which the driver gives a form's kernels")
+                        .with_help("a functional takes the levels it compares as arguments: `functional work(u, w) = ...`, evaluated at the step's new and old displacements"),
+                ));
+            };
+            return Ok(self.previous_level(&args[0], previous));
+        }
         Ok(self.builtin(f, args))
+    }
+
+    /// `a` with every field argument, value and gradient, read at the previous time level: the
+    /// form's field `previous`.
+    fn previous_level(&mut self, a: &Val, previous: u8) -> Val {
+        let map = |s: Sym| match s {
+            Sym::Field { comp, .. } => Some(Sym::Field { arg: previous, comp }),
+            Sym::FieldGrad { comp, dir, .. } => Some(Sym::FieldGrad { arg: previous, comp, dir }),
+            _ => None,
+        };
+        let c =
+            a.c.iter()
+                .map(|j| Jet {
+                    v: self.g.substitute(j.v, &map),
+                    g: j.g.as_ref().map(|g| g.iter().map(|&x| self.g.substitute(x, &map)).collect()),
+                })
+                .collect();
+        Val { shape: a.shape, c }
     }
 
     fn builtin(&mut self, f: &str, args: Vec<Val>) -> Val {

@@ -39,8 +39,12 @@ pub struct FormIr {
     /// `None` for a functional (no test function: one value per integral).
     pub test: Option<String>,
     pub integrals: Vec<IntegralIr>,
-    /// The tangent does not depend on the fields: assemble once.
+    /// The tangent does not depend on the fields, nor the form on the previous time level:
+    /// assemble once.
     pub linear: bool,
+    /// The form reads the previous time level's displacement (`prev`), as field argument
+    /// `fields.len()`, which the driver supplies and no tangent differentiates (forms only).
+    pub previous: bool,
 }
 
 pub struct IntegralIr {
@@ -133,7 +137,9 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
                         .of(&mut g, integrand.value)
                 })
                 .collect();
-            let tangents = (0..lf.fields.len()).map(|a| tangent(&mut g, d, a as u8, &f0, &f1)).collect::<Vec<_>>();
+            let previous = lf.fields.len() as u8;
+            let tangents =
+                (0..lf.fields.len()).map(|a| tangent(&mut g, d, a as u8, previous, &f0, &f1)).collect::<Vec<_>>();
             let estimated = [1, 2].map(|p| integral_degree(&g, p, &f0, &f1, &tangents));
             let degree = integrand.degree.map_or(estimated, |k| [k, k]);
             integrals.push(IntegralIr {
@@ -148,14 +154,19 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
             });
         }
         let tangent_nodes = integrals.iter().flat_map(|i| i.tangents.iter().flat_map(TangentIr::nodes));
-        let linear = !g
+        let constant_tangent = !g
             .reachable(tangent_nodes)
             .into_iter()
             .any(|n| matches!(g.node(n), Node::Sym(Sym::Field { .. } | Sym::FieldGrad { .. })));
+        let prev = lf.fields.len() as u8;
+        let is_previous = |n: NodeId| matches!(g.node(n), Node::Sym(Sym::Field { arg, .. } | Sym::FieldGrad { arg, .. }) if arg == prev);
+        let values = integrals.iter().flat_map(|i| i.f0.iter().chain(&i.f1).chain(&i.value)).copied();
+        let previous = g.reachable(values).into_iter().any(is_previous);
+        let linear = constant_tangent && !previous;
         if let Some(e) = degree_error(prog, &lf.name, &integrals) {
             diags.push(e);
         }
-        forms.push(FormIr { name: lf.name, fields: lf.fields, test: lf.test, integrals, linear });
+        forms.push(FormIr { name: lf.name, fields: lf.fields, test: lf.test, integrals, linear, previous });
     }
     if !diags.is_empty() {
         return Err(diags);
@@ -228,7 +239,10 @@ fn degree_error(prog: &Unit, name: &str, integrals: &[IntegralIr]) -> Option<Dia
     )
 }
 
-fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> TangentIr {
+/// The tangent of `f0`, `f1` with respect to field argument `arg`; the switches and the
+/// piecewise test count the previous level (field `previous`, never differentiated) as state
+/// too, so that a changed previous level is never taken for an unchanged tangent.
+fn tangent(g: &mut Graph, d: usize, arg: u8, previous: u8, f0: &[NodeId], f1: &[NodeId]) -> TangentIr {
     let val: Vec<Sym> = (0..d).map(|m| Sym::Field { arg, comp: m as u8 }).collect();
     let grad: Vec<Sym> =
         (0..d * d).map(|mn| Sym::FieldGrad { arg, comp: (mn / d) as u8, dir: (mn % d) as u8 }).collect();
@@ -255,7 +269,8 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, f0: &[NodeId], f1: &[NodeId]) -> Ta
         }
     }
     let mut t = TangentIr { c00, c01, c10, c11, switches: Vec::new(), piecewise: true };
-    let is_field = |s: Sym| matches!(s, Sym::Field { arg: x, .. } | Sym::FieldGrad { arg: x, .. } if x == arg);
+    let is_field =
+        |s: Sym| matches!(s, Sym::Field { arg: x, .. } | Sym::FieldGrad { arg: x, .. } if x == arg || x == previous);
     let roots: Vec<NodeId> = t.nodes().collect();
     for n in g.reachable(roots.iter().copied()) {
         if let Node::Heaviside(a) = g.node(n)

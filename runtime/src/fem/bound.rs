@@ -13,6 +13,11 @@ use crate::linalg::element_matrices::ElementMatrices;
 pub trait BoundForm {
     fn name(&self) -> &str;
     fn fields(&self) -> usize;
+    /// Whether it reads the displacement at the previous time level (`prev`): then every call
+    /// passes it after the `fields()` arguments (see [`with_previous`]).
+    fn previous(&self) -> bool {
+        false
+    }
     fn linear(&self) -> bool;
     fn piecewise(&self) -> bool;
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]);
@@ -43,6 +48,16 @@ pub trait BoundForm {
     }
 }
 
+/// `fields`, with `previous` after them when the form reads the previous time level (`reads`):
+/// the arguments of a form that may read it.
+pub fn with_previous<'a>(reads: bool, fields: &[&'a [f64]], previous: &'a [f64]) -> Vec<&'a [f64]> {
+    let mut all = fields.to_vec();
+    if reads {
+        all.push(previous);
+    }
+    all
+}
+
 /// A kernel with its integration data.
 pub struct Bound<'m, K: Kernel> {
     pub kernel: K,
@@ -64,6 +79,9 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
     }
     fn fields(&self) -> usize {
         self.kernel.meta().fields.len()
+    }
+    fn previous(&self) -> bool {
+        self.kernel.meta().previous
     }
     fn linear(&self) -> bool {
         self.kernel.meta().linear

@@ -249,6 +249,9 @@ pub struct FormMeta {
     pub linear: bool,
     /// The tangent depends on the fields only through the switches (the active set).
     pub piecewise: bool,
+    /// The form reads the displacement at the previous time level (`prev` in its file): its
+    /// kernels take it after the fields, as one more field that no tangent differentiates.
+    pub previous: bool,
     /// Suggested cell quadrature degree for P1 and P2, if the form has a volume integral.
     pub cell_degree: Option<[u32; 2]>,
     /// Boundary regions with suggested facet quadrature degrees for P1 and P2.

@@ -127,7 +127,9 @@ fn probe_here(
             continue;
         }
         for _ in 0..2 {
-            let state: Vec<Vec<f64>> = (0..form.fields()).map(|_| (0..n).map(|_| random()).collect()).collect();
+            // The fields, and the previous time level when the form reads it.
+            let count = form.fields() + usize::from(form.previous());
+            let state: Vec<Vec<f64>> = (0..count).map(|_| (0..n).map(|_| random()).collect()).collect();
             for sign in [1.0, -1.0] {
                 let fields: Vec<Vec<f64>> = state.iter().map(|f| f.iter().map(|x| sign * x).collect()).collect();
                 let refs: Vec<&[f64]> = fields.iter().map(Vec::as_slice).collect();

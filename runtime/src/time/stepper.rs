@@ -18,7 +18,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use signorini_descriptors::{Borrowed, Combination, Level, SchemeDesc, StageDesc};
+use signorini_descriptors::{Borrowed, Combination, Level, SchemeDesc, StageDesc, TermDesc};
 
 use crate::fem::assembly::Assembler;
 use crate::fem::bound::BoundForm;
@@ -108,6 +108,10 @@ pub struct Stepper<'a> {
     /// Recently assembled loads, by (form, time).
     loads: Vec<((String, u64), Vec<f64>)>,
     coefs: Vec<f64>,
+    /// Whether a form reads the previous time level (`prev`), and that level: the displacement
+    /// at the start of the last accepted step (u⁰ before the first). See [`Stepper::solve_stage`].
+    reads_previous: bool,
+    previous: Option<Vec<f64>>,
     /// Vectors of the problem's size no longer in use (states replaced, bases, products), for
     /// the next step: a step allocates none once the first has run.
     pool: Pool,
@@ -232,6 +236,7 @@ impl<'a> Stepper<'a> {
             })
             .collect();
         let coefs = vec![0.0; desc.coefficients];
+        let reads_previous = forms.values().any(|f| f.previous());
         Ok(Stepper {
             scheme,
             desc,
@@ -247,6 +252,8 @@ impl<'a> Stepper<'a> {
             half_pattern,
             loads: Vec::new(),
             coefs,
+            reads_previous,
+            previous: None,
             pool: Pool::default(),
         })
     }
@@ -336,6 +343,9 @@ impl<'a> Stepper<'a> {
 
     /// Solves the initial problem (e.g. M a⁰ = L⁰ − B(u⁰)) for its state, if the scheme has one.
     pub fn initialize(&mut self, states: &mut [Vec<f64>], t: f64) -> Result<Option<NewtonReport>, StepError> {
+        if self.reads_previous {
+            self.previous = Some(states[0].clone());
+        }
         let Some(init) = &self.desc.initial else { return Ok(None) };
         let state = init.state;
         let stage = StageDesc {
@@ -374,6 +384,24 @@ impl<'a> Stepper<'a> {
         Ok(Some(report))
     }
 
+    /// u at the start of the last accepted step (u⁰ before the first), which a term of the
+    /// accepted level reads as its `prev` (see `previous_level`), when a form reads `prev`:
+    /// state, which a checkpoint keeps with the scheme's states.
+    pub fn previous(&self) -> Option<&[f64]> {
+        self.previous.as_deref().filter(|_| self.reads_previous)
+    }
+
+    /// Whether a form reads the previous time level (then [`Stepper::previous`] is part of the
+    /// state).
+    pub fn reads_previous(&self) -> bool {
+        self.reads_previous
+    }
+
+    /// Restores the previous time level (from a checkpoint).
+    pub fn set_previous(&mut self, previous: Vec<f64>) {
+        self.previous = Some(previous);
+    }
+
     /// Drops the stages' factorizations, constant operators and loads: the next step runs as in
     /// a new stepper (see [`crate::nonlinear::newton::Newton::forget`]).
     pub fn forget(&mut self) {
@@ -403,6 +431,8 @@ impl<'a> Stepper<'a> {
         self.scheme.coefficients(dt, t, &mut self.coefs);
         let mut quantities: Vec<Vec<Vec<f64>>> = Vec::with_capacity(desc.stages.len());
         let mut report = StepReport::default();
+        // The displacement at the start of the step: the previous level of the next one.
+        let start = self.reads_previous.then(|| self.pool.copy(&states[0]));
         for (s, stage) in desc.stages.iter().enumerate() {
             // Newton starts from the state the unknown updates (u for u'), else the first state.
             let name = &stage.quantities[0];
@@ -441,6 +471,11 @@ impl<'a> Stepper<'a> {
         }
         for (st, v) in states.iter_mut().zip(new_states) {
             self.pool.give(std::mem::replace(st, v));
+        }
+        if let Some(start) = start
+            && let Some(old) = self.previous.replace(start)
+        {
+            self.pool.give(old);
         }
         quantities.into_iter().flatten().for_each(|v| self.pool.give(v));
         Ok(report)
@@ -551,6 +586,31 @@ impl<'a> Stepper<'a> {
         self.pool.give(product);
     }
 
+    /// The displacement a term's `prev` reads. A term of the accepted level u alone (HHT's
+    /// `α·contact(u)`, an explicit `contact(u)`, the initial problem's) is that level's law,
+    /// which reads the level before it: u at the start of the previous step (u⁰ at the first
+    /// and in the initial problem). Any other term is a new level's (u', um, (u + u')/2), which
+    /// reads the level the stage starts from: u for the first stage, the previous stage's
+    /// displacement (TR-BDF2's um) for a later one.
+    fn previous_level<'s>(
+        &'s self,
+        term: &TermDesc,
+        states: &'s [Vec<f64>],
+        quantities: &'s [Vec<Vec<f64>>],
+    ) -> &'s [f64] {
+        let accepted = |c: &Combination| {
+            c.unknown.is_none() && matches!(&*c.known, [(Level::State(0), k)] if self.coefs[*k] == 1.0)
+        };
+        if term.args.iter().all(accepted) {
+            return self.previous.as_deref().unwrap_or(&states[0]);
+        }
+        let Some(last) = quantities.len().checked_sub(1) else { return &states[0] };
+        match self.displacement(&self.desc.stages[last]) {
+            Some(q) => &quantities[last][q],
+            None => &states[0],
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn solve_stage(
         &mut self,
@@ -600,7 +660,13 @@ impl<'a> Stepper<'a> {
                 self.combine(c, reference, None, states, quantities, &mut b);
                 bases.push(b);
             }
-            let alphas: Vec<f64> = term.args.iter().map(|c| c.unknown.map_or(0.0, |k| self.coefs[k])).collect();
+            let mut alphas: Vec<f64> = term.args.iter().map(|c| c.unknown.map_or(0.0, |k| self.coefs[k])).collect();
+            if form.previous() {
+                let mut b = self.pool.take(n);
+                b.copy_from_slice(self.previous_level(term, states, quantities));
+                bases.push(b);
+                alphas.push(0.0);
+            }
             match self.matrices.get(&*term.form) {
                 Some(k) if alphas.len() == 1 => {
                     if let Some(c) = constant.as_mut() {

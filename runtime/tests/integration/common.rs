@@ -16,6 +16,7 @@ const META: FormMeta = FormMeta {
     test: Borrowed("v"),
     linear: true,
     piecewise: false,
+    previous: false,
     cell_degree: Some([2, 4]),
     facets: Borrowed(&[]),
     facet_sites: Borrowed(&[]),

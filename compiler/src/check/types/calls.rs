@@ -194,6 +194,13 @@ impl Checker<'_> {
             );
             return None;
         }
+        if name == "prev" && tys[0].test {
+            self.error(
+                Diagnostic::error("E0402", "test function inside `prev`", args[0].span, "depends on the test function")
+                    .with_note("`prev(e)` is `e` at the previous time level: the test function has none"),
+            );
+            return None;
+        }
         if name == "tangential" && tys[1].test {
             self.error(
                 Diagnostic::error("E0402", "test function in the normal of `tangential`", args[1].span, "depends on the test function")
