@@ -11,6 +11,7 @@ mod convergence;
 mod disc;
 mod elements;
 mod energy_guard;
+mod friction;
 mod genalpha;
 mod hertz;
 mod import_circles;
