@@ -133,7 +133,7 @@ impl<'a> Emitter<'a> {
             Node::Powi(a, k) => (format!("{}.powi({k})", wrap(sub(a), ATOM)), ATOM),
             Node::Powf(a, p) => (format!("{}.powf({})", wrap(sub(a), ATOM), literal(f64::from_bits(p)).0), ATOM),
             Node::Sqrt(a) => (format!("{}.sqrt()", wrap(sub(a), ATOM)), ATOM),
-            Node::Heaviside(a) => (format!("heaviside({})", sub(a).0), ATOM),
+            Node::Heaviside(a) | Node::Step(a) => (format!("heaviside({})", sub(a).0), ATOM),
         }
     }
 }

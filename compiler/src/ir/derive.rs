@@ -36,7 +36,7 @@ impl Derivative {
     fn local(&self, g: &mut Graph, id: NodeId) -> NodeId {
         let d = |x: NodeId| self.memo[&x];
         match g.node(id) {
-            Node::Const(_) | Node::Heaviside(_) => g.zero(),
+            Node::Const(_) | Node::Heaviside(_) | Node::Step(_) => g.zero(),
             Node::Sym(s) => {
                 if s == self.target {
                     g.one()
@@ -93,7 +93,7 @@ impl Derivative {
                 }
                 let two = g.constant(2.0);
                 let den = g.mul(two, id);
-                let on = g.heaviside(a);
+                let on = g.step(a);
                 let one = g.one();
                 let off = g.sub(one, on);
                 let den = g.add(den, off);
@@ -119,7 +119,7 @@ mod tests {
             Node::Powi(a, k) => eval(g, a, x).powi(k),
             Node::Powf(a, p) => eval(g, a, x).powf(f64::from_bits(p)),
             Node::Sqrt(a) => eval(g, a, x).sqrt(),
-            Node::Heaviside(a) => f64::from((eval(g, a, x) > 0.0) as u8),
+            Node::Heaviside(a) | Node::Step(a) => f64::from((eval(g, a, x) > 0.0) as u8),
         }
     }
 

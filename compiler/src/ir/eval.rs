@@ -105,7 +105,7 @@ impl Program {
                 Node::Powi(a, k) => Op::Powi(s(a), k),
                 Node::Powf(a, p) => Op::Powf(s(a), f64::from_bits(p)),
                 Node::Sqrt(a) => Op::Sqrt(s(a)),
-                Node::Heaviside(a) => Op::Heaviside(s(a)),
+                Node::Heaviside(a) | Node::Step(a) => Op::Heaviside(s(a)),
                 Node::Const(_) | Node::Sym(_) => continue,
             });
             slot.insert(n, next);

@@ -58,6 +58,11 @@ pub enum Node {
     Sqrt(NodeId),
     /// H(a) = 1 if a > 0, else 0. Every non-smooth built-in is defined through it.
     Heaviside(NodeId),
+    /// H(a) inside a built-in's definition (`proj_ball`'s regimes, the guard of `sqrt`'s
+    /// derivative): the same function, but not a switch of the law's active set, which counts
+    /// where the file's own `pos`, `neg`, `H`, ... turn (the contact points, not the regimes of a
+    /// projection).
+    Step(NodeId),
 }
 
 #[derive(Default, Clone, Debug)]
@@ -267,6 +272,14 @@ impl Graph {
         }
     }
 
+    /// H(a) as a built-in's inner step (not a switch; see [`Node::Step`]).
+    pub fn step(&mut self, a: NodeId) -> NodeId {
+        match self.as_const(a) {
+            Some(x) => self.constant(if x > 0.0 { 1.0 } else { 0.0 }),
+            None => self.intern(Node::Step(a)),
+        }
+    }
+
     /// Records a source name for a node (the first name given wins).
     pub fn name(&mut self, id: NodeId, name: &str) {
         if matches!(
@@ -284,7 +297,9 @@ impl Graph {
         let (a, b) = match self.node(id) {
             Node::Const(_) | Node::Sym(_) => (None, None),
             Node::Add(x, y) | Node::Mul(x, y) | Node::Div(x, y) => (Some(x), Some(y)),
-            Node::Neg(x) | Node::Powi(x, _) | Node::Powf(x, _) | Node::Sqrt(x) | Node::Heaviside(x) => (Some(x), None),
+            Node::Neg(x) | Node::Powi(x, _) | Node::Powf(x, _) | Node::Sqrt(x) | Node::Heaviside(x) | Node::Step(x) => {
+                (Some(x), None)
+            }
         };
         a.into_iter().chain(b)
     }
@@ -323,6 +338,7 @@ impl Graph {
                 Node::Powf(a, p) => self.powf(c(a), f64::from_bits(p)),
                 Node::Sqrt(a) => self.sqrt(c(a)),
                 Node::Heaviside(a) => self.heaviside(c(a)),
+                Node::Step(a) => self.step(c(a)),
             };
             new.insert(id, rebuilt);
         }

@@ -551,16 +551,17 @@ impl<'p> Lowerer<'p> {
                 // k·a + (1 − k)·ρ·a/D, D = |a| + (1 − H(|a|)). D is |a| where a ≠ 0 and 1 at
                 // a = 0, so that neither branch divides by zero, nor does their tangent (see the
                 // derivative of sqrt): the value is a inside the ball, ρ·a/|a| outside, 0 for
-                // ρ = 0; the tangent I inside, ρ/|a| (I − â âᵀ) outside, 0 for ρ = 0.
+                // ρ = 0; the tangent I inside, ρ/|a| (I − â âᵀ) outside, 0 for ρ = 0. Its steps
+                // are not switches of the law's active set (`Node::Step`).
                 let (a, r) = (next(), next().c.remove(0));
-                let hr = self.jheaviside(&r);
+                let hr = self.jstep(&r);
                 let rho = self.jmul(&r, &hr);
                 let size = self.jnorm(&a);
                 let gap = self.jsub(&rho, &size);
-                let k = self.jheaviside(&gap);
+                let k = self.jstep(&gap);
                 let one = self.constant(1.0);
                 let slip = self.jsub(&one, &k);
-                let nonzero = self.jheaviside(&size);
+                let nonzero = self.jstep(&size);
                 let guard = self.jsub(&one, &nonzero);
                 let den = self.jadd(&size, &guard);
                 let scale = self.jdiv(&rho, &den);
@@ -743,6 +744,12 @@ impl<'p> Lowerer<'p> {
             acc = self.jadd(&acc, &p);
         }
         self.jsqrt(&acc)
+    }
+
+    /// H as a built-in's inner step: not a switch (see `Node::Step`).
+    fn jstep(&mut self, a: &Jet) -> Jet {
+        let v = self.g.step(a.v);
+        Jet { v, g: self.zero_grad() }
     }
 
     fn jheaviside(&mut self, a: &Jet) -> Jet {

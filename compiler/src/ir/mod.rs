@@ -305,7 +305,7 @@ fn vanishes_with_a_clip(g: &Graph, id: NodeId) -> bool {
     for n in g.reachable([id]) {
         let v = |m: NodeId| vanishes[&m];
         let here = match g.node(n) {
-            Node::Heaviside(a) => g.depends_on(a, field),
+            Node::Heaviside(a) | Node::Step(a) => g.depends_on(a, field),
             Node::Mul(a, b) => v(a) || v(b),
             Node::Add(a, b) => v(a) && v(b),
             Node::Neg(a) | Node::Div(a, _) | Node::Sqrt(a) => v(a),
@@ -343,7 +343,7 @@ pub fn node_degrees(
             Node::Neg(a) => dg(a),
             Node::Powi(a, k) if k >= 0 => dg(a).saturating_mul(k as u32),
             Node::Powi(a, _) | Node::Powf(a, _) | Node::Sqrt(a) => dg(a).saturating_add(2),
-            Node::Heaviside(_) => 0,
+            Node::Heaviside(_) | Node::Step(_) => 0,
         };
         deg.insert(id, v);
     }

@@ -86,6 +86,7 @@ fn node(g: &Graph, id: NodeId, params: &[String], coefs: &[String]) -> String {
         Node::Powf(a, p) => format!("powf {} {}", o(a), f64::from_bits(p)),
         Node::Sqrt(a) => format!("sqrt {}", o(a)),
         Node::Heaviside(a) => format!("H {}", o(a)),
+        Node::Step(a) => format!("step {}", o(a)),
     }
 }
 

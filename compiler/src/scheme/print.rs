@@ -233,6 +233,6 @@ fn expr(g: &Graph, id: NodeId) -> (String, u8) {
         Node::Powi(a, k) => (format!("{}^{k}", wrap(infix(g, a), 4)), 4),
         Node::Powf(a, p) => (format!("{}^{}", wrap(infix(g, a), 4), f64::from_bits(p)), 4),
         Node::Sqrt(a) => (format!("sqrt({})", scalar(g, a)), 4),
-        Node::Heaviside(a) => (format!("H({})", scalar(g, a)), 4),
+        Node::Heaviside(a) | Node::Step(a) => (format!("H({})", scalar(g, a)), 4),
     }
 }

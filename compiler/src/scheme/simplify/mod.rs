@@ -133,7 +133,7 @@ fn value_and_scale(g: &Graph, id: NodeId, params: &[f64], dt: f64, t: f64) -> (f
                 (c(x).0.powf(p), c(x).1.powf(p))
             }
             Node::Sqrt(x) => (c(x).0.sqrt(), c(x).1.sqrt()),
-            Node::Heaviside(x) => (f64::from(c(x).0 > 0.0), 1.0),
+            Node::Heaviside(x) | Node::Step(x) => (f64::from(c(x).0 > 0.0), 1.0),
         };
         v.insert(n, r);
     }

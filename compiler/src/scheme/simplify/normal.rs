@@ -281,7 +281,8 @@ impl Normalizer {
                 let e = sub(a)?;
                 if e.is_zero() { Ok(Expr::default()) } else { Ok(Expr::atom(Atom::Sqrt(Box::new(e)))) }
             }
-            Node::Heaviside(a) => {
+            // Scheme coefficients have no built-in steps; one would read as H.
+            Node::Heaviside(a) | Node::Step(a) => {
                 let e = sub(a)?;
                 if e.is_zero() { Ok(Expr::default()) } else { Ok(Expr::atom(Atom::Heaviside(Box::new(e)))) }
             }
