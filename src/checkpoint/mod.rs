@@ -87,8 +87,8 @@ struct File {
     parts: Option<parts::Layout>,
 }
 
-/// When and where a run writes checkpoints, and the one it resumes.
-#[derive(Default)]
+/// When and where a run writes checkpoints, and the one it resumes (made by [`Control::new`],
+/// which decides which process writes).
 pub struct Control {
     /// Steps between checkpoints (0: none, except on an interrupt).
     pub every: usize,
