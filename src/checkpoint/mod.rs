@@ -184,9 +184,7 @@ impl Control {
         f.sync_data().map_err(log_error)?;
         let log_len = f.metadata().map_err(log_error)?.len();
         let file = File { program: program(), identity: self.identity.clone(), driver, log_len, parts };
-        let mut bytes = MAGIC.to_vec();
-        bytes.extend_from_slice(&FORMAT.to_le_bytes());
-        bytes.extend(postcard::to_stdvec(&file).map_err(|e| write_error(dir, std::io::Error::other(e)))?);
+        let bytes = encode(&file, MAGIC, FORMAT).map_err(|e| write_error(dir, std::io::Error::other(e)))?;
         let path = dir.join(FILE);
         crate::output::write_atomic(&path, &bytes).map_err(|e| write_error(dir, e))
     }
@@ -202,6 +200,27 @@ fn agree(result: Result<(), CaseError>) -> Result<(), CaseError> {
         )),
         Ok(_) => result,
     }
+}
+
+/// `value` as `magic`, the layout version `format` and postcard ([`decode`] reads it).
+fn encode(value: &impl Serialize, magic: &[u8; 8], format: u32) -> Result<Vec<u8>, postcard::Error> {
+    let mut bytes = magic.to_vec();
+    bytes.extend_from_slice(&format.to_le_bytes());
+    bytes.extend(postcard::to_stdvec(value)?);
+    Ok(bytes)
+}
+
+/// The value in `bytes`, written as `magic`, the layout version and postcard: refused, saying
+/// why, if it is not `what`, of another layout, or damaged.
+fn decode<T: serde::de::DeserializeOwned>(bytes: &[u8], magic: &[u8; 8], format: u32, what: &str) -> Result<T, String> {
+    if bytes.len() < 12 || &bytes[..8] != magic {
+        return Err(format!("not {what}"));
+    }
+    let found = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if found != format {
+        return Err(format!("its layout is version {found}; this signorini reads version {format}"));
+    }
+    postcard::from_bytes(&bytes[12..]).map_err(|e| format!("the file is damaged or truncated ({e})"))
 }
 
 fn write_error(dir: &Path, source: std::io::Error) -> CaseError {
@@ -225,15 +244,7 @@ fn read(
     let refuse = |why: String| CaseError::Option(format!("cannot resume from {}: {why}", path.display()));
     use crate::runtime::input::{MAX_CHECKPOINT_BYTES, read_bounded};
     let bytes = read_bounded(&path, MAX_CHECKPOINT_BYTES, "checkpoint").map_err(|e| refuse(e.to_string()))?;
-    if bytes.len() < 12 || &bytes[..8] != MAGIC {
-        return Err(refuse("not a signorini checkpoint".into()));
-    }
-    let format = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if format != FORMAT {
-        return Err(refuse(format!("its layout is version {format}; this signorini reads version {FORMAT}")));
-    }
-    let file: File =
-        postcard::from_bytes(&bytes[12..]).map_err(|e| refuse(format!("the file is damaged or truncated ({e})")))?;
+    let file: File = decode(&bytes, MAGIC, FORMAT, "a signorini checkpoint").map_err(refuse)?;
     if file.program != program() {
         return Err(refuse(format!("it was written by {}; this is {}", file.program, program())));
     }

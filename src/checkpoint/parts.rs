@@ -69,9 +69,7 @@ pub(super) fn write(dir: &Path, o: &Ownership, generation: u64, states: &[Vec<f6
         states: states.iter().map(|s| rows(s)).collect(),
         u0: rows(u0),
     };
-    let mut bytes = MAGIC.to_vec();
-    bytes.extend_from_slice(&FORMAT.to_le_bytes());
-    bytes.extend(postcard::to_stdvec(&part).map_err(|e| e.to_string())?);
+    let bytes = super::encode(&part, MAGIC, FORMAT).map_err(|e| e.to_string())?;
     let path = path(dir, part.rank, generation);
     crate::output::write_atomic(&path, &bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
@@ -130,15 +128,7 @@ fn read_part(dir: &Path, layout: &Layout, rank: u32) -> Result<Part, String> {
     let path = path(dir, rank, layout.generation);
     let refuse = |why: String| format!("{}: {why}", path.display());
     let bytes = read_bounded(&path, MAX_CHECKPOINT_BYTES, "checkpoint part").map_err(|e| refuse(e.to_string()))?;
-    if bytes.len() < 12 || &bytes[..8] != MAGIC {
-        return Err(refuse("not a part of a signorini checkpoint".into()));
-    }
-    let format = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if format != FORMAT {
-        return Err(refuse(format!("its layout is version {format}; this signorini reads version {FORMAT}")));
-    }
-    let part: Part =
-        postcard::from_bytes(&bytes[12..]).map_err(|e| refuse(format!("the file is damaged or truncated ({e})")))?;
+    let part: Part = super::decode(&bytes, MAGIC, FORMAT, "a part of a signorini checkpoint").map_err(refuse)?;
     if part.program != super::program() {
         return Err(refuse(format!("it was written by {}; this is {}", part.program, super::program())));
     }

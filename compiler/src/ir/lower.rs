@@ -473,12 +473,7 @@ impl<'p> Lowerer<'p> {
             }
             "inner" => {
                 let (a, b) = (next(), next());
-                let mut acc = self.constant(0.0);
-                for (x, y) in a.c.iter().zip(&b.c) {
-                    let p = self.jmul(x, y);
-                    acc = self.jadd(&acc, &p);
-                }
-                Self::scalar(acc)
+                Self::scalar(self.jinner(&a, &b))
             }
             "outer" => {
                 let (a, b) = (next(), next());
@@ -531,11 +526,7 @@ impl<'p> Lowerer<'p> {
             "tangential" => {
                 // a − (a·nc) nc
                 let (a, nc) = (next(), next());
-                let mut an = self.constant(0.0);
-                for (x, y) in a.c.iter().zip(&nc.c) {
-                    let p = self.jmul(x, y);
-                    an = self.jadd(&an, &p);
-                }
+                let an = self.jinner(&a, &nc);
                 let c =
                     a.c.iter()
                         .zip(&nc.c)
@@ -738,12 +729,18 @@ impl<'p> Lowerer<'p> {
 
     /// The Euclidean (Frobenius) size of a vector (tensor).
     fn jnorm(&mut self, a: &Val) -> Jet {
+        let square = self.jinner(a, a);
+        self.jsqrt(&square)
+    }
+
+    /// The full contraction Σ aᵢ bᵢ, summed in component order.
+    fn jinner(&mut self, a: &Val, b: &Val) -> Jet {
         let mut acc = self.constant(0.0);
-        for x in &a.c {
-            let p = self.jmul(x, x);
+        for (x, y) in a.c.iter().zip(&b.c) {
+            let p = self.jmul(x, y);
             acc = self.jadd(&acc, &p);
         }
-        self.jsqrt(&acc)
+        acc
     }
 
     /// H as a built-in's inner step: not a switch (see `Node::Step`).
