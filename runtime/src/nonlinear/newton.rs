@@ -62,7 +62,8 @@ fn converged(res: f64, floor: f64, threshold: f64, iterated: bool, small_step: b
 pub struct NewtonOptions {
     pub tol: f64,
     pub max_iterations: usize,
-    /// Backtracking on ‖R‖₂ (halving the step up to 10 times).
+    /// Backtracking on ‖R‖₂ (halving the step up to 10 times), for every problem; a problem
+    /// that is not piecewise (frictional) backtracks without it.
     pub line_search: bool,
     /// How the Jacobian systems are solved.
     pub solver: Solver,
@@ -244,7 +245,7 @@ impl Newton {
             let (mut refactor, mut updated) = (false, false);
             if changed {
                 self.reuse.factored_for = None;
-                match self.reuse.new_operator(p, w, piecewise, self.options.solver, self.options.max_rank) {
+                match self.reuse.new_operator(p, w, self.options.solver, self.options.max_rank) {
                     Ok(full) => (refactor, updated) = (full, !full),
                     Err(source) => return Err(NewtonError::Linear { source, report }),
                 }
@@ -394,7 +395,9 @@ impl Newton {
                 known = true;
                 1.0
             } else {
-                let step = self.step(p, w, delta, r);
+                // A problem that is not piecewise (a frictional law: its tangent turns with the
+                // slip) backtracks always: its semi-smooth steps may cycle between stick and slip.
+                let step = self.step(p, w, delta, r, self.options.line_search || !piecewise);
                 after.clear();
                 p.active_set(w, after);
                 small_step = after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w);
@@ -428,19 +431,19 @@ impl Newton {
         Ok(report)
     }
 
-    /// Takes the step (with backtracking if enabled); leaves R at the new iterate in `r`.
-    fn step(&self, p: &mut impl NonlinearProblem, w: &mut [f64], delta: &[f64], r: &mut [f64]) -> f64 {
-        let start: Vec<f64> = if self.options.line_search { w.to_vec() } else { Vec::new() };
-        let norm0 = if self.options.line_search { norm2(r) } else { 0.0 };
+    /// Takes the step (with backtracking if `search`); leaves R at the new iterate in `r`.
+    fn step(&self, p: &mut impl NonlinearProblem, w: &mut [f64], delta: &[f64], r: &mut [f64], search: bool) -> f64 {
+        let start: Vec<f64> = if search { w.to_vec() } else { Vec::new() };
+        let norm0 = if search { norm2(r) } else { 0.0 };
         let mut alpha = 1.0;
         loop {
-            if self.options.line_search {
+            if search {
                 w.iter_mut().zip(&start).zip(delta).for_each(|((x, s), d)| *x = s + alpha * d);
             } else {
                 w.iter_mut().zip(delta).for_each(|(x, d)| *x += d);
             }
             p.residual(w, r);
-            if !self.options.line_search || norm2(r) <= (1.0 - 1e-4 * alpha) * norm0 || alpha < 1e-3 {
+            if !search || norm2(r) <= (1.0 - 1e-4 * alpha) * norm0 || alpha < 1e-3 {
                 return alpha;
             }
             alpha *= 0.5;

@@ -27,7 +27,7 @@ pub(super) struct JacobianReuse {
     /// The active set the current operator (factorization and correction) was built for.
     pub(super) factored_for: Option<Vec<bool>>,
     /// The correction of the factorization towards the current Jacobian (direct solver,
-    /// piecewise problems), and how many corrections were made.
+    /// any nonlinear problem), and how many corrections were made.
     pub(super) low_rank: Option<LowRank>,
     updates: usize,
     /// Σ over solves of the correction's size since the last factorization, and whether it
@@ -205,18 +205,20 @@ impl JacobianReuse {
     }
 
     /// Makes the operator the Jacobian at w: a low-rank correction of the factored reference
-    /// when the problem is piecewise, the factorization direct and the change small enough,
-    /// else a refactorization (which becomes the new reference). Returns whether it refactored.
+    /// when the factorization is direct and the change small enough, else a refactorization
+    /// (which becomes the new reference). Returns whether it refactored. The correction is of
+    /// the Jacobian's values where they changed, so a problem that is not piecewise (a
+    /// frictional law, whose tangent turns with the slip) is corrected as exactly as one whose
+    /// tangent changes only with its active set.
     pub(super) fn new_operator(
         &mut self,
         p: &mut impl NonlinearProblem,
         w: &[f64],
-        piecewise: bool,
         solver: Solver,
         max_rank: usize,
     ) -> Result<bool, LinalgError> {
         let mut assembled = false;
-        if piecewise && !self.force_refactor && self.low_rank.is_some() {
+        if !self.force_refactor && self.low_rank.is_some() {
             assembled = true;
             let mut j = self.jacobian.take().expect("assembled with the reference");
             Self::assemble(p, w, &mut j, self.jacobian_current);
@@ -258,8 +260,7 @@ impl JacobianReuse {
         self.force_refactor = false;
         // The factored reference becomes the previous one, if it is worth keeping; the new
         // factorization shares its symbolic analysis.
-        let keep = piecewise
-            && self.low_rank.is_some()
+        let keep = self.low_rank.is_some()
             && self.factorization.as_ref().and_then(Factorization::factor_nnz).is_some_and(|nnz| 8 * nnz <= KEEP_BYTES);
         if keep && let Some(f) = self.factorization.as_ref() {
             let fork = f.fork();
@@ -278,7 +279,7 @@ impl JacobianReuse {
         self.reference_accuracy = None;
         self.refactor(p, w, assembled, solver)?;
         let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
-        if piecewise && direct && max_rank > 0 {
+        if direct && max_rank > 0 {
             let mut lr = LowRank::new(self.jacobian.as_ref().expect("assembled by refactor"));
             lr.set_elements(p.tangent_elements(w));
             self.low_rank = Some(lr);
