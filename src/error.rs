@@ -8,6 +8,9 @@
 pub enum CaseError {
     #[error("invalid option: {0}")]
     Option(String),
+    /// A form that takes tangential parts (a frictional law) bound on a 1D mesh, located.
+    #[error("{0}")]
+    NoTangentSpace(String),
     /// A case file problem, with file and line.
     #[error("{0}")]
     CaseFile(String),

@@ -64,6 +64,35 @@ pub fn region_site(unit: &crate::check::Unit, form: &str, region: &str) -> Strin
     i.map_or_else(|| "(source unknown)".to_string(), |i| location_col(&unit.sources, i.region.span))
 }
 
+/// `file.wf:line:col` of the first `tangential` form `form` takes, through the `fn`s and `let`s
+/// it calls: a part across the obstacle normal, which a 1D problem does not have (its runtime
+/// binding refuses such a form there, at this site).
+pub fn tangential_site(unit: &crate::check::Unit, form: &str) -> Option<String> {
+    use crate::check::Global;
+    use crate::syntax::ast::{Expr, ExprKind as K};
+    fn walk<'a>(unit: &'a crate::check::Unit, e: &'a Expr, seen: &mut Vec<&'a str>) -> Option<Span> {
+        let global = |name: &'a str, seen: &mut Vec<&'a str>| match unit.globals.get(name) {
+            Some(Global::Fn { body, .. } | Global::Let { value: body, .. }) if !seen.contains(&name) => {
+                seen.push(name);
+                walk(unit, body, seen)
+            }
+            _ => None,
+        };
+        match &e.kind {
+            K::Call(f, _) if f.name == "tangential" => Some(e.span),
+            K::Call(f, args) => global(&f.name, seen).or_else(|| args.iter().find_map(|a| walk(unit, a, seen))),
+            K::Name(n) => global(&n.name, seen),
+            K::Number(_) => None,
+            K::Neg(a) => walk(unit, a, seen),
+            K::Binary(_, a, b) | K::Index(a, b) => walk(unit, a, seen).or_else(|| walk(unit, b, seen)),
+            K::Vector(xs) => xs.iter().find_map(|a| walk(unit, a, seen)),
+        }
+    }
+    let f = unit.forms.iter().find(|f| f.name == form)?;
+    let mut seen = Vec::new();
+    f.integrals.iter().find_map(|i| walk(unit, &i.integrand, &mut seen)).map(|span| location_col(&unit.sources, span))
+}
+
 /// `file.wf:line:col` of a span's start.
 pub fn location_col(sources: &SourceMap, span: Span) -> String {
     let (line, col) = sources.line_col(span.file, span.start);

@@ -10,7 +10,7 @@ use signorini_descriptors::{CoefInfo, ParamError, ParamInfo, SchemeDesc, SlotInf
 
 use crate::fem::assembly::{Functional, Kernel, Quadrature};
 use crate::fem::bound::{Bound, BoundForm, BoundFunctional, BoundValue};
-use crate::fem::kernel::Coef;
+use crate::fem::kernel::{Coef, FormMeta};
 use crate::fem::mesh::Facet;
 use crate::time::scheme::TimeScheme;
 
@@ -102,6 +102,10 @@ pub enum LibraryError {
         "{at}: form `{form}` integrates over `{region}`, which the case does not define (it defines: {defined}){hint}"
     )]
     MissingRegion { form: String, region: String, at: String, defined: String, hint: String },
+    #[error(
+        "{at}: `{form}` takes a tangential part, across the obstacle normal, which a 1D problem does not have (its only direction is the normal): a frictional law needs a 2D or 3D problem"
+    )]
+    NoTangentSpace { form: String, at: String },
 }
 
 impl<'m> Binding<'m> {
@@ -137,9 +141,20 @@ impl<'m> Binding<'m> {
             .collect()
     }
 
+    /// A form that takes tangential parts cannot be bound in 1D.
+    fn tangent_space(&self, meta: &FormMeta) -> Result<(), LibraryError> {
+        match &meta.tangential {
+            Some(at) if self.dim == 1 => {
+                Err(LibraryError::NoTangentSpace { form: meta.name.to_string(), at: at.to_string() })
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// A form kernel bound to this mesh.
     pub fn form<K: Kernel + 'm>(&self, kernel: K) -> Result<SlotForm<'m>, LibraryError> {
         let meta = kernel.meta();
+        self.tangent_space(meta)?;
         let regions = self.regions_of(&meta.name, &meta.facets, &meta.facet_sites)?;
         Ok(SlotForm::Form(Box::new(Bound { kernel, quadrature: self.quadrature, regions })))
     }
@@ -147,6 +162,7 @@ impl<'m> Binding<'m> {
     /// A functional kernel bound to this mesh.
     pub fn functional<K: Functional + 'm>(&self, kernel: K) -> Result<SlotForm<'m>, LibraryError> {
         let meta = kernel.meta();
+        self.tangent_space(meta)?;
         let regions = self.regions_of(&meta.name, &meta.facets, &meta.facet_sites)?;
         Ok(SlotForm::Functional(Box::new(BoundValue { kernel, quadrature: self.quadrature, regions })))
     }

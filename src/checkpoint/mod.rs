@@ -36,7 +36,7 @@ pub const FILE: &str = "checkpoint.bin";
 pub const LOG: &str = "checkpoint.log";
 const MAGIC: &[u8; 8] = b"SIGNCKPT";
 /// The layout of the file; a checkpoint of another layout is refused.
-const FORMAT: u32 = 3;
+const FORMAT: u32 = 4;
 
 /// What a run must share with the checkpoint it resumes: (what, value) pairs, compared one by
 /// one so that a refusal names what differs.
@@ -60,6 +60,8 @@ pub struct DriverState {
     pub energy_varying_work: f64,
     /// The contact law's own work so far (Nitsche θ ≠ 1).
     pub energy_law_work: f64,
+    /// What the law's friction took so far (`friction_work`).
+    pub energy_dissipated: f64,
     /// (In a split run's manifest, this and `states` are empty: the parts hold them.)
     pub energy_u0: Vec<f64>,
     /// The largest kinetic energy so far and the largest growth (the guard's scale and record).
@@ -355,6 +357,7 @@ mod tests {
             energy_work: 0.0,
             energy_varying_work: 0.0,
             energy_law_work: 0.0,
+            energy_dissipated: 0.0,
             energy_u0: vec![0.0, 1.0],
             energy_kinetic: 0.5,
             energy_growth: 0.0,

@@ -392,7 +392,16 @@ impl FormsInUse {
                     crate::runtime::library::LibraryError::MissingCoef { name, .. } => provided_coefs(coefs, name),
                     _ => String::new(),
                 };
-                CaseError::Option(format!("{}: {e}{hint}", unit.file()))
+                // Errors located in the file already (a region, a tangential part) need no prefix.
+                match &e {
+                    crate::runtime::library::LibraryError::MissingRegion { .. } => {
+                        CaseError::Option(format!("{e}{hint}"))
+                    }
+                    crate::runtime::library::LibraryError::NoTangentSpace { .. } => {
+                        CaseError::NoTangentSpace(e.to_string())
+                    }
+                    _ => CaseError::Option(format!("{}: {e}{hint}", unit.file())),
+                }
             })?;
             for (name, form) in made {
                 if let Some((_, _, other)) = slots.iter().find(|(n, _, _)| *n == name) {

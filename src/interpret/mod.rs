@@ -220,5 +220,6 @@ fn meta(prog: &Program, irs: &[DimIr], fi: usize) -> FormMeta {
         cell_degree: f2.integrals.iter().find(|i| i.cell).map(|i| i.degree),
         facets: facets.clone().map(|i| (i.region.clone().into(), i.degree)).collect(),
         facet_sites: facets.map(|i| signorini_compiler::docs::region_site(prog, &f2.name, &i.region).into()).collect(),
+        tangential: signorini_compiler::docs::tangential_site(prog, &f2.name).map(Into::into),
     }
 }

@@ -482,14 +482,28 @@ pub fn initial(pf: &ProblemFile, ex: &mut Exprs, mesh: &Mesh, field: &str, t0: f
     let d = mesh.dim();
     let mut values = vec![0.0; mesh.num_nodes() * d];
     let Some(def) = pf.problem().initial.iter().find(|i| i.name.name == field) else { return Ok(values) };
-    let v = ex.lower(&def.value, &[]).map_err(|e| pf.render(*e))?;
-    let f = ex.function(&v, &def.value).map_err(|e| pf.render(*e))?;
+    // `settled(GUESS)`: the guess here; the run settles it (`settled`).
+    let value = match crate::compiler::check::problem::settled_guess(&def.value) {
+        Some([guess]) => guess,
+        _ => &def.value,
+    };
+    let v = ex.lower(value, &[]).map_err(|e| pf.render(*e))?;
+    let f = ex.function(&v, value).map_err(|e| pf.render(*e))?;
     let mut scratch = Vec::new();
     for (i, out) in values.chunks_mut(d).enumerate() {
         f.eval(&At { x: mesh.node(i), t: t0, ..At::default() }, &mut scratch, out);
         out.iter_mut().for_each(|x| *x += 0.0);
     }
     Ok(values)
+}
+
+/// Whether the problem's initial displacement is `settled(GUESS)`: in static equilibrium, sought
+/// from the guess [`initial`] gives.
+pub fn settled(pf: &ProblemFile) -> bool {
+    pf.problem()
+        .initial
+        .iter()
+        .any(|i| i.name.name == "u" && crate::compiler::check::problem::settled_guess(&i.value).is_some())
 }
 
 /// What a coef lookup by name gives the forms.

@@ -56,10 +56,10 @@ enum Measure {
         region: usize,
         f: PointFn,
     },
-    /// A functional of the files in use, at the row's state or at the step's midpoint.
+    /// A functional of the files in use, at the states its arguments name.
     Functional {
         index: usize,
-        mid: bool,
+        at: Vec<Level>,
     },
     /// Functional `which` of the problem's reference.
     Reference {
@@ -93,6 +93,17 @@ pub struct State<'a> {
     pub previous: &'a [f64],
     /// An intermediate stage's row (not a row of the series).
     pub stage: bool,
+}
+
+/// A state a functional argument names (the problem's `FUNCTIONAL_STATES`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Level {
+    /// `u`: the row's displacement.
+    Now,
+    /// `u_mid`: the step's midpoint, at t − Δt/2.
+    Mid,
+    /// `u_prev`: the step's start.
+    Start,
 }
 
 /// The problem's series, compiled for a bound run.
@@ -379,7 +390,15 @@ impl<'m> Observer<'m> {
                     add(self, m, 1, e.span)
                 }
                 name => {
-                    let mid = matches!(&args[0].kind, ExprKind::Name(n) if n.name == "u_mid");
+                    let at: Vec<Level> = args
+                        .iter()
+                        .map(|a| match &a.kind {
+                            ExprKind::Name(n) if n.name == "u_mid" => Level::Mid,
+                            ExprKind::Name(n) if n.name == "u_prev" => Level::Start,
+                            _ => Level::Now,
+                        })
+                        .collect();
+                    let mid = at.contains(&Level::Mid);
                     let by_reference = self.reference.as_ref().and_then(|(r, _)| {
                         r.functionals()
                             .iter()
@@ -392,8 +411,25 @@ impl<'m> Observer<'m> {
                         self.functionals.push((name.to_string(), f));
                         Some(self.functionals.len() - 1)
                     });
+                    if let Some(i) = index
+                        && self.functionals[i].1.fields() != at.len()
+                    {
+                        let fields = self.functionals[i].1.fields();
+                        let d = crate::compiler::Diagnostic::error(
+                            "E0201",
+                            format!("`{name}` takes {fields} state(s)"),
+                            e.span,
+                            format!("{} given", at.len()),
+                        )
+                        .with_help(if fields == 2 {
+                            format!("write `{name}(u, u_prev)`: the step's end and start")
+                        } else {
+                            format!("write `{name}(u)`")
+                        });
+                        return Err(pf.render(d));
+                    }
                     let m = match index {
-                        Some(index) => Measure::Functional { index, mid },
+                        Some(index) => Measure::Functional { index, at },
                         None => by_reference.ok_or_else(|| {
                             let mut d = crate::compiler::Diagnostic::error(
                                 "E0101",
@@ -586,15 +622,23 @@ impl<'m> Observer<'m> {
                         sampled.push((*region, f.key.clone(), values));
                         value
                     }
-                    Measure::Functional { index, mid: false } => {
-                        one(self.functionals[*index].1.value(asm, &[s.u], s.t))
-                    }
-                    Measure::Functional { index, mid: true } => {
+                    Measure::Functional { index, at } => {
                         let f = &self.functionals[*index].1;
-                        one(mid
-                            .get_or_insert_with(&mut midpoint)
-                            .as_ref()
-                            .map_or(f64::NAN, |(u, t)| f.value(asm, &[u], *t)))
+                        let m = if at.contains(&Level::Mid) {
+                            mid.get_or_insert_with(&mut midpoint).as_ref()
+                        } else {
+                            None
+                        };
+                        let t = m.map_or(s.t, |(_, t)| *t);
+                        let states: Option<Vec<&[f64]>> = at
+                            .iter()
+                            .map(|a| match a {
+                                Level::Now => Some(s.u),
+                                Level::Mid => m.map(|(u, _)| u.as_slice()),
+                                Level::Start => s.before.map(|(b, _)| b),
+                            })
+                            .collect();
+                        one(states.map_or(f64::NAN, |x| f.value(asm, &x, t)))
                     }
                     Measure::Reference { which, mid: false } => one(self
                         .reference

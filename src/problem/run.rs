@@ -319,6 +319,22 @@ fn simulate(
             (vec![row], vec![switches], vec![newton], Vec::new(), outcome, solution.counters, 0, last)
         }
         Runner::Time(sim) => {
+            let u0 = if super::bind::settled(pf) {
+                settle(
+                    pf,
+                    &asm,
+                    &coefs,
+                    contact_region,
+                    &constraints,
+                    held.is_some(),
+                    quadrature.facet,
+                    opts,
+                    in_use,
+                    u0,
+                )?
+            } else {
+                u0
+            };
             sim.initialize_at(t0, u0, v0)?;
             let u0 = &sim.states[0];
             let first = State { t: t0, u: u0, v: sim.velocity(), newton: 0, before: None, previous: u0, stage: false };
@@ -525,6 +541,42 @@ fn simulate(
 
 /// The contact law's `Gamma_C`: the obstacle's region (`on REGION`, or `Gamma_C`); none without
 /// an obstacle or a region `Gamma_C`.
+/// `initial u = settled(GUESS)`: the equilibrium K u + C(u) = F at the start, by the static
+/// driver from the guess (which a frictional law's `prev` reads: the stick holds the body
+/// where the guess put it, along the obstacle).
+#[allow(clippy::too_many_arguments)]
+fn settle(
+    pf: &ProblemFile,
+    asm: &Assembler,
+    coefs: &dyn Fn(&str) -> Option<crate::runtime::fem::kernel::Coef>,
+    contact: Option<&str>,
+    constraints: &crate::runtime::nonlinear::statics::Constraints,
+    moving: bool,
+    facet_degree: Option<u32>,
+    opts: &Options,
+    in_use: &FilesInUse,
+    guess: Vec<f64>,
+) -> Result<Vec<f64>, CaseError> {
+    let why = |what: &str| CaseError::Option(format!("{}: `initial u = settled(...)` {what}", pf.file));
+    let contact = contact.ok_or_else(|| why("needs the problem's contact (an obstacle, or `Gamma_C`) to rest on"))?;
+    if moving {
+        return Err(why("holds its Dirichlet values at zero: a held value that moves needs an initial u of its own"));
+    }
+    let problem = crate::simulation::statics::StaticProblem {
+        coefs,
+        contact,
+        contact_degree: facet_degree,
+        constraints: constraints.clone(),
+        newton: opts.newton,
+    };
+    let solution = crate::simulation::statics::solve(asm, problem, &in_use.forms, guess).map_err(|e| {
+        why(&format!(
+            "did not settle: {e} (a frictionless body free to slide along the obstacle has no equilibrium to settle in: hold it, or give it friction)"
+        ))
+    })?;
+    Ok(solution.u)
+}
+
 fn contact_region(pf: &ProblemFile) -> Option<&str> {
     let (p, contact) = (pf.problem(), super::bind::CONTACT);
     match p.obstacles.first() {

@@ -1,6 +1,6 @@
 //! The energy guard: after every step, E_aug = ½uᵀKu + ½vᵀMv + the contact law's energy against
 //! E_aug(0) + the work done on the body so far (the loads', the held dofs' reactions', a moving
-//! obstacle's, the contact law's own), with the allowance the scheme's energy law gives; a
+//! obstacle's, the contact law's own, less what its friction took), with the allowance the scheme's energy law gives; a
 //! growth beyond the tolerance, a negative potential energy, or a law's own work beyond the
 //! energy from outside stops the run (docs/mathematics.md §5).
 
@@ -22,6 +22,8 @@ pub(super) struct EnergyWatch {
     pub(super) varying_work: f64,
     /// The contact law's `contact_work` so far: energy the law itself gives or takes.
     pub(super) law_work: f64,
+    /// The law's `friction_work` so far: the energy its friction has taken.
+    pub(super) dissipated: f64,
     /// The largest kinetic energy so far.
     pub(super) kinetic: f64,
     /// The largest growth over the scale so far (the summary's `energy_growth`).
@@ -66,6 +68,7 @@ impl EnergyWatch {
             work: 0.0,
             varying_work: 0.0,
             law_work: 0.0,
+            dissipated: 0.0,
             kinetic,
             growth: 0.0,
             lowest: initial,
@@ -188,7 +191,11 @@ impl EnergyWatch {
         let external = self.varying_work + constant;
         self.work = self.work.max(external.abs());
         let scale = self.initial.abs().max(self.work).max(self.kinetic).max(f64::MIN_POSITIVE);
-        let work = external + self.law_work;
+        // What friction took counts where the scheme claims an energy law: an implicit scheme,
+        // whose friction is the new level's, as `friction_work` measures it. An explicit
+        // contact term applies the level before's, and its bound stays E_aug(0) + W.
+        let dissipated = if law.is_some() { self.dissipated } else { 0.0 };
+        let work = external + self.law_work - dissipated;
         let bound = match law {
             Some(EnergyLaw::Conserving) => self.initial + work + allowance,
             Some(EnergyLaw::Dissipative) => self.lowest + work,

@@ -263,6 +263,7 @@ impl<'m> Simulation<'m> {
                 work: saved.energy_work,
                 varying_work: saved.energy_varying_work,
                 law_work: saved.energy_law_work,
+                dissipated: saved.energy_dissipated,
                 kinetic: saved.energy_kinetic,
                 growth: saved.energy_growth,
                 lowest: saved.energy_lowest,
@@ -359,6 +360,9 @@ impl<'m> Simulation<'m> {
                 if let Some(work) = &ops.contact_work {
                     energy.law_work += work.value(ops.asm, &[&states[0], &before], t + 0.5 * h);
                 }
+                if let Some(work) = &ops.friction_work {
+                    energy.dissipated += work.value(ops.asm, &[&states[0], &before], t + h);
+                }
                 // Checked before the observer sees the step: the outputs end at the last good one.
                 if let Some(grown) =
                     energy.check(ops, states, *v_index, &before, h, t_end, guard.energy_tolerance, *law)
@@ -408,6 +412,7 @@ impl<'m> Simulation<'m> {
                         energy_work: energy.work,
                         energy_varying_work: energy.varying_work,
                         energy_law_work: energy.law_work,
+                        energy_dissipated: energy.dissipated,
                         energy_u0: energy.u0.clone(),
                         energy_kinetic: energy.kinetic,
                         energy_growth: energy.growth,

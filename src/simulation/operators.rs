@@ -31,6 +31,9 @@ pub struct Operators<'m> {
     /// The work over a step of the part of the law the energy does not keep (Nitsche θ ≠ 1),
     /// a functional of the step's end and start displacements.
     pub contact_work: Option<Box<dyn BoundFunctional + 'm>>,
+    /// The energy a frictional law takes over a step (its dissipation, ≥ 0 where the friction
+    /// opposes the slip), a functional of the step's end and start displacements.
+    pub friction_work: Option<Box<dyn BoundFunctional + 'm>>,
     pub contact_pressure: Option<Box<dyn BoundFunctional + 'm>>,
     pub contact_trial: Option<Box<dyn BoundFunctional + 'm>>,
     pub von_mises: Option<Box<dyn BoundFunctional + 'm>>,
@@ -302,6 +305,7 @@ impl<'m> Parts<'m> {
             contact_energy: inst.take_functional("contact_energy"),
             contact_jump: inst.take_functional("contact_jump"),
             contact_work: inst.take_functional("contact_work").filter(|f| f.fields() == 2),
+            friction_work: inst.take_functional("friction_work").filter(|f| f.fields() == 2),
             contact_pressure: inst.take_functional("contact_pressure"),
             contact_trial: inst.take_functional("contact_trial"),
             von_mises: inst.take_functional("von_mises"),

@@ -55,7 +55,7 @@ pub fn form_items(prog: &Program, irs: &[&DimIr], fi: usize, sname: &str) -> Str
         .collect();
     let _ = writeln!(
         s,
-        "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: Borrowed({:?}), fields: Borrowed(&[{}]), test: Borrowed({:?}), linear: {}, piecewise: {}, previous: {}, cell_degree: {cell_degree}, facets: Borrowed(&[{}]), facet_sites: Borrowed(&[{}]) }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }}\n{} }}",
+        "impl {sname} {{ pub const META: FormMeta = FormMeta {{ name: Borrowed({:?}), fields: Borrowed(&[{}]), test: Borrowed({:?}), linear: {}, piecewise: {}, previous: {}, cell_degree: {cell_degree}, facets: Borrowed(&[{}]), facet_sites: Borrowed(&[{}]), tangential: {} }}; }}\nimpl Form for {sname} {{ fn meta(&self) -> &FormMeta {{ &Self::META }}\n{} }}",
         form.name,
         fields.join(", "),
         form.test.as_ref().map_or("", |t| t.name.as_str()),
@@ -64,6 +64,7 @@ pub fn form_items(prog: &Program, irs: &[&DimIr], fi: usize, sname: &str) -> Str
         irs.iter().any(|ir| ir.forms[fi].previous),
         facets.join(", "),
         sites.join(", "),
+        crate::docs::tangential_site(prog, &form.name).map_or("None".to_string(), |s| format!("Some(Borrowed({s:?}))")),
         time_dependence(prog, irs, fi)
     );
     for ir in irs {

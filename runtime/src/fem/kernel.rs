@@ -259,6 +259,9 @@ pub struct FormMeta {
     /// Where each of `facets` is named in the source (`file.wf:line:col` of `int(NAME)`), for
     /// errors when a case does not define the region.
     pub facet_sites: List<Text>,
+    /// Where the form first takes a `tangential` part (`file.wf:line:col`): a 1D mesh has no
+    /// tangent space, and binding the form there is an error at this site.
+    pub tangential: Option<Text>,
 }
 
 /// Implemented by every generated form.

@@ -20,6 +20,7 @@ const META: FormMeta = FormMeta {
     cell_degree: Some([2, 4]),
     facets: Borrowed(&[]),
     facet_sites: Borrowed(&[]),
+    tangential: None,
 };
 
 impl Form for MassStiffness {

@@ -157,6 +157,10 @@ pub const FUNCTIONAL_STATES: &[(&str, &str)] = &[
         "u_mid",
         "the step's midpoint (uⁿ + uⁿ⁺¹)/2 at t − Δt/2, where the midpoint and hybrid schemes impose contact (NaN at the initial row and at stages)",
     ),
+    (
+        "u_prev",
+        "the step's start uⁿ, for a functional of two levels: friction_work(u, u_prev) (NaN at the initial row and at stages)",
+    ),
 ];
 
 /// The reducers of a summary key, over the rows of the series. Their argument is an expression
@@ -178,3 +182,16 @@ pub const SUMMARY_FUNCTIONS: &[&str] = &["sqrt", "abs", "pos"];
 
 /// Fields whose initial value a problem may give.
 pub const INITIAL_FIELDS: &[&str] = &["u", "v"];
+
+/// `initial u = settled(GUESS)`: the displacement in static equilibrium with the loads and the
+/// contact law, K u + C(u) = F, sought by Newton from GUESS (which should press the contact
+/// region in): a body that starts at rest on an obstacle instead of bouncing on it.
+pub const SETTLED: &str = "settled";
+
+/// The argument of `settled(GUESS)` in `initial u = ...`, if the value is one.
+pub fn settled_guess(value: &crate::syntax::ast::Expr) -> Option<&[crate::syntax::ast::Expr]> {
+    match &value.kind {
+        crate::syntax::ast::ExprKind::Call(f, args) if f.name == SETTLED => Some(args),
+        _ => None,
+    }
+}

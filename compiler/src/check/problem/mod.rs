@@ -44,7 +44,23 @@ pub(in crate::check) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diag
         if !INITIAL_FIELDS.contains(&d.name.name.as_str()) {
             diags.push(unknown_among(&d.name, INITIAL_FIELDS.iter().copied(), "initial field"));
         }
-        vector(c, &d.value, fields, diags);
+        match catalogue::settled_guess(&d.value) {
+            Some([guess]) if d.name.name == "u" => vector(c, guess, fields, diags),
+            Some(args) if d.name.name == "u" => diags.push(
+                Diagnostic::error(
+                    "E0201",
+                    "`settled` takes 1 argument(s)",
+                    d.value.span,
+                    format!("{} given", args.len()),
+                )
+                .with_help("write `initial u = settled([0, -1e-4])`: the guess Newton starts from"),
+            ),
+            Some(_) => diags.push(
+                Diagnostic::error("E0301", "only the displacement settles", d.value.span, "not a displacement")
+                    .with_help("write `initial u = settled(GUESS)`; the velocity is given as it is"),
+            ),
+            None => vector(c, &d.value, fields, diags),
+        }
     }
     let regions: Vec<&str> = p.regions.iter().map(|r| r.name.name.as_str()).collect();
     dirichlet(c, p, fields, &regions, diags);
