@@ -22,6 +22,10 @@ pub struct Bench {
     pub disc: String,
     /// `bench disc`: the explicit run timed beside the default one, (scheme, mass matrix).
     pub disc_explicit: (String, String),
+    /// `bench disc`: the frictional contact law timed beside the default one (its
+    /// factorizations and low-rank updates per 1000 steps: an unsymmetric tangent that turns
+    /// with the slip).
+    pub disc_friction: String,
     /// `bench sphere`: the problem timed against its size, and the options of each run.
     pub sphere: String,
     pub sphere_options: Vec<String>,

@@ -69,6 +69,19 @@ pub struct DiscTiming {
     /// median ms/step, its factorizations, and its estimated critical step.
     #[serde(default)]
     pub explicit: Option<ExplicitTiming>,
+    /// The frictional law of forms/library.toml on the same disc: its LU factorizations and
+    /// low-rank corrections per 1000 steps.
+    #[serde(default)]
+    pub friction: Option<FrictionTiming>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FrictionTiming {
+    pub contact: String,
+    pub ms_per_step: f64,
+    pub newton_total: usize,
+    pub factorizations_per_1000: f64,
+    pub low_rank_updates_per_1000: f64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -128,6 +141,7 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
         let cache = triad_bandwidth(model_bytes as usize);
         let cache_model_ms = 1e3 * model_bytes / cache;
         let explicit = explicit_timing(&opts, s.dt, repeats)?;
+        let friction = friction_timing(&opts, repeats)?;
         let fastest = mean.iter().copied().fold(f64::INFINITY, f64::min);
         let slowest = mean.iter().copied().fold(0.0, f64::max);
         let ms_per_step = median(mean);
@@ -155,6 +169,7 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             cache_model_ms,
             measured_over_cache_model: ms_per_step / cache_model_ms,
             explicit,
+            friction,
         };
         progress(&format!(
             "{}: {} dofs, {} steps, {} Newton iterations, {} factorizations, {} low-rank updates; {:.3} ms/step stepping (runs {:.3}–{:.3}; median step {:.3} ms), {:.3} ms/step whole run; model {:.3} ms ({:.2} MB at STREAM's {:.1} GB/s), measured/model {:.2} (median step/model {:.2}); in cache {:.3} ms (at {:.1} GB/s), measured/model {:.2}",
@@ -188,6 +203,17 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
                 e.ms_per_step,
                 e.factorizations,
                 e.stable_dt.map_or("—".into(), |d| format!("{d:.4}"))
+            ));
+        }
+        if let Some(f) = &t.friction {
+            progress(&format!(
+                "{}: contact {}: {:.3} ms/step stepping, {} Newton iterations, per 1000 steps {:.0} factorizations and {:.0} low-rank updates",
+                t.mesh,
+                f.contact,
+                f.ms_per_step,
+                f.newton_total,
+                f.factorizations_per_1000,
+                f.low_rank_updates_per_1000
             ));
         }
         out.push(t);
@@ -228,6 +254,29 @@ fn explicit_timing(opts: &Options, dt: f64, repeats: usize) -> Result<Option<Exp
         ms_per_step: median(per_step),
         factorizations: run.summary.factorizations,
         stable_dt: run.summary.stable_dt,
+    }))
+}
+
+/// The frictional law of forms/library.toml on the same disc, with the default scheme.
+fn friction_timing(opts: &Options, repeats: usize) -> Result<Option<FrictionTiming>, CaseError> {
+    let contact = &crate::settings::get().bench.disc_friction;
+    let methods = crate::driver::Methods { contact: contact.clone(), ..opts.methods.clone() };
+    let opts = Options { methods, ..opts.clone() };
+    let mut per_step = Vec::new();
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let run = disc::run(&opts)?;
+        per_step.push(run.summary.stepping_seconds / run.summary.steps.max(1) as f64 * 1e3);
+        last = Some(run.summary);
+    }
+    let s = last.expect("at least one run");
+    let per_1000 = |count: usize| 1000.0 * count as f64 / s.steps.max(1) as f64;
+    Ok(Some(FrictionTiming {
+        contact: contact.clone(),
+        ms_per_step: median(per_step),
+        newton_total: s.newton_total,
+        factorizations_per_1000: per_1000(s.factorizations),
+        low_rank_updates_per_1000: per_1000(s.low_rank_updates),
     }))
 }
 

@@ -23,6 +23,9 @@ signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
 signorini::forms!("tests/problems/power_law_penalty.wf");
 signorini::forms!("tests/problems/coulomb_penalty.wf");
+signorini::forms!("forms/contact_nitsche_coulomb.wf");
+signorini::forms!("forms/contact_nitsche_tresca.wf");
+signorini::forms!("forms/contact_penalty_coulomb.wf");
 signorini::forms!("forms/contact_nitsche_traction.wf");
 
 const TOL: f64 = 1e-12;
@@ -48,6 +51,8 @@ fn params(names: &[&'static str]) -> Vec<(&'static str, f64)> {
         "gamma0" => 7.5,
         "theta" => 0.5,
         "F" => 0.8,
+        "slip_scale" => 1.3,
+        "s" => 0.05,
         _ => panic!("no test value for parameter `{n}`"),
     };
     names.iter().map(|&n| (n, value(n))).collect()
@@ -362,7 +367,7 @@ unit_test!(
     "tests/problems/coulomb_penalty.wf",
     |d| coulomb_penalty::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact],
-    functionals: [ContactEnergy, ContactPressure, FrictionForce, Slip]
+    functionals: [ContactEnergy, ContactPressure, FrictionForce, FrictionWork, Slip]
 );
 
 fn bound<'m, K: Kernel + 'm>(kernel: K, contact: &'m [Facet]) -> Box<dyn BoundForm + 'm> {
@@ -489,3 +494,30 @@ fn errors_name_the_problem() {
     assert!(f.set_param("gamma0", -1.0).is_err());
     assert_eq!(f.param("gamma0"), Some(9.0));
 }
+
+unit_test!(
+    nitsche_coulomb_interpreted_matches_compiled,
+    contact_nitsche_coulomb,
+    "forms/contact_nitsche_coulomb.wf",
+    |d| contact_nitsche_coulomb::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
+    forms: [Contact, HybridContact],
+    functionals: [ContactEnergy, ContactWork, FrictionWork, FrictionForce, ContactJump, ContactPressure, ContactTrial]
+);
+
+unit_test!(
+    nitsche_tresca_interpreted_matches_compiled,
+    contact_nitsche_tresca,
+    "forms/contact_nitsche_tresca.wf",
+    |d| contact_nitsche_tresca::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
+    forms: [Contact, HybridContact],
+    functionals: [ContactEnergy, ContactWork, FrictionWork, FrictionForce, ContactJump, ContactPressure, ContactTrial]
+);
+
+unit_test!(
+    penalty_coulomb_interpreted_matches_compiled,
+    contact_penalty_coulomb,
+    "forms/contact_penalty_coulomb.wf",
+    |d| contact_penalty_coulomb::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
+    forms: [Contact, HybridContact],
+    functionals: [ContactEnergy, FrictionWork, FrictionForce, ContactJump, ContactPressure, ContactTrial]
+);

@@ -12,6 +12,7 @@ mod disc;
 mod elements;
 mod energy_guard;
 mod friction;
+mod friction_laws;
 mod genalpha;
 mod hertz;
 mod import_circles;

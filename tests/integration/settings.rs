@@ -27,6 +27,7 @@ fn library_settings_name_library_files() {
     }
     // verify binds the damping slot itself: it must be named.
     assert!(!s.verify.damping_slot.is_empty());
+    assert!(laws.contains(&s.bench.disc_friction.as_str()), "unknown contact law `{}`", s.bench.disc_friction);
     let (scheme, mass) = &s.bench.disc_explicit;
     known(scheme, &s.defaults.contact);
     <MassChoice as clap::ValueEnum>::from_str(mass, true).unwrap_or_else(|e| panic!("mass `{mass}`: {e}"));

@@ -82,9 +82,9 @@ fn tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
 }
 
 /// Deterministic pseudo-random numbers in [−1, 1] (xorshift), so failures reproduce.
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 impl Rng {
-    fn next(&mut self) -> f64 {
+    pub(crate) fn next(&mut self) -> f64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
