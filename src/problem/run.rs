@@ -539,10 +539,8 @@ fn simulate(
     Ok(run)
 }
 
-/// The contact law's `Gamma_C`: the obstacle's region (`on REGION`, or `Gamma_C`); none without
-/// an obstacle or a region `Gamma_C`.
-/// `initial u = settled(GUESS)`: the equilibrium K u + C(u) = F at the start, by the static
-/// driver from the guess (which a frictional law's `prev` reads: the stick holds the body
+/// `initial u = settled(GUESS)`: the equilibrium K u + C(u) = F, by the static driver (its loads
+/// and obstacle at t = 0) from the guess (which a frictional law's `prev` reads: the stick holds the body
 /// where the guess put it, along the obstacle).
 #[allow(clippy::too_many_arguments)]
 fn settle(
@@ -577,6 +575,8 @@ fn settle(
     Ok(solution.u)
 }
 
+/// The contact law's `Gamma_C`: the obstacle's region (`on REGION`, or `Gamma_C`); none without
+/// an obstacle or a region `Gamma_C`.
 fn contact_region(pf: &ProblemFile) -> Option<&str> {
     let (p, contact) = (pf.problem(), super::bind::CONTACT);
     match p.obstacles.first() {

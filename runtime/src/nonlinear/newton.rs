@@ -63,7 +63,8 @@ pub struct NewtonOptions {
     pub tol: f64,
     pub max_iterations: usize,
     /// Backtracking on ‖R‖₂ (halving the step up to 10 times), for every problem; a problem
-    /// that is not piecewise (frictional) backtracks without it.
+    /// that is not piecewise (frictional) backtracks without it once three full steps have not
+    /// lowered its residual.
     pub line_search: bool,
     /// How the Jacobian systems are solved.
     pub solver: Solver,
@@ -226,6 +227,11 @@ impl Newton {
         // A bound on what R(w) holds beyond r: the errors of solves whose residual was then
         // evaluated on the nonlinear terms' dofs only (`residual_on_support`).
         let mut carried = 0.0;
+        // Backtracking (`line_search`, or where full steps stall: a problem that is not
+        // piecewise, a frictional law, may cycle between stick and slip; semi-smooth Newton on a
+        // piecewise one converges without it, through residuals that grow on the way).
+        let mut search = self.options.line_search;
+        let (mut best, mut stalled) = (r0, 0usize);
         // ‖r‖∞ of the r the next solve is given.
         let mut norm_r = r0;
         while !converged(res, floor, threshold, !report.history.is_empty(), small_step) {
@@ -395,9 +401,7 @@ impl Newton {
                 known = true;
                 1.0
             } else {
-                // A problem that is not piecewise (a frictional law: its tangent turns with the
-                // slip) backtracks always: its semi-smooth steps may cycle between stick and slip.
-                let step = self.step(p, w, delta, r, self.options.line_search || !piecewise);
+                let step = self.step(p, w, delta, r, search);
                 after.clear();
                 p.active_set(w, after);
                 small_step = after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w);
@@ -406,6 +410,13 @@ impl Newton {
                 carried = 0.0;
                 step
             };
+            if res < best {
+                (best, stalled) = (res, 0);
+            } else {
+                stalled += 1;
+                // Three full steps without a new best residual: backtrack from here on.
+                search |= !piecewise && stalled >= 3;
+            }
             debug!(
                 iteration = report.history.len() + 1,
                 residual = res,
