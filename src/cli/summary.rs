@@ -45,12 +45,30 @@ pub(super) fn finish(result: Result<crate::problem::run::Run, crate::error::Case
                 1e3 * s.number("seconds_per_step").unwrap_or(f64::NAN),
                 s.number("peak_memory_bytes").map_or(String::new(), |b| format!(", peak memory {:.0} MB", b / 1e6))
             );
+            expectations(s);
             ExitCode::SUCCESS
         }
         Err(e) => {
             super::print_error(e);
             ExitCode::FAILURE
         }
+    }
+}
+
+/// One line per `expect` of the problem: the key against its expected value.
+fn expectations(s: &crate::problem::outputs::Summary) {
+    let Ok(list) = s.field::<Vec<crate::problem::summary::Expectation>>("expected") else { return };
+    let number = |x: Option<f64>| x.map_or("none".to_string(), |x| format!("{x:.6}"));
+    for x in list {
+        println!(
+            "  expect {} = {} (is {}, relative {}, within {}): {}",
+            x.key,
+            number(x.expected),
+            number(x.value),
+            x.relative.map_or("none".to_string(), |r| format!("{r:.2e}")),
+            x.within,
+            if x.met { "met" } else { "NOT MET" }
+        );
     }
 }
 

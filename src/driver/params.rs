@@ -96,11 +96,12 @@ impl Table {
         )))
     }
 
-    /// A case's overrides of form-file defaults; params the files in use do not declare are
-    /// left alone (a user's contact law may have no `gamma0`).
+    /// A case's overrides of the scheme's and form files' defaults (a problem's `set`); params
+    /// the files in use do not declare are left alone (a user's contact law may have no
+    /// `gamma0`, another scheme no `gam`).
     pub fn apply_case(&mut self, overrides: &[(&str, f64)]) -> Result<(), CaseError> {
         for &(name, value) in overrides {
-            for e in self.entries.iter_mut().filter(|e| !e.scheme && e.info.name == name) {
+            for e in self.entries.iter_mut().filter(|e| e.info.name == name) {
                 Self::check(e, value, "the case's override")?;
                 e.value = value;
                 e.source = Source::Case;

@@ -120,6 +120,15 @@ impl Held {
         }
     }
 
+    /// Whether every held value is zero at `t`: what the static driver, which holds them at
+    /// zero, may settle the body under.
+    pub(super) fn zero_at(&self, mesh: &crate::runtime::fem::mesh::Mesh, t: f64) -> bool {
+        let nodes: Vec<Vec<f64>> = (0..mesh.num_nodes()).map(|i| mesh.node(i).to_vec()).collect();
+        let mut g = vec![0.0; self.dofs.len()];
+        self.eval(&nodes, t, &mut g);
+        g.iter().all(|&x| x == 0.0)
+    }
+
     /// Imposes the held values at `t0` on u₀ and their rate (a centred difference) on v₀.
     pub(super) fn initial(&self, mesh: &crate::runtime::fem::mesh::Mesh, t0: f64, u0: &mut [f64], v0: &mut [f64]) {
         let nodes: Vec<Vec<f64>> = (0..mesh.num_nodes()).map(|i| mesh.node(i).to_vec()).collect();

@@ -77,6 +77,13 @@ enum Measure {
         a: PointFn,
         b: PointFn,
     },
+    /// `cumulative(COLUMN)` (`sum`) or `initial(COLUMN)`: an earlier column over the series
+    /// rows so far, kept in `value` from row to row (and rebuilt from the rows on a resume).
+    OverRows {
+        column: usize,
+        sum: bool,
+        value: std::cell::Cell<f64>,
+    },
 }
 
 /// A row's state: what the measures read.
@@ -324,6 +331,14 @@ impl<'m> Observer<'m> {
                     };
                     add(self, Measure::Force { slot: index, dofs }, d, e.span)
                 }
+                "cumulative" | "initial" => {
+                    let ExprKind::Name(id) = &args[0].kind else { unreachable!("checked: a column's name") };
+                    let column =
+                        self.columns.iter().position(|(n, _, _)| *n == id.name).expect("checked: an earlier column");
+                    let sum = f.name == "cumulative";
+                    let value = std::cell::Cell::new(if sum { 0.0 } else { f64::NAN });
+                    add(self, Measure::OverRows { column, sum, value }, 1, e.span)
+                }
                 "inner_mass" => {
                     let mut field = |e: &Expr| -> Result<PointFn, CaseError> {
                         let val = ex.lower(e, pointwise).map_err(|d| pf.render(*d))?;
@@ -477,6 +492,20 @@ impl<'m> Observer<'m> {
             self.deferred.push((column, by, std::cell::Cell::new(f64::NEG_INFINITY)));
         }
         ok
+    }
+
+    /// Takes up the rows a checkpoint kept, as though they had been measured here: the running
+    /// values of `cumulative` and `initial`, and the maxima `defer` compares with.
+    pub fn resume(&self, rows: &[(f64, Vec<f64>)]) {
+        for m in &self.measures {
+            if let Measure::OverRows { column, sum, value } = m {
+                let start = if *sum { 0.0 } else { f64::NAN };
+                value.set(rows.iter().fold(start, |x, (_, row)| over_rows(*sum, x, row[*column])));
+            }
+        }
+        for (_, by, best) in &self.deferred {
+            best.set(rows.iter().map(|(_, r)| r[*by]).fold(f64::NEG_INFINITY, f64::max));
+        }
     }
 
     /// The reference's figures of a state into `dir`, if the problem names one.
@@ -658,6 +687,13 @@ impl<'m> Observer<'m> {
                             points.iter().filter(|p| p.value != 0.0).map(|p| p.weight).sum()
                         })
                     }
+                    Measure::OverRows { column, sum, value } => {
+                        // A stage is not a row of the series: it reads the value at its step's start.
+                        if !s.stage {
+                            value.set(over_rows(*sum, value.get(), columns[*column]));
+                        }
+                        one(value.get())
+                    }
                     Measure::InnerMass { a, b } => {
                         let nodal = |f: &PointFn, scratch: &mut Vec<f64>| {
                             let mut out = vec![0.0; n];
@@ -686,6 +722,16 @@ impl<'m> Observer<'m> {
     /// column order, so a column's are measured just before it).
     fn belongs_after(&self, m: usize, c: usize) -> bool {
         self.owner.get(m).is_some_and(|&o| o > c)
+    }
+}
+
+/// The running value of `cumulative` (`sum`) or `initial` after a row whose column reads `x`:
+/// a sum leaves NaN out, `initial` keeps the first value.
+fn over_rows(sum: bool, running: f64, x: f64) -> f64 {
+    match (sum, x.is_nan(), running.is_nan()) {
+        (true, false, _) => running + x,
+        (false, _, true) => x,
+        _ => running,
     }
 }
 

@@ -326,7 +326,7 @@ fn simulate(
                     &coefs,
                     contact_region,
                     &constraints,
-                    held.is_some(),
+                    held.as_ref().is_some_and(|h| !h.zero_at(&mesh, t0)),
                     quadrature.facet,
                     opts,
                     in_use,
@@ -377,6 +377,7 @@ fn simulate(
                         }
                         snapshots.extend_written(record.snapshots);
                     }
+                    observer.resume(&series);
                     (saved_rows, saved_stages, saved_snapshots) =
                         (series.len(), stage_rows.borrow().len(), snapshots.written().len());
                 }
@@ -469,9 +470,12 @@ fn simulate(
     put("steps", steps.into());
     // The time reached (t_end, or where the run stopped).
     put("t_end", json(&series.last().map_or(t0, |r| r.0)));
-    let own = summary_fns.values(&series);
+    let (own, expectations) = summary_fns.values(&series);
     for (k, v) in &own {
         put(k, json(v));
+    }
+    if !expectations.is_empty() {
+        put("expected", json(&expectations));
     }
     put("newton_total", iterations.iter().sum::<usize>().into());
     put("newton_max", iterations.iter().max().copied().unwrap_or(0).into());
@@ -549,7 +553,7 @@ fn settle(
     coefs: &dyn Fn(&str) -> Option<crate::runtime::fem::kernel::Coef>,
     contact: Option<&str>,
     constraints: &crate::runtime::nonlinear::statics::Constraints,
-    moving: bool,
+    held_nonzero: bool,
     facet_degree: Option<u32>,
     opts: &Options,
     in_use: &FilesInUse,
@@ -557,15 +561,19 @@ fn settle(
 ) -> Result<Vec<f64>, CaseError> {
     let why = |what: &str| CaseError::Option(format!("{}: `initial u = settled(...)` {what}", pf.file));
     let contact = contact.ok_or_else(|| why("needs the problem's contact (an obstacle, or `Gamma_C`) to rest on"))?;
-    if moving {
-        return Err(why("holds its Dirichlet values at zero: a held value that moves needs an initial u of its own"));
+    if held_nonzero {
+        return Err(why(
+            "holds the Dirichlet values at zero: a value held away from zero at the start needs an initial u of its own",
+        ));
     }
     let problem = crate::simulation::statics::StaticProblem {
         coefs,
         contact,
         contact_degree: facet_degree,
         constraints: constraints.clone(),
-        newton: opts.newton,
+        // Backtracking on ‖R‖: a full step from a shallow guess can lift a free body off the
+        // obstacle, where its stiffness is singular (a disc of h = 0.05 settling did).
+        newton: crate::runtime::nonlinear::newton::NewtonOptions { line_search: true, ..opts.newton },
     };
     let solution = crate::simulation::statics::solve(asm, problem, &in_use.forms, guess).map_err(|e| {
         why(&format!(

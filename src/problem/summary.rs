@@ -37,9 +37,25 @@ struct Key {
     f: PointFn,
 }
 
+/// `expect KEY = VALUE within TOL`, measured: the key's value, the expected one, their
+/// relative difference |value − expected| / |expected| and whether it is within TOL.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct Expectation {
+    pub key: String,
+    pub value: Option<f64>,
+    pub expected: Option<f64>,
+    pub relative: Option<f64>,
+    pub within: f64,
+    pub met: bool,
+}
+
 /// The problem's summary keys, compiled.
 pub struct SummaryKeys {
+    /// The problem's keys, then one hidden key per expectation (its expected value).
     keys: Vec<Key>,
+    /// Per expectation: the key it names, its tolerance, and whether its value compiled (an
+    /// expected value these params make infinite, v0/μ at μ = 0, has none).
+    expects: Vec<(String, f64, bool)>,
     columns: usize,
     /// The names the reducers' expression arguments read (not plain columns).
     read_by_expressions: Vec<String>,
@@ -54,9 +70,17 @@ impl SummaryKeys {
         // columns + j.
         let mut row_scope: Vec<(String, Val)> =
             columns.iter().enumerate().map(|(i, c)| (c.clone(), ex.measured(i, 1))).collect();
-        for d in &pf.problem().summary {
+        let p = pf.problem();
+        let mut expects: Vec<(String, f64, bool)> = p
+            .expects
+            .iter()
+            .map(|x| (x.key.name.clone(), crate::compiler::check::const_value(&x.within).unwrap_or(0.0), true))
+            .collect();
+        let hidden = p.expects.iter().enumerate().map(|(i, x)| (Some(i), format!("#expect {}", x.key.name), &x.value));
+        let all = p.summary.iter().map(|d| (None, d.name.name.clone(), &d.value)).chain(hidden);
+        for (expect, name, value) in all {
             let mut calls = Vec::new();
-            let rewritten = summary_rewrite(&d.value, &mut calls);
+            let rewritten = summary_rewrite(value, &mut calls);
             let mut reduces = Vec::new();
             for (r, args) in calls {
                 let mut compiled = Vec::new();
@@ -81,12 +105,19 @@ impl SummaryKeys {
             for (j, k) in keys.iter().enumerate() {
                 scope.push((k.name.clone(), ex.measured(reduces.len() + j, 1)));
             }
-            let val = ex.lower(&rewritten, &scope).map_err(|e| pf.render(*e))?;
-            let f = ex.function(&val, &d.value).map_err(|e| pf.render(*e))?;
-            row_scope.push((d.name.name.clone(), ex.measured(columns.len() + keys.len(), 1)));
-            keys.push(Key { name: d.name.name.clone(), reduces, f });
+            let compiled = ex.lower(&rewritten, &scope).and_then(|val| ex.function(&val, value));
+            let f = match (compiled, expect) {
+                (Ok(f), _) => f,
+                (Err(_), Some(i)) => {
+                    expects[i].2 = false;
+                    continue;
+                }
+                (Err(e), None) => return Err(pf.render(*e)),
+            };
+            row_scope.push((name.clone(), ex.measured(columns.len() + keys.len(), 1)));
+            keys.push(Key { name, reduces, f });
         }
-        Ok(SummaryKeys { keys, columns: columns.len(), read_by_expressions })
+        Ok(SummaryKeys { keys, expects, columns: columns.len(), read_by_expressions })
     }
 
     /// The (column, of) pairs of `at_max(column, of)` whose column no other reducer reads: the
@@ -114,8 +145,28 @@ impl SummaryKeys {
         out
     }
 
-    /// The keys and their values over `rows` (time, values); null where a reducer has none.
-    pub fn values(&self, rows: &[(f64, Vec<f64>)]) -> Vec<(String, Option<f64>)> {
+    /// The problem's keys and their values over `rows` (time, values), null where a reducer has
+    /// none; and its expectations.
+    pub fn values(&self, rows: &[(f64, Vec<f64>)]) -> (Vec<(String, Option<f64>)>, Vec<Expectation>) {
+        let mut all = self.all_values(rows);
+        let compiled = self.expects.iter().filter(|e| e.2).count();
+        let mut expected = all.split_off(all.len() - compiled).into_iter().map(|(_, v)| v);
+        let expectations = self
+            .expects
+            .iter()
+            .map(|(key, within, ok)| {
+                let expected = if *ok { expected.next().flatten() } else { None };
+                let value = all.iter().find(|(k, _)| k == key).and_then(|(_, v)| *v);
+                let relative = value.zip(expected).map(|(v, e)| (v - e).abs() / e.abs());
+                let met = relative.is_some_and(|r| r <= *within);
+                Expectation { key: key.clone(), value, expected, relative, within: *within, met }
+            })
+            .collect();
+        (all, expectations)
+    }
+
+    /// Every key's value, the hidden expected values last.
+    fn all_values(&self, rows: &[(f64, Vec<f64>)]) -> Vec<(String, Option<f64>)> {
         let mut out: Vec<(String, Option<f64>)> = Vec::new();
         // A row as measured values: its columns, then the keys so far.
         let mut at_row: Vec<Vec<f64>> = vec![vec![0.0]; self.columns + self.keys.len()];

@@ -381,6 +381,16 @@ pub struct Plot {
     pub span: Span,
 }
 
+/// `expect KEY = VALUE within TOL`: summary key KEY is expected to be VALUE (an expression of
+/// the params and the keys) within the relative tolerance TOL.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expect {
+    pub key: Ident,
+    pub value: Expr,
+    pub within: Expr,
+    pub span: Span,
+}
+
 /// A problem: the body, its mesh and regions, the files bound to the run's roles, every coef,
 /// obstacles, Dirichlet data, initial fields, what is measured, and the run's defaults.
 #[derive(Clone, Debug, PartialEq)]
@@ -399,6 +409,8 @@ pub struct Problem {
     /// Series columns (written) and observed values (not written), in order.
     pub series: Vec<(Defined, bool)>,
     pub summary: Vec<Defined>,
+    /// `expect KEY = VALUE within TOL`: what a summary key should be, to a relative tolerance.
+    pub expects: Vec<Expect>,
     pub plots: Vec<Plot>,
     /// Run settings: `dt`, `t_end`, `t_start`.
     pub run: Vec<Defined>,

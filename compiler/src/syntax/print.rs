@@ -186,6 +186,9 @@ fn problem(p: &Problem, out: &mut String) {
     for d in &p.summary {
         line(out, "summary", d);
     }
+    for x in &p.expects {
+        out.push_str(&format!("  expect {} = {} within {}\n", x.key.name, expr(&x.value), expr(&x.within)));
+    }
     for pl in &p.plots {
         let c: Vec<&str> = pl.columns.iter().map(|c| c.name.as_str()).collect();
         out.push_str(&format!("  plot {:?}: {}\n", pl.title, c.join(", ")));

@@ -144,7 +144,20 @@ pub const ROW_REDUCERS: &[(&str, &str, &str)] = &[
         "density_support(NAME(u))",
         "the measure of the points of a boundary functional's region where its integrand is not zero: the contact zone's, of contact_pressure(u)",
     ),
+    (
+        "cumulative",
+        "cumulative(COLUMN)",
+        "the sum of an earlier column over the rows so far, this one included (NaN values left out; a stage reads the sum at its step's start): cumulative(dissipated) is the frictional work since the start",
+    ),
+    (
+        "initial",
+        "initial(COLUMN)",
+        "an earlier column's value at the first row: the balance energy_aug + cumulative(dissipated) - initial(energy_aug)",
+    ),
 ];
+
+/// The reducers of a series column that read an earlier column over the rows (not the state).
+pub const OVER_ROWS: &[&str] = &["cumulative", "initial"];
 
 /// Any other call in a series column, `NAME(u)`, is a functional of the files in use or of the
 /// problem's reference (checked when the problem is bound).

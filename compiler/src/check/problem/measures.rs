@@ -136,6 +136,26 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
                 scalar(c, &args[1], s.pointwise, diags, false);
             }
         }
+        name if OVER_ROWS.contains(&name) => {
+            if arity(1, diags) {
+                match &args[0].kind {
+                    K::Name(id) if s.earlier.contains(&id.name.as_str()) => {}
+                    K::Name(id) => diags.push(unknown_among(id, s.earlier.iter().copied(), "earlier column")),
+                    _ => diags.push(
+                        Diagnostic::error(
+                            "E0301",
+                            "shape mismatch",
+                            args[0].span,
+                            "an earlier column's name is needed here",
+                        )
+                        .with_help(format!(
+                            "name the column: `series dissipated = friction_work(u, u_prev)`, then `{}(dissipated)`",
+                            f.name
+                        )),
+                    ),
+                }
+            }
+        }
         "density_min" | "density_support" => {
             let functional = |a: &Expr| {
                 matches!(&a.kind, K::Call(_, xs) if xs.len() == 1

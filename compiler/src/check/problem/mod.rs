@@ -268,6 +268,28 @@ fn measures(c: &mut Checker, p: &Problem, constants: &Names, regions: &[&str], d
         summary(&d.value, &scope, false, diags);
         keys.push(&d.name.name);
     }
+    // An expectation names a key; its value is an expression as a key's (params, keys, reducers).
+    let mut expected: HashMap<&str, Span> = HashMap::new();
+    for x in &p.expects {
+        if !keys.contains(&x.key.name.as_str()) {
+            diags.push(unknown_among(&x.key, keys.iter().copied(), "summary key"));
+        } else if let Some(first) = expected.get(x.key.name.as_str()) {
+            diags.push(
+                Diagnostic::error("E0102", format!("`{}` is expected twice", x.key.name), x.key.span, "again here")
+                    .with_label(*first, "first here"),
+            );
+        } else {
+            expected.insert(&x.key.name, x.key.span);
+        }
+        let scope = SummaryScope { columns: &earlier, keys: &keys, constants };
+        summary(&x.value, &scope, false, diags);
+        if !crate::check::const_value(&x.within).is_some_and(|w| w > 0.0) {
+            diags.push(
+                Diagnostic::error("E0301", "a tolerance is a positive number", x.within.span, "not one")
+                    .with_help("a relative tolerance: `within 0.03` for 3 %"),
+            );
+        }
+    }
     for pl in &p.plots {
         for col in &pl.columns {
             if !p.series.iter().any(|(d, _)| d.name.name == col.name) {

@@ -230,11 +230,12 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         | Rule::series_decl
         | Rule::observe_decl
         | Rule::summary_decl
+        | Rule::expect_decl
         | Rule::plot_decl
         | Rule::run_decl
         | Rule::quadrature_decl
         | Rule::reference_decl => {
-            "a problem item (`mesh`, `region`, `bind`, `set`, `coef`, `obstacle`, `initial`, `dirichlet`, `series`, `observe`, `summary`, `plot`, `run`, `quadrature`, `reference`, `let`)"
+            "a problem item (`mesh`, `region`, `bind`, `set`, `coef`, `obstacle`, `initial`, `dirichlet`, `series`, `observe`, `summary`, `expect`, `plot`, `run`, `quadrature`, `reference`, `let`)"
         }
         Rule::named_arg | Rule::assignments => "`NAME = VALUE`",
         Rule::region_source | Rule::group_source | Rule::boundary_source => "`group \"NAME\"` or `boundary where ...`",

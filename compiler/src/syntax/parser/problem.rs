@@ -30,6 +30,7 @@ impl Builder {
             dirichlet: Vec::new(),
             series: Vec::new(),
             summary: Vec::new(),
+            expects: Vec::new(),
             plots: Vec::new(),
             run: Vec::new(),
             run_static: None,
@@ -101,6 +102,12 @@ impl Builder {
                 Rule::series_decl => pb.series.push((self.defined(span, next(), it.next())?, true)),
                 Rule::observe_decl => pb.series.push((self.defined(span, next(), it.next())?, false)),
                 Rule::summary_decl => pb.summary.push(self.defined(span, next(), it.next())?),
+                Rule::expect_decl => {
+                    let key = self.ident(next());
+                    let value = self.expr(next())?;
+                    let within = self.expr(next())?;
+                    pb.expects.push(Expect { key, value, within, span });
+                }
                 Rule::let_decl => pb.lets.push(self.defined(span, next(), it.next())?),
                 Rule::obstacle_decl => {
                     let shape = self.named_call(next())?;
