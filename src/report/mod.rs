@@ -2,7 +2,7 @@
 //! and figures: the bar (Nitsche against penalty with Crank–Nicolson and HHT, midpoint with and
 //! without mass redistribution, TR-BDF2, hybrid, every scheme's energy), the disc (energies and
 //! Newton iterations per scheme), `signorini verify`, the Δt sweeps of both cases, the Hertz
-//! cases, and the last `bench sphere` run.
+//! cases, friction, and the last `bench sphere` run.
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -17,6 +17,7 @@ use crate::plot::Curve;
 use crate::problem::run::Options;
 use crate::simulation::MassChoice;
 
+mod friction;
 mod hertz;
 pub mod sweep;
 
@@ -223,9 +224,10 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         md.push_str(&sweeps.markdown());
         md.push('\n');
         md.push_str(&hertz::section(out, progress)?);
+        md.push_str(&friction::section(out, progress)?);
     }
     // `bench sphere` takes an hour at full size: the report shows its last run in this directory.
-    md.push_str("## 6. Solvers for size (`signorini bench sphere`)\n\n");
+    md.push_str("## 7. Solvers for size (`signorini bench sphere`)\n\n");
     match crate::bench::sphere::read(out) {
         Some(Ok(bench)) => {
             let first = bench.runs.first();

@@ -1,11 +1,13 @@
 //! `signorini verify`: the claims the mathematics makes, measured (docs/mathematics.md §5, §7).
 //! (a) every scheme's time order on the oscillator and on the bar before impact, and its ρ∞;
 //! (b) space orders of P1 and P2 in 1D, 2D and 3D on manufactured solutions; (c) the discrete
-//! energy laws, with contact and without; (d) the disc's convergence under Δt and h refinement.
+//! energy laws, with contact and without; (d) the disc's convergence under Δt and h refinement;
+//! (e) the limits the library's problems expect (`expect` lines: rigid bodies, friction bounds).
 //! Written as DIR/verify.md with figures in DIR/verify/ (`signorini report` includes it).
 
 pub mod convergence;
 pub mod energy;
+pub mod limits;
 mod oscillator;
 pub mod scheme;
 pub mod space;
@@ -36,6 +38,7 @@ pub struct Verification {
     pub energy: Vec<energy::EnergyRow>,
     pub dissipation: Vec<energy::DissipationRow>,
     pub disc: convergence::DiscConvergence,
+    pub limits: Vec<limits::LimitRow>,
 }
 
 /// Runs every measurement.
@@ -46,6 +49,7 @@ pub fn run(progress: &mut dyn FnMut(&str)) -> Result<Verification, CaseError> {
         energy: energy::contact_laws(progress)?,
         dissipation: energy::dissipation(progress)?,
         disc: convergence::disc(progress),
+        limits: limits::expectations(progress)?,
     })
 }
 
@@ -256,6 +260,7 @@ impl Verification {
             "\nh refinement (Δt = 0.01) on the built-in meshes h = 4, 2, 1 against h = 0.5:\n\n| scheme | ū_y at h = 4, 2, 1 | order | v̄_y | order | f_y | order |\n|---|---|---|---|---|---|---|\n{}\n\n![disc convergence](verify/disc_convergence.png)\n",
             row(&self.disc.h)
         );
+        md.push_str(&limits::markdown(&self.limits));
         md
     }
 }

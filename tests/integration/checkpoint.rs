@@ -67,6 +67,14 @@ fn killed_and_resumed_frictional_discs_have_the_bits_of_an_uninterrupted_one() {
     }
 }
 
+/// Running columns (`cumulative`, `initial`) are rebuilt from the rows the checkpoint kept.
+#[test]
+fn killed_and_resumed_oblique_discs_have_the_bits_of_an_uninterrupted_one() {
+    let mut args = RUN.to_vec();
+    args[1] = "oblique_disc";
+    kill_and_resume("oblique", &args);
+}
+
 /// Runs `run` to the end; then again, killed at arbitrary moments and resumed from its
 /// checkpoints until a resumption ends it: both series.csv must have the same bytes.
 fn kill_and_resume(name: &str, run_args: &[&str]) {

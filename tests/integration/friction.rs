@@ -16,13 +16,40 @@ const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// The summary of `signorini ARGS`, run in a directory of its own named `name`.
 fn summary(name: &str, args: &[&str]) -> serde_json::Value {
+    run(name, args).0
+}
+
+/// The summary and the series (by column name) of `signorini ARGS`.
+fn run(name: &str, args: &[&str]) -> (serde_json::Value, Series) {
     let dir = std::env::temp_dir().join(format!("signorini-friction-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let out = Command::new(BIN).args(args).arg("--out").arg(&dir).output().expect("the binary runs");
     assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
     let summary = std::fs::read_to_string(Path::new(&dir).join("summary.json")).expect("a summary");
+    let csv = std::fs::read_to_string(Path::new(&dir).join("series.csv")).expect("a series");
     let _ = std::fs::remove_dir_all(&dir);
-    serde_json::from_str(&summary).expect("JSON")
+    (serde_json::from_str(&summary).expect("JSON"), Series::parse(&csv))
+}
+
+/// A series.csv: its header and rows.
+struct Series {
+    names: Vec<String>,
+    rows: Vec<Vec<f64>>,
+}
+
+impl Series {
+    fn parse(csv: &str) -> Series {
+        let mut lines = csv.lines();
+        let names = lines.next().expect("a header").split(',').map(str::to_string).collect();
+        let rows = lines.map(|l| l.split(',').map(|x| x.parse().expect("a number")).collect()).collect();
+        Series { names, rows }
+    }
+
+    /// Column `name` over the rows.
+    fn column(&self, name: &str) -> Vec<f64> {
+        let k = self.names.iter().position(|n| n == name).unwrap_or_else(|| panic!("no column {name}"));
+        self.rows.iter().map(|r| r[k]).collect()
+    }
 }
 
 fn law() -> String {
@@ -44,7 +71,7 @@ fn laws() -> Vec<(String, Vec<&'static str>)> {
 
 /// The library's sliding block with friction coefficient `f`, law `law` and `extra` arguments.
 fn block(name: &str, law: &str, f: f64, extra: &[&str]) -> serde_json::Value {
-    let coefficient = format!("F={f}");
+    let coefficient = format!("mu={f}");
     let args = [&["run", "sliding_block", "--contact", law, "--param", &coefficient][..], extra].concat();
     summary(name, &args)
 }
@@ -111,4 +138,111 @@ fn a_frictional_laws_active_points_are_its_contact_points() {
         |law: &str| summary(law.rsplit('/').next().unwrap(), &[&run[..], &[law]].concat())["first_contact"].as_f64();
     let frictionless = first("penalty").expect("the disc touches");
     assert_eq!(first(&law()), Some(frictionless), "the same first contact as the frictionless law");
+}
+
+/// The library's `rolling_disc`: settled on the plane and launched at v0 without spin, a stiff
+/// disc slides, then rolls from t* = v0/(3 μ g) at 2 v0/3 (a rigid uniform disc), within 3 %,
+/// under HHT with Nitsche–Coulomb θ = −1 (the file's) and with the penalty law.
+#[test]
+fn a_disc_launched_without_spin_rolls_from_where_a_rigid_disc_would() {
+    for (k, law) in ["nitsche-coulomb", "penalty-coulomb"].iter().enumerate() {
+        let s = summary(&format!("rolling-{k}"), &["run", "rolling_disc", "--contact", law]);
+        let (v0, mu, g) = (0.2, 0.3, 1.0);
+        let t_star = v0 / (3.0 * mu * g);
+        let time = s["rolling_time"].as_f64().expect("it rolls");
+        let speed = s["rolling_speed"].as_f64().unwrap();
+        let spin = s["rolling_spin"].as_f64().unwrap();
+        assert!((time / t_star - 1.0).abs() < 0.03, "{law}: rolls from {time}, the rigid disc from {t_star}");
+        assert!((speed / (2.0 * v0 / 3.0) - 1.0).abs() < 0.03, "{law}: rolls at {speed}, the rigid disc at 2 v0/3");
+        // Rolling: the spin times R = 1 is the speed (the slip below 1 % of v0).
+        assert!((spin - speed).abs() < 0.01 * v0, "{law}: spin {spin}, speed {speed}");
+    }
+}
+
+/// The library's `shear_block`: pressed by its weight N = 1 and sheared from the top, the
+/// block's tangential reaction T stays ≤ F N at every row (pointwise |λ_t| ≤ F |λ_N|
+/// integrated) and equals F N within 1 % once it slides; under Tresca it stays ≤ s |Γ_C| and
+/// saturates there. Each law's stick or slip is decided at the quadrature points: the bound
+/// holds to round-off. The same without inertia, under the examples' quasi-static scheme.
+#[test]
+fn a_sheared_block_s_reaction_saturates_at_the_friction_limit() {
+    // Without inertia too: the quasi-static scheme of the examples.
+    let quasistatic = format!("{ROOT}/examples/problems/quasistatic.wf");
+    let laws: [(&str, &[&str]); 6] = [
+        ("nitsche-coulomb", &[]),
+        ("nitsche-coulomb", &["--param", "theta=-1"]),
+        ("nitsche-coulomb", &["--param", "mu=0.5"]),
+        ("nitsche-coulomb", &["--scheme", &quasistatic]),
+        ("penalty-coulomb", &[]),
+        ("nitsche-tresca", &["--param", "s=0.1"]),
+    ];
+    for (k, (law, extra)) in laws.iter().enumerate() {
+        let args = [&["run", "shear_block", "--contact", law][..], extra].concat();
+        let (s, series) = run(&format!("shear-{k}"), &args);
+        let (t, tangential, normal) = (series.column("t"), series.column("tangential"), series.column("normal"));
+        // The limit and what it is compared with: F N, or s |Γ_C| (|Γ_C| = 2).
+        let limit = |i: usize| match *law {
+            "nitsche-tresca" => 2.0 * 0.1,
+            _ => normal[i] * if extra.contains(&"mu=0.5") { 0.5 } else { 0.3 },
+        };
+        for i in 0..t.len() {
+            assert!(
+                tangential[i] <= limit(i) * (1.0 + 1e-9),
+                "{law} {extra:?} at t = {}: T = {} > {}",
+                t[i],
+                tangential[i],
+                limit(i)
+            );
+        }
+        let onset = s["onset"].as_f64().expect("it slides");
+        assert!(onset < 1.0, "{law} {extra:?}: slides from {onset}");
+        // Once the drive's ramp and the block's swing have passed (t ≥ 2: the block slides at
+        // the drive's speed).
+        let sliding: Vec<usize> = (0..t.len()).filter(|&i| t[i] >= 2.0).collect();
+        assert!(sliding.len() > 20);
+        for &i in &sliding {
+            assert!(
+                (tangential[i] / limit(i) - 1.0).abs() < 0.01,
+                "{law} {extra:?} at t = {}: T = {}, the limit {}",
+                t[i],
+                tangential[i],
+                limit(i)
+            );
+        }
+    }
+}
+
+/// The library's `oblique_disc` (μ = 0.3, thrown at vx = 0.5) through its first impact:
+/// `cumulative` sums the frictional work of the steps and `initial` reads the first row, so
+/// the balance column is E_aug + W_fric − E_aug(0) on every row; friction takes energy (W_fric
+/// grows, and slows and spins the disc); and the balance is what Crank–Nicolson's trapezoidal
+/// friction leaves over the law's end-of-step work: it closes at first order in Δt.
+#[test]
+fn an_oblique_impact_s_frictional_work_closes_the_energy_balance_at_first_order() {
+    let window = ["run", "oblique_disc", "--h", "2", "--t-start", "5.5", "--t-end", "8.5"];
+    let mut defects = Vec::new();
+    for dt in ["0.02", "0.01"] {
+        let (s, series) = run(&format!("oblique-{dt}"), &[&window[..], &["--dt", dt]].concat());
+        let (work, total) = (series.column("dissipated"), series.column("friction_total"));
+        let (energy, balance) = (series.column("energy_aug"), series.column("balance"));
+        let mut sum = 0.0;
+        for i in 0..work.len() {
+            if !work[i].is_nan() {
+                sum += work[i];
+            }
+            assert_eq!(total[i], sum, "row {i}: cumulative(dissipated)");
+            let expected = energy[i] + total[i] - energy[0];
+            assert!((balance[i] - expected).abs() <= 1e-12 * energy[0], "row {i}: balance {} ≠ {expected}", balance[i]);
+        }
+        assert!(sum > 0.02 * energy[0], "friction took {sum} of E_aug(0) = {}", energy[0]);
+        assert!(s["vx_final"].as_f64().unwrap() < 0.5 && s["spin_final"].as_f64().unwrap() > 0.0, "{s}");
+        defects.push(s["balance_max"].as_f64().unwrap());
+    }
+    let ratio = defects[1] / defects[0];
+    assert!(
+        (0.35..0.65).contains(&ratio),
+        "halving Δt took the balance's defect from {} to {}",
+        defects[0],
+        defects[1]
+    );
 }

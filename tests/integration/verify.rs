@@ -2,7 +2,8 @@
 //! library is second order on the oscillator and on the bar before impact, with ρ∞ ≤ 1;
 //! Crank–Nicolson and midpoint conserve the augmented energy on every step whose active set is
 //! unchanged, on the bar and the disc, with Nitsche θ = 1 and penalty; without contact every
-//! scheme's energy decays per step like the square of its spectral radius.
+//! scheme's energy decays per step like the square of its spectral radius; the library's problems
+//! meet their `expect` lines.
 
 use signorini::verify;
 
@@ -105,4 +106,24 @@ fn without_contact_energy_decays_like_the_spectral_radius_squared() {
         }
         assert!(r.rho <= 1.0 + 1e-12, "{r:?}");
     }
+}
+
+/// `verify`'s (e): the library's problems that state `expect` lines (found in the library:
+/// the friction problems today) meet them at their defaults, and each row is the run's own
+/// key against a finite expected value.
+#[test]
+fn the_library_problems_meet_what_they_expect() {
+    let rows = verify::limits::expectations(&mut |_| {}).unwrap();
+    let problems: std::collections::BTreeSet<&str> = rows.iter().map(|r| r.problem.as_str()).collect();
+    for p in ["rolling_disc", "shear_block", "sliding_block"] {
+        assert!(problems.contains(p), "{p} states expectations: {problems:?}");
+    }
+    for r in &rows {
+        let x = &r.expectation;
+        assert!(x.expected.is_some_and(f64::is_finite) && x.value.is_some(), "{}: {x:?}", r.problem);
+        assert!(x.met, "{} ({} {}): {x:?}", r.problem, r.scheme, r.contact);
+    }
+    assert!(
+        verify::limits::markdown(&rows).contains("| rolling_disc | hht | contact_nitsche_coulomb | rolling_time |")
+    );
 }
