@@ -25,6 +25,16 @@ GetFEM pieces (no hand-written weak form in the dynamics):
     "Time scheme" below), with add_explicit_rhs/set_private_rhs for HHT's explicit part;
   - --contact penalty: add_nonlinear_term with eps [u_N - g]_+ v_N, eps = gamma0/element_size
     (GetFEM's add_penalized_contact_with_rigid_obstacle_brick takes a constant r instead);
+  - --contact nitsche-coulomb (Newmark only): forms/contact_nitsche_coulomb.wf as an
+    add_nonlinear_term built on GetFEM's own Coulomb operator,
+    -theta/gamma sigma(u)n.sigma(v)n + 1/gamma CFCP(sigma(u)n, n_c, alpha (u - Previous_u),
+    g - u.n_c, F, gamma).(theta sigma(v)n - gamma v), where
+    CFCP(lambda, n, Vs, g, f, r) = Coulomb_friction_coupled_projection
+    = -(lambda.n + r g)_- n + P_B(n, f (lambda.n + r g)_-)(lambda - r Vs), GetFEM's (and its
+    Nitsche brick's) projection, with its own derivative; Previous_u is the Newmark scheme's
+    previous displacement, as signorini's prev(u). Its contact terms use IM_TRIANGLE(8), whose
+    face rule has 5 Gauss points per edge, as the law's `degree = 8`. --vx gives the disc a
+    horizontal velocity (the oblique impact, forms/problems/oblique_disc.wf).
   - --contact nitsche-normal: signorini's normal form (forms/contact_nitsche.wf, compared with
     `signorini run disc --contact nitsche`) as an add_nonlinear_term in GWFL:
     -theta/gamma sigma_N(u) sigma_N(v) + 1/gamma [P_1,gamma(u)]_- (theta sigma_N(v) - gamma v.n_c),
@@ -61,11 +71,14 @@ GC = 10  # region number of the contact zone
 
 p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
 p.add_argument("--mesh", required=True, help="the benchmark mesh, disc_r10_h1_v22.msh (Gmsh 2.2)")
-p.add_argument("--contact", choices=["nitsche", "nitsche-normal", "penalty"], default="nitsche",
+p.add_argument("--contact", choices=["nitsche", "nitsche-normal", "nitsche-coulomb", "penalty"], default="nitsche",
                help="nitsche: GetFEM's Nitsche brick (full-traction theta term); nitsche-normal: signorini's "
                     "normal form (forms/contact_nitsche.wf) as a GWFL term; penalty: a GWFL term, "
                     "eps = gamma0/element_size (GetFEM's penalized contact brick takes a constant r, not gamma0/h)")
 p.add_argument("--theta", type=float, default=1.0)
+p.add_argument("--friction", type=float, default=0.3, help="nitsche-coulomb: the friction coefficient F")
+p.add_argument("--slip-scale", type=float, default=1.0, help="nitsche-coulomb: GetFEM's alpha")
+p.add_argument("--vx", type=float, default=0.0, help="the initial horizontal velocity")
 p.add_argument("--gamma0", type=float, default=1000.0)
 p.add_argument("--dt", type=float, default=0.02)
 p.add_argument("--t-end", type=float, default=20.0)
@@ -79,6 +92,9 @@ p.add_argument("--lsearch", default="default", help="GetFEM's Newton line search
 p.add_argument("--noisy", action="store_true")
 p.add_argument("--out", default="-")
 args = p.parse_args()
+coulomb = args.contact == "nitsche-coulomb"
+if coulomb and args.scheme != "newmark":
+    p.error("--contact nitsche-coulomb runs with --scheme newmark (the other schemes' Previous_u is not the previous step)")
 
 lam, mu, rho, grav = 20.0, 20.0, 1.0, 0.1
 
@@ -89,6 +105,8 @@ mf.set_classical_fem(2)  # FEM_PK(2,2), isoparametric on the GT_PK(2,2) cells
 mfs = gf.MeshFem(m, 1)
 mfs.set_classical_fem(2)
 mim = gf.MeshIm(m, gf.Integ(args.integ))
+# The frictional law's facet rule: 5 Gauss points per edge (its `degree = 8`).
+mim_c = gf.MeshIm(m, gf.Integ("IM_TRIANGLE(8)")) if coulomb else mim
 
 faces = m.outer_faces()
 normals = m.normal_of_faces(faces)  # at face centres: on a P2 edge, the chord normal
@@ -105,6 +123,8 @@ md.add_initialized_data("mu", [mu])
 md.add_initialized_data("rho", [rho])
 md.add_initialized_data("f", [0.0, -grav])
 md.add_initialized_data("gamma0", [args.gamma0])
+md.add_initialized_data("F", [args.friction])
+md.add_initialized_data("slip_scale", [args.slip_scale])
 md.add_initialized_fem_data("obs", mfs, mfs.basic_dof_nodes()[1, :])  # gap to {y = 0}
 md.add_isotropic_linearized_elasticity_brick(mim, "u", "lambda", "mu")
 md.add_source_term_brick(mim, "u", "f")
@@ -117,7 +137,13 @@ pen = f"pos_part(u.{nc} - obs)"  # [u_N - g]_+
 sn_u = f"(({neumann}).{nc})"
 sn_v = "(((lambda*Div_Test_u*Id(2) + 2*mu*Sym(Grad_Test_u))*Normal).{})".format(nc)
 P1 = f"({sn_u} + {gamma}*(obs - u.{nc}))"  # P_1,gamma(u) + gamma g, the trial value
-if args.contact == "nitsche":
+sigma_v_n = "((lambda*Div_Test_u*Id(2) + 2*mu*Sym(Grad_Test_u))*Normal)"
+# The frictional contact stress lambda_N n_c + lambda_t (Previous_u: the step's start).
+stress = (f"Coulomb_friction_coupled_projection({neumann}, {nc}, slip_scale*(u - Previous_u), "
+          f"obs - u.{nc}, F, {gamma})")
+if coulomb:
+    pass  # added with the time scheme, which declares Previous_u
+elif args.contact == "nitsche":
     md.add_Nitsche_contact_with_rigid_obstacle_brick(mim, "u", neumann, "obs", "gamma0", GC, args.theta)
 elif args.contact == "nitsche-normal":
     # forms/contact_nitsche.wf: C(u).v = -theta/gamma sn(u) sn(v) + 1/gamma [P_1(u) + gamma g]_- P_theta(v),
@@ -131,6 +157,7 @@ else:
 n = mf.nbdof()
 U0 = np.zeros(n)
 V0 = np.zeros(n)
+V0[0::2] = args.vx
 Mmat = gf.asm_generic(mim, 2, "rho*u.Test_u", -1, "rho", 0, [rho], "u", 1, mf, U0)
 Kmat = gf.asm_generic(mim, 2, "(lambda*Div_u*Id(2)+2*mu*Sym(Grad_u)):Grad_Test_u", -1,
                       "lambda", 0, [lam], "mu", 0, [mu], "u", 1, mf, U0)
@@ -139,30 +166,44 @@ ey = np.zeros(n)
 ey[1::2] = 1.0
 Mey = Mmat.mult(ey)
 total_mass = ey @ Mey
+ex = np.zeros(n)
+ex[0::2] = 1.0
+Mex = Mmat.mult(ex)
 
 
-def boundary(expr, U):
-    return gf.asm_generic(mim, 0, expr, GC, "u", 0, mf, U, "obs", 0, mfs, md.variable("obs"),
-                          "lambda", 0, [lam], "mu", 0, [mu], "gamma0", 0, [args.gamma0])
+def boundary(expr, U, W=None):
+    return gf.asm_generic(mim_c, 0, expr, GC, "u", 0, mf, U, "obs", 0, mfs, md.variable("obs"),
+                          "Previous_u", 0, mf, U if W is None else W,
+                          "lambda", 0, [lam], "mu", 0, [mu], "gamma0", 0, [args.gamma0],
+                          "F", 0, [args.friction], "slip_scale", 0, [args.slip_scale])
 
 
-def measure(t, U, V):
+def measure(t, U, V, W):
+    """The row at (U, V), W the step's start (U at the first row)."""
     energy = 0.5 * V @ Mmat.mult(V) + 0.5 * U @ Kmat.mult(U) - Fvec @ U
+    fx = 0.0
     if args.contact.startswith("nitsche"):
-        theta_term = f"Norm_sqr({neumann})" if args.contact == "nitsche" else f"sqr({sn_u})"
+        theta_term = f"sqr({sn_u})" if args.contact == "nitsche-normal" else f"Norm_sqr({neumann})"
         ce = boundary(f"-{theta}/(2*{gamma})*{theta_term}"
                       f" + 1/(2*{gamma})*sqr(neg_part({P1}))", U)
         fy = boundary(f"neg_part({P1})", U)  # GWFL neg_part(x) = max(-x, 0) = -[x]_-
+        if coulomb:  # the contact stress's resultant on the body
+            fx = boundary(f"({stress})(1)", U, W)
     else:
         ce = boundary(f"{gamma}/2*sqr({pen})", U)
         fy = boundary(f"{gamma}*{pen}", U)
-    return (t, energy, energy + ce, (Mey @ U) / total_mass, np.mean(U[1::2]), fy)
+    return (t, energy, energy + ce, (Mex @ U) / total_mass, (Mey @ U) / total_mass, np.mean(U[1::2]), fx, fy)
 
 
 # Initial acceleration: M a0 = F - K u0 - C(u0), the rhs of the model before the mass brick.
 md.set_variable("u", U0)
-md.assembly("build_rhs")
-r0 = md.rhs()
+if coulomb:
+    # Its term reads Previous_u, which the time scheme (added below) declares; the disc starts
+    # 2 above the ground, where C(u0) = 0.
+    r0 = Fvec - Kmat.mult(U0)
+else:
+    md.assembly("build_rhs")
+    r0 = md.rhs()
 jc, ir = Mmat.csc_ind()
 A0 = scipy.sparse.linalg.spsolve(scipy.sparse.csc_matrix((Mmat.csc_val(), ir, jc), shape=(n, n)), r0)
 
@@ -192,6 +233,9 @@ elif args.scheme == "hht":
 else:
     md.add_Newmark_scheme("u", 1.0, 0.5)
 md.add_mass_brick(mim, "Dot2_u", "rho")
+if coulomb:
+    md.add_nonlinear_term(mim_c, f"-{theta}/{gamma}*({neumann}).{sigma_v_n}"
+                                 f" + 1/{gamma}*({stress}).({theta}*{sigma_v_n} - {gamma}*Test_u)", GC)
 md.set_time_step(args.dt / 2 if args.scheme == "midpoint" else args.dt)
 
 
@@ -229,13 +273,13 @@ def trbdf2_step(U, V, A, t):
 
 U, V, A = U0.copy(), V0.copy(), A0.copy()
 B = Fvec - Mmat.mult(A0)  # B(u^0) = K u^0 + C(u^0)
-rows = [measure(0.0, U, V)]
+rows = [measure(0.0, U, V, U)]
 steps = int(round(args.t_end / args.dt))
 for k in range(steps):
     t = (k + 1) * args.dt
     if args.scheme == "trbdf2":
         U, V, A = trbdf2_step(U, V, A, t)
-        rows.append(measure(t, U, V))
+        rows.append(measure(t, U, V, U))
         continue
     md.set_variable("Previous_u", U)
     md.set_variable("Previous_Dot_u", V)
@@ -247,6 +291,7 @@ for k in range(steps):
                   "lsearch", args.lsearch, *(["noisy"] if args.noisy else []))
     if not it[1]:
         print(f"# Newton did not converge at t = {t:g}: {it}", file=sys.stderr)
+    start = U
     if args.scheme == "midpoint":
         W = md.variable("u")
         U, V = 2 * W - U, 4 * (W - U) / args.dt - V
@@ -256,10 +301,10 @@ for k in range(steps):
         V = md.variable("Previous_Dot_u")
         A = md.variable("Previous_Dot2_u")
         B = (Fvec - Mmat.mult(A) - alpha * B) / (1 - alpha)
-    rows.append(measure(t, U, V))
+    rows.append(measure(t, U, V, start))
 
 out = sys.stdout if args.out == "-" else open(args.out, "w")
-out.write("t,energy,energy_aug,uy_mean,uy_mean_nodal,fy_contact\n")
+out.write("t,energy,energy_aug,ux_mean,uy_mean,uy_mean_nodal,fx_contact,fy_contact\n")
 for r in rows:
     out.write(",".join(repr(float(x)) for x in r) + "\n")
 if out is not sys.stdout:
