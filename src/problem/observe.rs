@@ -24,6 +24,7 @@ enum Measure {
     Kinetic,
     Newton,
     ActivePoints,
+    StatusKept,
     /// An earlier column.
     Column(usize),
     Mean {
@@ -45,6 +46,11 @@ enum Measure {
     Force {
         slot: usize,
         dofs: Option<Vec<usize>>,
+    },
+    /// `work(SLOT)`: ½(r(uⁿ) + r(uⁿ⁺¹))·(uⁿ⁺¹ − uⁿ), slot form `slot`'s residual at the step's
+    /// two ends, each with its own previous level.
+    Work {
+        slot: usize,
     },
     /// `measure(REGION, EXPR)`: the weight of the region's points where EXPR ≥ 0.
     Area {
@@ -95,6 +101,8 @@ pub struct State<'a> {
     /// The displacement at the start of the step and the step (none at the initial row and at
     /// stages).
     pub before: Option<(&'a [f64], f64)>,
+    /// The level a law's `prev` read at the step's start (none when no law reads one).
+    pub before_previous: Option<&'a [f64]>,
     /// The level a contact law's `prev` reads at this row: the step's start (at a stage too),
     /// the initial state at the first row and in a static problem.
     pub previous: &'a [f64],
@@ -134,6 +142,8 @@ pub struct Observer<'m> {
     /// Columns measured only at the series rows where another column reaches a new maximum
     /// (NaN elsewhere): (the column, the other, its largest value so far).
     deferred: Vec<(usize, usize, std::cell::Cell<f64>)>,
+    /// The last series row's active set (`status_kept` compares with it).
+    last_switches: std::cell::RefCell<Option<Vec<bool>>>,
 }
 
 #[derive(Default)]
@@ -175,6 +185,7 @@ impl<'m> Observer<'m> {
             functionals: Vec::new(),
             reuse: Default::default(),
             deferred: Vec::new(),
+            last_switches: Default::default(),
         };
         let mut region_names: Vec<String> = Vec::new();
         let u = ex.field(0);
@@ -250,6 +261,7 @@ impl<'m> Observer<'m> {
                     "kinetic" => Some(Measure::Kinetic),
                     "newton" => Some(Measure::Newton),
                     "active_points" => Some(Measure::ActivePoints),
+                    "status_kept" => Some(Measure::StatusKept),
                     _ => None,
                 });
                 match row {
@@ -303,7 +315,7 @@ impl<'m> Observer<'m> {
                     };
                     add(self, m, 1, e.span)
                 }
-                "force" => {
+                "force" | "work" => {
                     let ExprKind::Name(slot) = &args[0].kind else { unreachable!("checked: a slot name") };
                     let index = match self.slots.iter().position(|(n, _)| *n == slot.name) {
                         Some(i) => i,
@@ -320,6 +332,9 @@ impl<'m> Observer<'m> {
                             self.slots.len() - 1
                         }
                     };
+                    if f.name == "work" {
+                        return Ok(add(self, Measure::Work { slot: index }, 1, e.span));
+                    }
                     // Over a region: the dofs of its nodes, component by component.
                     let dofs = match args.get(1).map(|a| &a.kind) {
                         Some(ExprKind::Name(region)) => {
@@ -495,8 +510,10 @@ impl<'m> Observer<'m> {
     }
 
     /// Takes up the rows a checkpoint kept, as though they had been measured here: the running
-    /// values of `cumulative` and `initial`, and the maxima `defer` compares with.
-    pub fn resume(&self, rows: &[(f64, Vec<f64>)]) {
+    /// values of `cumulative` and `initial`, the maxima `defer` compares with, and the last
+    /// row's active set (`switches`, per row).
+    pub fn resume(&self, rows: &[(f64, Vec<f64>)], switches: &[Vec<bool>]) {
+        *self.last_switches.borrow_mut() = switches.last().cloned();
         for m in &self.measures {
             if let Measure::OverRows { column, sum, value } = m {
                 let start = if *sum { 0.0 } else { f64::NAN };
@@ -581,6 +598,9 @@ impl<'m> Observer<'m> {
                     Measure::Kinetic => one(*kinetic.get_or_insert_with(|| ops.kinetic(s.v))),
                     Measure::Newton => one(s.newton as f64),
                     Measure::ActivePoints => one(switches.iter().filter(|b| **b).count() as f64),
+                    Measure::StatusKept => {
+                        one(f64::from(u8::from(self.last_switches.borrow().as_ref() == Some(&switches))))
+                    }
                     Measure::Column(i) => one(columns[*i]),
                     Measure::Mean { field: fi, weights, .. } => one(field(*fi).map_or(f64::NAN, |x| weights.of(x))),
                     Measure::NodalMean { field: fi, axis } => {
@@ -605,6 +625,18 @@ impl<'m> Observer<'m> {
                                 .map(|k| -dofs.iter().filter(|&&i| i % d == k).map(|&i| r[i]).sum::<f64>())
                                 .collect(),
                         }
+                    }
+                    Measure::Work { slot } => {
+                        let form = &self.slots[*slot].1;
+                        let value = s.before.map_or(f64::NAN, |(before, dt)| {
+                            // Both ends' residuals summed, then applied to the step's motion.
+                            let mut r = vec![0.0; n];
+                            let start = s.before_previous.unwrap_or(before);
+                            form.residual(asm, &with_previous(form.previous(), &[before], start), s.t - dt, &mut r);
+                            form.residual(asm, &with_previous(form.previous(), &[s.u], s.previous), s.t, &mut r);
+                            0.5 * r.iter().zip(s.u.iter().zip(before)).map(|(r, (a, b))| r * (a - b)).sum::<f64>()
+                        });
+                        one(value)
                     }
                     Measure::Area { region, f } | Measure::Peak { region, f } => {
                         // `measure` and `peak` of one expression share its values.
@@ -714,6 +746,9 @@ impl<'m> Observer<'m> {
             let mut out = [0.0];
             f.eval(&At { measured, ..At::default() }, &mut *scratch, &mut out);
             columns.push(out[0]);
+        }
+        if !s.stage {
+            *self.last_switches.borrow_mut() = Some(switches.clone());
         }
         (columns, switches)
     }

@@ -305,7 +305,16 @@ fn simulate(
             let newton = solution.newton.iterations();
             let (row, switches) = row(
                 ops,
-                State { t: t0, u: &solution.u, v: None, newton, before: None, previous: &initial, stage: false },
+                State {
+                    t: t0,
+                    u: &solution.u,
+                    v: None,
+                    newton,
+                    before: None,
+                    before_previous: None,
+                    previous: &initial,
+                    stage: false,
+                },
             );
             snapshots.write(ops, 0, t0, &solution.u, &vec![0.0; n])?;
             let outcome = crate::simulation::Outcome {
@@ -337,7 +346,16 @@ fn simulate(
             };
             sim.initialize_at(t0, u0, v0)?;
             let u0 = &sim.states[0];
-            let first = State { t: t0, u: u0, v: sim.velocity(), newton: 0, before: None, previous: u0, stage: false };
+            let first = State {
+                t: t0,
+                u: u0,
+                v: sim.velocity(),
+                newton: 0,
+                before: None,
+                before_previous: None,
+                previous: u0,
+                stage: false,
+            };
             let (first, first_switches) = row(&sim.ops, first);
             let mut series = vec![first];
             let mut switches = vec![first_switches];
@@ -377,7 +395,7 @@ fn simulate(
                         }
                         snapshots.extend_written(record.snapshots);
                     }
-                    observer.resume(&series);
+                    observer.resume(&series, &switches);
                     (saved_rows, saved_stages, saved_snapshots) =
                         (series.len(), stage_rows.borrow().len(), snapshots.written().len());
                 }
@@ -399,8 +417,16 @@ fn simulate(
                 &mut |ops, stage, v_index, start| {
                     if let Some(u) = stage.value_of(&names[0]) {
                         let v = v_index.and_then(|i| stage.value_of(&names[i]));
-                        let state =
-                            State { t: stage.time, u, v, newton: 0, before: None, previous: start, stage: true };
+                        let state = State {
+                            t: stage.time,
+                            u,
+                            v,
+                            newton: 0,
+                            before: None,
+                            before_previous: None,
+                            previous: start,
+                            stage: true,
+                        };
                         let ((t, values), _) = row(ops, state);
                         stage_rows.borrow_mut().push((stage.name.to_string(), t, values));
                     }
@@ -413,6 +439,7 @@ fn simulate(
                         v,
                         newton: step.report.iterations(),
                         before: Some((step.before, step.dt)),
+                        before_previous: step.previous,
                         previous: step.before,
                         stage: false,
                     };

@@ -38,7 +38,8 @@ struct Key {
 }
 
 /// `expect KEY = VALUE within TOL`, measured: the key's value, the expected one, their
-/// relative difference |value − expected| / |expected| and whether it is within TOL.
+/// relative difference |value − expected| / |expected| (absolute, |value|, when the expected
+/// value is 0) and whether it is within TOL.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq)]
 pub struct Expectation {
     pub key: String,
@@ -157,7 +158,8 @@ impl SummaryKeys {
             .map(|(key, within, ok)| {
                 let expected = if *ok { expected.next().flatten() } else { None };
                 let value = all.iter().find(|(k, _)| k == key).and_then(|(_, v)| *v);
-                let relative = value.zip(expected).map(|(v, e)| (v - e).abs() / e.abs());
+                let relative =
+                    value.zip(expected).map(|(v, e)| if e == 0.0 { v.abs() } else { (v - e).abs() / e.abs() });
                 let met = relative.is_some_and(|r| r <= *within);
                 Expectation { key: key.clone(), value, expected, relative, within: *within, met }
             })
@@ -196,8 +198,18 @@ impl SummaryKeys {
                     Some(vec![match r {
                         Reduce::Initial => arg(a, rows.first()?),
                         Reduce::Final => arg(a, rows.last()?),
-                        Reduce::Min => rows.iter().map(|row| arg(a, row)).fold(f64::INFINITY, f64::min),
-                        Reduce::Max => rows.iter().map(|row| arg(a, row)).fold(f64::NEG_INFINITY, f64::max),
+                        Reduce::Min | Reduce::Max => {
+                            let mut values = Vec::new();
+                            for row in rows {
+                                if args.get(1).is_none_or(|w| arg(w, row) > 0.0) {
+                                    values.push(arg(a, row));
+                                }
+                            }
+                            match r {
+                                Reduce::Min => values.into_iter().fold(f64::INFINITY, f64::min),
+                                _ => values.into_iter().fold(f64::NEG_INFINITY, f64::max),
+                            }
+                        }
                         Reduce::Sum => {
                             rows.iter().map(|row| arg(a, row)).filter(|v| !v.is_nan()).fold(0.0, |s, v| s + v)
                         }

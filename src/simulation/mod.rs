@@ -101,6 +101,9 @@ pub struct Step<'s> {
     pub states: &'s [Vec<f64>],
     /// The displacement at the start of the step.
     pub before: &'s [f64],
+    /// The level a law's `prev` read at the start of the step (the step before's start); none
+    /// when no law reads one.
+    pub previous: Option<&'s [f64]>,
     pub report: &'s StepReport,
 }
 
@@ -285,6 +288,7 @@ impl<'m> Simulation<'m> {
                 let t = t0 + (k as f64 + done as f64 / full as f64) * dt;
                 let saved = (max_cuts > 0).then(|| states.to_vec());
                 let before = states[0].clone();
+                let before_previous = stepper.previous().map(<[f64]>::to_vec);
                 // The held dofs' reaction takes the change of velocity over the step.
                 let v_before = v_index.filter(|_| !ops.held.is_empty()).map(|i| states[i].clone());
                 let clock = Instant::now();
@@ -394,7 +398,15 @@ impl<'m> Simulation<'m> {
                     break 'steps;
                 }
                 outcome.energy_growth = energy.growth;
-                let step = Step { k: accepted, t: t_end, dt: h, states, before: &before, report: &report };
+                let step = Step {
+                    k: accepted,
+                    t: t_end,
+                    dt: h,
+                    states,
+                    before: &before,
+                    previous: before_previous.as_deref(),
+                    report: &report,
+                };
                 on_step(ops, &step, record.as_mut())?;
                 streak += 1;
                 if level > 0 && streak >= 2 && done.is_multiple_of(2 * units) {

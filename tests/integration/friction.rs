@@ -246,3 +246,28 @@ fn an_oblique_impact_s_frictional_work_closes_the_energy_balance_at_first_order(
         defects[1]
     );
 }
+
+/// Crank–Nicolson's energy law with friction, on the library's `oblique_disc` (its default
+/// Newmark β = ¼, γ = ½): E_aug changes over each step by minus the `dissipation` column (the
+/// trapezoidal work of the contact force, `work(contact)`, less the change of the contact
+/// energy), to round-off, with every frictional law; for the penalty law, whose stick force
+/// goes with the slip, the dissipation is ≥ 0 on every step that keeps the contact status.
+#[test]
+fn crank_nicolson_s_energy_law_closes_with_the_frictional_dissipation() {
+    let window = ["run", "oblique_disc", "--h", "2", "--t-start", "5.5", "--t-end", "10"];
+    for law in ["nitsche-coulomb", "nitsche-tresca", "penalty-coulomb"] {
+        let (s, series) = run(&format!("cn-{law}"), &[&window[..], &["--contact", law]].concat());
+        let (energy, dissipation) = (series.column("energy_aug"), series.column("dissipation"));
+        let scale = energy.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+        for i in 1..energy.len() {
+            let defect = energy[i] - energy[i - 1] + dissipation[i];
+            assert!(defect.abs() < 1e-10 * scale, "{law}, row {i}: ΔE_aug + D = {defect:e} (scale {scale})");
+        }
+        let cn = s["expected"].as_array().unwrap().iter().find(|x| x["key"] == "cn_balance_max").unwrap();
+        assert_eq!(cn["met"], true, "{law}: {cn}");
+        if law == "penalty-coulomb" {
+            let negative = s["dissipation_negative"].as_f64().unwrap();
+            assert!(negative <= 1e-12 * scale, "{law}: a kept-status step gave back {negative}");
+        }
+    }
+}

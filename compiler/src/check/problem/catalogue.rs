@@ -111,6 +111,10 @@ pub const ROW_VALUES: &[(&str, &str)] = &[
     ("kinetic", "½vᵀMv, with the mass the scheme steps with (0 without a velocity)"),
     ("newton", "Newton iterations of the step (0 at the initial row and at stages)"),
     ("active_points", "contact quadrature points whose switch is on (the active set)"),
+    (
+        "status_kept",
+        "1 where the active set is the previous row's (every point's contact status kept over the step), else 0 (0 at the initial row)",
+    ),
 ];
 
 /// The reducers of a series column: name, arguments as written, meaning.
@@ -143,6 +147,11 @@ pub const ROW_REDUCERS: &[(&str, &str, &str)] = &[
         "density_support",
         "density_support(NAME(u))",
         "the measure of the points of a boundary functional's region where its integrand is not zero: the contact zone's, of contact_pressure(u)",
+    ),
+    (
+        "work",
+        "work(SLOT)",
+        "the work of a slot's residual over the step by the trapezoidal rule, ½(r(uⁿ) + r(uⁿ⁺¹))·(uⁿ⁺¹ − uⁿ), each end with its own previous level: Crank–Nicolson's E changes by −work(contact) (NaN at the initial row and at stages)",
     ),
     (
         "cumulative",
@@ -182,8 +191,8 @@ pub const FUNCTIONAL_STATES: &[(&str, &str)] = &[
 pub const SUMMARY_REDUCERS: &[(&str, &str, &str)] = &[
     ("initial", "initial(EXPR)", "the first row's value"),
     ("final", "final(EXPR)", "the last row's value"),
-    ("min", "min(EXPR)", "the least value"),
-    ("max", "max(EXPR)", "the largest value"),
+    ("min", "min(EXPR[, WHEN])", "the least value (over the rows where WHEN > 0)"),
+    ("max", "max(EXPR[, WHEN])", "the largest value (over the rows where WHEN > 0)"),
     ("sum", "sum(EXPR)", "the sum over the rows, in order"),
     ("first", "first(EXPR, WHEN)", "EXPR at the first row where WHEN > 0 (null if none)"),
     ("at_max", "at_max(EXPR, OF)", "EXPR at the first row where OF is largest"),

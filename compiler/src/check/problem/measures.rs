@@ -124,6 +124,11 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
                 diags.push(Diagnostic::error("E0301", "shape mismatch", args[0].span, "a slot's name is needed here"));
             }
         }
+        "work" => {
+            if arity(1, diags) && !matches!(&args[0].kind, K::Name(_)) {
+                diags.push(Diagnostic::error("E0301", "shape mismatch", args[0].span, "a slot's name is needed here"));
+            }
+        }
         "inner_mass" => {
             if arity(2, diags) {
                 vector(c, &args[0], s.pointwise, diags);
@@ -222,6 +227,8 @@ pub(super) fn summary(e: &Expr, s: &SummaryScope, in_row: bool, diags: &mut Vec<
         }
         K::Call(f, args) => {
             let (want, usage) = match SUMMARY_REDUCERS.iter().find(|(n, _, _)| *n == f.name) {
+                // min and max take an optional WHEN.
+                Some((name, usage, _)) if matches!(*name, "min" | "max") => (args.len().clamp(1, 2), *usage),
                 Some((name, usage, _)) => (if matches!(*name, "first" | "at_max") { 2 } else { 1 }, *usage),
                 None if SUMMARY_FUNCTIONS.contains(&f.name.as_str()) => (1, ""),
                 None => {
