@@ -297,6 +297,7 @@ fn simulate(
                 contact_degree: quadrature.facet,
                 constraints: constraints.clone(),
                 newton: opts.newton,
+                t: t0,
             };
             // The level a law's `prev` reads: the state the equilibrium is sought from.
             let initial = u0.clone();
@@ -340,6 +341,7 @@ fn simulate(
                     opts,
                     in_use,
                     u0,
+                    t0,
                 )?
             } else {
                 u0
@@ -571,7 +573,7 @@ fn simulate(
 }
 
 /// `initial u = settled(GUESS)`: the equilibrium K u + C(u) = F, by the static driver (its loads
-/// and obstacle at t = 0) from the guess (which a frictional law's `prev` reads: the stick holds the body
+/// and obstacle at the start time) from the guess (which a frictional law's `prev` reads: the stick holds the body
 /// where the guess put it, along the obstacle).
 #[allow(clippy::too_many_arguments)]
 fn settle(
@@ -585,6 +587,7 @@ fn settle(
     opts: &Options,
     in_use: &FilesInUse,
     guess: Vec<f64>,
+    t0: f64,
 ) -> Result<Vec<f64>, CaseError> {
     let why = |what: &str| CaseError::Option(format!("{}: `initial u = settled(...)` {what}", pf.file));
     let contact = contact.ok_or_else(|| why("needs the problem's contact (an obstacle, or `Gamma_C`) to rest on"))?;
@@ -601,6 +604,7 @@ fn settle(
         // Backtracking on ‖R‖: a full step from a shallow guess can lift a free body off the
         // obstacle, where its stiffness is singular (a disc of h = 0.05 settling did).
         newton: crate::runtime::nonlinear::newton::NewtonOptions { line_search: true, ..opts.newton },
+        t: t0,
     };
     let solution = crate::simulation::statics::solve(asm, problem, &in_use.forms, guess).map_err(|e| {
         why(&format!(

@@ -23,6 +23,8 @@ pub struct StaticProblem<'p> {
     pub contact_degree: Option<u32>,
     pub constraints: Constraints,
     pub newton: NewtonOptions,
+    /// The time the loads and the contact (its obstacle) are taken at.
+    pub t: f64,
 }
 
 /// The converged state and what the cases measure with.
@@ -63,7 +65,7 @@ pub fn solve<'m>(
     let mut on_boundary = forms.instantiate(problem.coefs, &boundary)?;
     let contact = on_boundary.take_form("contact").ok_or_else(|| missing("contact"))?;
     let mut load = vec![0.0; n];
-    load_form.residual(asm, &[], 0.0, &mut load);
+    load_form.residual(asm, &[], problem.t, &mut load);
     let mut static_problem =
         StaticContact::new(asm, stiffness.as_ref(), load, contact, problem.constraints, Structure::Auto);
     let mut u = initial;
@@ -73,6 +75,7 @@ pub fn solve<'m>(
     static_problem.constraints.zero(&mut u);
     // A law's `prev` (a frictional slip) is measured from the initial state.
     static_problem.previous.clone_from(&u);
+    static_problem.time = problem.t;
     // `--solver auto` factorizes here: without a mass term, Jacobi-CG on the stiffness alone
     // converges slowly (the threshold of `auto` is measured on time steps).
     let mut options = problem.newton;

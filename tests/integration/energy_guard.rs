@@ -35,9 +35,12 @@ fn judge(problem: &str, scheme: &str, contact: &str, mass: MassChoice, result: R
     }
 }
 
-/// The library's frictional laws (Coulomb's and Tresca's).
+/// Whether a library contact law is frictional: it provides `friction_work`.
 fn frictional(contact: &str) -> bool {
-    contact.contains("coulomb") || contact.contains("tresca")
+    signorini::driver::library().iter().any(|u| {
+        u.name.strip_prefix("contact_") == Some(contact)
+            && u.forms.is_some_and(|f| f.slots.iter().any(|s| s.name == "friction_work"))
+    })
 }
 
 fn methods(scheme: &str, contact: &str) -> Methods {

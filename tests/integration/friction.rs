@@ -271,3 +271,26 @@ fn crank_nicolson_s_energy_law_closes_with_the_frictional_dissipation() {
         }
     }
 }
+
+/// `settled` takes the loads at the start time: started at t = 0.5, where the slope's load
+/// along the plane is on (`H(t)`), a block on a slope steeper than the friction angle has no
+/// equilibrium to settle in (an error that says so); below the angle it settles and stays.
+#[test]
+fn settling_takes_the_loads_at_the_start_time() {
+    let run = |slope: &str| {
+        let dir = std::env::temp_dir().join(format!("signorini-friction-settle-{slope}-{}", std::process::id()));
+        let out = Command::new(BIN)
+            .args(["run", "sliding_block", "--param", "v0=0", "--param", &format!("slope={slope}")])
+            .args(["--t-start", "0.5", "--t-end", "0.7", "--out"])
+            .arg(&dir)
+            .output()
+            .expect("the binary runs");
+        let _ = std::fs::remove_dir_all(&dir);
+        out
+    };
+    let steep = run("0.4");
+    assert!(!steep.status.success(), "tan α = 0.4 > F = 0.3 settled");
+    assert!(String::from_utf8_lossy(&steep.stderr).contains("did not settle"), "{steep:?}");
+    let gentle = run("0.2");
+    assert!(gentle.status.success(), "{}", String::from_utf8_lossy(&gentle.stderr));
+}

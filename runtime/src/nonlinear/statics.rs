@@ -110,6 +110,8 @@ pub struct StaticContact<'m> {
     /// The previous level a contact law's `prev` reads: the state the equilibrium is sought
     /// from (zero, unless set), so a frictional law measures slip from there.
     pub previous: Vec<f64>,
+    /// The time the contact form (its obstacle, its coefs) is evaluated at (0, unless set).
+    pub time: f64,
 }
 
 impl<'m> StaticContact<'m> {
@@ -128,7 +130,17 @@ impl<'m> StaticContact<'m> {
         stiffness.tangent(asm, &[&zero], 0, 0.0, &mut k);
         let mut load = load;
         constraints.zero(&mut load);
-        StaticContact { asm, stiffness: k, load, magnitude: 0.0, contact, constraints, structure, previous: zero }
+        StaticContact {
+            asm,
+            stiffness: k,
+            load,
+            magnitude: 0.0,
+            contact,
+            constraints,
+            structure,
+            previous: zero,
+            time: 0.0,
+        }
     }
 
     /// The contact form's arguments at `u`: u, and the previous level if the law reads it.
@@ -145,7 +157,7 @@ impl<'m> StaticContact<'m> {
     /// The contact term's residual C(u) (unconstrained).
     pub fn contact_residual(&self, u: &[f64]) -> Vec<f64> {
         let mut c = vec![0.0; u.len()];
-        self.contact.residual(self.asm, &self.args(u), 0.0, &mut c);
+        self.contact.residual(self.asm, &self.args(u), self.time, &mut c);
         c
     }
 }
@@ -158,7 +170,7 @@ impl NonlinearProblem for StaticContact<'_> {
         use crate::linalg::norms::norm_inf;
         self.stiffness.mul_vec(u, r);
         let stiffness = norm_inf(r);
-        self.contact.residual(self.asm, &self.args(u), 0.0, r);
+        self.contact.residual(self.asm, &self.args(u), self.time, r);
         // The contact term's size is that of K u + C(u) at worst plus K u's.
         self.magnitude = stiffness.max(norm_inf(r)).max(norm_inf(&self.load));
         r.iter_mut().zip(&self.load).for_each(|(ri, li)| *ri -= li);
@@ -170,13 +182,13 @@ impl NonlinearProblem for StaticContact<'_> {
     }
 
     fn active_set(&mut self, u: &[f64], out: &mut Vec<bool>) -> bool {
-        self.contact.switches(self.asm, &self.args(u), 0, 0.0, out);
+        self.contact.switches(self.asm, &self.args(u), 0, self.time, out);
         self.contact.piecewise()
     }
 
     fn jacobian(&mut self, u: &[f64], j: &mut Matrix) {
         j.values.copy_from_slice(&self.stiffness.values);
-        self.contact.tangent(self.asm, &self.args(u), 0, 0.0, j);
+        self.contact.tangent(self.asm, &self.args(u), 0, self.time, j);
         self.constraints.apply(j);
     }
 
