@@ -54,6 +54,34 @@ pub struct Report {
     /// §5: the static Hertz problems and the impact problem.
     pub hertz: Vec<HertzStatic>,
     pub hertz_impact: String,
+    /// §6: friction problems, and the one every scheme × frictional law runs.
+    pub friction: Vec<FrictionRun>,
+    pub friction_table: FrictionTable,
+}
+
+/// A friction problem of the report: run with `contact` (the problem's own when empty) and
+/// `params`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrictionRun {
+    pub problem: String,
+    pub label: String,
+    #[serde(default)]
+    pub contact: String,
+    #[serde(default)]
+    pub params: std::collections::BTreeMap<String, f64>,
+}
+
+/// The problem the report runs with every scheme × frictional law.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrictionTable {
+    pub problem: String,
+    #[serde(default)]
+    pub params: std::collections::BTreeMap<String, f64>,
+    pub t_start: Option<f64>,
+    /// The summary keys of its table.
+    pub keys: Vec<String>,
 }
 
 #[derive(Debug, Deserialize)]

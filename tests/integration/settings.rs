@@ -28,12 +28,31 @@ fn library_settings_name_library_files() {
     // verify binds the damping slot itself: it must be named.
     assert!(!s.verify.damping_slot.is_empty());
     assert!(laws.contains(&s.bench.disc_friction.as_str()), "unknown contact law `{}`", s.bench.disc_friction);
+    let table = &s.report.friction_table;
+    let pf = signorini::problem::load(&table.problem).expect("the friction table's problem loads");
+    for key in &table.keys {
+        assert!(pf.problem().summary.iter().any(|d| d.name.name == *key), "{}: no summary key `{key}`", table.problem);
+    }
+    for f in s.report.friction.iter().filter(|f| !f.contact.is_empty()) {
+        assert!(laws.contains(&f.contact.as_str()), "report.friction: unknown contact law `{}`", f.contact);
+    }
     let (scheme, mass) = &s.bench.disc_explicit;
     known(scheme, &s.defaults.contact);
     <MassChoice as clap::ValueEnum>::from_str(mass, true).unwrap_or_else(|e| panic!("mass `{mass}`: {e}"));
     let problems = signorini::problem::library_names();
-    let named = [&s.cases.bar, &s.cases.disc, &s.bench.disc, &s.bench.sphere, &s.report.hertz_impact];
-    for problem in named.into_iter().chain(s.report.hertz.iter().map(|h| &h.problem)) {
+    let named = [
+        &s.cases.bar,
+        &s.cases.disc,
+        &s.bench.disc,
+        &s.bench.sphere,
+        &s.report.hertz_impact,
+        &s.report.friction_table.problem,
+    ];
+    for problem in named
+        .into_iter()
+        .chain(s.report.hertz.iter().map(|h| &h.problem))
+        .chain(s.report.friction.iter().map(|f| &f.problem))
+    {
         assert!(problems.contains(&problem.as_str()), "unknown problem `{problem}` (known: {problems:?})");
     }
 }
