@@ -58,17 +58,10 @@ pub(super) fn finish(result: Result<crate::problem::run::Run, crate::error::Case
 /// One line per `expect` of the problem: the key against its expected value.
 fn expectations(s: &crate::problem::outputs::Summary) {
     let Ok(list) = s.field::<Vec<crate::problem::summary::Expectation>>("expected") else { return };
-    let number = |x: Option<f64>| x.map_or("none".to_string(), |x| format!("{x:.6}"));
     for x in list {
-        println!(
-            "  expect {} = {} (is {}, relative {}, within {}): {}",
-            x.key,
-            number(x.expected),
-            number(x.value),
-            x.relative.map_or("none".to_string(), |r| format!("{r:.2e}")),
-            x.within,
-            if x.met { "met" } else { "NOT MET" }
-        );
+        let [value, expected, relative] = x.shown();
+        let met = if x.met { "met" } else { "NOT MET" };
+        println!("  expect {} = {expected} (is {value}, relative {relative}, within {}): {met}", x.key, x.within);
     }
 }
 

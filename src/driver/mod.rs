@@ -144,6 +144,18 @@ pub fn contact_names() -> Vec<&'static str> {
         .collect()
 }
 
+/// Names of the library's frictional contact laws (those that also provide `friction_work`),
+/// short form.
+pub fn frictional_contact_names() -> Vec<&'static str> {
+    let frictional = |name: &str| {
+        LIBRARY.iter().any(|u| {
+            u.name.strip_prefix("contact_").unwrap_or(u.name) == name
+                && u.forms.is_some_and(|f| f.slots.iter().any(|s| s.name == "friction_work"))
+        })
+    };
+    contact_names().into_iter().filter(|n| frictional(n)).collect()
+}
+
 /// Every scheme of the library, by name.
 pub fn all_schemes() -> Vec<&'static str> {
     scheme_names(&Methods::default())

@@ -50,6 +50,15 @@ pub struct Expectation {
     pub met: bool,
 }
 
+impl Expectation {
+    /// The value, the expected value and the relative difference as a table shows them
+    /// (`none` where there is none).
+    pub fn shown(&self) -> [String; 3] {
+        let number = |x: Option<f64>| x.map_or("none".to_string(), |x| format!("{x:.6}"));
+        [number(self.value), number(self.expected), self.relative.map_or("none".to_string(), |r| format!("{r:.2e}"))]
+    }
+}
+
 /// The problem's summary keys, compiled.
 pub struct SummaryKeys {
     /// The problem's keys, then one hidden key per expectation (its expected value).

@@ -12,19 +12,6 @@ use crate::error::CaseError;
 use crate::problem::run::{Options, run};
 use crate::problem::summary::Expectation;
 
-/// The library's frictional contact laws: those with a `friction_work` functional.
-fn frictional_laws() -> Vec<&'static str> {
-    crate::driver::library()
-        .iter()
-        .filter(|u| u.forms.is_some_and(|f| f.slots.iter().any(|s| s.name == "friction_work")))
-        .map(|u| u.name.strip_prefix("contact_").unwrap_or(u.name))
-        .collect()
-}
-
-fn number(x: Option<f64>) -> String {
-    x.map_or("none".to_string(), |x| format!("{x:.6}"))
-}
-
 pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, CaseError> {
     let settings = &crate::settings::get().report;
     let dir = out.join("friction");
@@ -53,16 +40,12 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         let s = run(&opts)?.summary;
         let contact = s.get("contact").and_then(|v| v.as_str()).unwrap_or_default().to_string();
         for x in s.field::<Vec<Expectation>>("expected")? {
+            let [value, expected, relative] = x.shown();
+            let met = if x.met { "yes" } else { "no (the expectation is another law's)" };
             let _ = writeln!(
                 md,
-                "| {} | {contact} | {} | {} | {} | {} | {} | {} |",
-                f.label,
-                x.key,
-                number(x.value),
-                number(x.expected),
-                x.relative.map_or("none".to_string(), |r| format!("{r:.2e}")),
-                x.within,
-                if x.met { "yes" } else { "no (the expectation is another law's)" }
+                "| {} | {contact} | {} | {value} | {expected} | {relative} | {} | {met} |",
+                f.label, x.key, x.within
             );
         }
         let _ = writeln!(figures, "![{}](friction/{sub}/{}.png)\n", f.label, f.problem);
@@ -80,7 +63,7 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         "---|".repeat(table.keys.len())
     );
     for scheme in crate::driver::all_schemes() {
-        for law in frictional_laws() {
+        for law in crate::driver::frictional_contact_names() {
             progress(&format!("friction: {} {scheme} {law}", table.problem));
             let mut methods = Methods { scheme: scheme.into(), contact: law.into(), ..Methods::default() };
             for (name, value) in &table.params {

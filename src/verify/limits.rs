@@ -44,20 +44,13 @@ pub fn markdown(rows: &[LimitRow]) -> String {
     let mut md = String::from(
         "### (e) Limits the problems expect\n\nEach library problem with `expect KEY = VALUE within TOL` lines, run at its defaults (`signorini run NAME` prints the same lines): the friction problems against the rigid body they approach and Coulomb's bound (docs/problems.md, Friction).\n\n| problem | scheme | contact | key | value | expected | relative | within | met |\n|---|---|---|---|---|---|---|---|---|\n",
     );
-    let number = |x: Option<f64>| x.map_or("none".to_string(), |x| format!("{x:.6}"));
     for r in rows {
         let x = &r.expectation;
+        let [value, expected, relative] = x.shown();
+        let met = if x.met { "yes" } else { "**no**" };
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
-            r.problem,
-            r.scheme,
-            r.contact,
-            x.key,
-            number(x.value),
-            number(x.expected),
-            x.relative.map_or("none".to_string(), |r| format!("{r:.2e}")),
-            x.within,
-            if x.met { "yes" } else { "**no**" }
+            "| {} | {} | {} | {} | {value} | {expected} | {relative} | {} | {met} |\n",
+            r.problem, r.scheme, r.contact, x.key, x.within
         ));
     }
     md

@@ -37,10 +37,7 @@ fn judge(problem: &str, scheme: &str, contact: &str, mass: MassChoice, result: R
 
 /// Whether a library contact law is frictional: it provides `friction_work`.
 fn frictional(contact: &str) -> bool {
-    signorini::driver::library().iter().any(|u| {
-        u.name.strip_prefix("contact_") == Some(contact)
-            && u.forms.is_some_and(|f| f.slots.iter().any(|s| s.name == "friction_work"))
-    })
+    signorini::driver::frictional_contact_names().contains(&contact)
 }
 
 fn methods(scheme: &str, contact: &str) -> Methods {
