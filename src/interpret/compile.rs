@@ -78,7 +78,17 @@ pub(super) struct Integral {
     pub residual: Option<Body>,
     pub tangents: Vec<Option<Body>>,
     pub switches: Vec<Option<Body>>,
+    /// Per field argument, where its tangent depends on the fields only through the switches.
+    pub decided: Vec<Decided>,
     pub value: Option<Body>,
+}
+
+/// Where a tangent depends on the fields only through its switches (`TangentIr::gates`).
+pub(super) enum Decided {
+    Always,
+    /// Where the switches at these indices are all off.
+    Gated(Vec<usize>),
+    Never,
 }
 
 /// The kernels of one form in one dimension.
@@ -93,6 +103,15 @@ pub(super) fn dim_kernels(prog: &Checked, ir: &DimIr, form: &FormIr) -> DimKerne
         residual: (form.test.is_some()).then(|| residual(prog, ir, i)).flatten(),
         tangents: (0..i.tangents.len()).map(|a| tangent(prog, ir, i, a)).collect(),
         switches: i.tangents.iter().map(|t| body(prog, ir, i.cell, &t.switches, Contract::Switches)).collect(),
+        decided: i
+            .tangents
+            .iter()
+            .map(|t| match (t.piecewise, &t.gates) {
+                (true, _) => Decided::Always,
+                (false, Some(g)) if !g.is_empty() => Decided::Gated(g.clone()),
+                (false, _) => Decided::Never,
+            })
+            .collect(),
         value: i.value.and_then(|v| body(prog, ir, i.cell, &[v], Contract::Value)),
     };
     DimKernels {

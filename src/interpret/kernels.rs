@@ -9,7 +9,7 @@ use signorini_runtime::fem::kernel::{
     CellCtx, FacetCtx, FormKernel, FunctionalKernel, LocalMatrix, LocalVector, Tabulation,
 };
 
-use super::compile::{Basis, Body, Contract, Integral, Leaf, Terms};
+use super::compile::{Basis, Body, Contract, Decided, Integral, Leaf, Terms};
 use super::form::InterpretedForm;
 
 /// Buffers reused across kernel calls, so that the loops allocate nothing.
@@ -179,14 +179,28 @@ impl InterpretedForm {
         });
     }
 
+    /// Pushes the switches of `integral`'s tangent with respect to `wrt`; whether they decide
+    /// it at these points (as generated kernels do).
     fn switches<const D: usize, const N: usize>(
         &self,
-        body: &Body,
+        integral: Option<&Integral>,
+        wrt: usize,
         place: &Place<'_, D, N>,
         fields: &[&LocalVector<D, N>],
         out: &mut Vec<bool>,
-    ) {
-        self.each_point(body, place, fields, |_, _, r| out.extend(r.iter().map(|&v| v > 0.0)));
+    ) -> bool {
+        let Some(integral) = integral else { return true };
+        let decided = integral.decided.get(wrt).unwrap_or(&Decided::Always);
+        let mut gated = !matches!(decided, Decided::Never);
+        if let Some(body) = integral.switches.get(wrt).and_then(Option::as_ref) {
+            self.each_point(body, place, fields, |_, _, r| {
+                out.extend(r.iter().map(|&v| v > 0.0));
+                if let Decided::Gated(gates) = decided {
+                    gated &= gates.iter().all(|&k| r[k] <= 0.0);
+                }
+            });
+        }
+        gated
     }
 
     fn value<const D: usize, const N: usize>(
@@ -245,10 +259,14 @@ impl<const D: usize, const N: usize> FormKernel<D, N> for InterpretedForm {
         }
     }
 
-    fn cell_switches(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>], wrt: usize, out: &mut Vec<bool>) {
-        if let Some(body) = self.cell_integral::<D>().and_then(|i| i.switches.get(wrt)?.as_ref()) {
-            self.switches(body, &Place::cell(ctx), fields, out);
-        }
+    fn cell_switches(
+        &self,
+        ctx: &CellCtx<'_, D, N>,
+        fields: &[&LocalVector<D, N>],
+        wrt: usize,
+        out: &mut Vec<bool>,
+    ) -> bool {
+        self.switches(self.cell_integral::<D>(), wrt, &Place::cell(ctx), fields, out)
     }
 
     fn facet_residual(
@@ -283,10 +301,8 @@ impl<const D: usize, const N: usize> FormKernel<D, N> for InterpretedForm {
         fields: &[&LocalVector<D, N>],
         wrt: usize,
         out: &mut Vec<bool>,
-    ) {
-        if let Some(body) = self.facet_integral::<D>(region).and_then(|i| i.switches.get(wrt)?.as_ref()) {
-            self.switches(body, &Place::facet(ctx), fields, out);
-        }
+    ) -> bool {
+        self.switches(self.facet_integral::<D>(region), wrt, &Place::facet(ctx), fields, out)
     }
 }
 

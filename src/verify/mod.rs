@@ -2,7 +2,8 @@
 //! (a) every scheme's time order on the oscillator and on the bar before impact, and its ρ∞;
 //! (b) space orders of P1 and P2 in 1D, 2D and 3D on manufactured solutions; (c) the discrete
 //! energy laws, with contact and without; (d) the disc's convergence under Δt and h refinement;
-//! (e) the limits the library's problems expect (`expect` lines: rigid bodies, friction bounds).
+//! (e) the limits the library's problems expect (`expect` lines: rigid bodies, friction bounds);
+//! (f) the frictional laws' tangents in separation, stick and slip.
 //! Written as DIR/verify.md with figures in DIR/verify/ (`signorini report` includes it).
 
 pub mod convergence;
@@ -11,6 +12,7 @@ pub mod limits;
 mod oscillator;
 pub mod scheme;
 pub mod space;
+pub mod tangents;
 pub mod time;
 
 use std::fmt::Write;
@@ -39,6 +41,7 @@ pub struct Verification {
     pub dissipation: Vec<energy::DissipationRow>,
     pub disc: convergence::DiscConvergence,
     pub limits: Vec<limits::LimitRow>,
+    pub regimes: Vec<tangents::RegimeRow>,
 }
 
 /// Runs every measurement.
@@ -50,6 +53,7 @@ pub fn run(progress: &mut dyn FnMut(&str)) -> Result<Verification, CaseError> {
         dissipation: energy::dissipation(progress)?,
         disc: convergence::disc(progress),
         limits: limits::expectations(progress)?,
+        regimes: tangents::regimes(progress)?,
     })
 }
 
@@ -261,6 +265,7 @@ impl Verification {
             row(&self.disc.h)
         );
         md.push_str(&limits::markdown(&self.limits));
+        md.push_str(&tangents::markdown(&self.regimes));
         md
     }
 }

@@ -131,6 +131,39 @@ fn without_friction_the_block_slides_on() {
     assert!((distance / (0.3 * 1.6) - 1.0).abs() < 1e-3, "v0 t_end = 0.48, slid {distance}");
 }
 
+/// With F = 0 a Coulomb law is its frictionless law: the same residual and tangent bits
+/// (tests/integration/friction_laws.rs), and, its friction radius zero at every point, a
+/// tangent that the active set decides, so that Newton takes the frictionless law's path: the
+/// same series, byte for byte, under every scheme but the hybrid one with penalty (whose
+/// Newton path agrees, but whose corrections of the factorization differ at round-off).
+#[test]
+fn without_friction_the_coulomb_laws_give_the_frictionless_laws_series_bit_for_bit() {
+    let window = ["run", "disc", "--h", "2", "--t-start", "5.5", "--t-end", "7.5", "--scheme"];
+    let series = |name: String, args: Vec<&str>| {
+        let dir = std::env::temp_dir().join(format!("signorini-friction-f0-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let out = Command::new(BIN).args(&args).arg("--out").arg(&dir).output().expect("the binary runs");
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        let csv = std::fs::read(dir.join("series.csv")).expect("a series");
+        let _ = std::fs::remove_dir_all(&dir);
+        csv
+    };
+    let pairs = [("nitsche-traction", "nitsche-coulomb", "theta=-1"), ("penalty", "penalty-coulomb", "gamma0=1000")];
+    for scheme in ["hht", "newmark", "midpoint", "trbdf2", "hybrid"] {
+        for (frictionless, coulomb, param) in pairs {
+            if scheme == "hybrid" && frictionless == "penalty" {
+                continue;
+            }
+            let free = [&window[..], &[scheme, "--contact", frictionless, "--param", param]].concat();
+            let zero = [&window[..], &[scheme, "--contact", coulomb, "--param", param, "--param", "F=0"]].concat();
+            assert!(
+                series(format!("{scheme}-{frictionless}"), free) == series(format!("{scheme}-{coulomb}"), zero),
+                "{scheme}: {coulomb} with F = 0 differs from {frictionless}"
+            );
+        }
+    }
+}
+
 #[test]
 fn a_frictional_laws_active_points_are_its_contact_points() {
     let run = ["run", "disc", "--h", "2", "--t-start", "5.5", "--t-end", "6.6", "--scheme", "hht", "--contact"];

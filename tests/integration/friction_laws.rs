@@ -72,7 +72,11 @@ fn residual<K: FormKernel<2, 6>>(k: &K, fields: &[&Nodes]) -> Nodes {
 }
 
 fn jacobian<K: FormKernel<2, 6>>(k: &K, fields: &[&Nodes]) -> Vec<Vec<f64>> {
-    facet_matrix(k, 0, &tab(), 0, &cell(), h(), fields, 0, 0.0)
+    jacobian_wrt(k, fields, 0)
+}
+
+fn jacobian_wrt<K: FormKernel<2, 6>>(k: &K, fields: &[&Nodes], wrt: usize) -> Vec<Vec<f64>> {
+    facet_matrix(k, 0, &tab(), 0, &cell(), h(), fields, wrt, 0.0)
 }
 
 /// Max-norm difference between the tangent and central differences of the residual in u (the
@@ -186,6 +190,37 @@ fn without_friction_the_coulomb_laws_are_the_frictionless_ones_bit_for_bit() {
             let law = nitsche_coulomb(theta, 0.0);
             assert_eq!(residual(&law, &both), residual(&frictionless, &[&u]), "θ = {theta}, {regime:?}");
             assert_eq!(jacobian(&law, &both), jacobian(&frictionless, &[&u]), "θ = {theta}, {regime:?}");
+        }
+        // The hybrid scheme's term, from u0 = previous to u1 = u, by each argument.
+        let coefs = || (f(), gap(), down());
+        let (f0, g0, n0) = coefs();
+        let p = penalty_coulomb::Params::default().with("F", 0.0).and_then(|p| p.with("gamma0", 50.0)).unwrap();
+        let law = penalty_coulomb::HybridContact::new(&p, &penalty_coulomb::Coefficients { f: f0, g: g0, nc: n0 });
+        let (f0, g0, n0) = coefs();
+        let p = penalty::Params::default().with("gamma0", 50.0).unwrap();
+        let frictionless = penalty::HybridContact::new(&p, &penalty::Coefficients { f: f0, g: g0, nc: n0 });
+        let steps = [&previous, &u];
+        assert_eq!(residual(&law, &steps), residual(&frictionless, &steps), "penalty hybrid, {regime:?}");
+        for wrt in 0..2 {
+            let (a, b) = (jacobian_wrt(&law, &steps, wrt), jacobian_wrt(&frictionless, &steps, wrt));
+            assert_eq!(a, b, "penalty hybrid by u{wrt}, {regime:?}");
+        }
+        for theta in [1.0, 0.0, -1.0] {
+            let (f0, g0, n0) = coefs();
+            let p = coulomb::Params::default()
+                .with("theta", theta)
+                .and_then(|p| p.with("F", 0.0))
+                .and_then(|p| p.with("gamma0", 50.0))
+                .unwrap();
+            let law = coulomb::HybridContact::new(&p, &coulomb::Coefficients { f: f0, g: g0, nc: n0 });
+            let (f0, g0, n0) = coefs();
+            let p = traction::Params::default().with("theta", theta).and_then(|p| p.with("gamma0", 50.0)).unwrap();
+            let frictionless = traction::HybridContact::new(&p, &traction::Coefficients { f: f0, g: g0, nc: n0 });
+            assert_eq!(residual(&law, &steps), residual(&frictionless, &steps), "θ = {theta} hybrid, {regime:?}");
+            for wrt in 0..2 {
+                let (a, b) = (jacobian_wrt(&law, &steps, wrt), jacobian_wrt(&frictionless, &steps, wrt));
+                assert_eq!(a, b, "θ = {theta} hybrid by u{wrt}, {regime:?}");
+            }
         }
     }
 }

@@ -1,6 +1,6 @@
 //! Interpreted forms (`signorini::interpret`) against the compiled kernels of the same files:
 //! every form and functional of the library files and of the hybrid test file, residuals,
-//! tangents with respect to every field, switches and functional values, on randomly shaped
+//! tangents with respect to every field, switches (and whether they decide the tangent) and functional values, on randomly shaped
 //! P1 and curved P2 cells in 1D, 2D and 3D at random states, with non-default parameters and
 //! function-valued coefs; and one assembly through `Assembler` and `scheme::Bound`.
 
@@ -155,8 +155,8 @@ fn compare_form_on<const D: usize, const N: usize, K: FormKernel<D, N>>(
                 stats.close(&what(&format!("cell tangent d/d{}", meta.fields[wrt])), &c.concat(), &i.concat());
                 let ctx = CellCtx { tab: &tab, coords: &x, t: T };
                 let (mut c, mut i) = (Vec::new(), Vec::new());
-                compiled.cell_switches(&ctx, &fields, wrt, &mut c);
-                interp.cell_switches(&ctx, &fields, wrt, &mut i);
+                let decided = compiled.cell_switches(&ctx, &fields, wrt, &mut c);
+                assert_eq!(decided, interp.cell_switches(&ctx, &fields, wrt, &mut i), "{}", what("cell gates"));
                 assert_eq!(c, i, "{}", what("cell switches"));
             }
         }
@@ -174,8 +174,9 @@ fn compare_form_on<const D: usize, const N: usize, K: FormKernel<D, N>>(
                     let (ftab, normal) = &tab.facets[facet];
                     let ctx = FacetCtx { tab: ftab, ref_normal: normal, coords: &x, h, t: T };
                     let (mut c, mut i) = (Vec::new(), Vec::new());
-                    compiled.facet_switches(region, &ctx, &fields, wrt, &mut c);
-                    interp.facet_switches(region, &ctx, &fields, wrt, &mut i);
+                    let decided = compiled.facet_switches(region, &ctx, &fields, wrt, &mut c);
+                    let interpreted = interp.facet_switches(region, &ctx, &fields, wrt, &mut i);
+                    assert_eq!(decided, interpreted, "{}", at("facet gates"));
                     assert_eq!(c, i, "{}", at("facet switches"));
                     for s in c {
                         stats.switches[usize::from(s)] += 1;

@@ -48,8 +48,9 @@ impl BoundForm for Recorder {
     fn tangent(&self, _: &Assembler, fields: &[&[f64]], _: usize, _: f64, _: &mut Matrix) {
         assert_eq!(fields.len(), 2, "the argument and the previous level");
     }
-    fn switches(&self, _: &Assembler, fields: &[&[f64]], _: usize, _: f64, _: &mut Vec<bool>) {
+    fn switches(&self, _: &Assembler, fields: &[&[f64]], _: usize, _: f64, _: &mut Vec<bool>) -> bool {
         assert_eq!(fields.len(), 2, "the argument and the previous level");
+        self.piecewise()
     }
 }
 

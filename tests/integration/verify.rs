@@ -3,7 +3,7 @@
 //! Crank–Nicolson and midpoint conserve the augmented energy on every step whose active set is
 //! unchanged, on the bar and the disc, with Nitsche θ = 1 and penalty; without contact every
 //! scheme's energy decays per step like the square of its spectral radius; the library's problems
-//! meet their `expect` lines.
+//! meet their `expect` lines; the frictional laws' tangents match finite differences in each regime.
 
 use signorini::verify;
 
@@ -126,4 +126,32 @@ fn the_library_problems_meet_what_they_expect() {
     assert!(
         verify::limits::markdown(&rows).contains("| rolling_disc | hht | contact_nitsche_coulomb | rolling_time |")
     );
+}
+
+/// verify (f): every frictional law of the library, in separation, stick and slip (each shown to
+/// be the regime intended by the law's own functionals), has a tangent equal to central
+/// differences of its residual; a Coulomb law's active set decides its tangent out of contact
+/// (no friction radius) and not in stick or slip, a Tresca law's nowhere (its radius is s).
+#[test]
+fn every_frictional_law_s_tangent_matches_finite_differences_in_every_regime() {
+    let rows = verify::tangents::regimes(&mut |_| {}).unwrap();
+    let laws = signorini::driver::frictional_contact_names();
+    assert_eq!(rows.len(), 3 * laws.len(), "three regimes per law");
+    for r in &rows {
+        assert!(r.present, "{} {}: not in its regime: {r:?}", r.contact, r.regime);
+        assert!(r.error <= verify::tangents::TOLERANCE, "{} {}: tangent off by {:e}", r.contact, r.regime, r.error);
+        let coulomb = r.contact.ends_with("coulomb");
+        assert_eq!(
+            r.decided,
+            coulomb && r.regime == "separation",
+            "{} {}: set decides: {}",
+            r.contact,
+            r.regime,
+            r.decided
+        );
+    }
+    for law in ["nitsche_coulomb", "nitsche_tresca", "penalty_coulomb"] {
+        assert!(rows.iter().any(|r| r.contact == law), "{law} is checked");
+    }
+    assert!(verify::tangents::markdown(&rows).contains("| penalty_coulomb | slip |"));
 }

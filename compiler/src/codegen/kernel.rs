@@ -38,6 +38,7 @@ const RESERVED: &[&str] = &[
     "Coefficients",
     "total",
     "value",
+    "gated",
     "std",
 ];
 
@@ -51,26 +52,29 @@ fn params(body: &str, list: &[(&str, String)]) -> String {
     named.join(", ")
 }
 
-/// `match on { k => { ... } ... _ => {} }` over the arms that have something to do, or an `if`
-/// for a single one; `None` without any.
-fn dispatch(on: &str, arms: Vec<(usize, String)>) -> Option<String> {
+/// `match on { k => { ... } ... _ => other }` over the arms that have something to do, or an
+/// `if` (`else { other }`) for a single one; `None` without any. `other` is the value of the
+/// arms not listed, `None` for a method that returns nothing.
+fn dispatch(on: &str, arms: Vec<(usize, String)>, other: Option<&str>) -> Option<String> {
+    let otherwise = other.map_or(String::new(), |o| format!(" else {{\n{o}\n}}"));
     match arms.as_slice() {
         [] => None,
-        // One arm around another: one `if` (clippy's collapsible_if).
+        // One arm around another: one `if` (clippy's collapsible_if). The inner `if`'s `else`,
+        // if any, is the outer one's too.
         [(k, body)] => match body.strip_prefix("if ").and_then(|rest| rest.split_once(" {\n")) {
             Some((inner, block)) => Some(format!("if {on} == {k} && {inner} {{\n{block}")),
-            None => Some(format!("if {on} == {k} {{\n{body}}}\n")),
+            None => Some(format!("if {on} == {k} {{\n{body}}}{otherwise}\n")),
         },
         _ => {
             let arms: String = arms.iter().map(|(k, body)| format!("{k} => {{\n{body}}}\n")).collect();
-            Some(format!("match {on} {{\n{arms}_ => {{}}\n}}\n"))
+            Some(format!("match {on} {{\n{arms}_ => {}\n}}\n", other.unwrap_or("{}")))
         }
     }
 }
 
-/// A method of a kernel trait: its name, its parameters after `&self` with their types, and
-/// its body, if it has something to do.
-type Method<'a> = (&'a str, Vec<(&'a str, String)>, Option<String>);
+/// A method of a kernel trait: its name, its parameters after `&self` with their types, its
+/// return type (empty for none), and its body, if it has something to do.
+type Method<'a> = (&'a str, Vec<(&'a str, String)>, &'a str, Option<String>);
 
 /// `impl<const N: usize> FormKernel<D, N> for Struct { ... }`.
 pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -> String {
@@ -80,13 +84,28 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
     // One arm per field argument with something to do.
     let per_field = |integral: &IntegralIr, mode: fn(usize) -> Mode| {
         let arms = (0..form.fields.len()).map(|a| (a, body(integral, mode(a)))).filter(|(_, b)| !b.is_empty());
-        dispatch("wrt", arms.collect())
+        dispatch("wrt", arms.collect(), None)
+    };
+    // The switches of each field argument, and whether the tangent depends on the fields only
+    // through them at these points (the trait's default, `true`, where nothing is listed).
+    let switches_per_field = |integral: &IntegralIr| {
+        let arms = (0..form.fields.len()).filter_map(|a| {
+            let b = body(integral, Mode::Switches(a));
+            let t = &integral.tangents[a];
+            match (t.piecewise, &t.gates) {
+                (true, _) if b.is_empty() => None,
+                (true, _) => Some((a, format!("{b}true\n"))),
+                (false, Some(g)) if !g.is_empty() => Some((a, format!("let mut gated = true;\n{b}gated\n"))),
+                (false, _) => Some((a, format!("{b}false\n"))),
+            }
+        });
+        dispatch("wrt", arms.collect(), Some("true"))
     };
     let cell = form.integrals.iter().find(|i| i.cell);
     let facets: Vec<&IntegralIr> = form.integrals.iter().filter(|i| !i.cell).collect();
     // One arm per boundary region with something to do.
-    let per_region = |f: &dyn Fn(&IntegralIr) -> Option<String>| {
-        dispatch("region", facets.iter().enumerate().filter_map(|(r, i)| f(i).map(|b| (r, b))).collect())
+    let per_region = |f: &dyn Fn(&IntegralIr) -> Option<String>, other: Option<&str>| {
+        dispatch("region", facets.iter().enumerate().filter_map(|(r, i)| f(i).map(|b| (r, b))).collect(), other)
     };
     let nonempty = |b: String| (!b.is_empty()).then_some(b);
     let (vec, mat, fields) =
@@ -100,22 +119,26 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
         (
             "cell_residual",
             vec![("ctx", cctx.clone()), ("fields", fields.clone()), ("out", vec.clone())],
+            "",
             cell.and_then(|i| nonempty(body(i, Mode::Residual))),
         ),
         (
             "cell_tangent",
             vec![("ctx", cctx.clone()), ("fields", fields.clone()), ("wrt", wrt.clone()), ("out", mat.clone())],
+            "",
             cell.and_then(|i| per_field(i, Mode::Tangent)),
         ),
         (
             "cell_switches",
             vec![("ctx", cctx), ("fields", fields.clone()), ("wrt", wrt.clone()), ("out", switches.clone())],
-            cell.and_then(|i| per_field(i, Mode::Switches)),
+            " -> bool",
+            cell.and_then(switches_per_field),
         ),
         (
             "facet_residual",
             vec![("region", region.clone()), ("ctx", fctx.clone()), ("fields", fields.clone()), ("out", vec)],
-            per_region(&|i| nonempty(body(i, Mode::Residual))),
+            "",
+            per_region(&|i| nonempty(body(i, Mode::Residual)), None),
         ),
         (
             "facet_tangent",
@@ -126,19 +149,21 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
                 ("wrt", wrt.clone()),
                 ("out", mat),
             ],
-            per_region(&|i| per_field(i, Mode::Tangent)),
+            "",
+            per_region(&|i| per_field(i, Mode::Tangent), None),
         ),
         (
             "facet_switches",
             vec![("region", region), ("ctx", fctx), ("fields", fields), ("wrt", wrt), ("out", switches)],
-            per_region(&|i| per_field(i, Mode::Switches)),
+            " -> bool",
+            per_region(&switches_per_field, Some("true")),
         ),
     ];
     let mut s = String::new();
     let _ = writeln!(s, "impl<const N: usize> FormKernel<{d}, N> for {struct_name} {{");
-    for (name, list, text) in methods {
+    for (name, list, ret, text) in methods {
         if let Some(text) = text {
-            let _ = writeln!(s, "fn {name}(&self, {}) {{\n{text}}}", params(&text, &list));
+            let _ = writeln!(s, "fn {name}(&self, {}){ret} {{\n{text}}}", params(&text, &list));
         }
     }
     s.push_str("}\n");
@@ -262,9 +287,17 @@ impl Body<'_> {
         match self.mode {
             Mode::Residual => s.push_str(&self.residual_loop(&outputs)),
             Mode::Tangent(_) => s.push_str(&self.tangent_loop(&outputs)),
-            Mode::Switches(_) => {
-                for o in outputs.iter().flat_map(|(_, l)| l.iter().flatten()) {
-                    let _ = writeln!(s, "out.push({} > 0.0);", o.name);
+            Mode::Switches(a) => {
+                let names: Vec<&str> =
+                    outputs.iter().flat_map(|(_, l)| l.iter().flatten()).map(|o| o.name.as_str()).collect();
+                for name in &names {
+                    let _ = writeln!(s, "out.push({name} > 0.0);");
+                }
+                // Off (a ≤ 0, or NaN: not off) at every gate: see `form_impl`.
+                let t = &self.integral.tangents[a];
+                if let Some(gates) = t.gates.as_ref().filter(|g| !t.piecewise && !g.is_empty()) {
+                    let off: Vec<String> = gates.iter().map(|&k| format!("{} <= 0.0", names[k])).collect();
+                    let _ = writeln!(s, "gated &= {};", off.join(" && "));
                 }
             }
             Mode::Value => s.push_str("total += value;\n"),

@@ -12,6 +12,8 @@ pub mod graph;
 pub mod lower;
 pub mod print;
 
+use std::collections::BTreeSet;
+
 use derive::Derivative;
 use graph::{Graph, Node, NodeId, Sym};
 
@@ -85,6 +87,12 @@ pub struct TangentIr {
     /// penalty contact, and for linear forms): an unchanged active set means an unchanged
     /// matrix.
     pub piecewise: bool,
+    /// Where it is not `piecewise`: indices into `switches` whose H(a) multiplies every field
+    /// dependence outside the switches, so that at a point where all of them are off (a ≤ 0)
+    /// the tangent depends on the fields only through the switches there. A Coulomb law is
+    /// piecewise where its friction radius is zero: out of contact, or everywhere at F = 0.
+    /// Empty where no such switches exist (or where the tangent is `piecewise`).
+    pub gates: Option<Vec<usize>>,
 }
 
 impl TangentIr {
@@ -268,7 +276,7 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, previous: u8, f0: &[NodeId], f1: &[
             c11.push(dg.of(g, f));
         }
     }
-    let mut t = TangentIr { c00, c01, c10, c11, switches: Vec::new(), piecewise: true };
+    let mut t = TangentIr { c00, c01, c10, c11, switches: Vec::new(), piecewise: true, gates: None };
     let is_field =
         |s: Sym| matches!(s, Sym::Field { arg: x, .. } | Sym::FieldGrad { arg: x, .. } if x == arg || x == previous);
     let roots: Vec<NodeId> = t.nodes().collect();
@@ -292,7 +300,53 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, previous: u8, f0: &[NodeId], f1: &[
             _ => stack.extend(g.children(n)),
         }
     }
+    if !t.piecewise {
+        let roots: Vec<NodeId> = t.nodes().collect();
+        t.gates = gates(g, &roots, is_field).map(|set| {
+            set.iter().map(|a| t.switches.iter().position(|s| s == a).expect("a gate is a switch")).collect()
+        });
+    }
     t
+}
+
+/// Switch arguments `a` such that, where every H(a) is off, `roots` depend on the fields
+/// (`is_field`) only through switches: each field dependence outside the switches sits in a
+/// product with a factor that such an H(a) zeroes. `None` if some dependence is not so gated.
+fn gates(g: &Graph, roots: &[NodeId], is_field: impl Fn(Sym) -> bool + Copy) -> Option<BTreeSet<NodeId>> {
+    use std::collections::HashMap;
+    let switch = |a: NodeId| g.depends_on(a, is_field);
+    // `open[n]`: the gates under which n is free of field dependence outside switches (`None`:
+    // none do). `zero[n]`: gates under which n is zero.
+    let mut open: HashMap<NodeId, Option<BTreeSet<NodeId>>> = HashMap::new();
+    let mut zero: HashMap<NodeId, Option<BTreeSet<NodeId>>> = HashMap::new();
+    let union = |a: &Option<BTreeSet<NodeId>>, b: &Option<BTreeSet<NodeId>>| match (a, b) {
+        (Some(x), Some(y)) => Some(x.union(y).copied().collect()),
+        _ => None,
+    };
+    // The smaller of two gate sets that both suffice.
+    let least = |a: Option<BTreeSet<NodeId>>, b: Option<BTreeSet<NodeId>>| match (a, b) {
+        (Some(x), Some(y)) => Some(if y.len() < x.len() { y } else { x }),
+        (x, y) => x.or(y),
+    };
+    for n in g.reachable(roots.iter().copied()) {
+        let (o, z) = match g.node(n) {
+            Node::Heaviside(a) if switch(a) => (Some(BTreeSet::new()), Some(BTreeSet::from([a]))),
+            Node::Sym(s) if is_field(s) => (None, None),
+            Node::Const(_) | Node::Sym(_) | Node::Heaviside(_) => (Some(BTreeSet::new()), None),
+            Node::Mul(a, b) => {
+                let z = least(zero[&a].clone(), zero[&b].clone());
+                (least(union(&open[&a], &open[&b]), z.clone()), z)
+            }
+            Node::Add(a, b) => (union(&open[&a], &open[&b]), union(&zero[&a], &zero[&b])),
+            Node::Div(a, b) => (least(union(&open[&a], &open[&b]), zero[&a].clone()), zero[&a].clone()),
+            Node::Neg(a) => (open[&a].clone(), zero[&a].clone()),
+            Node::Powi(a, k) => (open[&a].clone(), zero[&a].clone().filter(|_| k > 0)),
+            Node::Powf(a, _) | Node::Sqrt(a) | Node::Step(a) => (open[&a].clone(), None),
+        };
+        open.insert(n, o);
+        zero.insert(n, z);
+    }
+    roots.iter().try_fold(BTreeSet::new(), |acc, r| union(&Some(acc), &open[r]))
 }
 
 /// Whether `id` is zero wherever some H(a), `a` depending on the fields, is (a clip by `pos` or

@@ -19,10 +19,15 @@ pub trait BoundForm {
         false
     }
     fn linear(&self) -> bool;
+    /// The tangent depends on the fields only through the switches, everywhere (see
+    /// `switches` for where it does at an iterate).
     fn piecewise(&self) -> bool;
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]);
     fn tangent(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix);
-    fn switches(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, out: &mut Vec<bool>);
+    /// Appends the active-set switches of the tangent with respect to field `wrt` at `fields`;
+    /// whether the tangent depends on the fields only through them there (always where
+    /// `piecewise`; for a Coulomb law, where its friction radius is zero on every facet).
+    fn switches(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, out: &mut Vec<bool>) -> bool;
     /// The cells whose element matrices the tangent adds to, if not all of them (a form that
     /// integrates over boundary facets only): the Jacobian changes nowhere else.
     fn support(&self) -> Option<Vec<u32>> {
@@ -105,10 +110,15 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
             asm.facet_tangent(self.on(region, facets), fields, wrt, t, m);
         }
     }
-    fn switches(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, out: &mut Vec<bool>) {
+    fn switches(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, out: &mut Vec<bool>) -> bool {
+        let meta = self.kernel.meta();
+        // A volume integral's switches are not evaluated: its tangent counts as piecewise only
+        // where the form is.
+        let mut piecewise = meta.piecewise || meta.cell_degree.is_none();
         for (region, facets) in &self.regions {
-            asm.facet_switches(self.on(region, facets), fields, wrt, t, out);
+            piecewise &= asm.facet_switches(self.on(region, facets), fields, wrt, t, out);
         }
+        piecewise
     }
     fn support(&self) -> Option<Vec<u32>> {
         if self.kernel.meta().cell_degree.is_some() {
@@ -165,7 +175,9 @@ impl BoundForm for MatrixForm {
     fn tangent(&self, _asm: &Assembler, _fields: &[&[f64]], _wrt: usize, _t: f64, m: &mut Matrix) {
         m.add_scaled(1.0, &self.matrix);
     }
-    fn switches(&self, _asm: &Assembler, _fields: &[&[f64]], _wrt: usize, _t: f64, _out: &mut Vec<bool>) {}
+    fn switches(&self, _asm: &Assembler, _fields: &[&[f64]], _wrt: usize, _t: f64, _out: &mut Vec<bool>) -> bool {
+        true
+    }
     fn time_dependent(&self) -> bool {
         false
     }

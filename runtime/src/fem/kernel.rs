@@ -294,8 +294,18 @@ pub trait FormKernel<const D: usize, const N: usize>: Form {
     }
     /// Pushes, at every quadrature point, the sign (`a > 0`) of each active-set switch H(a) of
     /// the tangent with respect to field `wrt`. For a `piecewise` form, equal switches mean
-    /// an equal tangent.
-    fn cell_switches(&self, ctx: &CellCtx<'_, D, N>, fields: &[&LocalVector<D, N>], wrt: usize, out: &mut Vec<bool>) {}
+    /// an equal tangent. Returns whether the tangent depends on the fields only through these
+    /// switches at these points: always for a `piecewise` form, and for one that is not where
+    /// its gates are off (a Coulomb law where the friction radius is zero).
+    fn cell_switches(
+        &self,
+        ctx: &CellCtx<'_, D, N>,
+        fields: &[&LocalVector<D, N>],
+        wrt: usize,
+        out: &mut Vec<bool>,
+    ) -> bool {
+        true
+    }
     /// `region` indexes `META.facets`.
     fn facet_residual(
         &self,
@@ -321,7 +331,8 @@ pub trait FormKernel<const D: usize, const N: usize>: Form {
         fields: &[&LocalVector<D, N>],
         wrt: usize,
         out: &mut Vec<bool>,
-    ) {
+    ) -> bool {
+        true
     }
 }
 

@@ -220,9 +220,11 @@ impl Newton {
         let floor = (ROUNDOFF * p.magnitude()).max(f64::MIN_POSITIVE);
         let threshold = (self.options.tol * r0).max(floor);
         let mut res = r0;
-        let mut piecewise = false;
-        // The active set at the iterate, when the last step found it.
+        let mut piecewise;
+        // The active set at the iterate, when the last step found it, and whether it decides
+        // the tangent there.
         let mut known = false;
+        let mut piecewise_after = false;
         let mut small_step = false;
         // A bound on what R(w) holds beyond r: the errors of solves whose residual was then
         // evaluated on the nonlinear terms' dofs only (`residual_on_support`).
@@ -240,6 +242,7 @@ impl Newton {
             }
             if known {
                 std::mem::swap(set, after);
+                piecewise = piecewise_after;
             } else {
                 set.clear();
                 piecewise = p.active_set(w, set);
@@ -362,8 +365,8 @@ impl Newton {
                 // is at the new iterate, R there is R + J δ, and no assembly is needed.
                 w.iter_mut().zip(delta.iter()).for_each(|(x, d)| *x += d);
                 after.clear();
-                p.active_set(w, after);
-                let kept = after == set;
+                piecewise_after = p.active_set(w, after);
+                let kept = piecewise_after && after == set;
                 // After a trusted or estimated solve R there is the solve's error: its relative
                 // accuracy times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
                 let norm_delta = norm_inf(delta);

@@ -182,8 +182,9 @@ impl NonlinearProblem for StaticContact<'_> {
     }
 
     fn active_set(&mut self, u: &[f64], out: &mut Vec<bool>) -> bool {
-        self.contact.switches(self.asm, &self.args(u), 0, self.time, out);
-        self.contact.piecewise()
+        let here = self.contact.switches(self.asm, &self.args(u), 0, self.time, out);
+        // A split run's processes see their own facets' gates (see the stage problem's).
+        self.contact.piecewise() || (here && self.asm.pattern().ownership().is_none())
     }
 
     fn jacobian(&mut self, u: &[f64], j: &mut Matrix) {

@@ -49,6 +49,8 @@ pub(super) struct SwitchMemo {
     pub(super) forms: Vec<String>,
     pub(super) key: Vec<u64>,
     pub(super) set: Vec<bool>,
+    /// Whether the tangent depended on the fields only through `set` there.
+    pub(super) piecewise: bool,
     /// Scratch for the key being compared.
     pub(super) next: Vec<u64>,
 }
@@ -208,6 +210,7 @@ pub(super) struct StageProblem<'p, 'a> {
     pub(super) terms: Vec<ActiveTerm<'p>>,
     pub(super) constraints: &'p Constraints,
     pub(super) structure: Structure,
+    /// Every form's tangent depends on the fields only through the switches, everywhere.
     pub(super) piecewise: bool,
     /// Where the nonlinear terms' residuals and tangents can be nonzero, if known.
     pub(super) support: Option<&'p Support>,
@@ -415,19 +418,24 @@ impl NonlinearProblem for StageProblem<'_, '_> {
             }
             if memo.key == memo.next && memo.forms.iter().map(String::as_str).eq(self.terms.iter().map(|t| t.form)) {
                 out.extend_from_slice(&memo.set);
-                return self.piecewise;
+                return memo.piecewise;
             }
         }
         let start = out.len();
+        // Where not every form is piecewise, the set may still decide the tangent at this
+        // iterate (a Coulomb law's gates off: no friction radius). Not in a split run, whose
+        // processes see their own facets' gates and must take the same Newton steps.
+        let mut here = self.asm.pattern().ownership().is_none();
         for term in &self.terms {
             term.args_into(w, &mut self.args, dofs);
             let refs: Vec<&[f64]> = self.args.iter().map(Vec::as_slice).collect();
             for (k, a) in term.alphas.iter().enumerate() {
                 if *a != 0.0 {
-                    self.forms[term.form].switches(self.asm, &refs, k, term.t, out);
+                    here &= self.forms[term.form].switches(self.asm, &refs, k, term.t, out);
                 }
             }
         }
+        let piecewise = self.piecewise || here;
         if dofs.is_some() {
             std::mem::swap(&mut memo.key, &mut memo.next);
             if !memo.forms.iter().map(String::as_str).eq(self.terms.iter().map(|t| t.form)) {
@@ -435,8 +443,9 @@ impl NonlinearProblem for StageProblem<'_, '_> {
             }
             memo.set.clear();
             memo.set.extend_from_slice(&out[start..]);
+            memo.piecewise = piecewise;
         }
-        self.piecewise
+        piecewise
     }
 
     fn jacobian(&mut self, w: &[f64], j: &mut Matrix) {

@@ -280,9 +280,10 @@ impl BoundForm for Obstacle {
             m.values[at] += self.k;
         }
     }
-    fn switches(&self, _asm: &Assembler, fields: &[&[f64]], _wrt: usize, t: f64, out: &mut Vec<bool>) {
+    fn switches(&self, _asm: &Assembler, fields: &[&[f64]], _wrt: usize, t: f64, out: &mut Vec<bool>) -> bool {
         self.calls.set(self.calls.get() + 1);
         out.push(self.gap(fields[0], t) < 0.0);
+        true
     }
     fn support(&self) -> Option<Vec<u32>> {
         Some(vec![0])

@@ -114,13 +114,18 @@ pub(super) fn facet_tangent_elements<const D: usize, const N: usize, K: FormKern
     });
 }
 
-/// Appends the facets' active-set switches of field `wrt` to `out`.
+/// Appends the facets' active-set switches of field `wrt` to `out`; whether the tangent
+/// depends on the fields only through them on every facet (`FormKernel::facet_switches`).
 pub(super) fn facet_switches<const D: usize, const N: usize, K: FormKernel<D, N>>(
     job: &FacetJob<'_, K>,
     wrt: usize,
     out: &mut Vec<bool>,
-) {
-    job.visit_shared::<D, N>(|_, _, ctx, refs| job.job.kernel.facet_switches(job.region, ctx, refs, wrt, out));
+) -> bool {
+    let mut piecewise = true;
+    job.visit_shared::<D, N>(|_, _, ctx, refs| {
+        piecewise &= job.job.kernel.facet_switches(job.region, ctx, refs, wrt, out);
+    });
+    piecewise
 }
 
 /// The functional's integral over the facets, summed in their order.

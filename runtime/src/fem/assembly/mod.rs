@@ -206,7 +206,8 @@ impl<'m> Assembler<'m> {
         dispatch!(self.mesh.kind, facet_tangent_elements::<K>(&job, wrt, scatter, out))
     }
 
-    /// Appends the active-set switches of the boundary integral `on` (field `wrt`) to `out`.
+    /// Appends the active-set switches of the boundary integral `on` (field `wrt`) to `out`;
+    /// whether the tangent depends on the fields only through them there.
     pub fn facet_switches<K: Kernel>(
         &self,
         on: FacetIntegral<'_, K>,
@@ -214,8 +215,8 @@ impl<'m> Assembler<'m> {
         wrt: usize,
         t: f64,
         out: &mut Vec<bool>,
-    ) {
-        let Some(job) = self.facet_job(&on, fields, t) else { return };
+    ) -> bool {
+        let Some(job) = self.facet_job(&on, fields, t) else { return true };
         dispatch!(self.mesh.kind, facet_switches::<K>(&job, wrt, out))
     }
 
