@@ -86,8 +86,8 @@ pub(super) struct Integral {
 /// Where a tangent depends on the fields only through its switches (`TangentIr::gates`).
 pub(super) enum Decided {
     Always,
-    /// Where the switches at these indices are all off.
-    Gated(Vec<usize>),
+    /// Where the gates are all off: the body's outputs after the switches, from this index.
+    Gated(usize),
     Never,
 }
 
@@ -102,13 +102,21 @@ pub(super) fn dim_kernels(prog: &Checked, ir: &DimIr, form: &FormIr) -> DimKerne
     let integral = |i: &IntegralIr| Integral {
         residual: (form.test.is_some()).then(|| residual(prog, ir, i)).flatten(),
         tangents: (0..i.tangents.len()).map(|a| tangent(prog, ir, i, a)).collect(),
-        switches: i.tangents.iter().map(|t| body(prog, ir, i.cell, &t.switches, Contract::Switches)).collect(),
+        switches: i
+            .tangents
+            .iter()
+            .map(|t| {
+                let gates = t.gates.iter().flatten().filter(|_| !t.piecewise);
+                let roots: Vec<NodeId> = t.switches.iter().chain(gates).copied().collect();
+                body(prog, ir, i.cell, &roots, Contract::Switches)
+            })
+            .collect(),
         decided: i
             .tangents
             .iter()
             .map(|t| match (t.piecewise, &t.gates) {
                 (true, _) => Decided::Always,
-                (false, Some(g)) if !g.is_empty() => Decided::Gated(g.clone()),
+                (false, Some(g)) if !g.is_empty() => Decided::Gated(t.switches.len()),
                 (false, _) => Decided::Never,
             })
             .collect(),

@@ -193,11 +193,14 @@ impl InterpretedForm {
         let decided = integral.decided.get(wrt).unwrap_or(&Decided::Always);
         let mut gated = !matches!(decided, Decided::Never);
         if let Some(body) = integral.switches.get(wrt).and_then(Option::as_ref) {
+            let switches = match decided {
+                Decided::Gated(first) => *first,
+                _ => usize::MAX,
+            };
             self.each_point(body, place, fields, |_, _, r| {
-                out.extend(r.iter().map(|&v| v > 0.0));
-                if let Decided::Gated(gates) = decided {
-                    gated &= gates.iter().all(|&k| r[k] <= 0.0);
-                }
+                let (set, gates) = r.split_at(switches.min(r.len()));
+                out.extend(set.iter().map(|&v| v > 0.0));
+                gated &= gates.iter().all(|&v| v <= 0.0);
             });
         }
         gated

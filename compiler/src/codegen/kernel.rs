@@ -287,16 +287,20 @@ impl Body<'_> {
         match self.mode {
             Mode::Residual => s.push_str(&self.residual_loop(&outputs)),
             Mode::Tangent(_) => s.push_str(&self.tangent_loop(&outputs)),
-            Mode::Switches(a) => {
-                let names: Vec<&str> =
-                    outputs.iter().flat_map(|(_, l)| l.iter().flatten()).map(|o| o.name.as_str()).collect();
-                for name in &names {
+            Mode::Switches(_) => {
+                let names = |kind: &'static str| {
+                    outputs
+                        .iter()
+                        .filter(move |(k, _)| *k == kind)
+                        .flat_map(|(_, l)| l.iter().flatten())
+                        .map(|o| &o.name)
+                };
+                for name in names("s") {
                     let _ = writeln!(s, "out.push({name} > 0.0);");
                 }
-                // Off (a ≤ 0, or NaN: not off) at every gate: see `form_impl`.
-                let t = &self.integral.tangents[a];
-                if let Some(gates) = t.gates.as_ref().filter(|g| !t.piecewise && !g.is_empty()) {
-                    let off: Vec<String> = gates.iter().map(|&k| format!("{} <= 0.0", names[k])).collect();
+                // Off (a ≤ 0; NaN is not off) at every gate: see `form_impl`.
+                let off: Vec<String> = names("gate").map(|n| format!("{n} <= 0.0")).collect();
+                if !off.is_empty() {
                     let _ = writeln!(s, "gated &= {};", off.join(" && "));
                 }
             }
@@ -348,8 +352,14 @@ impl Body<'_> {
                 outputs.push(("value", vec![(!g.is_zero(node)).then(|| Output { name: "value".into(), node })]));
             }
             Mode::Switches(a) => {
-                let list = self.integral.tangents[a].switches.iter().enumerate();
+                let t = &self.integral.tangents[a];
+                let list = t.switches.iter().enumerate();
                 outputs.push(("s", list.map(|(k, &node)| Some(Output { name: format!("s_{k}"), node })).collect()));
+                if !t.piecewise {
+                    let gates = t.gates.iter().flatten().enumerate();
+                    let gates = gates.map(|(k, &node)| Some(Output { name: format!("gate_{k}"), node }));
+                    outputs.push(("gate", gates.collect()));
+                }
             }
         }
         outputs

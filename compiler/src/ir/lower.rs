@@ -543,11 +543,12 @@ impl<'p> Lowerer<'p> {
                 // a = 0, so that neither branch divides by zero, nor does their tangent (see the
                 // derivative of sqrt): the value is a inside the ball, ρ·a/|a| outside, 0 for
                 // ρ = 0; the tangent I inside, ρ/|a| (I − â âᵀ) outside, 0 for ρ = 0. Its steps
-                // are not switches of the law's active set (`Node::Step`), except H(r): the
-                // whole is H(r)·(...), so that where the radius is zero (out of contact, or a
-                // zero friction coefficient) the tangent is zero by a switch (`TangentIr::gates`).
+                // are not switches of the law's active set (`Node::Step`). The whole is
+                // H(r)·(...), so that where the radius is zero (out of contact, or a zero
+                // friction coefficient) the tangent is zero by that step: a gate
+                // (`TangentIr::gates`) where the active set decides the tangent.
                 let (a, r) = (next(), next().c.remove(0));
-                let hr = self.jheaviside(&r);
+                let hr = self.jstep(&r);
                 let rho = self.jmul(&r, &hr);
                 let size = self.jnorm(&a);
                 let gap = self.jsub(&rho, &size);

@@ -87,12 +87,13 @@ pub struct TangentIr {
     /// penalty contact, and for linear forms): an unchanged active set means an unchanged
     /// matrix.
     pub piecewise: bool,
-    /// Where it is not `piecewise`: indices into `switches` whose H(a) multiplies every field
-    /// dependence outside the switches, so that at a point where all of them are off (a ≤ 0)
-    /// the tangent depends on the fields only through the switches there. A Coulomb law is
-    /// piecewise where its friction radius is zero: out of contact, or everywhere at F = 0.
-    /// Empty where no such switches exist (or where the tangent is `piecewise`).
-    pub gates: Option<Vec<usize>>,
+    /// Where it is not `piecewise`: arguments `a` of steps H(a) (switches or a built-in's inner
+    /// steps) that multiply every field dependence outside the switches, so that at a point
+    /// where all of them are off (a ≤ 0) the tangent depends on the fields only through the
+    /// switches there. A Coulomb law's are its friction radius (`proj_ball`'s r): out of
+    /// contact, or everywhere at F = 0, the active set decides its tangent. `None` where no such
+    /// steps exist (or where the tangent is `piecewise`).
+    pub gates: Option<Vec<NodeId>>,
 }
 
 impl TangentIr {
@@ -302,16 +303,15 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, previous: u8, f0: &[NodeId], f1: &[
     }
     if !t.piecewise {
         let roots: Vec<NodeId> = t.nodes().collect();
-        t.gates = gates(g, &roots, is_field).map(|set| {
-            set.iter().map(|a| t.switches.iter().position(|s| s == a).expect("a gate is a switch")).collect()
-        });
+        t.gates = gates(g, &roots, is_field).map(|set| set.into_iter().collect());
     }
     t
 }
 
-/// Switch arguments `a` such that, where every H(a) is off, `roots` depend on the fields
+/// Step arguments `a` such that, where every H(a) is off, `roots` depend on the fields
 /// (`is_field`) only through switches: each field dependence outside the switches sits in a
-/// product with a factor that such an H(a) zeroes. `None` if some dependence is not so gated.
+/// product with a factor that such an H(a) (a switch or an inner step) zeroes. `None` if some
+/// dependence is not so gated.
 fn gates(g: &Graph, roots: &[NodeId], is_field: impl Fn(Sym) -> bool + Copy) -> Option<BTreeSet<NodeId>> {
     use std::collections::HashMap;
     let switch = |a: NodeId| g.depends_on(a, is_field);
@@ -341,6 +341,7 @@ fn gates(g: &Graph, roots: &[NodeId], is_field: impl Fn(Sym) -> bool + Copy) -> 
             Node::Div(a, b) => (least(union(&open[&a], &open[&b]), zero[&a].clone()), zero[&a].clone()),
             Node::Neg(a) => (open[&a].clone(), zero[&a].clone()),
             Node::Powi(a, k) => (open[&a].clone(), zero[&a].clone().filter(|_| k > 0)),
+            Node::Step(a) if switch(a) => (open[&a].clone(), Some(BTreeSet::from([a]))),
             Node::Powf(a, _) | Node::Sqrt(a) | Node::Step(a) => (open[&a].clone(), None),
         };
         open.insert(n, o);
