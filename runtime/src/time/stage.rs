@@ -418,7 +418,8 @@ impl NonlinearProblem for StageProblem<'_, '_> {
             }
             if memo.key == memo.next && memo.forms.iter().map(String::as_str).eq(self.terms.iter().map(|t| t.form)) {
                 out.extend_from_slice(&memo.set);
-                return memo.piecewise;
+                // (A memo never filled, of no terms, holds the default `false`.)
+                return self.piecewise || memo.piecewise;
             }
         }
         let start = out.len();
