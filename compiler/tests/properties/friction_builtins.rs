@@ -3,6 +3,7 @@
 //! ≤ 0; stick: |a| < r; slip: |a| > r, with a = tangential(u − w, nc), r = F (u·nc − g)), and
 //! at the points where a = 0 exactly, the form's value is the projection's definition and its
 //! automatic tangent matches central finite differences. Every regime is asserted present.
+//! Where the radius is ≤ 0 (its gate off) a Coulomb-like tangent is its frictionless law's.
 
 use std::path::Path;
 
@@ -179,5 +180,61 @@ fn frictional_builtins_have_their_values_and_their_tangents_in_every_regime() {
             let count = seen.iter().filter(|&&s| s == r).count();
             assert!(count >= 30, "{d}D: {count} points of {r:?}");
         }
+    }
+}
+
+/// A Coulomb-like law (normal stress pos(u·nc − g), friction onto F times it), the same law
+/// without friction, and a Tresca-like one (a constant radius F).
+const GATED: &str = "
+param F = 0.4 in [0, inf)
+coef nc: vector
+coef w: vector
+coef g
+form coulomb(u; v) = int(Gamma_C, degree = 4)
+    pos(dot(u, nc) - g) * dot(v, nc) + dot(proj_ball(tangential(u - w, nc), F*pos(dot(u, nc) - g)), v)
+form frictionless(u; v) = int(Gamma_C, degree = 4) pos(dot(u, nc) - g) * dot(v, nc)
+form tresca(u; v) = int(Gamma_C, degree = 4) dot(proj_ball(tangential(u - w, nc), F), v)
+";
+
+/// The gates of a projection: the Coulomb-like tangent is not piecewise, but has one gate,
+/// its radius; wherever that is ≤ 0 (out of contact, or F = 0) its tangent is the frictionless
+/// law's, which the active set decides. A constant radius gates nothing.
+#[test]
+fn a_projection_s_tangent_is_gated_by_its_radius() {
+    let compiled = compile_text(Path::new("gated.wf"), GATED, &MemLoader::default()).expect("the laws compile");
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    for d in [2, 3] {
+        let ir = compiled.ir(d);
+        let tangent = |form: usize| &ir.forms[form].integrals[0].tangents[0];
+        let (coulomb, frictionless, tresca) = (tangent(0), tangent(1), tangent(2));
+        assert!(!coulomb.piecewise && frictionless.piecewise && !tresca.piecewise, "{d}D");
+        let gates = coulomb.gates.clone().expect("the radius gates the projection");
+        assert_eq!(gates.len(), 1, "{d}D: {gates:?}");
+        assert!(tresca.gates.is_none(), "{d}D: a constant radius is no gate");
+        let (mut off, mut on) = (0, 0);
+        for _ in 0..200 {
+            let mut nc: Vec<f64> = (0..d).map(|_| rng.next()).collect();
+            let size = Point::dot(&nc, &nc).sqrt().max(0.1);
+            nc.iter_mut().for_each(|x| *x /= size);
+            // F = 0 on one point in four.
+            let f = if rng.next() < -0.5 { 0.0 } else { 1.5 + rng.next() };
+            let p = Point {
+                u: (0..d).map(|_| rng.next()).collect(),
+                w: (0..d).map(|_| rng.next()).collect(),
+                g: 0.5 * rng.next(),
+                f,
+                nc,
+            };
+            let gate = evaluate(&ir.graph, &gates, |s| p.leaf(s))[0];
+            let law = evaluate(&ir.graph, &coulomb.c00, |s| p.leaf(s));
+            let without = evaluate(&ir.graph, &frictionless.c00, |s| p.leaf(s));
+            if gate <= 0.0 {
+                off += 1;
+                assert_eq!(law, without, "{d}D: gate off at {:?} (F = {f})", p.u);
+            } else {
+                on += 1;
+            }
+        }
+        assert!(off > 20 && on > 20, "{d}D: {off} points with the gate off, {on} on");
     }
 }
