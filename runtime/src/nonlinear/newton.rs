@@ -225,6 +225,8 @@ impl Newton {
         // the tangent there.
         let mut known = false;
         let mut piecewise_after = false;
+        // ‖R‖₂ at the last solve's start (iterative solves).
+        let mut last_norm2: Option<f64> = None;
         let mut small_step = false;
         // A bound on what R(w) holds beyond r: the errors of solves whose residual was then
         // evaluated on the nonlinear terms' dofs only (`residual_on_support`).
@@ -273,9 +275,13 @@ impl Newton {
             let f = self.reuse.factorization.as_mut().expect("factored above");
             let iterative = f.iterates();
             let norm2_r = if iterative { norm2(r) } else { 0.0 };
+            // A tangent the set does not decide (a frictional law in contact) converges
+            // superlinearly at best: its early solves need only Eisenstat and Walker's accuracy.
+            let superlinear = (!piecewise).then(|| last_norm2.map_or(LOOSE, |last| 0.9 * (norm2_r / last).powi(2)));
+            last_norm2 = Some(norm2_r);
             let loose =
                 iterative && piecewise && !self.options.line_search && report.history.is_empty() && self.first_changed;
-            let eta = iterative.then(|| f.set_tolerance(forcing(norm2_r, threshold, loose)));
+            let eta = iterative.then(|| f.set_tolerance(forcing(norm2_r, threshold, loose, superlinear)));
             let trusted = if piecewise && !self.options.line_search { self.reuse.solve_accuracy } else { None };
             // A correction of a reference whose solves are trusted reports the residual it
             // leaves itself (`LowRank::solve`): its first solve needs no product J δ then.
@@ -468,11 +474,14 @@ impl Newton {
 /// The relative tolerance η of an iterative solve, ‖J δ + R‖₂ ≤ η‖R‖₂ (inexact Newton): loose
 /// where the iteration is expected to change the active set, whose next iteration corrects the
 /// solve's error anyway; otherwise what brings R below Newton's threshold (the 2-norm bounds
-/// the ∞-norm the threshold is in), never tighter than the solvers' default.
-fn forcing(norm2_r: f64, threshold: f64, loose: bool) -> f64 {
+/// the ∞-norm the threshold is in), or `superlinear` if that is looser (Eisenstat–Walker's
+/// choice 2 for a tangent that is not piecewise: 0.9 (‖R_k‖/‖R_{k−1}‖)², LOOSE first), never
+/// tighter than the solvers' default.
+fn forcing(norm2_r: f64, threshold: f64, loose: bool, superlinear: Option<f64>) -> f64 {
     let tight = crate::linalg::krylov::TOLERANCE;
+    let finish = FINISH * threshold / norm2_r;
     // The clamp also catches a zero or infinite ‖R‖₂ (NaN falls to the tight end).
-    if loose { LOOSE } else { (FINISH * threshold / norm2_r).clamp(tight, LOOSE).max(tight) }
+    if loose { LOOSE } else { superlinear.map_or(finish, |s| s.max(finish)).clamp(tight, LOOSE).max(tight) }
 }
 
 /// ‖v‖₂, scaled by ‖v‖∞ so that neither tiny nor huge entries under- or overflow.
