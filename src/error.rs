@@ -14,6 +14,9 @@ pub enum CaseError {
     /// A case file problem, with file and line.
     #[error("{0}")]
     CaseFile(String),
+    /// `initial u = settled(...)` found no equilibrium: what Newton saw, and why it may be.
+    #[error("{0}")]
+    Settle(String),
     #[error(transparent)]
     Mesh(#[from] crate::runtime::fem::mesh::MeshError),
     #[error(transparent)]

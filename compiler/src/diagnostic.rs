@@ -67,6 +67,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0820", "scheme: a state read at the start of a step that nothing sets at the start of the run"),
     ("E0901", "problem: no mesh"),
     ("E0905", "problem: a Dirichlet condition on a contact region"),
+    ("E0906", "problem: a `set` name that more than one file in use declares (qualify it: `material.rho`)"),
     ("W0001", "unused parameter (warning)"),
     ("W0002", "a scheme `let` hides another name (warning)"),
     ("W0003", "a `fn` or `form` argument hides a name of the file (warning)"),
@@ -77,7 +78,7 @@ pub const CODES: &[(&str, &str)] = &[
 
 /// Codes reported when a problem is bound to the files of a run (the facade's bad-input corpus
 /// exercises them; the compiler's own corpus cannot, as the files in use are not known there).
-pub const BINDING_CODES: &[&str] = &["W0004"];
+pub const BINDING_CODES: &[&str] = &["E0906", "W0004"];
 
 /// The meaning of a diagnostic code, from [`CODES`].
 pub fn describe(code: &str) -> Option<&'static str> {

@@ -16,11 +16,14 @@ pub(super) fn check(files: &[PathBuf]) -> ExitCode {
                 eprint!("{}", compiled.warnings);
                 print!("{}", quadrature_degrees(f, &compiled));
                 // A problem is also bound: its mesh and regions, the coefs of the files in use.
-                if !compiled.program.unit.problems.is_empty()
-                    && let Err(e) = crate::problem::run::check(&f.to_string_lossy())
-                {
-                    eprintln!("{e}");
-                    failed = true;
+                if !compiled.program.unit.problems.is_empty() {
+                    match crate::problem::run::check(&f.to_string_lossy()) {
+                        Ok(line) => println!("{line}"),
+                        Err(e) => {
+                            eprintln!("{e}");
+                            failed = true;
+                        }
+                    }
                 }
             }
             Err(e) => {

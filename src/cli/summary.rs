@@ -18,7 +18,7 @@ pub(super) fn finish(result: Result<crate::problem::run::Run, crate::error::Case
             let own: Vec<String> = s
                 .own
                 .iter()
-                .map(|k| format!("{k} {}", s.number(k).map_or("none".to_string(), |x| format!("{x:.6}"))))
+                .map(|k| format!("{k} {}", s.number(k).map_or("none".to_string(), crate::numbers::readable)))
                 .collect();
             let set: Vec<String> = s
                 .get("params")
@@ -59,9 +59,9 @@ pub(super) fn finish(result: Result<crate::problem::run::Run, crate::error::Case
 fn expectations(s: &crate::problem::outputs::Summary) {
     let Ok(list) = s.field::<Vec<crate::problem::summary::Expectation>>("expected") else { return };
     for x in list {
-        let [value, expected, relative] = x.shown();
+        let [value, expected, difference, within] = x.shown();
         let met = if x.met { "met" } else { "NOT MET" };
-        println!("  expect {} = {expected} (is {value}, relative {relative}, within {}): {met}", x.key, x.within);
+        println!("  expect {} = {expected} (is {value}, difference {difference}, within {within}): {met}", x.key);
     }
 }
 
@@ -94,7 +94,7 @@ pub(super) fn all_row(
         .iter()
         .map(|k| {
             let w = k.len().max(11);
-            s.number(k).map_or(format!("{:>w$}", "—"), |v| format!("{v:>w$.4e}"))
+            format!("{:>w$}", s.number(k).map_or("—".to_string(), crate::numbers::readable))
         })
         .collect();
     let count = |k: &str| s.get(k).and_then(|v| v.as_u64()).unwrap_or(0);

@@ -156,6 +156,17 @@ pub fn frictional_contact_names() -> Vec<&'static str> {
     contact_names().into_iter().filter(|n| frictional(n)).collect()
 }
 
+/// Whether a file of the library (a scheme or a form file) declares a param of that name.
+pub fn library_declares(name: &str) -> bool {
+    LIBRARY.iter().any(|u| {
+        u.schemes
+            .iter()
+            .flat_map(|s| s.params.iter())
+            .chain(u.forms.iter().flat_map(|f| f.params.iter()))
+            .any(|p| p.name == name)
+    })
+}
+
 /// Every scheme of the library, by name.
 pub fn all_schemes() -> Vec<&'static str> {
     scheme_names(&Methods::default())
@@ -212,6 +223,22 @@ pub fn form_units(methods: &Methods) -> Result<(Vec<FormSource>, usize), CaseErr
     Ok((units, contact_index))
 }
 
+fn apply_overrides(
+    table: &mut params::Table,
+    overrides: &[(&str, f64)],
+    locate: &dyn Fn(&params::Ambiguous) -> CaseError,
+) -> Result<(), CaseError> {
+    let files: Vec<&str> = LIBRARY.iter().map(|u| u.name).collect();
+    table.apply_case(overrides, &files).map_err(|e| match e {
+        params::CaseOverrideError::Invalid(e) => e,
+        params::CaseOverrideError::Ambiguous(a) => locate(&a),
+    })
+}
+
+fn unlocated(a: &params::Ambiguous) -> CaseError {
+    CaseError::Option(format!("the case's override: {}", a.message()))
+}
+
 /// A path that is one of the library's own files (compiled already).
 fn library_file(path: &Path) -> Option<&'static Unit> {
     let stem = path.file_stem()?.to_string_lossy().into_owned();
@@ -243,10 +270,20 @@ impl FilesInUse {
     /// Resolves a run's methods: files, then params (file defaults < `overrides` of the case < the
     /// user's settings).
     pub fn resolve(methods: &Methods, overrides: &[(&str, f64)]) -> Result<FilesInUse, CaseError> {
+        Self::resolve_located(methods, overrides, &unlocated)
+    }
+
+    /// As [`FilesInUse::resolve`], with `locate` saying where an ambiguous override was written
+    /// (a problem's `set` line).
+    pub fn resolve_located(
+        methods: &Methods,
+        overrides: &[(&str, f64)],
+        locate: &dyn Fn(&params::Ambiguous) -> CaseError,
+    ) -> Result<FilesInUse, CaseError> {
         let scheme = scheme(methods)?;
         let (units, contact) = form_units(methods)?;
-        let mut table = params::Table::new(Some(&scheme), &units);
-        table.apply_case(overrides)?;
+        let mut table = params::Table::new(Some(&scheme), &units, contact);
+        apply_overrides(&mut table, overrides, locate)?;
         table.apply_user(&methods.params)?;
         Ok(FilesInUse { scheme, forms: FormsInUse { units, contact, params: table }, guard: methods.guard })
     }
@@ -254,8 +291,8 @@ impl FilesInUse {
     /// The form files of a run's methods and their params, without a scheme.
     pub fn resolve_forms(methods: &Methods, overrides: &[(&str, f64)]) -> Result<FormsInUse, CaseError> {
         let (units, contact) = form_units(methods)?;
-        let mut table = params::Table::new(None, &units);
-        table.apply_case(overrides)?;
+        let mut table = params::Table::new(None, &units, contact);
+        apply_overrides(&mut table, overrides, &unlocated)?;
         table.apply_user(&methods.params)?;
         Ok(FormsInUse { units, contact, params: table })
     }

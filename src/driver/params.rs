@@ -58,8 +58,87 @@ pub fn declared_by(params: &BTreeMap<String, ParamValue>, stem: &str) -> Vec<(St
 struct Entry {
     info: ParamInfo,
     scheme: bool,
+    /// The roles of the file that declares it (`scheme`, `material`, `contact`, `forms`).
+    roles: Vec<&'static str>,
     value: f64,
     source: Source,
+}
+
+impl Entry {
+    /// Whether `owner.name` names this param: `owner` is a role (`material.rho`) or the
+    /// declaring file's stem (`elasticity.rho`; `nitsche.theta` for `contact_nitsche`).
+    fn answers(&self, owner: Option<&str>, name: &str) -> bool {
+        self.info.name == name
+            && owner.is_none_or(|o| {
+                self.roles.contains(&o) || self.info.owner == o || self.info.owner == format!("contact_{o}")
+            })
+    }
+
+    /// `owner.name` and the role's `role.name`, with the declaration: one choice of an
+    /// ambiguous name.
+    fn choice(&self) -> String {
+        let roles: Vec<String> = self.roles.iter().map(|r| format!("`{r}.{}`", self.info.name)).collect();
+        format!(
+            "`{}.{}` ({}{}: {})",
+            self.info.owner,
+            self.info.name,
+            if roles.is_empty() { String::new() } else { format!("or {}, ", roles.join(" or ")) },
+            self.info.declared,
+            self.info.doc
+        )
+    }
+}
+
+/// Splits `owner.name` (or `name`).
+fn qualified(name: &str) -> (Option<&str>, &str) {
+    match name.rsplit_once('.') {
+        Some((o, n)) => (Some(o), n),
+        None => (None, name),
+    }
+}
+
+/// A case's override that names no one param: the setting's index, its name and why.
+pub struct Ambiguous {
+    pub index: usize,
+    pub name: String,
+    pub why: Unnamed,
+}
+
+/// Why an override names no one param.
+pub enum Unnamed {
+    /// Several params answer to it: the choices, qualified.
+    Several(Vec<String>),
+    /// Its qualifier is no role and no file (of the library or in use): the closest.
+    UnknownQualifier(Option<String>),
+}
+
+impl Ambiguous {
+    /// The message (after the place it was written).
+    pub fn message(&self) -> String {
+        match &self.why {
+            Unnamed::Several(choices) => format!(
+                "param `{}` is declared by more than one file in use: write {}",
+                self.name,
+                choices.join(" or ")
+            ),
+            Unnamed::UnknownQualifier(closest) => format!(
+                "`{}` names no param of the files in use: its qualifier is neither a role ({}) nor a file{}",
+                self.name,
+                ROLES.join(", "),
+                closest.as_ref().map_or(String::new(), |c| format!("; did you mean `{c}`?"))
+            ),
+        }
+    }
+}
+
+/// The roles a qualified param name may start with (`material.rho`).
+pub const ROLES: &[&str] = &["scheme", "material", "contact", "forms"];
+
+/// Why a case's override was refused: a value out of its range, or a name several params
+/// answer to (which the caller locates at the override).
+pub enum CaseOverrideError {
+    Invalid(CaseError),
+    Ambiguous(Ambiguous),
 }
 
 /// Every param of a run's scheme and form files.
@@ -72,18 +151,76 @@ fn same(a: &ParamInfo, b: &ParamInfo) -> bool {
 }
 
 impl Table {
-    pub fn new(scheme: Option<&SchemeSource>, units: &[FormSource]) -> Table {
+    /// `units`: the material (first), the contact law (at `contact`) and the extra form files.
+    pub fn new(scheme: Option<&SchemeSource>, units: &[FormSource], contact: usize) -> Table {
         let mut entries: Vec<Entry> = scheme
             .map_or(&[][..], |s| s.params())
             .iter()
-            .map(|p| Entry { info: p.clone(), scheme: true, value: p.default, source: Source::File })
+            .map(|p| Entry {
+                info: p.clone(),
+                scheme: true,
+                roles: vec!["scheme"],
+                value: p.default,
+                source: Source::File,
+            })
             .collect();
-        for p in units.iter().flat_map(|u| u.params().iter()) {
-            if !entries.iter().any(|e| same(&e.info, p)) {
-                entries.push(Entry { info: p.clone(), scheme: false, value: p.default, source: Source::File });
+        // A file's role reaches the params it declares; a param only imported (elasticity's,
+        // through a contact law) takes the roles of the files that import it.
+        let mut imported: Vec<(usize, &'static str)> = Vec::new();
+        for (i, u) in units.iter().enumerate() {
+            let roles: Vec<&'static str> =
+                [(i == 0, "material"), (i == contact, "contact"), (i != 0 && i != contact, "forms")]
+                    .into_iter()
+                    .filter_map(|(holds, role)| holds.then_some(role))
+                    .collect();
+            for p in u.params() {
+                let index = match entries.iter().position(|e| same(&e.info, p)) {
+                    Some(k) => k,
+                    None => {
+                        entries.push(Entry {
+                            info: p.clone(),
+                            scheme: false,
+                            roles: Vec::new(),
+                            value: p.default,
+                            source: Source::File,
+                        });
+                        entries.len() - 1
+                    }
+                };
+                let own = p.owner == u.name();
+                for r in &roles {
+                    if own && !entries[index].roles.contains(r) {
+                        entries[index].roles.push(r);
+                    } else if !own {
+                        imported.push((index, r));
+                    }
+                }
+            }
+        }
+        for (index, role) in imported {
+            if entries[index].roles.iter().all(|r| *r == "scheme") {
+                entries[index].roles.push(role);
             }
         }
         Table { entries }
+    }
+
+    /// Whether the params `hits` are one quantity declared in several files: form files' params
+    /// of one name and one doc comment (a material of the user's and the elasticity a contact
+    /// law imports both declare `E`, "Young's modulus"). A scheme's param is its own.
+    fn one_quantity(&self, hits: &[usize]) -> bool {
+        let first = &self.entries[hits[0]];
+        hits.len() == 1
+            || hits
+                .iter()
+                .map(|&i| &self.entries[i])
+                .all(|e| !e.scheme && !first.scheme && !e.info.doc.is_empty() && e.info.doc == first.info.doc)
+    }
+
+    /// The params `name` (`rho`, `material.rho`, `elasticity.rho`) answers to.
+    fn answering(&self, name: &str) -> Vec<usize> {
+        let (owner, name) = qualified(name);
+        (0..self.entries.len()).filter(|&i| self.entries[i].answers(owner, name)).collect()
     }
 
     fn check(e: &Entry, value: f64, origin: &str) -> Result<(), CaseError> {
@@ -96,15 +233,41 @@ impl Table {
         )))
     }
 
-    /// A case's overrides of the scheme's and form files' defaults (a problem's `set`); params
-    /// the files in use do not declare are left alone (a user's contact law may have no
-    /// `gamma0`, another scheme no `gam`).
-    pub fn apply_case(&mut self, overrides: &[(&str, f64)]) -> Result<(), CaseError> {
-        for &(name, value) in overrides {
-            for e in self.entries.iter_mut().filter(|e| e.info.name == name) {
-                Self::check(e, value, "the case's override")?;
-                e.value = value;
-                e.source = Source::Case;
+    /// A case's overrides of the scheme's and form files' defaults (a problem's `set`), each
+    /// reaching the one param it names; params the files in use do not declare are left alone
+    /// (a user's contact law may have no `gamma0`, another scheme no `gam`). A name several
+    /// files declare (`rho`: the material's density, generalized-α's ρ∞) is refused, as on the
+    /// command line.
+    /// `files`: the names of the files a qualifier may name besides those in use (the library's).
+    pub fn apply_case(&mut self, overrides: &[(&str, f64)], files: &[&str]) -> Result<(), CaseOverrideError> {
+        for (index, &(name, value)) in overrides.iter().enumerate() {
+            match self.answering(name).as_slice() {
+                [] => {
+                    if let (Some(owner), bare) = qualified(name) {
+                        let owners = self.entries.iter().map(|e| &*e.info.owner);
+                        let known: Vec<&str> =
+                            ROLES.iter().copied().chain(files.iter().copied()).chain(owners).collect();
+                        let short = |k: &&str| *k == owner || k.strip_prefix("contact_") == Some(owner);
+                        if !known.iter().any(short) {
+                            let closest = crate::compiler::check::suggest_name(owner, known.iter().copied())
+                                .map(|q| format!("{q}.{bare}"));
+                            let why = Unnamed::UnknownQualifier(closest);
+                            return Err(CaseOverrideError::Ambiguous(Ambiguous { index, name: name.to_string(), why }));
+                        }
+                    }
+                }
+                hits if self.one_quantity(hits) => {
+                    for &i in hits {
+                        let e = &mut self.entries[i];
+                        Self::check(e, value, "the case's override").map_err(CaseOverrideError::Invalid)?;
+                        e.value = value;
+                        e.source = Source::Case;
+                    }
+                }
+                many => {
+                    let why = Unnamed::Several(many.iter().map(|&i| self.entries[i].choice()).collect());
+                    return Err(CaseOverrideError::Ambiguous(Ambiguous { index, name: name.to_string(), why }));
+                }
             }
         }
         Ok(())
@@ -112,38 +275,21 @@ impl Table {
 
     /// The user's settings, each matching exactly one param.
     pub fn apply_user(&mut self, settings: &[Setting]) -> Result<(), CaseError> {
-        for s in settings {
-            let (owner, name) = match s.name.rsplit_once('.') {
-                Some((o, n)) => (Some(o), n),
-                None => (None, s.name.as_str()),
-            };
-            let owner_matches =
-                |e: &Entry| owner.is_none_or(|o| e.info.owner == o || e.info.owner == format!("contact_{o}"));
-            let hits: Vec<usize> = (0..self.entries.len())
-                .filter(|&i| self.entries[i].info.name == name && owner_matches(&self.entries[i]))
-                .collect();
-            match hits.as_slice() {
-                [i] => {
-                    let e = &mut self.entries[*i];
-                    Self::check(e, s.value, &s.origin)?;
-                    e.value = s.value;
-                    e.source = Source::User;
-                }
+        for (index, s) in settings.iter().enumerate() {
+            match self.answering(&s.name).as_slice() {
                 [] => return Err(self.unknown(s)),
+                hits if self.one_quantity(hits) => {
+                    for &i in hits {
+                        let e = &mut self.entries[i];
+                        Self::check(e, s.value, &s.origin)?;
+                        e.value = s.value;
+                        e.source = Source::User;
+                    }
+                }
                 many => {
-                    let options: Vec<String> = many
-                        .iter()
-                        .map(|&i| {
-                            let e = &self.entries[i];
-                            format!("`{}.{}` ({}: {})", e.info.owner, e.info.name, e.info.declared, e.info.doc)
-                        })
-                        .collect();
-                    return Err(CaseError::Option(format!(
-                        "{}: param `{}` is ambiguous: write {}",
-                        s.origin,
-                        s.name,
-                        options.join(" or ")
-                    )));
+                    let why = Unnamed::Several(many.iter().map(|&i| self.entries[i].choice()).collect());
+                    let a = Ambiguous { index, name: s.name.clone(), why };
+                    return Err(CaseError::Option(format!("{}: {}", s.origin, a.message())));
                 }
             }
         }
@@ -169,6 +315,21 @@ impl Table {
         } else {
             e.info.name.to_string()
         }
+    }
+
+    /// The value of the one param `name` answers to (none if no file in use declares it; the
+    /// choices if several do).
+    pub fn lookup(&self, name: &str) -> Result<Option<f64>, Vec<String>> {
+        match self.answering(name).as_slice() {
+            [] => Ok(None),
+            hits if self.one_quantity(hits) => Ok(Some(self.entries[hits[0]].value)),
+            many => Err(many.iter().map(|&i| self.entries[i].choice()).collect()),
+        }
+    }
+
+    /// Every param's name (qualified where two share it).
+    pub fn names(&self) -> Vec<String> {
+        self.entries.iter().map(|e| self.display_name(e)).collect()
     }
 
     fn value_of(&self, p: &ParamInfo, scheme: bool) -> f64 {

@@ -8,7 +8,7 @@ use super::ProblemFile;
 use super::expr::{At, Exprs, PointFn};
 use crate::compiler::Diagnostic;
 use crate::compiler::ir::lower::Val;
-use crate::compiler::syntax::ast::{Expr, MeshSource, NamedCall, RegionSource};
+use crate::compiler::syntax::ast::{Condition, Expr, MeshSource, NamedCall, RegionSource};
 use crate::driver::FilesInUse;
 use crate::error::CaseError;
 use crate::runtime::fem::kernel::Coef;
@@ -127,35 +127,13 @@ pub fn mesh(
     for r in &p.regions {
         let mut found = false;
         for source in &r.sources {
-            match source {
-                RegionSource::Group { name: group, conditions, span } => {
-                    // A group the mesh has is the region, even empty (an error, not a fallback).
-                    if let Some(g) = mesh.regions.iter().find(|g| g.name == *group) {
-                        let mut facets = g.facets.clone();
-                        if !conditions.is_empty() {
-                            let test = predicate(pf, ex, conditions)?;
-                            facets.retain(|&f| {
-                                let (n, x) = mesh.facet_normal_and_centroid(f);
-                                test(&n, &x)
-                            });
-                        }
-                        if facets.is_empty() {
-                            return Err(pf.render(Diagnostic::error(
-                                "E0101",
-                                format!("group \"{group}\" of {label} has no facets"),
-                                *span,
-                                format!("region `{}` would be empty", r.name.name),
-                            )));
-                        }
-                        found = true;
-                        mesh.regions.retain(|x| x.name != r.name.name);
-                        mesh.regions.push(crate::runtime::fem::mesh::Region { name: r.name.name.clone(), facets });
-                    }
-                }
-                RegionSource::Boundary { conditions, .. } => {
-                    let test = predicate(pf, ex, conditions)?;
-                    let region = mesh.add_region_where(&r.name.name, test);
-                    found = !region.facets.is_empty();
+            // A group the mesh has is the region, even empty (an error, not a fallback).
+            if let Some(facets) = facets_of(pf, ex, &mesh, source, &r.name.name, &label)? {
+                found = !facets.is_empty();
+                if found || matches!(source, RegionSource::Group { .. }) {
+                    mesh.regions.retain(|x| x.name != r.name.name);
+                    mesh.regions.push(crate::runtime::fem::mesh::Region { name: r.name.name.clone(), facets });
+                    found = true;
                 }
             }
             if found {
@@ -187,26 +165,84 @@ pub fn mesh(
     Ok((mesh, label))
 }
 
-/// A facet test from comparisons of the outward normal `n` and the centroid `x` (all must hold).
+/// The facets of a region's source, in order: none when it is a group the mesh does not have
+/// (the next source is tried); an error for a group the mesh has with no facet there.
+fn facets_of(
+    pf: &ProblemFile,
+    ex: &mut Exprs,
+    mesh: &Mesh,
+    source: &RegionSource,
+    region: &str,
+    label: &str,
+) -> Result<Option<Vec<crate::runtime::fem::mesh::Facet>>, CaseError> {
+    let keep = |ex: &mut Exprs, facets: Vec<crate::runtime::fem::mesh::Facet>, condition: &Option<Condition>| {
+        let Some(c) = condition else { return Ok(facets) };
+        let test = predicate(pf, ex, c)?;
+        Ok::<_, CaseError>(
+            facets
+                .into_iter()
+                .filter(|&f| {
+                    let (n, x) = mesh.facet_normal_and_centroid(f);
+                    test(&n, &x)
+                })
+                .collect(),
+        )
+    };
+    Ok(Some(match source {
+        RegionSource::Group { name: group, condition, span } => {
+            let Some(g) = mesh.regions.iter().find(|g| g.name == *group) else { return Ok(None) };
+            let facets = keep(ex, g.facets.clone(), condition)?;
+            if facets.is_empty() {
+                return Err(pf.render(Diagnostic::error(
+                    "E0101",
+                    format!("group \"{group}\" of {label} has no facets"),
+                    *span,
+                    format!("region `{region}` would be empty"),
+                )));
+            }
+            facets
+        }
+        RegionSource::Boundary { condition, .. } => keep(ex, mesh.boundary_facets(), condition)?,
+        // Earlier regions are the mesh's by now (the checker refused later ones).
+        RegionSource::Region(id) => {
+            mesh.regions.iter().find(|g| g.name == id.name).map_or_else(Vec::new, |g| g.facets.clone())
+        }
+        RegionSource::Union(parts, _) => {
+            let mut all: Vec<crate::runtime::fem::mesh::Facet> = Vec::new();
+            for part in parts {
+                for f in facets_of(pf, ex, mesh, part, region, label)?.unwrap_or_default() {
+                    if !all.contains(&f) {
+                        all.push(f);
+                    }
+                }
+            }
+            all
+        }
+    }))
+}
+
+/// A facet test from a condition on the outward normal `n` and the centroid `x`.
 fn predicate(
     pf: &ProblemFile,
     ex: &mut Exprs,
-    conditions: &[crate::compiler::syntax::ast::Comparison],
+    condition: &Condition,
 ) -> Result<impl Fn(&[f64], &[f64]) -> bool, CaseError> {
     let mut tests = Vec::new();
-    for c in conditions {
+    for c in condition.comparisons() {
         let lhs = ex.lower(&c.lhs, &[]).map_err(|e| pf.render(*e))?;
         let rhs = ex.lower(&c.rhs, &[]).map_err(|e| pf.render(*e))?;
         let both = Val { shape: lhs.shape, c: vec![lhs.c[0].clone(), rhs.c[0].clone()] };
         tests.push((ex.function(&both, &c.lhs).map_err(|e| pf.render(*e))?, c.op));
     }
+    let condition = condition.clone();
     let work = std::cell::RefCell::new((Vec::new(), [0.0; 2]));
     Ok(move |n: &[f64], x: &[f64]| {
         let (scratch, out) = &mut *work.borrow_mut();
-        tests.iter().all(|(f, op)| {
+        let mut holds = tests.iter().map(|(f, op)| {
             f.eval(&At { x, n, ..At::default() }, scratch, out);
             op.holds(out[0], out[1])
-        })
+        });
+        condition.holds(&mut holds)
     })
 }
 

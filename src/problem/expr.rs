@@ -58,6 +58,12 @@ impl<'u> Exprs<'u> {
         self.low.g.as_const(v.c[0].v).ok_or_else(|| not_constant(e))
     }
 
+    /// A constant scalar of the params, `let`s and the `extra` names.
+    pub fn scalar_with(&mut self, e: &Expr, extra: &[(String, Val)]) -> Res<f64> {
+        let v = self.lower(e, extra)?;
+        self.low.g.as_const(v.c[0].v).ok_or_else(|| not_constant(e))
+    }
+
     /// A constant vector of the problem's dimension.
     pub fn vector(&mut self, e: &Expr) -> Res<Vec<f64>> {
         let v = self.lower(e, &[])?;

@@ -29,21 +29,61 @@ use crate::simulation::{Problem, Simulation, Snapshots};
 
 /// Binds a problem with the library's defaults without running it: its params, the files in use
 /// and their coefs, the mesh with its regions, the coefs' and initial fields' expressions in the
-/// problem's dimension (`signorini check` on a problem file).
-pub fn check(problem: &str) -> Result<(), CaseError> {
+/// problem's dimension (`signorini check` on a problem file). Returns one line saying what was
+/// checked and bound: the mesh, the regions with their facets, the unknowns, the files in use.
+pub fn check(problem: &str) -> Result<String, CaseError> {
     let opts = Options::new(problem);
-    bound(&opts, |pf, _, ex, _| {
+    bound(&opts, |pf, _, ex, in_use| {
         let p = pf.problem();
         reference(pf, ex.dim())?;
         super::bind::settings(pf, ex, &p.run)?;
         super::bind::settings(pf, ex, &p.quadrature)?;
-        let (mesh, _) = super::bind::mesh(pf, ex, None, CellSize::Diameter)?;
+        let (mesh, label) = super::bind::mesh(pf, ex, None, CellSize::Diameter)?;
         super::bind::coefs(pf, ex)?;
         super::bind::coef_vals(pf, ex)?;
         super::bind::initial(pf, ex, &mesh, "u", 0.0)?;
         super::bind::initial(pf, ex, &mesh, "v", 0.0)?;
-        Ok(())
+        let regions: Vec<String> = p
+            .regions
+            .iter()
+            .map(|r| {
+                let n = mesh.region(&r.name.name).map_or(0, |g| g.facets.len());
+                format!("{} ({n} facet{})", r.name.name, if n == 1 { "" } else { "s" })
+            })
+            .collect();
+        let forms = &in_use.forms;
+        let files: Vec<String> = std::iter::once(format!("{} (scheme)", in_use.scheme_name()))
+            .chain(forms.units.iter().enumerate().map(|(i, u)| {
+                let role = if i == 0 {
+                    "material"
+                } else if i == forms.contact {
+                    "contact"
+                } else {
+                    "forms"
+                };
+                format!("{} ({role})", u.name())
+            }))
+            .collect();
+        Ok(format!(
+            "{}: problem `{}` checked and bound: {}D mesh {label}, {} nodes, {} cells, {} unknowns; regions {}; files in use {}",
+            pf.file,
+            pf.name(),
+            mesh.dim(),
+            mesh.num_nodes(),
+            mesh.num_cells(),
+            mesh.num_nodes() * mesh.dim(),
+            if regions.is_empty() { "none".to_string() } else { regions.join(", ") },
+            files.join(", ")
+        ))
     })
+}
+
+/// The params of the files a run of `opts` would use, with their values and where each comes
+/// from (the files' defaults, the problem's `set`, the user), without building anything.
+pub fn params_in_use(
+    opts: &Options,
+) -> Result<std::collections::BTreeMap<String, crate::driver::ParamValue>, CaseError> {
+    bound(opts, |_, _, _, in_use| Ok(in_use.forms.params.values()))
 }
 
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
@@ -104,7 +144,20 @@ fn bound<R>(
         sets.push((s.name.name.clone(), ex.scalar(&s.value).map_err(|e| pf.render(*e))?));
     }
     let overrides: Vec<(&str, f64)> = sets.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    let in_use = FilesInUse::resolve(&methods, &overrides)?;
+    let locate = |a: &crate::driver::params::Ambiguous| {
+        use crate::compiler::Diagnostic;
+        use crate::driver::params::Unnamed;
+        let name = &p.sets[a.index].name;
+        let span = name.span;
+        pf.render(match &a.why {
+            Unnamed::Several(choices) => crate::compiler::check::problem::ambiguous_param(name, choices),
+            Unnamed::UnknownQualifier(_) => {
+                Diagnostic::error("E0101", format!("unknown qualifier in `{}`", a.name), span, "no such role or file")
+                    .with_note(a.message())
+            }
+        })
+    };
+    let in_use = FilesInUse::resolve_located(&methods, &overrides, &locate)?;
     unset_coefs(&pf, &in_use)?;
     f(&pf, &params, &mut ex, &in_use)
 }
@@ -260,7 +313,8 @@ fn simulate(
     )?;
     let columns: Vec<String> = observer.names().map(str::to_string).collect();
     let shown = observer.shown();
-    let summary_fns = SummaryKeys::new(pf, ex, &columns)?;
+    let applies = super::summary::applies(pf, ex, &in_use.forms.params)?;
+    let summary_fns = SummaryKeys::new(pf, ex, &columns, applies)?;
     // A column only `at_max` reads (not written, plotted or read by another column or key) is
     // measured only where its maximand reaches a new maximum: the contact radius at the peak
     // force samples the pressure at those rows, not at every step.
@@ -533,7 +587,10 @@ fn simulate(
     put("linear_solves", counters.solves.into());
     put("peak_memory_bytes", json(&crate::resources::peak_memory()));
     put("step_cuts", outcome.cuts.into());
-    if !statics {
+    // A run without inertia (static, or a scheme without `mass`) watches no energy.
+    if let Runner::Time(sim) = &runner
+        && sim.inertia
+    {
         put("energy_growth", json(&outcome.energy_growth));
     }
     if let Some(stopped) = &outcome.stopped {
@@ -606,12 +663,45 @@ fn settle(
         newton: crate::runtime::nonlinear::newton::NewtonOptions { line_search: true, ..opts.newton },
         t: t0,
     };
-    let solution = crate::simulation::statics::solve(asm, problem, &in_use.forms, guess).map_err(|e| {
-        why(&format!(
-            "did not settle: {e} (a frictionless body free to slide along the obstacle has no equilibrium to settle in: hold it, or give it friction)"
-        ))
-    })?;
+    let solution = crate::simulation::statics::solve(asm, problem, &in_use.forms, guess)
+        .map_err(|e| unsettled(pf, e, frictional(&in_use.forms)))?;
     Ok(solution.u)
+}
+
+/// Whether the contact law in use has friction (it provides `friction_work`).
+fn frictional(forms: &crate::driver::FormsInUse) -> bool {
+    forms.units[forms.contact].slots().iter().any(|s| &*s.name == "friction_work")
+}
+
+/// Why `settled` found no equilibrium: Newton's residuals and active points, and what a
+/// singular or non-converging equilibrium means for this law.
+fn unsettled(pf: &ProblemFile, e: CaseError, frictional: bool) -> CaseError {
+    use crate::runtime::nonlinear::newton::NewtonError;
+    let CaseError::Newton(newton) = &e else {
+        return CaseError::Settle(format!("{}: `initial u = settled(...)` did not settle: {e}", pf.file));
+    };
+    let report = newton.report();
+    let active = report.history.last().map_or(0, |it| it.active);
+    let cause = match (newton, frictional) {
+        (NewtonError::Linear { .. }, _) => format!(
+            "the equilibrium's tangent is singular at an iterate with {active} active contact point(s): they do not hold the body in every direction (it can pivot about them or slide along the obstacle)"
+        ),
+        (_, false) => {
+            "a frictionless body free to slide along the obstacle has no equilibrium to settle in".to_string()
+        }
+        (_, true) => "the frictional stick did not hold the body: the load along the obstacle may exceed the friction"
+            .to_string(),
+    };
+    let help = if frictional {
+        "press the guess in further so that more of the contact region starts active, or hold the body with a pin (`dirichlet nearest(POINT): u[0] = 0`)"
+    } else {
+        "hold the body (a pin: `dirichlet nearest(POINT): u[0] = 0`), or give it friction"
+    };
+    CaseError::Settle(format!(
+        "{}: `initial u = settled(...)` did not settle: {newton}\n  Newton: {}\n  {cause}; {help}",
+        pf.file,
+        report.describe()
+    ))
 }
 
 /// The contact law's `Gamma_C`: the obstacle's region (`on REGION`, or `Gamma_C`); none without

@@ -38,24 +38,46 @@ struct Key {
 }
 
 /// `expect KEY = VALUE within TOL`, measured: the key's value, the expected one, their
-/// relative difference |value − expected| / |expected| (absolute, |value|, when the expected
-/// value is 0) and whether it is within TOL.
+/// difference, relative |value − expected| / |expected| or, when the expected value is 0,
+/// absolute |value| (`absolute`), and whether it is within TOL.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq)]
 pub struct Expectation {
     pub key: String,
     pub value: Option<f64>,
     pub expected: Option<f64>,
-    pub relative: Option<f64>,
+    pub difference: Option<f64>,
+    /// The difference and the tolerance are absolute (the expected value is 0), not relative.
+    pub absolute: bool,
     pub within: f64,
     pub met: bool,
+    /// Whether its `when` holds on this run (an expectation that does not apply is not met,
+    /// and not a failure).
+    #[serde(default = "yes")]
+    pub applies: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Expectation {
-    /// The value, the expected value and the relative difference as a table shows them
-    /// (`none` where there is none).
-    pub fn shown(&self) -> [String; 3] {
-        let number = |x: Option<f64>| x.map_or("none".to_string(), |x| format!("{x:.6}"));
-        [number(self.value), number(self.expected), self.relative.map_or("none".to_string(), |r| format!("{r:.2e}"))]
+    /// The value, the expected value, the difference (`1.7e-2 relative`, `3.1e-11 absolute`)
+    /// and the tolerance as a table or a line shows them (`none` where there is none).
+    pub fn shown(&self) -> [String; 4] {
+        use crate::numbers::readable;
+        let number = |x: Option<f64>| x.map_or("none".to_string(), readable);
+        let kind = self.kind();
+        [
+            number(self.value),
+            number(self.expected),
+            self.difference.map_or("none".to_string(), |d| format!("{} {kind}", readable(d))),
+            format!("{} {kind}", readable(self.within)),
+        ]
+    }
+
+    /// `absolute` or `relative`: how the difference and the tolerance are measured.
+    pub fn kind(&self) -> &'static str {
+        if self.absolute { "absolute" } else { "relative" }
     }
 }
 
@@ -66,14 +88,22 @@ pub struct SummaryKeys {
     /// Per expectation: the key it names, its tolerance, and whether its value compiled (an
     /// expected value these params make infinite, v0/μ at μ = 0, has none).
     expects: Vec<(String, f64, bool)>,
+    /// Per expectation: whether its `when` holds on this run.
+    applies: Vec<bool>,
     columns: usize,
     /// The names the reducers' expression arguments read (not plain columns).
     read_by_expressions: Vec<String>,
 }
 
 impl SummaryKeys {
-    /// `columns`: every column's name, in row order.
-    pub fn new(pf: &ProblemFile, ex: &mut Exprs, columns: &[String]) -> Result<SummaryKeys, CaseError> {
+    /// `columns`: every column's name, in row order; `applies`: per expectation, whether its
+    /// `when` holds ([`applies`]).
+    pub fn new(
+        pf: &ProblemFile,
+        ex: &mut Exprs,
+        columns: &[String],
+        applies: Vec<bool>,
+    ) -> Result<SummaryKeys, CaseError> {
         let mut keys: Vec<Key> = Vec::new();
         let mut read_by_expressions = Vec::new();
         // In a reducer's argument: column i is measured value i, key j is measured value
@@ -127,7 +157,7 @@ impl SummaryKeys {
             row_scope.push((name.clone(), ex.measured(columns.len() + keys.len(), 1)));
             keys.push(Key { name, reduces, f });
         }
-        Ok(SummaryKeys { keys, expects, columns: columns.len(), read_by_expressions })
+        Ok(SummaryKeys { keys, expects, applies, columns: columns.len(), read_by_expressions })
     }
 
     /// The (column, of) pairs of `at_max(column, of)` whose column no other reducer reads: the
@@ -164,13 +194,24 @@ impl SummaryKeys {
         let expectations = self
             .expects
             .iter()
-            .map(|(key, within, ok)| {
+            .zip(&self.applies)
+            .map(|((key, within, ok), applies)| {
                 let expected = if *ok { expected.next().flatten() } else { None };
                 let value = all.iter().find(|(k, _)| k == key).and_then(|(_, v)| *v);
-                let relative =
-                    value.zip(expected).map(|(v, e)| if e == 0.0 { v.abs() } else { (v - e).abs() / e.abs() });
-                let met = relative.is_some_and(|r| r <= *within);
-                Expectation { key: key.clone(), value, expected, relative, within: *within, met }
+                let absolute = expected == Some(0.0);
+                let difference =
+                    value.zip(expected).map(|(v, e)| if absolute { v.abs() } else { (v - e).abs() / e.abs() });
+                let met = *applies && difference.is_some_and(|r| r <= *within);
+                Expectation {
+                    key: key.clone(),
+                    value,
+                    expected,
+                    difference,
+                    absolute,
+                    within: *within,
+                    met,
+                    applies: *applies,
+                }
             })
             .collect();
         (all, expectations)
@@ -283,19 +324,86 @@ fn summary_rewrite(e: &Expr, calls: &mut Vec<(Reduce, Vec<Expr>)>) -> Expr {
 
 /// Every name an expression reads.
 fn names_in(e: &Expr, out: &mut Vec<String>) {
+    let mut ids = Vec::new();
+    idents_in(e, &mut ids);
+    out.extend(ids.into_iter().map(|id| id.name.clone()));
+}
+
+/// Per `expect` line, whether its `when` holds on this run: a condition of the problem's params
+/// and `let`s and of the params of the files in use (by name, as `set` names them). A param
+/// only files not in use declare (another law's `F`) makes it not apply; a name no file of the
+/// library declares either is an error at it.
+pub fn applies(pf: &ProblemFile, ex: &mut Exprs, files: &crate::driver::params::Table) -> Result<Vec<bool>, CaseError> {
+    use crate::compiler::Diagnostic;
+    let mut out = Vec::new();
+    for x in &pf.problem().expects {
+        let Some(when) = &x.when else {
+            out.push(true);
+            continue;
+        };
+        let mut names = Vec::new();
+        for c in when.comparisons() {
+            idents_in(&c.lhs, &mut names);
+            idents_in(&c.rhs, &mut names);
+        }
+        let mut extra: Vec<(String, Val)> = Vec::new();
+        let mut in_use = true;
+        for id in names {
+            if ex.constant(&id.name).is_some() || extra.iter().any(|(n, _)| *n == id.name) {
+                continue;
+            }
+            match files.lookup(&id.name) {
+                Ok(Some(value)) => extra.push((id.name.clone(), ex.low.constant_val(value))),
+                Ok(None) if crate::driver::library_declares(&id.name) => in_use = false,
+                Ok(None) => {
+                    let known = files.names();
+                    let mut d = Diagnostic::error(
+                        "E0101",
+                        format!("unknown param `{}`", id.name),
+                        id.span,
+                        "no file declares it",
+                    )
+                    .with_note(format!(
+                        "`when` reads the problem's params and `let`s, and the params of the files in use: {}",
+                        known.join(", ")
+                    ));
+                    if let Some(s) = crate::compiler::check::suggest_name(&id.name, known.iter().map(String::as_str)) {
+                        d = d.with_help(format!("did you mean `{s}`?"));
+                    }
+                    return Err(pf.render(d));
+                }
+                Err(choices) => {
+                    return Err(pf.render(crate::compiler::check::problem::ambiguous_param(id, &choices).with_help(
+                        "compare a problem param the problem sets it from (`when F == mu` after `set F = mu`)",
+                    )));
+                }
+            }
+        }
+        if !in_use {
+            out.push(false);
+            continue;
+        }
+        let mut holds = Vec::new();
+        for c in when.comparisons() {
+            let lhs = ex.scalar_with(&c.lhs, &extra).map_err(|e| pf.render(*e))?;
+            let rhs = ex.scalar_with(&c.rhs, &extra).map_err(|e| pf.render(*e))?;
+            holds.push(c.op.holds(lhs, rhs));
+        }
+        out.push(when.holds(&mut holds.into_iter()));
+    }
+    Ok(out)
+}
+
+/// The names an expression reads, in order (calls' names left out).
+fn idents_in<'e>(e: &'e Expr, out: &mut Vec<&'e Ident>) {
     match &e.kind {
-        ExprKind::Name(n) => out.push(n.name.clone()),
-        ExprKind::Neg(a) => names_in(a, out),
-        ExprKind::Binary(_, a, b) => {
-            names_in(a, out);
-            names_in(b, out);
+        ExprKind::Name(id) => out.push(id),
+        ExprKind::Number(_) => {}
+        ExprKind::Neg(a) => idents_in(a, out),
+        ExprKind::Binary(_, a, b) | ExprKind::Index(a, b) => {
+            idents_in(a, out);
+            idents_in(b, out);
         }
-        ExprKind::Call(_, args) => args.iter().for_each(|a| names_in(a, out)),
-        ExprKind::Vector(items) => items.iter().for_each(|a| names_in(a, out)),
-        ExprKind::Index(a, i) => {
-            names_in(a, out);
-            names_in(i, out);
-        }
-        _ => {}
+        ExprKind::Call(_, args) | ExprKind::Vector(args) => args.iter().for_each(|a| idents_in(a, out)),
     }
 }

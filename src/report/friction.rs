@@ -21,7 +21,7 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
     problems.dedup();
     let runs: Vec<String> = problems.iter().map(|p| format!("`run {p}`")).collect();
     let mut md = format!("## 6. Friction ({})\n\n", runs.join(", "));
-    md.push_str("What the problems expect of themselves (`expect` lines: the rigid-body limits, Coulomb's bound; docs/problems.md, Friction), run at their defaults with the law shown:\n\n| run | contact | key | value | expected | relative | within | met |\n|---|---|---|---|---|---|---|---|\n");
+    md.push_str("What the problems expect of themselves (`expect` lines: the rigid-body limits, Coulomb's bound; docs/problems.md, Friction), run at their defaults with the law shown:\n\n| run | contact | key | value | expected | difference | within | met |\n|---|---|---|---|---|---|---|---|\n");
     let mut figures = String::new();
     for (k, f) in settings.friction.iter().enumerate() {
         progress(&format!("friction: {}", f.label));
@@ -40,12 +40,12 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         let s = run(&opts)?.summary;
         let contact = s.get("contact").and_then(|v| v.as_str()).unwrap_or_default().to_string();
         for x in s.field::<Vec<Expectation>>("expected")? {
-            let [value, expected, relative] = x.shown();
+            let [value, expected, difference, within] = x.shown();
             let met = if x.met { "yes" } else { "no (the expectation is another law's)" };
             let _ = writeln!(
                 md,
-                "| {} | {contact} | {} | {value} | {expected} | {relative} | {} | {met} |",
-                f.label, x.key, x.within
+                "| {} | {contact} | {} | {value} | {expected} | {difference} | {within} | {met} |",
+                f.label, x.key
             );
         }
         let _ = writeln!(figures, "![{}](friction/{sub}/{}.png)\n", f.label, f.problem);

@@ -89,6 +89,9 @@ pub struct Simulation<'m> {
     law: Option<EnergyLaw>,
     /// The critical step of a scheme that claims `cfl` (an explicit one).
     pub stable: Option<stability::StableStep>,
+    /// Whether the scheme applies a mass: without, each step is an equilibrium of its own and
+    /// no energy is watched.
+    pub inertia: bool,
 }
 
 /// One finished step, as the observer sees it.
@@ -162,7 +165,7 @@ impl<'m> Simulation<'m> {
             Some((_, cfl)) => Some(stability::estimate(&ops, coefs, &held, cfl)?),
             None => None,
         };
-        Ok(Simulation { stepper, ops, states, v_index, guard, params, law, stable })
+        Ok(Simulation { stepper, ops, states, v_index, guard, params, law, stable, inertia })
     }
 
     /// Sets the displacement and solves the scheme's initial problem (the acceleration).
@@ -499,19 +502,7 @@ pub struct Resumed {
 
 /// The residual history of a failed Newton, for the stop message.
 fn history(e: &crate::runtime::time::stepper::StepError) -> String {
-    use crate::runtime::nonlinear::newton::NewtonError;
     use crate::runtime::time::stepper::StepError;
     let StepError::Newton { source, .. } = e else { return String::new() };
-    let report = match source {
-        NewtonError::IterationLimit { report, .. } | NewtonError::NonFinite { report } => report,
-        NewtonError::Linear { report, .. } => report,
-    };
-    let mut text = format!("residual {:.3e}", report.initial_residual);
-    for it in &report.history {
-        match it.tolerance {
-            Some(eta) => text.push_str(&format!(" → {:.3e} ({} active, solved to {eta:.0e})", it.residual, it.active)),
-            None => text.push_str(&format!(" → {:.3e} ({} active)", it.residual, it.active)),
-        }
-    }
-    text
+    source.report().describe()
 }

@@ -42,15 +42,15 @@ pub fn expectations(progress: &mut dyn FnMut(&str)) -> Result<Vec<LimitRow>, Cas
 /// The table, as Markdown.
 pub fn markdown(rows: &[LimitRow]) -> String {
     let mut md = String::from(
-        "### (e) Limits the problems expect\n\nEach library problem with `expect KEY = VALUE within TOL` lines, run at its defaults (`signorini run NAME` prints the same lines): the friction problems against the rigid body they approach and Coulomb's bound (docs/problems.md, Friction).\n\n| problem | scheme | contact | key | value | expected | relative | within | met |\n|---|---|---|---|---|---|---|---|---|\n",
+        "### (e) Limits the problems expect\n\nEach library problem with `expect KEY = VALUE within TOL` lines, run at its defaults (`signorini run NAME` prints the same lines): the friction problems against the rigid body they approach and Coulomb's bound (docs/problems.md, Friction).\n\n| problem | scheme | contact | key | value | expected | difference | within | met |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let x = &r.expectation;
-        let [value, expected, relative] = x.shown();
+        let [value, expected, difference, within] = x.shown();
         let met = if x.met { "yes" } else { "**no**" };
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {value} | {expected} | {relative} | {} | {met} |\n",
-            r.problem, r.scheme, r.contact, x.key, x.within
+            "| {} | {} | {} | {} | {value} | {expected} | {difference} | {within} | {met} |\n",
+            r.problem, r.scheme, r.contact, x.key
         ));
     }
     md

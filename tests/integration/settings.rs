@@ -56,3 +56,40 @@ fn library_settings_name_library_files() {
         assert!(problems.contains(&problem.as_str()), "unknown problem `{problem}` (known: {problems:?})");
     }
 }
+
+/// A problem's `set` reaches only the params it names: under every library scheme, every
+/// library problem leaves each of the scheme's params at its file's default unless one of its
+/// `set`s names it (`rho` is the material's density and generalized-α's ρ∞: the problems say
+/// `material.rho`), and each `set` reaches exactly one param when the files declare it.
+#[test]
+fn a_problem_s_set_reaches_only_the_param_it_names() {
+    use signorini::driver::params::Source;
+    use signorini::problem::run::{Options, params_in_use};
+    for problem in signorini::problem::library_names() {
+        let pf = signorini::problem::load(problem).unwrap();
+        let sets: Vec<String> = pf.problem().sets.iter().map(|s| s.name.name.clone()).collect();
+        for scheme in driver::all_schemes() {
+            let mut opts = Options::new(problem);
+            opts.methods.scheme = scheme.to_string();
+            opts.chosen.scheme = true;
+            let params = params_in_use(&opts).unwrap_or_else(|e| panic!("{problem} with {scheme}: {e}"));
+            let file = format!("forms/schemes/{scheme}.wf:");
+            for (name, p) in params.iter().filter(|(_, p)| p.declared.starts_with(&file)) {
+                let bare = name.rsplit('.').next().unwrap();
+                let named = sets.iter().any(|s| match s.rsplit_once('.') {
+                    Some((owner, n)) => n == bare && (owner == "scheme" || owner == scheme),
+                    None => s == bare,
+                });
+                if named {
+                    assert_eq!(p.source, Source::Case, "{problem} with {scheme}: `{name}` is set by the problem");
+                } else {
+                    assert_eq!(p.source, Source::File, "{problem} with {scheme}: `{name}` = {} was not named", p.value);
+                }
+            }
+            // Each `set` the files in use declare reaches one param: the count of params the
+            // problem set is at most its count of `set`s.
+            let reached = params.values().filter(|p| p.source == Source::Case).count();
+            assert!(reached <= sets.len(), "{problem} with {scheme}: {reached} params set by {} `set`s", sets.len());
+        }
+    }
+}

@@ -254,7 +254,7 @@ pub enum MeshSource {
     Generator(NamedCall),
 }
 
-/// `lhs < rhs` and the like, in a region predicate.
+/// `lhs < rhs` and the like, in a region predicate or an expectation's `when`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Comparison {
     pub lhs: Expr,
@@ -269,6 +269,8 @@ pub enum Compare {
     LessEqual,
     Greater,
     GreaterEqual,
+    Equal,
+    NotEqual,
 }
 
 impl Compare {
@@ -278,6 +280,8 @@ impl Compare {
             Compare::LessEqual => "<=",
             Compare::Greater => ">",
             Compare::GreaterEqual => ">=",
+            Compare::Equal => "==",
+            Compare::NotEqual => "!=",
         }
     }
 
@@ -288,6 +292,39 @@ impl Compare {
             Compare::LessEqual => a <= b,
             Compare::Greater => a > b,
             Compare::GreaterEqual => a >= b,
+            Compare::Equal => a == b,
+            Compare::NotEqual => a != b,
+        }
+    }
+}
+
+/// Comparisons joined by `and`, `or` and `not`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Condition {
+    Compare(Comparison),
+    All(Vec<Condition>),
+    Any(Vec<Condition>),
+    Not(Box<Condition>),
+}
+
+impl Condition {
+    /// Every comparison, in the order written.
+    pub fn comparisons(&self) -> Vec<&Comparison> {
+        match self {
+            Condition::Compare(c) => vec![c],
+            Condition::All(parts) | Condition::Any(parts) => parts.iter().flat_map(Condition::comparisons).collect(),
+            Condition::Not(c) => c.comparisons(),
+        }
+    }
+
+    /// Whether it holds, given whether each comparison (in [`Condition::comparisons`]'s order)
+    /// holds. Every comparison is consumed, whatever short-circuits.
+    pub fn holds(&self, comparisons: &mut impl Iterator<Item = bool>) -> bool {
+        match self {
+            Condition::Compare(_) => comparisons.next().unwrap_or(false),
+            Condition::All(parts) => parts.iter().map(|c| c.holds(comparisons)).fold(true, |a, b| a & b),
+            Condition::Any(parts) => parts.iter().map(|c| c.holds(comparisons)).fold(false, |a, b| a | b),
+            Condition::Not(c) => !c.holds(comparisons),
         }
     }
 }
@@ -295,11 +332,26 @@ impl Compare {
 /// One way to find a region's facets.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RegionSource {
-    /// A Gmsh physical group, by name; with comparisons, its facets that satisfy them all.
-    Group { name: String, conditions: Vec<Comparison>, span: Span },
-    /// The boundary facets whose outward normal `n` and centroid `x` satisfy every comparison
+    /// A Gmsh physical group, by name; with a condition, its facets that satisfy it.
+    Group { name: String, condition: Option<Condition>, span: Span },
+    /// The boundary facets whose outward normal `n` and centroid `x` satisfy the condition
     /// (all of the boundary without one).
-    Boundary { conditions: Vec<Comparison>, span: Span },
+    Boundary { condition: Option<Condition>, span: Span },
+    /// An earlier region, by name.
+    Region(Ident),
+    /// The facets of every part, in the order written, each once.
+    Union(Vec<RegionSource>, Span),
+}
+
+impl RegionSource {
+    pub fn span(&self) -> Span {
+        match self {
+            RegionSource::Group { span, .. } | RegionSource::Boundary { span, .. } | RegionSource::Union(_, span) => {
+                *span
+            }
+            RegionSource::Region(id) => id.span,
+        }
+    }
 }
 
 /// `region NAME = SOURCE else SOURCE ...`: the first source that names anything.
@@ -388,6 +440,8 @@ pub struct Expect {
     pub key: Ident,
     pub value: Expr,
     pub within: Expr,
+    /// `when CONDITION`: of params; the runs where it does not hold do not check it.
+    pub when: Option<Condition>,
     pub span: Span,
 }
 

@@ -122,6 +122,36 @@ fn named_call(c: &NamedCall) -> String {
     format!("{}({})", c.name.name, a.join(", "))
 }
 
+fn region_source(s: &RegionSource) -> String {
+    let (head, c) = match s {
+        RegionSource::Group { name, condition, .. } => (format!("group {name:?}"), condition),
+        RegionSource::Boundary { condition, .. } => ("boundary".to_string(), condition),
+        RegionSource::Region(id) => return id.name.clone(),
+        RegionSource::Union(parts, _) => {
+            let parts: Vec<String> = parts.iter().map(|p| format!("({})", region_source(p))).collect();
+            return parts.join(" + ");
+        }
+    };
+    c.as_ref().map_or(head.clone(), |c| format!("{head} where {}", condition(c)))
+}
+
+/// A condition, parenthesised where `or` sits inside `and` or `not`.
+fn condition(c: &Condition) -> String {
+    let inner = |c: &Condition| match c {
+        Condition::Any(_) => format!("({})", condition(c)),
+        _ => condition(c),
+    };
+    match c {
+        Condition::Compare(c) => format!("{} {} {}", expr(&c.lhs), c.op.symbol(), expr(&c.rhs)),
+        Condition::All(parts) => parts.iter().map(inner).collect::<Vec<_>>().join(" and "),
+        Condition::Any(parts) => parts.iter().map(condition).collect::<Vec<_>>().join(" or "),
+        Condition::Not(c) => match **c {
+            Condition::Compare(_) => format!("not {}", condition(c)),
+            _ => format!("not ({})", condition(c)),
+        },
+    }
+}
+
 fn problem(p: &Problem, out: &mut String) {
     let line = |out: &mut String, what: &str, d: &Defined| {
         out.push_str(&format!("  {what} {} = {}\n", d.name.name, expr(&d.value)));
@@ -133,19 +163,7 @@ fn problem(p: &Problem, out: &mut String) {
         }
     }
     for r in &p.regions {
-        let sources: Vec<String> = r
-            .sources
-            .iter()
-            .map(|s| {
-                let (head, conditions) = match s {
-                    RegionSource::Group { name, conditions, .. } => (format!("group {name:?}"), conditions),
-                    RegionSource::Boundary { conditions, .. } => ("boundary".to_string(), conditions),
-                };
-                let c: Vec<String> =
-                    conditions.iter().map(|c| format!("{} {} {}", expr(&c.lhs), c.op.symbol(), expr(&c.rhs))).collect();
-                if c.is_empty() { head } else { format!("{head} where {}", c.join(" and ")) }
-            })
-            .collect();
+        let sources: Vec<String> = r.sources.iter().map(region_source).collect();
         out.push_str(&format!("  region {} = {}\n", r.name.name, sources.join(" else ")));
     }
     for b in &p.binds {
@@ -187,7 +205,8 @@ fn problem(p: &Problem, out: &mut String) {
         line(out, "summary", d);
     }
     for x in &p.expects {
-        out.push_str(&format!("  expect {} = {} within {}\n", x.key.name, expr(&x.value), expr(&x.within)));
+        let when = x.when.as_ref().map_or(String::new(), |c| format!(" when {}", condition(c)));
+        out.push_str(&format!("  expect {} = {} within {}{when}\n", x.key.name, expr(&x.value), expr(&x.within)));
     }
     for pl in &p.plots {
         let c: Vec<&str> = pl.columns.iter().map(|c| c.name.as_str()).collect();

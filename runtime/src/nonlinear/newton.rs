@@ -112,6 +112,21 @@ impl NewtonReport {
     pub fn iterations(&self) -> usize {
         self.history.len()
     }
+
+    /// The residuals from the first, with each iterate's active points (and the tolerance of
+    /// an iterative solve): what a failure message shows.
+    pub fn describe(&self) -> String {
+        let mut text = format!("residual {:.3e}", self.initial_residual);
+        for it in &self.history {
+            match it.tolerance {
+                Some(eta) => {
+                    text.push_str(&format!(" → {:.3e} ({} active, solved to {eta:.0e})", it.residual, it.active))
+                }
+                None => text.push_str(&format!(" → {:.3e} ({} active)", it.residual, it.active)),
+            }
+        }
+        text
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -122,6 +137,16 @@ pub enum NewtonError {
     NonFinite { report: NewtonReport },
     #[error("Newton's linear solve failed at iteration {}: {source}", .report.iterations() + 1)]
     Linear { source: LinalgError, report: NewtonReport },
+}
+
+impl NewtonError {
+    /// What Newton saw before it failed.
+    pub fn report(&self) -> &NewtonReport {
+        match self {
+            NewtonError::IterationLimit { report, .. } | NewtonError::NonFinite { report } => report,
+            NewtonError::Linear { report, .. } => report,
+        }
+    }
 }
 
 /// Newton's method with a reusable factorization.

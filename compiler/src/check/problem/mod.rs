@@ -118,13 +118,52 @@ fn mesh(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut Vec<Diagnos
 fn region_predicates(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut Vec<Diagnostic>) {
     distinct(p.regions.iter().map(|r| &r.name), "region", diags);
     // `x` and `t` are built-in names; `n` too, but it means something only on a facet.
-    for r in &p.regions {
+    for (i, r) in p.regions.iter().enumerate() {
+        let earlier: Vec<&str> = p.regions[..i].iter().map(|r| r.name.name.as_str()).collect();
         for s in &r.sources {
-            let (RegionSource::Boundary { conditions, .. } | RegionSource::Group { conditions, .. }) = s;
-            for cmp in conditions {
+            region_source(c, s, constants, &earlier, diags);
+        }
+    }
+}
+
+/// A region's source: its predicates' comparisons are scalars of `x` and `n`; a region it names
+/// is an earlier one.
+fn region_source(c: &mut Checker, s: &RegionSource, constants: &Names, earlier: &[&str], diags: &mut Vec<Diagnostic>) {
+    match s {
+        RegionSource::Boundary { condition, .. } | RegionSource::Group { condition, .. } => {
+            for cmp in condition.iter().flat_map(|c| c.comparisons()) {
                 for side in [&cmp.lhs, &cmp.rhs] {
+                    // A region's name in a predicate: the union's `+` was read as arithmetic.
+                    if let Some(id) = names_in(side).into_iter().find(|id| earlier.contains(&id.name.as_str())) {
+                        diags.push(
+                            Diagnostic::error(
+                                "E0301",
+                                format!("region `{}` inside a predicate", id.name),
+                                id.span,
+                                "a region, not a number",
+                            )
+                            .with_help(format!(
+                                "to join it, parenthesise the part before: `(boundary where ...) + {}`",
+                                id.name
+                            )),
+                        );
+                        continue;
+                    }
                     scalar(c, side, constants, diags, true);
                 }
+            }
+        }
+        RegionSource::Region(id) => {
+            if !earlier.contains(&id.name.as_str()) {
+                diags.push(
+                    unknown_among(id, earlier.iter().copied(), "region")
+                        .with_help("a union names regions defined above it"),
+                );
+            }
+        }
+        RegionSource::Union(parts, _) => {
+            for part in parts {
+                region_source(c, part, constants, earlier, diags);
             }
         }
     }
@@ -163,6 +202,12 @@ fn settings_of_the_run(c: &mut Checker, p: &Problem, constants: &Names, diags: &
         );
     }
     settings(&p.quadrature, QUADRATURE_SETTINGS.iter().copied(), "quadrature setting", c, constants, diags);
+    // The files' params: numbers of the problem's; which file declares each is known when the
+    // problem is bound to the files in use.
+    distinct(p.sets.iter().map(|d| &d.name), "`set` of a param", diags);
+    for d in &p.sets {
+        scalar(c, &d.value, constants, diags, false);
+    }
 }
 
 /// Dirichlet conditions: on `u`, on a known region that is not a contact region, or at the
@@ -440,4 +485,29 @@ pub fn unread_coef(name: &Ident, files: &[&str]) -> Diagnostic {
     )
     .with_note(format!("the files in use: {}", files.join(", ")))
     .with_help("check its name against the forms' `coef` lines, or add the file that reads it (--forms, --material)")
+}
+
+/// The names an expression reads (not the functions it calls), in order.
+fn names_in(e: &Expr) -> Vec<&Ident> {
+    use crate::syntax::ast::ExprKind as K;
+    match &e.kind {
+        K::Name(id) => vec![id],
+        K::Number(_) => Vec::new(),
+        K::Neg(a) => names_in(a),
+        K::Binary(_, a, b) | K::Index(a, b) => names_in(a).into_iter().chain(names_in(b)).collect(),
+        K::Call(_, args) | K::Vector(args) => args.iter().flat_map(names_in).collect(),
+    }
+}
+
+/// E0906: `name` (a `set`, or a param a `when` reads) answers to several params of the files
+/// in use; `choices` are their qualified names with their declarations.
+pub fn ambiguous_param(name: &Ident, choices: &[String]) -> Diagnostic {
+    Diagnostic::error(
+        "E0906",
+        format!("`{}` is ambiguous", name.name),
+        name.span,
+        "more than one file in use declares it",
+    )
+    .with_note(format!("write {}", choices.join(" or ")))
+    .with_help("qualify it by the file's role or name: `set material.rho = 1`, `set scheme.rho = 0.5`")
 }

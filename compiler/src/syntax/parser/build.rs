@@ -257,6 +257,36 @@ impl Builder {
         Ok(NamedCall { name, args, span })
     }
 
+    /// `a < b and not (c > d or e >= f)`: `or` of `and`s of (negated) comparisons.
+    pub(super) fn condition(&self, p: Pair<Rule>) -> Result<Condition, Box<Diagnostic>> {
+        let one_or = |mut parts: Vec<Condition>, all: bool| {
+            if parts.len() == 1 {
+                parts.remove(0)
+            } else if all {
+                Condition::All(parts)
+            } else {
+                Condition::Any(parts)
+            }
+        };
+        match p.as_rule() {
+            Rule::condition | Rule::conjunction => {
+                let all = p.as_rule() == Rule::conjunction;
+                let parts = p.into_inner().map(|q| self.condition(q)).collect::<Result<Vec<_>, _>>()?;
+                Ok(one_or(parts, all))
+            }
+            Rule::negation => {
+                let mut it = p.into_inner().peekable();
+                let negated = it.peek().is_some_and(|q| q.as_rule() == Rule::not_op);
+                if negated {
+                    it.next();
+                }
+                let inner = self.condition(it.next().expect("negated condition"))?;
+                Ok(if negated { Condition::Not(Box::new(inner)) } else { inner })
+            }
+            _ => Ok(Condition::Compare(self.comparison(p)?)),
+        }
+    }
+
     pub(super) fn comparison(&self, p: Pair<Rule>) -> Result<Comparison, Box<Diagnostic>> {
         let span = self.span(&p);
         let mut it = p.into_inner();
@@ -265,6 +295,8 @@ impl Builder {
             "<" => Compare::Less,
             "<=" => Compare::LessEqual,
             ">" => Compare::Greater,
+            "==" => Compare::Equal,
+            "!=" => Compare::NotEqual,
             _ => Compare::GreaterEqual,
         };
         let rhs = self.expr(it.next().expect("rhs"))?;

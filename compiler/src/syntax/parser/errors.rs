@@ -103,6 +103,21 @@ pub(super) fn syntax_error(file: FileId, chunk: &str, offset: usize, e: &pest::e
     let at_end = pos >= content_end;
     let pos = pos.min(content_end);
     let found = if at_end { "" } else { found_token(&chunk[pos..]) };
+    // A reserved word where a name was expected: the parser may have looked past it.
+    let before = chunk[..pos].trim_end();
+    let word_start = before.trim_end_matches(|c: char| c.is_ascii_alphanumeric() || c == '_').len();
+    if has("a name", &expected) && RESERVED.contains(&&before[word_start..]) && !RESERVED.contains(&found) {
+        let word = &before[word_start..];
+        let span = Span::new(file, offset + word_start, offset + before.len());
+        return Diagnostic::error(
+            "E0001",
+            "syntax error",
+            span,
+            format!("expected a name, found the reserved word `{word}`"),
+        )
+        .with_note(format!("`{word}` is a reserved word of the language: it cannot name anything"))
+        .with_help(format!("choose another name (`{word}_`, say)"));
+    }
     let span = Span::new(file, offset + pos, offset + pos + found.len());
     let found_text = if at_end { "the end of the item".to_string() } else { format!("`{found}`") };
     let message = if expected.is_empty() {
@@ -120,9 +135,62 @@ pub(super) fn syntax_error(file: FileId, chunk: &str, offset: usize, e: &pest::e
         );
     } else if found == ":" {
         d = d.with_help("declare case data with `coef NAME: vector`; parameters are `param NAME = VALUE`");
+    } else if has("a name", &expected) && RESERVED.contains(&found) {
+        d = d
+            .with_note(format!("`{found}` is a reserved word of the language: it cannot name anything"))
+            .with_help(format!("choose another name (`{found}_`, say)"));
     }
     d
 }
+
+/// The language's keywords (grammar.pest's `keyword`), which no name may be.
+const RESERVED: &[&str] = &[
+    "import",
+    "param",
+    "coef",
+    "let",
+    "fn",
+    "form",
+    "functional",
+    "int",
+    "in",
+    "scheme",
+    "state",
+    "unknown",
+    "new",
+    "claim",
+    "relate",
+    "residual",
+    "stage",
+    "at",
+    "initial",
+    "uses",
+    "problem",
+    "mesh",
+    "region",
+    "group",
+    "boundary",
+    "where",
+    "else",
+    "and",
+    "bind",
+    "set",
+    "obstacle",
+    "on",
+    "dirichlet",
+    "series",
+    "observe",
+    "summary",
+    "plot",
+    "run",
+    "quadrature",
+    "reference",
+    "expect",
+    "within",
+    "when",
+    "or",
+    "not",
+];
 
 /// Offset just after the last character of the chunk that is not whitespace or a comment.
 fn content_end(chunk: &str) -> usize {
@@ -243,4 +311,19 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::vector => "an expression",
         _ => return None,
     })
+}
+
+#[cfg(test)]
+mod reserved_words {
+    /// The reserved words named in messages are grammar.pest's keywords, all of them.
+    #[test]
+    fn are_the_grammar_s_keywords() {
+        let grammar = include_str!("../grammar.pest");
+        let rule = grammar.split("keyword    = @{").nth(1).and_then(|r| r.split("~ !ident_char").next()).unwrap();
+        let mut words: Vec<&str> = rule.split('"').skip(1).step_by(2).collect();
+        let mut reserved = super::RESERVED.to_vec();
+        words.sort_unstable();
+        reserved.sort_unstable();
+        assert_eq!(words, reserved);
+    }
 }

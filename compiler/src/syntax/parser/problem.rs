@@ -56,24 +56,7 @@ impl Builder {
                 }
                 Rule::region_decl => {
                     let name = self.ident(next());
-                    let mut sources = Vec::new();
-                    for q in it {
-                        let q = q.into_inner().next().expect("region source");
-                        let qspan = self.span(&q);
-                        sources.push(match q.as_rule() {
-                            Rule::group_source => {
-                                let mut parts = q.into_inner();
-                                let name = unquote(parts.next().expect("group name").as_str());
-                                let conditions = parts.map(|c| self.comparison(c)).collect::<Result<Vec<_>, _>>()?;
-                                RegionSource::Group { name, conditions, span: qspan }
-                            }
-                            _ => {
-                                let conditions =
-                                    q.into_inner().map(|c| self.comparison(c)).collect::<Result<Vec<_>, _>>()?;
-                                RegionSource::Boundary { conditions, span: qspan }
-                            }
-                        });
-                    }
+                    let sources = it.map(|q| self.region_source(q)).collect::<Result<Vec<_>, _>>()?;
                     pb.regions.push(RegionDecl { name, sources, span });
                 }
                 Rule::bind_decl => {
@@ -87,7 +70,14 @@ impl Builder {
                         pb.binds.push(Bind { role, target, is_path, span });
                     }
                 }
-                Rule::set_decl => pb.sets.extend(self.assignments(next())?),
+                Rule::set_decl => {
+                    for q in it {
+                        let span = self.span(&q);
+                        let mut parts = q.into_inner();
+                        let name = self.ident(parts.next().expect("param path"));
+                        pb.sets.push(Defined { name, value: self.expr(parts.next().expect("value"))?, span });
+                    }
+                }
                 Rule::run_decl => {
                     let q = next();
                     if q.as_rule() == Rule::run_static {
@@ -106,7 +96,8 @@ impl Builder {
                     let key = self.ident(next());
                     let value = self.expr(next())?;
                     let within = self.expr(next())?;
-                    pb.expects.push(Expect { key, value, within, span });
+                    let when = it.next().map(|q| self.condition(q)).transpose()?;
+                    pb.expects.push(Expect { key, value, within, when, span });
                 }
                 Rule::let_decl => pb.lets.push(self.defined(span, next(), it.next())?),
                 Rule::obstacle_decl => {
@@ -157,5 +148,31 @@ impl Builder {
             }
         }
         Ok(pb)
+    }
+
+    /// A region's source: a union of parts (one part is itself).
+    fn region_source(&self, p: Pair<Rule>) -> Result<RegionSource, Box<Diagnostic>> {
+        let span = self.span(&p);
+        let mut parts = p
+            .into_inner()
+            .map(|q| {
+                let qspan = self.span(&q);
+                Ok(match q.as_rule() {
+                    Rule::group_source => {
+                        let mut parts = q.into_inner();
+                        let name = unquote(parts.next().expect("group name").as_str());
+                        let condition = parts.next().map(|c| self.condition(c)).transpose()?;
+                        RegionSource::Group { name, condition, span: qspan }
+                    }
+                    Rule::boundary_source => {
+                        let condition = q.into_inner().next().map(|c| self.condition(c)).transpose()?;
+                        RegionSource::Boundary { condition, span: qspan }
+                    }
+                    Rule::region_name => RegionSource::Region(self.ident(q.into_inner().next().expect("name"))),
+                    _ => self.region_source(q)?,
+                })
+            })
+            .collect::<Result<Vec<_>, Box<Diagnostic>>>()?;
+        Ok(if parts.len() == 1 { parts.remove(0) } else { RegionSource::Union(parts, span) })
     }
 }
