@@ -1,6 +1,7 @@
 //! Writes the Rust generated for every `.wf` file of `forms/` and `forms/schemes/` into
 //! `OUT_DIR`, as `signorini emit --stage rust` prints it (and the snapshots record it), and
-//! `generated.rs`, which includes them all and lists their units.
+//! `generated.rs`, which includes them all and lists their units; and `fixtures.rs`, the same
+//! for the test files of `FIXTURES`.
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -35,4 +36,19 @@ fn main() {
         units.join(", ")
     );
     std::fs::write(out.join("generated.rs"), list).expect("OUT_DIR is writable");
+    // Files outside the library that exercise parts of the language it does not use yet.
+    let mut fixtures = String::new();
+    for f in FIXTURES {
+        let path = forms.join("..").join(f);
+        println!("cargo::rerun-if-changed={}", path.display());
+        let compiled = compile(&path, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", path.display()));
+        let code = compiled.print(Stage::Rust, 2).unwrap_or_else(|e| panic!("{}:\n{e}", path.display()));
+        let module = module_name(&path);
+        std::fs::write(out.join(format!("fixture_{module}.rs")), code).expect("OUT_DIR is writable");
+        let _ = writeln!(fixtures, "include!(concat!(env!(\"OUT_DIR\"), \"/fixture_{module}.rs\"));");
+    }
+    std::fs::write(out.join("fixtures.rs"), fixtures).expect("OUT_DIR is writable");
 }
+
+/// Test files (paths from the repository's root) whose generated Rust is compiled here too.
+const FIXTURES: &[&str] = &["tests/problems/transcendental.wf"];

@@ -27,6 +27,7 @@ signorini::forms!("forms/contact_nitsche_coulomb.wf");
 signorini::forms!("forms/contact_nitsche_tresca.wf");
 signorini::forms!("forms/contact_penalty_coulomb.wf");
 signorini::forms!("forms/contact_nitsche_traction.wf");
+signorini::forms!("tests/problems/transcendental.wf");
 
 const TOL: f64 = 1e-12;
 const T: f64 = 0.37;
@@ -53,6 +54,7 @@ fn params(names: &[&'static str]) -> Vec<(&'static str, f64)> {
         "F" => 0.8,
         "slip_scale" => 1.3,
         "s" => 0.05,
+        "omega" => 1.3,
         _ => panic!("no test value for parameter `{n}`"),
     };
     names.iter().map(|&n| (n, value(n))).collect()
@@ -369,6 +371,15 @@ unit_test!(
     |d| coulomb_penalty::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact],
     functionals: [ContactEnergy, ContactPressure, FrictionForce, FrictionWork, Slip]
+);
+
+unit_test!(
+    transcendental_interpreted_matches_compiled,
+    transcendental,
+    "tests/problems/transcendental.wf",
+    |d| transcendental::Coefficients { g: d.g.clone(), nc: d.nc.clone() },
+    forms: [Wave, Growth],
+    functionals: [Angle, Every]
 );
 
 fn bound<'m, K: Kernel + 'm>(kernel: K, contact: &'m [Facet]) -> Box<dyn BoundForm + 'm> {

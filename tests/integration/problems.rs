@@ -1,6 +1,7 @@
 //! Problems posed in files: a library problem copied elsewhere runs by path with the same bits;
 //! a user coef (a graded density) is supplied by the problem and the free fall it poses stays
-//! exact; an interpreted contact law agrees with the compiled one on a library problem.
+//! exact; an interpreted contact law agrees with the compiled one on a library problem; a
+//! problem's transcendental functions of its params fold to numbers.
 
 use std::path::{Path, PathBuf};
 
@@ -319,4 +320,17 @@ fn a_static_problem_is_one_equilibrium() {
         assert!((a - b).abs() <= 1e-9 * a.abs(), "{c}: static {a:e}, quasi-static {b:e}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `atan2`, `cos`, `sin`, `exp` and `ln` of a problem's params fold to numbers (in its lets,
+/// coefs and `set`): the block under gravity inclined by α = atan(0.2) rests on the ground with
+/// the normal part of its weight, 2 ρ g cos α = 2/√1.04 (ρ = g = 1; the held side takes the
+/// tangential part).
+#[test]
+fn transcendental_functions_of_a_problem_s_params_fold_to_numbers() {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems");
+    let r = run(&Options::new(here.join("inclined_block.wf").to_str().unwrap())).unwrap();
+    let force = *r.column("force").unwrap().last().unwrap();
+    let want = 2.0 / 1.04f64.sqrt();
+    assert!((force - want).abs() < 1e-9 * want, "normal force {force}, not {want}");
 }

@@ -7,6 +7,12 @@
 
 include!(concat!(env!("OUT_DIR"), "/generated.rs"));
 
+/// Test files outside the library (`tests/problems/transcendental.wf`: every transcendental
+/// built-in), compiled here too, and not among the library's units.
+pub mod fixtures {
+    include!(concat!(env!("OUT_DIR"), "/fixtures.rs"));
+}
+
 #[cfg(test)]
 mod tests {
     use std::path::{Path, PathBuf};
@@ -87,5 +93,55 @@ mod tests {
             }
         }
         assert!(checked >= 9, "{checked} schemes");
+    }
+
+    /// The fixture's functional `every`, which applies each transcendental built-in to the
+    /// field, has the same bits in the generated kernel as in the IR evaluator (the
+    /// interpreter), on a P1 and a curved P2 triangle: the emitter writes each function as the
+    /// `f64` method the evaluator calls, and a functional has no sum over basis functions whose
+    /// order could differ.
+    #[test]
+    fn generated_transcendental_functions_are_the_ir_evaluators_to_the_bit() {
+        use signorini::interpret::Library;
+        use signorini::runtime::fem::element::ElementKind;
+        use signorini::runtime::fem::kernel::{CellCtx, Coef, Form, FunctionalKernel, LocalVector, Tabulation};
+
+        use crate::fixtures::transcendental as fixture;
+
+        let path = library().join("../tests/problems/transcendental.wf");
+        let lib = Library::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let (g, nc) = (Coef::constant(vec![0.1]), Coef::constant(vec![0.6, -0.8]));
+        let coefs = fixture::Coefficients { g: g.clone(), nc: nc.clone() };
+        let compiled = fixture::Every::new(&fixture::Params::default(), &coefs);
+        let interpreted = lib.form("every", 2, &[], &[("g", g), ("nc", nc)]).expect("the functional binds");
+        let degree = compiled.meta().cell_degree.expect("a cell integral");
+        fn compare<const N: usize>(
+            compiled: &impl FunctionalKernel<2, N>,
+            interpreted: &impl FunctionalKernel<2, N>,
+            kind: ElementKind,
+            degree: u32,
+        ) -> usize {
+            let tab = Tabulation::<2, N>::cell(kind, degree).expect("a rule of this degree");
+            let nodes = kind.reference_nodes();
+            // The reference cell stretched and sheared, its nodes moved a little (curved P2).
+            let x: [[f64; 2]; N] = std::array::from_fn(|j| {
+                let (r, s) = (nodes[j][0], nodes[j][1]);
+                [1.2 * r + 0.3 * s + 0.01 * (j as f64).sin(), 0.9 * s - 0.1 * r + 0.01 * (j as f64).cos()]
+            });
+            let mut compared = 0;
+            for k in 0..8 {
+                let u: LocalVector<2, N> =
+                    std::array::from_fn(|j| [0.3 * ((k * N + j) as f64).sin(), 0.3 * ((k + 2 * j) as f64).cos()]);
+                let ctx = CellCtx { tab: &tab, coords: &x, t: 0.3 };
+                let (a, b) = (compiled.cell_value(&ctx, &[&u]), interpreted.cell_value(&ctx, &[&u]));
+                assert!(a.is_finite(), "{} state {k}: {a}", kind.name());
+                assert_eq!(a.to_bits(), b.to_bits(), "{} state {k}: generated {a}, evaluated {b}", kind.name());
+                compared += 1;
+            }
+            compared
+        }
+        let p1 = compare::<3>(&compiled, &interpreted, ElementKind::TriangleP1, degree[0]);
+        let p2 = compare::<6>(&compiled, &interpreted, ElementKind::TriangleP2, degree[1]);
+        assert_eq!(p1 + p2, 16);
     }
 }

@@ -5,7 +5,7 @@
 //! abstract values of their arguments, so a mistake that depends on how a function is used
 //! (a test function passed into `pos`) is reported inside the function, with the call site.
 
-mod builtins;
+pub mod builtins;
 pub mod load;
 pub mod problem;
 pub mod schemes;
@@ -19,7 +19,7 @@ use crate::diagnostic::Diagnostic;
 use crate::source::{FileId, SourceMap, Span};
 use crate::syntax::ast::{self, Expr, Ident, Shape};
 
-pub use builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES, NUMBER_FUNCTIONS};
+pub use builtins::{BUILTIN_VALUES, BUILTINS, Builtin, builtin};
 pub use schemes::{CLAIMS, EnergyLaw, SchemeDef, SchemeParamInfo};
 pub use types::{Ty, const_eval};
 
@@ -234,7 +234,9 @@ fn declare(prog: &mut Unit, files: &[(FileId, ast::File)], diags: &mut Vec<Diagn
     for (_, file) in files {
         for item in &file.items {
             let Some(name) = item.name() else { continue };
-            if BUILTIN_VALUES.iter().chain(BUILTIN_FUNCTIONS).any(|b| *b == name.name) || name.name == CELL_REGION {
+            if BUILTIN_VALUES.iter().copied().chain(builtins::function_names()).any(|b| b == name.name)
+                || name.name == CELL_REGION
+            {
                 diags.push(
                     Diagnostic::error(
                         "E0106",

@@ -134,6 +134,9 @@ impl<'a> Emitter<'a> {
             Node::Powf(a, p) => (format!("{}.powf({})", wrap(sub(a), ATOM), literal(f64::from_bits(p)).0), ATOM),
             Node::Sqrt(a) => (format!("{}.sqrt()", wrap(sub(a), ATOM)), ATOM),
             Node::Heaviside(a) | Node::Step(a) => (format!("heaviside({})", sub(a).0), ATOM),
+            // `f64`'s methods, as the IR evaluator calls them (`Func::apply`).
+            Node::Func(f, a) => (format!("{}.{}()", wrap(sub(a), ATOM), f.name()), ATOM),
+            Node::Atan2(y, x) => (format!("{}.atan2({})", wrap(sub(y), ATOM), sub(x).0), ATOM),
         }
     }
 }

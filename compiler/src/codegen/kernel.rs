@@ -59,6 +59,12 @@ fn dispatch(on: &str, arms: Vec<(usize, String)>, other: Option<&str>) -> Option
     let otherwise = other.map_or(String::new(), |o| format!(" else {{\n{o}\n}}"));
     match arms.as_slice() {
         [] => None,
+        // A boolean that is `true` elsewhere (a tangent that the switches do not decide for one
+        // field): `wrt != k || ...`, not `if` around a literal (clippy's needless_bool).
+        [(k, body)] if other == Some("true") && is_expression(body) => match body.trim() {
+            "false" => Some(format!("{on} != {k}\n")),
+            e => Some(format!("{on} != {k} || {e}\n")),
+        },
         // One arm around another: one `if` (clippy's collapsible_if). The inner `if`'s `else`,
         // if any, is the outer one's too.
         [(k, body)] => match body.strip_prefix("if ").and_then(|rest| rest.split_once(" {\n")) {
@@ -70,6 +76,12 @@ fn dispatch(on: &str, arms: Vec<(usize, String)>, other: Option<&str>) -> Option
             Some(format!("match {on} {{\n{arms}_ => {}\n}}\n", other.unwrap_or("{}")))
         }
     }
+}
+
+/// Whether a body is one expression (no statement, no block).
+fn is_expression(body: &str) -> bool {
+    let e = body.trim();
+    !e.contains(['\n', ';', '{']) && !e.starts_with("if ")
 }
 
 /// A method of a kernel trait: its name, its parameters after `&self` with their types, its

@@ -102,7 +102,9 @@ fn range_text(p: &ParamDecl) -> String {
 }
 
 /// A constant expression of the source as Rust, with its precedence: numbers, `inf`, `pi`,
-/// negation and `+ - * /` (not powers or functions).
+/// negation and `+ - * /`, which Rust rounds as the checker does. Not powers or functions
+/// (`sin(1)`): libm's results are not correctly rounded, so such a bound is written as the
+/// checker's value, whose bits the range checks of the checker and of the code then share.
 fn as_rust(e: &ast::Expr) -> Option<(String, u8)> {
     let wrap = |(t, p): (String, u8), min: u8| if p < min { format!("({t})") } else { t };
     match &e.kind {

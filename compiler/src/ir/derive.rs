@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 
-use super::graph::{Graph, Node, NodeId, Sym};
+use super::graph::{Func, Graph, Node, NodeId, Sym};
 
 /// Partial derivatives of many nodes with respect to one symbol, sharing work.
 pub struct Derivative {
@@ -100,8 +100,54 @@ impl Derivative {
                 let num = g.mul(da, on);
                 g.div(num, den)
             }
+            Node::Func(f, a) => {
+                let da = d(a);
+                if g.is_zero(da) {
+                    return g.zero();
+                }
+                func_derivative(g, f, a, id, da)
+            }
+            Node::Atan2(y, x) => {
+                let (dy, dx) = (d(y), d(x));
+                if g.is_zero(dy) && g.is_zero(dx) {
+                    return g.zero();
+                }
+                atan2_derivative(g, y, x, dy, dx)
+            }
         }
     }
+}
+
+/// d f(a) for f(a) = `fa`, given da ≠ 0: cos a da, −sin a da, da/cos² a, exp a da, da/a.
+pub fn func_derivative(g: &mut Graph, f: Func, a: NodeId, fa: NodeId, da: NodeId) -> NodeId {
+    match f {
+        Func::Sin => {
+            let c = g.func(Func::Cos, a);
+            g.mul(c, da)
+        }
+        Func::Cos => {
+            let s = g.func(Func::Sin, a);
+            let p = g.mul(s, da);
+            g.neg(p)
+        }
+        Func::Tan => {
+            let c = g.func(Func::Cos, a);
+            let c2 = g.powi(c, 2);
+            g.div(da, c2)
+        }
+        Func::Exp => g.mul(fa, da),
+        Func::Ln => g.div(da, a),
+    }
+}
+
+/// d atan2(y, x) = (x dy − y dx)/(x² + y²).
+pub fn atan2_derivative(g: &mut Graph, y: NodeId, x: NodeId, dy: NodeId, dx: NodeId) -> NodeId {
+    let l = g.mul(x, dy);
+    let r = g.mul(y, dx);
+    let num = g.sub(l, r);
+    let (x2, y2) = (g.powi(x, 2), g.powi(y, 2));
+    let den = g.add(x2, y2);
+    g.div(num, den)
 }
 
 #[cfg(test)]
@@ -120,6 +166,8 @@ mod tests {
             Node::Powf(a, p) => eval(g, a, x).powf(f64::from_bits(p)),
             Node::Sqrt(a) => eval(g, a, x).sqrt(),
             Node::Heaviside(a) | Node::Step(a) => f64::from((eval(g, a, x) > 0.0) as u8),
+            Node::Func(f, a) => f.apply(eval(g, a, x)),
+            Node::Atan2(a, b) => eval(g, a, x).atan2(eval(g, b, x)),
         }
     }
 

@@ -5,13 +5,13 @@
 //! over a flat array of slots, leaves (the [`Sym`]s) first, then constants, then one slot per
 //! operation in topological order. Running it per point allocates nothing once the scratch
 //! buffer has grown. Each node is one floating-point operation written exactly as the
-//! generated kernels write it (`a + b`, `a * b`, `a / b`, `-a`, `powi`, `sqrt`, H(a) = 1 if
-//! a > 0 else 0), so interpreted and compiled results agree bit for bit up to the order in
-//! which the kernels sum over basis functions.
+//! generated kernels write it (`a + b`, `a * b`, `a / b`, `-a`, `powi`, `sqrt`, `sin`, ...,
+//! `atan2`, H(a) = 1 if a > 0 else 0), so interpreted and compiled results agree bit for bit
+//! up to the order in which the kernels sum over basis functions.
 
 use std::collections::HashMap;
 
-use super::graph::{Graph, Node, NodeId, Sym};
+use super::graph::{Func, Graph, Node, NodeId, Sym};
 
 /// Slot index.
 type Slot = u32;
@@ -26,6 +26,8 @@ enum Op {
     Powf(Slot, f64),
     Sqrt(Slot),
     Heaviside(Slot),
+    Func(Func, Slot),
+    Atan2(Slot, Slot),
 }
 
 /// Straight-line code computing some roots of a graph from the values of its leaves.
@@ -106,6 +108,8 @@ impl Program {
                 Node::Powf(a, p) => Op::Powf(s(a), f64::from_bits(p)),
                 Node::Sqrt(a) => Op::Sqrt(s(a)),
                 Node::Heaviside(a) | Node::Step(a) => Op::Heaviside(s(a)),
+                Node::Func(f, a) => Op::Func(f, s(a)),
+                Node::Atan2(y, x) => Op::Atan2(s(y), s(x)),
                 Node::Const(_) | Node::Sym(_) => continue,
             });
             slot.insert(n, next);
@@ -204,6 +208,8 @@ impl Program {
                 Op::Powf(a, p) => v(a).powf(p),
                 Op::Sqrt(a) => v(a).sqrt(),
                 Op::Heaviside(a) => heaviside(v(a)),
+                Op::Func(f, a) => f.apply(v(a)),
+                Op::Atan2(y, x) => v(y).atan2(v(x)),
             };
         }
     }

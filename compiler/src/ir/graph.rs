@@ -43,6 +43,47 @@ pub enum Sym {
     },
 }
 
+/// A smooth function of one scalar: the language's `sin`, `cos`, `tan`, `exp` and `ln`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Func {
+    Sin,
+    Cos,
+    Tan,
+    Exp,
+    Ln,
+}
+
+impl Func {
+    pub const ALL: [Func; 5] = [Func::Sin, Func::Cos, Func::Tan, Func::Exp, Func::Ln];
+
+    /// Its name in the language, and the name of the `f64` method the generated code calls.
+    pub fn name(self) -> &'static str {
+        match self {
+            Func::Sin => "sin",
+            Func::Cos => "cos",
+            Func::Tan => "tan",
+            Func::Exp => "exp",
+            Func::Ln => "ln",
+        }
+    }
+
+    pub fn named(name: &str) -> Option<Func> {
+        Func::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// Its value: the `f64` method of the same name, as the generated code computes it (so that
+    /// folded constants, the evaluator and the kernels agree to the bit).
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            Func::Sin => x.sin(),
+            Func::Cos => x.cos(),
+            Func::Tan => x.tan(),
+            Func::Exp => x.exp(),
+            Func::Ln => x.ln(),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Node {
     /// The bits of an f64 (so that nodes hash).
@@ -63,6 +104,10 @@ pub enum Node {
     /// where the file's own `pos`, `neg`, `H`, ... turn (the contact points, not the regimes of a
     /// projection).
     Step(NodeId),
+    /// sin, cos, tan, exp or ln of a node.
+    Func(Func, NodeId),
+    /// atan2(y, x): the angle of the point (x, y), in (−π, π].
+    Atan2(NodeId, NodeId),
 }
 
 #[derive(Default, Clone, Debug)]
@@ -280,6 +325,20 @@ impl Graph {
         }
     }
 
+    pub fn func(&mut self, f: Func, a: NodeId) -> NodeId {
+        match self.as_const(a) {
+            Some(x) => self.constant(f.apply(x)),
+            None => self.intern(Node::Func(f, a)),
+        }
+    }
+
+    pub fn atan2(&mut self, y: NodeId, x: NodeId) -> NodeId {
+        match (self.as_const(y), self.as_const(x)) {
+            (Some(a), Some(b)) => self.constant(a.atan2(b)),
+            _ => self.intern(Node::Atan2(y, x)),
+        }
+    }
+
     /// Records a source name for a node (the first name given wins).
     pub fn name(&mut self, id: NodeId, name: &str) {
         if matches!(
@@ -296,10 +355,14 @@ impl Graph {
     pub fn children(&self, id: NodeId) -> impl Iterator<Item = NodeId> {
         let (a, b) = match self.node(id) {
             Node::Const(_) | Node::Sym(_) => (None, None),
-            Node::Add(x, y) | Node::Mul(x, y) | Node::Div(x, y) => (Some(x), Some(y)),
-            Node::Neg(x) | Node::Powi(x, _) | Node::Powf(x, _) | Node::Sqrt(x) | Node::Heaviside(x) | Node::Step(x) => {
-                (Some(x), None)
-            }
+            Node::Add(x, y) | Node::Mul(x, y) | Node::Div(x, y) | Node::Atan2(x, y) => (Some(x), Some(y)),
+            Node::Neg(x)
+            | Node::Powi(x, _)
+            | Node::Powf(x, _)
+            | Node::Sqrt(x)
+            | Node::Heaviside(x)
+            | Node::Step(x)
+            | Node::Func(_, x) => (Some(x), None),
         };
         a.into_iter().chain(b)
     }
@@ -339,6 +402,8 @@ impl Graph {
                 Node::Sqrt(a) => self.sqrt(c(a)),
                 Node::Heaviside(a) => self.heaviside(c(a)),
                 Node::Step(a) => self.step(c(a)),
+                Node::Func(f, a) => self.func(f, c(a)),
+                Node::Atan2(y, x) => self.atan2(c(y), c(x)),
             };
             new.insert(id, rebuilt);
         }

@@ -4,7 +4,9 @@
 
 use std::collections::HashMap;
 
-use super::graph::{Graph, NodeId, Sym};
+mod jets;
+
+use super::graph::{Func, Graph, NodeId, Sym};
 use crate::check::{CELL_REGION, Global, Unit};
 use crate::diagnostic::Diagnostic;
 use crate::source::Span;
@@ -366,9 +368,9 @@ impl<'p> Lowerer<'p> {
             self.calls.insert(key, v.clone());
             return Ok(v);
         }
-        if crate::check::NUMBER_FUNCTIONS.contains(&f) {
+        if let Some(b) = crate::check::builtin(f).filter(|b| b.numbers_only) {
             // `ceil`, `floor` (problems only): of numbers.
-            let Some(x) = self.g.as_const(args[0].c[0].v) else {
+            let Some(x) = self.g.as_const(args[0].c[0].v).and_then(|x| b.fold.apply(&[x])) else {
                 return Err(Box::new(
                     Diagnostic::error(
                         "E0303",
@@ -379,7 +381,7 @@ impl<'p> Lowerer<'p> {
                     .with_help(format!("`{f}` takes numbers and params only")),
                 ));
             };
-            return Ok(self.constant_val(if f == "ceil" { x.ceil() } else { x.floor() }));
+            return Ok(self.constant_val(x));
         }
         if f == "prev" {
             let Some(previous) = self.previous else {
@@ -523,6 +525,14 @@ impl<'p> Lowerer<'p> {
                 let a = next();
                 Self::scalar(self.jnorm(&a))
             }
+            "atan2" => {
+                let (y, x) = (next().c.remove(0), next().c.remove(0));
+                Self::scalar(self.jatan2(&y, &x))
+            }
+            _ if let Some(func) = Func::named(f) => {
+                let a = next().c.remove(0);
+                Self::scalar(self.jfunc(func, &a))
+            }
             "tangential" => {
                 // a − (a·nc) nc
                 let (a, nc) = (next(), next());
@@ -648,114 +658,6 @@ impl<'p> Lowerer<'p> {
     fn zip(&mut self, a: &Val, b: &Val, mut f: impl FnMut(&mut Self, &Jet, &Jet) -> Jet) -> Val {
         let c = a.c.iter().zip(&b.c).map(|(x, y)| f(self, x, y)).collect();
         Val { shape: a.shape, c }
-    }
-
-    // Scalar operations on jets (value and gradient together).
-
-    fn grads(&mut self, a: &Jet, b: &Jet, f: impl Fn(&mut Graph, NodeId, NodeId) -> NodeId) -> Option<Vec<NodeId>> {
-        let (ga, gb) = (a.g.as_ref()?, b.g.as_ref()?);
-        Some(ga.iter().zip(gb).map(|(&x, &y)| f(&mut self.g, x, y)).collect())
-    }
-
-    fn jadd(&mut self, a: &Jet, b: &Jet) -> Jet {
-        let v = self.g.add(a.v, b.v);
-        let g = self.grads(a, b, |g, x, y| g.add(x, y));
-        Jet { v, g }
-    }
-
-    fn jsub(&mut self, a: &Jet, b: &Jet) -> Jet {
-        let v = self.g.sub(a.v, b.v);
-        let g = self.grads(a, b, |g, x, y| g.sub(x, y));
-        Jet { v, g }
-    }
-
-    fn jneg(&mut self, a: &Jet) -> Jet {
-        let v = self.g.neg(a.v);
-        let g = a.g.as_ref().map(|ga| ga.iter().map(|&x| self.g.neg(x)).collect());
-        Jet { v, g }
-    }
-
-    fn jmul(&mut self, a: &Jet, b: &Jet) -> Jet {
-        let v = self.g.mul(a.v, b.v);
-        let (av, bv) = (a.v, b.v);
-        let g = self.grads(a, b, |g, x, y| {
-            let l = g.mul(x, bv);
-            let r = g.mul(av, y);
-            g.add(l, r)
-        });
-        Jet { v, g }
-    }
-
-    fn jdiv(&mut self, a: &Jet, b: &Jet) -> Jet {
-        let v = self.g.div(a.v, b.v);
-        let bv = b.v;
-        let g = self.grads(a, b, |g, x, y| {
-            // (a/b)' = (a' − (a/b)·b') / b
-            let q = g.mul(v, y);
-            let num = g.sub(x, q);
-            g.div(num, bv)
-        });
-        Jet { v, g }
-    }
-
-    fn jpowi(&mut self, a: &Jet, k: i32) -> Jet {
-        let v = self.g.powi(a.v, k);
-        let g = a.g.as_ref().map(|ga| {
-            let p = self.g.powi(a.v, k - 1);
-            let c = self.g.constant(k as f64);
-            let cp = self.g.mul(c, p);
-            ga.iter().map(|&x| self.g.mul(cp, x)).collect()
-        });
-        Jet { v, g }
-    }
-
-    fn jpowf(&mut self, a: &Jet, p: f64) -> Jet {
-        let v = self.g.powf(a.v, p);
-        let g = a.g.as_ref().map(|ga| {
-            let q = self.g.powf(a.v, p - 1.0);
-            let c = self.g.constant(p);
-            let cq = self.g.mul(c, q);
-            ga.iter().map(|&x| if self.g.is_zero(x) { x } else { self.g.mul(cq, x) }).collect()
-        });
-        Jet { v, g }
-    }
-
-    fn jsqrt(&mut self, a: &Jet) -> Jet {
-        let v = self.g.sqrt(a.v);
-        let g = a.g.as_ref().map(|ga| {
-            let two = self.g.constant(2.0);
-            let den = self.g.mul(two, v);
-            // A constant's gradient is zero even where the root is (sqrt(0)), not 0/0.
-            ga.iter().map(|&x| if self.g.is_zero(x) { x } else { self.g.div(x, den) }).collect()
-        });
-        Jet { v, g }
-    }
-
-    /// The Euclidean (Frobenius) size of a vector (tensor).
-    fn jnorm(&mut self, a: &Val) -> Jet {
-        let square = self.jinner(a, a);
-        self.jsqrt(&square)
-    }
-
-    /// The full contraction Σ aᵢ bᵢ, summed in component order.
-    fn jinner(&mut self, a: &Val, b: &Val) -> Jet {
-        let mut acc = self.constant(0.0);
-        for (x, y) in a.c.iter().zip(&b.c) {
-            let p = self.jmul(x, y);
-            acc = self.jadd(&acc, &p);
-        }
-        acc
-    }
-
-    /// H as a built-in's inner step: not a switch (see `Node::Step`).
-    fn jstep(&mut self, a: &Jet) -> Jet {
-        let v = self.g.step(a.v);
-        Jet { v, g: self.zero_grad() }
-    }
-
-    fn jheaviside(&mut self, a: &Jet) -> Jet {
-        let v = self.g.heaviside(a.v);
-        Jet { v, g: self.zero_grad() }
     }
 }
 

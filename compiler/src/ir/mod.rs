@@ -15,7 +15,7 @@ pub mod print;
 use std::collections::BTreeSet;
 
 use derive::Derivative;
-use graph::{Graph, Node, NodeId, Sym};
+use graph::{Func, Graph, Node, NodeId, Sym};
 
 use crate::check::{CELL_REGION, Unit};
 use crate::diagnostic::Diagnostic;
@@ -195,13 +195,20 @@ pub fn vanishing_denominators(prog: &Unit, ir: &DimIr) -> Vec<Diagnostic> {
         let Some(def) = prog.forms.iter().find(|f| f.name == form.name) else { continue };
         for integral in &form.integrals {
             let nodes = g.reachable(integral.tangents.iter().flat_map(TangentIr::nodes));
+            let power = "write the power directly: `d^(4/3)` rather than `d*d^(1/3)` differentiates to (4/3) d^(1/3), which is 0 at d = 0";
+            let log = "keep the logarithm's argument away from 0: `ln(c + pos(d))` with c > 0";
+            // A logarithm's derivative da/a divides by its argument.
+            let logarithm_of = |a: NodeId| (0..g.len() as NodeId).any(|m| g.node(m) == Node::Func(Func::Ln, a));
             let divides = nodes.iter().find_map(|&n| match g.node(n) {
-                Node::Div(_, den) if clipped(den) => Some("divides by"),
-                Node::Powi(a, k) if k < 0 && clipped(a) => Some("takes a negative power of"),
-                Node::Powf(a, p) if f64::from_bits(p) < 0.0 && clipped(a) => Some("takes a negative power of"),
+                Node::Div(_, den) if clipped(den) => Some(("divides by", if logarithm_of(den) { log } else { power })),
+                Node::Powi(a, k) if k < 0 && clipped(a) => Some(("takes a negative power of", power)),
+                Node::Powf(a, p) if f64::from_bits(p) < 0.0 && clipped(a) => Some(("takes a negative power of", power)),
+                // ln's derivative is da/a: a logarithm of a clipped value is a negative power.
+                Node::Func(Func::Ln, a) if clipped(a) => Some(("takes the logarithm of", log)),
                 _ => None,
             });
-            let (Some(what), Some(at)) = (divides, def.integrals.iter().find(|i| i.region.name == integral.region))
+            let (Some((what, help)), Some(at)) =
+                (divides, def.integrals.iter().find(|i| i.region.name == integral.region))
             else {
                 continue;
             };
@@ -213,7 +220,7 @@ pub fn vanishing_denominators(prog: &Unit, ir: &DimIr) -> Vec<Diagnostic> {
                     "its derivative is 0/0 (NaN) there",
                 )
                 .with_note("Newton's first Jacobian is then NaN wherever the clip is active (out of contact), and the solve fails as singular")
-                .with_help("write the power directly: `d^(4/3)` rather than `d*d^(1/3)` differentiates to (4/3) d^(1/3), which is 0 at d = 0"),
+                .with_help(help),
             );
         }
     }
@@ -343,6 +350,10 @@ fn gates(g: &Graph, roots: &[NodeId], is_field: impl Fn(Sym) -> bool + Copy) -> 
             Node::Powi(a, k) => (open[&a].clone(), zero[&a].clone().filter(|_| k > 0)),
             Node::Step(a) if switch(a) => (open[&a].clone(), Some(BTreeSet::from([a]))),
             Node::Powf(a, _) | Node::Sqrt(a) | Node::Step(a) => (open[&a].clone(), None),
+            // sin 0 = tan 0 = 0; cos, exp and ln are not zero where their argument is.
+            Node::Func(Func::Sin | Func::Tan, a) => (open[&a].clone(), zero[&a].clone()),
+            Node::Func(Func::Cos | Func::Exp | Func::Ln, a) => (open[&a].clone(), None),
+            Node::Atan2(y, x) => (union(&open[&y], &open[&x]), None),
         };
         open.insert(n, o);
         zero.insert(n, z);
@@ -366,6 +377,9 @@ fn vanishes_with_a_clip(g: &Graph, id: NodeId) -> bool {
             Node::Neg(a) | Node::Div(a, _) | Node::Sqrt(a) => v(a),
             Node::Powi(a, k) => k > 0 && v(a),
             Node::Powf(a, p) => f64::from_bits(p) > 0.0 && v(a),
+            Node::Func(Func::Sin | Func::Tan, a) => v(a),
+            // atan2(0, x) is π for x < 0.
+            Node::Func(Func::Cos | Func::Exp | Func::Ln, _) | Node::Atan2(..) => false,
             Node::Const(_) | Node::Sym(_) => false,
         };
         vanishes.insert(n, here);
@@ -397,7 +411,8 @@ pub fn node_degrees(
             Node::Mul(a, b) | Node::Div(a, b) => dg(a).saturating_add(dg(b)),
             Node::Neg(a) => dg(a),
             Node::Powi(a, k) if k >= 0 => dg(a).saturating_mul(k as u32),
-            Node::Powi(a, _) | Node::Powf(a, _) | Node::Sqrt(a) => dg(a).saturating_add(2),
+            Node::Powi(a, _) | Node::Powf(a, _) | Node::Sqrt(a) | Node::Func(_, a) => dg(a).saturating_add(2),
+            Node::Atan2(y, x) => dg(y).max(dg(x)).saturating_add(2),
             Node::Heaviside(_) | Node::Step(_) => 0,
         };
         deg.insert(id, v);

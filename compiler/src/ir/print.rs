@@ -87,6 +87,8 @@ fn node(g: &Graph, id: NodeId, params: &[String], coefs: &[String]) -> String {
         Node::Sqrt(a) => format!("sqrt {}", o(a)),
         Node::Heaviside(a) => format!("H {}", o(a)),
         Node::Step(a) => format!("step {}", o(a)),
+        Node::Func(f, a) => format!("{} {}", f.name(), o(a)),
+        Node::Atan2(y, x) => format!("atan2 {} {}", o(y), o(x)),
     }
 }
 

@@ -234,5 +234,7 @@ fn expr(g: &Graph, id: NodeId) -> (String, u8) {
         Node::Powf(a, p) => (format!("{}^{}", wrap(infix(g, a), 4), f64::from_bits(p)), 4),
         Node::Sqrt(a) => (format!("sqrt({})", scalar(g, a)), 4),
         Node::Heaviside(a) | Node::Step(a) => (format!("H({})", scalar(g, a)), 4),
+        Node::Func(f, a) => (format!("{}({})", f.name(), scalar(g, a)), 4),
+        Node::Atan2(y, x) => (format!("atan2({}, {})", scalar(g, y), scalar(g, x)), 4),
     }
 }

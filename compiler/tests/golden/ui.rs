@@ -67,6 +67,19 @@ fn the_catalogue_lists_exactly_the_codes_of_the_source() {
     assert_eq!(in_source, catalogue);
 }
 
+/// The docs name every built-in function of the table: docs/language.md those of every
+/// expression, docs/problems.md those of a problem's numbers (`ceil`, `floor`).
+#[test]
+fn the_docs_name_every_builtin_function() {
+    let language = std::fs::read_to_string("../docs/language.md").unwrap();
+    let problems = std::fs::read_to_string("../docs/problems.md").unwrap();
+    for b in signorini_compiler::check::BUILTINS {
+        let docs = if b.numbers_only { &problems } else { &language };
+        let named = docs.contains(&format!("`{}`", b.name)) || docs.contains(&format!("`{}(", b.name));
+        assert!(named, "the docs do not name `{}` ({})", b.name, b.doc);
+    }
+}
+
 /// docs/language.md has one table row `| CODE | meaning |` per catalogue entry, and no other
 /// code.
 #[test]

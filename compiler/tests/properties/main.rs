@@ -1,6 +1,8 @@
-//! The compiler's property tests, in one binary: random inputs never make it panic, and random
-//! schemes compile to stages that satisfy their relations.
+//! The compiler's property tests, in one binary: random inputs never make it panic, random
+//! schemes compile to stages that satisfy their relations, and the built-ins' tangents are
+//! their derivatives.
 
 mod friction_builtins;
 mod no_panic;
 mod scheme_properties;
+mod transcendental;

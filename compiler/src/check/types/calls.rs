@@ -3,7 +3,7 @@
 
 use super::{Checker, MAX_EXPANSIONS, MAX_INLINE_DEPTH, Ty};
 use crate::check::Global;
-use crate::check::builtins::{self, BUILTIN_FUNCTIONS, BUILTIN_VALUES, NONLINEAR};
+use crate::check::builtins::{self, BUILTIN_VALUES, Builtin};
 use crate::diagnostic::Diagnostic;
 use crate::syntax::ast::{Expr, Ident, Shape};
 
@@ -39,9 +39,9 @@ impl Checker<'_> {
                 None
             }
             // A problem's numbers round up or down (the lowering checks that they are numbers).
-            None if self.vectors_allowed && builtins::NUMBER_FUNCTIONS.contains(&f.name.as_str()) => {
-                if args.len() != 1 {
-                    self.arity_error(e, f, 1, args.len());
+            None if let Some(b) = builtins::builtin(&f.name).filter(|b| b.numbers_only && self.vectors_allowed) => {
+                if args.len() != b.arity {
+                    self.arity_error(e, f, b.arity, args.len());
                     return None;
                 }
                 let ty = arg_tys.into_iter().next().flatten()?;
@@ -54,17 +54,15 @@ impl Checker<'_> {
                     ));
                     return None;
                 }
-                let round = if f.name == "ceil" { f64::ceil } else { f64::floor };
-                Some(Ty { konst: ty.konst.map(round), ..ty })
+                Some(Ty { konst: ty.konst.and_then(|x| b.fold.apply(&[x])), ..ty })
             }
-            None if BUILTIN_FUNCTIONS.contains(&f.name.as_str()) => {
-                let want = builtins::arity(&f.name);
-                if want != args.len() {
-                    self.arity_error(e, f, want, args.len());
+            None if let Some(b) = builtins::function(&f.name) => {
+                if b.arity != args.len() {
+                    self.arity_error(e, f, b.arity, args.len());
                     return None;
                 }
                 let tys: Vec<Ty> = arg_tys.into_iter().collect::<Option<_>>()?;
-                self.builtin_ty(e, f, args, &tys)
+                self.builtin_ty(e, b, args, &tys)
             }
             None if BUILTIN_VALUES.contains(&f.name.as_str()) => {
                 self.error(Diagnostic::error(
@@ -166,10 +164,10 @@ impl Checker<'_> {
         self.error(d);
     }
 
-    pub(super) fn builtin_ty(&mut self, e: &Expr, f: &Ident, args: &[Expr], tys: &[Ty]) -> Option<Ty> {
-        let name = f.name.as_str();
+    pub(super) fn builtin_ty(&mut self, e: &Expr, b: &Builtin, args: &[Expr], tys: &[Ty]) -> Option<Ty> {
+        let name = b.name;
         let shapes: Vec<Shape> = tys.iter().map(|t| t.shape).collect();
-        let shape = match builtins::result_shape(name, &shapes) {
+        let shape = match b.result_shape(&shapes) {
             Ok(s) => s,
             Err(msg) => {
                 let mut d = Diagnostic::error("E0301", "shape mismatch", e.span, msg);
@@ -180,7 +178,7 @@ impl Checker<'_> {
                 return None;
             }
         };
-        if NONLINEAR.contains(&name)
+        if b.nonlinear
             && let Some((a, _)) = args.iter().zip(tys).find(|(_, t)| t.test)
         {
             self.error(
@@ -227,11 +225,11 @@ impl Checker<'_> {
                 }
                 ty.smooth = false;
             }
-            "sqrt" => ty.konst = tys[0].konst.map(f64::sqrt),
-            "abs" => ty.konst = tys[0].konst.map(f64::abs),
-            "min" => ty.konst = tys[0].konst.zip(tys[1].konst).map(|(a, b)| a.min(b)),
-            "max" => ty.konst = tys[0].konst.zip(tys[1].konst).map(|(a, b)| a.max(b)),
-            _ => {}
+            _ => {
+                // A function of numbers is a number (`cos(alpha)` of a problem's param).
+                let konst: Option<Vec<f64>> = tys.iter().map(|t| t.konst).collect();
+                ty.konst = konst.and_then(|k| b.fold.apply(&k));
+            }
         }
         Some(ty)
     }

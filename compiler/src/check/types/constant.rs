@@ -1,5 +1,7 @@
-//! Compile-time constants: numbers, arithmetic, `sqrt`, `abs`, `min`, `max`, `pi` and `inf`.
+//! Compile-time constants: numbers, arithmetic, the built-in functions that fold on numbers
+//! (`sqrt`, `min`, `sin`, `atan2`, ...: the table's `fold`), `pi` and `inf`.
 
+use crate::check::builtins;
 use crate::source::Span;
 use crate::syntax::ast::{BinOp, Expr, ExprKind};
 
@@ -24,12 +26,10 @@ pub fn const_eval(e: &Expr) -> Result<f64, Span> {
             }
         }
         ExprKind::Vector(_) | ExprKind::Index(..) => return Err(e.span),
-        ExprKind::Call(f, args) => match (f.name.as_str(), args.as_slice()) {
-            ("sqrt", [a]) => const_eval(a)?.sqrt(),
-            ("abs", [a]) => const_eval(a)?.abs(),
-            ("min", [a, b]) => const_eval(a)?.min(const_eval(b)?),
-            ("max", [a, b]) => const_eval(a)?.max(const_eval(b)?),
-            _ => return Err(e.span),
-        },
+        ExprKind::Call(f, args) => {
+            let Some(b) = builtins::function(&f.name) else { return Err(e.span) };
+            let values = args.iter().map(const_eval).collect::<Result<Vec<f64>, Span>>()?;
+            b.fold.apply(&values).ok_or(e.span)?
+        }
     })
 }

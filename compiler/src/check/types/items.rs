@@ -4,7 +4,7 @@
 use signorini_descriptors::ParamRange;
 
 use super::{Checker, LetState, Ty};
-use crate::check::builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES};
+use crate::check::builtins::{self, BUILTIN_VALUES};
 use crate::check::{CELL_REGION, Global, const_eval, range_written};
 use crate::diagnostic::Diagnostic;
 use crate::source::Span;
@@ -131,7 +131,7 @@ impl Checker<'_> {
                 }
             }
             ExprKind::Call(f, args) => {
-                if !self.prog.globals.contains_key(&f.name) && !BUILTIN_FUNCTIONS.contains(&f.name.as_str()) {
+                if !self.prog.globals.contains_key(&f.name) && builtins::function(&f.name).is_none() {
                     self.unknown(f);
                 }
                 for a in args {

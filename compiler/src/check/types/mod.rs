@@ -145,9 +145,13 @@ impl<'p> Checker<'p> {
             return None;
         }
         if let Some(v) = ty.konst.filter(|v| !v.is_finite()) {
+            let note = match &e.kind {
+                ExprKind::Call(f, _) => format!("a number outside the domain of `{}`, or an overflow", f.name),
+                _ => "a division by zero or an overflow of double precision".into(),
+            };
             self.error(
                 Diagnostic::error("E0004", "constant arithmetic is not finite", e.span, format!("evaluates to {v}"))
-                    .with_note("a division by zero or an overflow of double precision"),
+                    .with_note(note),
             );
             return None;
         }

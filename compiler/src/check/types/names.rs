@@ -2,7 +2,7 @@
 //! (with the closest known one).
 
 use super::{Checker, Ty};
-use crate::check::builtins::{BUILTIN_FUNCTIONS, BUILTIN_VALUES};
+use crate::check::builtins::{self, BUILTIN_VALUES};
 use crate::check::{Global, suggest_name};
 use crate::diagnostic::Diagnostic;
 use crate::syntax::ast::{Ident, Shape};
@@ -19,7 +19,7 @@ impl Checker<'_> {
             .keys()
             .map(String::as_str)
             .chain(BUILTIN_VALUES.iter().copied())
-            .chain(BUILTIN_FUNCTIONS.iter().copied())
+            .chain(builtins::function_names().map(|n| n as &str))
             .chain(scope_names.iter().map(String::as_str));
         let mut d = Diagnostic::error("E0101", format!("unknown name `{}`", id.name), id.span, "not defined");
         if let Some(s) = suggest_name(&id.name, candidates) {
@@ -68,7 +68,7 @@ impl Checker<'_> {
                     ));
                     None
                 }
-                _ if BUILTIN_FUNCTIONS.contains(&id.name.as_str()) => {
+                _ if builtins::function(&id.name).is_some() => {
                     self.error(
                         Diagnostic::error(
                             "E0205",

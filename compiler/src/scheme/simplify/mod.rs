@@ -134,6 +134,9 @@ fn value_and_scale(g: &Graph, id: NodeId, params: &[f64], dt: f64, t: f64) -> (f
             }
             Node::Sqrt(x) => (c(x).0.sqrt(), c(x).1.sqrt()),
             Node::Heaviside(x) | Node::Step(x) => (f64::from(c(x).0 > 0.0), 1.0),
+            // Not in schemes (their values refuse these functions); sized by the value.
+            Node::Func(f, x) => (f.apply(c(x).0), f.apply(c(x).0).abs()),
+            Node::Atan2(y, x) => (c(y).0.atan2(c(x).0), c(y).0.atan2(c(x).0).abs()),
         };
         v.insert(n, r);
     }

@@ -277,6 +277,8 @@ impl Normalizer {
             Node::Powi(a, k) => sub(a)?.powi(k),
             // Schemes take integer powers only (the checker refuses others there).
             Node::Powf(..) => Err(GiveUp),
+            // Nor do they take transcendental functions.
+            Node::Func(..) | Node::Atan2(..) => Err(GiveUp),
             Node::Sqrt(a) => {
                 let e = sub(a)?;
                 if e.is_zero() { Ok(Expr::default()) } else { Ok(Expr::atom(Atom::Sqrt(Box::new(e)))) }
