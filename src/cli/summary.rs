@@ -59,6 +59,10 @@ pub(super) fn finish(result: Result<crate::problem::run::Run, crate::error::Case
 fn expectations(s: &crate::problem::outputs::Summary) {
     let Ok(list) = s.field::<Vec<crate::problem::summary::Expectation>>("expected") else { return };
     for x in list {
+        if !x.applies {
+            println!("  expect {}: not checked, its `when` does not hold on this run", x.key);
+            continue;
+        }
         let [value, expected, difference, within] = x.shown();
         let met = if x.met { "met" } else { "NOT MET" };
         println!("  expect {} = {expected} (is {value}, difference {difference}, within {within}): {met}", x.key);

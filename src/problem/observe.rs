@@ -284,9 +284,12 @@ impl<'m> Observer<'m> {
             }
             ExprKind::Vector(_) => unreachable!("checked: no vector in a column"),
             ExprKind::Call(f, args) => match f.name.as_str() {
-                name if crate::compiler::check::problem::SUMMARY_FUNCTIONS.contains(&name) => {
-                    let a = self.rewrite(pf, ex, ops, inst, &args[0], leaves, pointwise, region_names, binding)?;
-                    Expr { kind: ExprKind::Call(f.clone(), vec![a]), span: e.span }
+                name if crate::compiler::check::problem::row_function(name).is_some() => {
+                    let args = args
+                        .iter()
+                        .map(|a| self.rewrite(pf, ex, ops, inst, a, leaves, pointwise, region_names, binding))
+                        .collect::<Result<Vec<_>, _>>()?;
+                    Expr { kind: ExprKind::Call(f.clone(), args), span: e.span }
                 }
                 "mean" | "nodal_mean" | "at_min" => {
                     let (field, axis) = component(&args[0]);

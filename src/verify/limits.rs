@@ -27,7 +27,7 @@ pub fn expectations(progress: &mut dyn FnMut(&str)) -> Result<Vec<LimitRow>, Cas
         progress(&format!("expectations: {name}"));
         let run = crate::problem::run::run(&crate::problem::options::Options::new(name))?;
         let text = |k: &str| run.summary.get(k).and_then(|v| v.as_str()).unwrap_or_default().to_string();
-        for expectation in run.summary.field::<Vec<Expectation>>("expected")? {
+        for expectation in run.summary.field::<Vec<Expectation>>("expected")?.into_iter().filter(|x| x.applies) {
             rows.push(LimitRow {
                 problem: name.to_string(),
                 scheme: text("scheme"),

@@ -334,3 +334,53 @@ fn transcendental_functions_of_a_problem_s_params_fold_to_numbers() {
     let want = 2.0 / 1.04f64.sqrt();
     assert!((force - want).abs() < 1e-9 * want, "normal force {force}, not {want}");
 }
+
+/// Regions joined by `+` and cut by `and`, `or`, `not` and `!=`: their facet counts are the
+/// rectangle's (4 at the bottom and the top, 2 at each side); `expect ... when` applies where its
+/// condition holds, and a param only another law declares makes it not apply.
+#[test]
+fn regions_join_and_expectations_apply_where_their_condition_holds() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems/joined_regions.wf");
+    let file = file.to_str().unwrap();
+    let line = signorini::problem::run::check(file).unwrap();
+    for region in [
+        "Gamma_top (4 facets)",
+        "Gamma_sides (4 facets)",
+        "Gamma_low_or_left (6 facets)",
+        "Gamma_not_top (8 facets)",
+        "Gamma_ring (12 facets)",
+        "Gamma_C (3 facets)",
+    ] {
+        assert!(line.contains(region), "{region} in {line}");
+    }
+    let expectations = |opts: &Options| {
+        let s = run(opts).unwrap().summary;
+        s.field::<Vec<signorini::problem::summary::Expectation>>("expected").unwrap()
+    };
+    let here = expectations(&Options::new(file));
+    let applies: Vec<bool> = here.iter().map(|x| x.applies).collect();
+    assert_eq!(applies, [true, false, false]);
+    assert!(here[0].met && !here[1].met && !here[2].met);
+    // Under a Coulomb law `F` is declared: the third applies, and is not met.
+    let mut coulomb = Options::new(file);
+    coulomb.methods.contact = "nitsche_coulomb".into();
+    coulomb.chosen.contact = true;
+    let there = expectations(&coulomb);
+    assert_eq!(there.iter().map(|x| x.applies).collect::<Vec<_>>(), [true, false, true]);
+    assert!(there[0].met && !there[2].met);
+}
+
+/// The same functions in every place of a problem (lets, `set`, run settings, coefs, initial
+/// fields, predicates, columns, keys, expectations, and a problem's own `fn`): on a free fall,
+/// which Newmark follows exactly, each expectation is what the functions give.
+#[test]
+fn the_language_s_functions_serve_every_place_of_a_problem() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems/functions_everywhere.wf");
+    let r = run(&Options::new(file.to_str().unwrap())).unwrap();
+    assert!((r.rows.last().unwrap().0 - 0.3).abs() < 1e-12, "t_end = min(0.5, max(0.2, 0.3))");
+    let expected = r.summary.field::<Vec<signorini::problem::summary::Expectation>>("expected").unwrap();
+    assert_eq!(expected.len(), 6);
+    for x in &expected {
+        assert!(x.met, "{x:?}");
+    }
+}

@@ -311,7 +311,8 @@ fn declare(prog: &mut Unit, files: &[(FileId, ast::File)], diags: &mut Vec<Diagn
                     Global::Scheme(prog.scheme_defs.len() - 1)
                 }
                 ast::Item::Problem(p) => {
-                    prog.problems.push((**p).clone());
+                    // Its `fn`s expanded where they are called: the problem as checked and run.
+                    prog.problems.push(problem::expand_fns(p, diags));
                     Global::Problem(prog.problems.len() - 1)
                 }
                 ast::Item::Import { .. } => continue,

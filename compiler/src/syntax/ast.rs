@@ -477,5 +477,16 @@ pub struct Problem {
     /// Its arguments (`reference hertz(radius = 10, force = F)`).
     pub reference_args: Vec<NamedArg>,
     pub lets: Vec<Defined>,
+    /// `fn NAME(ARGS) = EXPR`: functions of the problem, expanded where they are called.
+    pub fns: Vec<ProblemFn>,
+    pub span: Span,
+}
+
+/// `fn NAME(ARGS) = EXPR` in a problem.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProblemFn {
+    pub name: Ident,
+    pub params: Vec<Ident>,
+    pub body: Expr,
     pub span: Span,
 }

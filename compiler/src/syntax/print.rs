@@ -162,6 +162,10 @@ fn problem(p: &Problem, out: &mut String) {
             MeshSource::Generator(c) => out.push_str(&format!("  mesh {}\n", named_call(c))),
         }
     }
+    for f in &p.fns {
+        let params: Vec<&str> = f.params.iter().map(|a| a.name.as_str()).collect();
+        out.push_str(&format!("  fn {}({}) = {}\n", f.name.name, params.join(", "), expr(&f.body)));
+    }
     for r in &p.regions {
         let sources: Vec<String> = r.sources.iter().map(region_source).collect();
         out.push_str(&format!("  region {} = {}\n", r.name.name, sources.join(" else ")));

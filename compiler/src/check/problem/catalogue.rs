@@ -198,9 +198,18 @@ pub const SUMMARY_REDUCERS: &[(&str, &str, &str)] = &[
     ("at_max", "at_max(EXPR, OF)", "EXPR at the first row where OF is largest"),
 ];
 
-/// Functions of one number a series column or a summary key may apply (in a summary, inside or
-/// outside its reducers).
-pub const SUMMARY_FUNCTIONS: &[&str] = &["sqrt", "abs", "pos"];
+/// The functions of numbers a series column or a summary key may apply: the language's scalar
+/// built-ins (`sqrt`, `abs`, `pos`, `neg`, `H`, `min`, `max`, `sin`, ..., `ln`), the same as in
+/// coefs and forms. In a summary, `min` and `max` of the rows are reducers; inside a reducer's
+/// argument (a value of one row) they are these functions.
+pub fn row_function(name: &str) -> Option<&'static crate::check::builtins::Builtin> {
+    crate::check::builtins::function(name).filter(|b| b.shape == crate::check::builtins::ShapeRule::Scalars)
+}
+
+/// The names of [`row_function`]s, for messages.
+pub fn row_function_names() -> Vec<&'static str> {
+    crate::check::builtins::function_names().filter(|n| row_function(n).is_some()).collect()
+}
 
 /// Fields whose initial value a problem may give.
 pub const INITIAL_FIELDS: &[&str] = &["u", "v"];

@@ -66,7 +66,7 @@ fn row_help() -> String {
         values.join(", "),
         reducers.join(", "),
         FUNCTIONAL_STATES.iter().skip(1).map(|(s, _)| *s).collect::<Vec<_>>().join(", "),
-        SUMMARY_FUNCTIONS.join(", ")
+        row_function_names().join(", ")
     )
 }
 
@@ -97,9 +97,9 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
         _ => diags.push(Diagnostic::error("E0301", "shape mismatch", a.span, "a region's name is needed here")),
     };
     match f.name.as_str() {
-        name if SUMMARY_FUNCTIONS.contains(&name) => {
-            if arity(1, diags) {
-                row(c, &args[0], s, diags);
+        name if let Some(b) = row_function(name) => {
+            if arity(b.arity, diags) {
+                args.iter().for_each(|a| row(c, a, s, diags));
             }
         }
         "mean" | "nodal_mean" => {
@@ -226,25 +226,44 @@ pub(super) fn summary(e: &Expr, s: &SummaryScope, in_row: bool, diags: &mut Vec<
             summary(b, s, in_row, diags);
         }
         K::Call(f, args) => {
-            let (want, usage) = match SUMMARY_REDUCERS.iter().find(|(n, _, _)| *n == f.name) {
+            // Inside a reducer's argument (a value of one row) `min` and `max` of two are
+            // functions; of one, the reducer nested.
+            let nested = in_row && args.len() == 1;
+            let reducer = SUMMARY_REDUCERS
+                .iter()
+                .find(|(n, _, _)| *n == f.name)
+                .filter(|_| nested || !in_row || row_function(&f.name).is_none());
+            let (want, usage) = match (reducer, row_function(&f.name)) {
                 // min and max take an optional WHEN.
-                Some((name, usage, _)) if matches!(*name, "min" | "max") => (args.len().clamp(1, 2), *usage),
-                Some((name, usage, _)) => (if matches!(*name, "first" | "at_max") { 2 } else { 1 }, *usage),
-                None if SUMMARY_FUNCTIONS.contains(&f.name.as_str()) => (1, ""),
-                None => {
-                    let known = SUMMARY_REDUCERS.iter().map(|(n, _, _)| *n).chain(SUMMARY_FUNCTIONS.iter().copied());
-                    diags.push(unknown_among(f, known, "summary function"));
+                (Some((name, usage, _)), _) if matches!(*name, "min" | "max") => (args.len().clamp(1, 2), *usage),
+                (Some((name, usage, _)), _) => (if matches!(*name, "first" | "at_max") { 2 } else { 1 }, *usage),
+                (None, Some(b)) => (b.arity, ""),
+                (None, None) => {
+                    let mut known: Vec<&str> = SUMMARY_REDUCERS.iter().map(|(n, _, _)| *n).collect();
+                    for n in row_function_names() {
+                        if !known.contains(&n) {
+                            known.push(n);
+                        }
+                    }
+                    diags.push(unknown_among(f, known.into_iter(), "summary function"));
                     return;
                 }
             };
             let reducer = !usage.is_empty();
             if reducer && in_row {
-                diags.push(
+                let mut d =
                     Diagnostic::error("E0201", format!("`{}` inside a reducer", f.name), e.span, "a reducer of a row")
-                        .with_help("a reducer's argument is a value of one row: reduce it once"),
-                );
+                        .with_help("a reducer's argument is a value of one row: reduce it once");
+                if row_function(&f.name).is_some() {
+                    d = d.with_note(format!("inside a reducer, `{}(a, b)` of two values is the function", f.name));
+                }
+                diags.push(d);
             } else if args.len() != want {
-                let usage = if reducer { usage.to_string() } else { format!("{}(EXPR)", f.name) };
+                let usage = if reducer {
+                    usage.to_string()
+                } else {
+                    row_function(&f.name).map_or(String::new(), |b| b.doc.split(':').next().unwrap_or("").to_string())
+                };
                 diags.push(arity_error(f, e, want, args.len(), &usage));
             } else {
                 args.iter().for_each(|a| summary(a, s, in_row || reducer, diags));
@@ -262,6 +281,6 @@ fn summary_help() -> String {
     format!(
         "a summary reduces expressions of the columns: {}; it may apply {} and read the keys before it",
         reducers.join(", "),
-        SUMMARY_FUNCTIONS.join(", ")
+        row_function_names().join(", ")
     )
 }

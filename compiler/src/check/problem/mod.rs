@@ -9,11 +9,13 @@
 //! summary.
 
 mod catalogue;
+mod fns;
 mod measures;
 
 use std::collections::HashMap;
 
 pub use catalogue::*;
+pub(in crate::check) use fns::expand as expand_fns;
 use measures::{RowScope, SummaryScope, row, summary};
 
 use super::types::Checker;
@@ -76,10 +78,10 @@ fn params_and_lets(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) ->
     // A param named like a built-in value would hide it (`n`, the normal in region predicates).
     // `h` stays a param's name: problems read no cell size.
     for q in p.params.iter().map(|q| &q.name).chain(p.lets.iter().map(|l| &l.name)) {
-        if ["x", "t", "n", "pi"].contains(&q.name.as_str()) {
+        if ["x", "t", "n", "pi"].contains(&q.name.as_str()) || crate::check::builtins::builtin(&q.name).is_some() {
             diags.push(
                 Diagnostic::error("E0106", format!("`{}` is a built-in name", q.name), q.span, "would hide it")
-                    .with_note("x is the position, t the time, n the facet normal, pi is π")
+                    .with_note("x is the position, t the time, n the facet normal, pi is π; the functions (sin, max, ...) are the language's")
                     .with_help("give it another name"),
             );
         }
@@ -450,7 +452,7 @@ pub(super) fn vector(c: &mut Checker, e: &Expr, names: &[(String, Shape)], diags
     }
 }
 
-fn distinct<'a>(names: impl Iterator<Item = &'a Ident>, what: &str, diags: &mut Vec<Diagnostic>) {
+pub(super) fn distinct<'a>(names: impl Iterator<Item = &'a Ident>, what: &str, diags: &mut Vec<Diagnostic>) {
     let mut seen: HashMap<&str, Span> = HashMap::new();
     for n in names {
         if let Some(prev) = seen.insert(&n.name, n.span) {

@@ -38,6 +38,7 @@ impl Builder {
             reference: None,
             reference_args: Vec::new(),
             lets: Vec::new(),
+            fns: Vec::new(),
             span,
         };
         for p in rest {
@@ -100,6 +101,17 @@ impl Builder {
                     pb.expects.push(Expect { key, value, within, when, span });
                 }
                 Rule::let_decl => pb.lets.push(self.defined(span, next(), it.next())?),
+                Rule::fn_decl => {
+                    let name = self.ident(next());
+                    let (mut params, mut body) = (Vec::new(), None);
+                    for q in it {
+                        match q.as_rule() {
+                            Rule::ident_list => params = q.into_inner().map(|i| self.ident(i)).collect(),
+                            _ => body = Some(self.expr(q)?),
+                        }
+                    }
+                    pb.fns.push(ProblemFn { name, params, body: body.expect("fn has a body"), span });
+                }
                 Rule::obstacle_decl => {
                     let shape = self.named_call(next())?;
                     let region = it.next().map(|q| self.ident(q));
