@@ -68,6 +68,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0901", "problem: no mesh"),
     ("E0905", "problem: a Dirichlet condition on a contact region"),
     ("E0906", "problem: a `set` name that more than one file in use declares (qualify it: `material.rho`)"),
+    ("E0907", "problem: a `neumann` load on a Dirichlet or contact region"),
     ("W0001", "unused parameter (warning)"),
     ("W0002", "a scheme `let` hides another name (warning)"),
     ("W0003", "a `fn` or `form` argument hides a name of the file (warning)"),

@@ -240,6 +240,7 @@ fn methods(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Methods, CaseEr
         contact: parsed.contact.as_ref().map_or(d.contact, |s| name_or_path(s.get_ref(), base)),
         material: parsed.material.as_ref().map_or(d.material, |s| name_or_path(s.get_ref(), base)),
         forms: parsed.forms.as_ref().map_or_else(Vec::new, |f| f.get_ref().iter().map(|p| base.join(p)).collect()),
+        generated: Vec::new(),
         compiled: Vec::new(),
         params: Vec::new(),
         guard: crate::guard::Guard {

@@ -222,6 +222,7 @@ impl MethodArgs {
             contact: self.contact.clone().unwrap_or(d.contact),
             material: self.material.clone().unwrap_or(d.material),
             forms: self.forms.clone(),
+            generated: Vec::new(),
             compiled: Vec::new(),
             params,
             guard: Guard {

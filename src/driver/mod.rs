@@ -36,6 +36,9 @@ pub struct Methods {
     pub material: String,
     /// Extra form files whose slots the scheme applies.
     pub forms: Vec<PathBuf>,
+    /// Form files the run writes itself (a problem's `neumann` loads): a name and the text,
+    /// interpreted after the others.
+    pub generated: Vec<(String, String)>,
     /// Units compiled by the user's own crate (`forms!(...)::UNIT`): their schemes and form
     /// files are found by name before the library's.
     pub compiled: Vec<&'static Unit>,
@@ -53,6 +56,7 @@ impl Default for Methods {
             contact: d.contact.clone(),
             material: d.material.clone(),
             forms: Vec::new(),
+            generated: Vec::new(),
             compiled: Vec::new(),
             params: Vec::new(),
             guard: Default::default(),
@@ -220,6 +224,10 @@ pub fn form_units(methods: &Methods) -> Result<(Vec<FormSource>, usize), CaseErr
             units.push(u);
         }
     }
+    for (name, text) in &methods.generated {
+        let u = sources::interpret_text(name, text).map_err(CaseError::CaseFile)?;
+        units.push(FormSource::Interpreted(Box::new(u)));
+    }
     Ok((units, contact_index))
 }
 
@@ -313,7 +321,8 @@ impl FilesInUse {
             SchemeSource::Interpreted(i) => Some(i.file.clone()),
             SchemeSource::Compiled(_) => None,
         };
-        let forms = self.forms.units.iter().filter(|u| u.interpreted()).map(|u| u.file().to_string());
+        let written = |u: &FormSource| matches!(u, FormSource::Interpreted(i) if i.generated);
+        let forms = self.forms.units.iter().filter(|u| u.interpreted() && !written(u)).map(|u| u.file().to_string());
         scheme.into_iter().chain(forms).collect()
     }
 
@@ -453,17 +462,43 @@ impl FormsInUse {
                 }
             })?;
             for (name, form) in made {
-                if let Some((_, _, other)) = slots.iter().find(|(n, _, _)| *n == name) {
-                    return Err(CaseError::Option(format!(
-                        "slot `{name}` is provided by both {other} and {}: a run binds each slot once",
-                        unit.file()
-                    )));
-                }
-                slots.push((name.to_string(), form, unit.file().to_string()));
+                add_to_slot(&mut slots, name, form, unit.file())?;
             }
         }
         Ok(Instance { slots })
     }
+}
+
+/// Binds `form` to slot `name` for `file`: a slot another file provides already takes the sum
+/// of both forms (a problem's tractions add to the material's `load`), when both are forms of
+/// the same time levels; a functional is one file's (an energy summed from two laws would
+/// hide which law it measures).
+fn add_to_slot<'m>(
+    slots: &mut Vec<(String, SlotForm<'m>, String)>,
+    name: &str,
+    form: SlotForm<'m>,
+    file: &str,
+) -> Result<(), CaseError> {
+    let Some(i) = slots.iter().position(|(n, _, _)| n == name) else {
+        slots.push((name.to_string(), form, file.to_string()));
+        return Ok(());
+    };
+    let (_, earlier, other) = slots.remove(i);
+    let (SlotForm::Form(a), SlotForm::Form(b)) = (earlier, form) else {
+        return Err(CaseError::Option(format!(
+            "slot `{name}` is provided by both {other} and {file}: a functional is one file's (two would not say which law it measures); drop one of the files"
+        )));
+    };
+    if a.fields() != b.fields() {
+        return Err(CaseError::Option(format!(
+            "slot `{name}` is provided by {other} on {} time level(s) and by {file} on {}: forms added to one slot take the same levels",
+            a.fields(),
+            b.fields()
+        )));
+    }
+    let sum = crate::runtime::fem::summed::Summed::new(vec![a, b]);
+    slots.insert(i, (name.to_string(), SlotForm::Form(Box::new(sum)), format!("{other} + {file}")));
+    Ok(())
 }
 
 /// The coefs a case provides, among those the library's files declare, with the closest to

@@ -22,6 +22,8 @@ pub struct Interpreted {
     pub file: String,
     pub params: Vec<ParamInfo>,
     pub slots: Vec<SlotInfo>,
+    /// Written by the run itself (a problem's loads), not a file of the user's.
+    pub generated: bool,
     lib: Library,
 }
 
@@ -36,6 +38,22 @@ pub fn interpret(path: &Path) -> Result<Interpreted, String> {
         file: path.display().to_string(),
         params: describe::params(&prog),
         slots: describe::slots(&prog),
+        generated: false,
+        lib: Library::new(&prog),
+    })
+}
+
+/// Checks and lowers a form file the run writes itself (`name` is how messages name it).
+pub fn interpret_text(name: &str, text: &str) -> Result<Interpreted, String> {
+    let path = Path::new(name);
+    let prog = crate::compiler::pipeline::check_text(path, text, &LibraryLoader)
+        .map_err(|(diags, sources)| crate::compiler::render_all(&diags, &sources))?;
+    Ok(Interpreted {
+        name: module_name(path),
+        file: name.to_string(),
+        params: describe::params(&prog),
+        slots: describe::slots(&prog),
+        generated: true,
         lib: Library::new(&prog),
     })
 }

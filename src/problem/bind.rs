@@ -370,6 +370,10 @@ pub fn coefs(pf: &ProblemFile, ex: &mut Exprs) -> Result<Vec<(String, PointFn)>,
         out.push(("g".into(), ex.function(&g, e).map_err(|e| pf.render(*e))?));
         out.push(("nc".into(), ex.function(&nc, e).map_err(|e| pf.render(*e))?));
     }
+    for (k, b) in p.neumann.iter().enumerate() {
+        let v = ex.lower(&b.value, &[]).map_err(|e| pf.render(*e))?;
+        out.push((super::neumann::coef(k), ex.function(&v, &b.value).map_err(|e| pf.render(*e))?));
+    }
     Ok(out)
 }
 
@@ -575,6 +579,8 @@ pub fn unset_coefs(pf: &ProblemFile, in_use: &FilesInUse) -> Result<(), CaseErro
     if !p.obstacles.is_empty() {
         set.extend(["g", "nc"]);
     }
+    let loads: Vec<String> = (0..p.neumann.len()).map(super::neumann::coef).collect();
+    set.extend(loads.iter().map(String::as_str));
     let free = contact_free(pf);
     for (i, unit) in in_use.forms.units.iter().enumerate() {
         if free && i == in_use.forms.contact {

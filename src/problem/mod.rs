@@ -2,7 +2,8 @@
 //! `forms/problems/`, found by name, or a user's file by path. This module loads and checks
 //! the file and resolves its params; [`expr`] evaluates its expressions, [`bind`] builds the
 //! mesh, regions, coefs and initial fields (and checks the coefs against the files in use),
-//! [`dirichlet`] its held displacements, [`reference`] the analytic reference it names;
+//! [`dirichlet`] its held displacements, [`neumann`] its loads on regions, [`reference`] the
+//! analytic reference it names;
 //! [`observe`] measures its series columns at every row and [`summary`] its summary keys over
 //! the rows; [`run`] is the one loop that runs every problem, with [`options`] the choices over
 //! the problem's own, [`outputs`] what a run writes and [`resume`] what its checkpoints keep.
@@ -10,6 +11,7 @@
 pub mod bind;
 mod dirichlet;
 pub mod expr;
+mod neumann;
 pub mod observe;
 pub mod options;
 pub mod outputs;

@@ -135,6 +135,7 @@ fn bound<R>(
     let (params, rest) = super::params(&pf, &opts.methods.params)?;
     let mut methods = Methods { params: rest, ..opts.methods.clone() };
     bind_files(&pf, &mut methods, opts.chosen);
+    methods.generated.extend(super::neumann::forms(&pf));
     let values: Vec<(String, f64)> = params.iter().map(|p| (p.name.clone(), p.value)).collect();
     let d = super::bind::dimension(&pf, opts.mesh.as_deref(), &values)?;
     let p = pf.problem();
@@ -348,6 +349,7 @@ fn simulate(
             let problem = crate::simulation::statics::StaticProblem {
                 coefs: &coefs,
                 contact,
+                regions: &others,
                 contact_degree: quadrature.facet,
                 constraints: constraints.clone(),
                 newton: opts.newton,
@@ -384,19 +386,17 @@ fn simulate(
         }
         Runner::Time(sim) => {
             let u0 = if super::bind::settled(pf) {
-                settle(
-                    pf,
-                    &asm,
-                    &coefs,
-                    contact_region,
-                    &constraints,
-                    held.as_ref().is_some_and(|h| !h.zero_at(&mesh, t0)),
-                    quadrature.facet,
-                    opts,
-                    in_use,
-                    u0,
-                    t0,
-                )?
+                let held_nonzero = held.as_ref().is_some_and(|h| !h.zero_at(&mesh, t0));
+                let problem = crate::simulation::statics::StaticProblem {
+                    coefs: &coefs,
+                    contact: settle_contact(pf, contact_region, held_nonzero)?,
+                    regions: &others,
+                    contact_degree: quadrature.facet,
+                    constraints: constraints.clone(),
+                    newton: opts.newton,
+                    t: t0,
+                };
+                settle(pf, &asm, problem, in_use, u0)?
             } else {
                 u0
             };
@@ -629,40 +629,33 @@ fn simulate(
     Ok(run)
 }
 
-/// `initial u = settled(GUESS)`: the equilibrium K u + C(u) = F, by the static driver (its loads
-/// and obstacle at the start time) from the guess (which a frictional law's `prev` reads: the stick holds the body
-/// where the guess put it, along the obstacle).
-#[allow(clippy::too_many_arguments)]
-fn settle(
-    pf: &ProblemFile,
-    asm: &Assembler,
-    coefs: &dyn Fn(&str) -> Option<crate::runtime::fem::kernel::Coef>,
-    contact: Option<&str>,
-    constraints: &crate::runtime::nonlinear::statics::Constraints,
-    held_nonzero: bool,
-    facet_degree: Option<u32>,
-    opts: &Options,
-    in_use: &FilesInUse,
-    guess: Vec<f64>,
-    t0: f64,
-) -> Result<Vec<f64>, CaseError> {
-    let why = |what: &str| CaseError::Option(format!("{}: `initial u = settled(...)` {what}", pf.file));
+/// The contact `settled(GUESS)` rests on, after the checks that it can: a contact region, and
+/// Dirichlet values that are zero at the start (they are held at zero while settling).
+fn settle_contact<'p>(pf: &ProblemFile, contact: Option<&'p str>, held_nonzero: bool) -> Result<&'p str, CaseError> {
+    let why = |what: &str| CaseError::Settle(format!("{}: `initial u = settled(...)` {what}", pf.file));
     let contact = contact.ok_or_else(|| why("needs the problem's contact (an obstacle, or `Gamma_C`) to rest on"))?;
     if held_nonzero {
         return Err(why(
             "holds the Dirichlet values at zero: a value held away from zero at the start needs an initial u of its own",
         ));
     }
-    let problem = crate::simulation::statics::StaticProblem {
-        coefs,
-        contact,
-        contact_degree: facet_degree,
-        constraints: constraints.clone(),
-        // Backtracking on ‖R‖: a full step from a shallow guess can lift a free body off the
-        // obstacle, where its stiffness is singular (a disc of h = 0.05 settling did).
-        newton: crate::runtime::nonlinear::newton::NewtonOptions { line_search: true, ..opts.newton },
-        t: t0,
-    };
+    Ok(contact)
+}
+
+/// `initial u = settled(GUESS)`: the equilibrium K u + C(u) = F, by the static driver (its loads
+/// and obstacle at the start time) from the guess (which a frictional law's `prev` reads: the
+/// stick holds the body where the guess put it, along the obstacle). Newton backtracks on ‖R‖
+/// there: a full step from a shallow guess can lift a free body off the obstacle, where its
+/// stiffness is singular (a disc of h = 0.05 settling did).
+fn settle(
+    pf: &ProblemFile,
+    asm: &Assembler,
+    problem: crate::simulation::statics::StaticProblem,
+    in_use: &FilesInUse,
+    guess: Vec<f64>,
+) -> Result<Vec<f64>, CaseError> {
+    let newton = crate::runtime::nonlinear::newton::NewtonOptions { line_search: true, ..problem.newton };
+    let problem = crate::simulation::statics::StaticProblem { newton, ..problem };
     let solution = crate::simulation::statics::solve(asm, problem, &in_use.forms, guess)
         .map_err(|e| unsettled(pf, e, frictional(&in_use.forms)))?;
     Ok(solution.u)

@@ -19,6 +19,8 @@ pub struct StaticProblem<'p> {
     pub coefs: &'p dyn Fn(&str) -> Option<Coef>,
     /// The mesh region bound to the forms' `Gamma_C`.
     pub contact: &'p str,
+    /// The other regions the forms may integrate over (a load's), bound by their names.
+    pub regions: &'p [String],
     /// Degree of the contact term's facet rule (None: the form's own choice).
     pub contact_degree: Option<u32>,
     pub constraints: Constraints,
@@ -53,7 +55,12 @@ pub fn solve<'m>(
     let d = asm.mesh().dim();
     let n = asm.size();
     let facets = asm.region(problem.contact)?;
-    let regions = vec![("Gamma_C".to_string(), facets)];
+    // Every file's forms are bound twice (the volume terms with their own rules, the contact
+    // with the problem's facet rule): both bindings name every region a form may read.
+    let mut regions = vec![("Gamma_C".to_string(), facets)];
+    for name in problem.regions {
+        regions.push((name.clone(), asm.region(name)?));
+    }
     let volume = Binding { quadrature: Quadrature::default(), regions: regions.clone(), dim: d };
     let boundary = Binding { quadrature: Quadrature { cell: None, facet: problem.contact_degree }, regions, dim: d };
     let missing = |what: &str| {

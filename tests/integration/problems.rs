@@ -384,3 +384,34 @@ fn the_language_s_functions_serve_every_place_of_a_problem() {
         assert!(x.met, "{x:?}");
     }
 }
+
+/// A problem's `neumann` loads add to the material's `load` (a slot two files provide is their
+/// sum): the bar pulled by a traction, or by the same load as a pressure, runs the bits of
+/// traction_bar.wf, whose material file integrates the traction itself (and which follows
+/// d'Alembert at order 2); a block pressed by a pressure and pulled by a traction passes their
+/// resultants, 2 q and s, to the ground and to its held side.
+#[test]
+fn neumann_loads_add_to_the_material_s_load() {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems");
+    let bar = |file: &str, kind: f64| {
+        let mut o = Options::new(here.join(file).to_str().unwrap());
+        o.methods.params.push(Setting { name: "ne".into(), value: 80.0, origin: "test".into() });
+        if file.starts_with("neumann") {
+            o.methods.params.push(Setting { name: "kind".into(), value: kind, origin: "test".into() });
+        }
+        o.dt = Some(0.5 / 80.0);
+        run(&o).unwrap()
+    };
+    let reference = bar("traction_bar.wf", 0.0);
+    for kind in [0.0, 1.0] {
+        let r = bar("neumann_bar.wf", kind);
+        let (a, b) = (reference.column("u_end").unwrap(), r.column("u_end").unwrap());
+        assert_eq!(a.len(), b.len());
+        assert!(a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()), "kind {kind}");
+    }
+    let block = run(&Options::new(here.join("pressed_block.wf").to_str().unwrap())).unwrap();
+    for key in ["pressure_error", "held_error"] {
+        let e = block.summary.number(key).unwrap();
+        assert!(e.abs() < 1e-10, "{key} = {e}");
+    }
+}

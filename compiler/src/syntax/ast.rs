@@ -460,6 +460,8 @@ pub struct Problem {
     pub obstacles: Vec<Obstacle>,
     pub initial: Vec<Defined>,
     pub dirichlet: Vec<Dirichlet>,
+    /// Loads on regions: tractions and pressures.
+    pub neumann: Vec<Neumann>,
     /// Series columns (written) and observed values (not written), in order.
     pub series: Vec<(Defined, bool)>,
     pub summary: Vec<Defined>,
@@ -479,6 +481,17 @@ pub struct Problem {
     pub lets: Vec<Defined>,
     /// `fn NAME(ARGS) = EXPR`: functions of the problem, expanded where they are called.
     pub fns: Vec<ProblemFn>,
+    pub span: Span,
+}
+
+/// `neumann REGION: t = EXPR` (a traction) or `neumann REGION: p = EXPR` (a pressure, the
+/// traction −p n).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Neumann {
+    pub region: Ident,
+    /// `t` or `p`.
+    pub kind: Ident,
+    pub value: Expr,
     pub span: Span,
 }
 

@@ -202,6 +202,9 @@ fn problem(p: &Problem, out: &mut String) {
         };
         out.push_str(&format!("  dirichlet {on}: {}{k} = {}\n", d.field.name, expr(&d.value)));
     }
+    for b in &p.neumann {
+        out.push_str(&format!("  neumann {}: {} = {}\n", b.region.name, b.kind.name, expr(&b.value)));
+    }
     for (d, written) in &p.series {
         line(out, if *written { "series" } else { "observe" }, d);
     }

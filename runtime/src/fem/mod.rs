@@ -12,4 +12,5 @@ pub mod lumping;
 pub mod mesh;
 pub mod quadrature;
 pub mod redistribute;
+pub mod summed;
 pub mod test_matrices;

@@ -211,6 +211,12 @@ pub fn row_function_names() -> Vec<&'static str> {
     crate::check::builtins::function_names().filter(|n| row_function(n).is_some()).collect()
 }
 
+/// The loads `neumann REGION: KIND = EXPR` applies: a kind and its meaning.
+pub const NEUMANN_KINDS: &[(&str, &str)] = &[
+    ("t", "a traction, a vector of x and t: ∫ t·v over the region"),
+    ("p", "a pressure, a scalar of x and t: the traction −p n, ∫ −p n·v over the region"),
+];
+
 /// Fields whose initial value a problem may give.
 pub const INITIAL_FIELDS: &[&str] = &["u", "v"];
 

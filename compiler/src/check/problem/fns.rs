@@ -152,6 +152,7 @@ fn exprs_mut(p: &mut Problem) -> Vec<&mut Expr> {
         out.extend(d.component.as_mut());
         out.push(&mut d.value);
     }
+    out.extend(p.neumann.iter_mut().map(|b| &mut b.value));
     for x in &mut p.expects {
         out.push(&mut x.value);
         out.push(&mut x.within);

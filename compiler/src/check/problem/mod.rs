@@ -66,6 +66,7 @@ pub(in crate::check) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diag
     }
     let regions: Vec<&str> = p.regions.iter().map(|r| r.name.name.as_str()).collect();
     dirichlet(c, p, fields, &regions, diags);
+    neumann(c, p, fields, &regions, diags);
     obstacles(c, p, fields, &regions, diags);
     measures(c, p, &constants, &regions, diags);
 }
@@ -248,6 +249,39 @@ fn dirichlet(c: &mut Checker, p: &Problem, fields: &Names, regions: &[&str], dia
             );
         }
         held_value(c, d, fields, diags);
+    }
+}
+
+/// Loads on regions: a traction `t` (a vector of `x` and `t`) or a pressure `p` (a scalar), on
+/// a known region that no Dirichlet condition holds and no obstacle faces.
+fn neumann(c: &mut Checker, p: &Problem, fields: &Names, regions: &[&str], diags: &mut Vec<Diagnostic>) {
+    for b in &p.neumann {
+        match b.kind.name.as_str() {
+            "t" => vector(c, &b.value, fields, diags),
+            "p" => scalar(c, &b.value, fields, diags, false),
+            _ => diags.push(
+                unknown_among(&b.kind, NEUMANN_KINDS.iter().map(|(k, _)| *k), "boundary load")
+                    .with_help("`t = [..]` is a traction, `p = ..` a pressure (the traction −p n)"),
+            ),
+        }
+        let region = &b.region;
+        if !regions.contains(&region.name.as_str()) {
+            diags.push(unknown_among(region, regions.iter().copied(), "region"));
+            continue;
+        }
+        let held = p.dirichlet.iter().find(|d| d.on.region().is_some_and(|r| r.name == region.name));
+        let faced =
+            p.obstacles.iter().find(|o| o.region.as_ref().map_or("Gamma_C", |r| r.name.as_str()) == region.name);
+        let clash = held
+            .map(|d| (d.span, "held by this Dirichlet condition"))
+            .or(faced.map(|o| (o.span, "the obstacle faces it")));
+        if let Some((at, why)) = clash {
+            diags.push(
+                Diagnostic::error("E0907", "a load on a region whose displacement is decided elsewhere", region.span, "loaded here")
+                    .with_label(at, why)
+                    .with_help("a Dirichlet region takes no load (its reaction is `force(stiffness, REGION)`); a contact region's traction is the contact law's: load another region"),
+            );
+        }
     }
 }
 

@@ -190,6 +190,7 @@ const RESERVED: &[&str] = &[
     "when",
     "or",
     "not",
+    "neumann",
 ];
 
 /// Offset just after the last character of the chunk that is not whitespace or a comment.

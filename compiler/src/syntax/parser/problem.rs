@@ -39,6 +39,7 @@ impl Builder {
             reference_args: Vec::new(),
             lets: Vec::new(),
             fns: Vec::new(),
+            neumann: Vec::new(),
             span,
         };
         for p in rest {
@@ -134,6 +135,12 @@ impl Builder {
                     }
                     let value = self.expr(rest)?;
                     pb.dirichlet.push(Dirichlet { on, field, component, value, span });
+                }
+                Rule::neumann_decl => {
+                    let region = self.ident(next());
+                    let kind = self.ident(next());
+                    let value = self.expr(next())?;
+                    pb.neumann.push(Neumann { region, kind, value, span });
                 }
                 Rule::plot_decl => {
                     let title = unquote(next().as_str());
