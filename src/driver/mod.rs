@@ -171,6 +171,12 @@ pub fn library_declares(name: &str) -> bool {
     })
 }
 
+/// Whether a form file of the library provides a functional of that name (part of the
+/// documented contract of some law: `contact_trial`, `friction_work`).
+pub fn library_functional(name: &str) -> bool {
+    LIBRARY.iter().filter_map(|u| u.forms).any(|f| f.slots.iter().any(|s| s.functional && s.name == name))
+}
+
 /// Every scheme of the library, by name.
 pub fn all_schemes() -> Vec<&'static str> {
     scheme_names(&Methods::default())
@@ -530,6 +536,11 @@ impl<'m> Instance<'m> {
             SlotForm::Form(f) => Some(f),
             SlotForm::Functional(_) => unreachable!("matched a form"),
         }
+    }
+
+    /// Whether a file in use provides the functional `name` (and it is not taken yet).
+    pub fn provides_functional(&self, name: &str) -> bool {
+        self.slots.iter().any(|(n, f, _)| n == name && matches!(f, SlotForm::Functional(_)))
     }
 
     /// Takes the functional of a slot.

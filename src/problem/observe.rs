@@ -144,6 +144,9 @@ pub struct Observer<'m> {
     deferred: Vec<(usize, usize, std::cell::Cell<f64>)>,
     /// The last series row's active set (`status_kept` compares with it).
     last_switches: std::cell::RefCell<Option<Vec<bool>>>,
+    /// The columns left out of this run, and why: they read a functional that no file in use
+    /// provides (a user's law may have no `contact_trial`), or such a column.
+    pub left_out: Vec<(String, String)>,
 }
 
 #[derive(Default)]
@@ -186,6 +189,7 @@ impl<'m> Observer<'m> {
             reuse: Default::default(),
             deferred: Vec::new(),
             last_switches: Default::default(),
+            left_out: Vec::new(),
         };
         let mut region_names: Vec<String> = Vec::new();
         let u = ex.field(0);
@@ -193,6 +197,12 @@ impl<'m> Observer<'m> {
         let mut pointwise: Vec<(String, Val)> = vec![("u".into(), u), ("v".into(), v)];
         pointwise.extend(coef_vals.iter().cloned());
         for (d, written) in &p.series {
+            let required = p.required.iter().any(|r| r.name == d.name.name);
+            // A required column goes on, to the located error of the functional it lacks.
+            if let Some(why) = o.unavailable(&d.value, &inst).filter(|_| !required) {
+                o.left_out.push((d.name.name.clone(), why));
+                continue;
+            }
             let mut leaves: Vec<(usize, usize)> = Vec::new();
             let rewritten =
                 o.rewrite(pf, ex, ops, &mut inst, &d.value, &mut leaves, &pointwise, &mut region_names, binding)?;
@@ -213,6 +223,34 @@ impl<'m> Observer<'m> {
             o.columns.push((d.name.name.clone(), *written, f));
         }
         Ok(o)
+    }
+
+    /// Why a column's expression cannot be measured on this run, if it cannot: a functional of
+    /// the library's laws (not a misspelt name) that neither the files in use nor the reference
+    /// provide, or a column left out.
+    fn unavailable(&self, e: &Expr, inst: &crate::driver::Instance<'m>) -> Option<String> {
+        let state = |a: &Expr| {
+            matches!(&a.kind, ExprKind::Name(n)
+                if crate::compiler::check::problem::FUNCTIONAL_STATES.iter().any(|(s, _)| *s == n.name))
+        };
+        match &e.kind {
+            ExprKind::Name(id) => {
+                self.left_out.iter().any(|(c, _)| *c == id.name).then(|| format!("it reads `{}`, left out", id.name))
+            }
+            ExprKind::Call(f, args) if !args.is_empty() && args.iter().all(state) => {
+                let by_files = self.functionals.iter().any(|(n, _)| *n == f.name) || inst.provides_functional(&f.name);
+                let by_reference =
+                    self.reference.as_ref().is_some_and(|(r, _)| r.functionals().iter().any(|(n, _)| *n == f.name));
+                let known = crate::driver::library_functional(&f.name);
+                (known && !by_files && !by_reference).then(|| format!("no file in use provides `{}`", f.name))
+            }
+            ExprKind::Call(_, args) | ExprKind::Vector(args) => args.iter().find_map(|a| self.unavailable(a, inst)),
+            ExprKind::Neg(a) => self.unavailable(a, inst),
+            ExprKind::Binary(_, a, b) | ExprKind::Index(a, b) => {
+                self.unavailable(a, inst).or_else(|| self.unavailable(b, inst))
+            }
+            ExprKind::Number(_) => None,
+        }
     }
 
     /// `e` with every measured value replaced by a placeholder name; the measures are added.

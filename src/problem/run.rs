@@ -315,7 +315,13 @@ fn simulate(
     let columns: Vec<String> = observer.names().map(str::to_string).collect();
     let shown = observer.shown();
     let applies = super::summary::applies(pf, ex, &in_use.forms.params)?;
-    let summary_fns = SummaryKeys::new(pf, ex, &columns, applies)?;
+    let absent: Vec<String> = observer.left_out.iter().map(|(c, _)| c.clone()).collect();
+    let summary_fns = SummaryKeys::new(pf, ex, &columns, applies, &absent)?;
+    for (what, list) in [("series", &observer.left_out), ("summary key", &summary_fns.left_out)] {
+        for (name, why) in list {
+            eprintln!("note: {what} `{name}` is left out of this run: {why}");
+        }
+    }
     // A column only `at_max` reads (not written, plotted or read by another column or key) is
     // measured only where its maximand reaches a new maximum: the contact radius at the peak
     // force samples the pressure at those rows, not at every step.
@@ -599,8 +605,9 @@ fn simulate(
     if let Some(resumed) = &outcome.resumed {
         put("resumed", json(resumed));
     }
-    // Why a key is null: undefined on this run (0/0 or no row where `first` finds one).
-    let notes: Vec<String> = own
+    // Why a key is null: undefined on this run (0/0 or no row where `first` finds one); and
+    // what this run left out.
+    let mut notes: Vec<String> = own
         .iter()
         .filter(|(_, v)| !v.is_some_and(f64::is_finite))
         .map(|(k, _)| {
@@ -609,6 +616,9 @@ fn simulate(
             format!("{k} is undefined on this run (its expression at {}:{line} has no value)", pf.file)
         })
         .collect();
+    for (name, why) in observer.left_out.iter().chain(&summary_fns.left_out) {
+        notes.push(format!("{name} is left out of this run: {why}"));
+    }
     if !notes.is_empty() {
         put("notes", json(&notes));
     }

@@ -90,6 +90,8 @@ pub struct SummaryKeys {
     expects: Vec<(String, f64, bool)>,
     /// Per expectation: whether its `when` holds on this run.
     applies: Vec<bool>,
+    /// The keys left out of this run (they read a column left out, or such a key), and why.
+    pub left_out: Vec<(String, String)>,
     columns: usize,
     /// The names the reducers' expression arguments read (not plain columns).
     read_by_expressions: Vec<String>,
@@ -98,12 +100,17 @@ pub struct SummaryKeys {
 impl SummaryKeys {
     /// `columns`: every column's name, in row order; `applies`: per expectation, whether its
     /// `when` holds ([`applies`]).
+    /// `left_out`: the columns this run does not measure; the keys and expectations that read
+    /// them are left out too.
     pub fn new(
         pf: &ProblemFile,
         ex: &mut Exprs,
         columns: &[String],
-        applies: Vec<bool>,
+        mut applies: Vec<bool>,
+        left_out: &[String],
     ) -> Result<SummaryKeys, CaseError> {
+        let mut absent: Vec<String> = left_out.to_vec();
+        let mut skipped: Vec<(String, String)> = Vec::new();
         let mut keys: Vec<Key> = Vec::new();
         let mut read_by_expressions = Vec::new();
         // In a reducer's argument: column i is measured value i, key j is measured value
@@ -119,6 +126,21 @@ impl SummaryKeys {
         let hidden = p.expects.iter().enumerate().map(|(i, x)| (Some(i), format!("#expect {}", x.key.name), &x.value));
         let all = p.summary.iter().map(|d| (None, d.name.name.clone(), &d.value)).chain(hidden);
         for (expect, name, value) in all {
+            let mut read = Vec::new();
+            names_in(value, &mut read);
+            if let Some(missing) = read.iter().find(|n| absent.contains(n)) {
+                match expect {
+                    Some(i) => {
+                        expects[i].2 = false;
+                        applies[i] = false;
+                    }
+                    None => {
+                        skipped.push((name.clone(), format!("it reads `{missing}`, left out")));
+                        absent.push(name);
+                    }
+                }
+                continue;
+            }
             let mut calls = Vec::new();
             let rewritten = summary_rewrite(value, &mut calls);
             let mut reduces = Vec::new();
@@ -157,7 +179,7 @@ impl SummaryKeys {
             row_scope.push((name.clone(), ex.measured(columns.len() + keys.len(), 1)));
             keys.push(Key { name, reduces, f });
         }
-        Ok(SummaryKeys { keys, expects, applies, columns: columns.len(), read_by_expressions })
+        Ok(SummaryKeys { keys, expects, applies, left_out: skipped, columns: columns.len(), read_by_expressions })
     }
 
     /// The (column, of) pairs of `at_max(column, of)` whose column no other reducer reads: the

@@ -415,3 +415,20 @@ fn neumann_loads_add_to_the_material_s_load() {
         assert!(e.abs() < 1e-10, "{key} = {e}");
     }
 }
+
+/// A library problem runs with any law that provides the documented contract: the bar
+/// observes `contact_trial`, which a plain penalty law of the user's does not provide; the
+/// column is left out, with a note, and the rest of the run is the run (the contact stress
+/// against the exact one, the energy).
+#[test]
+fn a_column_the_law_cannot_measure_is_left_out_with_a_note() {
+    let law = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems/plain_penalty.wf");
+    let mut o = Options::new("bar");
+    o.methods.contact = law.to_str().unwrap().into();
+    o.chosen.contact = true;
+    let r = run(&o).unwrap();
+    assert!(!r.columns.iter().any(|c| c == "p1"), "{:?}", r.columns);
+    assert!(r.columns.iter().any(|c| c == "lambda") && r.summary.number("err_l2_lambda").is_some());
+    let notes: Vec<String> = r.summary.field("notes").unwrap();
+    assert!(notes.iter().any(|n| n.contains("p1") && n.contains("contact_trial")), "{notes:?}");
+}

@@ -464,6 +464,9 @@ pub struct Problem {
     pub neumann: Vec<Neumann>,
     /// Series columns (written) and observed values (not written), in order.
     pub series: Vec<(Defined, bool)>,
+    /// The columns marked `required`: one that reads a functional no file in use provides is
+    /// an error, not left out.
+    pub required: Vec<Ident>,
     pub summary: Vec<Defined>,
     /// `expect KEY = VALUE within TOL`: what a summary key should be, to a relative tolerance.
     pub expects: Vec<Expect>,

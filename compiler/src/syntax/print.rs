@@ -206,7 +206,13 @@ fn problem(p: &Problem, out: &mut String) {
         out.push_str(&format!("  neumann {}: {} = {}\n", b.region.name, b.kind.name, expr(&b.value)));
     }
     for (d, written) in &p.series {
-        line(out, if *written { "series" } else { "observe" }, d);
+        let required = if p.required.iter().any(|r| r.name == d.name.name) { " required" } else { "" };
+        out.push_str(&format!(
+            "  {} {} = {}{required}\n",
+            if *written { "series" } else { "observe" },
+            d.name.name,
+            expr(&d.value)
+        ));
     }
     for d in &p.summary {
         line(out, "summary", d);

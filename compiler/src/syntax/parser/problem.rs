@@ -40,6 +40,7 @@ impl Builder {
             lets: Vec::new(),
             fns: Vec::new(),
             neumann: Vec::new(),
+            required: Vec::new(),
             span,
         };
         for p in rest {
@@ -91,8 +92,13 @@ impl Builder {
                 Rule::quadrature_decl => pb.quadrature.extend(self.assignments(next())?),
                 Rule::coef_def => pb.coefs.push(self.defined(span, next(), it.next())?),
                 Rule::initial_field => pb.initial.push(self.defined(span, next(), it.next())?),
-                Rule::series_decl => pb.series.push((self.defined(span, next(), it.next())?, true)),
-                Rule::observe_decl => pb.series.push((self.defined(span, next(), it.next())?, false)),
+                Rule::series_decl | Rule::observe_decl => {
+                    let d = self.defined(span, next(), it.next())?;
+                    if it.next().is_some() {
+                        pb.required.push(d.name.clone());
+                    }
+                    pb.series.push((d, rule == Rule::series_decl));
+                }
                 Rule::summary_decl => pb.summary.push(self.defined(span, next(), it.next())?),
                 Rule::expect_decl => {
                     let key = self.ident(next());
