@@ -92,11 +92,6 @@ fn fill(
     Ok(out)
 }
 
-/// A named argument of a generator or helper.
-fn arg<'a>(call: &'a NamedCall, name: &str) -> Option<&'a Expr> {
-    call.args.iter().find(|a| a.name.name == name).map(|a| &a.value)
-}
-
 /// The mesh: `mesh_file` (`--mesh`) or the problem's, with the problem's regions, validated.
 /// The label says what it is in summaries.
 pub fn mesh(
@@ -246,27 +241,20 @@ fn predicate(
     })
 }
 
-/// A built-in generator's mesh, after a check that it fits in memory.
+/// A built-in generator's mesh, after a check that it fits in memory; and its label, the
+/// arguments' values (`built-in disc(radius = 10, h = 1, centre = [0.0, 12.0])`).
 fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh, String), CaseError> {
+    use crate::compiler::check::problem::Generator;
     use crate::runtime::fem::mesh::{ball::ball, disc::disc, structured};
-    // The scalar arguments, evaluated up front (the checker knows which each generator takes).
-    let mut scalars: Vec<(String, f64)> = Vec::new();
-    let vectors = crate::compiler::check::problem::GENERATORS
-        .iter()
-        .find(|g| g.name == call.name.name)
-        .map_or(&[][..], |g| g.args)
-        .iter()
-        .filter(|(_, shape, _)| *shape == crate::compiler::syntax::ast::Shape::Vector)
-        .map(|(n, _, _)| *n)
-        .collect::<Vec<_>>();
-    for a in call.args.iter().filter(|a| !vectors.contains(&a.name.name.as_str())) {
-        // A generator's numbers are constants: an expression of x or t is an error here.
-        let v = ex.scalar(&a.value).map_err(|e| pf.render(*e))?;
-        scalars.push((a.name.name.clone(), v));
-    }
+    let generator = crate::compiler::check::problem::generator(call)
+        .map_err(|why| pf.render(Diagnostic::error("E0101", why, call.span, "not a generator this run knows")))?;
     let mut values = Vec::new();
-    let mut get = |name: &str, default: f64| -> Result<f64, CaseError> {
-        let v = scalars.iter().find(|(n, _)| n == name).map_or(default, |(_, v)| *v);
+    // A generator's numbers are constants: an expression of x or t is an error here.
+    let mut get = |ex: &mut Exprs, name: &str, e: Option<&Expr>, default: f64| -> Result<f64, CaseError> {
+        let v = match e {
+            Some(e) => ex.scalar(e).map_err(|d| pf.render(*d))?,
+            None => default,
+        };
         values.push(format!("{name} = {v}"));
         Ok(v)
     };
@@ -287,23 +275,23 @@ fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh,
             Err(CaseError::Option(format!("{}: `{name}` must be positive, not {v}", pf.file)))
         }
     };
+    let vector = |ex: &mut Exprs, e: &Expr| ex.vector(e).map_err(|d| pf.render(*d));
+    let origin = |ex: &mut Exprs, e: Option<&Expr>, dim: usize| e.map_or(Ok(vec![0.0; dim]), |e| vector(ex, e));
     let name = pf.name().to_string();
-    let gen_name = call.name.name.as_str();
-    let mesh = match gen_name {
-        "interval" => {
-            let (length, cells, start) = (get("length", 0.0)?, get("cells", 0.0)?, get("start", 0.0)?);
+    let mesh = match generator {
+        Generator::Interval { length, cells, start } => {
+            let (length, cells) = (get(ex, "length", Some(length), 0.0)?, get(ex, "cells", Some(cells), 0.0)?);
+            let start = get(ex, "start", start, 0.0)?;
             let cells = count("cells", cells)?;
             crate::resources::check(&name, cells as f64 + 1.0, 1, None)?;
             structured::interval(cells, start, start + positive("length", length)?)
         }
-        "disc" | "ball" => {
-            let (radius, h) = (positive("radius", get("radius", 0.0)?)?, positive("h", get("h", 0.0)?)?);
-            let centre = match arg(call, "centre") {
-                Some(e) => ex.vector(e).map_err(|e| pf.render(*e))?,
-                None => vec![0.0; 3],
-            };
+        Generator::Disc { radius, centre, h } | Generator::Ball { radius, centre, h } => {
+            let radius = positive("radius", get(ex, "radius", Some(radius), 0.0)?)?;
+            let h = positive("h", get(ex, "h", Some(h), 0.0)?)?;
+            let centre = vector(ex, centre)?;
             values.push(format!("centre = {centre:?}"));
-            if gen_name == "disc" {
+            if matches!(generator, Generator::Disc { .. }) {
                 // P2 nodes: 3m² vertices on m rings.
                 let dofs = 2.0 * 4.0 * 3.0 * (radius / h).ceil().powi(2);
                 crate::resources::check(&name, dofs, 2, Some(h))?;
@@ -315,13 +303,13 @@ fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh,
                 ball(radius, [centre[0], centre[1], centre[2]], h)
             }
         }
-        "rectangle" => {
-            let (w, h) = (positive("width", get("width", 0.0)?)?, positive("height", get("height", 0.0)?)?);
-            let (nx, ny) = (count("nx", get("nx", 0.0)?)?, count("ny", get("ny", 0.0)?)?);
-            let degree = get("degree", 1.0)?;
-            let degree = if degree == 2.0 { 2 } else { 1 };
+        Generator::Rectangle { width, height, nx, ny, degree, origin: at } => {
+            let w = positive("width", get(ex, "width", Some(width), 0.0)?)?;
+            let h = positive("height", get(ex, "height", Some(height), 0.0)?)?;
+            let (nx, ny) = (count("nx", get(ex, "nx", Some(nx), 0.0)?)?, count("ny", get(ex, "ny", Some(ny), 0.0)?)?);
+            let degree = if get(ex, "degree", degree, 1.0)? == 2.0 { 2 } else { 1 };
             crate::resources::check(&name, 2.0 * ((degree * nx + 1) * (degree * ny + 1)) as f64, 2, None)?;
-            let o = origin(pf, ex, call, 2)?;
+            let o = origin(ex, at, 2)?;
             values.push(format!("origin = {o:?}"));
             structured::rectangle(
                 nx,
@@ -332,30 +320,22 @@ fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh,
                 degree as u32,
             )
         }
-        _ => {
-            // `box`: the checker knows no other generator.
-            let size = match arg(call, "size") {
-                Some(e) => ex.vector(e).map_err(|e| pf.render(*e))?,
-                None => vec![1.0; 3],
-            };
-            let n = [count("nx", get("nx", 0.0)?)?, count("ny", get("ny", 0.0)?)?, count("nz", get("nz", 0.0)?)?];
-            let degree = if get("degree", 1.0)? == 2.0 { 2 } else { 1 };
+        Generator::Box { size, nx, ny, nz, degree, origin: at } => {
+            let size = vector(ex, size)?;
+            let n = [
+                count("nx", get(ex, "nx", Some(nx), 0.0)?)?,
+                count("ny", get(ex, "ny", Some(ny), 0.0)?)?,
+                count("nz", get(ex, "nz", Some(nz), 0.0)?)?,
+            ];
+            let degree = if get(ex, "degree", degree, 1.0)? == 2.0 { 2 } else { 1 };
             let nodes: usize = n.iter().map(|k| degree * k + 1).product();
             crate::resources::check(&name, 3.0 * nodes as f64, 3, None)?;
-            let o = origin(pf, ex, call, 3)?;
+            let o = origin(ex, at, 3)?;
             values.push(format!("origin = {o:?}"));
             structured::cuboid(n, [o[0], o[0] + size[0]], [o[1], o[1] + size[1]], [o[2], o[2] + size[2]], degree as u32)
         }
     };
-    Ok((mesh, format!("built-in {gen_name}({})", values.join(", "))))
-}
-
-/// A generator's `origin` (its least corner; default 0).
-fn origin(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall, dim: usize) -> Result<Vec<f64>, CaseError> {
-    match arg(call, "origin") {
-        Some(e) => ex.vector(e).map_err(|d| pf.render(*d)),
-        None => Ok(vec![0.0; dim]),
-    }
+    Ok((mesh, format!("built-in {}({})", call.name.name, values.join(", "))))
 }
 
 /// The coefs the problem sets, by name: its `coef` lines, then its obstacles' `g` and `nc`.
@@ -404,14 +384,17 @@ fn obstacle_vals<'p>(pf: &'p ProblemFile, ex: &mut Exprs) -> Result<Vec<(Val, Va
     }
     let mut out = Vec::new();
     for o in &p.obstacles {
-        let lower = |ex: &mut Exprs, name: &str| -> Result<(Val, &'p Expr), CaseError> {
-            let e = arg(&o.shape, name).expect("checked: required argument");
+        use crate::compiler::check::problem::ObstacleShape;
+        let shape = crate::compiler::check::problem::obstacle(&o.shape).map_err(|why| {
+            pf.render(Diagnostic::error("E0101", why, o.shape.span, "not an obstacle this run knows"))
+        })?;
+        let lower = |ex: &mut Exprs, e: &'p Expr| -> Result<(Val, &'p Expr), CaseError> {
             Ok((ex.lower(e, &[]).map_err(|d| pf.render(*d))?, e))
         };
         let x = ex.lower(&x_expr(o.shape.span), &[]).map_err(|e| pf.render(*e))?;
-        match o.shape.name.name.as_str() {
-            "plane" => {
-                let ((point, e), (normal, _)) = (lower(ex, "point")?, lower(ex, "normal")?);
+        let (centre, radius, axis) = match shape {
+            ObstacleShape::Plane { point, normal } => {
+                let ((point, e), (normal, _)) = (lower(ex, point)?, lower(ex, normal)?);
                 let g = &mut ex.low.g;
                 // gap = (x − point)·normal, nc = −normal.
                 let mut gap = g.zero();
@@ -422,77 +405,79 @@ fn obstacle_vals<'p>(pf: &'p ProblemFile, ex: &mut Exprs) -> Result<Vec<(Val, Va
                 }
                 let nc = normal.c.iter().map(|j| crate::compiler::ir::lower::Jet { v: g.neg(j.v), g: None }).collect();
                 out.push((scalar(gap), Val { shape: normal.shape, c: nc }, e));
+                continue;
             }
-            shape => {
-                // `sphere`: gap = |x − centre| − radius, nc = (centre − x)/|x − centre|.
-                // `cylinder`: the same with the part of x − point across the axis.
-                let centre_arg = if shape == "sphere" { "centre" } else { "point" };
-                let ((centre, e), (radius, _)) = (lower(ex, centre_arg)?, lower(ex, "radius")?);
-                let axis = match arg(&o.shape, "axis") {
-                    Some(a) if x.c.len() == 3 => {
-                        let axis = ex.lower(a, &[]).map_err(|d| pf.render(*d))?;
-                        // A constant axis must have a direction (one that moves is the user's).
-                        let constant: Option<Vec<f64>> = axis.c.iter().map(|j| ex.low.g.as_const(j.v)).collect();
-                        if constant.is_some_and(|v| v.iter().all(|x| *x == 0.0)) {
-                            return Err(pf.render(Diagnostic::error(
-                                "E0301",
-                                "a cylinder's axis is not zero",
-                                a.span,
-                                "no direction",
-                            )));
-                        }
-                        Some(axis)
-                    }
-                    Some(a) => {
-                        return Err(pf.render(
-                            Diagnostic::error("E0302", "wrong dimension", a.span, "a 2D cylinder has no axis")
-                                .with_help("in 2D a cylinder is its section, the disc of `radius` about `point`"),
-                        ));
-                    }
-                    None if shape == "cylinder" && x.c.len() == 3 => {
-                        return Err(pf.render(Diagnostic::error(
-                            "E0201",
-                            "a cylinder in 3D needs its `axis`",
-                            o.shape.span,
-                            "no `axis = [...]`",
-                        )));
-                    }
-                    None => None,
-                };
-                let g = &mut ex.low.g;
-                let mut diff: Vec<_> = (0..x.c.len()).map(|k| g.sub(x.c[k].v, centre.c[k].v)).collect();
-                if let Some(axis) = axis {
-                    // d − (d·a) a / (a·a)
-                    let (mut along, mut norm2) = (g.zero(), g.zero());
-                    for k in 0..diff.len() {
-                        let p = g.mul(diff[k], axis.c[k].v);
-                        along = g.add(along, p);
-                        let q = g.mul(axis.c[k].v, axis.c[k].v);
-                        norm2 = g.add(norm2, q);
-                    }
-                    let s = g.div(along, norm2);
-                    for k in 0..diff.len() {
-                        let p = g.mul(s, axis.c[k].v);
-                        diff[k] = g.sub(diff[k], p);
-                    }
+            ObstacleShape::Sphere { centre, radius } => (centre, radius, None),
+            ObstacleShape::Cylinder { point, radius, axis } => {
+                if axis.is_none() && x.c.len() == 3 {
+                    return Err(pf.render(Diagnostic::error(
+                        "E0201",
+                        "a cylinder in 3D needs its `axis`",
+                        o.shape.span,
+                        "no `axis = [...]`",
+                    )));
                 }
-                let mut r2 = g.zero();
-                for &dk in &diff {
-                    let sq = g.mul(dk, dk);
-                    r2 = g.add(r2, sq);
+                (point, radius, axis)
+            }
+        };
+        // A sphere: gap = |x − centre| − radius, nc = (centre − x)/|x − centre|; a
+        // cylinder: the same with the part of x − point across the axis.
+        let ((centre, e), (radius, _)) = (lower(ex, centre)?, lower(ex, radius)?);
+        let axis = match axis {
+            Some(a) if x.c.len() == 3 => {
+                let axis = ex.lower(a, &[]).map_err(|d| pf.render(*d))?;
+                // A constant axis must have a direction (one that moves is the user's).
+                let constant: Option<Vec<f64>> = axis.c.iter().map(|j| ex.low.g.as_const(j.v)).collect();
+                if constant.is_some_and(|v| v.iter().all(|x| *x == 0.0)) {
+                    return Err(pf.render(Diagnostic::error(
+                        "E0301",
+                        "a cylinder's axis is not zero",
+                        a.span,
+                        "no direction",
+                    )));
                 }
-                let dist = g.sqrt(r2);
-                let gap = g.sub(dist, radius.c[0].v);
-                let nc = diff
-                    .iter()
-                    .map(|&dk| {
-                        let q = g.div(dk, dist);
-                        crate::compiler::ir::lower::Jet { v: g.neg(q), g: None }
-                    })
-                    .collect();
-                out.push((scalar(gap), Val { shape: centre.shape, c: nc }, e));
+                Some(axis)
+            }
+            Some(a) => {
+                return Err(pf.render(
+                    Diagnostic::error("E0302", "wrong dimension", a.span, "a 2D cylinder has no axis")
+                        .with_help("in 2D a cylinder is its section, the disc of `radius` about `point`"),
+                ));
+            }
+            None => None,
+        };
+        let g = &mut ex.low.g;
+        let mut diff: Vec<_> = (0..x.c.len()).map(|k| g.sub(x.c[k].v, centre.c[k].v)).collect();
+        if let Some(axis) = axis {
+            // d − (d·a) a / (a·a)
+            let (mut along, mut norm2) = (g.zero(), g.zero());
+            for k in 0..diff.len() {
+                let p = g.mul(diff[k], axis.c[k].v);
+                along = g.add(along, p);
+                let q = g.mul(axis.c[k].v, axis.c[k].v);
+                norm2 = g.add(norm2, q);
+            }
+            let s = g.div(along, norm2);
+            for k in 0..diff.len() {
+                let p = g.mul(s, axis.c[k].v);
+                diff[k] = g.sub(diff[k], p);
             }
         }
+        let mut r2 = g.zero();
+        for &dk in &diff {
+            let sq = g.mul(dk, dk);
+            r2 = g.add(r2, sq);
+        }
+        let dist = g.sqrt(r2);
+        let gap = g.sub(dist, radius.c[0].v);
+        let nc = diff
+            .iter()
+            .map(|&dk| {
+                let q = g.div(dk, dist);
+                crate::compiler::ir::lower::Jet { v: g.neg(q), g: None }
+            })
+            .collect();
+        out.push((scalar(gap), Val { shape: centre.shape, c: nc }, e));
     }
     Ok(out)
 }

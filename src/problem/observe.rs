@@ -6,6 +6,7 @@
 
 use super::ProblemFile;
 use super::expr::{At, Exprs, PointFn};
+use crate::compiler::check::problem::RowReducer as R;
 use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
 use crate::driver::FormsInUse;
@@ -321,22 +322,22 @@ impl<'m> Observer<'m> {
                 Expr { kind: ExprKind::Index(Box::new(a), k.clone()), span: e.span }
             }
             ExprKind::Vector(_) => unreachable!("checked: no vector in a column"),
-            ExprKind::Call(f, args) => match f.name.as_str() {
-                name if crate::compiler::check::problem::row_function(name).is_some() => {
+            ExprKind::Call(f, args) => match crate::compiler::check::problem::row_reducer(&f.name).map(|r| r.kind) {
+                None if crate::compiler::check::problem::row_function(&f.name).is_some() => {
                     let args = args
                         .iter()
                         .map(|a| self.rewrite(pf, ex, ops, inst, a, leaves, pointwise, region_names, binding))
                         .collect::<Result<Vec<_>, _>>()?;
                     Expr { kind: ExprKind::Call(f.clone(), args), span: e.span }
                 }
-                "mean" | "nodal_mean" | "at_min" => {
+                Some(kind @ (R::Mean | R::NodalMean | R::AtMin)) => {
                     let (field, axis) = component(&args[0]);
                     if axis >= d {
                         return Err(bad_axis(&args[0], axis));
                     }
-                    let m = match f.name.as_str() {
-                        "mean" => Measure::Mean { field, weights: ops.axis_mean(axis) },
-                        "nodal_mean" => Measure::NodalMean { field, axis },
+                    let m = match kind {
+                        R::Mean => Measure::Mean { field, weights: ops.axis_mean(axis) },
+                        R::NodalMean => Measure::NodalMean { field, axis },
                         _ => {
                             let val = ex.lower(&args[1], &[]).map_err(|e| pf.render(*e))?;
                             let key = ex.function(&val, &args[1]).map_err(|e| pf.render(*e))?;
@@ -356,7 +357,7 @@ impl<'m> Observer<'m> {
                     };
                     add(self, m, 1, e.span)
                 }
-                "force" | "work" => {
+                Some(kind @ (R::Force | R::Work)) => {
                     let ExprKind::Name(slot) = &args[0].kind else { unreachable!("checked: a slot name") };
                     let index = match self.slots.iter().position(|(n, _)| *n == slot.name) {
                         Some(i) => i,
@@ -373,7 +374,7 @@ impl<'m> Observer<'m> {
                             self.slots.len() - 1
                         }
                     };
-                    if f.name == "work" {
+                    if kind == R::Work {
                         return Ok(add(self, Measure::Work { slot: index }, 1, e.span));
                     }
                     // Over a region: the dofs of its nodes, component by component.
@@ -387,15 +388,21 @@ impl<'m> Observer<'m> {
                     };
                     add(self, Measure::Force { slot: index, dofs }, d, e.span)
                 }
-                "cumulative" | "initial" => {
+                Some(kind @ (R::Cumulative | R::Initial)) => {
                     let ExprKind::Name(id) = &args[0].kind else { unreachable!("checked: a column's name") };
-                    let column =
-                        self.columns.iter().position(|(n, _, _)| *n == id.name).expect("checked: an earlier column");
-                    let sum = f.name == "cumulative";
+                    let column = self.columns.iter().position(|(n, _, _)| *n == id.name).ok_or_else(|| {
+                        pf.render(crate::compiler::Diagnostic::error(
+                            "E0101",
+                            format!("no earlier column `{}` on this run", id.name),
+                            id.span,
+                            "not measured",
+                        ))
+                    })?;
+                    let sum = kind == R::Cumulative;
                     let value = std::cell::Cell::new(if sum { 0.0 } else { f64::NAN });
                     add(self, Measure::OverRows { column, sum, value }, 1, e.span)
                 }
-                "inner_mass" => {
+                Some(R::InnerMass) => {
                     let mut field = |e: &Expr| -> Result<PointFn, CaseError> {
                         let val = ex.lower(e, pointwise).map_err(|d| pf.render(*d))?;
                         ex.function(&val, e).map_err(|d| pf.render(*d))
@@ -403,7 +410,7 @@ impl<'m> Observer<'m> {
                     let (a, b) = (field(&args[0])?, field(&args[1])?);
                     add(self, Measure::InnerMass { a, b }, 1, e.span)
                 }
-                "density_min" | "density_support" => {
+                Some(kind @ (R::DensityMin | R::DensitySupport)) => {
                     let ExprKind::Call(name, _) = &args[0].kind else { unreachable!("checked: a functional") };
                     let known = self.functionals.iter().position(|(n, _)| *n == name.name);
                     let index = match known {
@@ -433,9 +440,9 @@ impl<'m> Observer<'m> {
                         )
                         .with_help("density_min and density_support read a functional over a boundary region: `int(Gamma_C) ...`")));
                     }
-                    add(self, Measure::Density { index, min: f.name == "density_min" }, 1, e.span)
+                    add(self, Measure::Density { index, min: kind == R::DensityMin }, 1, e.span)
                 }
-                "measure" | "peak" => {
+                Some(kind @ (R::Measure | R::Peak)) => {
                     let ExprKind::Name(region) = &args[0].kind else { unreachable!("checked: a region name") };
                     let facets = binding
                         .regions
@@ -453,14 +460,15 @@ impl<'m> Observer<'m> {
                     };
                     let val = ex.lower(&args[1], pointwise).map_err(|e| pf.render(*e))?;
                     let pf_fn = ex.function(&val, &args[1]).map_err(|e| pf.render(*e))?;
-                    let m = if f.name == "measure" {
+                    let m = if kind == R::Measure {
                         Measure::Area { region: index, f: pf_fn }
                     } else {
                         Measure::Peak { region: index, f: pf_fn }
                     };
                     add(self, m, 1, e.span)
                 }
-                name => {
+                None => {
+                    let name = f.name.as_str();
                     let at: Vec<Level> = args
                         .iter()
                         .map(|a| match &a.kind {

@@ -9,19 +9,8 @@ use crate::compiler::ir::lower::Val;
 use crate::compiler::syntax::ast::{Expr, ExprKind, Ident};
 use crate::error::CaseError;
 
-/// A summary reducer over the rows.
-#[derive(Clone, Copy)]
-enum Reduce {
-    Initial,
-    Final,
-    Min,
-    Max,
-    Sum,
-    /// The first argument at the first row where the second is positive.
-    First,
-    /// The first argument at the first row where the second is largest (NaN rows left out).
-    AtMax,
-}
+// A summary reducer over the rows: the catalogue's.
+use crate::compiler::check::problem::SummaryReducer as Reduce;
 
 /// A reducer's argument: a column as it is (`None`: the row's time), or an expression of the
 /// row (its columns, `t` and the keys before).
@@ -318,21 +307,12 @@ impl SummaryKeys {
 fn summary_rewrite(e: &Expr, calls: &mut Vec<(Reduce, Vec<Expr>)>) -> Expr {
     let kind = match &e.kind {
         ExprKind::Call(f, args) => {
-            let r = match f.name.as_str() {
-                "initial" => Reduce::Initial,
-                "final" => Reduce::Final,
-                "min" => Reduce::Min,
-                "max" => Reduce::Max,
-                "sum" => Reduce::Sum,
-                "first" => Reduce::First,
-                "at_max" => Reduce::AtMax,
-                // A function of a number (`sqrt`): kept, its argument rewritten.
-                _ => {
-                    let args = args.iter().map(|a| summary_rewrite(a, calls)).collect();
-                    return Expr { kind: ExprKind::Call(f.clone(), args), span: e.span };
-                }
+            // A function of a number (`sqrt`): kept, its argument rewritten.
+            let Some(r) = crate::compiler::check::problem::summary_reducer(&f.name) else {
+                let args = args.iter().map(|a| summary_rewrite(a, calls)).collect();
+                return Expr { kind: ExprKind::Call(f.clone(), args), span: e.span };
             };
-            calls.push((r, args.clone()));
+            calls.push((r.reducer, args.clone()));
             ExprKind::Name(Ident { name: placeholder(calls.len() - 1), span: e.span })
         }
         ExprKind::Neg(a) => ExprKind::Neg(Box::new(summary_rewrite(a, calls))),

@@ -2,7 +2,7 @@
 //! arguments, the run and quadrature settings, the roles files are bound to, and what series
 //! columns and summaries may read and reduce.
 
-use crate::syntax::ast::Shape;
+use crate::syntax::ast::{Expr, NamedCall, Shape};
 
 /// A built-in mesh generator or obstacle helper: its name, its dimension (0: any) and its
 /// arguments with their shapes (`true`: optional).
@@ -117,56 +117,103 @@ pub const ROW_VALUES: &[(&str, &str)] = &[
     ),
 ];
 
-/// The reducers of a series column: name, arguments as written, meaning.
-pub const ROW_REDUCERS: &[(&str, &str, &str)] = &[
-    ("mean", "mean(u[k])", "mass-weighted mean of a component of u or v over the body (the centre of mass's)"),
-    ("nodal_mean", "nodal_mean(u[k])", "plain mean of a component of u or v over the nodes"),
-    ("at_min", "at_min(u[k], EXPR)", "a component of u or v at the node where EXPR (of x) is least"),
-    (
-        "force",
-        "force(SLOT[, REGION])",
-        "the resultant of a slot's residual on the body, or at a region's nodes (a vector): force(contact), force(stiffness, Gamma_D)",
-    ),
-    (
-        "inner_mass",
-        "inner_mass(A, B)",
-        "aᵀ M b with the mass the scheme steps with, for vector fields A and B of x, t, u, v at the nodes (∫ρ A·B)",
-    ),
-    ("measure", "measure(REGION, EXPR)", "the measure of the region's quadrature points where EXPR ≥ 0"),
-    (
-        "peak",
-        "peak(REGION, EXPR)",
-        "the largest value of EXPR over the region's quadrature points, or 0 if none is positive",
-    ),
-    (
-        "density_min",
-        "density_min(NAME(u))",
-        "the least value of a boundary functional's integrand over 16 points per edge of its region: -density_min(contact_pressure(u)) is the peak contact pressure",
-    ),
-    (
-        "density_support",
-        "density_support(NAME(u))",
-        "the measure of the points of a boundary functional's region where its integrand is not zero: the contact zone's, of contact_pressure(u)",
-    ),
-    (
-        "work",
-        "work(SLOT)",
-        "the work of a slot's residual over the step by the trapezoidal rule, ½(r(uⁿ) + r(uⁿ⁺¹))·(uⁿ⁺¹ − uⁿ), each end with its own previous level: Crank–Nicolson's E changes by −work(contact) (NaN at the initial row and at stages)",
-    ),
-    (
-        "cumulative",
-        "cumulative(COLUMN)",
-        "the sum of an earlier column over the rows so far, this one included (NaN values left out; a stage reads the sum at its step's start): cumulative(dissipated) is the frictional work since the start",
-    ),
-    (
-        "initial",
-        "initial(COLUMN)",
-        "an earlier column's value at the first row: the balance energy_aug + cumulative(dissipated) - initial(energy_aug)",
-    ),
-];
+/// A reducer of a series column: what a column measures of a state (or of the rows so far).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RowReducer {
+    Mean,
+    NodalMean,
+    AtMin,
+    Force,
+    InnerMass,
+    Measure,
+    Peak,
+    DensityMin,
+    DensitySupport,
+    Work,
+    Cumulative,
+    Initial,
+}
 
-/// The reducers of a series column that read an earlier column over the rows (not the state).
-pub const OVER_ROWS: &[&str] = &["cumulative", "initial"];
+/// A series reducer's row of the catalogue: what it is, its name, how it is written, its
+/// meaning.
+pub struct RowReducerInfo {
+    pub kind: RowReducer,
+    pub name: &'static str,
+    pub usage: &'static str,
+    pub doc: &'static str,
+}
+
+/// The reducers of a series column.
+pub const ROW_REDUCERS: &[RowReducerInfo] = {
+    use RowReducer::*;
+    const fn r(kind: RowReducer, name: &'static str, usage: &'static str, doc: &'static str) -> RowReducerInfo {
+        RowReducerInfo { kind, name, usage, doc }
+    }
+    &[
+        r(
+            Mean,
+            "mean",
+            "mean(u[k])",
+            "mass-weighted mean of a component of u or v over the body (the centre of mass's)",
+        ),
+        r(NodalMean, "nodal_mean", "nodal_mean(u[k])", "plain mean of a component of u or v over the nodes"),
+        r(AtMin, "at_min", "at_min(u[k], EXPR)", "a component of u or v at the node where EXPR (of x) is least"),
+        r(
+            Force,
+            "force",
+            "force(SLOT[, REGION])",
+            "the resultant of a slot's residual on the body, or at a region's nodes (a vector): force(contact), force(stiffness, Gamma_D)",
+        ),
+        r(
+            InnerMass,
+            "inner_mass",
+            "inner_mass(A, B)",
+            "aᵀ M b with the mass the scheme steps with, for vector fields A and B of x, t, u, v at the nodes (∫ρ A·B)",
+        ),
+        r(Measure, "measure", "measure(REGION, EXPR)", "the measure of the region's quadrature points where EXPR ≥ 0"),
+        r(
+            Peak,
+            "peak",
+            "peak(REGION, EXPR)",
+            "the largest value of EXPR over the region's quadrature points, or 0 if none is positive",
+        ),
+        r(
+            DensityMin,
+            "density_min",
+            "density_min(NAME(u))",
+            "the least value of a boundary functional's integrand over 16 points per edge of its region: -density_min(contact_pressure(u)) is the peak contact pressure",
+        ),
+        r(
+            DensitySupport,
+            "density_support",
+            "density_support(NAME(u))",
+            "the measure of the points of a boundary functional's region where its integrand is not zero: the contact zone's, of contact_pressure(u)",
+        ),
+        r(
+            Work,
+            "work",
+            "work(SLOT)",
+            "the work of a slot's residual over the step by the trapezoidal rule, ½(r(uⁿ) + r(uⁿ⁺¹))·(uⁿ⁺¹ − uⁿ), each end with its own previous level: Crank–Nicolson's E changes by −work(contact) (NaN at the initial row and at stages)",
+        ),
+        r(
+            Cumulative,
+            "cumulative",
+            "cumulative(COLUMN)",
+            "the sum of an earlier column over the rows so far, this one included (NaN values left out; a stage reads the sum at its step's start): cumulative(dissipated) is the frictional work since the start",
+        ),
+        r(
+            Initial,
+            "initial",
+            "initial(COLUMN)",
+            "an earlier column's value at the first row: the balance energy_aug + cumulative(dissipated) - initial(energy_aug)",
+        ),
+    ]
+};
+
+/// The series reducer of this name.
+pub fn row_reducer(name: &str) -> Option<&'static RowReducerInfo> {
+    ROW_REDUCERS.iter().find(|r| r.name == name)
+}
 
 /// Any other call in a series column, `NAME(u)`, is a functional of the files in use or of the
 /// problem's reference (checked when the problem is bound).
@@ -185,18 +232,59 @@ pub const FUNCTIONAL_STATES: &[(&str, &str)] = &[
     ),
 ];
 
+/// A reducer of a summary key over the rows of the series.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SummaryReducer {
+    Initial,
+    Final,
+    Min,
+    Max,
+    Sum,
+    /// The first argument at the first row where the second is positive.
+    First,
+    /// The first argument at the first row where the second is largest (NaN rows left out).
+    AtMax,
+}
+
+/// A summary reducer's row of the catalogue: what it is, its name, how it is written, its
+/// meaning, and how many arguments it takes (least, most).
+pub struct Reducer {
+    pub reducer: SummaryReducer,
+    pub name: &'static str,
+    pub usage: &'static str,
+    pub doc: &'static str,
+    pub arity: (usize, usize),
+}
+
 /// The reducers of a summary key, over the rows of the series. Their argument is an expression
 /// of the row (columns, `t`, earlier summary keys, params); rows where it is NaN (undefined, as
 /// a `u_mid` value at the initial row) are left out of `min`, `max` and `sum`.
-pub const SUMMARY_REDUCERS: &[(&str, &str, &str)] = &[
-    ("initial", "initial(EXPR)", "the first row's value"),
-    ("final", "final(EXPR)", "the last row's value"),
-    ("min", "min(EXPR[, WHEN])", "the least value (over the rows where WHEN > 0)"),
-    ("max", "max(EXPR[, WHEN])", "the largest value (over the rows where WHEN > 0)"),
-    ("sum", "sum(EXPR)", "the sum over the rows, in order"),
-    ("first", "first(EXPR, WHEN)", "EXPR at the first row where WHEN > 0 (null if none)"),
-    ("at_max", "at_max(EXPR, OF)", "EXPR at the first row where OF is largest"),
-];
+pub const SUMMARY_REDUCERS: &[Reducer] = {
+    use SummaryReducer::*;
+    const fn r(
+        reducer: SummaryReducer,
+        name: &'static str,
+        usage: &'static str,
+        doc: &'static str,
+        arity: (usize, usize),
+    ) -> Reducer {
+        Reducer { reducer, name, usage, doc, arity }
+    }
+    &[
+        r(Initial, "initial", "initial(EXPR)", "the first row's value", (1, 1)),
+        r(Final, "final", "final(EXPR)", "the last row's value", (1, 1)),
+        r(Min, "min", "min(EXPR[, WHEN])", "the least value (over the rows where WHEN > 0)", (1, 2)),
+        r(Max, "max", "max(EXPR[, WHEN])", "the largest value (over the rows where WHEN > 0)", (1, 2)),
+        r(Sum, "sum", "sum(EXPR)", "the sum over the rows, in order", (1, 1)),
+        r(First, "first", "first(EXPR, WHEN)", "EXPR at the first row where WHEN > 0 (null if none)", (2, 2)),
+        r(AtMax, "at_max", "at_max(EXPR, OF)", "EXPR at the first row where OF is largest", (2, 2)),
+    ]
+};
+
+/// The summary reducer of this name.
+pub fn summary_reducer(name: &str) -> Option<&'static Reducer> {
+    SUMMARY_REDUCERS.iter().find(|r| r.name == name)
+}
 
 /// The functions of numbers a series column or a summary key may apply: the language's scalar
 /// built-ins (`sqrt`, `abs`, `pos`, `neg`, `H`, `min`, `max`, `sin`, ..., `ln`), the same as in
@@ -230,5 +318,131 @@ pub fn settled_guess(value: &crate::syntax::ast::Expr) -> Option<&[crate::syntax
     match &value.kind {
         crate::syntax::ast::ExprKind::Call(f, args) if f.name == SETTLED => Some(args),
         _ => None,
+    }
+}
+
+/// A mesh generator's call, typed: the catalogue's one match on a generator's name. Its
+/// arguments are the expressions written (`None`: an optional one left out).
+pub enum Generator<'a> {
+    Interval {
+        length: &'a Expr,
+        cells: &'a Expr,
+        start: Option<&'a Expr>,
+    },
+    Rectangle {
+        width: &'a Expr,
+        height: &'a Expr,
+        nx: &'a Expr,
+        ny: &'a Expr,
+        degree: Option<&'a Expr>,
+        origin: Option<&'a Expr>,
+    },
+    Box {
+        size: &'a Expr,
+        nx: &'a Expr,
+        ny: &'a Expr,
+        nz: &'a Expr,
+        degree: Option<&'a Expr>,
+        origin: Option<&'a Expr>,
+    },
+    Disc {
+        radius: &'a Expr,
+        centre: &'a Expr,
+        h: &'a Expr,
+    },
+    Ball {
+        radius: &'a Expr,
+        centre: &'a Expr,
+        h: &'a Expr,
+    },
+}
+
+/// An obstacle helper's call, typed (see [`OBSTACLES`]).
+pub enum ObstacleShape<'a> {
+    Plane { point: &'a Expr, normal: &'a Expr },
+    Sphere { centre: &'a Expr, radius: &'a Expr },
+    Cylinder { point: &'a Expr, radius: &'a Expr, axis: Option<&'a Expr> },
+}
+
+/// The argument `name` of a call.
+fn argument<'a>(call: &'a NamedCall, name: &str) -> Option<&'a Expr> {
+    call.args.iter().find(|a| a.name.name == name).map(|a| &a.value)
+}
+
+/// `call` as a generator, or why not: an unknown name, or a required argument missing (the
+/// checker reports both at the call; a caller that did not check gets the message).
+pub fn generator(call: &NamedCall) -> Result<Generator<'_>, String> {
+    let need = |name: &str| argument(call, name).ok_or_else(|| format!("`{}` needs `{name}`", call.name.name));
+    let optional = |name: &str| argument(call, name);
+    Ok(match call.name.name.as_str() {
+        "interval" => Generator::Interval { length: need("length")?, cells: need("cells")?, start: optional("start") },
+        "rectangle" => Generator::Rectangle {
+            width: need("width")?,
+            height: need("height")?,
+            nx: need("nx")?,
+            ny: need("ny")?,
+            degree: optional("degree"),
+            origin: optional("origin"),
+        },
+        "box" => Generator::Box {
+            size: need("size")?,
+            nx: need("nx")?,
+            ny: need("ny")?,
+            nz: need("nz")?,
+            degree: optional("degree"),
+            origin: optional("origin"),
+        },
+        "disc" => Generator::Disc { radius: need("radius")?, centre: need("centre")?, h: need("h")? },
+        "ball" => Generator::Ball { radius: need("radius")?, centre: need("centre")?, h: need("h")? },
+        other => return Err(format!("no mesh generator `{other}`")),
+    })
+}
+
+/// `call` as an obstacle, or why not (as [`generator`]).
+pub fn obstacle(call: &NamedCall) -> Result<ObstacleShape<'_>, String> {
+    let need = |name: &str| argument(call, name).ok_or_else(|| format!("`{}` needs `{name}`", call.name.name));
+    Ok(match call.name.name.as_str() {
+        "plane" => ObstacleShape::Plane { point: need("point")?, normal: need("normal")? },
+        "sphere" => ObstacleShape::Sphere { centre: need("centre")?, radius: need("radius")? },
+        "cylinder" => {
+            ObstacleShape::Cylinder { point: need("point")?, radius: need("radius")?, axis: argument(call, "axis") }
+        }
+        other => return Err(format!("no obstacle `{other}`")),
+    })
+}
+
+#[cfg(test)]
+mod typed {
+    use super::*;
+
+    /// Every generator and obstacle of the tables has its typed call, with every argument the
+    /// table lists as required, and no other name is one.
+    #[test]
+    fn the_tables_and_the_typed_calls_agree() {
+        use crate::source::Span;
+        use crate::syntax::ast::{ExprKind, Ident, NamedArg};
+        let id = |name: &str| Ident { name: name.to_string(), span: Span::new(0, 0, 0) };
+        let call = |b: &Builtin, with_optional: bool| NamedCall {
+            name: id(b.name),
+            args: b
+                .args
+                .iter()
+                .filter(|(_, _, optional)| with_optional || !optional)
+                .map(|(n, _, _)| NamedArg {
+                    name: id(n),
+                    value: Expr { kind: ExprKind::Number(1.0), span: Span::new(0, 0, 0) },
+                })
+                .collect(),
+            span: Span::new(0, 0, 0),
+        };
+        for b in GENERATORS {
+            assert!(generator(&call(b, false)).is_ok(), "{}", b.name);
+            assert!(generator(&call(b, true)).is_ok(), "{}", b.name);
+        }
+        for b in OBSTACLES {
+            assert!(obstacle(&call(b, false)).is_ok(), "{}", b.name);
+        }
+        let unknown = NamedCall { name: id("torus"), args: Vec::new(), span: Span::new(0, 0, 0) };
+        assert!(generator(&unknown).is_err() && obstacle(&unknown).is_err());
     }
 }

@@ -60,7 +60,7 @@ fn arity_error(f: &Ident, e: &Expr, want: usize, given: usize, usage: &str) -> D
 
 fn row_help() -> String {
     let values: Vec<&str> = ROW_VALUES.iter().map(|(n, _)| *n).collect();
-    let reducers: Vec<&str> = ROW_REDUCERS.iter().map(|(_, w, _)| *w).collect();
+    let reducers: Vec<&str> = ROW_REDUCERS.iter().map(|r| r.usage).collect();
     format!(
         "a column reads the row values ({}), earlier columns, params, and reducers: {}, or a functional `{FUNCTIONAL_CALL}` (also at {}), with arithmetic and {}",
         values.join(", "),
@@ -74,7 +74,7 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
     use crate::syntax::ast::ExprKind as K;
     let arity = |want: usize, diags: &mut Vec<Diagnostic>| {
         if args.len() != want {
-            let usage = ROW_REDUCERS.iter().find(|(n, _, _)| *n == f.name).map_or(FUNCTIONAL_CALL, |(_, u, _)| u);
+            let usage = row_reducer(&f.name).map_or(FUNCTIONAL_CALL, |r| r.usage);
             diags.push(arity_error(f, e, want, args.len(), usage));
             return false;
         }
@@ -96,24 +96,25 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
         K::Name(id) => diags.push(unknown_among(id, s.regions.iter().copied(), "region")),
         _ => diags.push(Diagnostic::error("E0301", "shape mismatch", a.span, "a region's name is needed here")),
     };
-    match f.name.as_str() {
-        name if let Some(b) = row_function(name) => {
+    use RowReducer as R;
+    match row_reducer(&f.name).map(|r| r.kind) {
+        None if let Some(b) = row_function(&f.name) => {
             if arity(b.arity, diags) {
                 args.iter().for_each(|a| row(c, a, s, diags));
             }
         }
-        "mean" | "nodal_mean" => {
+        Some(R::Mean | R::NodalMean) => {
             if arity(1, diags) {
                 component(&args[0], diags);
             }
         }
-        "at_min" => {
+        Some(R::AtMin) => {
             if arity(2, diags) {
                 component(&args[0], diags);
                 scalar(c, &args[1], s.constants, diags, false);
             }
         }
-        "force" => {
+        Some(R::Force) => {
             // force(SLOT) over the body, force(SLOT, REGION) over the region's nodes.
             if args.len() == 2 {
                 region(&args[1], diags);
@@ -124,24 +125,24 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
                 diags.push(Diagnostic::error("E0301", "shape mismatch", args[0].span, "a slot's name is needed here"));
             }
         }
-        "work" => {
+        Some(R::Work) => {
             if arity(1, diags) && !matches!(&args[0].kind, K::Name(_)) {
                 diags.push(Diagnostic::error("E0301", "shape mismatch", args[0].span, "a slot's name is needed here"));
             }
         }
-        "inner_mass" => {
+        Some(R::InnerMass) => {
             if arity(2, diags) {
                 vector(c, &args[0], s.pointwise, diags);
                 vector(c, &args[1], s.pointwise, diags);
             }
         }
-        "measure" | "peak" => {
+        Some(R::Measure | R::Peak) => {
             if arity(2, diags) {
                 region(&args[0], diags);
                 scalar(c, &args[1], s.pointwise, diags, false);
             }
         }
-        name if OVER_ROWS.contains(&name) => {
+        Some(R::Cumulative | R::Initial) => {
             if arity(1, diags) {
                 match &args[0].kind {
                     K::Name(id) if s.earlier.contains(&id.name.as_str()) => {}
@@ -161,7 +162,7 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
                 }
             }
         }
-        "density_min" | "density_support" => {
+        Some(R::DensityMin | R::DensitySupport) => {
             let functional = |a: &Expr| {
                 matches!(&a.kind, K::Call(_, xs) if xs.len() == 1
                 && matches!(&xs[0].kind, K::Name(n) if n.name == "u"))
@@ -173,7 +174,7 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
                 );
             }
         }
-        _ => {
+        None => {
             let state = |n: &str| FUNCTIONAL_STATES.iter().any(|(s, _)| *s == n);
             let fields = args.iter().all(|a| matches!(&a.kind, K::Name(n) if state(&n.name)));
             if args.is_empty() || !fields {
@@ -229,17 +230,12 @@ pub(super) fn summary(e: &Expr, s: &SummaryScope, in_row: bool, diags: &mut Vec<
             // Inside a reducer's argument (a value of one row) `min` and `max` of two are
             // functions; of one, the reducer nested.
             let nested = in_row && args.len() == 1;
-            let reducer = SUMMARY_REDUCERS
-                .iter()
-                .find(|(n, _, _)| *n == f.name)
-                .filter(|_| nested || !in_row || row_function(&f.name).is_none());
+            let reducer = summary_reducer(&f.name).filter(|_| nested || !in_row || row_function(&f.name).is_none());
             let (want, usage) = match (reducer, row_function(&f.name)) {
-                // min and max take an optional WHEN.
-                (Some((name, usage, _)), _) if matches!(*name, "min" | "max") => (args.len().clamp(1, 2), *usage),
-                (Some((name, usage, _)), _) => (if matches!(*name, "first" | "at_max") { 2 } else { 1 }, *usage),
+                (Some(r), _) => (args.len().clamp(r.arity.0, r.arity.1), r.usage),
                 (None, Some(b)) => (b.arity, ""),
                 (None, None) => {
-                    let mut known: Vec<&str> = SUMMARY_REDUCERS.iter().map(|(n, _, _)| *n).collect();
+                    let mut known: Vec<&str> = SUMMARY_REDUCERS.iter().map(|r| r.name).collect();
                     for n in row_function_names() {
                         if !known.contains(&n) {
                             known.push(n);
@@ -277,7 +273,7 @@ pub(super) fn summary(e: &Expr, s: &SummaryScope, in_row: bool, diags: &mut Vec<
 }
 
 fn summary_help() -> String {
-    let reducers: Vec<&str> = SUMMARY_REDUCERS.iter().map(|(_, u, _)| *u).collect();
+    let reducers: Vec<&str> = SUMMARY_REDUCERS.iter().map(|r| r.usage).collect();
     format!(
         "a summary reduces expressions of the columns: {}; it may apply {} and read the keys before it",
         reducers.join(", "),
