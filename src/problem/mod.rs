@@ -9,6 +9,7 @@
 //! the problem's own, [`outputs`] what a run writes and [`resume`] what its checkpoints keep.
 
 pub mod bind;
+mod check;
 mod dirichlet;
 pub mod expr;
 mod neumann;
@@ -16,8 +17,10 @@ pub mod observe;
 pub mod options;
 pub mod outputs;
 mod reference;
+mod resolve;
 mod resume;
 pub mod run;
+mod settle;
 pub mod summary;
 
 use std::path::{Path, PathBuf};

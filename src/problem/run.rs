@@ -7,7 +7,8 @@ use std::cell::RefCell;
 use std::time::Instant;
 
 use super::ProblemFile;
-use super::bind::{coef_shapes, unset_coefs};
+use super::bind::coef_shapes;
+pub use super::check::{check, params_in_use};
 use super::dirichlet::dirichlet;
 use super::expr::Exprs;
 use super::observe::{Observer, State};
@@ -15,76 +16,17 @@ use super::options::Times;
 pub use super::options::{Chosen, Options};
 pub use super::outputs::Run;
 use super::outputs::{Summary, all_params, json, write_outputs};
-use super::reference::{bound_reference, reference};
+use super::reference::bound_reference;
+use super::resolve::bound;
 use super::resume::{Record, identity};
 use super::summary::SummaryKeys;
 use crate::checkpoint::Control;
-use crate::driver::{FilesInUse, Methods};
+use crate::driver::FilesInUse;
 use crate::error::CaseError;
 use crate::runtime::fem::assembly::{Assembler, Quadrature};
-use crate::runtime::fem::mesh::CellSize;
 use crate::runtime::library::Binding;
 use crate::runtime::linalg::pattern::Owners;
 use crate::simulation::{Problem, Simulation, Snapshots};
-
-/// Binds a problem with the library's defaults without running it: its params, the files in use
-/// and their coefs, the mesh with its regions, the coefs' and initial fields' expressions in the
-/// problem's dimension (`signorini check` on a problem file). Returns one line saying what was
-/// checked and bound: the mesh, the regions with their facets, the unknowns, the files in use.
-pub fn check(problem: &str) -> Result<String, CaseError> {
-    let opts = Options::new(problem);
-    bound(&opts, |pf, _, ex, in_use| {
-        let p = pf.problem();
-        reference(pf, ex.dim())?;
-        super::bind::settings(pf, ex, &p.run)?;
-        super::bind::settings(pf, ex, &p.quadrature)?;
-        let (mesh, label) = super::bind::mesh(pf, ex, None, CellSize::Diameter)?;
-        super::bind::coefs(pf, ex)?;
-        super::bind::coef_vals(pf, ex)?;
-        super::bind::initial(pf, ex, &mesh, "u", 0.0)?;
-        super::bind::initial(pf, ex, &mesh, "v", 0.0)?;
-        let regions: Vec<String> = p
-            .regions
-            .iter()
-            .map(|r| {
-                let n = mesh.region(&r.name.name).map_or(0, |g| g.facets.len());
-                format!("{} ({n} facet{})", r.name.name, if n == 1 { "" } else { "s" })
-            })
-            .collect();
-        let forms = &in_use.forms;
-        let files: Vec<String> = std::iter::once(format!("{} (scheme)", in_use.scheme_name()))
-            .chain(forms.units.iter().enumerate().map(|(i, u)| {
-                let role = if i == 0 {
-                    "material"
-                } else if i == forms.contact {
-                    "contact"
-                } else {
-                    "forms"
-                };
-                format!("{} ({role})", u.name())
-            }))
-            .collect();
-        Ok(format!(
-            "{}: problem `{}` checked and bound: {}D mesh {label}, {} nodes, {} cells, {} unknowns; regions {}; files in use {}",
-            pf.file,
-            pf.name(),
-            mesh.dim(),
-            mesh.num_nodes(),
-            mesh.num_cells(),
-            mesh.num_nodes() * mesh.dim(),
-            if regions.is_empty() { "none".to_string() } else { regions.join(", ") },
-            files.join(", ")
-        ))
-    })
-}
-
-/// The params of the files a run of `opts` would use, with their values and where each comes
-/// from (the files' defaults, the problem's `set`, the user), without building anything.
-pub fn params_in_use(
-    opts: &Options,
-) -> Result<std::collections::BTreeMap<String, crate::driver::ParamValue>, CaseError> {
-    bound(opts, |_, _, _, in_use| Ok(in_use.forms.params.values()))
-}
 
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
     if let Some(options) = &opts.petsc_options {
@@ -122,65 +64,6 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         }
         simulate(opts, pf, params, ex, in_use, &times)
     })
-}
-
-/// Loads the problem, resolves its params and the files in use (the problem's `set` values as
-/// the case's overrides, the user's settings over them), checks what the driver needs of it,
-/// and hands the bound pieces to `f`.
-fn bound<R>(
-    opts: &Options,
-    f: impl FnOnce(&ProblemFile, &[super::ProblemParam], &mut Exprs, &FilesInUse) -> Result<R, CaseError>,
-) -> Result<R, CaseError> {
-    let pf = super::load(&opts.problem)?;
-    let (params, rest) = super::params(&pf, &opts.methods.params)?;
-    let mut methods = Methods { params: rest, ..opts.methods.clone() };
-    bind_files(&pf, &mut methods, opts.chosen);
-    methods.generated.extend(super::neumann::forms(&pf));
-    let values: Vec<(String, f64)> = params.iter().map(|p| (p.name.clone(), p.value)).collect();
-    let d = super::bind::dimension(&pf, opts.mesh.as_deref(), &values)?;
-    let p = pf.problem();
-    let mut ex = Exprs::new(&pf.program.unit, d, &values, &p.lets).map_err(|e| pf.render(*e))?;
-    let mut sets = Vec::new();
-    for s in &p.sets {
-        sets.push((s.name.name.clone(), ex.scalar(&s.value).map_err(|e| pf.render(*e))?));
-    }
-    let overrides: Vec<(&str, f64)> = sets.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    let locate = |a: &crate::driver::params::Ambiguous| {
-        use crate::compiler::Diagnostic;
-        use crate::driver::params::Unnamed;
-        let name = &p.sets[a.index].name;
-        let span = name.span;
-        pf.render(match &a.why {
-            Unnamed::Several(choices) => crate::compiler::check::problem::ambiguous_param(name, choices),
-            Unnamed::UnknownQualifier(_) => {
-                Diagnostic::error("E0101", format!("unknown qualifier in `{}`", a.name), span, "no such role or file")
-                    .with_note(a.message())
-            }
-        })
-    };
-    let in_use = FilesInUse::resolve_located(&methods, &overrides, &locate)?;
-    unset_coefs(&pf, &in_use)?;
-    f(&pf, &params, &mut ex, &in_use)
-}
-
-/// The problem's `bind` lines, for the roles the user did not choose; a path is relative to the
-/// problem file.
-fn bind_files(pf: &ProblemFile, methods: &mut Methods, chosen: Chosen) {
-    for b in &pf.problem().binds {
-        let target = if b.is_path { pf.dir.join(&b.target).display().to_string() } else { b.target.clone() };
-        match b.role.name.as_str() {
-            "scheme" if !chosen.scheme => methods.scheme = target,
-            "contact" if !chosen.contact => methods.contact = target,
-            "material" if !chosen.material => methods.material = target,
-            "forms" => {
-                let path = std::path::PathBuf::from(target);
-                if !methods.forms.contains(&path) {
-                    methods.forms.push(path);
-                }
-            }
-            _ => {}
-        }
-    }
 }
 
 fn simulate(
@@ -395,14 +278,14 @@ fn simulate(
                 let held_nonzero = held.as_ref().is_some_and(|h| !h.zero_at(&mesh, t0));
                 let problem = crate::simulation::statics::StaticProblem {
                     coefs: &coefs,
-                    contact: settle_contact(pf, contact_region, held_nonzero)?,
+                    contact: super::settle::contact(pf, contact_region, held_nonzero)?,
                     regions: &others,
                     contact_degree: quadrature.facet,
                     constraints: constraints.clone(),
                     newton: opts.newton,
                     t: t0,
                 };
-                settle(pf, &asm, problem, in_use, u0)?
+                super::settle::settle(pf, &asm, problem, in_use, u0)?
             } else {
                 u0
             };
@@ -637,74 +520,6 @@ fn simulate(
         return Err(e);
     }
     Ok(run)
-}
-
-/// The contact `settled(GUESS)` rests on, after the checks that it can: a contact region, and
-/// Dirichlet values that are zero at the start (they are held at zero while settling).
-fn settle_contact<'p>(pf: &ProblemFile, contact: Option<&'p str>, held_nonzero: bool) -> Result<&'p str, CaseError> {
-    let why = |what: &str| CaseError::Settle(format!("{}: `initial u = settled(...)` {what}", pf.file));
-    let contact = contact.ok_or_else(|| why("needs the problem's contact (an obstacle, or `Gamma_C`) to rest on"))?;
-    if held_nonzero {
-        return Err(why(
-            "holds the Dirichlet values at zero: a value held away from zero at the start needs an initial u of its own",
-        ));
-    }
-    Ok(contact)
-}
-
-/// `initial u = settled(GUESS)`: the equilibrium K u + C(u) = F, by the static driver (its loads
-/// and obstacle at the start time) from the guess (which a frictional law's `prev` reads: the
-/// stick holds the body where the guess put it, along the obstacle). Newton backtracks on ‖R‖
-/// there: a full step from a shallow guess can lift a free body off the obstacle, where its
-/// stiffness is singular (a disc of h = 0.05 settling did).
-fn settle(
-    pf: &ProblemFile,
-    asm: &Assembler,
-    problem: crate::simulation::statics::StaticProblem,
-    in_use: &FilesInUse,
-    guess: Vec<f64>,
-) -> Result<Vec<f64>, CaseError> {
-    let newton = crate::runtime::nonlinear::newton::NewtonOptions { line_search: true, ..problem.newton };
-    let problem = crate::simulation::statics::StaticProblem { newton, ..problem };
-    let solution = crate::simulation::statics::solve(asm, problem, &in_use.forms, guess)
-        .map_err(|e| unsettled(pf, e, frictional(&in_use.forms)))?;
-    Ok(solution.u)
-}
-
-/// Whether the contact law in use has friction (it provides `friction_work`).
-fn frictional(forms: &crate::driver::FormsInUse) -> bool {
-    forms.units[forms.contact].slots().iter().any(|s| &*s.name == "friction_work")
-}
-
-/// Why `settled` found no equilibrium: Newton's residuals and active points, and what a
-/// singular or non-converging equilibrium means for this law.
-fn unsettled(pf: &ProblemFile, e: CaseError, frictional: bool) -> CaseError {
-    use crate::runtime::nonlinear::newton::NewtonError;
-    let CaseError::Newton(newton) = &e else {
-        return CaseError::Settle(format!("{}: `initial u = settled(...)` did not settle: {e}", pf.file));
-    };
-    let report = newton.report();
-    let active = report.history.last().map_or(0, |it| it.active);
-    let cause = match (newton, frictional) {
-        (NewtonError::Linear { .. }, _) => format!(
-            "the equilibrium's tangent is singular at an iterate with {active} active contact point(s): they do not hold the body in every direction (it can pivot about them or slide along the obstacle)"
-        ),
-        (_, false) => {
-            "a frictionless body free to slide along the obstacle has no equilibrium to settle in".to_string()
-        }
-        (_, true) => "the frictional stick did not hold the body: the load along the obstacle may exceed the friction"
-            .to_string(),
-    };
-    let help = if frictional {
-        "press the guess in further so that more of the contact region starts active, or hold the body with a pin (`dirichlet nearest(POINT): u[0] = 0`)"
-    } else {
-        "hold the body (a pin: `dirichlet nearest(POINT): u[0] = 0`), or give it friction"
-    };
-    CaseError::Settle(format!(
-        "{}: `initial u = settled(...)` did not settle: {newton}\n  Newton: {}\n  {cause}; {help}",
-        pf.file,
-        report.describe()
-    ))
 }
 
 /// The contact law's `Gamma_C`: the obstacle's region (`on REGION`, or `Gamma_C`); none without
