@@ -333,3 +333,40 @@ fn a_problems_params_are_options_of_its_run() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// What a run prints reads back: keys with six significant digits (a value of 1e-17 is not
+/// `0.000000`), and an expectation of 0 says its difference and tolerance are absolute;
+/// series.csv holds the shortest text of each double, which parses back to the same bits as
+/// the summary's.
+#[test]
+fn a_run_prints_significant_digits_and_says_absolute() {
+    let out = std::env::temp_dir().join(format!("signorini-cli-digits-{}", std::process::id()));
+    let (code, stdout, err) =
+        signorini(&["run", "tests/problems/functions_everywhere.wf", "--out", out.to_str().unwrap(), "--force"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("drop_final -0.045,"), "{stdout}");
+    assert!(stdout.contains("within 1e-12 absolute): met"), "{stdout}");
+    assert!(stdout.contains("within 1e-9 relative): met"), "{stdout}");
+    // ln(exp(t)) − t is round-off: shown as such, not as six zeros.
+    let log_error = stdout.split("log_error ").nth(1).and_then(|r| r.split(',').next()).unwrap();
+    assert!((log_error == "0" || log_error.contains("e-")) && log_error.parse::<f64>().unwrap() < 1e-12, "{stdout}");
+    let csv = std::fs::read_to_string(out.join("series.csv")).unwrap();
+    let last: Vec<f64> = csv.lines().last().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let uy = last[header.iter().position(|h| *h == "uy").unwrap()];
+    assert_eq!(uy.to_bits(), summary["drop_final"].as_f64().unwrap().to_bits());
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// `check` on a problem file ends with one line saying what it bound.
+#[test]
+fn check_says_what_it_bound() {
+    let (code, stdout, err) = signorini(&["check", "forms/problems/disc.wf"]);
+    assert_eq!(code, 0, "{err}");
+    let line = stdout.lines().last().unwrap();
+    for part in ["problem `disc` checked and bound", "1261 nodes", "Gamma_C (30 facets)", "contact_nitsche (contact)"] {
+        assert!(line.contains(part), "{part} in {line}");
+    }
+}
