@@ -319,6 +319,8 @@ fn a_static_problem_is_one_equilibrium() {
         let (a, b) = (r.column(c).unwrap()[0], *q.column(c).unwrap().last().unwrap());
         assert!((a - b).abs() <= 1e-9 * a.abs(), "{c}: static {a:e}, quasi-static {b:e}");
     }
+    // Neither watches an energy: neither reports its growth.
+    assert!(r.summary.get("energy_growth").is_none() && q.summary.get("energy_growth").is_none());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
