@@ -36,7 +36,7 @@ pub fn params(prog: &Program) -> Vec<ParamInfo> {
     let src = &prog.sources;
     prog.params
         .iter()
-        .map(|p| param(src, &p.name, p.default, p.range, p.span, &crate::module_name(src.path(p.span.file))))
+        .map(|p| param(src, &p.name, p.default, p.range, p.span, &crate::source::module_name(src.path(p.span.file))))
         .collect()
 }
 

@@ -100,7 +100,7 @@ pub fn location_col(sources: &SourceMap, span: Span) -> String {
 }
 
 fn file_name(sources: &SourceMap, span: Span) -> String {
-    crate::display_name(sources.path(span.file))
+    crate::source::display_name(sources.path(span.file))
 }
 
 #[cfg(test)]

@@ -22,7 +22,7 @@ pub mod syntax;
 pub use diagnostic::{Diagnostic, Severity, render_all};
 pub use pipeline::{
     Checked, Compiled, Expansion, Failure, Stage, check_file, check_path, check_text, compile, compile_text,
-    compile_to_rust, display_name, expand, module_name,
+    compile_to_rust, expand,
 };
 pub use program::Program;
-pub use source::{FileId, FsLoader, Loader, MemLoader, SourceMap, Span};
+pub use source::{FileId, FsLoader, Loader, MemLoader, SourceMap, Span, display_name, module_name};

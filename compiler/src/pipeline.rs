@@ -10,7 +10,7 @@ use crate::diagnostic::{self, Diagnostic, render_all};
 use crate::ir::{self, DimIr};
 use crate::program::Program;
 use crate::scheme::{self, SchemeIr};
-use crate::source::{Loader, SourceMap};
+use crate::source::{Loader, SourceMap, display_name, module_name};
 use crate::syntax::ast;
 
 /// Why a unit did not compile: rendered diagnostics, or an I/O problem with the root file.
@@ -175,16 +175,6 @@ pub fn expand(path: &Path, loader: &dyn Loader, opts: &codegen::Options) -> Resu
     let compiled = compile(path, loader).map_err(|f| f.rendered)?;
     let file = compiled.rust(opts).map_err(|f| f.rendered)?;
     Ok(Expansion { file, sources: compiled.source_paths() })
-}
-
-/// The default module name of a .wf file: its stem.
-pub fn module_name(path: &Path) -> String {
-    path.file_stem().map_or_else(|| "forms".to_string(), |s| s.to_string_lossy().into_owned())
-}
-
-/// The file name shown in generated documentation (no machine-specific directories).
-pub fn display_name(path: &Path) -> String {
-    path.file_name().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned())
 }
 
 /// Checks a loaded unit and compiles its schemes; returns the program and the root's AST.

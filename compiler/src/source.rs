@@ -146,6 +146,17 @@ impl Loader for MemLoader {
     }
 }
 
+/// The default module name of a .wf file: its stem. (Here, below every stage, because codegen
+/// and the docs name files too, and the pipeline runs them.)
+pub fn module_name(path: &Path) -> String {
+    path.file_stem().map_or_else(|| "forms".to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// The file name shown in generated documentation (no machine-specific directories).
+pub fn display_name(path: &Path) -> String {
+    path.file_name().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned())
+}
+
 /// Lexical normalisation (`a/./b/../c` → `a/c`), so that one file imported along two paths is
 /// recognised as one without touching the filesystem.
 pub fn normalize(path: &Path) -> PathBuf {

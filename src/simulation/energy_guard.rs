@@ -4,10 +4,32 @@
 //! growth beyond the tolerance, a negative potential energy, or a law's own work beyond the
 //! energy from outside stops the run (docs/mathematics.md §5).
 
+use std::borrow::Cow;
+
 use super::Operators;
 use crate::compiler::scheme::EnergyLaw;
 use crate::guard::ENERGY_TOLERANCE;
 use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
+
+/// The step the guard checks: the states at its end, the displacement at its start, its size
+/// and its end time.
+pub(super) struct Ended<'s> {
+    pub(super) states: &'s [Vec<f64>],
+    /// The velocity state, if the scheme has one (else the step's difference quotient serves).
+    pub(super) v_index: Option<usize>,
+    pub(super) before: &'s [f64],
+    pub(super) h: f64,
+    pub(super) t: f64,
+}
+
+impl Ended<'_> {
+    fn velocity(&self) -> Cow<'_, [f64]> {
+        match self.v_index {
+            Some(i) => Cow::Borrowed(self.states[i].as_slice()),
+            None => Cow::Owned(self.states[0].iter().zip(self.before).map(|(a, b)| (a - b) / self.h).collect()),
+        }
+    }
+}
 
 /// The energy guard: the growth of E_aug = ½uᵀKu + ½vᵀMv + the contact law's
 /// `contact_energy(u)` beyond E_aug(0) + the work of the loads, over the problem's energy scale
@@ -144,63 +166,19 @@ impl EnergyWatch {
     /// E_aug − W may not exceed the lowest value it reached. The kinetic energy of this step
     /// joins the scale only once the step passes (a blow-up's own motion does not widen its
     /// bound).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn check(
         &mut self,
         ops: &Operators,
-        states: &[Vec<f64>],
-        v_index: Option<usize>,
-        before: &[f64],
-        h: f64,
-        t: f64,
+        step: &Ended,
         tolerance: f64,
         law: Option<EnergyLaw>,
     ) -> Option<Grown> {
-        let u = &states[0];
-        let fd: Vec<f64>;
-        let v = match v_index {
-            Some(i) => states[i].as_slice(),
-            None => {
-                fd = u.iter().zip(before).map(|(a, b)| (a - b) / h).collect();
-                &fd
-            }
-        };
-        let kinetic = ops.kinetic(Some(v));
-        let potential = ops.elastic(u) + Self::contact(ops, u, t);
+        let u = &step.states[0];
+        let kinetic = ops.kinetic(Some(&step.velocity()));
+        let potential = ops.elastic(u) + Self::contact(ops, u, step.t);
         let energy = potential + kinetic;
-        // A conserving scheme: the allowance grows on the steps where the active set changes.
-        let (switches, allowance) = match law {
-            Some(EnergyLaw::Conserving) => {
-                let switches = ops.contact_switches(u, before, t);
-                let jump = if switches != self.switches {
-                    let value = |x: &[f64], at: f64| Self::value(&ops.contact_jump, ops, x, at);
-                    value(u, t).max(value(before, t - h))
-                } else {
-                    0.0
-                };
-                (switches, self.allowance + jump)
-            }
-            _ => (Vec::new(), 0.0),
-        };
-        // The work summed step by step (a varying load's, the held dofs', a moving obstacle's),
-        // a constant load's from u(0), and the law's own.
-        let constant: f64 = match ops.varying_load {
-            Some(_) => 0.0,
-            None => ops.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum(),
-        };
-        let external = self.varying_work + constant;
-        self.work = self.work.max(external.abs());
-        let scale = self.initial.abs().max(self.work).max(self.kinetic).max(f64::MIN_POSITIVE);
-        // What friction took counts where the scheme claims an energy law: an implicit scheme,
-        // whose friction is the new level's, as `friction_work` measures it. An explicit
-        // contact term applies the level before's, and its bound stays E_aug(0) + W.
-        let dissipated = if law.is_some() { self.dissipated } else { 0.0 };
-        let work = external + self.law_work - dissipated;
-        let bound = match law {
-            Some(EnergyLaw::Conserving) => self.initial + work + allowance,
-            Some(EnergyLaw::Dissipative) => self.lowest + work,
-            None => self.initial + work,
-        };
+        let (switches, allowance) = self.allowance(ops, step, law);
+        let (work, bound, scale) = self.balance(ops, u, law, allowance);
         // The law's own work (Nitsche θ ≠ 1) is part of the balance, but it may not drive the
         // motion: beyond the energy that came from outside (initially and by the loads), the
         // balance would hold while the motion grows without bound.
@@ -229,5 +207,50 @@ impl EnergyWatch {
         self.allowance = allowance;
         self.lowest = self.lowest.min(energy - work);
         None
+    }
+
+    /// A conserving scheme's allowance, which grows on the steps where the active set changes
+    /// (see [`EnergyWatch::check`]), and the contact switches at the step's end.
+    fn allowance(&self, ops: &Operators, step: &Ended, law: Option<EnergyLaw>) -> (Vec<bool>, f64) {
+        let (u, before, t, h) = (&step.states[0], step.before, step.t, step.h);
+        match law {
+            Some(EnergyLaw::Conserving) => {
+                let switches = ops.contact_switches(u, before, t);
+                let jump = if switches != self.switches {
+                    let value = |x: &[f64], at: f64| Self::value(&ops.contact_jump, ops, x, at);
+                    value(u, t).max(value(before, t - h))
+                } else {
+                    0.0
+                };
+                (switches, self.allowance + jump)
+            }
+            _ => (Vec::new(), 0.0),
+        }
+    }
+
+    /// The energy balance at the step's end: the work that entered (net of what friction took,
+    /// under an energy law), the bound on E_aug that `law` sets, and the scale growths are
+    /// measured in (which the largest external work so far joins).
+    fn balance(&mut self, ops: &Operators, u: &[f64], law: Option<EnergyLaw>, allowance: f64) -> (f64, f64, f64) {
+        // The work summed step by step (a varying load's, the held dofs', a moving obstacle's),
+        // a constant load's from u(0), and the law's own.
+        let constant: f64 = match ops.varying_load {
+            Some(_) => 0.0,
+            None => ops.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum(),
+        };
+        let external = self.varying_work + constant;
+        self.work = self.work.max(external.abs());
+        let scale = self.initial.abs().max(self.work).max(self.kinetic).max(f64::MIN_POSITIVE);
+        // What friction took counts where the scheme claims an energy law: an implicit scheme,
+        // whose friction is the new level's, as `friction_work` measures it. An explicit
+        // contact term applies the level before's, and its bound stays E_aug(0) + W.
+        let dissipated = if law.is_some() { self.dissipated } else { 0.0 };
+        let work = external + self.law_work - dissipated;
+        let bound = match law {
+            Some(EnergyLaw::Conserving) => self.initial + work + allowance,
+            Some(EnergyLaw::Dissipative) => self.lowest + work,
+            None => self.initial + work,
+        };
+        (work, bound, scale)
     }
 }

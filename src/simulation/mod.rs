@@ -19,7 +19,7 @@ use crate::runtime::linalg::Structure;
 use crate::runtime::nonlinear::newton::NewtonOptions;
 use crate::runtime::nonlinear::statics::Constraints;
 use crate::runtime::time::scheme::StageView;
-use crate::runtime::time::stepper::{StepReport, Stepper};
+use crate::runtime::time::stepper::{StepError, StepReport, Stepper};
 
 mod energy_guard;
 pub mod operators;
@@ -27,7 +27,7 @@ mod snapshots;
 pub mod stability;
 pub mod statics;
 
-use energy_guard::{Cause, EnergyWatch};
+use energy_guard::{Cause, Ended, EnergyWatch, Grown};
 use operators::Parts;
 pub use operators::{AxisMean, Energies, Operators, resultant};
 pub use snapshots::Snapshots;
@@ -207,7 +207,7 @@ impl<'m> Simulation<'m> {
     /// checkpoint period or an interrupt, `on_step` gets a buffer for its own record of the run
     /// so far (the case restores it from `control.observer()` before calling `run`). A run with
     /// `control.resume` starts from that checkpoint's states and counters.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments)] // The signature its caller in src/problem/run.rs uses.
     pub fn run(
         &mut self,
         t0: f64,
@@ -218,6 +218,136 @@ impl<'m> Simulation<'m> {
         on_stage: &mut OnStage,
         on_step: &mut OnStep,
     ) -> Result<Outcome, CaseError> {
+        self.check_stable(dt)?;
+        let intermediate: Vec<String> =
+            self.stepper.desc().stages.iter().rev().skip(1).map(|s| s.name.to_string()).collect();
+        let mut outcome = Outcome::new(steps);
+        let mut bar = crate::progress::Progress::new(steps, progress);
+        let guard = self.guard;
+        let mut energy = EnergyWatch::new(&self.ops, &self.states, self.v_index, t0);
+        // Progress through a nominal step in units of dt / 2^max_cuts.
+        let max_cuts = guard.max_step_cuts.min(MAX_STEP_CUTS);
+        let full: u64 = 1 << max_cuts;
+        let mut at = Cursor::default();
+        if let Some((saved, _)) = &control.resume {
+            (at, energy) = self.resume(saved, &mut outcome)?;
+        }
+        // Fault injection for the restart tests: the process aborts, as if killed, right after
+        // this accepted step (and its checkpoint, if one is due).
+        let crash_at: Option<usize> = std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok());
+        'steps: for k in at.first..steps {
+            bar.tick(k);
+            let mut done: u64 = 0;
+            while done < full {
+                let units = full >> at.level;
+                let h = dt * units as f64 / full as f64;
+                let t = t0 + (k as f64 + done as f64 / full as f64) * dt;
+                let (result, start, stages_seen, clock) = self.attempt(on_stage, &intermediate, t, h, max_cuts);
+                let report = match result {
+                    Ok(report) => report,
+                    Err(e) => match at.cut(e, t, h, max_cuts, &mut outcome) {
+                        Some(stop) => {
+                            outcome.stopped = Some(stop);
+                            break 'steps;
+                        }
+                        None => continue,
+                    },
+                };
+                outcome.step_seconds.push(clock.elapsed().as_secs_f64());
+                done += units;
+                at.accepted += 1;
+                let t_end = if done == full { t0 + (k + 1) as f64 * dt } else { t + h };
+                let due = Due::at(control, k, steps, done == full)?;
+                let mut record = due.record.then(Vec::new);
+                let (ops, states, v_index) = (&self.ops, &self.states, self.v_index);
+                add_work(&mut energy, ops, Interval { start: &start, states, v_index, t, h }, stages_seen);
+                // Checked before the observer sees the step: the outputs end at the last good one.
+                let ended = Ended { states, v_index, before: &start.before, h, t: t_end };
+                if let Some(grown) = energy.check(ops, &ended, guard.energy_tolerance, self.law) {
+                    outcome.stopped = Some(energy_stop(grown, t_end, guard.energy_tolerance, &self.params, self.law));
+                    break 'steps;
+                }
+                outcome.energy_growth = energy.growth;
+                let (before, previous) = (&start.before, start.before_previous.as_deref());
+                let step = Step { k: at.accepted, t: t_end, dt: h, states, before, previous, report: &report };
+                on_step(ops, &step, record.as_mut())?;
+                at.accept(done, units);
+                if let Some(record) = record {
+                    let previous = self.stepper.previous();
+                    let driver = at.driver_state(k + 1, outcome.cuts, &energy, states, previous, !due.interrupted);
+                    if let Err(e) = self.checkpoint(control, driver, record) {
+                        // The outputs up to here are still written.
+                        outcome.stopped = Some(e);
+                        break 'steps;
+                    }
+                }
+                if crash_at == Some(at.accepted) {
+                    std::process::abort();
+                }
+                // An interrupt lets the nominal step finish, so that its checkpoint is on the
+                // nominal time levels.
+                if due.interrupted && done == full {
+                    outcome.stopped = Some(CaseError::Interrupted { t: t_end });
+                    break 'steps;
+                }
+            }
+        }
+        bar.finish();
+        Ok(outcome)
+    }
+
+    /// Takes one step of `h` from `t`, showing its intermediate stages to `on_stage`; a failed
+    /// step leaves the states as they were at its start (when a cut may follow). Returns the
+    /// step's start, its intermediate stages' displacements and velocities (for the held dofs'
+    /// work) and when it began.
+    fn attempt(
+        &mut self,
+        on_stage: &mut OnStage,
+        intermediate: &[String],
+        t: f64,
+        h: f64,
+        max_cuts: usize,
+    ) -> (Result<StepReport, StepError>, Start, Vec<StageSeen>, Instant) {
+        let Simulation { stepper, ops, states, v_index, .. } = self;
+        let start = Start::of(states, stepper, *v_index, ops, max_cuts);
+        let clock = Instant::now();
+        let mut stages_seen: Vec<StageSeen> = Vec::new();
+        let result = stepper.step_observed(states, t, h, &mut |stage| {
+            if intermediate.iter().any(|name| name == stage.name) {
+                on_stage(ops, stage, *v_index, &start.before);
+                if !ops.held.is_empty()
+                    && let Some(u) = stage.value_of("u")
+                {
+                    stages_seen.push((stage.time, u.to_vec(), stage.value_of("v").map(<[f64]>::to_vec)));
+                }
+            }
+        });
+        if result.is_err()
+            && let Some(saved) = &start.saved
+        {
+            states.clone_from_slice(saved);
+        }
+        (result, start, stages_seen, clock)
+    }
+
+    /// Writes a due checkpoint. After a periodic one (not an interrupt's) the stepper forgets
+    /// its factorizations, so that the run goes on as a run resumed from it would, bit for bit.
+    fn checkpoint(
+        &mut self,
+        control: &mut Control,
+        driver: crate::checkpoint::DriverState,
+        record: Vec<u8>,
+    ) -> Result<(), CaseError> {
+        let periodic = driver.periodic;
+        control.write(driver, record)?;
+        if periodic {
+            self.stepper.forget();
+        }
+        Ok(())
+    }
+
+    /// Refuses a Δt beyond an explicit scheme's critical step, unless the guard allows it.
+    fn check_stable(&self, dt: f64) -> Result<(), CaseError> {
         if let Some(stable) = self.stable
             && dt > stable.dt
             && !self.guard.allow_unstable_dt
@@ -233,237 +363,220 @@ impl<'m> Simulation<'m> {
                 mass: self.ops.mass_choice.name().to_string(),
             });
         }
-        let intermediate: Vec<String> =
-            self.stepper.desc().stages.iter().rev().skip(1).map(|s| s.name.to_string()).collect();
-        let mut outcome = Outcome {
-            step_seconds: Vec::with_capacity(steps),
-            cuts: 0,
-            stopped: None,
-            resumed: None,
-            energy_growth: 0.0,
+        Ok(())
+    }
+
+    /// Restores a checkpoint's states (and the previous level, when a law reads it), its
+    /// counters and its energy watch.
+    fn resume(
+        &mut self,
+        saved: &crate::checkpoint::DriverState,
+        outcome: &mut Outcome,
+    ) -> Result<(Cursor, EnergyWatch), CaseError> {
+        let Simulation { stepper, ops, states, .. } = self;
+        // The scheme's states, then the previous level when a law reads it (`prev`).
+        let count = states.len() + usize::from(stepper.reads_previous());
+        if saved.states.len() != count || saved.states.iter().any(|s| s.len() != ops.asm.size()) {
+            return Err(CaseError::Option("the checkpoint's states do not fit this run's scheme and mesh".into()));
+        }
+        let scheme_states = states.len();
+        states.clone_from_slice(&saved.states[..scheme_states]);
+        if let Some(previous) = saved.states.get(scheme_states) {
+            stepper.set_previous(previous.clone());
+        }
+        let at = Cursor { first: saved.steps_done, accepted: saved.accepted, level: saved.level, streak: saved.streak };
+        outcome.cuts = saved.cuts;
+        let energy = EnergyWatch {
+            initial: saved.energy_initial,
+            u0: saved.energy_u0.clone(),
+            work: saved.energy_work,
+            varying_work: saved.energy_varying_work,
+            law_work: saved.energy_law_work,
+            dissipated: saved.energy_dissipated,
+            kinetic: saved.energy_kinetic,
+            growth: saved.energy_growth,
+            lowest: saved.energy_lowest,
+            allowance: saved.energy_allowance,
+            switches: saved.energy_switches.clone(),
         };
-        let mut bar = crate::progress::Progress::new(steps, progress);
-        let guard = self.guard;
-        let mut energy = EnergyWatch::new(&self.ops, &self.states, self.v_index, t0);
-        let Simulation { stepper, ops, states, v_index, params, law, .. } = self;
-        // Progress through a nominal step in units of dt / 2^max_cuts.
-        let max_cuts = guard.max_step_cuts.min(MAX_STEP_CUTS);
-        let full: u64 = 1 << max_cuts;
-        let (mut level, mut streak, mut accepted, mut first) = (0usize, 0usize, 0usize, 0usize);
-        if let Some((saved, _)) = &control.resume {
-            // The scheme's states, then the previous level when a law reads it (`prev`).
-            let count = states.len() + usize::from(stepper.reads_previous());
-            if saved.states.len() != count || saved.states.iter().any(|s| s.len() != ops.asm.size()) {
-                return Err(CaseError::Option("the checkpoint's states do not fit this run's scheme and mesh".into()));
-            }
-            let scheme_states = states.len();
-            states.clone_from_slice(&saved.states[..scheme_states]);
-            if let Some(previous) = saved.states.get(scheme_states) {
-                stepper.set_previous(previous.clone());
-            }
-            (first, accepted, level, streak) = (saved.steps_done, saved.accepted, saved.level, saved.streak);
-            outcome.cuts = saved.cuts;
-            energy = EnergyWatch {
-                initial: saved.energy_initial,
-                u0: saved.energy_u0.clone(),
-                work: saved.energy_work,
-                varying_work: saved.energy_varying_work,
-                law_work: saved.energy_law_work,
-                dissipated: saved.energy_dissipated,
-                kinetic: saved.energy_kinetic,
-                growth: saved.energy_growth,
-                lowest: saved.energy_lowest,
-                allowance: saved.energy_allowance,
-                switches: saved.energy_switches.clone(),
-            };
-            outcome.resumed = Some(Resumed { step: saved.steps_done, bit_for_bit: saved.periodic });
-            stepper.forget();
+        outcome.resumed = Some(Resumed { step: saved.steps_done, bit_for_bit: saved.periodic });
+        stepper.forget();
+        Ok((at, energy))
+    }
+}
+
+/// An intermediate stage's time, displacement and velocity (if the scheme has one).
+type StageSeen = (f64, Vec<f64>, Option<Vec<f64>>);
+
+/// Where a run is: the nominal steps done before it (from a checkpoint), the steps accepted,
+/// how many times Δt is halved now, and the steps accepted since it last changed.
+#[derive(Clone, Copy, Default)]
+struct Cursor {
+    first: usize,
+    accepted: usize,
+    level: usize,
+    streak: usize,
+}
+
+impl Cursor {
+    /// After a failed step: None to retry it with Δt halved, or why the run stops (a law whose
+    /// derivative is 0/0 is so at any Δt: no cut helps; nor one beyond `max_cuts`).
+    fn cut(&mut self, e: StepError, t: f64, h: f64, max_cuts: usize, outcome: &mut Outcome) -> Option<CaseError> {
+        if let StepError::NonFiniteTangent { .. } = e {
+            return Some(CaseError::Failed { t, cause: e.to_string() });
         }
-        // Fault injection for the restart tests: the process aborts, as if killed, right after
-        // this accepted step (and its checkpoint, if one is due).
-        let crash_at: Option<usize> = std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok());
-        'steps: for k in first..steps {
-            bar.tick(k);
-            let mut done: u64 = 0;
-            while done < full {
-                let units = full >> level;
-                let h = dt * units as f64 / full as f64;
-                let t = t0 + (k as f64 + done as f64 / full as f64) * dt;
-                let saved = (max_cuts > 0).then(|| states.to_vec());
-                let before = states[0].clone();
-                let before_previous = stepper.previous().map(<[f64]>::to_vec);
-                // The held dofs' reaction takes the change of velocity over the step.
-                let v_before = v_index.filter(|_| !ops.held.is_empty()).map(|i| states[i].clone());
-                let clock = Instant::now();
-                // The intermediate stages' displacements and velocities, for the held dofs' work.
-                let mut stages_seen: Vec<(f64, Vec<f64>, Option<Vec<f64>>)> = Vec::new();
-                let result = stepper.step_observed(states, t, h, &mut |stage| {
-                    if intermediate.iter().any(|name| name == stage.name) {
-                        on_stage(ops, stage, *v_index, &before);
-                        if !ops.held.is_empty()
-                            && let Some(u) = stage.value_of("u")
-                        {
-                            stages_seen.push((stage.time, u.to_vec(), stage.value_of("v").map(<[f64]>::to_vec)));
-                        }
-                    }
-                });
-                let report = match result {
-                    Ok(report) => report,
-                    Err(e) => {
-                        if let Some(saved) = saved {
-                            states.clone_from_slice(&saved);
-                        }
-                        // A law whose derivative is 0/0 is so at any Δt: no cut helps.
-                        if let crate::runtime::time::stepper::StepError::NonFiniteTangent { .. } = e {
-                            outcome.stopped = Some(CaseError::Failed { t, cause: e.to_string() });
-                            break 'steps;
-                        }
-                        if level < max_cuts {
-                            level += 1;
-                            streak = 0;
-                            outcome.cuts += 1;
-                            tracing::warn!(t, dt = h / 2.0, "step failed ({e}); retrying with Δt halved");
-                            continue;
-                        }
-                        outcome.stopped = Some(CaseError::Stopped {
-                            t,
-                            cuts: level,
-                            dt: h,
-                            cause: e.to_string(),
-                            history: history(&e),
-                        });
-                        break 'steps;
-                    }
-                };
-                outcome.step_seconds.push(clock.elapsed().as_secs_f64());
-                done += units;
-                accepted += 1;
-                let t_end = if done == full { t0 + (k + 1) as f64 * dt } else { t + h };
-                // A checkpoint after the last step would resume nothing.
-                let periodic = control.every > 0 && (k + 1).is_multiple_of(control.every) && k + 1 < steps;
-                let interrupted = crate::interrupt::agreed().map_err(|e| CaseError::Option(format!("MPI: {e}")))?;
-                // With periodic checkpoints an interrupt keeps the last one, which resumes bit
-                // for bit; without, it writes one of its own (which resumes to round-off).
-                let on_interrupt = interrupted && control.every == 0;
-                let mut record = (done == full && (periodic || on_interrupt)).then(Vec::new);
-                if let Some(load) = &ops.varying_load {
-                    energy.step_work(ops, load.as_ref(), &before, &states[0], t + 0.5 * h);
-                }
-                if !ops.held.is_empty() {
-                    // Over each sub-interval between the step's stages.
-                    let v = v_index.map(|i| states[i].clone());
-                    let mut points = vec![(t, before.clone(), v_before.clone())];
-                    points.append(&mut stages_seen);
-                    points.push((t + h, states[0].clone(), v));
-                    for w in points.windows(2) {
-                        let ((t0, u0, v0), (t1, u1, v1)) = (&w[0], &w[1]);
-                        let vs = v0.as_deref().zip(v1.as_deref());
-                        energy.held_work(ops, u0, u1, vs, t1 - t0, 0.5 * (t0 + t1));
-                    }
-                }
-                if ops.probe.as_ref().is_some_and(|p| p.time_dependent()) {
-                    energy.obstacle_work(ops, &before, &states[0], t, h);
-                }
-                if let Some(work) = &ops.contact_work {
-                    energy.law_work += work.value(ops.asm, &[&states[0], &before], t + 0.5 * h);
-                }
-                if let Some(work) = &ops.friction_work {
-                    energy.dissipated += work.value(ops.asm, &[&states[0], &before], t + h);
-                }
-                // Checked before the observer sees the step: the outputs end at the last good one.
-                if let Some(grown) =
-                    energy.check(ops, states, *v_index, &before, h, t_end, guard.energy_tolerance, *law)
-                {
-                    outcome.stopped = Some(match grown.cause {
-                        Cause::Negative(potential) => CaseError::NotCoercive {
-                            t: t_end,
-                            potential,
-                            scale: grown.scale,
-                            tolerance: guard.energy_tolerance,
-                            params: params.clone(),
-                        },
-                        Cause::LawWork { work, outside } => {
-                            CaseError::LawWork { t: t_end, work, outside, params: params.clone() }
-                        }
-                        Cause::Growth => CaseError::BlowUp {
-                            t: t_end,
-                            energy: grown.energy,
-                            bound: grown.bound,
-                            scale: grown.scale,
-                            tolerance: guard.energy_tolerance,
-                            law: law.map_or_else(
-                                || " (the scheme claims no energy law)".to_string(),
-                                |l| format!(" beyond what a {} scheme allows", l.name()),
-                            ),
-                            params: params.clone(),
-                        },
-                    });
-                    break 'steps;
-                }
-                outcome.energy_growth = energy.growth;
-                let step = Step {
-                    k: accepted,
-                    t: t_end,
-                    dt: h,
-                    states,
-                    before: &before,
-                    previous: before_previous.as_deref(),
-                    report: &report,
-                };
-                on_step(ops, &step, record.as_mut())?;
-                streak += 1;
-                if level > 0 && streak >= 2 && done.is_multiple_of(2 * units) {
-                    level -= 1;
-                    streak = 0;
-                }
-                if let Some(record) = record {
-                    let driver = crate::checkpoint::DriverState {
-                        steps_done: k + 1,
-                        accepted,
-                        level,
-                        streak,
-                        cuts: outcome.cuts,
-                        energy_initial: energy.initial,
-                        energy_work: energy.work,
-                        energy_varying_work: energy.varying_work,
-                        energy_law_work: energy.law_work,
-                        energy_dissipated: energy.dissipated,
-                        energy_u0: energy.u0.clone(),
-                        energy_kinetic: energy.kinetic,
-                        energy_growth: energy.growth,
-                        energy_lowest: energy.lowest,
-                        energy_allowance: energy.allowance,
-                        energy_switches: energy.switches.clone(),
-                        states: states
-                            .iter()
-                            .map(Vec::as_slice)
-                            .chain(stepper.previous())
-                            .map(<[f64]>::to_vec)
-                            .collect(),
-                        periodic: !interrupted,
-                    };
-                    if let Err(e) = control.write(driver, record) {
-                        // The outputs up to here are still written.
-                        outcome.stopped = Some(e);
-                        break 'steps;
-                    }
-                    if !interrupted {
-                        stepper.forget();
-                    }
-                }
-                if crash_at == Some(accepted) {
-                    std::process::abort();
-                }
-                // An interrupt lets the nominal step finish, so that its checkpoint is on the
-                // nominal time levels.
-                if interrupted && done == full {
-                    outcome.stopped = Some(CaseError::Interrupted { t: t_end });
-                    break 'steps;
-                }
-            }
+        if self.level < max_cuts {
+            self.level += 1;
+            self.streak = 0;
+            outcome.cuts += 1;
+            tracing::warn!(t, dt = h / 2.0, "step failed ({e}); retrying with Δt halved");
+            return None;
         }
-        bar.finish();
-        Ok(outcome)
+        Some(CaseError::Stopped { t, cuts: self.level, dt: h, cause: e.to_string(), history: history(&e) })
+    }
+
+    /// After an accepted step of `units`: Δt doubles back after two accepted steps that end on
+    /// a multiple of the doubled size, so that the run returns to the nominal time levels.
+    fn accept(&mut self, done: u64, units: u64) {
+        self.streak += 1;
+        if self.level > 0 && self.streak >= 2 && done.is_multiple_of(2 * units) {
+            self.level -= 1;
+            self.streak = 0;
+        }
+    }
+
+    /// The driver's part of a checkpoint after `steps_done` nominal steps.
+    fn driver_state(
+        &self,
+        steps_done: usize,
+        cuts: usize,
+        energy: &EnergyWatch,
+        states: &[Vec<f64>],
+        previous: Option<&[f64]>,
+        periodic: bool,
+    ) -> crate::checkpoint::DriverState {
+        crate::checkpoint::DriverState {
+            steps_done,
+            accepted: self.accepted,
+            level: self.level,
+            streak: self.streak,
+            cuts,
+            energy_initial: energy.initial,
+            energy_work: energy.work,
+            energy_varying_work: energy.varying_work,
+            energy_law_work: energy.law_work,
+            energy_dissipated: energy.dissipated,
+            energy_u0: energy.u0.clone(),
+            energy_kinetic: energy.kinetic,
+            energy_growth: energy.growth,
+            energy_lowest: energy.lowest,
+            energy_allowance: energy.allowance,
+            energy_switches: energy.switches.clone(),
+            states: states.iter().map(Vec::as_slice).chain(previous).map(<[f64]>::to_vec).collect(),
+            periodic,
+        }
+    }
+}
+
+/// What a step keeps of its start: the states for a retry (when a cut may follow), the
+/// displacement, the level a law's `prev` read, and the velocity when held dofs take the
+/// change of velocity over the step into their reaction.
+struct Start {
+    saved: Option<Vec<Vec<f64>>>,
+    before: Vec<f64>,
+    before_previous: Option<Vec<f64>>,
+    v_before: Option<Vec<f64>>,
+}
+
+impl Start {
+    fn of(states: &[Vec<f64>], stepper: &Stepper, v_index: Option<usize>, ops: &Operators, max_cuts: usize) -> Self {
+        Start {
+            saved: (max_cuts > 0).then(|| states.to_vec()),
+            before: states[0].clone(),
+            before_previous: stepper.previous().map(<[f64]>::to_vec),
+            v_before: v_index.filter(|_| !ops.held.is_empty()).map(|i| states[i].clone()),
+        }
+    }
+}
+
+/// Whether an accepted step writes a checkpoint, and whether the run was interrupted.
+struct Due {
+    record: bool,
+    interrupted: bool,
+}
+
+impl Due {
+    /// After nominal step `k` (of `steps`), `whole` when the step ended a nominal one.
+    fn at(control: &Control, k: usize, steps: usize, whole: bool) -> Result<Due, CaseError> {
+        // A checkpoint after the last step would resume nothing.
+        let periodic = control.every > 0 && (k + 1).is_multiple_of(control.every) && k + 1 < steps;
+        let interrupted = crate::interrupt::agreed().map_err(|e| CaseError::Option(format!("MPI: {e}")))?;
+        // With periodic checkpoints an interrupt keeps the last one, which resumes bit
+        // for bit; without, it writes one of its own (which resumes to round-off).
+        let on_interrupt = interrupted && control.every == 0;
+        Ok(Due { record: whole && (periodic || on_interrupt), interrupted })
+    }
+}
+
+/// One accepted step's interval: its start, the states at its end, its time and size.
+struct Interval<'s> {
+    start: &'s Start,
+    states: &'s [Vec<f64>],
+    v_index: Option<usize>,
+    t: f64,
+    h: f64,
+}
+
+/// Adds the step's work to the energy watch: a varying load's, the held dofs' (over each
+/// sub-interval between the step's stages), a moving obstacle's, the law's own, and what
+/// friction dissipated.
+fn add_work(energy: &mut EnergyWatch, ops: &Operators, step: Interval, mut stages_seen: Vec<StageSeen>) {
+    let Interval { start, states, v_index, t, h } = step;
+    let before = &start.before;
+    if let Some(load) = &ops.varying_load {
+        energy.step_work(ops, load.as_ref(), before, &states[0], t + 0.5 * h);
+    }
+    if !ops.held.is_empty() {
+        // Over each sub-interval between the step's stages.
+        let v = v_index.map(|i| states[i].clone());
+        let mut points = vec![(t, before.clone(), start.v_before.clone())];
+        points.append(&mut stages_seen);
+        points.push((t + h, states[0].clone(), v));
+        for w in points.windows(2) {
+            let ((t0, u0, v0), (t1, u1, v1)) = (&w[0], &w[1]);
+            let vs = v0.as_deref().zip(v1.as_deref());
+            energy.held_work(ops, u0, u1, vs, t1 - t0, 0.5 * (t0 + t1));
+        }
+    }
+    if ops.probe.as_ref().is_some_and(|p| p.time_dependent()) {
+        energy.obstacle_work(ops, before, &states[0], t, h);
+    }
+    if let Some(work) = &ops.contact_work {
+        energy.law_work += work.value(ops.asm, &[&states[0], before], t + 0.5 * h);
+    }
+    if let Some(work) = &ops.friction_work {
+        energy.dissipated += work.value(ops.asm, &[&states[0], before], t + h);
+    }
+}
+
+/// The error that stops a run whose energy the guard refused at `t`.
+fn energy_stop(grown: Grown, t: f64, tolerance: f64, params: &str, law: Option<EnergyLaw>) -> CaseError {
+    let params = params.to_string();
+    match grown.cause {
+        Cause::Negative(potential) => CaseError::NotCoercive { t, potential, scale: grown.scale, tolerance, params },
+        Cause::LawWork { work, outside } => CaseError::LawWork { t, work, outside, params },
+        Cause::Growth => CaseError::BlowUp {
+            t,
+            energy: grown.energy,
+            bound: grown.bound,
+            scale: grown.scale,
+            tolerance,
+            law: law.map_or_else(
+                || " (the scheme claims no energy law)".to_string(),
+                |l| format!(" beyond what a {} scheme allows", l.name()),
+            ),
+            params,
+        },
     }
 }
 
@@ -488,6 +601,12 @@ pub struct Outcome {
     pub resumed: Option<Resumed>,
     /// The energy guard's largest growth of E_aug beyond E_aug(0) + work, over the energy scale.
     pub energy_growth: f64,
+}
+
+impl Outcome {
+    fn new(steps: usize) -> Self {
+        Outcome { step_seconds: Vec::with_capacity(steps), cuts: 0, stopped: None, resumed: None, energy_growth: 0.0 }
+    }
 }
 
 /// Where a resumed run started.

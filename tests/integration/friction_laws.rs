@@ -9,7 +9,7 @@ use signorini::forms::{
     contact_penalty as penalty, contact_penalty_coulomb as penalty_coulomb,
 };
 use signorini::runtime::fem::element::ElementKind;
-use signorini::runtime::fem::kernel::{Coef, FacetTabulation, FormKernel, facet_matrix, facet_vector};
+use signorini::runtime::fem::kernel::{Coef, FacetTabulation, FormKernel, OnFacet, facet_matrix, facet_vector};
 
 use crate::tangents::Rng;
 
@@ -68,7 +68,7 @@ fn h() -> f64 {
 }
 
 fn residual<K: FormKernel<2, 6>>(k: &K, fields: &[&Nodes]) -> Nodes {
-    facet_vector(k, 0, &tab(), 0, &cell(), h(), fields, 0.0)
+    facet_vector(k, &tab(), OnFacet { region: 0, facet: 0, h: h() }, &cell(), fields, 0.0)
 }
 
 fn jacobian<K: FormKernel<2, 6>>(k: &K, fields: &[&Nodes]) -> Vec<Vec<f64>> {
@@ -76,7 +76,7 @@ fn jacobian<K: FormKernel<2, 6>>(k: &K, fields: &[&Nodes]) -> Vec<Vec<f64>> {
 }
 
 fn jacobian_wrt<K: FormKernel<2, 6>>(k: &K, fields: &[&Nodes], wrt: usize) -> Vec<Vec<f64>> {
-    facet_matrix(k, 0, &tab(), 0, &cell(), h(), fields, wrt, 0.0)
+    facet_matrix(k, &tab(), OnFacet { region: 0, facet: 0, h: h() }, &cell(), fields, wrt, 0.0)
 }
 
 /// Max-norm difference between the tangent and central differences of the residual in u (the

@@ -12,8 +12,8 @@ use signorini::runtime::fem::bound::{Bound, BoundForm};
 use signorini::runtime::fem::element::ElementKind;
 use signorini::runtime::fem::geometry;
 use signorini::runtime::fem::kernel::{
-    CellCtx, Coef, FacetCtx, FacetTabulation, Form, FormKernel, FunctionalKernel, LocalVector, Tabulation, cell_matrix,
-    cell_vector, facet_matrix, facet_vector,
+    CellCtx, Coef, FacetCtx, FacetTabulation, Form, FormKernel, FunctionalKernel, LocalVector, OnFacet, Tabulation,
+    cell_matrix, cell_vector, facet_matrix, facet_vector,
 };
 use signorini::runtime::fem::mesh::Facet;
 use signorini::runtime::fem::mesh::structured::{self, Diagonal};
@@ -166,12 +166,13 @@ fn compare_form_on<const D: usize, const N: usize, K: FormKernel<D, N>>(
             let tab = FacetTabulation::<D, N>::new(kind, deg[p]).unwrap();
             for facet in 0..tab.facets.len() {
                 let at = |part: &str| what(&format!("{part} on {name}, local facet {facet}"));
-                let c = facet_vector(compiled, region, &tab, facet, &x, h, &fields, T);
-                let i = facet_vector(interp, region, &tab, facet, &x, h, &fields, T);
+                let on = OnFacet { region, facet, h };
+                let c = facet_vector(compiled, &tab, on, &x, &fields, T);
+                let i = facet_vector(interp, &tab, on, &x, &fields, T);
                 stats.close(&at("facet residual"), &flat(&c), &flat(&i));
                 for wrt in 0..meta.fields.len() {
-                    let c = facet_matrix(compiled, region, &tab, facet, &x, h, &fields, wrt, T);
-                    let i = facet_matrix(interp, region, &tab, facet, &x, h, &fields, wrt, T);
+                    let c = facet_matrix(compiled, &tab, on, &x, &fields, wrt, T);
+                    let i = facet_matrix(interp, &tab, on, &x, &fields, wrt, T);
                     stats.close(&at(&format!("facet tangent d/d{}", meta.fields[wrt])), &c.concat(), &i.concat());
                     let (ftab, normal) = &tab.facets[facet];
                     let ctx = FacetCtx { tab: ftab, ref_normal: normal, coords: &x, h, t: T };

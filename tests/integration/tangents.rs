@@ -4,7 +4,7 @@
 //! closed-form kernel of spec §3.4, which pins down the sign conventions of the .wf files.
 
 use signorini::runtime::fem::element::ElementKind;
-use signorini::runtime::fem::kernel::{Coef, FacetTabulation, FormKernel, facet_matrix, facet_vector};
+use signorini::runtime::fem::kernel::{Coef, FacetTabulation, FormKernel, OnFacet, facet_matrix, facet_vector};
 
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
@@ -53,7 +53,7 @@ fn fd_error<const D: usize, const N: usize, K: FormKernel<D, N>>(
     u: &[[f64; D]; N],
 ) -> f64 {
     let h = signorini::runtime::fem::geometry::diameter(x, D + 1);
-    let jac = facet_matrix(k, 0, tab, 0, x, h, &[u], 0, 0.0);
+    let jac = facet_matrix(k, tab, OnFacet { region: 0, facet: 0, h }, x, &[u], 0, 0.0);
     let scale = jac.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut worst = 0.0f64;
     for col in 0..N * D {
@@ -61,8 +61,8 @@ fn fd_error<const D: usize, const N: usize, K: FormKernel<D, N>>(
         let (mut up, mut um) = (*u, *u);
         up[col / D][col % D] += eps;
         um[col / D][col % D] -= eps;
-        let rp = facet_vector(k, 0, tab, 0, x, h, &[&up], 0.0);
-        let rm = facet_vector(k, 0, tab, 0, x, h, &[&um], 0.0);
+        let rp = facet_vector(k, tab, OnFacet { region: 0, facet: 0, h }, x, &[&up], 0.0);
+        let rm = facet_vector(k, tab, OnFacet { region: 0, facet: 0, h }, x, &[&um], 0.0);
         for row in 0..N * D {
             let fd = (rp[row / D][row % D] - rm[row / D][row % D]) / (2.0 * eps);
             worst = worst.max((fd - jac[row][col]).abs() / scale);
@@ -78,7 +78,7 @@ fn tangent<const D: usize, const N: usize, K: FormKernel<D, N>>(
     u: &[[f64; D]; N],
 ) -> Vec<Vec<f64>> {
     let h = signorini::runtime::fem::geometry::diameter(x, D + 1);
-    facet_matrix(k, 0, tab, 0, x, h, &[u], 0, 0.0)
+    facet_matrix(k, tab, OnFacet { region: 0, facet: 0, h }, x, &[u], 0, 0.0)
 }
 
 /// Deterministic pseudo-random numbers in [−1, 1] (xorshift), so failures reproduce.
@@ -159,7 +159,7 @@ fn a_real_power_differentiates_as_p_times_the_power_below() {
         let tab = FacetTabulation::<1, 2>::new(ElementKind::IntervalP1, 1).unwrap();
         let (h, delta) = (0.25, 0.04);
         let x = [[0.0], [h]];
-        let jac = facet_matrix(&k, 0, &tab, 0, &x, h, &[&[[-delta], [0.0]]], 0, 0.0);
+        let jac = facet_matrix(&k, &tab, OnFacet { region: 0, facet: 0, h }, &x, &[&[[-delta], [0.0]]], 0, 0.0);
         let exact = 1.5 * 5.0 / h * delta.sqrt();
         assert!((jac[0][0] - exact).abs() < 1e-12 * exact, "{} against {exact}", jac[0][0]);
     }
@@ -215,7 +215,7 @@ fn one_dimensional_contact_residual_is_the_spec_kernel() {
                 -theta / gamma * su * s[0] + neg / gamma * (theta * s[0] + gamma),
                 -theta / gamma * su * s[1] + neg / gamma * theta * s[1],
             ];
-            let got = facet_vector(&k, 0, &tab, 0, &x, h, &[&u], 0.0);
+            let got = facet_vector(&k, &tab, OnFacet { region: 0, facet: 0, h }, &x, &[&u], 0.0);
             for i in 0..2 {
                 assert!(
                     (got[i][0] - expect[i]).abs() < 1e-12 * (1.0 + expect[i].abs()),
@@ -227,7 +227,7 @@ fn one_dimensional_contact_residual_is_the_spec_kernel() {
     let k = penalty(gamma0, 1);
     for _ in 0..20 {
         let u = [[0.05 * rng.next()], [0.05 * rng.next()]];
-        let got = facet_vector(&k, 0, &tab, 0, &x, h, &[&u], 0.0);
+        let got = facet_vector(&k, &tab, OnFacet { region: 0, facet: 0, h }, &x, &[&u], 0.0);
         let expect = gamma * u[0][0].min(0.0);
         assert!((got[0][0] - expect).abs() < 1e-12 && got[1][0] == 0.0, "penalty: {got:?} vs {expect}");
     }
@@ -250,7 +250,7 @@ fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
         let u0 = state_2d(&mut rng, 0.0);
         let u1 = state_2d(&mut rng, 0.02);
         for wrt in 0..2 {
-            let jac = facet_matrix(&k, 0, &tab, 0, &x, h, &[&u0, &u1], wrt, 0.0);
+            let jac = facet_matrix(&k, &tab, OnFacet { region: 0, facet: 0, h }, &x, &[&u0, &u1], wrt, 0.0);
             let scale = jac.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
             assert!(scale > 0.0);
             for col in 0..12 {
@@ -259,8 +259,8 @@ fn hybrid_contact_tangents_match_finite_differences_for_each_time_level() {
                 let mut minus = [u0, u1];
                 plus[wrt][col / 2][col % 2] += eps;
                 minus[wrt][col / 2][col % 2] -= eps;
-                let rp = facet_vector(&k, 0, &tab, 0, &x, h, &[&plus[0], &plus[1]], 0.0);
-                let rm = facet_vector(&k, 0, &tab, 0, &x, h, &[&minus[0], &minus[1]], 0.0);
+                let rp = facet_vector(&k, &tab, OnFacet { region: 0, facet: 0, h }, &x, &[&plus[0], &plus[1]], 0.0);
+                let rm = facet_vector(&k, &tab, OnFacet { region: 0, facet: 0, h }, &x, &[&minus[0], &minus[1]], 0.0);
                 for row in 0..12 {
                     let fd = (rp[row / 2][row % 2] - rm[row / 2][row % 2]) / (2.0 * eps);
                     let err = (fd - jac[row][col]).abs() / scale;

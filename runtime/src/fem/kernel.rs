@@ -382,37 +382,42 @@ pub fn cell_matrix<const D: usize, const N: usize, K: FormKernel<D, N>>(
     flatten(&out)
 }
 
-/// Facet residual of region `region` on local facet `facet`.
-#[allow(clippy::too_many_arguments)]
+/// Which facet term is evaluated where: the form's region, the cell's local facet, and the
+/// cell's size h (Nitsche's and the penalty's scale).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OnFacet {
+    pub region: usize,
+    pub facet: usize,
+    pub h: f64,
+}
+
+/// Facet residual of region `at.region` on local facet `at.facet`.
 pub fn facet_vector<const D: usize, const N: usize, K: FormKernel<D, N>>(
     k: &K,
-    region: usize,
     tab: &FacetTabulation<D, N>,
-    facet: usize,
+    at: OnFacet,
     coords: &[[f64; D]; N],
-    h: f64,
     fields: &[&LocalVector<D, N>],
     t: f64,
 ) -> LocalVector<D, N> {
+    let OnFacet { region, facet, h } = at;
     let (ftab, normal) = &tab.facets[facet];
     let mut out = [[0.0; D]; N];
     k.facet_residual(region, &FacetCtx { tab: ftab, ref_normal: normal, coords, h, t }, fields, &mut out);
     out
 }
 
-/// Facet tangent of region `region` on local facet `facet`, row-major.
-#[allow(clippy::too_many_arguments)]
+/// Facet tangent of region `at.region` on local facet `at.facet`, row-major.
 pub fn facet_matrix<const D: usize, const N: usize, K: FormKernel<D, N>>(
     k: &K,
-    region: usize,
     tab: &FacetTabulation<D, N>,
-    facet: usize,
+    at: OnFacet,
     coords: &[[f64; D]; N],
-    h: f64,
     fields: &[&LocalVector<D, N>],
     wrt: usize,
     t: f64,
 ) -> Vec<Vec<f64>> {
+    let OnFacet { region, facet, h } = at;
     let (ftab, normal) = &tab.facets[facet];
     let mut out = Box::new([[[[0.0; D]; N]; D]; N]);
     k.facet_tangent(region, &FacetCtx { tab: ftab, ref_normal: normal, coords, h, t }, fields, wrt, &mut out);

@@ -10,7 +10,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use crate::linalg::pattern::Owners;
+use crate::linalg::pattern::{Connectivity, Owners};
 use crate::linalg::{LinalgError, ranks};
 
 #[derive(Debug)]
@@ -28,25 +28,28 @@ pub struct Ownership {
 }
 
 impl Ownership {
-    /// The nodes of `mesh` split among the processes of this run (METIS's partition of the
+    /// The nodes of `cells` split among the processes of this run (METIS's partition of the
     /// graph of nodes that share a cell, the same on every process); None in a run of one.
-    pub fn of(mesh: &crate::fem::mesh::Mesh) -> Result<Option<Arc<Ownership>>, LinalgError> {
+    /// `cells` is plain data, so that this layer knows nothing of meshes: `fem` converts a
+    /// `&Mesh` into it (`Mesh::connectivity`).
+    pub fn of<'c>(cells: impl Into<Connectivity<'c>>) -> Result<Option<Arc<Ownership>>, LinalgError> {
+        let cells: Connectivity = cells.into();
         let (rank, size) = ranks::world();
         if size == 1 {
             return Ok(None);
         }
         #[cfg(feature = "petsc")]
         {
-            let owner = crate::linalg::petsc::partition_mesh(mesh, size)?;
+            let owner = crate::linalg::petsc::partition_nodes(&cells, size)?;
             // Each process partitioned alone: a process whose METIS (another build, another
             // machine of a cluster) split otherwise would exchange the wrong rows, silently.
-            let ownership = Ownership::new(owner, mesh.dim(), rank, size);
+            let ownership = Ownership::new(owner, cells.dim, rank, size);
             let mut first = ownership.fingerprint().to_le_bytes().to_vec();
             ranks::broadcast(&mut first)?;
             if ranks::any(first != ownership.fingerprint().to_le_bytes())? {
                 return Err(LinalgError::Other(format!(
                     "the processes split the mesh's {} nodes differently (METIS gave rank {rank} other parts than rank 0): every process must run the same build",
-                    mesh.num_nodes()
+                    cells.num_nodes
                 )));
             }
             Ok(Some(Arc::new(ownership)))
@@ -54,7 +57,7 @@ impl Ownership {
         #[cfg(not(feature = "petsc"))]
         Err(LinalgError::Other(format!(
             "{size} processes, in a build without MPI (rank {rank}, {} nodes)",
-            mesh.num_nodes()
+            cells.num_nodes
         )))
     }
 

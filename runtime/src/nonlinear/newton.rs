@@ -171,6 +171,94 @@ struct Scratch {
     after: Vec<bool>,
 }
 
+/// What one solve carries from one Newton iteration to the next.
+struct Progress {
+    /// The convergence measure: ‖R‖∞ (plus what `carried` bounds).
+    res: f64,
+    /// Newton's threshold on `res` for this solve.
+    threshold: f64,
+    /// The active set at the iterate, when the last step found it (in `Scratch::after`), and
+    /// whether it decides the tangent there.
+    known: bool,
+    piecewise_after: bool,
+    /// ‖R‖₂ at the last solve's start (iterative solves).
+    last_norm2: Option<f64>,
+    small_step: bool,
+    /// A bound on what R(w) holds beyond r: the errors of solves whose residual was then
+    /// evaluated on the nonlinear terms' dofs only (`residual_on_support`).
+    carried: f64,
+    /// Backtracking (`line_search`, or where full steps stall: a problem that is not
+    /// piecewise, a frictional law, may cycle between stick and slip; semi-smooth Newton on a
+    /// piecewise one converges without it, through residuals that grow on the way).
+    search: bool,
+    best: f64,
+    stalled: usize,
+    /// ‖r‖∞ of the r the next solve is given.
+    norm_r: f64,
+}
+
+impl Progress {
+    fn new(r0: f64, threshold: f64, line_search: bool) -> Self {
+        Progress {
+            res: r0,
+            threshold,
+            known: false,
+            piecewise_after: false,
+            last_norm2: None,
+            small_step: false,
+            carried: 0.0,
+            search: line_search,
+            best: r0,
+            stalled: 0,
+            norm_r: r0,
+        }
+    }
+
+    /// The active set at the iterate into `scratch.set` (the one the last step found, if it
+    /// did), and whether it decides the tangent there.
+    fn active_set(&mut self, p: &mut impl NonlinearProblem, w: &[f64], scratch: &mut Scratch) -> bool {
+        let piecewise = if self.known {
+            std::mem::swap(&mut scratch.set, &mut scratch.after);
+            self.piecewise_after
+        } else {
+            scratch.set.clear();
+            p.active_set(w, &mut scratch.set)
+        };
+        self.known = false;
+        piecewise
+    }
+
+    /// Keeps the best residual so far; three full steps without a new best turn backtracking
+    /// on from here on (a tangent that is not piecewise only).
+    fn note_best(&mut self, piecewise: bool) {
+        if self.res < self.best {
+            (self.best, self.stalled) = (self.res, 0);
+        } else {
+            self.stalled += 1;
+            self.search |= !piecewise && self.stalled >= 3;
+        }
+    }
+}
+
+/// One Newton step's linear solve: what it was asked for and what is known of its accuracy.
+struct Solved {
+    /// The relative tolerance an iterative solve was given (none: a direct solve).
+    eta: Option<f64>,
+    /// ‖R‖₂ at the solve (iterative solves; 0 otherwise).
+    norm2_r: f64,
+    /// The step is the solve's first.
+    first: bool,
+    /// The solve was loose ([`LOOSE`]): the active set is expected to change.
+    loose: bool,
+    /// The relative accuracy a trusted operator's solves have.
+    trusted: Option<f64>,
+    /// A corrected operator's first solve, estimated from its reference's accuracy and the
+    /// correction's own residual.
+    estimate: Option<f64>,
+    /// Its accuracy is measured by a product J δ.
+    checked: bool,
+}
+
 impl Newton {
     pub fn new(options: NewtonOptions) -> Self {
         Newton { options, reuse: JacobianReuse::default(), scratch: Scratch::default(), first_changed: false }
@@ -231,11 +319,8 @@ impl Newton {
         w: &mut [f64],
         scratch: &mut Scratch,
     ) -> Result<NewtonReport, NewtonError> {
-        let n = w.len();
-        let Scratch { r, delta, jd, set, after } = scratch;
-        let (r, delta, jd) = (r.as_mut_slice(), delta.as_mut_slice(), jd.as_mut_slice());
-        p.residual(w, r);
-        let r0 = norm_inf(r);
+        p.residual(w, &mut scratch.r);
+        let r0 = norm_inf(&scratch.r);
         let mut report = NewtonReport { initial_residual: r0, history: Vec::new() };
         if !r0.is_finite() {
             return Err(NewtonError::NonFinite { report });
@@ -244,125 +329,26 @@ impl Newton {
         // for long) makes the thresholds underflow to 0, which no subnormal residual could reach.
         let floor = (ROUNDOFF * p.magnitude()).max(f64::MIN_POSITIVE);
         let threshold = (self.options.tol * r0).max(floor);
-        let mut res = r0;
-        let mut piecewise;
-        // The active set at the iterate, when the last step found it, and whether it decides
-        // the tangent there.
-        let mut known = false;
-        let mut piecewise_after = false;
-        // ‖R‖₂ at the last solve's start (iterative solves).
-        let mut last_norm2: Option<f64> = None;
-        let mut small_step = false;
-        // A bound on what R(w) holds beyond r: the errors of solves whose residual was then
-        // evaluated on the nonlinear terms' dofs only (`residual_on_support`).
-        let mut carried = 0.0;
-        // Backtracking (`line_search`, or where full steps stall: a problem that is not
-        // piecewise, a frictional law, may cycle between stick and slip; semi-smooth Newton on a
-        // piecewise one converges without it, through residuals that grow on the way).
-        let mut search = self.options.line_search;
-        let (mut best, mut stalled) = (r0, 0usize);
-        // ‖r‖∞ of the r the next solve is given.
-        let mut norm_r = r0;
-        while !converged(res, floor, threshold, !report.history.is_empty(), small_step) {
+        let mut s = Progress::new(r0, threshold, self.options.line_search);
+        while !converged(s.res, floor, threshold, !report.history.is_empty(), s.small_step) {
             if report.history.len() >= self.options.max_iterations {
                 return Err(NewtonError::IterationLimit { report, threshold });
             }
-            if known {
-                std::mem::swap(set, after);
-                piecewise = piecewise_after;
-            } else {
-                set.clear();
-                piecewise = p.active_set(w, set);
-            }
-            known = false;
-            let active = set.iter().filter(|b| **b).count();
-            let changed =
-                !piecewise || self.reuse.force_refactor || self.reuse.factored_for.as_deref() != Some(set.as_slice());
-            let (mut refactor, mut updated) = (false, false);
-            if changed {
-                self.reuse.factored_for = None;
-                match self.reuse.new_operator(p, w, self.options.solver, self.options.max_rank) {
-                    Ok(full) => (refactor, updated) = (full, !full),
-                    Err(source) => return Err(NewtonError::Linear { source, report }),
-                }
-                self.reuse.factored_for = piecewise.then(|| set.clone());
-                self.reuse.jacobian_norm = match (updated, &self.reuse.low_rank) {
-                    (true, Some(lr)) => self.reuse.reference_norm + lr.change_norm(),
-                    _ => {
-                        self.reuse.reference_norm =
-                            self.reuse.jacobian.as_ref().map_or(f64::INFINITY, Matrix::norm_inf);
-                        self.reuse.reference_norm
-                    }
-                };
-                self.reuse.solve_accuracy = None;
-            }
-            delta.iter_mut().zip(r.iter()).for_each(|(d, ri)| *d = -ri);
-            let f = self.reuse.factorization.as_mut().expect("factored above");
-            let iterative = f.iterates();
-            let norm2_r = if iterative { norm2(r) } else { 0.0 };
-            // A tangent the set does not decide (a frictional law in contact) converges
-            // superlinearly at best: its early solves need only Eisenstat and Walker's accuracy.
-            let superlinear = (!piecewise).then(|| last_norm2.map_or(LOOSE, |last| 0.9 * (norm2_r / last).powi(2)));
-            last_norm2 = Some(norm2_r);
-            let loose =
-                iterative && piecewise && !self.options.line_search && report.history.is_empty() && self.first_changed;
-            let eta = iterative.then(|| f.set_tolerance(forcing(norm2_r, threshold, loose, superlinear)));
-            let trusted = if piecewise && !self.options.line_search { self.reuse.solve_accuracy } else { None };
-            // A correction of a reference whose solves are trusted reports the residual it
-            // leaves itself (`LowRank::solve`): its first solve needs no product J δ then.
-            let defect =
-                trusted.is_none() && piecewise && !self.options.line_search && self.reuse.reference_accuracy.is_some();
-            let f = self.reuse.factorization.as_mut().expect("factored above");
-            let solved = match &self.reuse.low_rank {
-                Some(lr) => lr.solve(f, delta, defect),
-                None => f.solve_in_place(delta).map(|()| None),
-            };
-            let defect = match solved {
-                Ok(defect) => defect,
+            let piecewise = s.active_set(p, w, scratch);
+            let active = scratch.set.iter().filter(|b| **b).count();
+            let (refactor, updated) = match self.operator_for(p, w, &scratch.set, piecewise) {
+                Ok(built) => built,
                 Err(source) => return Err(NewtonError::Linear { source, report }),
             };
-            if let Some(lr) = &self.reuse.low_rank {
-                self.reuse.overhead = self.reuse.overhead.saturating_add(lr.entries());
-                self.reuse.force_refactor = self.reuse.overhead > self.reuse.overhead_budget(n);
-            }
-            // A direct solve is backward stable unless the operator is numerically singular or
-            // its correction ill-conditioned: the first solve with a new operator is checked
-            // (J δ + R), and if it is accurate, ten times its relative error bounds the later
-            // solves' (no product J δ for them). Iterative solves are always checked. A
-            // corrected operator's first solve is estimated instead, when its reference's solves
-            // are trusted: their accuracy plus the correction's own residual, if that is small.
-            // (`norm_r` is ‖r‖∞ here: the loop goes on only after a step that evaluated r.)
-            let estimate = defect
-                .zip(self.reuse.reference_accuracy)
-                .map(|(d, a)| a + d / norm_r)
-                .filter(|e| *e <= TRUSTED_ACCURACY);
-            let checked = trusted.is_none() && estimate.is_none();
-            let j = self.reuse.jacobian.as_ref().expect("assembled above");
-            let linear = if let Some(e) = estimate {
-                e
-            } else if !checked {
-                0.0
-            } else {
-                // Aᵀ δ reads half the bytes, but only a problem declared symmetric is sure to stay
-                // so (under Structure::Auto a corrected Cholesky reference may meet a nonsymmetric J).
-                if p.jacobian_product(j, delta, jd) {
-                    // Test builds check the problem's product against j's, to round-off.
-                    if cfg!(debug_assertions) {
-                        let mut full = vec![0.0; n];
-                        j.mul_vec(delta, &mut full);
-                        let scale = j.norm_inf() * norm_inf(delta);
-                        let err = full.iter().zip(jd.iter()).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-                        assert!(err <= 64.0 * f64::EPSILON * scale, "jacobian_product differs by {err:e}");
-                    }
-                } else if p.structure() == Structure::SymmetricPositiveDefinite {
-                    j.mul_vec_transposed(delta, jd);
-                } else {
-                    j.mul_vec(delta, jd);
-                }
-                jd.iter().zip(r.iter()).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_r
+            let first = report.history.is_empty();
+            let solved = match self.solve_linear(scratch, piecewise, first, &mut s) {
+                Ok(solved) => solved,
+                Err(source) => return Err(NewtonError::Linear { source, report }),
             };
+            let linear = self.linear_residual(p, &solved, scratch, s.norm_r);
             // An iterative solve's residual is what it was asked for (its ∞-norm at most its 2-norm).
-            let allowed = eta.map_or(LINEAR_TOLERANCE, |eta| LINEAR_TOLERANCE.max(2.0 * eta * norm2_r / norm_r));
+            let allowed =
+                solved.eta.map_or(LINEAR_TOLERANCE, |eta| LINEAR_TOLERANCE.max(2.0 * eta * solved.norm2_r / s.norm_r));
             if linear.is_nan() || linear > allowed {
                 if self.reuse.low_rank.as_ref().is_some_and(|lr| lr.rank() > 0) {
                     // An ill-conditioned correction: refactor at this iterate and retry.
@@ -376,104 +362,230 @@ impl Newton {
                 debug!(linear_residual = linear, "the Jacobian is singular to working precision");
                 return Err(NewtonError::Linear { source, report });
             }
-            // Only an operator whose first solve was accurate to near round-off is trusted; an
-            // ill-conditioned one (a huge penalty or Nitsche parameter) is checked at every solve.
-            if trusted.is_none()
-                && linear <= TRUSTED_ACCURACY
-                && self.reuse.factorization.as_ref().is_some_and(Factorization::is_direct)
-            {
-                self.reuse.solve_accuracy = Some(10.0 * linear);
-                // A new factorization's first solve, checked: the reference its corrections
-                // are estimated from.
-                if refactor && checked {
-                    self.reuse.reference_accuracy = self.reuse.solve_accuracy;
-                }
-            }
-            // The relative accuracy of this solve, where it is not measured by a product.
-            let accuracy = trusted.or(estimate);
+            self.trust(&solved, linear, refactor);
             let step = if piecewise && !self.options.line_search {
-                // R is affine wherever the active set is the one J was built for: if it still
-                // is at the new iterate, R there is R + J δ, and no assembly is needed.
-                w.iter_mut().zip(delta.iter()).for_each(|(x, d)| *x += d);
-                after.clear();
-                piecewise_after = p.active_set(w, after);
-                let kept = piecewise_after && after == set;
-                // After a trusted or estimated solve R there is the solve's error: its relative
-                // accuracy times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
-                let norm_delta = norm_inf(delta);
-                let bound = accuracy.map(|a| a * norm_r + ROUNDOFF * self.reuse.jacobian_norm * norm_delta + carried);
-                let estimated = kept && bound.is_some_and(|b| b <= threshold);
-                if estimated {
-                    res = bound.expect("trusted");
-                } else if kept && checked {
-                    r.iter_mut().zip(jd.iter()).for_each(|(ri, x)| *ri += x);
-                } else if let Some(b) = bound.filter(|_| !kept)
-                    && p.residual_on_support(w, r)
-                {
-                    // The set changed where the nonlinear terms are: elsewhere R is this
-                    // solve's error, bounded by b.
-                    carried = b;
-                } else {
-                    p.residual(w, r);
-                    carried = 0.0;
-                }
-                if !estimated {
-                    norm_r = norm_inf(r);
-                    if carried > 0.0 && norm_r <= threshold && norm_r + carried > threshold {
-                        // Only the carried bound stands between r and convergence: the whole
-                        // residual decides (and the next solve is never given an r of zero).
-                        p.residual(w, r);
-                        carried = 0.0;
-                        norm_r = norm_inf(r);
-                    }
-                    res = norm_r + carried;
-                }
-                small_step = kept && !loose && norm_delta <= self.options.tol * norm_inf(w);
-                if report.history.is_empty() {
-                    self.first_changed = !kept;
-                }
-                known = true;
-                1.0
+                self.affine_step(p, w, scratch, &solved, &mut s)
             } else {
-                let step = self.step(p, w, delta, r, search);
-                after.clear();
-                p.active_set(w, after);
-                small_step = after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w);
-                res = norm_inf(r);
-                norm_r = res;
-                carried = 0.0;
-                step
+                self.full_step(p, w, scratch, &mut s)
             };
-            if res < best {
-                (best, stalled) = (res, 0);
-            } else {
-                stalled += 1;
-                // Three full steps without a new best residual: backtrack from here on.
-                search |= !piecewise && stalled >= 3;
-            }
+            s.note_best(piecewise);
+            let it = Iteration { residual: s.res, active, refactored: refactor, updated, step, tolerance: solved.eta };
             debug!(
                 iteration = report.history.len() + 1,
-                residual = res,
+                residual = it.residual,
                 active,
                 refactor,
                 updated,
                 step,
-                tolerance = eta,
+                tolerance = it.tolerance,
                 "newton"
             );
-            report.history.push(Iteration {
-                residual: res,
-                active,
-                refactored: refactor,
-                updated,
-                step,
-                tolerance: eta,
-            });
-            if !res.is_finite() || w.iter().any(|x| !x.is_finite()) {
+            report.history.push(it);
+            if !s.res.is_finite() || w.iter().any(|x| !x.is_finite()) {
                 return Err(NewtonError::NonFinite { report });
             }
         }
         Ok(report)
+    }
+
+    /// The operator for the active set `set`: kept while `set` is the one it was factored for
+    /// (and the tangent piecewise), else a new one, corrected or refactored. Returns whether it
+    /// was refactored, and whether corrected.
+    fn operator_for(
+        &mut self,
+        p: &mut impl NonlinearProblem,
+        w: &[f64],
+        set: &[bool],
+        piecewise: bool,
+    ) -> Result<(bool, bool), LinalgError> {
+        let changed = !piecewise || self.reuse.force_refactor || self.reuse.factored_for.as_deref() != Some(set);
+        if !changed {
+            return Ok((false, false));
+        }
+        self.reuse.factored_for = None;
+        let full = self.reuse.new_operator(p, w, self.options.solver, self.options.max_rank)?;
+        let (refactor, updated) = (full, !full);
+        self.reuse.factored_for = piecewise.then(|| set.to_vec());
+        self.reuse.jacobian_norm = match (updated, &self.reuse.low_rank) {
+            (true, Some(lr)) => self.reuse.reference_norm + lr.change_norm(),
+            _ => {
+                self.reuse.reference_norm = self.reuse.jacobian.as_ref().map_or(f64::INFINITY, Matrix::norm_inf);
+                self.reuse.reference_norm
+            }
+        };
+        self.reuse.solve_accuracy = None;
+        Ok((refactor, updated))
+    }
+
+    /// Solves J δ = −R into `delta`, asking an iterative solve for what this iteration needs,
+    /// and says what is known of the solve's accuracy.
+    fn solve_linear(
+        &mut self,
+        scratch: &mut Scratch,
+        piecewise: bool,
+        first: bool,
+        s: &mut Progress,
+    ) -> Result<Solved, LinalgError> {
+        let (r, delta) = (&scratch.r, &mut scratch.delta);
+        delta.iter_mut().zip(r.iter()).for_each(|(d, ri)| *d = -ri);
+        let f = self.reuse.factorization.as_mut().expect("factored above");
+        let iterative = f.iterates();
+        let norm2_r = if iterative { norm2(r) } else { 0.0 };
+        // A tangent the set does not decide (a frictional law in contact) converges
+        // superlinearly at best: its early solves need only Eisenstat and Walker's accuracy.
+        let superlinear = (!piecewise).then(|| s.last_norm2.map_or(LOOSE, |last| 0.9 * (norm2_r / last).powi(2)));
+        s.last_norm2 = Some(norm2_r);
+        let plain = piecewise && !self.options.line_search;
+        let loose = iterative && plain && first && self.first_changed;
+        let eta = iterative.then(|| f.set_tolerance(forcing(norm2_r, s.threshold, loose, superlinear)));
+        let trusted = if plain { self.reuse.solve_accuracy } else { None };
+        // A correction of a reference whose solves are trusted reports the residual it
+        // leaves itself (`LowRank::solve`): its first solve needs no product J δ then.
+        let defect = trusted.is_none() && plain && self.reuse.reference_accuracy.is_some();
+        let f = self.reuse.factorization.as_mut().expect("factored above");
+        let defect = match &self.reuse.low_rank {
+            Some(lr) => lr.solve(f, delta, defect)?,
+            None => f.solve_in_place(delta).map(|()| None)?,
+        };
+        if let Some(lr) = &self.reuse.low_rank {
+            self.reuse.overhead = self.reuse.overhead.saturating_add(lr.entries());
+            self.reuse.force_refactor = self.reuse.overhead > self.reuse.overhead_budget(delta.len());
+        }
+        // A direct solve is backward stable unless the operator is numerically singular or
+        // its correction ill-conditioned: the first solve with a new operator is checked
+        // (J δ + R), and if it is accurate, ten times its relative error bounds the later
+        // solves' (no product J δ for them). Iterative solves are always checked. A
+        // corrected operator's first solve is estimated instead, when its reference's solves
+        // are trusted: their accuracy plus the correction's own residual, if that is small.
+        // (`norm_r` is ‖r‖∞ here: the loop goes on only after a step that evaluated r.)
+        let estimate =
+            defect.zip(self.reuse.reference_accuracy).map(|(d, a)| a + d / s.norm_r).filter(|e| *e <= TRUSTED_ACCURACY);
+        let checked = trusted.is_none() && estimate.is_none();
+        Ok(Solved { eta, norm2_r, first, loose, trusted, estimate, checked })
+    }
+
+    /// The solve's relative residual ‖J δ + R‖∞ / ‖R‖∞: estimated, bounded (0: trusted), or
+    /// measured by the product J δ, which is left in `scratch.jd`.
+    fn linear_residual(
+        &self,
+        p: &mut impl NonlinearProblem,
+        solved: &Solved,
+        scratch: &mut Scratch,
+        norm_r: f64,
+    ) -> f64 {
+        let Scratch { r, delta, jd, .. } = scratch;
+        let j = self.reuse.jacobian.as_ref().expect("assembled above");
+        if let Some(e) = solved.estimate {
+            return e;
+        }
+        if !solved.checked {
+            return 0.0;
+        }
+        // Aᵀ δ reads half the bytes, but only a problem declared symmetric is sure to stay
+        // so (under Structure::Auto a corrected Cholesky reference may meet a nonsymmetric J).
+        if p.jacobian_product(j, delta, jd) {
+            // Test builds check the problem's product against j's, to round-off.
+            if cfg!(debug_assertions) {
+                let mut full = vec![0.0; delta.len()];
+                j.mul_vec(delta, &mut full);
+                let scale = j.norm_inf() * norm_inf(delta);
+                let err = full.iter().zip(jd.iter()).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                assert!(err <= 64.0 * f64::EPSILON * scale, "jacobian_product differs by {err:e}");
+            }
+        } else if p.structure() == Structure::SymmetricPositiveDefinite {
+            j.mul_vec_transposed(delta, jd);
+        } else {
+            j.mul_vec(delta, jd);
+        }
+        jd.iter().zip(r.iter()).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max) / norm_r
+    }
+
+    /// Only an operator whose first solve was accurate to near round-off is trusted; an
+    /// ill-conditioned one (a huge penalty or Nitsche parameter) is checked at every solve.
+    fn trust(&mut self, solved: &Solved, linear: f64, refactor: bool) {
+        if solved.trusted.is_none()
+            && linear <= TRUSTED_ACCURACY
+            && self.reuse.factorization.as_ref().is_some_and(Factorization::is_direct)
+        {
+            self.reuse.solve_accuracy = Some(10.0 * linear);
+            // A new factorization's first solve, checked: the reference its corrections
+            // are estimated from.
+            if refactor && solved.checked {
+                self.reuse.reference_accuracy = self.reuse.solve_accuracy;
+            }
+        }
+    }
+
+    /// The full step of a piecewise tangent without line search. R is affine wherever the
+    /// active set is the one J was built for: if it still is at the new iterate, R there is
+    /// R + J δ (or, after a trusted or estimated solve, bounded by the solve's error), and no
+    /// assembly is needed. Leaves the new active set in `scratch.after`.
+    fn affine_step(
+        &mut self,
+        p: &mut impl NonlinearProblem,
+        w: &mut [f64],
+        scratch: &mut Scratch,
+        solved: &Solved,
+        s: &mut Progress,
+    ) -> f64 {
+        let Scratch { r, delta, jd, set, after } = scratch;
+        let threshold = s.threshold;
+        // The relative accuracy of this solve, where it is not measured by a product.
+        let accuracy = solved.trusted.or(solved.estimate);
+        w.iter_mut().zip(delta.iter()).for_each(|(x, d)| *x += d);
+        after.clear();
+        s.piecewise_after = p.active_set(w, after);
+        let kept = s.piecewise_after && after == set;
+        // After a trusted or estimated solve R there is the solve's error: its relative
+        // accuracy times ‖R‖, plus the round-off ε‖J‖‖δ‖ of the solve.
+        let norm_delta = norm_inf(delta);
+        let bound = accuracy.map(|a| a * s.norm_r + ROUNDOFF * self.reuse.jacobian_norm * norm_delta + s.carried);
+        let estimated = kept && bound.is_some_and(|b| b <= threshold);
+        if estimated {
+            s.res = bound.expect("trusted");
+        } else if kept && solved.checked {
+            r.iter_mut().zip(jd.iter()).for_each(|(ri, x)| *ri += x);
+        } else if let Some(b) = bound.filter(|_| !kept)
+            && p.residual_on_support(w, r)
+        {
+            // The set changed where the nonlinear terms are: elsewhere R is this
+            // solve's error, bounded by b.
+            s.carried = b;
+        } else {
+            p.residual(w, r);
+            s.carried = 0.0;
+        }
+        if !estimated {
+            s.norm_r = norm_inf(r);
+            if s.carried > 0.0 && s.norm_r <= threshold && s.norm_r + s.carried > threshold {
+                // Only the carried bound stands between r and convergence: the whole
+                // residual decides (and the next solve is never given an r of zero).
+                p.residual(w, r);
+                s.carried = 0.0;
+                s.norm_r = norm_inf(r);
+            }
+            s.res = s.norm_r + s.carried;
+        }
+        s.small_step = kept && !solved.loose && norm_delta <= self.options.tol * norm_inf(w);
+        if solved.first {
+            self.first_changed = !kept;
+        }
+        s.known = true;
+        1.0
+    }
+
+    /// A step with line search, or of a tangent that is not piecewise: R evaluated at the new
+    /// iterate, into `scratch.r`.
+    fn full_step(&self, p: &mut impl NonlinearProblem, w: &mut [f64], scratch: &mut Scratch, s: &mut Progress) -> f64 {
+        let Scratch { r, delta, set, after, .. } = &mut *scratch;
+        let step = self.step(p, w, delta, r, s.search);
+        after.clear();
+        p.active_set(w, after);
+        s.small_step = after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w);
+        s.res = norm_inf(r);
+        s.norm_r = s.res;
+        s.carried = 0.0;
+        step
     }
 
     /// Takes the step (with backtracking if `search`); leaves R at the new iterate in `r`.

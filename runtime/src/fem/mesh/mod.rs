@@ -394,6 +394,14 @@ impl Mesh {
     }
 }
 
+/// A mesh as the graph `linalg` reads (its cells' nodes): what `linalg::ownership` partitions,
+/// the conversion kept here so that the bottom layer knows nothing of meshes.
+impl<'m> From<&'m Mesh> for Connectivity<'m> {
+    fn from(mesh: &'m Mesh) -> Self {
+        mesh.connectivity()
+    }
+}
+
 fn det(j: &[[f64; 3]; 3], d: usize) -> f64 {
     match d {
         1 => j[0][0],

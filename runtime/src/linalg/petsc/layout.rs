@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex, Weak};
 
 use super::{petsc_int, sys};
 use crate::linalg::LinalgError;
-use crate::linalg::pattern::Pattern;
+use crate::linalg::pattern::{Connectivity, Pattern};
 
 pub(super) struct Layout {
     /// PETSc's index of each dof.
@@ -74,11 +74,11 @@ impl Layout {
     }
 }
 
-/// The process that owns each node of `mesh` among `size`: see [`partition`]. Every process
+/// The process that owns each node of `cells` among `size`: see [`partition`]. Every process
 /// computes it alone, and gets the same.
-pub fn partition_mesh(mesh: &crate::fem::mesh::Mesh, size: usize) -> Result<Vec<u32>, LinalgError> {
-    let (ptr, adj) = crate::linalg::pattern::node_adjacency(&mesh.connectivity());
-    partition(mesh.num_nodes(), |node| &adj[ptr[node]..ptr[node + 1]], size)
+pub fn partition_nodes(cells: &Connectivity, size: usize) -> Result<Vec<u32>, LinalgError> {
+    let (ptr, adj) = crate::linalg::pattern::node_adjacency(cells);
+    partition(cells.num_nodes, |node| &adj[ptr[node]..ptr[node + 1]], size)
 }
 
 /// The process that owns each node: METIS's partition into `size` parts of the graph whose

@@ -188,7 +188,7 @@ handle!(OwnedScatter, sys::VecScatter, VecScatterDestroy);
 
 mod layout;
 use layout::Layout;
-pub use layout::partition_mesh;
+pub use layout::partition_nodes;
 
 impl OwnedVec {
     /// Runs `f` on the vector's values.
