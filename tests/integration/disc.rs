@@ -10,7 +10,7 @@ fn scheme(name: &str) -> Methods {
 }
 
 /// The gravity of a library problem, read from its file: its body force `coef f` (a force
-/// density) over the density `rho` it sets, vertically. Until the first contact the body falls
+/// density) over the density `material.rho` it sets, vertically. Until the first contact the body falls
 /// freely, u = −g t²/2.
 pub(crate) fn gravity(problem: &str) -> f64 {
     use signorini::compiler::check::const_value;
@@ -22,7 +22,8 @@ pub(crate) fn gravity(problem: &str) -> f64 {
         d.value.clone()
     };
     let ExprKind::Vector(f) = value(&p.coefs, "f").kind else { panic!("{problem}: `coef f` is not a vector") };
-    let rho = const_value(&value(&p.sets, "rho")).expect("a constant ρ");
+    // The material's density: `set material.rho = ...` (`rho` alone would be ambiguous).
+    let rho = const_value(&value(&p.sets, "material.rho")).expect("a constant ρ");
     -const_value(f.last().expect("a component")).expect("a constant force") / rho
 }
 
