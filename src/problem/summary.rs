@@ -358,7 +358,9 @@ pub fn applies(pf: &ProblemFile, ex: &mut Exprs, files: &crate::driver::params::
                 Ok(Some(value)) => extra.push((id.name.clone(), ex.low.constant_val(value))),
                 Ok(None) if crate::driver::library_declares(&id.name) => in_use = false,
                 Ok(None) => {
-                    let known = files.names();
+                    let p = pf.problem();
+                    let own = p.params.iter().map(|q| &q.name).chain(p.lets.iter().map(|l| &l.name));
+                    let known: Vec<String> = own.map(|n| n.name.clone()).chain(files.names()).collect();
                     let mut d = Diagnostic::error(
                         "E0101",
                         format!("unknown param `{}`", id.name),
