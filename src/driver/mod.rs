@@ -240,16 +240,16 @@ pub fn form_units(methods: &Methods) -> Result<(Vec<FormSource>, usize), CaseErr
 fn apply_overrides(
     table: &mut params::Table,
     overrides: &[(&str, f64)],
-    locate: &dyn Fn(&params::Ambiguous) -> CaseError,
+    locate: &dyn Fn(&params::Unmatched) -> CaseError,
 ) -> Result<(), CaseError> {
     let files: Vec<&str> = LIBRARY.iter().map(|u| u.name).collect();
     table.apply_case(overrides, &files).map_err(|e| match e {
         params::CaseOverrideError::Invalid(e) => e,
-        params::CaseOverrideError::Ambiguous(a) => locate(&a),
+        params::CaseOverrideError::Unmatched(a) => locate(&a),
     })
 }
 
-fn unlocated(a: &params::Ambiguous) -> CaseError {
+fn unlocated(a: &params::Unmatched) -> CaseError {
     CaseError::Option(format!("the case's override: {}", a.message()))
 }
 
@@ -292,7 +292,7 @@ impl FilesInUse {
     pub fn resolve_located(
         methods: &Methods,
         overrides: &[(&str, f64)],
-        locate: &dyn Fn(&params::Ambiguous) -> CaseError,
+        locate: &dyn Fn(&params::Unmatched) -> CaseError,
     ) -> Result<FilesInUse, CaseError> {
         let scheme = scheme(methods)?;
         let (units, contact) = form_units(methods)?;

@@ -98,7 +98,7 @@ fn qualified(name: &str) -> (Option<&str>, &str) {
 }
 
 /// A case's override that names no one param: the setting's index, its name and why.
-pub struct Ambiguous {
+pub struct Unmatched {
     pub index: usize,
     pub name: String,
     pub why: Unnamed,
@@ -112,7 +112,7 @@ pub enum Unnamed {
     UnknownQualifier(Option<String>),
 }
 
-impl Ambiguous {
+impl Unmatched {
     /// The message (after the place it was written).
     pub fn message(&self) -> String {
         match &self.why {
@@ -138,7 +138,7 @@ pub const ROLES: &[&str] = &["scheme", "material", "contact", "forms"];
 /// answer to (which the caller locates at the override).
 pub enum CaseOverrideError {
     Invalid(CaseError),
-    Ambiguous(Ambiguous),
+    Unmatched(Unmatched),
 }
 
 /// Every param of a run's scheme and form files.
@@ -252,7 +252,7 @@ impl Table {
                             let closest = crate::compiler::check::suggest_name(owner, known.iter().copied())
                                 .map(|q| format!("{q}.{bare}"));
                             let why = Unnamed::UnknownQualifier(closest);
-                            return Err(CaseOverrideError::Ambiguous(Ambiguous { index, name: name.to_string(), why }));
+                            return Err(CaseOverrideError::Unmatched(Unmatched { index, name: name.to_string(), why }));
                         }
                     }
                 }
@@ -266,7 +266,7 @@ impl Table {
                 }
                 many => {
                     let why = Unnamed::Several(many.iter().map(|&i| self.entries[i].choice()).collect());
-                    return Err(CaseOverrideError::Ambiguous(Ambiguous { index, name: name.to_string(), why }));
+                    return Err(CaseOverrideError::Unmatched(Unmatched { index, name: name.to_string(), why }));
                 }
             }
         }
@@ -288,7 +288,7 @@ impl Table {
                 }
                 many => {
                     let why = Unnamed::Several(many.iter().map(|&i| self.entries[i].choice()).collect());
-                    let a = Ambiguous { index, name: s.name.clone(), why };
+                    let a = Unmatched { index, name: s.name.clone(), why };
                     return Err(CaseError::Option(format!("{}: {}", s.origin, a.message())));
                 }
             }

@@ -30,7 +30,7 @@ pub(super) fn bound<R>(
         sets.push((s.name.name.clone(), ex.scalar(&s.value).map_err(|e| pf.render(*e))?));
     }
     let overrides: Vec<(&str, f64)> = sets.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    let locate = |a: &crate::driver::params::Ambiguous| {
+    let locate = |a: &crate::driver::params::Unmatched| {
         use crate::compiler::Diagnostic;
         use crate::driver::params::Unnamed;
         let name = &p.sets[a.index].name;

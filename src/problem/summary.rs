@@ -326,9 +326,7 @@ fn summary_rewrite(e: &Expr, calls: &mut Vec<(Reduce, Vec<Expr>)>) -> Expr {
 
 /// Every name an expression reads.
 fn names_in(e: &Expr, out: &mut Vec<String>) {
-    let mut ids = Vec::new();
-    idents_in(e, &mut ids);
-    out.extend(ids.into_iter().map(|id| id.name.clone()));
+    out.extend(crate::compiler::check::problem::names_in(e).into_iter().map(|id| id.name.clone()));
 }
 
 /// Per `expect` line, whether its `when` holds on this run: a condition of the problem's params
@@ -345,8 +343,8 @@ pub fn applies(pf: &ProblemFile, ex: &mut Exprs, files: &crate::driver::params::
         };
         let mut names = Vec::new();
         for c in when.comparisons() {
-            idents_in(&c.lhs, &mut names);
-            idents_in(&c.rhs, &mut names);
+            names.extend(crate::compiler::check::problem::names_in(&c.lhs));
+            names.extend(crate::compiler::check::problem::names_in(&c.rhs));
         }
         let mut extra: Vec<(String, Val)> = Vec::new();
         let mut in_use = true;
@@ -396,18 +394,4 @@ pub fn applies(pf: &ProblemFile, ex: &mut Exprs, files: &crate::driver::params::
         out.push(when.holds(&mut holds.into_iter()));
     }
     Ok(out)
-}
-
-/// The names an expression reads, in order (calls' names left out).
-fn idents_in<'e>(e: &'e Expr, out: &mut Vec<&'e Ident>) {
-    match &e.kind {
-        ExprKind::Name(id) => out.push(id),
-        ExprKind::Number(_) => {}
-        ExprKind::Neg(a) => idents_in(a, out),
-        ExprKind::Binary(_, a, b) | ExprKind::Index(a, b) => {
-            idents_in(a, out);
-            idents_in(b, out);
-        }
-        ExprKind::Call(_, args) | ExprKind::Vector(args) => args.iter().for_each(|a| idents_in(a, out)),
-    }
 }

@@ -5,7 +5,6 @@
 use super::assembly::Assembler;
 use super::bound::{BoundForm, with_previous};
 use crate::linalg::Matrix;
-use crate::linalg::element_matrices::ElementMatrices;
 
 /// The forms of one slot, summed; they take the same number of time levels.
 pub struct Summed<'m> {
@@ -30,6 +29,8 @@ impl<'m> Summed<'m> {
     }
 }
 
+// `tangent_elements` keeps the trait's default (none): a sum's Jacobian is assembled whole; the
+// summed slots are loads and other linear terms, whose matrices are constant.
 impl BoundForm for Summed<'_> {
     fn name(&self) -> &str {
         &self.name
@@ -69,19 +70,6 @@ impl BoundForm for Summed<'_> {
             cells.extend(p.support()?);
         }
         Some(cells)
-    }
-    /// A sum gives no element matrices: its Jacobian is assembled whole (the summed slots are
-    /// loads and other linear terms, whose matrices are constant).
-    fn tangent_elements(
-        &self,
-        _asm: &Assembler,
-        _fields: &[&[f64]],
-        _wrt: usize,
-        _t: f64,
-        _m: Option<&mut Matrix>,
-        _out: &mut ElementMatrices,
-    ) -> bool {
-        false
     }
     fn time_dependent(&self) -> bool {
         self.parts.iter().any(|p| p.time_dependent())

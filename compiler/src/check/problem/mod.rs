@@ -524,7 +524,7 @@ pub fn unread_coef(name: &Ident, files: &[&str]) -> Diagnostic {
 }
 
 /// The names an expression reads (not the functions it calls), in order.
-fn names_in(e: &Expr) -> Vec<&Ident> {
+pub fn names_in(e: &Expr) -> Vec<&Ident> {
     use crate::syntax::ast::ExprKind as K;
     match &e.kind {
         K::Name(id) => vec![id],
@@ -545,5 +545,5 @@ pub fn ambiguous_param(name: &Ident, choices: &[String]) -> Diagnostic {
         "more than one file in use declares it",
     )
     .with_note(format!("write {}", choices.join(" or ")))
-    .with_help("qualify it by the file's role or name: `set material.rho = 1`, `set scheme.rho = 0.5`")
+    .with_help("qualify it by a role or a file's name, as listed (`material.rho`, `scheme.rho`)")
 }
