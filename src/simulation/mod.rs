@@ -207,42 +207,34 @@ impl<'m> Simulation<'m> {
     /// checkpoint period or an interrupt, `on_step` gets a buffer for its own record of the run
     /// so far (the case restores it from `control.observer()` before calling `run`). A run with
     /// `control.resume` starts from that checkpoint's states and counters.
-    #[allow(clippy::too_many_arguments)] // The signature its caller in src/problem/run.rs uses.
     pub fn run(
         &mut self,
-        t0: f64,
-        dt: f64,
-        steps: usize,
+        span: Span,
         progress: bool,
         control: &mut Control,
-        on_stage: &mut OnStage,
-        on_step: &mut OnStep,
+        watch: Watch,
     ) -> Result<Outcome, CaseError> {
-        self.check_stable(dt)?;
+        self.check_stable(span.dt)?;
         let intermediate: Vec<String> =
             self.stepper.desc().stages.iter().rev().skip(1).map(|s| s.name.to_string()).collect();
-        let mut outcome = Outcome::new(steps);
-        let mut bar = crate::progress::Progress::new(steps, progress);
-        let guard = self.guard;
-        let mut energy = EnergyWatch::new(&self.ops, &self.states, self.v_index, t0);
+        let mut outcome = Outcome::new(span.steps);
+        let mut bar = crate::progress::Progress::new(span.steps, progress);
+        let mut energy = EnergyWatch::new(&self.ops, &self.states, self.v_index, span.t0);
         // Progress through a nominal step in units of dt / 2^max_cuts.
-        let max_cuts = guard.max_step_cuts.min(MAX_STEP_CUTS);
+        let max_cuts = self.guard.max_step_cuts.min(MAX_STEP_CUTS);
         let full: u64 = 1 << max_cuts;
         let mut at = Cursor::default();
         if let Some((saved, _)) = &control.resume {
             (at, energy) = self.resume(saved, &mut outcome)?;
         }
-        // Fault injection for the restart tests: the process aborts, as if killed, right after
-        // this accepted step (and its checkpoint, if one is due).
-        let crash_at: Option<usize> = std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok());
-        'steps: for k in at.first..steps {
+        'steps: for k in at.first..span.steps {
             bar.tick(k);
             let mut done: u64 = 0;
             while done < full {
                 let units = full >> at.level;
-                let h = dt * units as f64 / full as f64;
-                let t = t0 + (k as f64 + done as f64 / full as f64) * dt;
-                let (result, start, stages_seen, clock) = self.attempt(on_stage, &intermediate, t, h, max_cuts);
+                let h = span.dt * units as f64 / full as f64;
+                let t = span.t0 + (k as f64 + done as f64 / full as f64) * span.dt;
+                let (result, start, stages_seen, clock) = self.attempt(watch.stage, &intermediate, t, h, max_cuts);
                 let report = match result {
                     Ok(report) => report,
                     Err(e) => match at.cut(e, t, h, max_cuts, &mut outcome) {
@@ -256,44 +248,62 @@ impl<'m> Simulation<'m> {
                 outcome.step_seconds.push(clock.elapsed().as_secs_f64());
                 done += units;
                 at.accepted += 1;
-                let t_end = if done == full { t0 + (k + 1) as f64 * dt } else { t + h };
-                let due = Due::at(control, k, steps, done == full)?;
-                let mut record = due.record.then(Vec::new);
-                let (ops, states, v_index) = (&self.ops, &self.states, self.v_index);
-                add_work(&mut energy, ops, Interval { start: &start, states, v_index, t, h }, stages_seen);
-                // Checked before the observer sees the step: the outputs end at the last good one.
-                let ended = Ended { states, v_index, before: &start.before, h, t: t_end };
-                if let Some(grown) = energy.check(ops, &ended, guard.energy_tolerance, self.law) {
-                    outcome.stopped = Some(energy_stop(grown, t_end, guard.energy_tolerance, &self.params, self.law));
+                let whole = done == full;
+                let t_end = if whole { span.t0 + (k + 1) as f64 * span.dt } else { t + h };
+                let taken = Taken { k, whole, t, h, t_end, start: &start, stages_seen, report: &report };
+                let mut walk = Walk { at: &mut at, energy: &mut energy, outcome: &mut outcome, control: &mut *control };
+                if let Some(stop) = self.accept(&mut walk, span.steps, taken, watch.step)? {
+                    outcome.stopped = Some(stop);
                     break 'steps;
                 }
-                outcome.energy_growth = energy.growth;
-                let (before, previous) = (&start.before, start.before_previous.as_deref());
-                let step = Step { k: at.accepted, t: t_end, dt: h, states, before, previous, report: &report };
-                on_step(ops, &step, record.as_mut())?;
                 at.accept(done, units);
-                if let Some(record) = record {
-                    let previous = self.stepper.previous();
-                    let driver = at.driver_state(k + 1, outcome.cuts, &energy, states, previous, !due.interrupted);
-                    if let Err(e) = self.checkpoint(control, driver, record) {
-                        // The outputs up to here are still written.
-                        outcome.stopped = Some(e);
-                        break 'steps;
-                    }
-                }
-                if crash_at == Some(at.accepted) {
-                    std::process::abort();
-                }
-                // An interrupt lets the nominal step finish, so that its checkpoint is on the
-                // nominal time levels.
-                if due.interrupted && done == full {
-                    outcome.stopped = Some(CaseError::Interrupted { t: t_end });
-                    break 'steps;
-                }
             }
         }
         bar.finish();
         Ok(outcome)
+    }
+
+    /// After an accepted step: the energy guard, the observer, the checkpoint if one is due;
+    /// why the run stops here, if it does (an observer's error ends it at once).
+    fn accept(
+        &mut self,
+        walk: &mut Walk,
+        steps: usize,
+        taken: Taken,
+        on_step: &mut OnStep,
+    ) -> Result<Option<CaseError>, CaseError> {
+        let Taken { k, whole, t, h, t_end, start, stages_seen, report } = taken;
+        let due = Due::at(walk.control, k, steps, whole)?;
+        let mut record = due.record.then(Vec::new);
+        let (ops, states, v_index) = (&self.ops, &self.states, self.v_index);
+        add_work(walk.energy, ops, Interval { start, states, v_index, t, h }, stages_seen);
+        // Checked before the observer sees the step: the outputs end at the last good one.
+        let ended = Ended { states, v_index, before: &start.before, h, t: t_end };
+        let tolerance = self.guard.energy_tolerance;
+        if let Some(grown) = walk.energy.check(ops, &ended, tolerance, self.law) {
+            return Ok(Some(energy_stop(grown, t_end, tolerance, &self.params, self.law)));
+        }
+        walk.outcome.energy_growth = walk.energy.growth;
+        let (before, previous) = (&start.before, start.before_previous.as_deref());
+        let step = Step { k: walk.at.accepted, t: t_end, dt: h, states, before, previous, report };
+        on_step(ops, &step, record.as_mut())?;
+        if let Some(record) = record {
+            let previous = self.stepper.previous();
+            let cuts = walk.outcome.cuts;
+            let driver = walk.at.driver_state(k + 1, cuts, walk.energy, states, previous, !due.interrupted);
+            // The outputs up to here are still written.
+            if let Err(e) = self.checkpoint(walk.control, driver, record) {
+                return Ok(Some(e));
+            }
+        }
+        // Fault injection for the restart tests: the process aborts, as if killed, right after
+        // this accepted step (and its checkpoint, if one is due).
+        if std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok()) == Some(walk.at.accepted) {
+            std::process::abort();
+        }
+        // An interrupt lets the nominal step finish, so that its checkpoint is on the nominal
+        // time levels.
+        Ok((due.interrupted && whole).then_some(CaseError::Interrupted { t: t_end }))
     }
 
     /// Takes one step of `h` from `t`, showing its intermediate stages to `on_stage`; a failed
@@ -403,6 +413,40 @@ impl<'m> Simulation<'m> {
         stepper.forget();
         Ok((at, energy))
     }
+}
+
+/// The steps a run takes: `steps` nominal steps of `dt` from `t0`.
+#[derive(Clone, Copy)]
+pub struct Span {
+    pub t0: f64,
+    pub dt: f64,
+    pub steps: usize,
+}
+
+/// What a run shows its intermediate stages and its accepted steps to.
+pub struct Watch<'w, 'a> {
+    pub stage: &'w mut OnStage<'a>,
+    pub step: &'w mut OnStep<'a>,
+}
+
+/// The run's state an accepted step moves on.
+struct Walk<'w> {
+    at: &'w mut Cursor,
+    energy: &'w mut EnergyWatch,
+    outcome: &'w mut Outcome,
+    control: &'w mut Control,
+}
+
+/// An accepted step of nominal step `k` (`whole` when it ends one): from `t` by `h` to `t_end`.
+struct Taken<'s> {
+    k: usize,
+    whole: bool,
+    t: f64,
+    h: f64,
+    t_end: f64,
+    start: &'s Start,
+    stages_seen: Vec<StageSeen>,
+    report: &'s StepReport,
 }
 
 /// An intermediate stage's time, displacement and velocity (if the scheme has one).

@@ -1,0 +1,108 @@
+//! The report's benchmark sections: the last `bench sphere` and `bench disc` runs in the
+//! report's directory (they take too long to run with it), tabulated.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use super::bench_methods;
+
+/// `bench sphere` takes an hour at full size: the report shows its last run in this directory.
+pub(super) fn sphere(out: &Path) -> String {
+    let mut md = String::new();
+    md.push_str("## 7. Solvers for size (`signorini bench sphere`)\n\n");
+    match crate::bench::sphere::read(out) {
+        Some(Ok(bench)) => {
+            let first = bench.runs.first();
+            let methods = first.map_or_else(String::new, |r| {
+                bench_methods(r.scheme.as_deref(), r.contact.as_deref(), &r.contact_params)
+            });
+            let steps = first.map_or_else(String::new, |r| match (r.dt, r.t_end) {
+                (Some(dt), Some(t_end)) => format!("{} steps of Δt = {dt} to t = {t_end}", r.steps),
+                _ => format!("{} steps", r.steps),
+            });
+            let _ = writeln!(
+                md,
+                "Time per step and peak memory of the bouncing sphere against its size ({methods}; {steps}), from `bench_sphere.json` in this directory:\n"
+            );
+            md.push_str("| unknowns | solver | ms/step, whole run | median step (ms) | Newton | factorizations | Krylov iterations | peak memory (MB) |\n|---|---|---|---|---|---|---|---|\n");
+            for r in &bench.runs {
+                let iterations = if r.solver == "direct" { "—".to_string() } else { r.krylov_iterations.to_string() };
+                let memory = r.peak_memory_bytes.map_or("—".to_string(), |b| format!("{:.0}", b as f64 / 1e6));
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {:.0} | {:.0} | {} | {} | {iterations} | {memory} |",
+                    r.dofs, r.solver, r.ms_per_step_with_setup, r.median_step_ms, r.newton_total, r.factorizations
+                );
+            }
+            if out.join("bench_sphere.png").exists() {
+                md.push_str("\n![bench sphere](bench_sphere.png)\n");
+            }
+            md.push('\n');
+        }
+        Some(Err(e)) => {
+            let _ = writeln!(md, "`bench_sphere.json` in this directory cannot be read: {e}\n");
+        }
+        None => {
+            let _ = writeln!(
+                md,
+                "Not run: `signorini bench sphere --out {}` writes bench_sphere.json and the log-log plot this section shows.\n",
+                out.display()
+            );
+        }
+    }
+    md
+}
+
+/// The last `bench disc` run in this directory.
+pub(super) fn disc(out: &Path) -> String {
+    let mut md = String::new();
+    md.push_str("## 7. Time per step of the disc (`signorini bench disc`)\n\n");
+    match crate::bench::disc::read(out) {
+        Some(Ok(bench)) => {
+            let _ = writeln!(
+                md,
+                "Timed: {}; Δt = {}, to t = {}; the stepper alone, medians of {} runs, from `bench_disc.json` in this directory. The model: one residual product and one pair of triangular solves per step, as bytes read at STREAM's triad bandwidth (one thread, arrays out of cache); the in-cache model reads the same bytes at the triad bandwidth of a working set of their size.\n",
+                bench_methods(bench.scheme.as_deref(), bench.contact.as_deref(), &bench.contact_params),
+                bench.dt,
+                bench.t_end,
+                bench.repeats
+            );
+            md.push_str("| mesh | unknowns | ms/step (mean) | median step (ms) | factorizations /1000 steps | low-rank updates /1000 steps | nnz(K) | nnz(L) | model (ms) | STREAM GB/s | measured/model | median step/model | in-cache model (ms) | in-cache GB/s | measured/in-cache model |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+            for m in &bench.meshes {
+                let name = std::path::Path::new(&m.mesh)
+                    .file_name()
+                    .map_or(m.mesh.clone(), |f| f.to_string_lossy().into_owned());
+                let _ = writeln!(
+                    md,
+                    "| {name} | {} | {:.3} | {:.3} | {:.0} | {:.0} | {} | {} | {:.3} | {:.1} | {:.2} | {:.2} | {:.3} | {:.1} | {:.2} |",
+                    m.dofs,
+                    m.ms_per_step,
+                    m.median_step_ms,
+                    m.factorizations_per_1000,
+                    m.low_rank_updates_per_1000,
+                    m.matrix_nnz,
+                    m.factor_nnz.map_or("—".into(), |n| n.to_string()),
+                    m.model_ms,
+                    m.stream_gb_s,
+                    m.measured_over_model,
+                    m.median_over_model,
+                    m.cache_model_ms,
+                    m.cache_gb_s,
+                    m.measured_over_cache_model
+                );
+            }
+            md.push('\n');
+        }
+        Some(Err(e)) => {
+            let _ = writeln!(md, "`bench_disc.json` in this directory cannot be read: {e}\n");
+        }
+        None => {
+            let _ = writeln!(
+                md,
+                "Not run: `signorini bench disc --mesh FILE.msh ... --out {}` writes bench_disc.json, which this section tabulates.\n",
+                out.display()
+            );
+        }
+    }
+    md
+}

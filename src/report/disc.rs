@@ -1,0 +1,90 @@
+//! Section 2 of the report: the bouncing disc, energies and Newton iterations per scheme.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use super::{Laws, past_the_guard, write_error};
+use crate::cases::disc;
+use crate::driver::Methods;
+use crate::error::CaseError;
+use crate::plot::Curve;
+use crate::problem::run::Options;
+
+pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, CaseError> {
+    let mut md = String::new();
+    let cases = &crate::settings::get().cases;
+    let mut table = String::new();
+    let mut laws = Laws::default();
+    let mut disc_run: Option<disc::Summary> = None;
+    let mut disc_energies = Vec::new();
+    let mut disc_newton = Vec::new();
+    for scheme in crate::driver::all_schemes() {
+        progress(&format!("disc {scheme}"));
+        let dir = out.join(&cases.disc).join(scheme);
+        let methods = Methods { scheme: scheme.into(), ..Methods::default() };
+        // A scheme that fails here (explicit contact is unstable at this step) is a result.
+        let run = past_the_guard(methods, |methods| {
+            disc::run(&Options { methods, out: Some(dir.clone()), ..disc::options() })
+        });
+        let (r, guard) = match run {
+            Ok(r) => r,
+            Err(e) => {
+                let _ = writeln!(table, "| {scheme} | failed: {} | | | | | |", e.to_string().replace('|', "/"));
+                continue;
+            }
+        };
+        let s = &r.summary;
+        let _ = writeln!(
+            table,
+            "| {scheme}{} | {} | {:.2e} | {:.5} | {} | {} | {:.2} |",
+            guard.map_or(String::new(), |g| format!(" ({g})")),
+            s.first_contact.map_or("—".into(), |t| format!("{t:.2}")),
+            s.max_penetration,
+            s.energy_aug_final,
+            s.newton_total,
+            s.newton_max,
+            1e3 * s.seconds_per_step
+        );
+        laws.add(&s.contact, &s.params);
+        disc_run.get_or_insert_with(|| s.clone());
+        disc_energies
+            .push((scheme.to_string(), r.series.iter().map(|row| (row.t, row.energy_aug)).collect::<Vec<_>>()));
+        disc_newton
+            .push((scheme.to_string(), r.series.iter().map(|row| (row.t, row.newton as f64)).collect::<Vec<_>>()));
+    }
+    let (mesh, dt, t_end) =
+        disc_run.as_ref().map_or((String::new(), f64::NAN, f64::NAN), |s| (s.mesh.clone(), s.dt, s.t_end));
+    let _ = write!(
+        md,
+        "## 2. Bouncing disc (docs/mathematics.md §6)\n\nMesh: {mesh}; {}; Δt = {dt}, T = {t_end}.\n\n",
+        laws.text()
+    );
+    let _ = writeln!(
+        md,
+        "| scheme | first contact | max penetration | E_aug({t_end}) | Newton total | max/step | ms/step |\n|---|---|---|---|---|---|---|"
+    );
+    md.push_str(&table);
+    crate::plot::panels(
+        &out.join("disc_energies.png"),
+        "t",
+        &[
+            (
+                "E_Θ per scheme",
+                "E_Θ",
+                disc_energies.iter().map(|(l, p)| Curve { label: l, points: p.clone(), dashed: false }).collect(),
+            ),
+            (
+                "Newton iterations per step",
+                "iterations",
+                disc_newton.iter().map(|(l, p)| Curve { label: l, points: p.clone(), dashed: false }).collect(),
+            ),
+        ],
+    )
+    .map_err(write_error(out))?;
+    let _ = write!(
+        md,
+        "\n![disc energies and Newton iterations](disc_energies.png)\n\nPer scheme: `{p}/<scheme>/{p}.png` (energies, displacements, contact force, Newton).\n\n",
+        p = cases.disc
+    );
+    Ok(md)
+}
