@@ -55,7 +55,12 @@ pub(super) fn run(
             stages.borrow_mut().push((stage.name.to_string(), t, values));
         }
     };
-    let mut saved = Saved::of(&rows, &stages.borrow(), snapshots);
+    // A fresh run's first record holds its initial row and snapshot; a resumed run's, what
+    // came after the checkpoint.
+    let mut saved = match control.observer() {
+        Some(_) => Saved::of(&rows, &stages.borrow(), snapshots),
+        None => Saved { rows: 0, stages: 0, snapshots: 0 },
+    };
     let mut on_step = |ops: &Operators, step: &Step, record: Option<&mut Vec<u8>>| {
         let state = State {
             t: step.t,
