@@ -85,7 +85,7 @@ impl Compiled {
 
     /// The generated Rust formatted for reading, with its line count in a header comment.
     pub fn rust_pretty(&self, opts: &codegen::Options) -> Result<String, Failure> {
-        Ok(codegen::pretty(&self.rust(opts)?, &opts.source_name))
+        codegen::pretty(&self.program, &self.irs(), opts).map_err(Failure::internal)
     }
 
     /// A stage as text, the one way every tool shows it (`signorini emit`, the snapshots):

@@ -59,7 +59,7 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
             return Err(format!("{} declares several schemes ({}): name one", path.display(), names.join(", ")));
         }
     };
-    let Layout { desc, coefficients } = layout(s, &prog.sources);
+    let Layout { desc, coefficients, .. } = layout(s, &prog.sources);
     Ok(Interpreted {
         file: path.display().to_string(),
         desc: Arc::new(desc),

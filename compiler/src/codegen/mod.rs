@@ -85,15 +85,96 @@ const IMPORTS: &[(&str, &[&str])] = &[
 /// Generated code of a unit, as a syn file (one `pub mod`), from its IR for every dimension of
 /// `ir::DIMS` (in order; `crate::Compiled::irs`).
 pub fn generate(prog: &Program, irs: &[&DimIr], opts: &Options) -> Result<syn::File, String> {
-    let items = items(prog, irs, opts);
-    let text = module_text(&items, opts)?;
-    syn::parse_file(&text).map_err(|e| format!("internal error: generated code does not parse: {e}\n{text}"))
+    module(prog, irs, opts).map(|(file, _)| file)
 }
 
-/// Generated code formatted for reading, with its line count in a header comment.
-pub fn pretty(file: &syn::File, source_name: &str) -> String {
-    let code = prettyplease::unparse(file);
-    format!("// {} lines generated from {source_name}\n{code}", code.lines().count())
+/// Generated code formatted for reading: what each scheme coefficient is for above it, and the
+/// line count in a header comment.
+pub fn pretty(prog: &Program, irs: &[&DimIr], opts: &Options) -> Result<String, String> {
+    let (file, uses) = module(prog, irs, opts)?;
+    let code = annotate(&prettyplease::unparse(&file), &uses);
+    Ok(format!("// {} lines generated from {}\n{code}", code.lines().count(), opts.source_name))
+}
+
+/// Per scheme struct, what each of its coefficients is for (`Layout::uses`).
+type CoefficientUses = Vec<(String, Vec<Vec<String>>)>;
+
+fn module(prog: &Program, irs: &[&DimIr], opts: &Options) -> Result<(syn::File, CoefficientUses), String> {
+    let (items, uses) = items(prog, irs, opts);
+    let text = module_text(&items, opts)?;
+    let file =
+        syn::parse_file(&text).map_err(|e| format!("internal error: generated code does not parse: {e}\n{text}"))?;
+    Ok((file, uses))
+}
+
+/// Formatted code with `// uses` comments above each `out[k] = ...;` of each scheme's
+/// `fn coefficients` (prettyplease drops comments, so they go into its output): a statement
+/// starts at the body's indentation, its wrapped lines deeper.
+fn annotate(code: &str, uses: &CoefficientUses) -> String {
+    let mut out = String::with_capacity(code.len() + code.len() / 4);
+    let mut scheme: Option<&[Vec<String>]> = None;
+    // The indentation of the `fn coefficients` being annotated, and how many `out[k]` so far.
+    let mut body: Option<(usize, usize)> = None;
+    for line in code.lines() {
+        let text = line.trim_start();
+        let indent = line.len() - text.len();
+        if let Some(name) = text.strip_prefix("impl TimeScheme for ").and_then(|r| r.strip_suffix(" {")) {
+            scheme = uses.iter().find(|(s, _)| s == name).map(|(_, u)| u.as_slice());
+        } else if let Some((at, seen)) = &mut body {
+            if indent == *at && text == "}" {
+                debug_assert_eq!(Some(*seen), scheme.map(<[_]>::len), "every coefficient annotated");
+                body = None;
+                scheme = None;
+            } else if let Some(k) = (indent == *at + 4).then(|| assignment(text)).flatten()
+                && let Some(lines) = scheme.and_then(|u| u.get(k))
+            {
+                *seen += 1;
+                for l in lines.iter().flat_map(|l| wrapped(l, COMMENT_WIDTH.saturating_sub(indent + 3))) {
+                    let _ = writeln!(out, "{}// {l}", &line[..indent]);
+                }
+            }
+        } else if scheme.is_some() && text.starts_with("fn coefficients(") {
+            body = Some((indent, 0));
+        }
+        out.push_str(line);
+        out.push('\n');
+    }
+    out
+}
+
+/// Where comment lines end, about where prettyplease ends code lines.
+const COMMENT_WIDTH: usize = 100;
+
+/// `text` in lines of at most `width` characters (but for a longer word), each clause (up to a
+/// `; `) on a line of its own when it does not fit on the current one; continued lines are
+/// indented by two.
+fn wrapped(text: &str, width: usize) -> Vec<String> {
+    let len = |s: &str| s.chars().count();
+    let mut lines = vec![String::new()];
+    for clause in text.split_inclusive("; ").map(str::trim_end) {
+        let line = lines.last().expect("one line");
+        if !line.trim().is_empty() && len(line) + 1 + len(clause) > width {
+            lines.push("  ".into());
+        }
+        for word in clause.split(' ') {
+            let line = lines.last_mut().expect("one line");
+            if line.trim().is_empty() {
+                line.push_str(word);
+            } else if len(line) + 1 + len(word) <= width {
+                line.push(' ');
+                line.push_str(word);
+            } else {
+                lines.push(format!("  {word}"));
+            }
+        }
+    }
+    lines
+}
+
+/// `k` of a statement `out[k] = ...`.
+fn assignment(text: &str) -> Option<usize> {
+    let (k, rest) = text.strip_prefix("out[")?.split_once(']')?;
+    rest.starts_with(" =").then(|| k.parse().ok()).flatten()
 }
 
 /// The module around its items, with the imports they use.
@@ -143,7 +224,7 @@ fn identifiers(tokens: proc_macro2::TokenStream, out: &mut HashSet<String>) {
 
 /// The module's items: params and coefs and a struct per form of the file (imported files
 /// have modules of their own), a struct per scheme, and `UNIT`.
-fn items(prog: &Program, irs: &[&DimIr], opts: &Options) -> String {
+fn items(prog: &Program, irs: &[&DimIr], opts: &Options) -> (String, CoefficientUses) {
     let mut s = String::new();
     let own: Vec<usize> = (0..prog.forms.len()).filter(|&i| prog.forms[i].span.file == prog.root).collect();
     if !own.is_empty() {
@@ -163,13 +244,16 @@ fn items(prog: &Program, irs: &[&DimIr], opts: &Options) -> String {
         s.push_str(&forms::form_items(prog, irs, fi, &struct_names[fi]));
     }
     let mut scheme_units = Vec::new();
+    let mut uses = Vec::new();
     for sch in &prog.schemes {
         let mut name = camel(&sch.name);
         while taken.contains(&name) || struct_names.contains(&name) {
             name.push_str("Scheme");
         }
         struct_names.push(name.clone());
-        s.push_str(&scheme::scheme_text(prog, sch, &name));
+        let (items, coefficients) = scheme::scheme_text(prog, sch, &name);
+        s.push_str(&items);
+        uses.push((name.clone(), coefficients));
         let (items, unit) = library::scheme_unit(prog, sch, &name);
         s.push_str(&items);
         scheme_units.push(unit);
@@ -190,5 +274,71 @@ fn items(prog: &Program, irs: &[&DimIr], opts: &Options) -> String {
         crate::docs::file(prog.sources.text(prog.root)),
         scheme_units.join(", ")
     );
-    s
+    (s, uses)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Only `out[k]` statements of a scheme's `fn coefficients` get their comment, above
+    /// the first line of a statement prettyplease wrapped.
+    #[test]
+    fn coefficient_comments_go_above_their_statements() {
+        let code = "\
+impl TimeScheme for Euler {
+    fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]) {
+        let tmp1 = dt
+            * 2.0;
+        out[0] = 1.0;
+        out[1] = tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1
+            + out[0];
+    }
+    fn other(&self, out: &mut [f64]) {
+        out[0] = 2.0;
+    }
+}
+impl Other for Euler {
+    fn coefficients(&self, out: &mut [f64]) {
+        out[0] = 3.0;
+    }
+}
+";
+        let uses = vec![("Euler".to_string(), vec![vec!["stage `s`: weight of `mass(a')`".to_string()], vec![]])];
+        let want = "\
+impl TimeScheme for Euler {
+    fn coefficients(&self, dt: f64, t: f64, out: &mut [f64]) {
+        let tmp1 = dt
+            * 2.0;
+        // stage `s`: weight of `mass(a')`
+        out[0] = 1.0;
+        out[1] = tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1 * tmp1
+            + out[0];
+    }
+    fn other(&self, out: &mut [f64]) {
+        out[0] = 2.0;
+    }
+}
+impl Other for Euler {
+    fn coefficients(&self, out: &mut [f64]) {
+        out[0] = 3.0;
+    }
+}
+";
+        assert_eq!(annotate(code, &uses), want);
+    }
+
+    #[test]
+    fn long_comments_break_between_clauses_then_words() {
+        let text = "stage `s`: coefficient of `u` in `u'`; coefficient of `v` in `v'`; weight of `mass(a')`";
+        assert_eq!(
+            wrapped(text, 50),
+            ["stage `s`: coefficient of `u` in `u'`;", "  coefficient of `v` in `v'`; weight of `mass(a')`"]
+        );
+        assert_eq!(
+            wrapped(text, 30),
+            ["stage `s`: coefficient of `u`", "  in `u'`;", "  coefficient of `v` in `v'`;", "  weight of `mass(a')`"]
+        );
+        assert_eq!(wrapped("short; enough", 50), ["short; enough"]);
+    }
 }

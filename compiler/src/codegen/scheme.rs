@@ -1,6 +1,8 @@
 //! Rust for a compiled scheme: a parameter struct named after the scheme, and its
 //! `TimeScheme` implementation: its description (the layout's, printed by `descriptors`), and
 //! the evaluation of every coefficient for a step size (written by `emit`, as the kernels are).
+//! What each coefficient is for (`Layout::uses`) goes back to the caller: prettyplease drops
+//! comments, so they are written into the formatted text (`super::annotate`).
 
 use std::collections::HashMap;
 use std::fmt::Write;
@@ -13,7 +15,8 @@ use crate::program::Program;
 use crate::scheme::SchemeIr;
 use crate::scheme::layout;
 
-pub fn scheme_text(prog: &Program, s: &SchemeIr, struct_name: &str) -> String {
+/// The scheme's items, and per coefficient the lines saying what it is for.
+pub fn scheme_text(prog: &Program, s: &SchemeIr, struct_name: &str) -> (String, Vec<Vec<String>>) {
     let params: Vec<ParamDecl> = s
         .params
         .iter()
@@ -31,7 +34,7 @@ pub fn scheme_text(prog: &Program, s: &SchemeIr, struct_name: &str) -> String {
     out.push_str("fn desc(&self) -> &SchemeDesc { &Self::DESC }\n");
     out.push_str(&coefficients);
     out.push_str("}\n");
-    out
+    (out, layout.uses)
 }
 
 /// `fn coefficients`: every coefficient of the layout, `out[k]`, by the one emitter: the
