@@ -27,28 +27,32 @@ pub enum CaseError {
     Write { path: String, source: std::io::Error },
     /// Newton failed at a step even after `cuts` halvings of Δt.
     #[error(
-        "stopped at t = {t} after {cuts} step cuts (Δt = {dt:.3e}): {cause}\n  Newton: {history}\n  results up to the last good step are written; more cuts: --max-step-cuts, or try a smaller Δt"
+        "stopped at t = {at} after {cuts} step cuts (Δt = {dt:.3e}): {cause}\n  Newton: {history}\n  results up to the last good step are written; more cuts: --max-step-cuts, or try a smaller Δt",
+        at = at(.t)
     )]
     Stopped { t: f64, cuts: usize, dt: f64, cause: String, history: String },
     /// A step failed in a way no smaller Δt mends.
-    #[error("stopped at t = {t}: {cause}\n  results up to the last good step are written")]
+    #[error("stopped at t = {at}: {cause}\n  results up to the last good step are written", at = at(.t))]
     Failed { t: f64, cause: String },
     /// The energy grew past what a stable scheme allows.
     #[error(
-        "stopped at t = {t}: the energy E_aug = ½uᵀKu + ½vᵀMv + contact energy = {energy:.6e} exceeds E_aug(0) + the work of the loads = {bound:.6e} by {:.1} % of the problem's energy scale {scale:.4e} (the largest of |E_aug(0)|, the work and the kinetic energy reached); the tolerance is {:.1} %{law}: the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Δt beyond a conditionally stable scheme's limit (an explicit scheme, an explicit contact term), Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt, a contact parameter so large (γ0 or ε ≳ 1e12 × E) that the contact rows' round-off swamps the solve, or degenerate cells. Results up to the last good step are written; --energy-tolerance sets the tolerance (0 turns this check off)",
+        "stopped at t = {at}: the energy E_aug = ½uᵀKu + ½vᵀMv + contact energy = {energy:.6e} exceeds E_aug(0) + the work of the loads = {bound:.6e} by {:.1} % of the problem's energy scale {scale:.4e} (the largest of |E_aug(0)|, the work and the kinetic energy reached); the tolerance is {:.1} %{law}: the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Δt beyond a conditionally stable scheme's limit (an explicit scheme, an explicit contact term), Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt, a contact parameter so large (γ0 or ε ≳ 1e12 × E) that the contact rows' round-off swamps the solve, or degenerate cells. Results up to the last good step are written; --energy-tolerance sets the tolerance (0 turns this check off)",
         100.0 * (energy - bound) / scale,
-        100.0 * tolerance
+        100.0 * tolerance,
+        at = at(.t)
     )]
     BlowUp { t: f64, energy: f64, bound: f64, scale: f64, tolerance: f64, law: String, params: String },
     /// The potential energy went negative: the contact law is not coercive for its params.
     #[error(
-        "stopped at t = {t}: the potential energy ½uᵀKu + contact energy = {potential:.6e} is negative, beyond {:.1} % of the problem's energy scale {scale:.4e}: the discrete problem is not stable. Most likely the contact law is not coercive for these params (Nitsche θ = 1 or 0 with γ0 too small against the material's stiffness; θ = −1 is coercive for any γ0), and the motion grows without bound while E_aug is kept; otherwise the steps' solutions diverge (an iterative solve that is not accurate enough: try --solver direct).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
-        100.0 * tolerance
+        "stopped at t = {at}: the potential energy ½uᵀKu + contact energy = {potential:.6e} is negative, beyond {:.1} % of the problem's energy scale {scale:.4e}: the discrete problem is not stable. Most likely the contact law is not coercive for these params (Nitsche θ = 1 or 0 with γ0 too small against the material's stiffness; θ = −1 is coercive for any γ0), and the motion grows without bound while E_aug is kept; otherwise the steps' solutions diverge (an iterative solve that is not accurate enough: try --solver direct).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
+        100.0 * tolerance,
+        at = at(.t)
     )]
     NotCoercive { t: f64, potential: f64, scale: f64, tolerance: f64, params: String },
     /// The contact law's own work outgrew the energy from outside.
     #[error(
-        "stopped at t = {t}: the contact law's own work (the part of the law the energy does not keep, `contact_work`: Nitsche with θ ≠ 1) = {work:.6e} exceeds the energy that came from outside, {outside:.6e} (the largest of |E_aug(0)| and the loads' work): the law drives the motion, which grows without bound (γ0 far too small for θ ≠ 1).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off"
+        "stopped at t = {at}: the contact law's own work (the part of the law the energy does not keep, `contact_work`: Nitsche with θ ≠ 1) = {work:.6e} exceeds the energy that came from outside, {outside:.6e} (the largest of |E_aug(0)| and the loads' work): the law drives the motion, which grows without bound (γ0 far too small for θ ≠ 1).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
+        at = at(.t)
     )]
     LawWork { t: f64, work: f64, outside: f64, params: String },
     /// An explicit scheme asked to step beyond its critical step.
@@ -66,6 +70,11 @@ pub enum CaseError {
         mass: String,
     },
     /// SIGINT or SIGTERM.
-    #[error("interrupted at t = {t}: results up to there are written")]
+    #[error("interrupted at t = {at}: results up to there are written", at = at(.t))]
     Interrupted { t: f64 },
+}
+
+/// A time in a message: six significant digits (`t = 4.475`, not `4.4750000000000005`).
+fn at(t: &f64) -> String {
+    crate::numbers::readable(*t)
 }

@@ -4,10 +4,12 @@
 use std::fmt::Write;
 use std::path::Path;
 
+use super::table::Table;
 use super::{Laws, optional, past_the_guard, write_error};
 use crate::cases::bar;
 use crate::driver::Methods;
 use crate::error::CaseError;
+use crate::numbers::readable;
 use crate::plot::Curve;
 use crate::problem::run::Options;
 use crate::simulation::MassChoice;
@@ -26,7 +28,16 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
             (s.as_str(), c.as_str(), mass)
         })
         .collect();
-    let mut table = String::new();
+    let mut table = Table::new(&[
+        "run",
+        "err_u",
+        "err_λ",
+        "err_λ½",
+        "E_Θ(0)",
+        "E_Θ(T)",
+        "max penetration",
+        "Newton iterations (total/max per step)",
+    ]);
     let mut energies: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     let mut figures = String::new();
     let mut laws = Laws::default();
@@ -43,22 +54,18 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
             bar::run(&Options { methods, mass, out: Some(dir.clone()), ..bar::options() })
         })?;
         let s = &r.summary;
-        let _ = writeln!(
-            table,
-            "| {scheme} {contact} {}{} | {:.4} | {} | {} | {:.5} | {:.5} | {:.2e} | {}/{} |",
-            mass.name(),
-            guard.as_ref().map_or(String::new(), |g| format!(" ({g})")),
-            s.err_linf_l2_u,
+        table.row([
+            format!("{scheme} {contact} {}{}", mass.name(), if guard.is_some() { " (†)" } else { "" }),
+            format!("{:.4}", s.err_linf_l2_u),
             optional(s.err_l2_lambda, 4),
             optional(s.err_l2_lambda_half, 4),
-            s.energy_aug_initial,
-            s.energy_aug_final,
-            s.max_penetration,
-            s.newton_total,
-            s.newton_max
-        );
-        if guard.is_some() {
-            stopped.push(label.clone());
+            format!("{:.5}", s.energy_aug_initial),
+            format!("{:.5}", s.energy_aug_final),
+            format!("{:.2e}", s.max_penetration),
+            format!("{}/{}", s.newton_total, s.newton_max),
+        ]);
+        if let Some(g) = guard {
+            stopped.push(format!("{label} ({g})"));
         }
         let _ = writeln!(figures, "**{label}**\n\n![{label}]({p}/{label}/{p}.png)\n", p = cases.bar);
         laws.add(&s.contact, &s.params);
@@ -72,14 +79,12 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
     let (elements, dt, t_end) = bar_run.as_ref().map_or((0, f64::NAN, f64::NAN), |s| (s.elements, s.dt, s.t_end));
     let _ = write!(
         md,
-        "## 1. Compressed bar (docs/mathematics.md §6)\n\nN = {elements} elements, Δt = {dt}, T = {t_end}; {}. `err_u` = max‖u_h − I_h u‖/max‖I_h u‖ (mass norm), `err_λ` = relative ℓ² error of the contact stress at tⁿ, `err_λ½` the same at t^{{n+½}} from (uⁿ + uⁿ⁺¹)/2 (where midpoint and hybrid impose contact).\n\n",
+        "## 1. Compressed bar (docs/mathematics.md §6)\n\nN = {elements} elements, Δt = {}, T = {}; {}. `err_u` = max‖u_h − I_h u‖/max‖I_h u‖ (mass norm), `err_λ` = relative ℓ² error of the contact stress at tⁿ, `err_λ½` the same at t^{{n+½}} from (uⁿ + uⁿ⁺¹)/2 (where midpoint and hybrid impose contact).\n\n",
+        readable(dt),
+        readable(t_end),
         laws.text()
     );
-    let _ = writeln!(
-        md,
-        "| run | err_u | err_λ | err_λ½ | E_Θ(0) | E_Θ({t_end}) | max penetration | Newton (max/step) |\n|---|---|---|---|---|---|---|---|"
-    );
-    md.push_str(&table);
+    md.push_str(&table.markdown());
     let curves: Vec<Curve> =
         energies.iter().map(|(name, pts)| Curve { label: name, points: pts.clone(), dashed: false }).collect();
     let title = format!("E_Θ of every scheme ({})", laws.of(default_contact));
@@ -88,8 +93,8 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
     if !stopped.is_empty() {
         let _ = write!(
             md,
-            "\nThe energy guard (docs/language.md) stopped these runs, whose energy grows: {}; they are shown without the guard.\n",
-            stopped.join(", ")
+            "\n† The energy guard (docs/language.md) stopped these runs, whose energy grows; they are shown without the guard: {}.\n",
+            stopped.join("; ")
         );
     }
     md.push_str("\n### Energy of every scheme\n\n![energies](bar_energies.png)\n\n");

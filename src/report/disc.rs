@@ -3,17 +3,28 @@
 use std::fmt::Write;
 use std::path::Path;
 
+use super::table::{Failures, Table};
 use super::{Laws, past_the_guard, write_error};
 use crate::cases::disc;
 use crate::driver::Methods;
 use crate::error::CaseError;
+use crate::numbers::readable;
 use crate::plot::Curve;
 use crate::problem::run::Options;
 
 pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, CaseError> {
     let mut md = String::new();
     let cases = &crate::settings::get().cases;
-    let mut table = String::new();
+    let mut table = Table::new(&[
+        "scheme",
+        "first contact",
+        "max penetration",
+        "E_aug(T)",
+        "Newton iterations (total)",
+        "Newton iterations (max per step)",
+        "ms per step",
+    ]);
+    let failures = Failures::new(out);
     let mut laws = Laws::default();
     let mut disc_run: Option<disc::Summary> = None;
     let mut disc_energies = Vec::new();
@@ -29,22 +40,29 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
         let (r, guard) = match run {
             Ok(r) => r,
             Err(e) => {
-                let _ = writeln!(table, "| {scheme} | failed: {} | | | | | |", e.to_string().replace('|', "/"));
+                let cell = failures.cell(&format!("disc_{scheme}"), &e.to_string());
+                table.row([
+                    scheme.to_string(),
+                    cell,
+                    String::new(),
+                    String::new(),
+                    String::new(),
+                    String::new(),
+                    String::new(),
+                ]);
                 continue;
             }
         };
         let s = &r.summary;
-        let _ = writeln!(
-            table,
-            "| {scheme}{} | {} | {:.2e} | {:.5} | {} | {} | {:.2} |",
-            guard.map_or(String::new(), |g| format!(" ({g})")),
+        table.row([
+            format!("{scheme}{}", guard.map_or(String::new(), |g| format!(" ({g})"))),
             s.first_contact.map_or("—".into(), |t| format!("{t:.2}")),
-            s.max_penetration,
-            s.energy_aug_final,
-            s.newton_total,
-            s.newton_max,
-            1e3 * s.seconds_per_step
-        );
+            format!("{:.2e}", s.max_penetration),
+            format!("{:.5}", s.energy_aug_final),
+            s.newton_total.to_string(),
+            s.newton_max.to_string(),
+            format!("{:.2}", 1e3 * s.seconds_per_step),
+        ]);
         laws.add(&s.contact, &s.params);
         disc_run.get_or_insert_with(|| s.clone());
         disc_energies
@@ -56,14 +74,12 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
         disc_run.as_ref().map_or((String::new(), f64::NAN, f64::NAN), |s| (s.mesh.clone(), s.dt, s.t_end));
     let _ = write!(
         md,
-        "## 2. Bouncing disc (docs/mathematics.md §6)\n\nMesh: {mesh}; {}; Δt = {dt}, T = {t_end}.\n\n",
-        laws.text()
+        "## 2. Bouncing disc (docs/mathematics.md §6)\n\nMesh: {mesh}; {}; Δt = {}, T = {}.\n\n",
+        laws.text(),
+        readable(dt),
+        readable(t_end)
     );
-    let _ = writeln!(
-        md,
-        "| scheme | first contact | max penetration | E_aug({t_end}) | Newton total | max/step | ms/step |\n|---|---|---|---|---|---|---|"
-    );
-    md.push_str(&table);
+    md.push_str(&table.markdown());
     crate::plot::panels(
         &out.join("disc_energies.png"),
         "t",

@@ -6,8 +6,10 @@ use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
 
+use super::table::Table;
 use crate::driver::{Methods, ParamValue};
 use crate::error::CaseError;
+use crate::numbers::readable;
 use crate::problem::run::{Options, run};
 
 /// Impact speeds of the regime study (on the coarsest mesh), fastest first, before the
@@ -35,7 +37,16 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         let (problem, size, levels) = (&h.problem, &h.size, h.finest + 1);
         for contact in contacts {
             let _ = writeln!(body, "### {problem}, {contact}\n");
-            body.push_str("| level | unknowns | h | a (error) | p₀ (error) | profile error | Newton | s |\n|---|---|---|---|---|---|---|---|\n");
+            let mut table = Table::new(&[
+                "level",
+                "unknowns",
+                "h",
+                "a (error)",
+                "p₀ (error)",
+                "profile error",
+                "Newton iterations",
+                "wall time (s)",
+            ]);
             let mut errors: [Vec<f64>; 3] = Default::default();
             let mut sizes = Vec::new();
             let mut figure = String::new();
@@ -54,22 +65,23 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
                 let (a, a_err, p0, p0_err) =
                     (get(size), get(&format!("{size}_error")), get("peak_pressure"), get("peak_pressure_error"));
                 let (profile, h) = (get("profile_l2_error"), get("h_contact"));
-                let _ = writeln!(
-                    md,
-                    "| {level} | {} | {h:.3} | {a:.4} ({:+.2}%) | {p0:.4} ({:+.2}%) | {:.2}% | {} | {:.1} |",
-                    get("dofs"),
-                    100.0 * a_err,
-                    100.0 * p0_err,
-                    100.0 * profile,
-                    get("newton_total"),
-                    get("wall_seconds")
-                );
+                table.row([
+                    level.to_string(),
+                    get("dofs").to_string(),
+                    format!("{h:.3}"),
+                    format!("{a:.4} ({:+.2} %)", 100.0 * a_err),
+                    format!("{p0:.4} ({:+.2} %)", 100.0 * p0_err),
+                    format!("{:.2} %", 100.0 * profile),
+                    get("newton_total").to_string(),
+                    format!("{:.1}", get("wall_seconds")),
+                ]);
                 sizes.push(h);
                 errors[0].push(a_err);
                 errors[1].push(p0_err);
                 errors[2].push(profile);
                 figure = format!("![profile](hertz/{problem}_{contact}_{level}/profile.png)\n");
             }
+            body.push_str(&table.markdown());
             let _ = writeln!(
                 body,
                 "\nObserved orders (successive levels): a {}; p₀ {}; profile {}.\n\nFinest level:\n\n{figure}",
@@ -88,7 +100,17 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         files.join(", ")
     );
     md.push_str(&body);
-    let mut table = String::new();
+    let mut table = Table::new(&[
+        "level",
+        "v",
+        "δ_max/R",
+        "t_c c_p/R",
+        "contact time (error)",
+        "peak force (error)",
+        "contact radius (error)",
+        "restitution",
+        "wall time (s)",
+    ]);
     let mut impact_params: Option<BTreeMap<String, ParamValue>> = None;
     let mut runs: Vec<(usize, Option<f64>)> = SPEEDS.iter().map(|&v| (0, Some(v))).collect();
     runs.extend([(0, None), (1, None)]);
@@ -108,20 +130,20 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         let speed = params.get(&format!("{impact}.speed")).map_or(f64::NAN, |p| p.value);
         impact_params.get_or_insert(params);
         let get = |k: &str| s.number(k).unwrap_or(f64::NAN);
-        let _ = writeln!(
-            table,
-            "| {level} | {speed} | {:.4} | {:.1} | {:.3} ({:+.2}%) | {:.4} ({:+.2}%) | {:.4} ({:+.2}%) | {:.5} | {:.0} |",
-            get("indentation_ratio"),
-            get("contact_time_over_wave_time"),
-            get("contact_duration"),
-            100.0 * get("contact_duration_error"),
-            get("peak_force"),
-            100.0 * get("peak_force_error"),
-            get("contact_radius"),
-            100.0 * get("contact_radius_error"),
-            get("restitution"),
-            get("wall_seconds")
-        );
+        let with_error = |value: &str, digits: usize| {
+            format!("{:.digits$} ({:+.2} %)", get(value), 100.0 * get(&format!("{value}_error")))
+        };
+        table.row([
+            level.to_string(),
+            readable(speed),
+            format!("{:.4}", get("indentation_ratio")),
+            format!("{:.1}", get("contact_time_over_wave_time")),
+            with_error("contact_duration", 3),
+            with_error("peak_force", 4),
+            with_error("contact_radius", 4),
+            format!("{:.5}", get("restitution")),
+            format!("{:.0}", get("wall_seconds")),
+        ]);
         figure = format!("![force](hertz/{name}/{impact}.png)\n");
     }
     let params = impact_params.map_or_else(String::new, |p| super::params_by_file(&p, &["level", "speed"]));
@@ -130,8 +152,7 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         "### Impact (`run {impact}`)\n\nThe quarter ball hits the plane at speed v without gravity (Δt = Hertz's contact time / steps; run with {params}). Hertz's"
     );
     md.push_str(" impact formulas are quasi-static; the regime columns say how far a run is from that limit (δ_max/R and the contact time over R/c_p), and the errors shrink with v.\n\n");
-    md.push_str("| level | v | δ_max/R | t_c c_p/R | contact time (error) | peak force (error) | contact radius (error) | restitution | s |\n|---|---|---|---|---|---|---|---|---|\n");
-    md.push_str(&table);
+    md.push_str(&table.markdown());
     let _ = writeln!(md, "\nThe last run's force history against Hertz's:\n\n{figure}");
     Ok(md)
 }

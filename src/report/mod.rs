@@ -18,6 +18,7 @@ mod disc;
 mod friction;
 mod hertz;
 pub mod sweep;
+pub mod table;
 
 /// Runs `run` with `methods`; a run the energy guard stops (IMEX-HHT: explicit contact is only
 /// conditionally stable) runs again with the guard off, so that the report shows how its
@@ -64,7 +65,7 @@ pub fn write(out: &Path, quick: bool, progress: &mut dyn FnMut(&str)) -> Result<
         let json = out.join("dt_sweep.json");
         crate::output::write_json(&json, &sweeps)
             .map_err(|source| CaseError::Write { path: json.display().to_string(), source })?;
-        md.push_str(&sweeps.markdown());
+        md.push_str(&sweeps.markdown(&table::Failures::new(out)));
         md.push('\n');
         md.push_str(&hertz::section(out, progress)?);
         md.push_str(&friction::section(out, progress)?);

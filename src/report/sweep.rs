@@ -12,8 +12,10 @@ use crate::cases::bar;
 use crate::cases::disc;
 use crate::driver::Methods;
 use crate::error::CaseError;
+use crate::numbers::readable;
 use crate::plot::Curve;
 use crate::problem::run::Options;
+use crate::report::table::{Failures, Table};
 use crate::simulation::MassChoice;
 
 const BAR_STEPS: [f64; 7] = [0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5];
@@ -171,7 +173,8 @@ impl Sweeps {
         self.series(case, scheme, mass).into_iter().take_while(|p| p.converged()).last().map(|p| p.dt)
     }
 
-    pub fn markdown(&self) -> String {
+    /// The sweeps' tables; a failed run's full message goes to `failures`.
+    pub fn markdown(&self, failures: &Failures) -> String {
         let mut cases: Vec<&str> = self.points.iter().map(|p| p.case).collect();
         cases.dedup();
         // What each case ran, from its first run that has measures.
@@ -190,59 +193,52 @@ impl Sweeps {
         );
         let columns: Vec<(&str, &str)> =
             cases.iter().flat_map(|&c| MASSES.iter().map(move |&m| (c, m.name()))).collect();
-        md.push_str("| scheme |");
-        for (case, mass) in &columns {
-            let _ = write!(md, " {case}, {mass} |");
-        }
-        md.push_str("\n|---|");
-        md.push_str(&"---|".repeat(columns.len()));
-        md.push('\n');
+        let mut header = vec!["scheme".to_string()];
+        header.extend(columns.iter().map(|(case, mass)| format!("{case}, {mass}")));
+        let mut largest = Table::new(&header);
         for scheme in crate::driver::all_schemes() {
-            let _ = write!(md, "| {scheme} |");
-            for (case, mass) in &columns {
-                let cell = self.largest_converging(case, scheme, mass).map_or("none".to_string(), |dt| format!("{dt}"));
-                let _ = write!(md, " {cell} |");
-            }
-            md.push('\n');
-        }
-        for case in cases {
-            let _ = write!(
-                md,
-                "\n### {case}\n\n![{case} Δt sweep]({case}_dt_sweep.png)\n\n| scheme | mass | Δt | ΔE_aug | osc | osc½ | max penetration | Newton mean/max |\n|---|---|---|---|---|---|---|---|\n"
+            let mut row = vec![scheme.to_string()];
+            row.extend(
+                columns.iter().map(|(case, mass)| {
+                    self.largest_converging(case, scheme, mass).map_or("none".to_string(), readable)
+                }),
             );
+            largest.row_vec(row);
+        }
+        md.push_str(&largest.markdown());
+        for case in cases {
+            let _ = write!(md, "\n### {case}\n\n![{case} Δt sweep]({case}_dt_sweep.png)\n\n");
+            let mut table = Table::new(&[
+                "scheme",
+                "mass",
+                "Δt",
+                "ΔE_aug",
+                "osc",
+                "osc½",
+                "max penetration",
+                "Newton iterations per step (mean/max)",
+            ]);
             for p in self.points.iter().filter(|p| p.case == case) {
+                let (scheme, mass, dt) = (p.scheme.clone(), p.mass.to_string(), readable(p.dt));
                 match &p.outcome {
-                    Ok(m) => {
-                        let _ = writeln!(
-                            md,
-                            "| {} | {} | {} | {:+.2e} | {:.2} | {} | {:.2e} | {:.2}/{} |",
-                            p.scheme,
-                            p.mass,
-                            p.dt,
-                            m.energy_change,
-                            m.oscillation,
-                            if m.oscillation_half.is_nan() {
-                                "—".into()
-                            } else {
-                                format!("{:.2}", m.oscillation_half)
-                            },
-                            m.max_penetration,
-                            m.newton_mean,
-                            m.newton_max
-                        );
-                    }
+                    Ok(m) => table.row([
+                        scheme,
+                        mass,
+                        dt,
+                        format!("{:+.2e}", m.energy_change),
+                        format!("{:.2}", m.oscillation),
+                        if m.oscillation_half.is_nan() { "—".into() } else { format!("{:.2}", m.oscillation_half) },
+                        format!("{:.2e}", m.max_penetration),
+                        format!("{:.2}/{}", m.newton_mean, m.newton_max),
+                    ]),
                     Err(e) => {
-                        let _ = writeln!(
-                            md,
-                            "| {} | {} | {} | failed: {} | | | | |",
-                            p.scheme,
-                            p.mass,
-                            p.dt,
-                            e.replace('|', "/")
-                        );
+                        let name = format!("{case}_{}_{}_dt{}", p.scheme, p.mass, readable(p.dt));
+                        let cell = failures.cell(&name, e);
+                        table.row([scheme, mass, dt, cell, String::new(), String::new(), String::new(), String::new()])
                     }
                 }
             }
+            md.push_str(&table.markdown());
         }
         md
     }
