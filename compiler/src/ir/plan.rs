@@ -351,3 +351,63 @@ fn body(unit: &Unit, ir: &DimIr, cell: bool, roots: Vec<Root>, contract: Contrac
     let uses_dphi = contract.reads_dphi() || leaves.iter().any(|l| matches!(l, Leaf::Grad { .. }));
     Some(Body { roots, prog, leaves, coefs, coef_len, uses_x, uses_dphi, contract })
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::{MemLoader, check_path};
+
+    /// The 2D plan of form `name` of the file `text`.
+    fn plan(text: &str, name: &str) -> FormPlan {
+        let loader = MemLoader::default().with("t.wf", text);
+        let (prog, _) = check_path(Path::new("t.wf"), &loader).unwrap_or_else(|f| panic!("{}", f.rendered));
+        let ir = &prog.irs[1];
+        let fi = ir.forms.iter().position(|f| f.name == name).expect("declared");
+        form(&prog, ir, &ir.forms[fi])
+    }
+
+    #[test]
+    fn a_residual_sums_its_non_zero_coefficients_by_basis() {
+        let p =
+            plan("param k = 2.0 in (0, inf)\nform f(u; v) = int(Omega) k * dot(u, v) + inner(grad(u), grad(v))\n", "f");
+        let cell = p.cell.expect("a volume integral");
+        let r = cell.residual.as_ref().expect("non-zero");
+        let roots: Vec<(Array, usize)> = r.roots.iter().map(|r| (r.array, r.at)).collect();
+        let f1 = (0..4).map(|at| (Array::F1, at));
+        assert_eq!(roots, [(Array::F0, 0), (Array::F0, 1)].into_iter().chain(f1).collect::<Vec<_>>());
+        let Contract::Residual { rows } = &r.contract else { panic!("a residual") };
+        assert_eq!(rows[0], [(Basis::Phi, 0), (Basis::Dphi(0), 2), (Basis::Dphi(1), 3)]);
+        assert_eq!(rows[1], [(Basis::Phi, 1), (Basis::Dphi(0), 4), (Basis::Dphi(1), 5)]);
+        assert!(r.leaf(Sym::Param(0)).is_some_and(Leaf::hoisted));
+        assert_eq!(r.leaf(Sym::FieldGrad { arg: 0, comp: 1, dir: 0 }), Some(Leaf::Grad { arg: 0, comp: 1, dir: 0 }));
+        assert!(r.uses_dphi && !r.uses_x && r.weighted());
+        // Linear: the tangent is constant, so the (absent) switches decide it.
+        assert_eq!(cell.decided, [Decided::Always]);
+        assert!(cell.switches[0].is_none());
+        let Some(Body { contract: Contract::Tangent { a, b }, .. }) = &cell.tangents[0] else { panic!("a tangent") };
+        assert_eq!(a[1], []); // ∂f0[0]/∂u_1 = 0, and f1 reads no u.
+        assert_eq!(b.iter().filter(|t| !t.is_empty()).count(), 4); // ∂_n u_m with m = k
+    }
+
+    #[test]
+    fn a_facet_body_lays_out_its_coefs_and_hoists_the_cell_diameter() {
+        let text = "param gamma0 = 5.0 in (0, inf)\ncoef g\ncoef nc: vector\n\
+                    form c(u; v) = int(Gamma_C) gamma0 / h * pos(dot(u, nc) - g) * dot(v, nc)\n";
+        let p = plan(text, "c");
+        assert!(p.cell.is_none());
+        let facet = &p.facets[0];
+        let r = facet.residual.as_ref().expect("non-zero");
+        let layout: Vec<(u16, usize, usize)> = r.coefs.iter().map(|c| (c.id, c.at, c.len)).collect();
+        assert_eq!((layout, r.coef_len), (vec![(0, 0, 1), (1, 1, 2)], 3));
+        assert_eq!(r.leaf(Sym::Coef { id: 1, comp: 1 }), Some(Leaf::Coef { id: 1, comp: 1, at: 2 }));
+        assert!(r.leaf(Sym::CellDiameter).is_some_and(Leaf::hoisted));
+        assert!(r.uses_x && !r.uses_dphi);
+        // Penalty contact: the active set decides the tangent; its switch is a sign, unweighted.
+        assert_eq!(facet.decided, [Decided::Always]);
+        let s = facet.switches[0].as_ref().expect("a switch");
+        assert!(matches!(s.contract, Contract::Switches { count: 1 }) && !s.weighted());
+        assert_eq!(s.roots.iter().map(|r| r.array).collect::<Vec<_>>(), [Array::Switch]);
+    }
+}
