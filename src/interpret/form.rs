@@ -2,9 +2,9 @@
 
 use std::sync::Arc;
 
+use signorini_compiler::ir::plan::FormPlan;
 use signorini_runtime::fem::kernel::{Coef, Form, FormMeta, check_coef};
 
-use super::compile::DimKernels;
 use super::{InterpretError, Unit};
 
 /// A form of a [`super::Library`] with its parameters and coefs, for cells of one dimension.
@@ -95,7 +95,7 @@ impl InterpretedForm {
     }
 
     /// The kernels for cells of dimension `D`.
-    pub(super) fn kernels<const D: usize>(&self) -> &DimKernels {
+    pub(super) fn kernels<const D: usize>(&self) -> &FormPlan {
         // Calling a kernel with another dimension is a programming error, like a wrongly sized
         // array: the coefs were checked for `dim` only.
         assert!(D == self.dim, "interpreted form `{}` is bound for dimension {}, not {D}", self.meta().name, self.dim);

@@ -1,15 +1,16 @@
-//! `FormKernel` and `FunctionalKernel` for interpreted forms: the quadrature loop of the
-//! generated kernels (codegen/kernel.rs), with the pointwise coefficients computed by the IR
-//! evaluator and contracted with the basis functions in the same order.
+//! `FormKernel` and `FunctionalKernel` for interpreted forms: the compiler's kernel plan
+//! (`ir::plan`) run as the generated kernels run it, with the pointwise coefficients computed
+//! by the IR evaluator and contracted with the basis functions by the plan's terms, in their
+//! order.
 
 use std::cell::Cell;
 
+use signorini_compiler::ir::plan::{Basis, Body, Contract, Decided, Integral, Leaf, Terms};
 use signorini_runtime::fem::geometry;
 use signorini_runtime::fem::kernel::{
     CellCtx, FacetCtx, FormKernel, FunctionalKernel, LocalMatrix, LocalVector, Tabulation,
 };
 
-use super::compile::{Basis, Body, Contract, Decided, Integral, Leaf, Terms};
 use super::form::InterpretedForm;
 
 /// Buffers reused across kernel calls, so that the loops allocate nothing.
@@ -60,17 +61,18 @@ impl InterpretedForm {
         coefs.resize(body.coef_len, 0.0);
         roots.resize(prog.outputs(), 0.0);
         let h = place.facet.map_or(f64::NAN, |f| f.1);
-        for (slot, leaf) in slots.iter_mut().zip(&body.leaves) {
+        // The hoisted leaves, once per call; the others at each point.
+        for (slot, leaf) in slots.iter_mut().zip(&body.leaves).filter(|(_, l)| l.hoisted()) {
             *slot = match *leaf {
                 Leaf::Param(i) => self.params.get(i as usize).copied().unwrap_or(f64::NAN),
                 Leaf::CellDiameter => h,
                 Leaf::Time => place.t,
-                Leaf::Zero => 0.0,
-                _ => continue,
+                // `Leaf::Zero`: the other leaves are not hoisted.
+                _ => 0.0,
             };
         }
         prog.exec_invariant(slots);
-        let weighted = !matches!(body.contract, Contract::Switches);
+        let weighted = body.weighted();
         let tab = place.tab;
         for q in 0..tab.len() {
             let phi = &tab.phi[q];
@@ -84,10 +86,10 @@ impl InterpretedForm {
             };
             let dphi = if body.uses_dphi { geometry::physical_gradients(&jac, &tab.dphi[q]) } else { [[0.0; D]; N] };
             let x = if body.uses_x { geometry::interpolate(place.coords, phi) } else { [0.0; D] };
-            for &(c, off, len) in &body.coefs {
-                self.coefs[c].eval(&x, place.t, &mut coefs[off..off + len]);
+            for c in &body.coefs {
+                self.coefs[c.id as usize].eval(&x, place.t, &mut coefs[c.at..c.at + c.len]);
             }
-            for (slot, leaf) in slots.iter_mut().zip(&body.leaves) {
+            for (slot, leaf) in slots.iter_mut().zip(&body.leaves).filter(|(_, l)| !l.hoisted()) {
                 *slot = match *leaf {
                     // `geometry::interpolate` and `geometry::gradient`, one component each.
                     Leaf::Value { arg, comp } => fields.get(arg as usize).map_or(f64::NAN, |u| {
@@ -106,7 +108,8 @@ impl InterpretedForm {
                     }),
                     Leaf::Normal(k) => n[k as usize],
                     Leaf::Coord(k) => x[k as usize],
-                    Leaf::Coef(i) => coefs[i as usize],
+                    Leaf::Coef { at, .. } => coefs[at as usize],
+                    // Hoisted: set once above.
                     Leaf::Param(_) | Leaf::CellDiameter | Leaf::Time | Leaf::Zero => continue,
                 };
             }
@@ -193,12 +196,9 @@ impl InterpretedForm {
         let decided = integral.decided.get(wrt).unwrap_or(&Decided::Always);
         let mut gated = !matches!(decided, Decided::Never);
         if let Some(body) = integral.switches.get(wrt).and_then(Option::as_ref) {
-            let switches = match decided {
-                Decided::Gated(first) => *first,
-                _ => usize::MAX,
-            };
+            let Contract::Switches { count } = body.contract else { return gated };
             self.each_point(body, place, fields, |_, _, r| {
-                let (set, gates) = r.split_at(switches.min(r.len()));
+                let (set, gates) = r.split_at(count);
                 out.extend(set.iter().map(|&v| v > 0.0));
                 gated &= gates.iter().all(|&v| v <= 0.0);
             });

@@ -19,14 +19,13 @@
 //! # Ok::<(), signorini::interpret::InterpretError>(())
 //! ```
 
-mod compile;
 mod form;
 mod kernels;
 
 use std::path::Path;
 use std::sync::Arc;
 
-use signorini_compiler::ir::DimIr;
+use signorini_compiler::ir::{DimIr, plan};
 use signorini_compiler::{FsLoader, Program, Span};
 use signorini_runtime::descriptors::ParamRange;
 use signorini_runtime::fem::kernel::{Coef, FormMeta};
@@ -115,7 +114,7 @@ struct CoefDecl {
 struct FormEntry {
     meta: FormMeta,
     /// Kernels for dimensions 1, 2, 3.
-    dims: Vec<compile::DimKernels>,
+    dims: Vec<plan::FormPlan>,
 }
 
 impl Library {
@@ -154,7 +153,7 @@ impl Library {
             .filter(|&fi| prog.forms[fi].span.file == prog.root)
             .map(|fi| FormEntry {
                 meta: meta(prog, irs, fi),
-                dims: irs.iter().map(|ir| compile::dim_kernels(prog, ir, &ir.forms[fi])).collect(),
+                dims: irs.iter().map(|ir| plan::form(prog, ir, &ir.forms[fi])).collect(),
             })
             .collect();
         let file = prog.sources.path(prog.root).display().to_string();

@@ -1,14 +1,16 @@
-//! Element kernels of one form in one dimension: for each integral, the residual and the
-//! tangent with respect to each field argument, as loops over quadrature points and local
-//! nodes with the pointwise coefficients written out as straight-line code (`emit`).
+//! Element kernels of one form in one dimension: its kernel plan (`ir::plan`) written out as
+//! Rust, for each integral the residual and the tangent with respect to each field argument
+//! as loops over quadrature points and local nodes, the plan's roots as straight-line code
+//! (`emit`) and its terms as the sums over basis functions. What is left here is naming.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 use std::fmt::Write;
 
 use super::emit::{Emitter, UNARY};
 use super::names::{Namer, ident, words};
 use crate::ir::graph::{Graph, NodeId, Sym};
-use crate::ir::{DimIr, FormIr, IntegralIr};
+use crate::ir::plan::{self, Array, Basis, Body, Contract, Decided, Integral, Leaf, Root, Terms};
+use crate::ir::{DimIr, FormIr};
 use crate::program::Program;
 
 /// Locals every kernel may define.
@@ -84,73 +86,34 @@ fn is_expression(body: &str) -> bool {
     !e.contains(['\n', ';', '{']) && !e.starts_with("if ")
 }
 
-/// A method of a kernel trait: its name, its parameters after `&self` with their types, its
-/// return type (empty for none), and its body, if it has something to do.
-type Method<'a> = (&'a str, Vec<(&'a str, String)>, &'a str, Option<String>);
+/// A method of a kernel trait: its name, its parameters after `&self` with their types and its
+/// return type (empty for none).
+type Method = (&'static str, Vec<(&'static str, String)>, &'static str);
 
-/// `impl<const N: usize> FormKernel<D, N> for Struct { ... }`.
-pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -> String {
-    let d = ir.dim;
-    let g = &ir.graph;
-    let body = |integral: &IntegralIr, mode: Mode| Body { prog, g, d, form, integral, mode }.emit();
-    // One arm per field argument with something to do.
-    let per_field = |integral: &IntegralIr, mode: fn(usize) -> Mode| {
-        let arms = (0..form.fields.len()).map(|a| (a, body(integral, mode(a)))).filter(|(_, b)| !b.is_empty());
-        dispatch("wrt", arms.collect(), None)
-    };
-    // The switches of each field argument, and whether the tangent depends on the fields only
-    // through them at these points (the trait's default, `true`, where nothing is listed).
-    let switches_per_field = |integral: &IntegralIr| {
-        let arms = (0..form.fields.len()).filter_map(|a| {
-            let b = body(integral, Mode::Switches(a));
-            let t = &integral.tangents[a];
-            match (t.piecewise, &t.gates) {
-                (true, _) if b.is_empty() => None,
-                (true, _) => Some((a, format!("{b}true\n"))),
-                (false, Some(g)) if !g.is_empty() => Some((a, format!("let mut gated = true;\n{b}gated\n"))),
-                (false, _) => Some((a, format!("{b}false\n"))),
-            }
-        });
-        dispatch("wrt", arms.collect(), Some("true"))
-    };
-    let cell = form.integrals.iter().find(|i| i.cell);
-    let facets: Vec<&IntegralIr> = form.integrals.iter().filter(|i| !i.cell).collect();
-    // One arm per boundary region with something to do.
-    let per_region = |f: &dyn Fn(&IntegralIr) -> Option<String>, other: Option<&str>| {
-        dispatch("region", facets.iter().enumerate().filter_map(|(r, i)| f(i).map(|b| (r, b))).collect(), other)
-    };
-    let nonempty = |b: String| (!b.is_empty()).then_some(b);
+/// The methods of `FormKernel<d, N>` that a form may override, in the order they are written.
+fn form_methods(d: usize) -> [Method; 6] {
     let (vec, mat, fields) =
         (format!("&mut LocalVector<{d}, N>"), format!("&mut LocalMatrix<{d}, N>"), format!("&[&LocalVector<{d}, N>]"));
     let (cctx, fctx) = (format!("&CellCtx<'_, {d}, N>"), format!("&FacetCtx<'_, {d}, N>"));
     let switches = "&mut Vec<bool>".to_string();
     let wrt = "usize".to_string();
     let region = "usize".to_string();
-    // Methods with nothing to add keep the trait's default (which adds nothing).
-    let methods: [Method; 6] = [
-        (
-            "cell_residual",
-            vec![("ctx", cctx.clone()), ("fields", fields.clone()), ("out", vec.clone())],
-            "",
-            cell.and_then(|i| nonempty(body(i, Mode::Residual))),
-        ),
+    [
+        ("cell_residual", vec![("ctx", cctx.clone()), ("fields", fields.clone()), ("out", vec.clone())], ""),
         (
             "cell_tangent",
             vec![("ctx", cctx.clone()), ("fields", fields.clone()), ("wrt", wrt.clone()), ("out", mat.clone())],
             "",
-            cell.and_then(|i| per_field(i, Mode::Tangent)),
         ),
         (
             "cell_switches",
             vec![("ctx", cctx), ("fields", fields.clone()), ("wrt", wrt.clone()), ("out", switches.clone())],
             " -> bool",
-            cell.and_then(switches_per_field),
         ),
         (
             "facet_residual",
             vec![("region", region.clone()), ("ctx", fctx.clone()), ("fields", fields.clone()), ("out", vec)],
             "",
-            per_region(&|i| nonempty(body(i, Mode::Residual)), None),
         ),
         (
             "facet_tangent",
@@ -162,18 +125,57 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
                 ("out", mat),
             ],
             "",
-            per_region(&|i| per_field(i, Mode::Tangent), None),
         ),
         (
             "facet_switches",
             vec![("region", region), ("ctx", fctx), ("fields", fields), ("wrt", wrt), ("out", switches)],
             " -> bool",
-            per_region(&switches_per_field, Some("true")),
         ),
+    ]
+}
+
+/// `impl<const N: usize> FormKernel<D, N> for Struct { ... }`.
+pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -> String {
+    let d = ir.dim;
+    let plan = plan::form(prog, ir, form);
+    let kernel = Kernel { prog, g: &ir.graph, d, form };
+    let residual = |i: &Integral| i.residual.as_ref().map(|b| kernel.emit(i.cell, b));
+    // One arm per field argument with something to do.
+    let per_field = |i: &Integral| {
+        let arms = i.tangents.iter().enumerate().filter_map(|(a, b)| Some((a, kernel.emit(i.cell, b.as_ref()?))));
+        dispatch("wrt", arms.collect(), None)
+    };
+    // The switches of each field argument, and whether the tangent depends on the fields only
+    // through them at these points (the trait's default, `true`, where nothing is listed).
+    let switches_per_field = |i: &Integral| {
+        let arms = i.decided.iter().zip(&i.switches).enumerate().filter_map(|(a, (decided, b))| {
+            let b = b.as_ref().map_or(String::new(), |b| kernel.emit(i.cell, b));
+            match decided {
+                Decided::Always if b.is_empty() => None,
+                Decided::Always => Some((a, format!("{b}true\n"))),
+                Decided::Gated => Some((a, format!("let mut gated = true;\n{b}gated\n"))),
+                Decided::Never => Some((a, format!("{b}false\n"))),
+            }
+        });
+        dispatch("wrt", arms.collect(), Some("true"))
+    };
+    // One arm per boundary region with something to do.
+    let per_region = |f: &dyn Fn(&Integral) -> Option<String>, other: Option<&str>| {
+        dispatch("region", plan.facets.iter().enumerate().filter_map(|(r, i)| f(i).map(|b| (r, b))).collect(), other)
+    };
+    let cell = plan.cell.as_ref();
+    let bodies = [
+        cell.and_then(residual),
+        cell.and_then(per_field),
+        cell.and_then(switches_per_field),
+        per_region(&residual, None),
+        per_region(&per_field, None),
+        per_region(&switches_per_field, Some("true")),
     ];
     let mut s = String::new();
     let _ = writeln!(s, "impl<const N: usize> FormKernel<{d}, N> for {struct_name} {{");
-    for (name, list, ret, text) in methods {
+    // Methods with nothing to add keep the trait's default (which adds nothing).
+    for ((name, list, ret), text) in form_methods(d).into_iter().zip(bodies) {
         if let Some(text) = text {
             let _ = writeln!(s, "fn {name}(&self, {}){ret} {{\n{text}}}", params(&text, &list));
         }
@@ -186,27 +188,23 @@ pub fn form_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -
 /// integral of a functional.
 pub fn functional_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &str) -> String {
     let d = ir.dim;
-    let g = &ir.graph;
-    let body = |integral: &IntegralIr| {
-        let b = Body { prog, g, d, form, integral, mode: Mode::Value }.emit();
+    let plan = plan::form(prog, ir, form);
+    let kernel = Kernel { prog, g: &ir.graph, d, form };
+    let body = |i: &Integral| {
+        let b = i.value.as_ref().map_or(String::new(), |b| kernel.emit(i.cell, b));
         format!("let mut total = 0.0;\n{b}total\n")
     };
     let fields = format!("&[&LocalVector<{d}, N>]");
     let mut s = String::new();
     let _ = writeln!(s, "impl<const N: usize> FunctionalKernel<{d}, N> for {struct_name} {{");
     // A functional without a volume (facet) integral keeps the trait's default: 0.
-    if let Some(cell) = form.integrals.iter().find(|i| i.cell) {
+    if let Some(cell) = &plan.cell {
         let text = body(cell);
         let list = [("ctx", format!("&CellCtx<'_, {d}, N>")), ("fields", fields.clone())];
         let _ = writeln!(s, "fn cell_value(&self, {}) -> f64 {{\n{text}}}", params(&text, &list));
     }
-    let arms: Vec<String> = form
-        .integrals
-        .iter()
-        .filter(|i| !i.cell)
-        .enumerate()
-        .map(|(r, i)| format!("{r} => {{\n{}}}\n", body(i)))
-        .collect();
+    let arms: Vec<String> =
+        plan.facets.iter().enumerate().map(|(r, i)| format!("{r} => {{\n{}}}\n", body(i))).collect();
     if !arms.is_empty() {
         let text = format!("match region {{\n{}_ => 0.0,\n}}\n", arms.concat());
         let list = [("region", "usize".to_string()), ("ctx", format!("&FacetCtx<'_, {d}, N>")), ("fields", fields)];
@@ -216,35 +214,13 @@ pub fn functional_impl(prog: &Program, ir: &DimIr, form: &FormIr, struct_name: &
     s
 }
 
-#[derive(Clone, Copy, PartialEq)]
-enum Mode {
-    Residual,
-    Tangent(usize),
-    /// Signs of the active-set switches of the tangent with respect to a field.
-    Switches(usize),
-    /// The integral of a functional.
-    Value,
-}
-
-struct Body<'a> {
+/// What the Rust of a planned body needs besides the plan: the names of the params, coefs and
+/// fields it reads.
+struct Kernel<'a> {
     prog: &'a Program,
     g: &'a Graph,
     d: usize,
     form: &'a FormIr,
-    integral: &'a IntegralIr,
-    mode: Mode,
-}
-
-/// A weighted pointwise coefficient: its local name and node.
-struct Output {
-    name: String,
-    node: NodeId,
-}
-
-type Outputs = Vec<(&'static str, Vec<Option<Output>>)>;
-
-fn output(outputs: &Outputs, kind: &str, flat: usize) -> Option<String> {
-    outputs.iter().find(|(k, _)| *k == kind)?.1.get(flat)?.as_ref().map(|o| o.name.clone())
 }
 
 /// The leaves of a body: their names, and the lines that read them from the context.
@@ -256,135 +232,93 @@ struct Leaves {
     field_val: Vec<Option<(String, String)>>,
     /// Per field argument: its dofs and its gradient.
     field_grad: Vec<Option<(String, String)>>,
-    /// The coefs read, and their locals.
-    coefs: Vec<(u16, String)>,
-    uses_x: bool,
+    /// The local of each coef of the plan's `coefs`.
+    coefs: Vec<String>,
     uses_normal: bool,
 }
 
-impl Body<'_> {
-    fn emit(&self) -> String {
-        let g = self.g;
-        let outputs = self.outputs();
-        let roots: Vec<NodeId> = outputs.iter().flat_map(|(_, l)| l.iter().flatten()).map(|o| o.node).collect();
-        if roots.is_empty() {
-            return String::new();
-        }
-        let nodes = g.reachable(roots.iter().copied());
-        let syms: HashSet<Sym> = nodes
-            .iter()
-            .filter_map(|&n| if let crate::ir::graph::Node::Sym(s) = g.node(n) { Some(s) } else { None })
-            .collect();
-        let mut namer = self.namer(&outputs);
-        let leaves = self.leaves(&syms, &mut namer);
-        let emitter = Emitter::new(g, &leaves.leaf);
-        // Constant over the cell: hoisted out of the quadrature loop.
-        let varies = |s: Sym| !matches!(s, Sym::Param(_) | Sym::CellDiameter | Sym::Time);
-        let lines = emitter.bind(&roots, varies, true, &mut namer);
-        // Weighted outputs (switches are signs: no weight).
+/// The local of a root: its IR list and its indices in it (`c10_k_l_m`).
+fn root_name(r: &Root, d: usize) -> String {
+    let (list, rank) = match r.array {
+        Array::F0 => ("f0", 1),
+        Array::F1 => ("f1", 2),
+        Array::C00 => ("c00", 2),
+        Array::C01 => ("c01", 3),
+        Array::C10 => ("c10", 3),
+        Array::C11 => ("c11", 4),
+        Array::Switch => return format!("s_{}", r.at),
+        Array::Gate => return format!("gate_{}", r.at),
+        Array::Value => return "value".into(),
+    };
+    let mut ix = Vec::new();
+    let mut rest = r.at;
+    for _ in 0..rank {
+        ix.push((rest % d).to_string());
+        rest /= d;
+    }
+    ix.reverse();
+    format!("{list}_{}", ix.join("_"))
+}
+
+/// `φ` or `∂_l φ` at node `node`.
+fn basis_at(basis: Basis, node: &str) -> String {
+    match basis {
+        Basis::Phi => format!("phi[{node}]"),
+        Basis::Dphi(l) => format!("dphi[{node}][{l}]"),
+    }
+}
+
+impl Kernel<'_> {
+    fn emit(&self, cell: bool, body: &Body) -> String {
+        let names: Vec<String> = body.roots.iter().map(|r| root_name(r, self.d)).collect();
+        let nodes: Vec<NodeId> = body.roots.iter().map(|r| r.node).collect();
+        let mut namer = self.namer(&names);
+        let leaves = self.leaves(body, &mut namer);
+        let emitter = Emitter::new(self.g, &leaves.leaf);
+        let varies = |s: Sym| !body.leaf(s).is_some_and(Leaf::hoisted);
+        let lines = emitter.bind(&nodes, varies, true, &mut namer);
         let mut weighted = String::new();
-        let weight = if matches!(self.mode, Mode::Switches(_)) { "" } else { "w * " };
-        for o in outputs.iter().flat_map(|(_, l)| l.iter().flatten()) {
-            let (text, prec) = emitter.value(o.node, &lines);
+        let weight = if body.weighted() { "w * " } else { "" };
+        for (name, &node) in names.iter().zip(&nodes) {
+            let (text, prec) = emitter.value(node, &lines);
             let text = if prec < UNARY && !weight.is_empty() { format!("({text})") } else { text };
-            let _ = writeln!(weighted, "let {} = {weight}{text};", o.name);
+            let _ = writeln!(weighted, "let {name} = {weight}{text};");
         }
         let mut s = String::new();
         s.push_str(&leaves.prologue);
         s.push_str(&lines.invariant);
         s.push_str("for q in 0..ctx.tab.len() {\n");
-        s.push_str(&self.point(&outputs, &leaves));
+        s.push_str(&self.point(cell, body, &leaves));
         s.push_str(&lines.varying);
         s.push_str(&weighted);
-        match self.mode {
-            Mode::Residual => s.push_str(&self.residual_loop(&outputs)),
-            Mode::Tangent(_) => s.push_str(&self.tangent_loop(&outputs)),
-            Mode::Switches(_) => {
-                let names = |kind: &'static str| {
-                    outputs
-                        .iter()
-                        .filter(move |(k, _)| *k == kind)
-                        .flat_map(|(_, l)| l.iter().flatten())
-                        .map(|o| &o.name)
-                };
-                for name in names("s") {
+        match &body.contract {
+            Contract::Residual { rows } => s.push_str(&residual_loop(rows, &names)),
+            Contract::Tangent { a, b } => s.push_str(&self.tangent_loop(a, b, &names)),
+            Contract::Switches { count } => {
+                let (set, gates) = names.split_at(*count);
+                for name in set {
                     let _ = writeln!(s, "out.push({name} > 0.0);");
                 }
                 // Off (a ≤ 0; NaN is not off) at every gate: see `form_impl`.
-                let off: Vec<String> = names("gate").map(|n| format!("{n} <= 0.0")).collect();
+                let off: Vec<String> = gates.iter().map(|n| format!("{n} <= 0.0")).collect();
                 if !off.is_empty() {
                     let _ = writeln!(s, "gated &= {};", off.join(" && "));
                 }
             }
-            Mode::Value => s.push_str("total += value;\n"),
+            Contract::Value => {
+                let _ = writeln!(s, "total += {};", names[0]);
+            }
         }
         s.push_str("}\n");
         s
     }
 
-    /// The pointwise coefficients this body needs, by the index conventions of ir::TangentIr.
-    fn outputs(&self) -> Outputs {
-        let (d, g) = (self.d, self.g);
-        let idx = |v: &[usize]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join("_");
-        let mut outputs: Outputs = Vec::new();
-        let mut add = |kind: &'static str, nodes: &[NodeId], dims: usize| {
-            let list = nodes
-                .iter()
-                .enumerate()
-                .map(|(flat, &n)| {
-                    if g.is_zero(n) {
-                        return None;
-                    }
-                    let mut ix = Vec::new();
-                    let mut rest = flat;
-                    for _ in 0..dims {
-                        ix.push(rest % d);
-                        rest /= d;
-                    }
-                    ix.reverse();
-                    Some(Output { name: format!("{kind}_{}", idx(&ix)), node: n })
-                })
-                .collect();
-            outputs.push((kind, list));
-        };
-        match self.mode {
-            Mode::Residual => {
-                add("f0", &self.integral.f0, 1);
-                add("f1", &self.integral.f1, 2);
-            }
-            Mode::Tangent(a) => {
-                let t = &self.integral.tangents[a];
-                add("c00", &t.c00, 2);
-                add("c01", &t.c01, 3);
-                add("c10", &t.c10, 3);
-                add("c11", &t.c11, 4);
-            }
-            Mode::Value => {
-                let node = self.integral.value.expect("functionals have a value");
-                outputs.push(("value", vec![(!g.is_zero(node)).then(|| Output { name: "value".into(), node })]));
-            }
-            Mode::Switches(a) => {
-                let t = &self.integral.tangents[a];
-                let list = t.switches.iter().enumerate();
-                outputs.push(("s", list.map(|(k, &node)| Some(Output { name: format!("s_{k}"), node })).collect()));
-                if !t.piecewise {
-                    let gates = t.gates.iter().flatten().enumerate();
-                    let gates = gates.map(|(k, &node)| Some(Output { name: format!("gate_{k}"), node }));
-                    outputs.push(("gate", gates.collect()));
-                }
-            }
-        }
-        outputs
-    }
-
-    /// The body's locals: the kernel's own, the outputs and the tangent's rows taken.
-    fn namer(&self, outputs: &Outputs) -> Namer {
+    /// The body's locals: the kernel's own, the roots and the tangent's rows taken.
+    fn namer(&self, roots: &[String]) -> Namer {
         let d = self.d;
         let mut namer = Namer::new(RESERVED);
-        for (_, list) in outputs {
-            for o in list.iter().flatten() {
-                namer.fresh(&o.name);
-            }
+        for name in roots {
+            namer.fresh(name);
         }
         for k in 0..d {
             for m in 0..d {
@@ -398,25 +332,24 @@ impl Body<'_> {
     }
 
     /// Names of the leaves the body reads, and the prologue that reads the cell-constant ones.
-    fn leaves(&self, syms: &HashSet<Sym>, namer: &mut Namer) -> Leaves {
-        let mut leaf: HashMap<Sym, String> = HashMap::new();
+    fn leaves(&self, body: &Body, namer: &mut Namer) -> Leaves {
         let mut prologue = String::new();
-        let mut params: Vec<u16> =
-            syms.iter().filter_map(|s| if let Sym::Param(i) = s { Some(*i) } else { None }).collect();
-        params.sort_unstable();
-        for i in params {
-            let pname = &self.prog.params[i as usize].name;
-            let local = namer.fresh(pname);
-            let _ = writeln!(prologue, "let {local} = self.params.{};", ident(pname));
-            leaf.insert(Sym::Param(i), local);
+        let mut params: HashMap<u16, String> = HashMap::new();
+        for leaf in &body.leaves {
+            if let Leaf::Param(i) = *leaf {
+                let pname = &self.prog.params[i as usize].name;
+                let local = namer.fresh(pname);
+                let _ = writeln!(prologue, "let {local} = self.params.{};", ident(pname));
+                params.insert(i, local);
+            }
         }
         // The previous time level (`prev`), when read, is one more field after the arguments.
         let nfields = self.form.fields.len() + usize::from(self.form.previous);
         let mut field_val = vec![None; nfields];
         let mut field_grad = vec![None; nfields];
         for a in 0..nfields {
-            let uses_val = syms.iter().any(|s| matches!(s, Sym::Field { arg, .. } if *arg as usize == a));
-            let uses_grad = syms.iter().any(|s| matches!(s, Sym::FieldGrad { arg, .. } if *arg as usize == a));
+            let uses_val = body.leaves.iter().any(|l| matches!(l, Leaf::Value { arg, .. } if *arg as usize == a));
+            let uses_grad = body.leaves.iter().any(|l| matches!(l, Leaf::Grad { arg, .. } if *arg as usize == a));
             if uses_val || uses_grad {
                 let fname = self.form.fields.get(a).map_or("previous", String::as_str);
                 let dofs = namer.fresh(fname);
@@ -429,60 +362,48 @@ impl Body<'_> {
                 }
             }
         }
-        let mut coef_ids: Vec<u16> =
-            syms.iter().filter_map(|s| if let Sym::Coef { id, .. } = s { Some(*id) } else { None }).collect();
-        coef_ids.sort_unstable();
-        coef_ids.dedup();
-        let coefs: Vec<(u16, String)> =
-            coef_ids.iter().map(|&id| (id, namer.fresh(&self.prog.coefs[id as usize].name))).collect();
-        for s in syms {
-            let name = match *s {
-                Sym::Param(_) => continue,
-                Sym::Field { arg, comp } => {
-                    format!("{}[{comp}]", field_val[arg as usize].as_ref().expect("named above").1)
+        let coefs: Vec<String> = body.coefs.iter().map(|c| namer.fresh(&self.prog.coefs[c.id as usize].name)).collect();
+        let local = |v: &Option<(String, String)>| v.as_ref().expect("named above").1.clone();
+        let mut leaf: HashMap<Sym, String> = HashMap::new();
+        for (&s, &l) in body.prog.syms().iter().zip(&body.leaves) {
+            let name = match l {
+                Leaf::Param(i) => params[&i].clone(),
+                Leaf::Value { arg, comp } => format!("{}[{comp}]", local(&field_val[arg as usize])),
+                Leaf::Grad { arg, comp, dir } => format!("{}[{comp}][{dir}]", local(&field_grad[arg as usize])),
+                Leaf::Normal(k) => format!("n[{k}]"),
+                Leaf::CellDiameter => "h".into(),
+                Leaf::Coord(k) => format!("x[{k}]"),
+                Leaf::Time => "t".into(),
+                Leaf::Coef { id, comp, .. } => {
+                    let c = body.coefs.iter().position(|c| c.id == id).expect("laid out");
+                    format!("{}[{comp}]", coefs[c])
                 }
-                Sym::FieldGrad { arg, comp, dir } => {
-                    format!("{}[{comp}][{dir}]", field_grad[arg as usize].as_ref().expect("named above").1)
-                }
-                Sym::Normal(k) => format!("n[{k}]"),
-                Sym::CellDiameter => "h".into(),
-                Sym::Coord(k) => format!("x[{k}]"),
-                Sym::Time => "t".into(),
-                Sym::Dt => "dt".into(), // never in a form
-                Sym::Coef { id, comp } => {
-                    format!("{}[{comp}]", coefs.iter().find(|(i, _)| *i == id).expect("named above").1)
-                }
-                Sym::Test { .. } | Sym::TestGrad { .. } => "0.0".into(), // linear forms: never reached
+                Leaf::Zero => "0.0".into(),
             };
-            leaf.insert(*s, name);
+            leaf.insert(s, name);
         }
         // Coefs are functions of position and time.
-        if syms.contains(&Sym::Time) || !coefs.is_empty() {
+        if body.leaves.contains(&Leaf::Time) || !coefs.is_empty() {
             prologue.push_str("let t = ctx.t;\n");
         }
-        if syms.contains(&Sym::CellDiameter) {
+        if body.leaves.contains(&Leaf::CellDiameter) {
             prologue.push_str("let h = ctx.h;\n");
         }
-        let uses_x = syms.iter().any(|s| matches!(s, Sym::Coord(_))) || !coefs.is_empty();
-        let uses_normal = syms.iter().any(|s| matches!(s, Sym::Normal(_)));
-        Leaves { leaf, prologue, field_val, field_grad, coefs, uses_x, uses_normal }
+        let uses_normal = body.leaves.iter().any(|l| matches!(l, Leaf::Normal(_)));
+        Leaves { leaf, prologue, field_val, field_grad, coefs, uses_normal }
     }
 
     /// The geometry, coefs and fields at quadrature point `q`.
-    fn point(&self, outputs: &Outputs, leaves: &Leaves) -> String {
-        let needs = |kinds: &[&str]| outputs.iter().any(|(k, l)| kinds.contains(k) && l.iter().any(Option::is_some));
+    fn point(&self, cell: bool, body: &Body, leaves: &Leaves) -> String {
         let field_vals = leaves.field_val.iter().any(Option::is_some);
-        let field_grads = leaves.field_grad.iter().any(Option::is_some);
-        let need_phi = field_vals || leaves.uses_x || needs(&["f0", "c00", "c01", "c10"]);
-        let need_dphi = field_grads || needs(&["f1", "c01", "c10", "c11"]);
-        // Switches are signs: they need no quadrature weight.
-        let weighted = !matches!(self.mode, Mode::Switches(_));
-        let normal = !self.integral.cell && (weighted || leaves.uses_normal);
+        let need_phi = field_vals || body.uses_x || body.contract.reads_phi();
+        let weighted = body.weighted();
+        let normal = !cell && (weighted || leaves.uses_normal);
         let mut s = String::new();
         if need_phi {
             s.push_str("let phi = &ctx.tab.phi[q];\n");
         }
-        if weighted || need_dphi || normal {
+        if weighted || body.uses_dphi || normal {
             s.push_str("let jac = geometry::jacobian(ctx.coords, &ctx.tab.dphi[q]);\n");
         }
         if normal {
@@ -490,25 +411,20 @@ impl Body<'_> {
             let scale = if weighted { "scale" } else { "_" };
             let _ = writeln!(s, "let ({n}, {scale}) = geometry::facet_normal(&jac, ctx.ref_normal);");
         }
-        match (weighted, self.integral.cell) {
+        match (weighted, cell) {
             (false, _) => {}
             (true, true) => s.push_str("let w = ctx.tab.weights[q] * jac.det.abs();\n"),
             (true, false) => s.push_str("let w = ctx.tab.weights[q] * scale;\n"),
         }
-        if need_dphi {
+        if body.uses_dphi {
             s.push_str("let dphi = geometry::physical_gradients(&jac, &ctx.tab.dphi[q]);\n");
         }
-        if leaves.uses_x {
+        if body.uses_x {
             s.push_str("let x = geometry::interpolate(ctx.coords, phi);\n");
         }
-        for (id, local) in &leaves.coefs {
-            let c = &self.prog.coefs[*id as usize];
-            let len = crate::ir::lower::components(c.shape, self.d);
-            let _ = writeln!(
-                s,
-                "let mut {local} = [0.0; {len}];\nself.coefs.{}.eval(&x, t, &mut {local});",
-                ident(&c.name)
-            );
+        for (c, local) in body.coefs.iter().zip(&leaves.coefs) {
+            let name = ident(&self.prog.coefs[c.id as usize].name);
+            let _ = writeln!(s, "let mut {local} = [0.0; {}];\nself.coefs.{name}.eval(&x, t, &mut {local});", c.len);
         }
         for (dofs, val) in leaves.field_val.iter().flatten() {
             let _ = writeln!(s, "let {val} = geometry::interpolate({dofs}, phi);");
@@ -519,67 +435,31 @@ impl Body<'_> {
         s
     }
 
-    fn residual_loop(&self, outputs: &Outputs) -> String {
-        let get = |kind: &str, flat: usize| output(outputs, kind, flat);
+    /// out[i][k][j][m] += a[k][m]·φ_j + Σ_n b[k][m][n]·∂_n φ_j, with a and b summed from the
+    /// plan's terms at test node i.
+    fn tangent_loop(&self, a: &[Terms], b: &[Terms], names: &[String]) -> String {
         let d = self.d;
-        let mut s = String::from("for j in 0..N {\n");
-        for k in 0..d {
-            let mut terms = Vec::new();
-            if let Some(o) = get("f0", k) {
-                terms.push(format!("{o} * phi[j]"));
-            }
-            for l in 0..d {
-                if let Some(o) = get("f1", k * d + l) {
-                    terms.push(format!("{o} * dphi[j][{l}]"));
-                }
-            }
-            if !terms.is_empty() {
-                let _ = writeln!(s, "out[j][{k}] += {};", terms.join(" + "));
-            }
-        }
-        s.push_str("}\n");
-        s
-    }
-
-    /// out[i][k][j][m] += a[k][m]·φ_j + Σ_n b[k][m][n]·∂_n φ_j, with
-    /// a[k][m] = φ_i c00[k][m] + Σ_l ∂_l φ_i c10[k][l][m] and
-    /// b[k][m][n] = φ_i c01[k][m][n] + Σ_l ∂_l φ_i c11[k][l][m][n].
-    fn tangent_loop(&self, outputs: &Outputs) -> String {
-        let d = self.d;
-        let get = |kind: &str, flat: usize| output(outputs, kind, flat);
+        let sum = |terms: &Terms| {
+            let terms: Vec<String> =
+                terms.iter().map(|&(basis, r)| format!("{} * {}", basis_at(basis, "i"), names[r as usize])).collect();
+            terms.join(" + ")
+        };
         let mut rows = String::new();
         let mut a_names = vec![None; d * d];
         let mut b_names = vec![None; d * d * d];
         for k in 0..d {
             for m in 0..d {
-                let mut terms = Vec::new();
-                if let Some(c) = get("c00", k * d + m) {
-                    terms.push(format!("phi[i] * {c}"));
-                }
-                for l in 0..d {
-                    if let Some(c) = get("c10", (k * d + l) * d + m) {
-                        terms.push(format!("dphi[i][{l}] * {c}"));
-                    }
-                }
-                if !terms.is_empty() {
+                let km = k * d + m;
+                if !a[km].is_empty() {
                     let name = format!("a_{k}_{m}");
-                    let _ = writeln!(rows, "let {name} = {};", terms.join(" + "));
-                    a_names[k * d + m] = Some(name);
+                    let _ = writeln!(rows, "let {name} = {};", sum(&a[km]));
+                    a_names[km] = Some(name);
                 }
                 for n in 0..d {
-                    let mut terms = Vec::new();
-                    if let Some(c) = get("c01", (k * d + m) * d + n) {
-                        terms.push(format!("phi[i] * {c}"));
-                    }
-                    for l in 0..d {
-                        if let Some(c) = get("c11", ((k * d + l) * d + m) * d + n) {
-                            terms.push(format!("dphi[i][{l}] * {c}"));
-                        }
-                    }
-                    if !terms.is_empty() {
+                    if !b[km * d + n].is_empty() {
                         let name = format!("b_{k}_{m}_{n}");
-                        let _ = writeln!(rows, "let {name} = {};", terms.join(" + "));
-                        b_names[(k * d + m) * d + n] = Some(name);
+                        let _ = writeln!(rows, "let {name} = {};", sum(&b[km * d + n]));
+                        b_names[km * d + n] = Some(name);
                     }
                 }
             }
@@ -603,4 +483,18 @@ impl Body<'_> {
         }
         format!("for i in 0..N {{\n{rows}for j in 0..N {{\n{cols}}}\n}}\n")
     }
+}
+
+/// out[j][k] += Σ root·basis over the terms of row k.
+fn residual_loop(rows: &[Terms], names: &[String]) -> String {
+    let mut s = String::from("for j in 0..N {\n");
+    for (k, terms) in rows.iter().enumerate() {
+        if !terms.is_empty() {
+            let terms: Vec<String> =
+                terms.iter().map(|&(basis, r)| format!("{} * {}", names[r as usize], basis_at(basis, "j"))).collect();
+            let _ = writeln!(s, "out[j][{k}] += {};", terms.join(" + "));
+        }
+    }
+    s.push_str("}\n");
+    s
 }

@@ -198,7 +198,7 @@ impl Program {
         let base = self.syms.len() + self.consts.len();
         for i in from..to {
             let v = |s: Slot| slots[s as usize];
-            // The generated code's spelling of each node (codegen/kernel.rs `Body::expr`).
+            // The generated code's spelling of each node (codegen/emit.rs `Emitter::expr`).
             slots[base + i] = match self.ops[i] {
                 Op::Add(a, b) => v(a) + v(b),
                 Op::Mul(a, b) => v(a) * v(b),

@@ -10,6 +10,7 @@ pub mod derive;
 pub mod eval;
 pub mod graph;
 pub mod lower;
+pub mod plan;
 pub mod print;
 
 use std::collections::BTreeSet;
