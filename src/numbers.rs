@@ -10,6 +10,13 @@ pub fn shortest(x: f64) -> String {
     if exponent.len() < plain.len() { exponent } else { plain }
 }
 
+/// A time level as people write it: fifteen significant digits in the shortest form, so that
+/// the 14th step of 0.1 reads `1.4`, not `1.4000000000000001` (the double that 14 × 0.1
+/// sums to; the two differ in the 17th digit).
+pub fn time(t: f64) -> String {
+    shortest(format!("{t:.14e}").parse().unwrap_or(t))
+}
+
 /// `x` to six significant digits, trailing zeros dropped: plain from 10⁻³ to 10⁶
 /// (`0.226`, `1234.57`), in exponent form beyond (`1.1e-12`, `3.5e+08` as `3.5e8`).
 pub fn readable(x: f64) -> String {
@@ -71,5 +78,8 @@ mod tests {
         assert_eq!(shortest(1e-12), "1e-12");
         assert_eq!(shortest(1.4000000000000001), "1.4000000000000001");
         assert_eq!(shortest(0.25), "0.25");
+        assert_eq!(time(14.0 * 0.1), "1.4");
+        assert_eq!(time(1e-20), "1e-20");
+        assert_eq!(time(0.1 + 0.2), "0.3");
     }
 }

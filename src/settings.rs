@@ -57,6 +57,16 @@ pub struct Report {
     /// §6: friction problems, and the one every scheme × frictional law runs.
     pub friction: Vec<FrictionRun>,
     pub friction_table: FrictionTable,
+    /// §9: the sources of the methods.
+    pub references: Vec<Citation>,
+}
+
+/// A source of the methods, and what it is behind (schemes, laws, problems, sections).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Citation {
+    pub cite: String,
+    pub behind: Vec<String>,
 }
 
 /// A friction problem of the report: run with `contact` (the problem's own when empty) and

@@ -154,6 +154,7 @@ pub fn write_collection(path: &Path, entries: &[(f64, String)]) -> std::io::Resu
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n",
     );
     for (t, file) in entries {
+        let t = crate::numbers::time(*t);
         let _ = writeln!(s, "<DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{file}\"/>");
     }
     s.push_str("</Collection>\n</VTKFile>\n");

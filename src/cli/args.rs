@@ -24,7 +24,8 @@ pub enum Command {
         #[command(subcommand)]
         what: BenchCommand,
     },
-    /// Run the talk's comparisons and write DIR/report.md with tables and figures.
+    /// Run the comparisons of Huang, Chouly, Drouet and Pignet's talk (CANUM 2022) and the
+    /// validation cases, and write DIR/report.md with tables, figures and references.
     Report {
         #[arg(long, default_value = "results/report")]
         out: PathBuf,
@@ -295,13 +296,15 @@ pub struct CheckpointArgs {
 
 impl CheckpointArgs {
     /// The output directory: the resumed run's, or `--out` prepared (see `output::prepare`).
-    pub(super) fn out(&self, out: Option<PathBuf>) -> Result<Option<PathBuf>, String> {
+    /// The run's directory, and whether the run prepares it as a fresh one when it starts
+    /// (not a resumed run's, which holds its checkpoint).
+    pub(super) fn out(&self, out: Option<PathBuf>) -> Result<(Option<PathBuf>, bool), String> {
         match &self.resume {
-            Some(dir) => Ok(Some(dir.clone())),
+            Some(dir) => Ok((Some(dir.clone()), false)),
             None if self.checkpoint_every > 0 && out.is_none() => {
                 Err("--checkpoint-every needs --out DIR: the checkpoints go there".into())
             }
-            None => super::out_dir(out),
+            None => Ok((out, true)),
         }
     }
 }

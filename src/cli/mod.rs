@@ -59,6 +59,11 @@ fn negative_values(cmd: clap::Command) -> clap::Command {
 /// `--force`, for the output directories of every command.
 static FORCE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 
+/// `--force`, as given.
+pub(super) fn force() -> bool {
+    FORCE.get().copied().unwrap_or(false)
+}
+
 /// The directory a run writes to (see `output::prepare`), announced when it is not `--out`.
 pub(super) fn out_dir(out: Option<PathBuf>) -> Result<Option<PathBuf>, String> {
     let Some(dir) = out else { return Ok(None) };
@@ -86,7 +91,14 @@ fn error_prefix() -> String {
 /// stderr, and their lines must not interleave.
 pub fn print_error(message: impl std::fmt::Display) {
     use std::io::Write;
-    let line = format!("{}: {message}\n", error_prefix());
+    let text = message.to_string();
+    // A rendered diagnostic (`error[E0001]: ...`) says "error" itself: one prefix, not two.
+    let line = match (text.starts_with("error[") || text.starts_with("error:"), crate::runtime::linalg::ranks::world())
+    {
+        (true, (_, 1)) => format!("{text}\n"),
+        (true, (rank, size)) => format!("(rank {rank} of {size}) {text}\n"),
+        (false, _) => format!("{}: {text}\n", error_prefix()),
+    };
     let _ = std::io::stderr().lock().write_all(line.as_bytes());
 }
 

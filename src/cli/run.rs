@@ -1,7 +1,7 @@
 //! `run`: a problem by name or file with the options of the command line, every scheme ×
 //! contact law × mass matrix of it (`--all`), or a case file.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
 use super::args::ProblemArgs;
@@ -36,6 +36,10 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
         };
         return all(opts, methods);
     }
+    let (out, fresh) = match a.checkpoint.out(a.out) {
+        Ok(out) => out,
+        Err(e) => return fail(e),
+    };
     let opts = crate::problem::run::Options {
         problem: problem.to_string(),
         methods,
@@ -51,10 +55,8 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
             ..Default::default()
         },
         petsc_options: a.petsc_options,
-        out: match a.checkpoint.out(a.out) {
-            Ok(dir) => dir,
-            Err(e) => return fail(e),
-        },
+        out,
+        out_fresh: fresh.then(super::force),
         vtu_every: a.vtu_every,
         progress: true,
         checkpoint_every: a.checkpoint.checkpoint_every,
@@ -135,15 +137,11 @@ fn all(base: crate::problem::run::Options, methods: Methods) -> ExitCode {
 
 pub(super) fn case_file(file: &Path) -> ExitCode {
     use crate::cases::file;
-    let out = |opts_out: &mut Option<PathBuf>| -> Result<(), String> {
-        *opts_out = out_dir(Some(opts_out.take().unwrap_or_else(|| file::default_out(file))))?;
-        Ok(())
-    };
     match file::read(file) {
         Ok(mut opts) => {
-            if let Err(e) = out(&mut opts.out) {
-                return fail(e);
-            }
+            // Prepared when the run starts (a refused case writes nothing).
+            opts.out = Some(opts.out.take().unwrap_or_else(|| file::default_out(file)));
+            opts.out_fresh = Some(super::force());
             opts.progress = true;
             finish(crate::problem::run::run(&opts))
         }

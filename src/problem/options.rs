@@ -29,6 +29,10 @@ pub struct Options {
     /// `petsc` solver.
     pub petsc_options: Option<String>,
     pub out: Option<PathBuf>,
+    /// `out` is prepared (`output::prepare`, with this `--force`) once the run is bound, so
+    /// that a run refused before it starts leaves no directory behind; `None`: `out` is used
+    /// as it is.
+    pub out_fresh: Option<bool>,
     pub vtu_every: usize,
     pub progress: bool,
     pub checkpoint_every: usize,
@@ -68,6 +72,7 @@ impl Options {
             newton: NewtonOptions::default(),
             petsc_options: None,
             out: None,
+            out_fresh: None,
             vtu_every: 0,
             progress: false,
             checkpoint_every: 0,

@@ -111,9 +111,10 @@ pub(super) fn write_outputs(dir: &Path, pf: &ProblemFile, run: &Run, shown: &[bo
         .chain(run.columns.iter().zip(shown).filter(|(_, s)| **s).map(|(c, _)| c.as_str()))
         .collect();
     let header = header.join(",");
-    // Each number as the shortest text that reads back to the same double.
+    // Each value as the shortest text that reads back to the same double; the time as its
+    // level is written (`numbers::time`).
     let line = |t: f64, values: &[f64]| {
-        let mut s = crate::numbers::shortest(t);
+        let mut s = crate::numbers::time(t);
         for (v, _) in values.iter().zip(shown).filter(|(_, s)| **s) {
             s.push(',');
             s.push_str(&crate::numbers::shortest(*v));

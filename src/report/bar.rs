@@ -59,8 +59,8 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
             format!("{:.4}", s.err_linf_l2_u),
             optional(s.err_l2_lambda, 4),
             optional(s.err_l2_lambda_half, 4),
-            format!("{:.5}", s.energy_aug_initial),
-            format!("{:.5}", s.energy_aug_final),
+            readable(s.energy_aug_initial),
+            readable(s.energy_aug_final),
             format!("{:.2e}", s.max_penetration),
             format!("{}/{}", s.newton_total, s.newton_max),
         ]);

@@ -5,6 +5,8 @@ use std::fmt::Write;
 use std::path::Path;
 
 use super::bench_methods;
+use super::table::Table;
+use crate::numbers::readable;
 
 /// `bench sphere` takes an hour at full size: the report shows its last run in this directory.
 pub(super) fn sphere(out: &Path) -> String {
@@ -17,23 +19,40 @@ pub(super) fn sphere(out: &Path) -> String {
                 bench_methods(r.scheme.as_deref(), r.contact.as_deref(), &r.contact_params)
             });
             let steps = first.map_or_else(String::new, |r| match (r.dt, r.t_end) {
-                (Some(dt), Some(t_end)) => format!("{} steps of Δt = {dt} to t = {t_end}", r.steps),
+                (Some(dt), Some(t_end)) => {
+                    format!("{} steps of Δt = {} to t = {}", r.steps, readable(dt), readable(t_end))
+                }
                 _ => format!("{} steps", r.steps),
             });
             let _ = writeln!(
                 md,
                 "Time per step and peak memory of the bouncing sphere against its size ({methods}; {steps}), from `bench_sphere.json` in this directory:\n"
             );
-            md.push_str("| unknowns | solver | ms/step, whole run | median step (ms) | Newton | factorizations | Krylov iterations | peak memory (MB) |\n|---|---|---|---|---|---|---|---|\n");
+            let mut table = Table::new(&[
+                "unknowns",
+                "solver",
+                "ms per step, whole run",
+                "median step (ms)",
+                "Newton iterations",
+                "factorizations",
+                "Krylov iterations",
+                "peak memory (MB)",
+            ]);
             for r in &bench.runs {
                 let iterations = if r.solver == "direct" { "—".to_string() } else { r.krylov_iterations.to_string() };
                 let memory = r.peak_memory_bytes.map_or("—".to_string(), |b| format!("{:.0}", b as f64 / 1e6));
-                let _ = writeln!(
-                    md,
-                    "| {} | {} | {:.0} | {:.0} | {} | {} | {iterations} | {memory} |",
-                    r.dofs, r.solver, r.ms_per_step_with_setup, r.median_step_ms, r.newton_total, r.factorizations
-                );
+                table.row([
+                    r.dofs.to_string(),
+                    r.solver.to_string(),
+                    format!("{:.0}", r.ms_per_step_with_setup),
+                    format!("{:.0}", r.median_step_ms),
+                    r.newton_total.to_string(),
+                    r.factorizations.to_string(),
+                    iterations,
+                    memory,
+                ]);
             }
+            md.push_str(&table.markdown());
             if out.join("bench_sphere.png").exists() {
                 md.push_str("\n![bench sphere](bench_sphere.png)\n");
             }
@@ -56,41 +75,57 @@ pub(super) fn sphere(out: &Path) -> String {
 /// The last `bench disc` run in this directory.
 pub(super) fn disc(out: &Path) -> String {
     let mut md = String::new();
-    md.push_str("## 7. Time per step of the disc (`signorini bench disc`)\n\n");
+    md.push_str("## 8. Time per step of the disc (`signorini bench disc`)\n\n");
     match crate::bench::disc::read(out) {
         Some(Ok(bench)) => {
             let _ = writeln!(
                 md,
                 "Timed: {}; Δt = {}, to t = {}; the stepper alone, medians of {} runs, from `bench_disc.json` in this directory. The model: one residual product and one pair of triangular solves per step, as bytes read at STREAM's triad bandwidth (one thread, arrays out of cache); the in-cache model reads the same bytes at the triad bandwidth of a working set of their size.\n",
                 bench_methods(bench.scheme.as_deref(), bench.contact.as_deref(), &bench.contact_params),
-                bench.dt,
-                bench.t_end,
+                readable(bench.dt),
+                readable(bench.t_end),
                 bench.repeats
             );
-            md.push_str("| mesh | unknowns | ms/step (mean) | median step (ms) | factorizations /1000 steps | low-rank updates /1000 steps | nnz(K) | nnz(L) | model (ms) | STREAM GB/s | measured/model | median step/model | in-cache model (ms) | in-cache GB/s | measured/in-cache model |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+            let mut table = Table::new(&[
+                "mesh",
+                "unknowns",
+                "ms per step (mean)",
+                "median step (ms)",
+                "factorizations per 1000 steps",
+                "low-rank updates per 1000 steps",
+                "nnz(K)",
+                "nnz(L)",
+                "model (ms)",
+                "STREAM GB/s",
+                "measured/model",
+                "median step/model",
+                "in-cache model (ms)",
+                "in-cache GB/s",
+                "measured/in-cache model",
+            ]);
             for m in &bench.meshes {
                 let name = std::path::Path::new(&m.mesh)
                     .file_name()
                     .map_or(m.mesh.clone(), |f| f.to_string_lossy().into_owned());
-                let _ = writeln!(
-                    md,
-                    "| {name} | {} | {:.3} | {:.3} | {:.0} | {:.0} | {} | {} | {:.3} | {:.1} | {:.2} | {:.2} | {:.3} | {:.1} | {:.2} |",
-                    m.dofs,
-                    m.ms_per_step,
-                    m.median_step_ms,
-                    m.factorizations_per_1000,
-                    m.low_rank_updates_per_1000,
-                    m.matrix_nnz,
+                table.row([
+                    name,
+                    m.dofs.to_string(),
+                    format!("{:.3}", m.ms_per_step),
+                    format!("{:.3}", m.median_step_ms),
+                    format!("{:.0}", m.factorizations_per_1000),
+                    format!("{:.0}", m.low_rank_updates_per_1000),
+                    m.matrix_nnz.to_string(),
                     m.factor_nnz.map_or("—".into(), |n| n.to_string()),
-                    m.model_ms,
-                    m.stream_gb_s,
-                    m.measured_over_model,
-                    m.median_over_model,
-                    m.cache_model_ms,
-                    m.cache_gb_s,
-                    m.measured_over_cache_model
-                );
+                    format!("{:.3}", m.model_ms),
+                    format!("{:.1}", m.stream_gb_s),
+                    format!("{:.2}", m.measured_over_model),
+                    format!("{:.2}", m.median_over_model),
+                    format!("{:.3}", m.cache_model_ms),
+                    format!("{:.1}", m.cache_gb_s),
+                    format!("{:.2}", m.measured_over_cache_model),
+                ]);
             }
+            md.push_str(&table.markdown());
             md.push('\n');
         }
         Some(Err(e)) => {

@@ -29,6 +29,7 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
     let mut disc_run: Option<disc::Summary> = None;
     let mut disc_energies = Vec::new();
     let mut disc_newton = Vec::new();
+    let mut stopped: Vec<String> = Vec::new();
     for scheme in crate::driver::all_schemes() {
         progress(&format!("disc {scheme}"));
         let dir = out.join(&cases.disc).join(scheme);
@@ -55,18 +56,23 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
         };
         let s = &r.summary;
         table.row([
-            format!("{scheme}{}", guard.map_or(String::new(), |g| format!(" ({g})"))),
+            format!("{scheme}{}", if guard.is_some() { " (†)" } else { "" }),
             s.first_contact.map_or("—".into(), |t| format!("{t:.2}")),
             format!("{:.2e}", s.max_penetration),
-            format!("{:.5}", s.energy_aug_final),
+            readable(s.energy_aug_final),
             s.newton_total.to_string(),
             s.newton_max.to_string(),
             format!("{:.2}", 1e3 * s.seconds_per_step),
         ]);
         laws.add(&s.contact, &s.params);
         disc_run.get_or_insert_with(|| s.clone());
-        disc_energies
-            .push((scheme.to_string(), r.series.iter().map(|row| (row.t, row.energy_aug)).collect::<Vec<_>>()));
+        // A run whose energy grows is in the table, not on the energy's scale of the others.
+        if let Some(g) = guard {
+            stopped.push(format!("{scheme} ({g})"));
+        } else {
+            disc_energies
+                .push((scheme.to_string(), r.series.iter().map(|row| (row.t, row.energy_aug)).collect::<Vec<_>>()));
+        }
         disc_newton
             .push((scheme.to_string(), r.series.iter().map(|row| (row.t, row.newton as f64)).collect::<Vec<_>>()));
     }
@@ -80,6 +86,13 @@ pub(super) fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<Stri
         readable(t_end)
     );
     md.push_str(&table.markdown());
+    if !stopped.is_empty() {
+        let _ = write!(
+            md,
+            "\n† The energy guard stopped these runs, whose energy grows; they ran on without it and their energy is left out of the figure: {}.\n",
+            stopped.join("; ")
+        );
+    }
     crate::plot::panels(
         &out.join("disc_energies.png"),
         "t",

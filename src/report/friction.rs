@@ -7,8 +7,10 @@
 use std::fmt::Write;
 use std::path::Path;
 
+use super::table::{Failures, Table};
 use crate::driver::Methods;
 use crate::error::CaseError;
+use crate::numbers::readable;
 use crate::problem::run::{Options, run};
 use crate::problem::summary::Expectation;
 
@@ -21,7 +23,8 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
     problems.dedup();
     let runs: Vec<String> = problems.iter().map(|p| format!("`run {p}`")).collect();
     let mut md = format!("## 6. Friction ({})\n\n", runs.join(", "));
-    md.push_str("What the problems expect of themselves (`expect` lines: the rigid-body limits, Coulomb's bound; docs/problems.md, Friction), run at their defaults with the law shown:\n\n| run | contact | key | value | expected | difference | within | met |\n|---|---|---|---|---|---|---|---|\n");
+    md.push_str("What the problems expect of themselves (`expect` lines: the rigid-body limits, Coulomb's bound; docs/problems.md, Friction), run at their defaults with the law shown:\n\n");
+    let mut expected = Table::new(&["run", "contact", "key", "value", "expected", "difference", "within", "met"]);
     let mut figures = String::new();
     for (k, f) in settings.friction.iter().enumerate() {
         progress(&format!("friction: {}", f.label));
@@ -40,28 +43,37 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
         let s = run(&opts)?.summary;
         let contact = s.get("contact").and_then(|v| v.as_str()).unwrap_or_default().to_string();
         for x in s.field::<Vec<Expectation>>("expected")?.into_iter().filter(|x| x.applies) {
-            let [value, expected, difference, within] = x.shown();
+            let [value, expected_value, difference, within] = x.shown();
             let met = if x.met { "yes" } else { "**no**" };
-            let _ = writeln!(
-                md,
-                "| {} | {contact} | {} | {value} | {expected} | {difference} | {within} | {met} |",
-                f.label, x.key
-            );
+            expected.row([
+                f.label.clone(),
+                contact.clone(),
+                x.key,
+                value,
+                expected_value,
+                difference,
+                within,
+                met.into(),
+            ]);
         }
         let _ = writeln!(figures, "![{}](friction/{sub}/{}.png)\n", f.label, f.problem);
     }
+    md.push_str(&expected.markdown());
     md.push('\n');
     md.push_str(&figures);
     let params: Vec<String> = table.params.iter().map(|(k, v)| format!("{k} = {v}")).collect();
     let _ = write!(
         md,
-        "`{}` ({}{}) with every library scheme and frictional law at their defaults (the keys: docs/problems.md, Friction; the balances: docs/mathematics.md §3), Newton, and ms/step.\n\n| scheme | law | {} | Newton | ms/step |\n|---|---|{}---|---|\n",
+        "`{}` ({}{}) with every library scheme and frictional law at their defaults (the keys: docs/problems.md, Friction; the balances: docs/mathematics.md §3), Newton's iterations, and the time per step.\n\n",
         table.problem,
         params.join(", "),
-        table.t_start.map_or(String::new(), |t| format!(", from t = {t}")),
-        table.keys.join(" | "),
-        "---|".repeat(table.keys.len())
+        table.t_start.map_or(String::new(), |t| format!(", from t = {}", readable(t)))
     );
+    let mut header = vec!["scheme", "law"];
+    header.extend(table.keys.iter().map(String::as_str));
+    header.extend(["Newton iterations (total)", "ms per step"]);
+    let mut rows = Table::new(&header);
+    let failures = Failures::new(out);
     for scheme in crate::driver::all_schemes() {
         for law in crate::driver::frictional_contact_names() {
             progress(&format!("friction: {} {scheme} {law}", table.problem));
@@ -73,28 +85,25 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
             opts.chosen.scheme = true;
             opts.chosen.contact = true;
             opts.t_start = table.t_start;
-            let row = match super::past_the_guard(methods, |methods| run(&Options { methods, ..opts.clone() })) {
+            let mut row = vec![scheme.to_string()];
+            match super::past_the_guard(methods, |methods| run(&Options { methods, ..opts.clone() })) {
                 Ok((r, note)) => {
                     let s = r.summary;
                     let get = |k: &str| s.number(k).unwrap_or(f64::NAN);
-                    let note = note.map_or(String::new(), |n| format!(" ({n})"));
-                    let keys: Vec<String> = table.keys.iter().map(|k| format!("{:.4e}", get(k))).collect();
-                    format!(
-                        "| {scheme} | {law}{note} | {} | {} | {:.2} |",
-                        keys.join(" | "),
-                        get("newton_total"),
-                        1e3 * get("seconds_per_step")
-                    )
+                    row.push(format!("{law}{}", note.map_or(String::new(), |n| format!(" ({n})"))));
+                    row.extend(table.keys.iter().map(|k| format!("{:.4e}", get(k))));
+                    row.extend([get("newton_total").to_string(), format!("{:.2}", 1e3 * get("seconds_per_step"))]);
                 }
                 Err(e) => {
-                    let e = e.to_string();
-                    let blank = " |".repeat(table.keys.len() + 1);
-                    format!("| {scheme} | {law} | failed: {}{blank}", e.lines().next().unwrap_or("").replace('|', "/"))
+                    row.push(law.to_string());
+                    row.push(failures.cell(&format!("friction_{scheme}_{law}"), &e.to_string()));
+                    row.resize(header.len(), String::new());
                 }
-            };
-            let _ = writeln!(md, "{row}");
+            }
+            rows.row_vec(row);
         }
     }
+    md.push_str(&rows.markdown());
     md.push('\n');
     Ok(md)
 }

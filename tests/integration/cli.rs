@@ -178,6 +178,39 @@ fn report_writes_markdown_with_its_figures() {
         assert!(md.contains(png.split('/').next().unwrap()), "{png} not referenced");
         assert!(std::fs::read(dir.join(png)).unwrap().starts_with(b"\x89PNG"), "{png}");
     }
+    markdown_is_a_document(&md, &dir);
+}
+
+/// Every table of a Markdown document has a separator line and rows, each row as many cells as
+/// its header; every section number is used once; every local link names a file that exists.
+fn markdown_is_a_document(md: &str, dir: &std::path::Path) {
+    let cells = |line: &str| line.replace("\\|", "").matches('|').count();
+    let lines: Vec<&str> = md.lines().collect();
+    let mut k = 0;
+    while k < lines.len() {
+        if !lines[k].starts_with('|') {
+            k += 1;
+            continue;
+        }
+        let table: Vec<&str> = lines[k..].iter().take_while(|l| l.starts_with('|')).copied().collect();
+        let header = cells(table[0]);
+        assert!(table.len() >= 3, "a table without rows at line {}:\n{}", k + 1, table.join("\n"));
+        assert!(table[1].starts_with("|---"), "no separator under the header at line {}", k + 1);
+        for (i, row) in table.iter().enumerate() {
+            assert_eq!(cells(row), header, "line {}: {row}\nunder {}", k + i + 1, table[0]);
+        }
+        k += table.len();
+    }
+    let mut numbers: Vec<&str> =
+        lines.iter().filter_map(|l| l.strip_prefix("## ")).filter_map(|l| l.split_once(". ")).map(|(n, _)| n).collect();
+    let all = numbers.len();
+    numbers.dedup();
+    assert_eq!(numbers.len(), all, "a section number used twice");
+    for link in md.split("](").skip(1).filter_map(|rest| rest.split_once(')')).map(|(l, _)| l) {
+        if !link.starts_with("http") {
+            assert!(dir.join(link).exists(), "the report links {link}, which it did not write");
+        }
+    }
 }
 
 #[test]

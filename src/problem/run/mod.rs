@@ -120,16 +120,17 @@ fn simulate(
         constraints: &constraints,
         held: held.as_ref(),
     };
-    // In a run of several processes each holds the whole state and takes the same steps; rank 0
-    // writes the results, and the checkpoints with the others' parts in a split run (any
-    // number of processes resumes them). Collective.
-    let shared = shared_dir(opts.out.as_ref())?;
-    let id = identity(opts, pf, params, in_use, &mesh, times);
-    let mut control = Control::new(opts.checkpoint_every, shared.clone(), id, opts.resume, ownership.clone())?;
-    let out = if writes { opts.out.clone() } else { None };
     let mut runner = Runner::bind(&req, &asm, &bound)?;
     let (u0, v0) = initial_fields(pf, ex, &mesh, &bound, times.t_start)?;
     let observing = Observing::new(&req, ex, &runner, &asm, &bound, times.t_start)?;
+    // Bound: the run starts, and only now makes its output directory.
+    let out = if writes { prepared(opts)? } else { None };
+    // In a run of several processes each holds the whole state and takes the same steps; rank 0
+    // writes the results, and the checkpoints with the others' parts in a split run (any
+    // number of processes resumes them). Collective.
+    let shared = shared_dir(out.as_ref())?;
+    let id = identity(opts, pf, params, in_use, &mesh, times);
+    let mut control = Control::new(opts.checkpoint_every, shared.clone(), id, opts.resume, ownership.clone())?;
     // Every process of a split run writes its piece of each snapshot, into rank 0's directory.
     let pieces = if ownership.is_some() { shared.clone() } else { out.clone() };
     let mut snapshots = Snapshots::new(pieces.as_ref(), opts.vtu_every, pf.name());
@@ -389,6 +390,17 @@ pub(super) fn row(observer: &Observer, ops: &Operators, state: State) -> RowValu
 }
 
 pub(super) type RowValues = ((f64, Vec<f64>), Vec<bool>);
+
+/// The run's output directory: `--out` prepared now when the command line asked for a fresh
+/// one (`output::prepare`: a new, emptied or `run-N` directory), else as given.
+fn prepared(opts: &Options) -> Result<Option<PathBuf>, CaseError> {
+    let (Some(dir), Some(force)) = (&opts.out, opts.out_fresh) else { return Ok(opts.out.clone()) };
+    let (dir, note) = crate::output::prepare(dir, force).map_err(CaseError::Option)?;
+    if let Some(note) = note {
+        eprintln!("note: {note}");
+    }
+    Ok(Some(dir))
+}
 
 /// The contact law's `Gamma_C`: the obstacle's region (`on REGION`, or `Gamma_C`); none without
 /// an obstacle or a region `Gamma_C`.
