@@ -159,7 +159,12 @@ fn panel(area: &Area, title: &str, x_label: &str, y_label: &str, curves: &[Curve
         let line = ShapeStyle { color: colour.to_rgba(), filled: false, stroke_width: 2 };
         let data = c.points.iter().copied().filter(|p| finite(&p));
         match pattern {
-            Pattern::Solid => chart.draw_series(LineSeries::new(data, line)).map(|_| ()),
+            // Segment by segment: plotters joins a wide path's segments with miters, which
+            // shoot far out of the panel where an oscillating curve turns sharply.
+            Pattern::Solid => {
+                let points: Vec<(f64, f64)> = data.collect();
+                chart.draw_series(points.windows(2).map(|w| PathElement::new(vec![w[0], w[1]], line))).map(|_| ())
+            }
             Pattern::Dashed => chart.draw_series(DashedLineSeries::new(data, 10, 5, line)).map(|_| ()),
             Pattern::Dotted => chart.draw_series(DashedLineSeries::new(data, 2, 4, line)).map(|_| ()),
         }

@@ -4,7 +4,13 @@
 use std::process::Command;
 
 fn signorini(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).output().expect("the binary runs");
+    signorini_in(&std::env::temp_dir(), args)
+}
+
+/// Runs the binary in `dir`, where a case file without `out` would write `results/`.
+fn signorini_in(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).current_dir(dir).output().expect("the binary runs");
     (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
@@ -89,12 +95,16 @@ fn mistakes_are_reported_with_their_line() {
         ("case.toml", "case = \"beam\"\n", ":1: `case`: no problem `beam` in the library"),
         ("solver.toml", "case = \"bar\"\nsolver = \"cholmod\"\n", ":2: `solver`: `cholmod`: expected direct"),
     ];
+    // A refused case writes nothing, not even its output directory.
+    let cwd = std::env::temp_dir().join(format!("signorini-refused-cases-{}", std::process::id()));
+    std::fs::create_dir_all(&cwd).unwrap();
     for (name, text, want) in cases {
         let path = write(name, text);
-        let (code, err) = signorini(&["run", path.to_str().unwrap()]);
+        let (code, err) = signorini_in(&cwd, &["run", path.to_str().unwrap()]);
         assert_eq!(code, 1, "{name}");
         assert!(err.contains(name) && err.contains(want), "{name}: expected `{want}` in `{err}`");
     }
+    assert!(!cwd.join("results").exists(), "a refused case made its output directory");
 }
 
 /// A case file names any problem, a library one or a file (relative to the case file), and its

@@ -149,9 +149,18 @@ fn bar_writes_series_summary_and_plots() {
     }
     let bytes = std::fs::read(dir.join("bar.png")).unwrap();
     assert!(bytes.starts_with(b"\x89PNG"), "bar.png is not a PNG");
-    let (code, _, err) = signorini(&["run", "bar", "--scheme", "midpoint", "--param", "alpha=0.1"]);
+    let refused = std::env::temp_dir().join(format!("signorini-refused-{}", std::process::id()));
+    let (code, _, err) =
+        signorini(&["run", "bar", "--scheme", "midpoint", "--param", "alpha=0.1", "--out", refused.to_str().unwrap()]);
     assert_eq!(code, 1);
     assert!(err.contains("--param alpha=0.1: unknown param `alpha`"), "{err}");
+    assert!(!refused.exists(), "a refused run made its --out directory");
+    // A rendered diagnostic is its own error line: one prefix.
+    let bad = std::env::temp_dir().join(format!("signorini-bad-{}.wf", std::process::id()));
+    std::fs::write(&bad, "problem p {\n  bogus\n}\n").unwrap();
+    let (code, _, err) = signorini(&["run", bad.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(err.starts_with("error[E0001]"), "{err}");
     // A param of the scheme or form files has no option of its own.
     let (code, _, err) = signorini(&["run", "bar", "--scheme", "hht", "--alpha", "0.1"]);
     assert_eq!(code, 2);

@@ -24,6 +24,7 @@ mod mpi;
 mod petsc;
 mod previous_level;
 mod problems;
+mod readme;
 mod redistribution;
 mod schemes;
 mod settings;
