@@ -73,7 +73,7 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
                     format!("{p0:.4} ({:+.2} %)", 100.0 * p0_err),
                     format!("{:.2} %", 100.0 * profile),
                     get("newton_total").to_string(),
-                    format!("{:.1}", get("wall_seconds")),
+                    readable(get("wall_seconds")),
                 ]);
                 sizes.push(h);
                 errors[0].push(a_err);
@@ -142,7 +142,7 @@ pub fn section(out: &Path, progress: &mut dyn FnMut(&str)) -> Result<String, Cas
             with_error("peak_force", 4),
             with_error("contact_radius", 4),
             format!("{:.5}", get("restitution")),
-            format!("{:.0}", get("wall_seconds")),
+            readable(get("wall_seconds")),
         ]);
         figure = format!("![force](hertz/{name}/{impact}.png)\n");
     }

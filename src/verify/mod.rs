@@ -244,7 +244,10 @@ impl Verification {
             s.errors.iter().map(|e| format!("{:.2e}", f(e))).collect::<Vec<_>>().join(", ")
         };
         let row = |s: &convergence::Study| match &s.failure {
-            Some(f) => format!("| {} | failed: {} | | | | | |", s.scheme, f.replace('|', "/")),
+            // The cause in a sentence: a multi-line message would break the table's row.
+            Some(f) => {
+                format!("| {} | failed: {} | | | | | |", s.scheme, crate::report::table::cause(f).replace('|', "/"))
+            }
             None => format!(
                 "| {} | {} | {:.2} | {} | {:.2} | {} | {:.2} |",
                 s.scheme,
