@@ -16,9 +16,9 @@ pub enum ShapeRule {
     Same,
     Grad,
     Div,
-    /// A tensor to a tensor (`sym`, `transpose`).
+    /// A tensor to a tensor (`sym`, `transpose`, `inv`, ...).
     Tensor,
-    /// A tensor to a scalar (`tr`).
+    /// A tensor to a scalar (`tr`, `det`).
     Trace,
     Dot,
     Inner,
@@ -88,6 +88,11 @@ pub const BUILTINS: &[Builtin] = {
         row("sym", 1, Tensor, false, "sym(A): the symmetric part of a tensor"),
         row("tr", 1, Trace, false, "tr(A): the trace of a tensor"),
         row("transpose", 1, Tensor, false, "transpose(A): the transpose of a tensor"),
+        row("det", 1, Trace, true, "det(A): the determinant of a tensor"),
+        row("inv", 1, Tensor, true, "inv(A): the inverse of a tensor, cofac(A)ᵀ/det(A)"),
+        row("cofac", 1, Tensor, true, "cofac(A): the cofactor tensor, det(A) inv(A)ᵀ"),
+        row("dev", 1, Tensor, false, "dev(A): the deviatoric part of a tensor, A − tr(A)/d I"),
+        row("skew", 1, Tensor, false, "skew(A): the skew-symmetric part of a tensor, (A − Aᵀ)/2"),
         row("dot", 2, Dot, false, "dot(a, b): the contraction of the last index"),
         row("inner", 2, Inner, false, "inner(a, b): the full contraction"),
         row("outer", 2, Outer, false, "outer(a, b): the tensor product of two vectors"),
