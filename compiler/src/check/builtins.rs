@@ -187,6 +187,22 @@ impl Builtin {
             }
         }
     }
+
+    /// What to write instead, for arguments of shapes it does not take (after
+    /// [`Builtin::result_shape`] refused them).
+    pub fn shape_help(&self, args: &[Shape]) -> Option<String> {
+        let name = self.name;
+        match (self.shape, args) {
+            (ShapeRule::Tensor | ShapeRule::Trace, [Shape::Vector]) => Some(format!(
+                "`{name}` takes a d×d tensor, such as `grad(u)` of a vector field `u` or `outer(a, b)` of two vectors"
+            )),
+            (ShapeRule::Tensor | ShapeRule::Trace, [Shape::Scalar]) => {
+                Some(format!("`{name}` takes a d×d tensor; a scalar `s` times the identity is `s*I`"))
+            }
+            (ShapeRule::Outer, _) => Some("`outer(a, b)` is the tensor a_i b_j of two vectors".into()),
+            _ => None,
+        }
+    }
 }
 
 #[cfg(test)]
