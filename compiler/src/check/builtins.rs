@@ -16,9 +16,9 @@ pub enum ShapeRule {
     Same,
     Grad,
     Div,
-    /// A tensor to a tensor (`sym`, `transpose`).
+    /// A tensor to a tensor (`sym`, `transpose`, `inv`, ...).
     Tensor,
-    /// A tensor to a scalar (`tr`).
+    /// A tensor to a scalar (`tr`, `det`).
     Trace,
     Dot,
     Inner,
@@ -88,6 +88,11 @@ pub const BUILTINS: &[Builtin] = {
         row("sym", 1, Tensor, false, "sym(A): the symmetric part of a tensor"),
         row("tr", 1, Trace, false, "tr(A): the trace of a tensor"),
         row("transpose", 1, Tensor, false, "transpose(A): the transpose of a tensor"),
+        row("det", 1, Trace, true, "det(A): the determinant of a tensor"),
+        row("inv", 1, Tensor, true, "inv(A): the inverse of a tensor, cofac(A)ᵀ/det(A)"),
+        row("cofac", 1, Tensor, true, "cofac(A): the cofactor tensor, det(A) inv(A)ᵀ"),
+        row("dev", 1, Tensor, false, "dev(A): the deviatoric part of a tensor, A − tr(A)/d I"),
+        row("skew", 1, Tensor, false, "skew(A): the skew-symmetric part of a tensor, (A − Aᵀ)/2"),
         row("dot", 2, Dot, false, "dot(a, b): the contraction of the last index"),
         row("inner", 2, Inner, false, "inner(a, b): the full contraction"),
         row("outer", 2, Outer, false, "outer(a, b): the tensor product of two vectors"),
@@ -180,6 +185,22 @@ impl Builtin {
                 let got: Vec<_> = shapes.iter().map(|s| s.name()).collect();
                 Err(format!("{name} takes scalars, not {}", got.join(" and ")))
             }
+        }
+    }
+
+    /// What to write instead, for arguments of shapes it does not take (after
+    /// [`Builtin::result_shape`] refused them).
+    pub fn shape_help(&self, args: &[Shape]) -> Option<String> {
+        let name = self.name;
+        match (self.shape, args) {
+            (ShapeRule::Tensor | ShapeRule::Trace, [Shape::Vector]) => Some(format!(
+                "`{name}` takes a d×d tensor, such as `grad(u)` of a vector field `u` or `outer(a, b)` of two vectors"
+            )),
+            (ShapeRule::Tensor | ShapeRule::Trace, [Shape::Scalar]) => {
+                Some(format!("`{name}` takes a d×d tensor; a scalar `s` times the identity is `s*I`"))
+            }
+            (ShapeRule::Outer, _) => Some("`outer(a, b)` is the tensor a_i b_j of two vectors".into()),
+            _ => None,
         }
     }
 }

@@ -5,6 +5,7 @@
 use std::collections::HashMap;
 
 mod jets;
+mod tensor;
 
 use super::graph::{Func, Graph, NodeId, Sym};
 use crate::check::{CELL_REGION, Global, Unit};
@@ -481,6 +482,10 @@ impl<'p> Lowerer<'p> {
                 let (a, b) = (next(), next());
                 let c = (0..d * d).map(|k| self.jmul(&a.c[k / d], &b.c[k % d])).collect();
                 Val { shape: Shape::Tensor, c }
+            }
+            "det" | "inv" | "cofac" | "dev" | "skew" => {
+                let a = next();
+                self.tensor_fn(f, &a)
             }
             "H" => {
                 let a = next();

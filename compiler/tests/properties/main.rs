@@ -1,8 +1,9 @@
 //! The compiler's property tests, in one binary: random inputs never make it panic, random
 //! schemes compile to stages that satisfy their relations, and the built-ins' tangents are
-//! their derivatives.
+//! their derivatives (the tensor functions also their identities).
 
 mod friction_builtins;
 mod no_panic;
 mod scheme_properties;
+mod tensor_builtins;
 mod transcendental;

@@ -174,6 +174,9 @@ impl Checker<'_> {
                 for (a, t) in args.iter().zip(tys) {
                     d = d.with_label(a.span, t.shape.name());
                 }
+                if let Some(help) = b.shape_help(&shapes) {
+                    d = d.with_help(help);
+                }
                 self.error(d);
                 return None;
             }
