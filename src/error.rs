@@ -14,6 +14,9 @@ pub enum CaseError {
     /// A case file problem, with file and line.
     #[error("{0}")]
     CaseFile(String),
+    /// Files that check but ask for what the runtime cannot do yet (a nonlinear stiffness).
+    #[error("not supported yet: {0}")]
+    Unsupported(String),
     /// `initial u = settled(...)` found no equilibrium: what Newton saw, and why it may be.
     #[error("{0}")]
     Settle(String),

@@ -269,8 +269,17 @@ impl<'m> Parts<'m> {
                 material.ok_or_else(|| missing("mass"))?.tangent(asm, &[&zero], 0, 0.0, &mut mass);
             }
         }
+        let stiffness_form = &forms[slot(&forms, "stiffness")?].1;
+        // The energies, the energy guard and the static driver read the stiffness as one matrix
+        // (½uᵀKu, K u): a stiffness nonlinear in u would make them silently wrong.
+        if !stiffness_form.linear() {
+            return Err(CaseError::Unsupported(
+                "the `stiffness` slot is nonlinear in u (a finite-strain material): the energy measures, the energy guard and the static driver read the stiffness as one matrix at u = 0, so such a material cannot run yet"
+                    .into(),
+            ));
+        }
         let mut stiffness = asm.zero_matrix();
-        forms[slot(&forms, "stiffness")?].1.tangent(asm, &[&zero], 0, 0.0, &mut stiffness);
+        stiffness_form.tangent(asm, &[&zero], 0, 0.0, &mut stiffness);
         let mut load = vec![0.0; n];
         forms[slot(&forms, "load")?].1.residual(asm, &[], 0.0, &mut load);
         let contact_nodes = match problem.contact {
