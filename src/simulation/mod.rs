@@ -224,6 +224,9 @@ impl<'m> Simulation<'m> {
         let max_cuts = self.guard.max_step_cuts.min(MAX_STEP_CUTS);
         let full: u64 = 1 << max_cuts;
         let mut at = Cursor::default();
+        // Fault injection for the restart tests: the process aborts, as if killed, right after
+        // this accepted step (and its checkpoint, if one is due). Read once, not every step.
+        let crash_at: Option<usize> = std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok());
         if let Some((saved, _)) = &control.resume {
             (at, energy) = self.resume(saved, &mut outcome)?;
         }
@@ -251,7 +254,8 @@ impl<'m> Simulation<'m> {
                 let whole = done == full;
                 let t_end = if whole { span.t0 + (k + 1) as f64 * span.dt } else { t + h };
                 let taken = Taken { k, whole, t, h, t_end, start: &start, stages_seen, report: &report };
-                let mut walk = Walk { at: &mut at, energy: &mut energy, outcome: &mut outcome, control: &mut *control };
+                let (energy, outcome, control) = (&mut energy, &mut outcome, &mut *control);
+                let mut walk = Walk { at: &mut at, energy, outcome, control, crash_at };
                 if let Some(stop) = self.accept(&mut walk, span.steps, taken, watch.step)? {
                     outcome.stopped = Some(stop);
                     break 'steps;
@@ -296,9 +300,8 @@ impl<'m> Simulation<'m> {
                 return Ok(Some(e));
             }
         }
-        // Fault injection for the restart tests: the process aborts, as if killed, right after
-        // this accepted step (and its checkpoint, if one is due).
-        if std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok()) == Some(walk.at.accepted) {
+        // Fault injection for the restart tests (`Walk::crash_at`).
+        if walk.crash_at == Some(walk.at.accepted) {
             std::process::abort();
         }
         // An interrupt lets the nominal step finish, so that its checkpoint is on the nominal
@@ -432,6 +435,8 @@ pub struct Watch<'w, 'a> {
 /// The run's state an accepted step moves on.
 struct Walk<'w> {
     at: &'w mut Cursor,
+    /// The accepted step after which the process aborts (`SIGNORINI_CRASH_AFTER_STEP`).
+    crash_at: Option<usize>,
     energy: &'w mut EnergyWatch,
     outcome: &'w mut Outcome,
     control: &'w mut Control,

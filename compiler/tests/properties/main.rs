@@ -4,6 +4,7 @@
 
 mod friction_builtins;
 mod no_panic;
+mod points;
 mod scheme_properties;
 mod tensor_builtins;
 mod transcendental;

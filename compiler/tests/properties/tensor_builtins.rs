@@ -10,10 +10,10 @@ use std::path::Path;
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
-use signorini_compiler::ir::DimIr;
 use signorini_compiler::ir::eval::evaluate;
-use signorini_compiler::ir::graph::Sym;
 use signorini_compiler::{Compiled, MemLoader, compile_text};
+
+use crate::points::{Point, check_tangent, close, coefficients, differences, points};
 
 /// F = I + ∇u near the identity; W the compressible neo-Hookean energy density and P its first
 /// Piola stress ∂W/∂F = mu (F − F⁻ᵀ) + lam ln(J) F⁻ᵀ, with F⁻ᵀ written once through `inv` and
@@ -48,51 +48,6 @@ const TANGENT_FORMS: &[&str] = &["nh", "t_det", "t_inv", "t_cofac", "t_dev", "t_
 const MU: f64 = 1.3;
 const LAM: f64 = 0.7;
 
-/// A point: the field's value and gradient (`gu[k*d + l]` = ∂_l u_k) and the coefs.
-#[derive(Clone, Debug)]
-struct Point {
-    d: usize,
-    u: Vec<f64>,
-    gu: Vec<f64>,
-    a: Vec<f64>,
-    b: Vec<f64>,
-}
-
-impl Point {
-    fn leaf(&self, s: Sym) -> f64 {
-        match s {
-            Sym::Field { arg: 0, comp } => self.u[comp as usize],
-            Sym::FieldGrad { arg: 0, comp, dir } => self.gu[comp as usize * self.d + dir as usize],
-            Sym::Coef { id: 0, comp } => self.a[comp as usize],
-            Sym::Coef { id: 1, comp } => self.b[comp as usize],
-            Sym::Param(0) => MU,
-            Sym::Param(1) => LAM,
-            other => panic!("the forms read no {other:?}"),
-        }
-    }
-
-    /// ∇u as a matrix.
-    fn at(&self, i: usize, j: usize) -> f64 {
-        self.gu[i * self.d + j]
-    }
-}
-
-/// Points whose gradient entries lie in (−g, g).
-fn point(g: f64) -> impl Strategy<Value = Point> {
-    let v = |lo: f64, hi: f64, n: usize| proptest::collection::vec(lo..hi, n);
-    (1usize..=3, v(-0.5, 0.5, 3), v(-g, g, 9), v(-1.0, 1.0, 3), v(-1.0, 1.0, 3)).prop_map(|(d, u, gu, a, b)| Point {
-        d,
-        u: u[..d].to_vec(),
-        gu: gu[..d * d].to_vec(),
-        a: a[..d].to_vec(),
-        b: b[..d].to_vec(),
-    })
-}
-
-fn close(got: f64, want: f64, tol: f64) -> bool {
-    got.is_finite() && (got - want).abs() <= tol * (1.0 + want.abs())
-}
-
 /// The determinant by Leibniz's formula (a sum over the d! permutations), independent of the
 /// compiler's cofactor expansion.
 fn leibniz(p: &Point) -> f64 {
@@ -109,60 +64,6 @@ fn leibniz(p: &Point) -> f64 {
         ],
     };
     perms.iter().map(|(s, sign)| sign * s.iter().enumerate().map(|(i, &j)| p.at(i, j)).product::<f64>()).sum()
-}
-
-/// The form's coefficients: f0 (of v, d of them) then f1 (of ∇v, d·d).
-fn coefficients(ir: &DimIr, form: &str, p: &Point) -> Vec<f64> {
-    let integral = &ir.forms.iter().find(|f| f.name == form).expect("the form is lowered").integrals[0];
-    let mut out = evaluate(&ir.graph, &integral.f0, |s| p.leaf(s));
-    out.extend(evaluate(&ir.graph, &integral.f1, |s| p.leaf(s)));
-    out
-}
-
-/// Central differences of `f` in each of the values that `bump` perturbs (`count` of them).
-fn differences(
-    p: &Point,
-    count: usize,
-    bump: fn(&mut Point, usize, f64),
-    f: impl Fn(&Point) -> Vec<f64>,
-) -> Vec<Vec<f64>> {
-    let e = 1e-6;
-    (0..count)
-        .map(|j| {
-            let (mut plus, mut minus) = (p.clone(), p.clone());
-            bump(&mut plus, j, e);
-            bump(&mut minus, j, -e);
-            f(&plus).iter().zip(f(&minus)).map(|(x, y)| (x - y) / (2.0 * e)).collect()
-        })
-        .collect()
-}
-
-/// The four blocks of the form's tangent against central differences of its coefficients, in
-/// u's value (c00, c10) and in its gradient (c01, c11).
-fn check_tangent(compiled: &Compiled, form: &str, p: &Point) -> Result<(), TestCaseError> {
-    let d = p.d;
-    let ir = compiled.ir(d);
-    let t = &ir.forms.iter().find(|f| f.name == form).expect("the form is lowered").integrals[0].tangents[0];
-    let at = |nodes: &[_]| evaluate(&ir.graph, nodes, |s| p.leaf(s));
-    let (c00, c01, c10, c11) = (at(&t.c00), at(&t.c01), at(&t.c10), at(&t.c11));
-    let (n0, n1) = (d, d * d);
-    let by_value = differences(p, d, |q, m, e| q.u[m] += e, |q| coefficients(ir, form, q));
-    let by_grad = differences(p, n1, |q, mn, e| q.gu[mn] += e, |q| coefficients(ir, form, q));
-    for i in 0..n0 + n1 {
-        for (m, fd) in by_value.iter().enumerate() {
-            let auto = if i < n0 { c00[i * d + m] } else { c10[(i - n0) * d + m] };
-            prop_assert!(close(auto, fd[i], 1e-6), "{form} {d}D: ∂coef[{i}]/∂u{m} {auto} against {} at {p:?}", fd[i]);
-        }
-        for (mn, fd) in by_grad.iter().enumerate() {
-            let auto = if i < n0 { c01[i * n1 + mn] } else { c11[(i - n0) * n1 + mn] };
-            prop_assert!(
-                close(auto, fd[i], 1e-6),
-                "{form} {d}D: ∂coef[{i}]/∂∇u[{mn}] {auto} against {} at {p:?}",
-                fd[i]
-            );
-        }
-    }
-    Ok(())
 }
 
 /// The neo-Hookean stress (form `nh`, of `inv` and `cofac`) is ∂W/∂F, the central differences
@@ -191,7 +92,7 @@ fn tensor_functions_have_exact_tangents_and_the_stress_is_the_energy_derivative(
     let mut runner = TestRunner::new(Config { cases: 150, ..Config::default() });
     // |∂_l u_k| < 0.25: ‖∇u‖ < 0.75, so F = I + ∇u has singular values above 1/4 and J > 0.
     runner
-        .run(&point(0.25), |p| {
+        .run(&points(0.25, &[MU, LAM]), |p| {
             for form in TANGENT_FORMS {
                 check_tangent(&compiled, form, &p)?;
             }
@@ -227,7 +128,7 @@ fn tensor_functions_satisfy_their_identities_on_random_matrices() {
         .unwrap_or_else(|e| panic!("the forms compile:\n{e}"));
     let mut runner = TestRunner::new(Config { cases: 400, ..Config::default() });
     runner
-        .run(&point(1.0), |p| {
+        .run(&points(1.0, &[MU, LAM]), |p| {
             // Entries in (−1, 1) and |det A| > 0.1 bound ‖A⁻¹‖ by about 20: well-conditioned.
             prop_assume!(leibniz(&p).abs() > 0.1);
             let ir = compiled.ir(p.d);

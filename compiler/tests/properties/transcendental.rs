@@ -12,6 +12,8 @@ use signorini_compiler::ir::eval::evaluate;
 use signorini_compiler::ir::graph::Sym;
 use signorini_compiler::{Compiled, MemLoader, compile_text};
 
+use crate::points::{Point, check_tangent, close, coefficients, points};
+
 /// One function: its name, the arguments of its two terms (of u, and of ∇u), the same
 /// computed here, and the argument of its `grad` form (of s = x·x).
 struct Case {
@@ -29,8 +31,8 @@ const CASES: &[Case] = &[
         name: "sin",
         value_term: "sin(dot(u, a))",
         grad_term: "sin(div(u))",
-        value: |p| p.ua().sin(),
-        grad: |p| p.div().sin(),
+        value: |p| ua(p).sin(),
+        grad: |p| div(p).sin(),
         of_x: "sin(2*dot(x, x) + 0.3)",
         of_s: |s| (2.0 * s + 0.3).sin(),
     },
@@ -38,8 +40,8 @@ const CASES: &[Case] = &[
         name: "cos",
         value_term: "cos(dot(u, a))",
         grad_term: "cos(div(u))",
-        value: |p| p.ua().cos(),
-        grad: |p| p.div().cos(),
+        value: |p| ua(p).cos(),
+        grad: |p| div(p).cos(),
         of_x: "cos(2*dot(x, x) + 0.3)",
         of_s: |s| (2.0 * s + 0.3).cos(),
     },
@@ -48,8 +50,8 @@ const CASES: &[Case] = &[
         name: "tan",
         value_term: "tan(dot(u, a))",
         grad_term: "tan(div(u))",
-        value: |p| p.ua().tan(),
-        grad: |p| p.div().tan(),
+        value: |p| ua(p).tan(),
+        grad: |p| div(p).tan(),
         of_x: "tan(dot(x, x) + 0.3)",
         of_s: |s| (s + 0.3).tan(),
     },
@@ -57,8 +59,8 @@ const CASES: &[Case] = &[
         name: "exp",
         value_term: "exp(dot(u, a))",
         grad_term: "exp(div(u))",
-        value: |p| p.ua().exp(),
-        grad: |p| p.div().exp(),
+        value: |p| ua(p).exp(),
+        grad: |p| div(p).exp(),
         of_x: "exp(2*dot(x, x) - 1)",
         of_s: |s| (2.0 * s - 1.0).exp(),
     },
@@ -66,8 +68,8 @@ const CASES: &[Case] = &[
         name: "ln",
         value_term: "ln(0.1 + dot(u, u))",
         grad_term: "ln(2 + div(u))",
-        value: |p| (0.1 + p.uu()).ln(),
-        grad: |p| (2.0 + p.div()).ln(),
+        value: |p| (0.1 + uu(p)).ln(),
+        grad: |p| (2.0 + div(p)).ln(),
         of_x: "ln(dot(x, x) + 0.05)",
         of_s: |s| (s + 0.05).ln(),
     },
@@ -76,8 +78,8 @@ const CASES: &[Case] = &[
         name: "atan2",
         value_term: "atan2(dot(u, a), dot(u, b))",
         grad_term: "atan2(div(u), 2 + dot(u, b))",
-        value: |p| p.ua().atan2(p.ub()),
-        grad: |p| p.div().atan2(2.0 + p.ub()),
+        value: |p| ua(p).atan2(ub(p)),
+        grad: |p| div(p).atan2(2.0 + ub(p)),
         // From about 10° to 150° as x·x grows, in the upper half plane (off the cut).
         of_x: "atan2(dot(x, x) + 0.05, 0.3 - 2*dot(x, x))",
         of_s: |s| (s + 0.05).atan2(0.3 - 2.0 * s),
@@ -98,78 +100,27 @@ fn source() -> String {
     s
 }
 
-/// A point: the field's value and gradient (`gu[k*d + l]` = ∂_l u_k), the coefs, x.
-#[derive(Clone, Debug)]
-struct Point {
-    d: usize,
-    u: Vec<f64>,
-    gu: Vec<f64>,
-    a: Vec<f64>,
-    b: Vec<f64>,
-    x: Vec<f64>,
+/// u·a, u·b, u·u and div u at a point: the functions' arguments.
+fn ua(p: &Point) -> f64 {
+    Point::dot(&p.u, &p.a)
 }
-
-impl Point {
-    fn dot(p: &[f64], q: &[f64]) -> f64 {
-        p.iter().zip(q).map(|(x, y)| x * y).sum()
-    }
-    fn ua(&self) -> f64 {
-        Point::dot(&self.u, &self.a)
-    }
-    fn ub(&self) -> f64 {
-        Point::dot(&self.u, &self.b)
-    }
-    fn uu(&self) -> f64 {
-        Point::dot(&self.u, &self.u)
-    }
-    fn div(&self) -> f64 {
-        (0..self.d).map(|k| self.gu[k * self.d + k]).sum()
-    }
-
-    fn leaf(&self, s: Sym) -> f64 {
-        match s {
-            Sym::Field { arg: 0, comp } => self.u[comp as usize],
-            Sym::FieldGrad { arg: 0, comp, dir } => self.gu[comp as usize * self.d + dir as usize],
-            Sym::Coef { id: 0, comp } => self.a[comp as usize],
-            Sym::Coef { id: 1, comp } => self.b[comp as usize],
-            Sym::Coord(k) => self.x[k as usize],
-            other => panic!("the forms read no {other:?}"),
-        }
-    }
+fn ub(p: &Point) -> f64 {
+    Point::dot(&p.u, &p.b)
 }
-
-fn point() -> impl Strategy<Value = Point> {
-    let v = |lo: f64, hi: f64| proptest::collection::vec(lo..hi, 3);
-    (1usize..=3, v(-0.5, 0.5), proptest::collection::vec(-0.5..0.5, 9), v(-1.0, 1.0), v(-1.0, 1.0), v(-0.5, 0.5))
-        .prop_map(|(d, u, gu, a, b, x)| Point {
-            d,
-            u: u[..d].to_vec(),
-            gu: gu[..d * d].to_vec(),
-            a: a[..d].to_vec(),
-            b: b[..d].to_vec(),
-            x: x[..d].to_vec(),
-        })
+fn uu(p: &Point) -> f64 {
+    Point::dot(&p.u, &p.u)
 }
-
-fn close(got: f64, want: f64, tol: f64) -> bool {
-    got.is_finite() && (got - want).abs() <= tol * (1.0 + want.abs())
+fn div(p: &Point) -> f64 {
+    (0..p.d).map(|k| p.at(k, k)).sum()
 }
 
 /// The coefficients f0 (of v) and f1 (of ∇v) of form `f_NAME`, and its four tangents, match
 /// the function's values and finite differences of them.
 fn check_form(compiled: &Compiled, c: &Case, p: &Point) -> Result<(), TestCaseError> {
     let d = p.d;
-    let ir = compiled.ir(d);
-    let form = ir.forms.iter().find(|f| f.name == format!("f_{}", c.name)).expect("the form is lowered");
-    let integral = &form.integrals[0];
-    let t = &integral.tangents[0];
-    let coefficients = |q: &Point| {
-        let mut out = evaluate(&ir.graph, &integral.f0, |s| q.leaf(s));
-        out.extend(evaluate(&ir.graph, &integral.f1, |s| q.leaf(s)));
-        out
-    };
+    let form = format!("f_{}", c.name);
     // f0[k] = F(value) b_k, f1[k*d + l] = F(grad) δ_kl.
-    let got = coefficients(p);
+    let got = coefficients(compiled.ir(d), &form, p);
     let (fv, fg) = ((c.value)(p), (c.grad)(p));
     for k in 0..d {
         prop_assert!(close(got[k], fv * p.b[k], 1e-14), "{} f0[{k}] {} against {}", c.name, got[k], fv * p.b[k]);
@@ -180,36 +131,7 @@ fn check_form(compiled: &Compiled, c: &Case, p: &Point) -> Result<(), TestCaseEr
         }
     }
     // ∂/∂u_m and ∂/∂(∂_n u_m), by central differences of the coefficients.
-    let e = 1e-6;
-    let n0 = d;
-    let n1 = d * d;
-    let c00 = evaluate(&ir.graph, &t.c00, |s| p.leaf(s));
-    let c01 = evaluate(&ir.graph, &t.c01, |s| p.leaf(s));
-    let c10 = evaluate(&ir.graph, &t.c10, |s| p.leaf(s));
-    let c11 = evaluate(&ir.graph, &t.c11, |s| p.leaf(s));
-    for m in 0..d {
-        let (mut plus, mut minus) = (p.clone(), p.clone());
-        plus.u[m] += e;
-        minus.u[m] -= e;
-        let (fp, fm) = (coefficients(&plus), coefficients(&minus));
-        for i in 0..n0 + n1 {
-            let fd = (fp[i] - fm[i]) / (2.0 * e);
-            let auto = if i < n0 { c00[i * d + m] } else { c10[(i - n0) * d + m] };
-            prop_assert!(close(auto, fd, 1e-6), "{} {d}D: ∂coef[{i}]/∂u{m} {auto} against {fd} at {p:?}", c.name);
-        }
-    }
-    for mn in 0..n1 {
-        let (mut plus, mut minus) = (p.clone(), p.clone());
-        plus.gu[mn] += e;
-        minus.gu[mn] -= e;
-        let (fp, fm) = (coefficients(&plus), coefficients(&minus));
-        for i in 0..n0 + n1 {
-            let fd = (fp[i] - fm[i]) / (2.0 * e);
-            let auto = if i < n0 { c01[i * n1 + mn] } else { c11[(i - n0) * n1 + mn] };
-            prop_assert!(close(auto, fd, 1e-6), "{} {d}D: ∂coef[{i}]/∂∇u[{mn}] {auto} against {fd} at {p:?}", c.name);
-        }
-    }
-    Ok(())
+    check_tangent(compiled, &form, p)
 }
 
 /// `grad(F(x·x))`, the coefficient of v in form `g_NAME`, against central differences in x of
@@ -237,10 +159,10 @@ fn transcendental_functions_have_their_values_and_exact_tangents() {
         .unwrap_or_else(|e| panic!("the forms compile:\n{e}"));
     let mut runner = TestRunner::new(Config { cases: 300, ..Config::default() });
     runner
-        .run(&point(), |p| {
+        .run(&points(0.5, &[]), |p| {
             // atan2's first term: keep off the origin (its derivative grows as 1/r there) and the
             // cut (x < 0, y = 0), where the angle jumps by 2π and differences measure the jump.
-            let (y, x) = (p.ua(), p.ub());
+            let (y, x) = (ua(&p), ub(&p));
             prop_assume!(x.hypot(y) > 0.1 && (x > 0.0 || y.abs() > 0.05));
             for c in CASES {
                 check_form(&compiled, c, &p)?;
