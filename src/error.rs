@@ -14,9 +14,13 @@ pub enum CaseError {
     /// A case file problem, with file and line.
     #[error("{0}")]
     CaseFile(String),
-    /// Files that check but ask for what the runtime cannot do yet (a nonlinear stiffness).
-    #[error("not supported yet: {0}")]
-    Unsupported(String),
+    /// Files that check but lack what a run needs of them (a nonlinear stiffness without its
+    /// stored energy).
+    #[error("the files in use: {0}")]
+    Incomplete(String),
+    /// A static equilibrium Newton did not reach, with where it went wrong (an inverted cell).
+    #[error("{0}")]
+    Diverged(String),
     /// `initial u = settled(...)` found no equilibrium: what Newton saw, and why it may be.
     #[error("{0}")]
     Settle(String),
@@ -30,7 +34,7 @@ pub enum CaseError {
     Write { path: String, source: std::io::Error },
     /// Newton failed at a step even after `cuts` halvings of Δt.
     #[error(
-        "stopped at t = {at} after {cuts} step cuts (Δt = {dt:.3e}): {cause}\n  Newton: {history}\n  results up to the last good step are written; more cuts: --max-step-cuts, or try a smaller Δt",
+        "stopped at t = {at} after {cuts} step cuts (Δt = {dt:.3e}): {cause}\n{history}  results up to the last good step are written; more cuts: --max-step-cuts, or try a smaller Δt",
         at = at(.t)
     )]
     Stopped { t: f64, cuts: usize, dt: f64, cause: String, history: String },
@@ -39,7 +43,7 @@ pub enum CaseError {
     Failed { t: f64, cause: String },
     /// The energy grew past what a stable scheme allows.
     #[error(
-        "stopped at t = {at}: the energy E_aug = ½uᵀKu + ½vᵀMv + contact energy = {energy:.6e} exceeds E_aug(0) + the work of the loads = {bound:.6e} by {:.1} % of the problem's energy scale {scale:.4e} (the largest of |E_aug(0)|, the work and the kinetic energy reached); the tolerance is {:.1} %{law}: the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Δt beyond a conditionally stable scheme's limit (an explicit scheme, an explicit contact term), Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt, a contact parameter so large (γ0 or ε ≳ 1e12 × E) that the contact rows' round-off swamps the solve, or degenerate cells. Results up to the last good step are written; --energy-tolerance sets the tolerance (0 turns this check off)",
+        "stopped at t = {at}: the energy E_aug = W(u) + ½vᵀMv + contact energy = {energy:.6e} (W the stored energy: ½uᵀKu for a linear material) exceeds E_aug(0) + the work of the loads = {bound:.6e} by {:.1} % of the problem's energy scale {scale:.4e} (the largest of |E_aug(0)|, the work and the kinetic energy reached); the tolerance is {:.1} %{law}: the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Δt beyond a conditionally stable scheme's limit (an explicit scheme, an explicit contact term), Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt, a contact parameter so large (γ0 or ε ≳ 1e12 × E) that the contact rows' round-off swamps the solve, or degenerate cells. Results up to the last good step are written; --energy-tolerance sets the tolerance (0 turns this check off)",
         100.0 * (energy - bound) / scale,
         100.0 * tolerance,
         at = at(.t)
@@ -47,7 +51,7 @@ pub enum CaseError {
     BlowUp { t: f64, energy: f64, bound: f64, scale: f64, tolerance: f64, law: String, params: String },
     /// The potential energy went negative: the contact law is not coercive for its params.
     #[error(
-        "stopped at t = {at}: the potential energy ½uᵀKu + contact energy = {potential:.6e} is negative, beyond {:.1} % of the problem's energy scale {scale:.4e}: the discrete problem is not stable. Most likely the contact law is not coercive for these params (Nitsche θ = 1 or 0 with γ0 too small against the material's stiffness; θ = −1 is coercive for any γ0), and the motion grows without bound while E_aug is kept; otherwise the steps' solutions diverge (an iterative solve that is not accurate enough: try --solver direct).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
+        "stopped at t = {at}: the potential energy W(u) + contact energy = {potential:.6e} is negative, beyond {:.1} % of the problem's energy scale {scale:.4e}: the discrete problem is not stable. Most likely the contact law is not coercive for these params (Nitsche θ = 1 or 0 with γ0 too small against the material's stiffness; θ = −1 is coercive for any γ0), and the motion grows without bound while E_aug is kept; otherwise the steps' solutions diverge (an iterative solve that is not accurate enough: try --solver direct).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
         100.0 * tolerance,
         at = at(.t)
     )]

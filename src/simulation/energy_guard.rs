@@ -1,4 +1,5 @@
-//! The energy guard: after every step, E_aug = ½uᵀKu + ½vᵀMv + the contact law's energy against
+//! The energy guard: after every step, E_aug = W(u) + ½vᵀMv + the contact law's energy (W the
+//! stored energy, ½uᵀKu for a linear material) against
 //! E_aug(0) + the work done on the body so far (the loads', the held dofs' reactions', a moving
 //! obstacle's, the contact law's own, less what its friction took), with the allowance the scheme's energy law gives; a
 //! growth beyond the tolerance, a negative potential energy, or a law's own work beyond the
@@ -31,7 +32,7 @@ impl Ended<'_> {
     }
 }
 
-/// The energy guard: the growth of E_aug = ½uᵀKu + ½vᵀMv + the contact law's
+/// The energy guard: the growth of E_aug = W(u) + ½vᵀMv + the contact law's
 /// `contact_energy(u)` beyond E_aug(0) + the work of the loads, over the problem's energy scale
 /// (the largest of |E_aug(0)|, the work's magnitude so far, and the kinetic energy reached).
 pub(super) struct EnergyWatch {
@@ -72,7 +73,7 @@ pub(super) struct Grown {
 pub(super) enum Cause {
     /// E_aug beyond its bound.
     Growth,
-    /// ½uᵀKu + the contact energy negative beyond the tolerance.
+    /// W(u) + the contact energy negative beyond the tolerance.
     Negative(f64),
     /// The law's own work beyond the energy from outside.
     LawWork { work: f64, outside: f64 },
@@ -118,7 +119,7 @@ impl EnergyWatch {
     }
 
     /// Adds the work of the held dofs' reactions over one step: the reaction at the step's
-    /// midpoint, K u_mid − F + M (v' − v)/Δt at the held dofs (exact for Crank–Nicolson; without
+    /// midpoint, S(u_mid) − F + M (v' − v)/Δt at the held dofs (S the internal force, K u for a linear material) (exact for Crank–Nicolson; without
     /// a velocity state, its quasi-static part), times their motion.
     pub(super) fn held_work(
         &mut self,
@@ -130,8 +131,7 @@ impl EnergyWatch {
         t_mid: f64,
     ) {
         let mid: Vec<f64> = before.iter().zip(u).map(|(a, b)| 0.5 * (a + b)).collect();
-        let mut reaction = vec![0.0; u.len()];
-        ops.stiffness.mul_vec(&mid, &mut reaction);
+        let mut reaction = ops.internal_force(&mid);
         if let Some((v0, v1)) = v {
             let dv: Vec<f64> = v1.iter().zip(v0).map(|(a, b)| (a - b) / h).collect();
             let mut inertia = vec![0.0; u.len()];

@@ -142,7 +142,12 @@ impl<'m> Simulation<'m> {
             }
             stepper.initial_constraints = Some(initial);
         }
-        ops.energies = Energies::new(asm, stepper.half_pattern(), &ops.stiffness, ops.scheme_mass());
+        ops.energies = Energies::new(
+            asm,
+            stepper.half_pattern(),
+            ops.nonlinear.is_none().then_some(&ops.stiffness),
+            ops.scheme_mass(),
+        );
         let n = asm.size();
         let names = &stepper.desc().states;
         let states = names.iter().map(|_| vec![0.0; n]).collect();
@@ -334,6 +339,16 @@ impl<'m> Simulation<'m> {
                     stages_seen.push((stage.time, u.to_vec(), stage.value_of("v").map(<[f64]>::to_vec)));
                 }
             }
+        });
+        // A finite-strain material's step may converge where the stiffness's quadrature points
+        // see a positive J but the body is inside out at the stored energy's (a NaN energy):
+        // the step fails, and a cut may mend it.
+        let result = result.and_then(|report| match ops.nonlinear.is_some() && !ops.elastic(&states[0]).is_finite() {
+            true => match crate::runtime::fem::mesh::inverted::anywhere(ops.asm, &states[0]) {
+                Some(at) => Err(StepError::Inverted { stage: "the step's end".into(), t: t + h, at }),
+                None => Err(StepError::NonFinite { t: t + h }),
+            },
+            false => Ok(report),
         });
         if result.is_err()
             && let Some(saved) = &start.saved
@@ -669,8 +684,10 @@ pub struct Resumed {
 }
 
 /// The residual history of a failed Newton, for the stop message.
+/// Newton's iterations of the last attempt, as a line of the stop's message (none when the step
+/// failed otherwise: an inverted cell).
 fn history(e: &crate::runtime::time::stepper::StepError) -> String {
     use crate::runtime::time::stepper::StepError;
     let StepError::Newton { source, .. } = e else { return String::new() };
-    source.report().describe()
+    format!("  Newton: {}\n", source.report().describe())
 }

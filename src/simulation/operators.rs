@@ -1,8 +1,9 @@
 //! What a run measures with, bound on its mesh: the material's mass, the mass the scheme steps
 //! with, the stiffness and the load; the contact form (its residual is the contact force, its
 //! switches the active set) and the contact law's functionals (energy, jump, work, pressure);
-//! the energies ½uᵀKu and ½vᵀMv, each computed once per step; and the binding of all of it,
-//! with the scheme's forms, from the files in use.
+//! the energies ½uᵀKu (or the material's `strain_energy(u)` for a stiffness nonlinear in u) and
+//! ½vᵀMv, each computed once per step; and the binding of all of it, with the scheme's forms,
+//! from the files in use.
 
 use std::sync::Arc;
 
@@ -42,7 +43,10 @@ pub struct Operators<'m> {
     /// lumped: [`Operators::scheme_mass`]), the stiffness and the load vector at t = 0.
     pub mass: Matrix,
     pub other_mass: Option<Matrix>,
+    /// The stiffness's tangent at u = 0 (K itself for a linear material).
     pub stiffness: Matrix,
+    /// A stiffness nonlinear in u (a finite-strain material): its form and stored energy.
+    pub nonlinear: Option<NonlinearStiffness<'m>>,
     pub load: Vec<f64>,
     /// The `load` slot when it changes with time (a traction p(t)): the energy check then sums
     /// its work step by step instead of taking the load at t = 0.
@@ -60,6 +64,13 @@ pub struct Operators<'m> {
     pub energies: Energies,
     /// The last `contact_switches` asked for: u, t's bits and the answer.
     last_switches: std::sync::Mutex<Option<KeptSwitches>>,
+}
+
+/// A stiffness nonlinear in u: the form, whose residual S(u) is the internal force, and the
+/// material's `strain_energy(u)`, whose derivative it is.
+pub struct NonlinearStiffness<'m> {
+    pub form: Box<dyn BoundForm + 'm>,
+    pub energy: Box<dyn BoundFunctional + 'm>,
 }
 
 /// Switches kept for the u, the previous level (empty when the law does not read it) and the
@@ -82,19 +93,40 @@ pub struct Energies {
     mass: Option<LowerHalf>,
     work: std::sync::Mutex<Vec<f64>>,
     last: std::sync::Mutex<LastQuads>,
+    /// The last u and value of a nonlinear material's stored energy (the step's end is read by
+    /// the stepper's check, the guard and the observers).
+    last_stored: std::sync::Mutex<Option<(Vec<f64>, f64)>>,
 }
 
 impl Energies {
     /// Without lower halves: the full products.
     pub fn full() -> Energies {
-        Energies { stiffness: None, mass: None, work: Default::default(), last: Default::default() }
+        Energies {
+            stiffness: None,
+            mass: None,
+            work: Default::default(),
+            last: Default::default(),
+            last_stored: Default::default(),
+        }
     }
 
-    /// With the stepper's lower-half pattern when it has one (the same pattern).
-    pub fn new(asm: &Assembler, half: Option<&Arc<HalfPattern>>, stiffness: &Matrix, mass: &Matrix) -> Energies {
+    /// With the stepper's lower-half pattern when it has one (the same pattern); without a
+    /// stiffness matrix when the stiffness is nonlinear (its energy is a functional).
+    pub fn new(
+        asm: &Assembler,
+        half: Option<&Arc<HalfPattern>>,
+        stiffness: Option<&Matrix>,
+        mass: &Matrix,
+    ) -> Energies {
         let half = half.cloned().unwrap_or_else(|| Arc::new(HalfPattern::new(asm.pattern())));
         let lower = |a: &Matrix| a.is_symmetric_everywhere(1e-12).then(|| LowerHalf::new(a, &half));
-        Energies { stiffness: lower(stiffness), mass: lower(mass), work: Default::default(), last: Default::default() }
+        Energies {
+            stiffness: stiffness.and_then(lower),
+            mass: lower(mass),
+            work: Default::default(),
+            last: Default::default(),
+            last_stored: Default::default(),
+        }
     }
 
     /// xᵀAx for A the stiffness (`which` 0) or the mass (1): the last value again for the
@@ -144,19 +176,38 @@ impl Operators<'_> {
         v.map_or(0.0, |v| 0.5 * self.energies.quad(1, self.scheme_mass(), v))
     }
 
-    /// E = ½uᵀKu + ½vᵀMv − Fᵀu.
+    /// E = W(u) + ½vᵀMv − Fᵀu, W the stored energy ([`Operators::elastic`]).
     pub fn energy(&self, u: &[f64], v: Option<&[f64]>) -> f64 {
         self.energy_with_kinetic(u, self.kinetic(v))
     }
 
-    /// E = ½uᵀKu + `kinetic` − Fᵀu, with ½vᵀMv already computed.
+    /// E = W(u) + `kinetic` − Fᵀu, with ½vᵀMv already computed.
     pub fn energy_with_kinetic(&self, u: &[f64], kinetic: f64) -> f64 {
         self.elastic(u) + kinetic - self.load.iter().zip(u).map(|(l, x)| l * x).sum::<f64>()
     }
 
-    /// ½uᵀKu.
+    /// The stored energy W(u): ½uᵀKu, or a nonlinear material's `strain_energy(u)`.
     pub fn elastic(&self, u: &[f64]) -> f64 {
-        0.5 * self.energies.quad(0, &self.stiffness, u)
+        let Some(m) = &self.nonlinear else { return 0.5 * self.energies.quad(0, &self.stiffness, u) };
+        let mut last = self.energies.last_stored.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((kept, value)) = &*last
+            && kept.as_slice() == u
+        {
+            return *value;
+        }
+        let value = m.energy.value(self.asm, &[u], 0.0);
+        *last = Some((u.to_vec(), value));
+        value
+    }
+
+    /// The internal force S(u): K u, or a nonlinear material's residual.
+    pub fn internal_force(&self, u: &[f64]) -> Vec<f64> {
+        let mut f = vec![0.0; u.len()];
+        match &self.nonlinear {
+            Some(m) => m.form.residual(self.asm, &[u], 0.0, &mut f),
+            None => self.stiffness.mul_vec(u, &mut f),
+        }
+        f
     }
 
     /// The resultant of the contact term on the body along each axis (zeros without a
@@ -269,15 +320,20 @@ impl<'m> Parts<'m> {
                 material.ok_or_else(|| missing("mass"))?.tangent(asm, &[&zero], 0, 0.0, &mut mass);
             }
         }
-        let stiffness_form = &forms[slot(&forms, "stiffness")?].1;
-        // The energies, the energy guard and the static driver read the stiffness as one matrix
-        // (½uᵀKu, K u): a stiffness nonlinear in u would make them silently wrong.
-        if !stiffness_form.linear() {
-            return Err(CaseError::Unsupported(
-                "the `stiffness` slot is nonlinear in u (a finite-strain material): the energy measures, the energy guard and the static driver read the stiffness as one matrix at u = 0, so such a material cannot run yet"
-                    .into(),
-            ));
-        }
+        // A scheme that applies another slot in its place (an energy–momentum stress) still
+        // measures with the material's.
+        let material_stiffness;
+        let stiffness_form = match forms.iter().find(|(s, _)| s == "stiffness") {
+            Some((_, f)) => f,
+            None => {
+                material_stiffness = in_use.forms.instantiate(problem.coefs, &binding)?.take_form("stiffness");
+                material_stiffness.as_ref().ok_or_else(|| missing("stiffness"))?
+            }
+        };
+        let nonlinear = match stiffness_form.linear() {
+            true => None,
+            false => Some(nonlinear_stiffness(in_use, problem.coefs, &binding, &mut inst)?),
+        };
         let mut stiffness = asm.zero_matrix();
         stiffness_form.tangent(asm, &[&zero], 0, 0.0, &mut stiffness);
         let mut load = vec![0.0; n];
@@ -325,6 +381,7 @@ impl<'m> Parts<'m> {
             mass,
             other_mass: scheme_mass,
             stiffness,
+            nonlinear,
             load,
             varying_load: in_use
                 .forms
@@ -350,6 +407,25 @@ impl<'m> Parts<'m> {
             }
         }
         Ok(Parts { ops, forms, inertia })
+    }
+}
+
+/// The stiffness slot again, for the internal force, and the `strain_energy` its files provide
+/// (the energy columns and the guard read it: ½uᵀKu would be the energy of the tangent at rest).
+fn nonlinear_stiffness<'m>(
+    in_use: &FilesInUse,
+    coefs: &dyn Fn(&str) -> Option<crate::runtime::fem::kernel::Coef>,
+    binding: &Binding<'m>,
+    inst: &mut crate::driver::Instance<'m>,
+) -> Result<NonlinearStiffness<'m>, CaseError> {
+    let form = in_use.forms.instantiate(coefs, binding)?.take_form("stiffness");
+    let energy = inst.take_functional("strain_energy").filter(|f| f.fields() == 1);
+    match (form, energy) {
+        (Some(form), Some(energy)) => Ok(NonlinearStiffness { form, energy }),
+        _ => Err(CaseError::Incomplete(
+            "the `stiffness` slot is nonlinear in u (a finite-strain material), and no file provides its stored energy: add `functional strain_energy(u) = int(Omega) W` to the material's file (the energy columns and the energy guard read it; ½uᵀKu is the energy of a linear material only)"
+                .into(),
+        )),
     }
 }
 

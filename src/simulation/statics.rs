@@ -7,6 +7,7 @@ use crate::runtime::fem::assembly::{Assembler, Quadrature};
 use crate::runtime::fem::bound::BoundFunctional;
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::fem::mesh::Facet;
+use crate::runtime::fem::mesh::inverted::most_inverted;
 use crate::runtime::library::Binding;
 use crate::runtime::linalg::{Counters, Structure};
 use crate::runtime::nonlinear::newton::{Newton, NewtonOptions, NewtonReport};
@@ -17,8 +18,9 @@ use crate::runtime::nonlinear::statics::{Constraints, StaticContact};
 pub struct StaticProblem<'p> {
     /// The case's coefficients by name (`f`, `g`, `nc`, ...).
     pub coefs: &'p dyn Fn(&str) -> Option<Coef>,
-    /// The mesh region bound to the forms' `Gamma_C`.
-    pub contact: &'p str,
+    /// The mesh region bound to the forms' `Gamma_C` (none: the contact law integrates over no
+    /// facet, and Dirichlet conditions must hold the body).
+    pub contact: Option<&'p str>,
     /// The other regions the forms may integrate over (a load's), bound by their names.
     pub regions: &'p [String],
     /// Degree of the contact term's facet rule (None: the form's own choice).
@@ -54,7 +56,10 @@ pub fn solve<'m>(
 ) -> Result<StaticSolution<'m>, CaseError> {
     let d = asm.mesh().dim();
     let n = asm.size();
-    let facets = asm.region(problem.contact)?;
+    let facets = match problem.contact {
+        Some(name) => asm.region(name)?,
+        None => &[],
+    };
     // Every file's forms are bound twice (the volume terms with their own rules, the contact
     // with the problem's facet rule): both bindings name every region a form may read.
     let mut regions = vec![("Gamma_C".to_string(), facets)];
@@ -73,13 +78,12 @@ pub fn solve<'m>(
     let contact = on_boundary.take_form("contact").ok_or_else(|| missing("contact"))?;
     let mut load = vec![0.0; n];
     load_form.residual(asm, &[], problem.t, &mut load);
-    let mut static_problem =
-        StaticContact::new(asm, stiffness.as_ref(), load, contact, problem.constraints, Structure::Auto);
+    let mut static_problem = StaticContact::new(asm, stiffness, load, contact, problem.constraints, Structure::Auto);
     let mut u = initial;
     if u.len() != n {
         return Err(CaseError::Option(format!("the initial state has {} values, the mesh {n} unknowns", u.len())));
     }
-    static_problem.constraints.zero(&mut u);
+    static_problem.constraints.impose(&mut u);
     // A law's `prev` (a frictional slip) is measured from the initial state.
     static_problem.previous.clone_from(&u);
     static_problem.time = problem.t;
@@ -90,7 +94,12 @@ pub fn solve<'m>(
         options.solver = crate::runtime::linalg::Solver::Direct;
     }
     let mut newton = Newton::new(options);
-    let report = newton.solve(&mut static_problem, &mut u)?;
+    let report = newton.solve(&mut static_problem, &mut u).map_err(|e| match most_inverted(asm.mesh(), &u) {
+        Some(cell) => CaseError::Diverged(format!(
+            "the static equilibrium was not found ({e}): at Newton's last iterate {cell}, where a finite-strain material's stress is not defined (ln J, F⁻¹); start from a guess closer to the equilibrium (`initial u`), or move the held values less"
+        )),
+        None => CaseError::Newton(e),
+    })?;
     let contact_force = super::resultant(&static_problem.contact_residual(&u), d);
     let mut set = Vec::new();
     static_problem.active_set(&u, &mut set);

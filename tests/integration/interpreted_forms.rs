@@ -19,6 +19,8 @@ use signorini::runtime::fem::mesh::Facet;
 use signorini::runtime::fem::mesh::structured::{self, Diagonal};
 
 signorini::forms!("forms/elasticity.wf");
+signorini::forms!("forms/neo_hookean.wf");
+signorini::forms!("forms/saint_venant_kirchhoff.wf");
 signorini::forms!("forms/contact_nitsche.wf");
 signorini::forms!("forms/contact_penalty.wf");
 signorini::forms!("tests/problems/power_law_penalty.wf");
@@ -325,8 +327,26 @@ unit_test!(
     elasticity,
     "forms/elasticity.wf",
     |d| elasticity::Coefficients { f: d.f.clone() },
-    forms: [Mass, Stiffness, Load],
+    forms: [Mass, Stiffness, Load, StiffnessDg],
     functionals: [VonMises, Measure]
+);
+
+unit_test!(
+    neo_hookean_interpreted_matches_compiled,
+    neo_hookean,
+    "forms/neo_hookean.wf",
+    |d| neo_hookean::Coefficients { f: d.f.clone() },
+    forms: [Mass, Stiffness, Load],
+    functionals: [StrainEnergy, Measure]
+);
+
+unit_test!(
+    saint_venant_kirchhoff_interpreted_matches_compiled,
+    saint_venant_kirchhoff,
+    "forms/saint_venant_kirchhoff.wf",
+    |d| saint_venant_kirchhoff::Coefficients { f: d.f.clone() },
+    forms: [Mass, Stiffness, Load, StiffnessDg],
+    functionals: [StrainEnergy, Measure]
 );
 
 unit_test!(

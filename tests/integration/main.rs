@@ -11,6 +11,7 @@ mod convergence;
 mod disc;
 mod elements;
 mod energy_guard;
+mod finite_strain;
 mod friction;
 mod friction_laws;
 mod genalpha;

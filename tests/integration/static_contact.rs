@@ -108,8 +108,14 @@ fn factorization_is_reused_while_the_active_set_is_unchanged() {
     let mut constraints = Constraints::none(n);
     let centre = (0..mesh.num_nodes()).find(|&i| mesh.node(i) == [0.0, 0.0]).unwrap();
     constraints.fix(2 * centre);
-    let mut problem =
-        StaticContact::new(&asm, &stiffness, load.clone(), contact, constraints, Structure::SymmetricPositiveDefinite);
+    let mut problem = StaticContact::new(
+        &asm,
+        Box::new(stiffness),
+        load.clone(),
+        contact,
+        constraints,
+        Structure::SymmetricPositiveDefinite,
+    );
     let mut u = vec![0.0; n];
     // Below the deepest gap (0.5 at the corners): every contact point active at the start.
     u.iter_mut().skip(1).step_by(2).for_each(|x| *x = -0.5 - 1e-7);
@@ -156,8 +162,14 @@ fn newton_failures_are_typed_errors_with_history() {
         Coef::function(1, |x, _, o| o[0] = x[1] + 10.0),
         Quadrature::default(),
     );
-    let mut problem =
-        StaticContact::new(&asm, &stiffness, load, contact, Constraints::none(n), Structure::SymmetricPositiveDefinite);
+    let mut problem = StaticContact::new(
+        &asm,
+        Box::new(stiffness),
+        load,
+        contact,
+        Constraints::none(n),
+        Structure::SymmetricPositiveDefinite,
+    );
     let mut u = vec![0.0; n];
     match Newton::new(NewtonOptions::default()).solve(&mut problem, &mut u) {
         Err(NewtonError::Linear { report, source }) => {

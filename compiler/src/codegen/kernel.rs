@@ -73,6 +73,20 @@ fn dispatch(on: &str, arms: Vec<(usize, String)>, other: Option<&str>) -> Option
             Some((inner, block)) => Some(format!("if {on} == {k} && {inner} {{\n{block}")),
             None => Some(format!("if {on} == {k} {{\n{body}}}{otherwise}\n")),
         },
+        // Arms that are all boolean literals, as the default is: `matches!` (clippy's
+        // match_like_matches_macro), listing the arms that differ from the default.
+        _ if other.is_some_and(|o| o == "true" || o == "false")
+            && arms.iter().all(|(_, b)| matches!(b.trim(), "true" | "false")) =>
+        {
+            let other = other.unwrap_or("true");
+            let differ: Vec<String> =
+                arms.iter().filter(|(_, b)| b.trim() != other).map(|(k, _)| k.to_string()).collect();
+            let not = if other == "true" { "!" } else { "" };
+            Some(match differ.is_empty() {
+                true => format!("{other}\n"),
+                false => format!("{not}matches!({on}, {})\n", differ.join(" | ")),
+            })
+        }
         _ => {
             let arms: String = arms.iter().map(|(k, body)| format!("{k} => {{\n{body}}}\n")).collect();
             Some(format!("match {on} {{\n{arms}_ => {}\n}}\n", other.unwrap_or("{}")))

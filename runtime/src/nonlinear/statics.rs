@@ -1,6 +1,7 @@
-//! Static problems assembled from compiled forms: K u + C(u) = L, where K is a linear form
-//! assembled once, C a contact form on a boundary region, and L the loads; Dirichlet
-//! conditions on chosen dofs.
+//! Static problems assembled from compiled forms: S(u) + C(u) = L, where S is the stiffness
+//! (a linear form K u, assembled once, or a material nonlinear in u, assembled at every
+//! iterate), C a contact form on a boundary region, and L the loads; Dirichlet conditions on
+//! chosen dofs, held at their values.
 
 use crate::fem::assembly::Assembler;
 use crate::fem::bound::BoundForm;
@@ -96,10 +97,16 @@ pub fn solve_linear(
     Ok(rhs)
 }
 
-/// K u + C(u) − L = 0.
+/// The stiffness term of a static problem: K, assembled once, or a form nonlinear in u.
+enum Stiffness<'m> {
+    Matrix(Matrix),
+    Nonlinear(Box<dyn BoundForm + 'm>),
+}
+
+/// S(u) + C(u) − L = 0.
 pub struct StaticContact<'m> {
     asm: &'m Assembler<'m>,
-    stiffness: Matrix,
+    stiffness: Stiffness<'m>,
     load: Vec<f64>,
     /// The largest term of the last residual.
     magnitude: f64,
@@ -115,10 +122,10 @@ pub struct StaticContact<'m> {
 }
 
 impl<'m> StaticContact<'m> {
-    /// Assembles the linear form `stiffness` once.
+    /// Assembles `stiffness` once when it is linear in u; a nonlinear one is kept as a form.
     pub fn new(
         asm: &'m Assembler<'m>,
-        stiffness: &dyn BoundForm,
+        stiffness: Box<dyn BoundForm + 'm>,
         load: Vec<f64>,
         contact: Box<dyn BoundForm + 'm>,
         constraints: Constraints,
@@ -126,13 +133,18 @@ impl<'m> StaticContact<'m> {
     ) -> Self {
         let n = asm.size();
         let zero = vec![0.0; n];
-        let mut k = asm.zero_matrix();
-        stiffness.tangent(asm, &[&zero], 0, 0.0, &mut k);
+        let stiffness = if stiffness.linear() {
+            let mut k = asm.zero_matrix();
+            stiffness.tangent(asm, &[&zero], 0, 0.0, &mut k);
+            Stiffness::Matrix(k)
+        } else {
+            Stiffness::Nonlinear(stiffness)
+        };
         let mut load = load;
         constraints.zero(&mut load);
         StaticContact {
             asm,
-            stiffness: k,
+            stiffness,
             load,
             magnitude: 0.0,
             contact,
@@ -168,7 +180,13 @@ impl NonlinearProblem for StaticContact<'_> {
     }
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
         use crate::linalg::norms::norm_inf;
-        self.stiffness.mul_vec(u, r);
+        match &self.stiffness {
+            Stiffness::Matrix(k) => k.mul_vec(u, r),
+            Stiffness::Nonlinear(form) => {
+                r.fill(0.0);
+                form.residual(self.asm, &[u], self.time, r);
+            }
+        }
         let stiffness = norm_inf(r);
         self.contact.residual(self.asm, &self.args(u), self.time, r);
         // The contact term's size is that of K u + C(u) at worst plus K u's.
@@ -183,12 +201,17 @@ impl NonlinearProblem for StaticContact<'_> {
 
     fn active_set(&mut self, u: &[f64], out: &mut Vec<bool>) -> bool {
         let here = self.contact.switches(self.asm, &self.args(u), 0, self.time, out);
+        // A nonlinear stiffness's tangent changes with u everywhere.
+        let linear = matches!(self.stiffness, Stiffness::Matrix(_));
         // A split run's processes see their own facets' gates (see the stage problem's).
-        self.contact.piecewise() || (here && self.asm.pattern().ownership().is_none())
+        linear && (self.contact.piecewise() || (here && self.asm.pattern().ownership().is_none()))
     }
 
     fn jacobian(&mut self, u: &[f64], j: &mut Matrix) {
-        j.values.copy_from_slice(&self.stiffness.values);
+        match &self.stiffness {
+            Stiffness::Matrix(k) => j.values.copy_from_slice(&k.values),
+            Stiffness::Nonlinear(form) => form.tangent(self.asm, &[u], 0, self.time, j),
+        }
         self.contact.tangent(self.asm, &self.args(u), 0, self.time, j);
         self.constraints.apply(j);
     }

@@ -89,12 +89,15 @@ pub(super) fn zero_sum_groups(coefs: &[f64]) -> Vec<Vec<usize>> {
 
 /// Cholesky if every form's tangent is symmetric, LU otherwise. Nonlinear tangents are probed at
 /// pseudo-random states ±s, larger than the mesh, so that a switched term (a contact law's
-/// active set) is active at each point in one of them. In a split run every process probes its
-/// cells, and one nonsymmetric part decides for all.
+/// active set) is active at each point in one of them, and at states a thousandth of the mesh's
+/// cells in size, where a finite-strain material is defined (J = det F > 0; at the large states
+/// its ln J is NaN). A tangent that is not finite says nothing and is passed over; a form with no
+/// finite probe at all is taken as nonsymmetric. In a split run every process probes its cells,
+/// and one nonsymmetric part decides for all.
 pub(super) fn probe_structure(
     asm: &Assembler,
     forms: &HashMap<String, Box<dyn BoundForm + '_>>,
-    matrices: &HashMap<String, Matrix>,
+    matrices: &HashMap<String, Vec<Matrix>>,
 ) -> Structure {
     let here = probe_here(asm, forms, matrices);
     match asm.pattern().ownership() {
@@ -107,15 +110,16 @@ pub(super) fn probe_structure(
 fn probe_here(
     asm: &Assembler,
     forms: &HashMap<String, Box<dyn BoundForm + '_>>,
-    matrices: &HashMap<String, Matrix>,
+    matrices: &HashMap<String, Vec<Matrix>>,
 ) -> Structure {
-    if matrices.values().any(|m| !m.is_symmetric(1e-12)) {
+    if matrices.values().flatten().any(|m| !m.is_symmetric(1e-12)) {
         return Structure::General;
     }
     let n = asm.size();
-    let scale = 10.0 * asm.mesh().max_diameter() * asm.mesh().num_cells().max(1) as f64;
+    let large = 10.0 * asm.mesh().max_diameter() * asm.mesh().num_cells().max(1) as f64;
+    let small = 1e-3 * asm.mesh().max_diameter();
     let mut seed = 0x9E37_79B9_7F4A_7C15u64;
-    let mut random = || {
+    let mut random = |scale: f64| {
         seed ^= seed << 13;
         seed ^= seed >> 7;
         seed ^= seed << 17;
@@ -128,21 +132,29 @@ fn probe_here(
         if form.fields() == 0 {
             continue;
         }
-        for _ in 0..2 {
+        let mut finite = false;
+        for scale in [large, large, small] {
             // The fields, and the previous time level when the form reads it.
             let count = form.fields() + usize::from(form.previous());
-            let state: Vec<Vec<f64>> = (0..count).map(|_| (0..n).map(|_| random()).collect()).collect();
+            let state: Vec<Vec<f64>> = (0..count).map(|_| (0..n).map(|_| random(scale)).collect()).collect();
             for sign in [1.0, -1.0] {
                 let fields: Vec<Vec<f64>> = state.iter().map(|f| f.iter().map(|x| sign * x).collect()).collect();
                 let refs: Vec<&[f64]> = fields.iter().map(Vec::as_slice).collect();
                 for wrt in 0..form.fields() {
                     let mut m = asm.zero_matrix();
                     form.tangent(asm, &refs, wrt, 0.0, &mut m);
+                    if m.values.iter().any(|v| !v.is_finite()) {
+                        continue;
+                    }
+                    finite = true;
                     if !m.is_symmetric(1e-12) {
                         return Structure::General;
                     }
                 }
             }
+        }
+        if !finite {
+            return Structure::General;
         }
     }
     Structure::SymmetricPositiveDefinite

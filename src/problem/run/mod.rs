@@ -219,7 +219,7 @@ impl Bound<'_> {
 
     /// The equilibrium with the contact on `contact` at time `t` (a static problem's, or the
     /// settled start's).
-    pub(super) fn statics<'p>(&'p self, contact: &'p str, opts: &Options, t: f64) -> StaticProblem<'p> {
+    pub(super) fn statics<'p>(&'p self, contact: Option<&'p str>, opts: &Options, t: f64) -> StaticProblem<'p> {
         StaticProblem {
             coefs: self.coefs,
             contact,
@@ -460,18 +460,12 @@ pub(super) enum Runner<'m> {
 }
 
 impl<'m> Runner<'m> {
-    /// A static problem is one equilibrium, from u₀ (no initial acceleration to solve for): it
-    /// binds the operators, and no stepper.
+    /// A static problem is one equilibrium, from u₀ (no initial acceleration to solve for), with
+    /// the held values at the start time: it binds the operators, and no stepper.
     fn bind(req: &Request, asm: &'m Assembler, bound: &Bound) -> Result<Runner<'m>, CaseError> {
         let problem = bound.problem(req.opts, asm.mesh());
         if req.pf.problem().run_static.is_none() {
             return Ok(Runner::Time(Box::new(Simulation::new(asm, problem, req.in_use)?)));
-        }
-        if bound.held.is_some() {
-            return Err(CaseError::Option(format!(
-                "{}: a static problem holds its Dirichlet values at zero (a nonzero held value needs a time run)",
-                req.pf.file
-            )));
         }
         Ok(Runner::Static(Box::new(Operators::bind(asm, problem, req.in_use)?)))
     }

@@ -19,13 +19,14 @@ pub(super) fn run(
     u0: Vec<f64>,
 ) -> Result<Stepped, CaseError> {
     let t0 = req.times.t_start;
-    let contact = bound.contact.ok_or_else(|| {
-        CaseError::Option(format!("{}: a static problem needs its contact (an obstacle, or `Gamma_C`)", req.pf.file))
-    })?;
     let clock = Instant::now();
     // The level a law's `prev` reads: the state the equilibrium is sought from.
     let initial = u0.clone();
-    let problem = bound.statics(contact, req.opts, t0);
+    let mut problem = bound.statics(bound.contact, req.opts, t0);
+    // The held dofs keep the values the initial fields took from the Dirichlet conditions.
+    for dof in problem.constraints.dofs() {
+        problem.constraints.values[dof] = u0[dof];
+    }
     let solution = crate::simulation::statics::solve(asm, problem, &req.in_use.forms, u0)?;
     let seconds = clock.elapsed().as_secs_f64();
     let newton = solution.newton.iterations();

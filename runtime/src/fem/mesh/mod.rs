@@ -8,6 +8,7 @@ mod boundary;
 pub mod disc;
 pub mod gmsh;
 mod integrity;
+pub mod inverted;
 mod part;
 pub mod structured;
 mod validate;

@@ -56,10 +56,17 @@ pub enum StepError {
     )]
     NonFiniteTangent { stage: String, t: f64, at: NonFiniteTangent },
     #[error(
+        "stage `{stage}` at t = {t}: {at}: a finite-strain material's stress is not defined there (ln J, F⁻¹); a smaller Δt, or a stiffer or better-shaped mesh where the body is compressed hardest, keeps it positive"
+    )]
+    Inverted { stage: String, t: f64, at: crate::fem::mesh::inverted::Inverted },
+    #[error(
         "stage `{stage}` of scheme `{scheme}` has no displacement quantity (u', um, ...) that depends on its unknown (a nonzero coefficient at this Δt): a moving held displacement cannot be imposed there"
     )]
     NoDisplacement { scheme: String, stage: String },
 }
+
+/// A linear form's field: the form's name and the field's index (its matrix K_j).
+type FormField = (String, usize);
 
 /// Displacements held at values that change with time (a moving Dirichlet condition): the
 /// held dofs (among the constraints' fixed ones) and their values at a time, in that order.
@@ -108,8 +115,9 @@ pub struct Stepper<'a> {
     pub newton_options: NewtonOptions,
     /// Per stage: its Newton (keeps its factorization) and the constant operator for `dt`.
     stages: Vec<StageCache>,
-    /// Linear forms' matrices (assembled once).
-    matrices: HashMap<String, Matrix>,
+    /// Linear forms' matrices (assembled once), one per field: the residual of a form linear in
+    /// its fields w₁ … w_k is Σ K_j w_j.
+    matrices: HashMap<String, Vec<Matrix>>,
     /// The pattern's lower half, when the stage matrices are symmetric.
     half_pattern: Option<Arc<HalfPattern>>,
     /// Recently assembled loads, by (form, time).
@@ -134,7 +142,7 @@ struct StageCache {
     scratch: Option<Matrix>,
     /// The linear terms' forms, and their matrices' lower halves fused for one product (in
     /// groups of at most `MAX_FUSED`), when the matrices are symmetric.
-    linear: Option<(Vec<String>, Vec<LowerHalf>)>,
+    linear: Option<(Vec<FormField>, Vec<LowerHalf>)>,
     /// The nonlinear terms' arguments and residual, kept from one step to the next.
     args: Vec<Vec<f64>>,
     term: Vec<f64>,
@@ -163,10 +171,16 @@ impl<'a> Stepper<'a> {
         let mut matrices = HashMap::new();
         let zero = vec![0.0; asm.size()];
         for (name, f) in &forms {
-            if f.linear() && f.fields() == 1 {
-                let mut m = asm.zero_matrix();
-                f.tangent(asm, &[&zero], 0, 0.0, &mut m);
-                matrices.insert(name.clone(), m);
+            if f.linear() && f.fields() >= 1 {
+                let zeros = vec![zero.as_slice(); f.fields()];
+                let per_field = (0..f.fields())
+                    .map(|j| {
+                        let mut m = asm.zero_matrix();
+                        f.tangent(asm, &zeros, j, 0.0, &mut m);
+                        m
+                    })
+                    .collect();
+                matrices.insert(name.clone(), per_field);
             }
         }
         let structure = match structure {
@@ -236,7 +250,7 @@ impl<'a> Stepper<'a> {
 
     /// The matrix of a linear one-field form (e.g. `mass`, for energies).
     pub fn matrix(&self, form: &str) -> Option<&Matrix> {
-        self.matrices.get(form)
+        self.matrices.get(form).filter(|m| m.len() == 1).map(|m| &m[0])
     }
 
     /// Holds `p.dofs` (fixed in the constraints) at the moving values `p.values`: refused when a

@@ -10,6 +10,7 @@ use super::levels::Levels;
 use super::{LOAD_CACHE, StageCache, StepError, Stepper};
 use crate::fem::assembly::Assembler;
 use crate::fem::bound::BoundForm;
+use crate::fem::mesh::inverted::{self, Inverted};
 use crate::linalg::Matrix;
 use crate::linalg::lower_half::{LowerHalf, MAX_FUSED};
 use crate::nonlinear::newton::{Newton, NewtonReport};
@@ -18,8 +19,8 @@ use crate::time::stage::{
     ActiveTerm, Linear, NonFiniteTangent, RecordedTangent, StageProblem, Support, tangent_support,
 };
 
-/// Linear terms coef·K·(α w + base): their forms, coefficients and bases.
-type LinearTerms<'s> = (Vec<&'s str>, Vec<f64>, Vec<Vec<f64>>);
+/// Linear terms coef·K_j·(α_j w + base_j): their forms and fields j, coefficients and bases.
+type LinearTerms<'s> = (Vec<(&'s str, usize)>, Vec<f64>, Vec<Vec<f64>>);
 
 /// A stage's known parts: the constant part of its residual, and the terms Newton evaluates.
 struct Known<'s> {
@@ -44,8 +45,8 @@ impl Stepper<'_> {
     }
 
     /// Sorts the stage's terms: a load or a term of known levels only goes into the constant
-    /// residual; a linear one-field term into the constant operator Σ coef·α·K (rebuilt when
-    /// Δt changed) and, through its base, the residual; every other term is Newton's.
+    /// residual; a linear term into the constant operator Σ_j coef·α_j·K_j (rebuilt when Δt
+    /// changed) and, through its bases, the residual; every other term is Newton's.
     fn known_parts<'s>(&mut self, stage: &'s StageDesc, cache: usize, levels: &Levels, dt: f64) -> Known<'s> {
         let n = self.asm.size();
         // Known parts of every argument, and the constant part of the residual.
@@ -64,13 +65,16 @@ impl Stepper<'_> {
             let form = &self.forms[&*term.form];
             let term_t = self.coefs[term.time];
             match self.matrices.get(&*term.form) {
-                Some(k) if alphas.len() == 1 => {
+                // A form that reads `prev` has one more argument than fields: Newton's.
+                Some(ks) if ks.len() == alphas.len() => {
                     if let Some(c) = constant.as_mut() {
-                        c.add_scaled(coef * alphas[0], k);
+                        ks.iter().zip(&alphas).for_each(|(k, a)| c.add_scaled(coef * a, k));
                     }
-                    linear.0.push(&term.form);
-                    linear.1.push(coef);
-                    linear.2.extend(bases);
+                    for (j, base) in bases.into_iter().enumerate() {
+                        linear.0.push((&term.form, j));
+                        linear.1.push(coef);
+                        linear.2.push(base);
+                    }
                 }
                 _ if alphas.iter().all(|a| *a == 0.0) => {
                     let refs: Vec<&[f64]> = bases.iter().map(Vec::as_slice).collect();
@@ -138,32 +142,30 @@ impl Stepper<'_> {
         (bases, alphas)
     }
 
-    /// Adds Σ coef·K·base over a stage's linear terms (forms, coefficients, bases) to `rhs`:
-    /// one pass over the matrices' fused lower halves when they are symmetric.
-    fn add_linear(
-        &mut self,
-        cache: usize,
-        (forms, coefs, bases): &(Vec<&str>, Vec<f64>, Vec<Vec<f64>>),
-        rhs: &mut [f64],
-    ) {
+    /// Adds Σ coef·K_j·base over a stage's linear terms (forms and fields, coefficients, bases)
+    /// to `rhs`: one pass over the matrices' fused lower halves when they are symmetric.
+    fn add_linear(&mut self, cache: usize, (forms, coefs, bases): &LinearTerms, rhs: &mut [f64]) {
         if forms.is_empty() {
             return;
         }
         let mut product = self.pool.take(rhs.len());
         let Some(half) = self.half_pattern.as_ref() else {
-            for ((form, coef), base) in forms.iter().zip(coefs).zip(bases) {
-                self.matrices[*form].mul_vec(base, &mut product);
+            for (((form, j), coef), base) in forms.iter().zip(coefs).zip(bases) {
+                self.matrices[*form][*j].mul_vec(base, &mut product);
                 rhs.iter_mut().zip(&product).for_each(|(r, x)| *r += coef * x);
             }
             self.pool.give(product);
             return;
         };
         let entry = &mut self.stages[cache];
-        if entry.linear.as_ref().is_none_or(|(cached, _)| !cached.iter().map(String::as_str).eq(forms.iter().copied()))
+        if entry
+            .linear
+            .as_ref()
+            .is_none_or(|(cached, _)| !cached.iter().map(|(f, j)| (f.as_str(), *j)).eq(forms.iter().copied()))
         {
-            let matrices: Vec<&Matrix> = forms.iter().map(|f| &self.matrices[*f]).collect();
+            let matrices: Vec<&Matrix> = forms.iter().map(|(f, j)| &self.matrices[*f][*j]).collect();
             let groups = matrices.chunks(MAX_FUSED).map(|g| LowerHalf::fused(g, half)).collect();
-            entry.linear = Some((forms.iter().map(|f| f.to_string()).collect(), groups));
+            entry.linear = Some((forms.iter().map(|(f, j)| (f.to_string(), *j)).collect(), groups));
         }
         let (_, groups) = entry.linear.as_ref().expect("built above");
         let terms: Vec<(f64, &[f64])> = coefs.iter().zip(bases).map(|(c, b)| (*c, b.as_slice())).collect();
@@ -216,17 +218,37 @@ impl Stepper<'_> {
             delta[i] = values[i] - w0[i];
         }
         let report = newton.solve(&mut problem, &mut delta);
-        if report.is_err()
-            && let Some(at) = non_finite_anywhere(self.asm, problem.non_finite.take())
-        {
-            return Err(StepError::NonFiniteTangent { stage: stage.name.to_string(), t: stage_t, at });
-        }
+        let non_finite = if report.is_err() { problem.non_finite.take() } else { None };
         (*args, *term, *recorded) = (problem.args, problem.term, problem.recorded);
         self.pool.give(problem.rhs);
         problem.terms.into_iter().flat_map(|t| t.bases).for_each(|b| self.pool.give(b));
+        // Where a failed Newton left a cell inside out (answered by a step cut), or met a
+        // tangent that is not finite (at any Δt).
+        if report.is_err()
+            && let Some(at) = self.inverted_at(stage, levels, &delta)
+        {
+            return Err(StepError::Inverted { stage: stage.name.to_string(), t: stage_t, at });
+        }
+        if report.is_err()
+            && let Some(at) = non_finite_anywhere(self.asm, non_finite)
+        {
+            return Err(StepError::NonFiniteTangent { stage: stage.name.to_string(), t: stage_t, at });
+        }
         let report =
             report.map_err(|source| StepError::Newton { stage: stage.name.to_string(), t: stage_t, source })?;
         Ok((delta, report))
+    }
+}
+
+impl Stepper<'_> {
+    /// After a failed Newton, the most inverted cell of the stage's displacement quantity (u',
+    /// um, ...) at its last iterate, if one is inverted. In a split run every process says so
+    /// when one saw it (each decides alike what follows: a step cut).
+    fn inverted_at(&self, stage: &StageDesc, levels: &Levels, delta: &[f64]) -> Option<Inverted> {
+        let q = self.displacement(stage)?;
+        let mut u = vec![0.0; self.asm.size()];
+        self.combine(&stage.values[q], levels, Some(delta), &mut u);
+        inverted::anywhere(self.asm, &u)
     }
 }
 

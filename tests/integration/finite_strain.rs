@@ -1,0 +1,152 @@
+//! Finite strain: materials whose stiffness is nonlinear in u (docs/mathematics.md §8). A block
+//! pulled to a homogeneous stretch has the material's closed-form stress to round-off; a free
+//! body spun through whole turns keeps its exact angular and linear momenta under the
+//! midpoint rule, and stays strain-free to round-off of its kinetic energy.
+
+use signorini::driver::Setting;
+use signorini::problem::run::{Options, run};
+
+fn setting(name: &str, value: f64) -> Setting {
+    Setting { name: name.into(), value, origin: "test".into() }
+}
+
+/// Lamé's constants of E = 100, ν = 0.3 (the stretched block's).
+fn lame() -> (f64, f64) {
+    let (e, nu) = (100.0, 0.3);
+    (e / (2.0 * (1.0 + nu)), e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)))
+}
+
+/// The first Piola–Kirchhoff stress's diagonal and the stored energy of F = diag(λ₁, λ₂) (plane
+/// strain): neo-Hookean and Saint Venant–Kirchhoff.
+fn closed_form(material: &str, l1: f64, l2: f64) -> (f64, f64, f64) {
+    let (mu, lambda) = lame();
+    match material {
+        "neo_hookean" => {
+            let lj = (l1 * l2).ln();
+            let p = |l: f64| mu * (l - 1.0 / l) + lambda * lj / l;
+            let w = mu / 2.0 * (l1 * l1 + l2 * l2 - 2.0) - mu * lj + lambda / 2.0 * lj * lj;
+            (p(l1), p(l2), w)
+        }
+        "saint_venant_kirchhoff" => {
+            let (e1, e2) = ((l1 * l1 - 1.0) / 2.0, (l2 * l2 - 1.0) / 2.0);
+            let s = |e: f64| lambda * (e1 + e2) + 2.0 * mu * e;
+            let w = lambda / 2.0 * (e1 + e2).powi(2) + mu * (e1 * e1 + e2 * e2);
+            (l1 * s(e1), l2 * s(e2), w)
+        }
+        _ => unreachable!(),
+    }
+}
+
+#[test]
+fn a_block_stretched_homogeneously_has_the_closed_form_stress_to_round_off() {
+    for material in ["neo_hookean", "saint_venant_kirchhoff"] {
+        for (stretch, cells) in [(2.0, 2.0), (0.7, 3.0), (1.0 + 1e-3, 2.0)] {
+            let mut o = Options::new("stretched_block");
+            o.methods.material = material.into();
+            o.chosen.material = true;
+            o.methods.params.extend([setting("stretch", stretch), setting("cells", cells)]);
+            let r = run(&o).unwrap();
+            let key = |k: &str| r.summary.number(k).unwrap();
+            let l2 = key("lateral_stretch");
+            let (p11, p22, w) = closed_form(material, stretch, l2);
+            // The stresses are sums of terms of size E that cancel at small strain: round-off
+            // and Newton's tolerance are relative to |P₁₁| + E.
+            let scale = p11.abs() + 100.0;
+            // The lateral faces are free: P₂₂ = 0 fixes λ₂.
+            assert!(p22.abs() < 1e-11 * scale, "{material} λ₁ = {stretch}: P₂₂ = {p22:e} at λ₂ = {l2}");
+            let pulled = key("pulled");
+            assert!((pulled - p11).abs() < 1e-11 * scale, "{material} λ₁ = {stretch}: force {pulled} vs P₁₁ {p11}");
+            let stored = key("stored");
+            // W is P's integral: its error is the stress's times the strain.
+            let strain = (stretch - 1.0f64).abs().max((l2 - 1.0).abs());
+            assert!((stored - w).abs() < 1e-11 * scale * strain, "{material}: W {stored} vs {w}");
+            assert!(key("iterations") <= 12.0);
+        }
+    }
+}
+
+/// The turning disc (ω = 1, R = 1, ρ = 1) through three turns at h = 0.5, Δt = 0.02, with a
+/// material, a scheme and E.
+fn turning(material: &str, scheme: &str, young: f64) -> signorini::problem::run::Run {
+    let mut o = Options::new("turning_disc");
+    o.methods.material = material.into();
+    o.chosen.material = true;
+    o.methods.scheme = scheme.into();
+    o.chosen.scheme = true;
+    o.dt = Some(0.02);
+    o.methods.params.extend([setting("h", 0.5), setting("young", young), setting("turns", 3.0)]);
+    run(&o).unwrap()
+}
+
+#[test]
+fn the_midpoint_rule_keeps_a_turning_body_s_momenta() {
+    let r = turning("neo_hookean", "midpoint", 1e4);
+    let key = |k: &str| r.summary.number(k).unwrap();
+    // Three whole turns: the point that started at (1, 0) went round.
+    let turned = r.column("turned").unwrap();
+    let laps = turned.windows(2).filter(|w| w[0] > 3.0 && w[1] < -3.0).count();
+    assert_eq!(laps, 3, "the disc turned {laps} times");
+    // ∫ρ (x + u) × v and ∫ρ v, exact for frame-indifferent W (docs/mathematics.md §8), to
+    // Newton's tolerance.
+    assert!(key("angular_drift") < 1e-10, "angular momentum drifted by {:e}", key("angular_drift"));
+    assert!(key("momentum_max") < 1e-12 * key("angular_initial"), "linear momentum {:e}", key("momentum_max"));
+    // Strain-free turning: the disc keeps its size (the linear material's grows without bound).
+    assert!((key("radius_max") - 1.0).abs() < 1e-3, "radius {}", key("radius_max"));
+    let linear = turning("elasticity", "midpoint", 1e4);
+    assert!(linear.summary.number("radius_max").unwrap() > 10.0, "a linear material turned strain-free");
+}
+
+#[test]
+fn the_energy_momentum_scheme_keeps_the_energy_and_strains_only_centrifugally() {
+    let mut stored = Vec::new();
+    for young in [1e4, 1e8] {
+        let r = turning("saint_venant_kirchhoff", "energy_momentum", young);
+        let key = |k: &str| r.summary.number(k).unwrap();
+        // W(u') − W(u) is the discrete gradient's work exactly: E is kept to Newton's tolerance.
+        assert!(key("energy_drift") < 1e-9, "E = {young}: energy drifted by {:e}", key("energy_drift"));
+        assert!(key("angular_drift") < 1e-9, "E = {young}: angular momentum drifted by {:e}", key("angular_drift"));
+        stored.push(key("stored_max") / (key("kinetic_initial") * key("strain_scale")));
+    }
+    // The stored energy is the centrifugal stretch's, of order ρω²R²/E of the kinetic energy,
+    // with the same constant for a body 10⁴ times stiffer: none of it is the rotation's.
+    assert!(stored.iter().all(|s| *s > 0.1 && *s < 2.0), "W_max / (K ρω²R²/E) = {stored:?}");
+    assert!((stored[0] / stored[1] - 1.0).abs() < 0.05, "{stored:?}");
+}
+
+#[test]
+fn a_step_that_turns_a_cell_inside_out_is_cut_and_the_cut_steps_go_through() {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems/crushed_block.wf");
+    let r = run(&Options::new(file.to_str().unwrap())).unwrap();
+    assert!(r.summary.number("step_cuts").unwrap() > 0.0, "no step was cut");
+    assert_eq!(r.summary.number("final_width"), Some(0.5));
+    // Every row written is a state with J > 0: its strain energy is finite.
+    assert!(r.column("stored").unwrap().iter().all(|w| w.is_finite() && *w >= 0.0));
+}
+
+/// Hertz's cylinder (level 1) with a load `ratio` = a/R, linear or neo-Hookean: the peak
+/// contact pressure.
+fn hertz_peak(material: &str, ratio: f64) -> f64 {
+    let mut o = Options::new("hertz_cylinder");
+    o.methods.material = material.into();
+    o.chosen.material = true;
+    o.methods.params.extend([setting("level", 1.0), setting("ratio", ratio)]);
+    run(&o).unwrap().summary.number("peak_pressure").unwrap()
+}
+
+#[test]
+fn at_small_loads_the_neo_hookean_contact_approaches_the_linear_one_at_first_order() {
+    // The strains scale with a/R: the finite-strain terms change the stress by a relative
+    // O(a/R), so the relative difference of the peak pressures halves with the load's a/R.
+    let gaps: Vec<f64> = [0.1, 0.05, 0.025]
+        .iter()
+        .map(|&r| {
+            let linear = hertz_peak("elasticity", r);
+            (hertz_peak("neo_hookean", r) - linear).abs() / linear
+        })
+        .collect();
+    for w in gaps.windows(2) {
+        let order = (w[0] / w[1]).log2();
+        assert!((0.8..1.3).contains(&order), "relative differences {gaps:?}: order {order}");
+    }
+    assert!(gaps[2] < 3e-3, "{gaps:?}");
+}
