@@ -40,6 +40,15 @@ GetFEM pieces (no hand-written weak form in the dynamics):
     -theta/gamma sigma_N(u) sigma_N(v) + 1/gamma [P_1,gamma(u)]_- (theta sigma_N(v) - gamma v.n_c),
     sigma_N(u) = (sigma(u) n).n_c with n the outward normal (GWFL's Normal) and n_c = -e_y the
     obstacle normal, P_1,gamma(u) = sigma_N(u) + gamma (g - u.n_c), gamma = gamma0/element_size.
+  - --material neo_hookean: forms/neo_hookean.wf in place of the elasticity brick, an
+    add_nonlinear_term P(u):Grad_Test_u with F = Id(2) + Grad_u, P = mu (F - F^-T) + lambda ln(det F) F^-T
+    (plane strain); GetFEM derives the tangent. The contact laws keep the LINEAR Hooke stress
+    sigma(u) = lambda div u I + 2 mu sym grad u in sigma(u)n, written out (a nonlinear term declares
+    no Neumann term), as signorini's laws do (they import elasticity.wf). --polish 1 adds one
+    Newton iteration after GetFEM's solve, whose criterion min(|R|_1/load estimate, |du|_1/|u|_1)
+    <= max_res leaves |R|_2 up to ~4e-9 |F|_2 here (after it: ~1e-11, the round-off floor).
+    --newton-rtol emulates signorini's Newton criterion, --check-residual reports the residual
+    (scripts/getfem/README.md, "Neo-Hookean material").
 GetFEM's own linear solver choice matters in Debian's 5.4.2 build: 'superlu' (and
 linsolve_superlu) segfault, so the script uses 'mumps', and scipy for the mass solve. Newton's
 max_res is 1e-9: GetFEM's relative criterion has a round-off floor near 1e-11 on this problem,
@@ -52,7 +61,8 @@ Quadrature: IM_TRIANGLE(6), the 12-point degree-6 rule (the same Dunavant rule a
 whose face rule is IM_GAUSS1D(6), i.e. 4 Gauss points per edge (degree 7), as signorini's facets.
 
 Measures (per step, t = 0 first), the columns of signorini's series.csv:
-  energy      = 1/2 v.M v + 1/2 u.K u - F.u  (M, K, F assembled by GetFEM)
+  energy      = 1/2 v.M v + 1/2 u.K u - F.u  (M, K, F assembled by GetFEM; neo_hookean: int W(u) in
+                place of 1/2 u.K u, W = mu/2 (|F|^2 - 2) - mu ln J + lambda/2 (ln J)^2, J = det F)
   energy_aug  = energy - theta/(2 gamma) ||sigma(u)n||^2_GC + 1/(2 gamma) ||[P_1,gamma(u)]_-||^2_GC
                 (nitsche-normal: sigma_N(u)^2 in place of |sigma(u)n|^2, the normal form's E_Theta)
   uy_mean     = e_y.M u / e_y.M e_y (centre of mass), uy_mean_nodal = plain mean of nodal u_y
@@ -75,6 +85,9 @@ p.add_argument("--contact", choices=["nitsche", "nitsche-normal", "nitsche-coulo
                help="nitsche: GetFEM's Nitsche brick (full-traction theta term); nitsche-normal: signorini's "
                     "normal form (forms/contact_nitsche.wf) as a GWFL term; penalty: a GWFL term, "
                     "eps = gamma0/element_size (GetFEM's penalized contact brick takes a constant r, not gamma0/h)")
+p.add_argument("--material", choices=["elasticity", "neo_hookean"], default="elasticity",
+               help="elasticity: GetFEM's linearized elasticity brick; neo_hookean: forms/neo_hookean.wf as a "
+                    "GWFL term (the contact laws keep the linear Hooke stress, as signorini's do)")
 p.add_argument("--theta", type=float, default=1.0)
 p.add_argument("--friction", type=float, default=0.3, help="nitsche-coulomb: the friction coefficient F")
 p.add_argument("--slip-scale", type=float, default=1.0, help="nitsche-coulomb: GetFEM's alpha")
@@ -89,6 +102,19 @@ p.add_argument("--gam", type=float, default=0.5)
 p.add_argument("--integ", default="IM_TRIANGLE(6)")
 p.add_argument("--max-res", type=float, default=1e-9)
 p.add_argument("--lsearch", default="default", help="GetFEM's Newton line search")
+p.add_argument("--polish", type=int, default=0,
+               help="Newton iterations to add after GetFEM's solve, each with the model's own tangent and "
+                    "residual and a scipy LU solve (GetFEM stops at min(|R|_1/load estimate, |du|_1/|u|_1) "
+                    "<= max_res; one more step takes the neo-Hookean runs to the round-off floor)")
+p.add_argument("--newton-rtol", type=float, default=None,
+               help="instead of GetFEM's solve, a plain Newton (the model's tangent and residual, a scipy "
+                    "LU solve) from the current u, stopped at |R|_inf <= rtol |R(u0)|_inf after at least one "
+                    "iteration: signorini's relative criterion (its tol is 1e-10), from signorini's first "
+                    "iterate u (newmark, hht, midpoint), for tolerance studies")
+p.add_argument("--check-residual", action="store_true",
+               help="after each solve, assemble the residual R(u) once more and report the largest "
+                    "|R|_2/(|F|_2 + |f_int(u)|_2) over the run on stderr (F: the body load, f_int: the "
+                    "material's internal force)")
 p.add_argument("--noisy", action="store_true")
 p.add_argument("--out", default="-")
 args = p.parse_args()
@@ -126,9 +152,23 @@ md.add_initialized_data("gamma0", [args.gamma0])
 md.add_initialized_data("F", [args.friction])
 md.add_initialized_data("slip_scale", [args.slip_scale])
 md.add_initialized_fem_data("obs", mfs, mfs.basic_dof_nodes()[1, :])  # gap to {y = 0}
-md.add_isotropic_linearized_elasticity_brick(mim, "u", "lambda", "mu")
+# forms/neo_hookean.wf, plane strain: F = I + grad u, J = det F,
+# P = mu (F - F^-T) + lambda ln J F^-T, W = mu/2 (|F|^2 - 2) - mu ln J + lambda/2 (ln J)^2.
+defgrad = "(Id(2)+Grad_u)"
+piola = f"(mu*({defgrad} - Inv({defgrad})') + lambda*log(Det({defgrad}))*Inv({defgrad})')"
+strain_energy = (f"mu/2*(Norm_sqr({defgrad}) - 2) - mu*log(Det({defgrad}))"
+                 f" + lambda/2*sqr(log(Det({defgrad})))")
+if args.material == "elasticity":
+    md.add_isotropic_linearized_elasticity_brick(mim, "u", "lambda", "mu")
+else:
+    md.add_nonlinear_term(mim, f"{piola}:Grad_Test_u")
 md.add_source_term_brick(mim, "u", "f")
-neumann = md.Neumann_term("u", GC)  # sigma(u) n, as the elasticity brick declares it
+if args.material == "elasticity":
+    neumann = md.Neumann_term("u", GC)  # sigma(u) n, as the elasticity brick declares it
+else:
+    # A nonlinear term declares no Neumann term. The contact laws (they import elasticity.wf)
+    # take the linear Hooke stress whatever the material: sigma(u) n written out.
+    neumann = "((lambda*Div_u*Id(2) + 2*mu*Sym(Grad_u))*Normal)"
 nc = "(-Normalized(Grad_obs))"
 gamma = "(gamma0/element_size)"
 theta = f"({args.theta!r})"
@@ -161,6 +201,21 @@ V0[0::2] = args.vx
 Mmat = gf.asm_generic(mim, 2, "rho*u.Test_u", -1, "rho", 0, [rho], "u", 1, mf, U0)
 Kmat = gf.asm_generic(mim, 2, "(lambda*Div_u*Id(2)+2*mu*Sym(Grad_u)):Grad_Test_u", -1,
                       "lambda", 0, [lam], "mu", 0, [mu], "u", 1, mf, U0)
+
+
+def strain_energy_of(U):
+    """The stored energy: 1/2 u.K u, or the integral of the neo-Hookean W(u)."""
+    if args.material == "elasticity":
+        return 0.5 * U @ Kmat.mult(U)
+    return gf.asm_generic(mim, 0, strain_energy, -1, "u", 0, mf, U, "lambda", 0, [lam], "mu", 0, [mu])
+
+
+def internal_force(U):
+    if args.material == "elasticity":
+        return Kmat.mult(U)
+    return gf.asm_generic(mim, 1, f"{piola}:Grad_Test_u", -1, "u", 1, mf, U, "lambda", 0, [lam], "mu", 0, [mu])
+
+
 Fvec = gf.asm_generic(mim, 1, "f.Test_u", -1, "f", 0, [0.0, -grav], "u", 1, mf, U0)
 ey = np.zeros(n)
 ey[1::2] = 1.0
@@ -180,7 +235,7 @@ def boundary(expr, U, W=None):
 
 def measure(t, U, V, W):
     """The row at (U, V), W the step's start (U at the first row)."""
-    energy = 0.5 * V @ Mmat.mult(V) + 0.5 * U @ Kmat.mult(U) - Fvec @ U
+    energy = 0.5 * V @ Mmat.mult(V) + strain_energy_of(U) - Fvec @ U
     fx = 0.0
     if args.contact.startswith("nitsche"):
         theta_term = f"sqr({sn_u})" if args.contact == "nitsche-normal" else f"Norm_sqr({neumann})"
@@ -200,7 +255,7 @@ md.set_variable("u", U0)
 if coulomb:
     # Its term reads Previous_u, which the time scheme (added below) declares; the disc starts
     # 2 above the ground, where C(u0) = 0.
-    r0 = Fvec - Kmat.mult(U0)
+    r0 = Fvec - internal_force(U0)
 else:
     md.assembly("build_rhs")
     r0 = md.rhs()
@@ -240,12 +295,49 @@ md.set_time_step(args.dt / 2 if args.scheme == "midpoint" else args.dt)
 
 
 
+worst_residual = [0.0, 0.0]  # the largest |R(u)|_2/(|F|_2 + |f_int(u)|_2) after a solve, and its time
+
+
+def tangent():
+    """The model's tangent K at the current u, and its rhs -R(u) (GetFEM's Newton solves K du = rhs)."""
+    md.assembly("build_all")
+    jc, ir = md.tangent_matrix().csc_ind()
+    return scipy.sparse.csc_matrix((md.tangent_matrix().csc_val(), ir, jc), shape=(n, n)), md.rhs()
+
+
+def newton_step(K, rhs):
+    md.set_variable("u", md.variable("u") + scipy.sparse.linalg.spsolve(K, rhs))
+
+
 def solve(t):
     md.set_time(t)
-    it = md.solve("max_res", args.max_res, "max_iter", 50, "lsolver", "mumps",
-                  "lsearch", args.lsearch, *(["noisy"] if args.noisy else []))
-    if not it[1]:
-        print(f"# Newton did not converge at t = {t:g}: {it}", file=sys.stderr)
+    if args.newton_rtol is None:
+        it = md.solve("max_res", args.max_res, "max_iter", 50, "lsolver", "mumps",
+                      "lsearch", args.lsearch, *(["noisy"] if args.noisy else []))
+        if not it[1]:
+            print(f"# Newton did not converge at t = {t:g}: {it}", file=sys.stderr)
+    else:
+        # A solve that stops before its first iteration: GetFEM's standard_solve still advances
+        # the time and updates the scheme's affine dependent variables (Dot_u, Dot2_u of u),
+        # which the Python interface does not expose otherwise.
+        md.solve("max_res", 1e300, "max_iter", 1, "lsolver", "mumps")
+        K, rhs = tangent()
+        r0 = np.max(np.abs(rhs))
+        for k in range(51):
+            if k >= 1 and np.max(np.abs(rhs)) <= args.newton_rtol * r0:
+                break
+            if k == 50:
+                print(f"# Newton did not converge at t = {t:g}", file=sys.stderr)
+                break
+            newton_step(K, rhs)
+            K, rhs = tangent()
+    for _ in range(args.polish):
+        newton_step(*tangent())
+    if args.check_residual:
+        md.assembly("build_rhs")
+        rel = np.linalg.norm(md.rhs()) / (np.linalg.norm(Fvec) + np.linalg.norm(internal_force(md.variable("u"))))
+        if rel > worst_residual[0]:
+            worst_residual[:] = [rel, t]
     return md.variable("u")
 
 
@@ -286,11 +378,9 @@ for k in range(steps):
     md.set_variable("Previous_Dot2_u", np.zeros(n) if args.scheme == "midpoint" else A)
     if args.scheme == "hht":
         md.set_private_rhs(ib_explicit, (Fvec - alpha * B) / (1 - alpha) - Fvec)
-    md.set_time(t)
-    it = md.solve("max_res", args.max_res, "max_iter", 50, "lsolver", "mumps",
-                  "lsearch", args.lsearch, *(["noisy"] if args.noisy else []))
-    if not it[1]:
-        print(f"# Newton did not converge at t = {t:g}: {it}", file=sys.stderr)
+    if args.newton_rtol is not None:
+        md.set_variable("u", U)  # signorini's first iterate: the step's start (midpoint: w = u)
+    solve(t)
     start = U
     if args.scheme == "midpoint":
         W = md.variable("u")
@@ -303,6 +393,9 @@ for k in range(steps):
         B = (Fvec - Mmat.mult(A) - alpha * B) / (1 - alpha)
     rows.append(measure(t, U, V, start))
 
+if args.check_residual:
+    print(f"# largest |R(u)|_2/(|F|_2 + |f_int(u)|_2) after a solve: {worst_residual[0]:.3e} "
+          f"(t = {worst_residual[1]:g})", file=sys.stderr)
 out = sys.stdout if args.out == "-" else open(args.out, "w")
 out.write("t,energy,energy_aug,ux_mean,uy_mean,uy_mean_nodal,fx_contact,fy_contact\n")
 for r in rows:
