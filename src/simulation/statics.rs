@@ -10,7 +10,7 @@ use crate::runtime::fem::mesh::Facet;
 use crate::runtime::fem::mesh::inverted::most_inverted;
 use crate::runtime::library::Binding;
 use crate::runtime::linalg::{Counters, Structure};
-use crate::runtime::nonlinear::newton::{Newton, NewtonOptions, NewtonReport};
+use crate::runtime::nonlinear::newton::{Newton, NewtonError, NewtonOptions, NewtonReport};
 use crate::runtime::nonlinear::problem::NonlinearProblem;
 use crate::runtime::nonlinear::statics::{Constraints, StaticContact};
 
@@ -94,11 +94,12 @@ pub fn solve<'m>(
         options.solver = crate::runtime::linalg::Solver::Direct;
     }
     let mut newton = Newton::new(options);
-    let report = newton.solve(&mut static_problem, &mut u).map_err(|e| match most_inverted(asm.mesh(), &u) {
-        Some(cell) => CaseError::Diverged(format!(
+    // A NaN is explained by a cell turned inside out, where there is one.
+    let report = newton.solve(&mut static_problem, &mut u).map_err(|e| match e {
+        NewtonError::NonFinite { .. } if let Some(cell) = most_inverted(asm.mesh(), &u) => CaseError::Diverged(format!(
             "the static equilibrium was not found ({e}): at Newton's last iterate {cell}, where a finite-strain material's stress is not defined (ln J, F⁻¹); start from a guess closer to the equilibrium (`initial u`), or move the held values less"
         )),
-        None => CaseError::Newton(e),
+        e => CaseError::Newton(e),
     })?;
     let contact_force = super::resultant(&static_problem.contact_residual(&u), d);
     let mut set = Vec::new();

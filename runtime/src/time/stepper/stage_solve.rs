@@ -13,7 +13,7 @@ use crate::fem::bound::BoundForm;
 use crate::fem::mesh::inverted::{self, Inverted};
 use crate::linalg::Matrix;
 use crate::linalg::lower_half::{LowerHalf, MAX_FUSED};
-use crate::nonlinear::newton::{Newton, NewtonReport};
+use crate::nonlinear::newton::{Newton, NewtonError, NewtonReport};
 use crate::nonlinear::statics::Constraints;
 use crate::time::stage::{
     ActiveTerm, Linear, NonFiniteTangent, RecordedTangent, StageProblem, Support, tangent_support,
@@ -222,16 +222,15 @@ impl Stepper<'_> {
         (*args, *term, *recorded) = (problem.args, problem.term, problem.recorded);
         self.pool.give(problem.rhs);
         problem.terms.into_iter().flat_map(|t| t.bases).for_each(|b| self.pool.give(b));
-        // Where a failed Newton left a cell inside out (answered by a step cut), or met a
-        // tangent that is not finite (at any Δt).
-        if report.is_err()
-            && let Some(at) = self.inverted_at(stage, levels, &delta)
-        {
+        // A NaN in a failed Newton (its residual, or a tangent) is explained by a cell turned
+        // inside out where there is one (answered by a step cut), else it is a law's derivative
+        // that is not finite (at any Δt). Both are decided alike by every process.
+        let tangent = if report.is_err() { non_finite_anywhere(self.asm, non_finite) } else { None };
+        let nan = matches!(report, Err(NewtonError::NonFinite { .. })) || tangent.is_some();
+        if nan && let Some(at) = self.inverted_at(stage, levels, &delta) {
             return Err(StepError::Inverted { stage: stage.name.to_string(), t: stage_t, at });
         }
-        if report.is_err()
-            && let Some(at) = non_finite_anywhere(self.asm, non_finite)
-        {
+        if let Some(at) = tangent {
             return Err(StepError::NonFiniteTangent { stage: stage.name.to_string(), t: stage_t, at });
         }
         let report =
