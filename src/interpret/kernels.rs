@@ -5,11 +5,24 @@
 
 use std::cell::Cell;
 
+use signorini_compiler::ir::eval::CoefsAt;
 use signorini_compiler::ir::plan::{Basis, Body, Contract, Decided, Integral, Leaf, Terms};
 use signorini_runtime::fem::geometry;
 use signorini_runtime::fem::kernel::{
-    CellCtx, FacetCtx, FormKernel, FunctionalKernel, LocalMatrix, LocalVector, Tabulation,
+    CellCtx, Coef, FacetCtx, FormKernel, FunctionalKernel, LocalMatrix, LocalVector, Tabulation,
 };
+
+/// The form's coefs at the time of a kernel call, for the points a body reads them at.
+struct CoefsAtTime<'a> {
+    coefs: &'a [Coef],
+    t: f64,
+}
+
+impl CoefsAt for CoefsAtTime<'_> {
+    fn at(&self, id: u16, comp: u8, dirs: &[u8], point: &[f64]) -> f64 {
+        self.coefs.get(id as usize).map_or(f64::NAN, |c| c.at(point, self.t, comp as usize, dirs))
+    }
+}
 
 use super::form::InterpretedForm;
 
@@ -71,7 +84,8 @@ impl InterpretedForm {
                 _ => 0.0,
             };
         }
-        prog.exec_invariant(slots);
+        let at = CoefsAtTime { coefs: &self.coefs, t: place.t };
+        prog.exec_invariant_with(slots, &at);
         let weighted = body.weighted();
         let tab = place.tab;
         for q in 0..tab.len() {
@@ -113,7 +127,7 @@ impl InterpretedForm {
                     Leaf::Param(_) | Leaf::CellDiameter | Leaf::Time | Leaf::Zero => continue,
                 };
             }
-            prog.exec_varying(slots);
+            prog.exec_varying_with(slots, &at);
             for (i, r) in roots.iter_mut().enumerate() {
                 let v = prog.root(slots, i);
                 *r = if weighted { w * v } else { v };

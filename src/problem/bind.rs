@@ -344,11 +344,11 @@ pub fn coefs(pf: &ProblemFile, ex: &mut Exprs) -> Result<Vec<(String, PointFn)>,
     let mut out = Vec::new();
     for c in &p.coefs {
         let v = ex.lower(&c.value, &[]).map_err(|e| pf.render(*e))?;
-        out.push((c.name.name.clone(), ex.function(&v, &c.value).map_err(|e| pf.render(*e))?));
+        out.push((c.name.name.clone(), ex.coef_function(&v, &c.value).map_err(|e| pf.render(*e))?));
     }
     for (g, nc, e) in obstacle_vals(pf, ex)? {
-        out.push(("g".into(), ex.function(&g, e).map_err(|e| pf.render(*e))?));
-        out.push(("nc".into(), ex.function(&nc, e).map_err(|e| pf.render(*e))?));
+        out.push(("g".into(), ex.coef_function(&g, e).map_err(|e| pf.render(*e))?));
+        out.push(("nc".into(), ex.coef_function(&nc, e).map_err(|e| pf.render(*e))?));
     }
     for (k, b) in p.neumann.iter().enumerate() {
         let v = ex.lower(&b.value, &[]).map_err(|e| pf.render(*e))?;

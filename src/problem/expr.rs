@@ -84,6 +84,43 @@ impl<'u> Exprs<'u> {
         Val { shape: if components == 1 { Shape::Scalar } else { Shape::Vector }, c }
     }
 
+    /// As [`Exprs::function`], with the first and second derivatives with respect to `x` (a coef
+    /// that a contact law may read at the displaced point, `g(x + u)`, and differentiate there).
+    pub fn coef_function(&mut self, v: &Val, e: &Expr) -> Res<PointFn> {
+        use crate::compiler::ir::derive::Derivative;
+        let mut f = self.function(v, e)?;
+        if f.constant().is_some() {
+            return Ok(f);
+        }
+        let d = self.d;
+        let roots: Vec<NodeId> = v.c.iter().map(|j| j.v).collect();
+        let by = |g: &mut crate::compiler::ir::graph::Graph, nodes: &[NodeId]| -> Vec<NodeId> {
+            let mut out = Vec::with_capacity(nodes.len() * d);
+            for &n in nodes {
+                for k in 0..d {
+                    out.push(Derivative::new(Sym::Coord(k as u8)).of(g, n));
+                }
+            }
+            out
+        };
+        let first = by(&mut self.low.g, &roots);
+        let second = by(&mut self.low.g, &first);
+        let mut derivatives = Vec::new();
+        for nodes in [first, second] {
+            let program = Program::new(&self.low.g, &nodes);
+            derivatives.push(PointFn::new(program, nodes).map_err(|what| {
+                Box::new(Diagnostic::error(
+                    "E0501",
+                    format!("{what} means nothing here"),
+                    e.span,
+                    "not known at a point",
+                ))
+            })?);
+        }
+        f.derivatives = derivatives;
+        Ok(f)
+    }
+
     /// Compiles the components of `v` (at `e`, for errors).
     pub fn function(&self, v: &Val, e: &Expr) -> Res<PointFn> {
         let roots: Vec<NodeId> = v.c.iter().map(|j| j.v).collect();
@@ -131,6 +168,9 @@ pub struct PointFn {
     trivial: Option<Vec<Result<usize, f64>>>,
     /// The roots in the problem's graph: equal keys, equal functions (the graph is hash-consed).
     pub key: Vec<NodeId>,
+    /// The first and second derivatives with respect to `x`, component-major (a coef's; see
+    /// [`Exprs::coef_function`]), or none.
+    derivatives: Vec<PointFn>,
 }
 
 impl PointFn {
@@ -152,7 +192,7 @@ impl PointFn {
             })
             .collect::<Result<_, _>>()?;
         let trivial = program.trivial_roots();
-        Ok(PointFn { program, leaves, trivial, key })
+        Ok(PointFn { program, leaves, trivial, key, derivatives: Vec::new() })
     }
 
     /// Number of components.
@@ -217,11 +257,27 @@ impl PointFn {
     /// As a coef of the forms: a constant, a function of x, or of x and t. Values have no
     /// negative zeros (`−0` and `0` are one value of a coef; the kernels then do the same
     /// arithmetic whichever was written).
-    pub fn coef(self) -> crate::runtime::fem::kernel::Coef {
+    pub fn coef(mut self) -> crate::runtime::fem::kernel::Coef {
         use crate::runtime::fem::kernel::Coef;
         if let Some(values) = self.constant() {
             return Coef::constant(values.into_iter().map(|v| v + 0.0).collect::<Vec<_>>());
         }
+        // Assembly calls coefs from every thread: each has its scratch.
+        thread_local!(static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) });
+        let derivatives = std::mem::take(&mut self.derivatives);
+        let coef = self.values();
+        if derivatives.is_empty() {
+            return coef;
+        }
+        coef.with_derivatives(move |x, t, order, out| match derivatives.get(order.wrapping_sub(1)) {
+            Some(d) => SCRATCH.with(|s| d.eval(&At { x, t, ..At::default() }, &mut s.borrow_mut(), out)),
+            None => out.fill(f64::NAN),
+        })
+    }
+
+    /// The values as a coef (not constant), without derivatives.
+    fn values(self) -> crate::runtime::fem::kernel::Coef {
+        use crate::runtime::fem::kernel::Coef;
         let n = self.len();
         let steady = !self.reads_time();
         // Components that are coordinates or constants (a plane's gap `x[1]`): copied, with no
@@ -248,7 +304,6 @@ impl PointFn {
                 }
             });
         }
-        // Assembly calls coefs from every thread: each has its scratch.
         thread_local!(static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) });
         let f = move |x: &[f64], t: f64, out: &mut [f64]| {
             SCRATCH.with(|s| self.eval(&At { x, t, ..At::default() }, &mut s.borrow_mut(), out));

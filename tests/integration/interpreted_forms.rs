@@ -28,6 +28,7 @@ signorini::forms!("tests/problems/coulomb_penalty.wf");
 signorini::forms!("forms/contact_nitsche_coulomb.wf");
 signorini::forms!("forms/contact_nitsche_tresca.wf");
 signorini::forms!("forms/contact_penalty_coulomb.wf");
+signorini::forms!("forms/contact_penalty_deformed.wf");
 signorini::forms!("forms/contact_nitsche_traction.wf");
 signorini::forms!("tests/problems/transcendental.wf");
 
@@ -79,7 +80,15 @@ impl Data {
                     *o = (1.3 * x[k] + t).sin() - 0.4 * x[0] * (k as f64 + 1.0);
                 }
             }),
-            g: Coef::function(1, |x, t, out| out[0] = 0.5 * (x[0] - 0.3) + 0.01 * t),
+            // With its derivatives, for a law that reads it at the displaced point.
+            g: Coef::function(1, |x, t, out| out[0] = 0.5 * (x[0] - 0.3) + 0.01 * t).with_derivatives(
+                |_, _, order, out| {
+                    out.fill(0.0);
+                    if order == 1 {
+                        out[0] = 0.5;
+                    }
+                },
+            ),
             nc: Coef::constant((0..d).map(|k| if k == d - 1 { -1.0 } else { 0.0 }).collect::<Vec<_>>()),
         }
     }
@@ -551,6 +560,15 @@ unit_test!(
     contact_penalty_coulomb,
     "forms/contact_penalty_coulomb.wf",
     |d| contact_penalty_coulomb::Coefficients { f: d.f.clone(), g: d.g.clone(), nc: d.nc.clone() },
+    forms: [Contact, HybridContact],
+    functionals: [ContactEnergy, FrictionWork, FrictionForce, ContactJump, ContactPressure, ContactTrial]
+);
+
+unit_test!(
+    penalty_deformed_interpreted_matches_compiled,
+    contact_penalty_deformed,
+    "forms/contact_penalty_deformed.wf",
+    |d| contact_penalty_deformed::Coefficients { g: d.g.clone(), nc: d.nc.clone() },
     forms: [Contact, HybridContact],
     functionals: [ContactEnergy, FrictionWork, FrictionForce, ContactJump, ContactPressure, ContactTrial]
 );

@@ -8,6 +8,7 @@ mod case_files;
 mod checkpoint;
 mod cli;
 mod convergence;
+mod deformed_contact;
 mod disc;
 mod elements;
 mod energy_guard;

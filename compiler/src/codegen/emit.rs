@@ -34,11 +34,18 @@ pub struct Lines {
 pub struct Emitter<'a> {
     g: &'a Graph,
     leaf: &'a HashMap<Sym, String>,
+    /// The field of `self.coefs` of each coef, by id: where a kernel evaluates one at a point.
+    coefs: &'a [String],
 }
 
 impl<'a> Emitter<'a> {
     pub fn new(g: &'a Graph, leaf: &'a HashMap<Sym, String>) -> Self {
-        Emitter { g, leaf }
+        Emitter { g, leaf, coefs: &[] }
+    }
+
+    /// With the coefs' names, for a kernel that evaluates coefs at points (`Node::CoefAt`).
+    pub fn with_coefs(self, coefs: &'a [String]) -> Self {
+        Emitter { coefs, ..self }
     }
 
     /// The `let`s the nodes `outputs` need, named by `namer`. `varies(s)`: whether leaf `s`
@@ -137,6 +144,12 @@ impl<'a> Emitter<'a> {
             // `f64`'s methods, as the IR evaluator calls them (`Func::apply`).
             Node::Func(f, a) => (format!("{}.{}()", wrap(sub(a), ATOM), f.name()), ATOM),
             Node::Atan2(y, x) => (format!("{}.atan2({})", wrap(sub(y), ATOM), sub(x).0), ATOM),
+            // `Coef::at`, as the IR evaluator calls it through `CoefsAt`.
+            Node::CoefAt { id: c, comp, dirs, point } => {
+                let at: Vec<String> = g.point(point).iter().map(|&p| sub(p).0).collect();
+                let name = self.coefs.get(c as usize).map_or("coef", String::as_str);
+                (format!("self.coefs.{name}.at(&[{}], t, {comp}, &{:?})", at.join(", "), dirs.as_slice()), ATOM)
+            }
         }
     }
 }

@@ -288,7 +288,8 @@ impl Kernel<'_> {
         let nodes: Vec<NodeId> = body.roots.iter().map(|r| r.node).collect();
         let mut namer = self.namer(&names);
         let leaves = self.leaves(body, &mut namer);
-        let emitter = Emitter::new(self.g, &leaves.leaf);
+        let coefs: Vec<String> = self.prog.coefs.iter().map(|c| ident(&c.name)).collect();
+        let emitter = Emitter::new(self.g, &leaves.leaf).with_coefs(&coefs);
         let varies = |s: Sym| !body.leaf(s).is_some_and(Leaf::hoisted);
         let lines = emitter.bind(&nodes, varies, true, &mut namer);
         let mut weighted = String::new();
@@ -397,7 +398,7 @@ impl Kernel<'_> {
             leaf.insert(s, name);
         }
         // Coefs are functions of position and time.
-        if body.leaves.contains(&Leaf::Time) || !coefs.is_empty() {
+        if body.leaves.contains(&Leaf::Time) || !coefs.is_empty() || body.coefs_at {
             prologue.push_str("let t = ctx.t;\n");
         }
         if body.leaves.contains(&Leaf::CellDiameter) {

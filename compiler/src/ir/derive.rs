@@ -114,6 +114,26 @@ impl Derivative {
                 }
                 atan2_derivative(g, y, x, dy, dx)
             }
+            // The chain rule through the point: Σ_k ∂_k c(p) dp_k.
+            Node::CoefAt { id: coef, comp, dirs, point } => {
+                let at = g.point(point).to_vec();
+                let mut sum = g.zero();
+                for (k, &p) in at.iter().enumerate() {
+                    let dp = d(p);
+                    if g.is_zero(dp) {
+                        continue;
+                    }
+                    // Past `Dirs::MAX` derivatives (no form takes them: `grad` of a gradient
+                    // is refused), a NaN that no kernel reads.
+                    let dc = match dirs.and(k as u8) {
+                        Some(more) => g.coef_at(coef, comp, more, &at),
+                        None => g.constant(f64::NAN),
+                    };
+                    let term = g.mul(dc, dp);
+                    sum = g.add(sum, term);
+                }
+                sum
+            }
         }
     }
 }
@@ -168,6 +188,7 @@ mod tests {
             Node::Heaviside(a) | Node::Step(a) => f64::from((eval(g, a, x) > 0.0) as u8),
             Node::Func(f, a) => f.apply(eval(g, a, x)),
             Node::Atan2(a, b) => eval(g, a, x).atan2(eval(g, b, x)),
+            Node::CoefAt { .. } => f64::NAN,
         }
     }
 

@@ -11,7 +11,7 @@
 
 use std::collections::HashMap;
 
-use super::graph::{Func, Graph, Node, NodeId, Sym};
+use super::graph::{Dirs, Func, Graph, Node, NodeId, Sym};
 
 /// Slot index.
 type Slot = u32;
@@ -28,6 +28,30 @@ enum Op {
     Heaviside(Slot),
     Func(Func, Slot),
     Atan2(Slot, Slot),
+    /// Component `comp` of coef `id` (or a derivative) at a point: the slots of its
+    /// components, `len` of them.
+    CoefAt {
+        id: u16,
+        comp: u8,
+        dirs: Dirs,
+        point: [Slot; 3],
+        len: u8,
+    },
+}
+
+/// The values of case data at points other than the quadrature point ([`Node::CoefAt`]):
+/// component `comp` of coef `id` at `point`, differentiated along `dirs`.
+pub trait CoefsAt {
+    fn at(&self, id: u16, comp: u8, dirs: &[u8], point: &[f64]) -> f64;
+}
+
+/// For programs that read no coef at a point: NaN if one does.
+struct NoCoefs;
+
+impl CoefsAt for NoCoefs {
+    fn at(&self, _: u16, _: u8, _: &[u8], _: &[f64]) -> f64 {
+        f64::NAN
+    }
 }
 
 /// Straight-line code computing some roots of a graph from the values of its leaves.
@@ -110,6 +134,14 @@ impl Program {
                 Node::Heaviside(a) | Node::Step(a) => Op::Heaviside(s(a)),
                 Node::Func(f, a) => Op::Func(f, s(a)),
                 Node::Atan2(y, x) => Op::Atan2(s(y), s(x)),
+                Node::CoefAt { id, comp, dirs, point } => {
+                    let at = g.point(point);
+                    let mut slots = [0; 3];
+                    for (o, &p) in slots.iter_mut().zip(at) {
+                        *o = s(p);
+                    }
+                    Op::CoefAt { id, comp, dirs, point: slots, len: at.len() as u8 }
+                }
                 Node::Const(_) | Node::Sym(_) => continue,
             });
             slot.insert(n, next);
@@ -163,17 +195,27 @@ impl Program {
 
     /// Runs every operation on `slots` (prepared, with the leaves written).
     pub fn exec(&self, slots: &mut [f64]) {
-        self.exec_ops(slots, 0, self.ops.len());
+        self.exec_ops(slots, 0, self.ops.len(), &NoCoefs);
     }
 
     /// Runs the operations that depend only on invariant leaves.
     pub fn exec_invariant(&self, slots: &mut [f64]) {
-        self.exec_ops(slots, 0, self.invariant);
+        self.exec_ops(slots, 0, self.invariant, &NoCoefs);
     }
 
     /// Runs the operations that depend on varying leaves (after [`Program::exec_invariant`]).
     pub fn exec_varying(&self, slots: &mut [f64]) {
-        self.exec_ops(slots, self.invariant, self.ops.len());
+        self.exec_ops(slots, self.invariant, self.ops.len(), &NoCoefs);
+    }
+
+    /// [`Program::exec_invariant`] for a program that reads coefs at points.
+    pub fn exec_invariant_with(&self, slots: &mut [f64], coefs: &dyn CoefsAt) {
+        self.exec_ops(slots, 0, self.invariant, coefs);
+    }
+
+    /// [`Program::exec_varying`] for a program that reads coefs at points.
+    pub fn exec_varying_with(&self, slots: &mut [f64], coefs: &dyn CoefsAt) {
+        self.exec_ops(slots, self.invariant, self.ops.len(), coefs);
     }
 
     /// The value of root `i` after a run.
@@ -194,7 +236,7 @@ impl Program {
         }
     }
 
-    fn exec_ops(&self, slots: &mut [f64], from: usize, to: usize) {
+    fn exec_ops(&self, slots: &mut [f64], from: usize, to: usize, coefs: &dyn CoefsAt) {
         let base = self.syms.len() + self.consts.len();
         for i in from..to {
             let v = |s: Slot| slots[s as usize];
@@ -210,6 +252,13 @@ impl Program {
                 Op::Heaviside(a) => heaviside(v(a)),
                 Op::Func(f, a) => f.apply(v(a)),
                 Op::Atan2(y, x) => v(y).atan2(v(x)),
+                Op::CoefAt { id, comp, dirs, point, len } => {
+                    let mut at = [0.0; 3];
+                    for (o, &p) in at.iter_mut().zip(&point[..len as usize]) {
+                        *o = v(p);
+                    }
+                    coefs.at(id, comp, dirs.as_slice(), &at[..len as usize])
+                }
             };
         }
     }

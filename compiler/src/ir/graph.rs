@@ -108,12 +108,55 @@ pub enum Node {
     Func(Func, NodeId),
     /// atan2(y, x): the angle of the point (x, y), in (−π, π].
     Atan2(NodeId, NodeId),
+    /// A case datum evaluated at a point other than the quadrature point (`g(x + u)`): component
+    /// `comp` of coef `id`, or its partial derivative with respect to the point's coordinates
+    /// `dirs` (see [`Dirs`]), at the point [`Graph::point`]`(point)`, whose components are
+    /// this node's children.
+    CoefAt {
+        id: u16,
+        comp: u8,
+        dirs: Dirs,
+        point: u32,
+    },
+}
+
+/// The coordinates a [`Node::CoefAt`] is differentiated along, sorted (partial derivatives
+/// commute): at most [`Dirs::MAX`] of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+pub struct Dirs {
+    len: u8,
+    dirs: [u8; 3],
+}
+
+impl Dirs {
+    /// The most derivatives a kernel takes of a coef at a point: a residual may read its
+    /// gradient (`grad(g(x + u))`), its tangent one more, and a third leaves room for both.
+    pub const MAX: usize = 3;
+
+    pub fn as_slice(&self) -> &[u8] {
+        &self.dirs[..self.len as usize]
+    }
+
+    /// One more derivative, along `k`; `None` past [`Dirs::MAX`].
+    pub fn and(self, k: u8) -> Option<Dirs> {
+        if self.len as usize == Self::MAX {
+            return None;
+        }
+        let mut d = self;
+        d.dirs[d.len as usize] = k;
+        d.len += 1;
+        d.dirs[..d.len as usize].sort_unstable();
+        Some(d)
+    }
 }
 
 #[derive(Default, Clone, Debug)]
 pub struct Graph {
     nodes: Vec<Node>,
     index: HashMap<Node, NodeId>,
+    /// The points coefs are evaluated at ([`Node::CoefAt`]), each once.
+    points: Vec<Vec<NodeId>>,
+    point_index: HashMap<Vec<NodeId>, u32>,
     /// Names from the source (`let mu`, `fn sn`), used for readable generated code.
     pub names: HashMap<NodeId, String>,
 }
@@ -332,6 +375,26 @@ impl Graph {
         }
     }
 
+    /// The components of point `i` (see [`Node::CoefAt`]).
+    pub fn point(&self, i: u32) -> &[NodeId] {
+        &self.points[i as usize]
+    }
+
+    /// Component `comp` of coef `id` at the point with components `at`, differentiated along
+    /// `dirs`.
+    pub fn coef_at(&mut self, id: u16, comp: u8, dirs: Dirs, at: &[NodeId]) -> NodeId {
+        let point = match self.point_index.get(at) {
+            Some(&i) => i,
+            None => {
+                let i = self.points.len() as u32;
+                self.points.push(at.to_vec());
+                self.point_index.insert(at.to_vec(), i);
+                i
+            }
+        };
+        self.intern(Node::CoefAt { id, comp, dirs, point })
+    }
+
     pub fn atan2(&mut self, y: NodeId, x: NodeId) -> NodeId {
         match (self.as_const(y), self.as_const(x)) {
             (Some(a), Some(b)) => self.constant(a.atan2(b)),
@@ -352,9 +415,20 @@ impl Graph {
     }
 
     /// Children of a node.
-    pub fn children(&self, id: NodeId) -> impl Iterator<Item = NodeId> {
-        let (a, b) = match self.node(id) {
-            Node::Const(_) | Node::Sym(_) => (None, None),
+    pub fn children(&self, id: NodeId) -> impl Iterator<Item = NodeId> + '_ {
+        let (a, b, point) = match self.node(id) {
+            Node::CoefAt { point, .. } => (None, None, self.point(point)),
+            n => {
+                let (a, b) = Self::operands(n);
+                (a, b, &[][..])
+            }
+        };
+        a.into_iter().chain(b).chain(point.iter().copied())
+    }
+
+    fn operands(n: Node) -> (Option<NodeId>, Option<NodeId>) {
+        match n {
+            Node::Const(_) | Node::Sym(_) | Node::CoefAt { .. } => (None, None),
             Node::Add(x, y) | Node::Mul(x, y) | Node::Div(x, y) | Node::Atan2(x, y) => (Some(x), Some(y)),
             Node::Neg(x)
             | Node::Powi(x, _)
@@ -363,8 +437,7 @@ impl Graph {
             | Node::Heaviside(x)
             | Node::Step(x)
             | Node::Func(_, x) => (Some(x), None),
-        };
-        a.into_iter().chain(b)
+        }
     }
 
     /// The nodes reachable from `roots`, children before parents (ids are created children
@@ -404,6 +477,10 @@ impl Graph {
                 Node::Step(a) => self.step(c(a)),
                 Node::Func(f, a) => self.func(f, c(a)),
                 Node::Atan2(y, x) => self.atan2(c(y), c(x)),
+                Node::CoefAt { id: coef, comp, dirs, point } => {
+                    let at: Vec<NodeId> = self.point(point).iter().map(|&p| c(p)).collect();
+                    self.coef_at(coef, comp, dirs, &at)
+                }
             };
             new.insert(id, rebuilt);
         }

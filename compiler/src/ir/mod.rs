@@ -355,6 +355,11 @@ fn gates(g: &Graph, roots: &[NodeId], is_field: impl Fn(Sym) -> bool + Copy) -> 
             Node::Func(Func::Sin | Func::Tan, a) => (open[&a].clone(), zero[&a].clone()),
             Node::Func(Func::Cos | Func::Exp | Func::Ln, a) => (open[&a].clone(), None),
             Node::Atan2(y, x) => (union(&open[&y], &open[&x]), None),
+            // Not zero where its point's components are.
+            Node::CoefAt { point, .. } => {
+                let at = g.point(point);
+                (at.iter().try_fold(BTreeSet::new(), |acc, p| union(&Some(acc), &open[p])), None)
+            }
         };
         open.insert(n, o);
         zero.insert(n, z);
@@ -380,7 +385,7 @@ fn vanishes_with_a_clip(g: &Graph, id: NodeId) -> bool {
             Node::Powf(a, p) => f64::from_bits(p) > 0.0 && v(a),
             Node::Func(Func::Sin | Func::Tan, a) => v(a),
             // atan2(0, x) is π for x < 0.
-            Node::Func(Func::Cos | Func::Exp | Func::Ln, _) | Node::Atan2(..) => false,
+            Node::Func(Func::Cos | Func::Exp | Func::Ln, _) | Node::Atan2(..) | Node::CoefAt { .. } => false,
             Node::Const(_) | Node::Sym(_) => false,
         };
         vanishes.insert(n, here);
@@ -414,6 +419,9 @@ pub fn node_degrees(
             Node::Powi(a, k) if k >= 0 => dg(a).saturating_mul(k as u32),
             Node::Powi(a, _) | Node::Powf(a, _) | Node::Sqrt(a) | Node::Func(_, a) => dg(a).saturating_add(2),
             Node::Atan2(y, x) => dg(y).max(dg(x)).saturating_add(2),
+            // Case data at a point that moves with the fields: a function of the point, as a
+            // non-polynomial function of it.
+            Node::CoefAt { point, .. } => g.point(point).iter().map(|&c| dg(c)).max().unwrap_or(0).saturating_add(2),
             Node::Heaviside(_) | Node::Step(_) => 0,
         };
         deg.insert(id, v);

@@ -160,6 +160,8 @@ pub struct Body {
     pub coef_len: usize,
     /// Physical coordinates of the point are needed (for `x` or for a coef).
     pub uses_x: bool,
+    /// Some coef is evaluated at a point of the body's own (`g(x + u)`: `Node::CoefAt`).
+    pub coefs_at: bool,
     /// Physical basis gradients are needed (by a field gradient or the contraction).
     pub uses_dphi: bool,
     pub contract: Contract,
@@ -325,12 +327,11 @@ fn body(unit: &Unit, ir: &DimIr, cell: bool, roots: Vec<Root>, contract: Contrac
     }
     let g = &ir.graph;
     let nodes: Vec<NodeId> = roots.iter().map(|r| r.node).collect();
+    let reachable = g.reachable(nodes.iter().copied());
+    let coefs_at = reachable.iter().any(|&n| matches!(g.node(n), Node::CoefAt { .. }));
     // In slot order: `Program` sorts its leaves as `Sym` does.
-    let mut syms: Vec<Sym> = g
-        .reachable(nodes.iter().copied())
-        .into_iter()
-        .filter_map(|n| if let Node::Sym(s) = g.node(n) { Some(s) } else { None })
-        .collect();
+    let mut syms: Vec<Sym> =
+        reachable.into_iter().filter_map(|n| if let Node::Sym(s) = g.node(n) { Some(s) } else { None }).collect();
     syms.sort_unstable();
     let mut coefs: Vec<CoefSlot> = Vec::new();
     let mut coef_len = 0;
@@ -349,7 +350,7 @@ fn body(unit: &Unit, ir: &DimIr, cell: bool, roots: Vec<Root>, contract: Contrac
     debug_assert_eq!(prog.syms(), syms.as_slice());
     let uses_x = !coefs.is_empty() || leaves.iter().any(|l| matches!(l, Leaf::Coord(_)));
     let uses_dphi = contract.reads_dphi() || leaves.iter().any(|l| matches!(l, Leaf::Grad { .. }));
-    Some(Body { roots, prog, leaves, coefs, coef_len, uses_x, uses_dphi, contract })
+    Some(Body { roots, prog, leaves, coefs, coef_len, uses_x, coefs_at, uses_dphi, contract })
 }
 
 #[cfg(test)]

@@ -89,6 +89,11 @@ fn node(g: &Graph, id: NodeId, params: &[String], coefs: &[String]) -> String {
         Node::Step(a) => format!("step {}", o(a)),
         Node::Func(f, a) => format!("{} {}", f.name(), o(a)),
         Node::Atan2(y, x) => format!("atan2 {} {}", o(y), o(x)),
+        Node::CoefAt { id: c, comp, dirs, point } => {
+            let at: Vec<String> = g.point(point).iter().map(|&p| o(p)).collect();
+            let name = coefs.get(c as usize).map_or("coef", String::as_str);
+            format!("{name}[{comp}] d{:?} at {}", dirs.as_slice(), at.join(" "))
+        }
     }
 }
 

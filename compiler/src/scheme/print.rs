@@ -236,5 +236,7 @@ fn expr(g: &Graph, id: NodeId) -> (String, u8) {
         Node::Heaviside(a) | Node::Step(a) => (format!("H({})", scalar(g, a)), 4),
         Node::Func(f, a) => (format!("{}({})", f.name(), scalar(g, a)), 4),
         Node::Atan2(y, x) => (format!("atan2({}, {})", scalar(g, y), scalar(g, x)), 4),
+        // Schemes read no coef.
+        Node::CoefAt { .. } => ("?".into(), 4),
     }
 }

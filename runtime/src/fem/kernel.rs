@@ -158,15 +158,21 @@ pub struct FacetCtx<'a, const D: usize, const N: usize> {
 /// `f(x, t, out)`: a coef's values at position `x` and time `t`.
 pub type CoefFn = Arc<dyn Fn(&[f64], f64, &mut [f64]) + Send + Sync>;
 
+/// `f(x, t, order, out)`: a coef's partial derivatives of `order` (1 or 2) with respect to the
+/// position, component-major: `out[c·d + k]` = ∂_k c, `out[(c·d + k)·d + l]` = ∂_k ∂_l c.
+pub type CoefDerivativesFn = Arc<dyn Fn(&[f64], f64, usize, &mut [f64]) + Send + Sync>;
+
 /// Case data (`coef` in a .wf file): a constant or a function of position and time.
 #[derive(Clone)]
 pub enum Coef {
     Constant(Vec<f64>),
-    /// `steady`: the function ignores the time.
+    /// `steady`: the function ignores the time. `derivatives`, where known, for a kernel that
+    /// reads the coef at a point of its own (`g(x + u)`), whose tangent differentiates it.
     Function {
         components: usize,
         f: CoefFn,
         steady: bool,
+        derivatives: Option<CoefDerivativesFn>,
     },
 }
 
@@ -182,13 +188,53 @@ impl Coef {
 
     /// `f(x, t, out)` writes the `components` values at position `x` and time `t`.
     pub fn function(components: usize, f: impl Fn(&[f64], f64, &mut [f64]) + Send + Sync + 'static) -> Self {
-        Coef::Function { components, f: Arc::new(f), steady: false }
+        Coef::Function { components, f: Arc::new(f), steady: false, derivatives: None }
     }
 
     /// `f(x, out)` writes the `components` values at position `x`, at every time (loads made
     /// of steady coefs are assembled once, not at every step).
     pub fn of_position(components: usize, f: impl Fn(&[f64], &mut [f64]) + Send + Sync + 'static) -> Self {
-        Coef::Function { components, f: Arc::new(move |x, _, out| f(x, out)), steady: true }
+        Coef::Function { components, f: Arc::new(move |x, _, out| f(x, out)), steady: true, derivatives: None }
+    }
+
+    /// With its first and second derivatives with respect to the position (see
+    /// [`CoefDerivativesFn`]); a constant has them already.
+    pub fn with_derivatives(self, d: impl Fn(&[f64], f64, usize, &mut [f64]) + Send + Sync + 'static) -> Self {
+        match self {
+            Coef::Function { components, f, steady, .. } => {
+                Coef::Function { components, f, steady, derivatives: Some(Arc::new(d)) }
+            }
+            c => c,
+        }
+    }
+
+    /// Component `comp` at the point `y` (a kernel's own, `g(x + u)`), or its partial derivative
+    /// along the coordinates `dirs` (at most two; sorted or not). NaN where the coef has no
+    /// derivatives (a function made in Rust without [`Coef::with_derivatives`]), or past the
+    /// second: the run stops at a non-finite residual or tangent, never on a wrong one.
+    #[inline]
+    pub fn at(&self, y: &[f64], t: f64, comp: usize, dirs: &[u8]) -> f64 {
+        let d = y.len();
+        match (self, dirs) {
+            (Coef::Constant(v), []) => v.get(comp).copied().unwrap_or(f64::NAN),
+            (Coef::Constant(_), _) => 0.0,
+            (Coef::Function { f, components, .. }, []) => {
+                let mut out = [0.0; 9];
+                f(y, t, &mut out[..(*components).min(9)]);
+                out.get(comp).copied().unwrap_or(f64::NAN)
+            }
+            (Coef::Function { derivatives: Some(df), components, .. }, [k]) => {
+                let mut out = [0.0; 27];
+                df(y, t, 1, &mut out[..(components * d).min(27)]);
+                out.get(comp * d + *k as usize).copied().unwrap_or(f64::NAN)
+            }
+            (Coef::Function { derivatives: Some(df), components, .. }, [k, l]) => {
+                let mut out = [0.0; 81];
+                df(y, t, 2, &mut out[..(components * d * d).min(81)]);
+                out.get((comp * d + *k as usize) * d + *l as usize).copied().unwrap_or(f64::NAN)
+            }
+            _ => f64::NAN,
+        }
     }
 
     /// Whether the values may change with time.

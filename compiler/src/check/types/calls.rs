@@ -21,6 +21,10 @@ impl Checker<'_> {
         let arg_tys: Vec<Option<Ty>> = args.iter().map(|a| self.ty(a)).collect();
         match self.prog.globals.get(&f.name) {
             Some(Global::Fn { params, body, .. }) => self.inline_call(e, f, params, body, arg_tys),
+            Some(Global::Coef(i)) => {
+                let i = *i;
+                self.coef_at_ty(e, f, i, args, arg_tys)
+            }
             Some(g) => {
                 if let Global::Param(i) = g {
                     self.used_params.insert(*i);
@@ -143,6 +147,40 @@ impl Checker<'_> {
         self.used_params.extend(used.iter().copied());
         self.memo.insert(key, (ty, used));
         ty
+    }
+
+    /// A coef evaluated at a point (`g(x + u)`, contact on the deformed configuration): one
+    /// vector argument that does not hold the test function; the value has the coef's shape,
+    /// and a gradient where the point has one.
+    fn coef_at_ty(&mut self, e: &Expr, f: &Ident, i: usize, args: &[Expr], arg_tys: Vec<Option<Ty>>) -> Option<Ty> {
+        if args.len() != 1 {
+            self.arity_error(e, f, 1, args.len());
+            return None;
+        }
+        let point = arg_tys.into_iter().next().flatten()?;
+        if point.shape != Shape::Vector {
+            self.error(
+                Diagnostic::error(
+                    "E0301",
+                    "shape mismatch",
+                    args[0].span,
+                    format!("coef `{}` is read at a point: a vector, not a {}", f.name, point.shape.name()),
+                )
+                .with_help(format!("`{}(x + u)` reads it at the displaced point", f.name)),
+            );
+            return None;
+        }
+        if point.test {
+            self.error(Diagnostic::error(
+                "E0402",
+                format!("test function in the point coef `{}` is read at", f.name),
+                args[0].span,
+                "depends on the test function",
+            ));
+            return None;
+        }
+        let shape = self.prog.coefs[i].shape;
+        Some(Ty { shape, konst: None, height: point.height.saturating_add(1), ..point })
     }
 
     pub(super) fn arity_error(&mut self, e: &Expr, f: &Ident, want: usize, got: usize) {

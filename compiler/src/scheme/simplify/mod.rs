@@ -137,6 +137,7 @@ fn value_and_scale(g: &Graph, id: NodeId, params: &[f64], dt: f64, t: f64) -> (f
             // Not in schemes (their values refuse these functions); sized by the value.
             Node::Func(f, x) => (f.apply(c(x).0), f.apply(c(x).0).abs()),
             Node::Atan2(y, x) => (c(y).0.atan2(c(x).0), c(y).0.atan2(c(x).0).abs()),
+            Node::CoefAt { .. } => (f64::NAN, f64::NAN),
         };
         v.insert(n, r);
     }

@@ -278,7 +278,7 @@ impl Normalizer {
             // Schemes take integer powers only (the checker refuses others there).
             Node::Powf(..) => Err(GiveUp),
             // Nor do they take transcendental functions.
-            Node::Func(..) | Node::Atan2(..) => Err(GiveUp),
+            Node::Func(..) | Node::Atan2(..) | Node::CoefAt { .. } => Err(GiveUp),
             Node::Sqrt(a) => {
                 let e = sub(a)?;
                 if e.is_zero() { Ok(Expr::default()) } else { Ok(Expr::atom(Atom::Sqrt(Box::new(e)))) }
