@@ -80,7 +80,13 @@ pub fn regimes(progress: &mut dyn FnMut(&str)) -> Result<Vec<RegimeRow>, CaseErr
         dim: 2,
     };
     let coefs = |name: &str| match name {
-        "g" => Some(Coef::function(1, |x, _, out| out[0] = x[1])),
+        // With its derivatives, for a law that reads it at the displaced point.
+        "g" => Some(Coef::function(1, |x, _, out| out[0] = x[1]).with_derivatives(|_, _, order, out| {
+            out.fill(0.0);
+            if order == 1 {
+                out[1] = 1.0;
+            }
+        })),
         "nc" => Some(Coef::constant(vec![0.0, -1.0])),
         "f" => Some(Coef::constant(vec![0.0, 0.0])),
         _ => None,
