@@ -38,6 +38,10 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0404", "test function multiplied by itself"),
     ("E0405", "form not linear in the test function (a term without it)"),
     ("E0406", "`prev` outside a form (a functional or a problem's expression has no previous time level)"),
+    (
+        "E0407",
+        "`derivative(e, u, d)` with respect to something that is not a field of the form or an argument of the function",
+    ),
     ("E0501", "`n` or `h` in a volume integral"),
     ("E0502", "derivative of something that has none"),
     ("E0503", "form needs a quadrature degree above the cap (20)"),

@@ -26,6 +26,8 @@ pub enum ShapeRule {
     Norm,
     ProjBall,
     Tangential,
+    /// `derivative(e, u, d)`: the shape of `e`.
+    Derivative,
 }
 
 /// A built-in's value on constant arguments.
@@ -107,6 +109,13 @@ pub const BUILTINS: &[Builtin] = {
         row("proj_ball", 2, ProjBall, true, "proj_ball(a, r): the projection of a onto the ball of radius r"),
         row("tangential", 2, Tangential, false, "tangential(a, nc): a − (a·nc) nc"),
         row("prev", 1, Same, false, "prev(e): e at the previous time level"),
+        row(
+            "derivative",
+            3,
+            Derivative,
+            false,
+            "derivative(e, u, d): the derivative of e with respect to u (a field or a function's argument) in the direction d",
+        ),
         scalar_fn("sin", Fold::Unary(f64::sin), "sin(a): the sine, a in radians"),
         scalar_fn("cos", Fold::Unary(f64::cos), "cos(a): the cosine, a in radians"),
         scalar_fn("tan", Fold::Unary(f64::tan), "tan(a): the tangent, a in radians"),
@@ -180,6 +189,7 @@ impl Builtin {
                 Err(format!("tangential takes a vector and a unit normal, not a {} and a {}", a.name(), b.name()))
             }
             (ShapeRule::Same, [a]) => Ok(*a),
+            (ShapeRule::Derivative, [e, _, _]) => Ok(*e),
             (ShapeRule::Scalars, shapes) if shapes.iter().all(|s| *s == Scalar) => Ok(Scalar),
             (_, shapes) => {
                 let got: Vec<_> = shapes.iter().map(|s| s.name()).collect();

@@ -41,6 +41,10 @@ pub enum Sym {
         id: u16,
         comp: u8,
     },
+    /// The variation parameter of a `derivative(e, u, d)` being lowered (its nesting level):
+    /// `e` is lowered at u + s·d, differentiated in s and read at s = 0, so no seed outlives
+    /// the lowering of its call.
+    Seed(u8),
 }
 
 /// A smooth function of one scalar: the language's `sin`, `cos`, `tan`, `exp` and `ln`.
@@ -460,12 +464,18 @@ impl Graph {
     /// `root` with every leaf `s` for which `map(s)` is some other leaf replaced by it, rebuilt
     /// through the constructors (children first: ids are a topological order).
     pub fn substitute(&mut self, root: NodeId, map: &impl Fn(Sym) -> Option<Sym>) -> NodeId {
+        self.replace(root, &|g: &mut Graph, s| map(s).map(|t| g.sym(t)))
+    }
+
+    /// `root` with every leaf `s` for which `map(s)` is a node replaced by that node, rebuilt
+    /// through the constructors, which fold what becomes constant (a seed set to 0).
+    pub fn replace(&mut self, root: NodeId, map: &impl Fn(&mut Graph, Sym) -> Option<NodeId>) -> NodeId {
         let mut new: HashMap<NodeId, NodeId> = HashMap::new();
         for id in self.reachable([root]) {
             let c = |x: NodeId| new[&x];
             let rebuilt = match self.node(id) {
                 Node::Const(_) => id,
-                Node::Sym(s) => map(s).map_or(id, |t| self.sym(t)),
+                Node::Sym(s) => map(self, s).unwrap_or(id),
                 Node::Add(a, b) => self.add(c(a), c(b)),
                 Node::Mul(a, b) => self.mul(c(a), c(b)),
                 Node::Div(a, b) => self.div(c(a), c(b)),

@@ -5,6 +5,7 @@
 use std::collections::HashMap;
 
 mod coef_at;
+mod derivative;
 mod jets;
 mod tensor;
 
@@ -67,6 +68,8 @@ pub struct Lowerer<'p> {
     /// Graph size when the current form began, for [`MAX_FORM_NODES`], and its name.
     form_start: usize,
     form_name: String,
+    /// `derivative` calls being lowered: the level of the next one's seed.
+    seeds: u8,
     /// In a form of n field arguments, n: `prev(u)` reads the previous time level's
     /// displacement as an n+1-th field, which no tangent differentiates. None outside forms
     /// (functionals, a problem's expressions).
@@ -84,6 +87,7 @@ impl<'p> Lowerer<'p> {
             calls: HashMap::new(),
             form_start: 0,
             form_name: String::new(),
+            seeds: 0,
             previous: None,
         }
     }
@@ -226,6 +230,7 @@ impl<'p> Lowerer<'p> {
                 }
                 self.binary(*op, a, b, b_const(e))
             }
+            ExprKind::Call(f, args) if f.name == "derivative" => self.derivative(args)?,
             ExprKind::Call(f, args) => {
                 let args: Vec<Val> = args.iter().map(|a| self.expr(a)).collect::<Res<_>>()?;
                 self.call(&f.name, args, e.span)?
@@ -403,17 +408,25 @@ impl<'p> Lowerer<'p> {
 
     /// `a` with every field argument, value and gradient, read at the previous time level: the
     /// form's field `previous`.
+    /// A seed of a `derivative` being lowered is 0 there: the previous level does not vary with
+    /// the unknown.
     fn previous_level(&mut self, a: &Val, previous: u8) -> Val {
-        let map = |s: Sym| match s {
-            Sym::Field { comp, .. } => Some(Sym::Field { arg: previous, comp }),
-            Sym::FieldGrad { comp, dir, .. } => Some(Sym::FieldGrad { arg: previous, comp, dir }),
+        let map = |g: &mut Graph, s: Sym| match s {
+            Sym::Field { comp, .. } => Some(g.sym(Sym::Field { arg: previous, comp })),
+            Sym::FieldGrad { comp, dir, .. } => Some(g.sym(Sym::FieldGrad { arg: previous, comp, dir })),
+            Sym::Seed(_) => Some(g.zero()),
             _ => None,
         };
+        self.map_nodes(a, |g, x| g.replace(x, &map))
+    }
+
+    /// `a` with `f` applied to every node of its components, values and gradients.
+    fn map_nodes(&mut self, a: &Val, mut f: impl FnMut(&mut Graph, NodeId) -> NodeId) -> Val {
         let c =
             a.c.iter()
                 .map(|j| Jet {
-                    v: self.g.substitute(j.v, &map),
-                    g: j.g.as_ref().map(|g| g.iter().map(|&x| self.g.substitute(x, &map)).collect()),
+                    v: f(&mut self.g, j.v),
+                    g: j.g.as_ref().map(|g| g.iter().map(|&x| f(&mut self.g, x)).collect()),
                 })
                 .collect();
         Val { shape: a.shape, c }

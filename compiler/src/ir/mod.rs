@@ -410,7 +410,7 @@ pub fn node_degrees(
                 Sym::Field { .. } | Sym::Test { .. } | Sym::Coef { .. } => p,
                 Sym::FieldGrad { .. } | Sym::TestGrad { .. } => p - 1,
                 Sym::Coord(_) => 1,
-                Sym::Param(_) | Sym::Normal(_) | Sym::CellDiameter | Sym::Time | Sym::Dt => 0,
+                Sym::Param(_) | Sym::Normal(_) | Sym::CellDiameter | Sym::Time | Sym::Dt | Sym::Seed(_) => 0,
             },
             Node::Add(a, b) => dg(a).max(dg(b)),
             // Saturating: deep products overflow u32; the cap on the degree reports them.

@@ -109,6 +109,7 @@ pub fn sym(s: Sym, params: &[String], coefs: &[String]) -> String {
         Sym::Coord(k) => format!("x[{k}]"),
         Sym::Time => "t".into(),
         Sym::Dt => "dt".into(),
+        Sym::Seed(k) => format!("seed{k}"),
         Sym::Coef { id, comp } => format!("{}[{comp}]", coefs.get(id as usize).map_or("coef", String::as_str)),
     }
 }

@@ -2,6 +2,7 @@
 //! schemes compile to stages that satisfy their relations, and the built-ins' tangents are
 //! their derivatives (the tensor functions also their identities).
 
+mod derivative;
 mod friction_builtins;
 mod no_panic;
 mod points;

@@ -5,7 +5,7 @@ use super::{Checker, MAX_EXPANSIONS, MAX_INLINE_DEPTH, Ty};
 use crate::check::Global;
 use crate::check::builtins::{self, BUILTIN_VALUES, Builtin};
 use crate::diagnostic::Diagnostic;
-use crate::syntax::ast::{Expr, Ident, Shape};
+use crate::syntax::ast::{Expr, ExprKind, Ident, Shape};
 
 impl Checker<'_> {
     pub(super) fn call_ty(&mut self, e: &Expr, f: &Ident, args: &[Expr]) -> Option<Ty> {
@@ -60,6 +60,7 @@ impl Checker<'_> {
                 }
                 Some(Ty { konst: ty.konst.and_then(|x| b.fold.apply(&[x])), ..ty })
             }
+            None if f.name == "derivative" => self.derivative_ty(e, f, args, arg_tys),
             None if let Some(b) = builtins::function(&f.name) => {
                 if b.arity != args.len() {
                     self.arity_error(e, f, b.arity, args.len());
@@ -181,6 +182,78 @@ impl Checker<'_> {
         }
         let shape = self.prog.coefs[i].shape;
         Some(Ty { shape, konst: None, height: point.height.saturating_add(1), ..point })
+    }
+
+    /// `derivative(e, u, d)`: `u` a name of the scope (a field, or an argument of the function
+    /// the call is written in), `d` a direction of its shape; `e` is differentiated, so it must
+    /// not hold the test function, and the result is linear in `d`.
+    fn derivative_ty(&mut self, e: &Expr, f: &Ident, args: &[Expr], arg_tys: Vec<Option<Ty>>) -> Option<Ty> {
+        if args.len() != 3 {
+            self.arity_error(e, f, 3, args.len());
+            return None;
+        }
+        let tys: Vec<Ty> = arg_tys.into_iter().collect::<Option<_>>()?;
+        let (te, tu, td) = (tys[0], tys[1], tys[2]);
+        let named = matches!(&args[1].kind, ExprKind::Name(id) if self.scope.iter().any(|(n, _)| *n == id.name));
+        if !named {
+            self.error(
+                Diagnostic::error(
+                    "E0407",
+                    "`derivative` with respect to something that is not an argument",
+                    args[1].span,
+                    "not a field of the form or an argument of the function",
+                )
+                .with_help("`derivative(e, u, v)` varies a name: a field of the form, or an argument of the `fn` it is written in (`fn dpn(u, v) = derivative(pn(u), u, v)`)"),
+            );
+            return None;
+        }
+        if tu.test {
+            self.error(Diagnostic::error(
+                "E0402",
+                "`derivative` with respect to the test function",
+                args[1].span,
+                "the test function",
+            ));
+            return None;
+        }
+        if te.test {
+            self.error(
+                Diagnostic::error("E0402", "test function inside `derivative`", args[0].span, "depends on the test function")
+                    .with_note("the expression is differentiated, and a form must be linear in its test function: give the test function as the direction, `derivative(e, u, v)`"),
+            );
+            return None;
+        }
+        if td.shape != tu.shape {
+            self.error(
+                Diagnostic::error(
+                    "E0301",
+                    "shape mismatch",
+                    args[2].span,
+                    format!(
+                        "the direction of `derivative` must have the shape of what it varies, a {}, not a {}",
+                        tu.shape.name(),
+                        td.shape.name()
+                    ),
+                )
+                .with_label(args[1].span, tu.shape.name()),
+            );
+            return None;
+        }
+        if tu.smooth && !td.smooth {
+            self.error(
+                Diagnostic::error("E0502", "the direction of `derivative` has no gradient", args[2].span, "no gradient")
+                    .with_note("what it varies has one, which the expression may read: the direction must be a field, a test function, or a smooth expression of them"),
+            );
+            return None;
+        }
+        Some(Ty {
+            shape: te.shape,
+            test: td.test,
+            facet: te.facet.or(td.facet),
+            smooth: te.smooth && td.smooth,
+            konst: None,
+            height: te.height.max(td.height).saturating_add(1),
+        })
     }
 
     pub(super) fn arity_error(&mut self, e: &Expr, f: &Ident, want: usize, got: usize) {
