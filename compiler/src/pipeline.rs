@@ -179,8 +179,9 @@ pub fn expand(path: &Path, loader: &dyn Loader, opts: &codegen::Options) -> Resu
 
 /// Checks a loaded unit and compiles its schemes; returns the program and the root's AST.
 fn front(loaded: load::Loaded, diags: Vec<Diagnostic>) -> Result<(Program, ast::File), (Vec<Diagnostic>, SourceMap)> {
-    let load::Loaded { sources, mut files, root } = loaded;
+    let load::Loaded { sources, mut files, root, roles } = loaded;
     let (mut unit, mut diags) = check::check(sources, root, &files, diags);
+    unit.roles = roles;
     let checked = !diags.iter().any(Diagnostic::is_error);
     // The schemes need nothing the forms' errors break: their mistakes are shown in the same
     // run. A scheme whose declaration has a syntax error is not compiled.

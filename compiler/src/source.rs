@@ -74,6 +74,12 @@ impl SourceMap {
 /// Reads source files (the filesystem, or an in-memory map for tests and fuzzing).
 pub trait Loader {
     fn load(&self, path: &Path) -> std::io::Result<String>;
+
+    /// The file a run binds to a role (`import material = elasticity` reads the run's material
+    /// in place of `elasticity.wf`); `None` keeps the file the import names.
+    fn role(&self, _role: &str) -> Option<PathBuf> {
+        None
+    }
 }
 
 /// Reads from the filesystem.

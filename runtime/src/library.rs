@@ -48,6 +48,10 @@ pub struct FormUnit {
     pub coefs: &'static [CoefInfo],
     /// The forms and functionals declared in the file itself.
     pub slots: &'static [SlotInfo],
+    /// The roles its files import (`import material = elasticity`): the role, and the file
+    /// stem compiled in its place. A run that binds another file to the role compiles the
+    /// file again, at run time, with that one.
+    pub roles: &'static [(&'static str, &'static str)],
     pub make: MakeForms,
 }
 

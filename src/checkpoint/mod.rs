@@ -302,6 +302,7 @@ pub fn identity(case: &str, in_use: &FilesInUse, mesh: &Mesh, more: &[(&str, Str
         ("scheme", in_use.scheme_name().to_string()),
         ("contact law", in_use.forms.contact_name().to_string()),
         ("files run interpreted", in_use.interpreted().join(", ")),
+        ("files compiled for the material", format!("{:?}", in_use.rebound())),
         ("step guard", format!("{:?}", in_use.guard)),
         ("mesh", mesh_fingerprint(mesh)),
     ];

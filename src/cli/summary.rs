@@ -12,6 +12,14 @@ pub(super) fn finish(result: Result<crate::problem::run::Run, crate::error::Case
                 let files: Vec<String> = files.iter().filter_map(|f| f.as_str().map(str::to_string)).collect();
                 interpreted_note(&files);
             }
+            if let Some(files) = s.get("compiled_for_material").and_then(|v| v.as_array()) {
+                for pair in files.iter().filter_map(|p| p.as_array()) {
+                    let [file, material] = [0, 1].map(|k| pair.get(k).and_then(|v| v.as_str()).unwrap_or_default());
+                    eprintln!(
+                        "note: {file} was compiled at run time with the material {material} (its `import material = ...`): interpreted, same results as compiled"
+                    );
+                }
+            }
             let text =
                 |k: &str| s.get(k).map_or(String::new(), |v| v.as_str().map_or_else(|| v.to_string(), str::to_string));
             // The problem's own summary keys; null where a reducer found nothing.

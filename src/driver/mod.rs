@@ -204,28 +204,83 @@ pub fn scheme(methods: &Methods) -> Result<SchemeSource, CaseError> {
         .ok_or_else(|| unknown("scheme", &methods.scheme, &scheme_names(methods)))
 }
 
+/// The role a form file imports to read the run's material (`import material = elasticity`:
+/// a Nitsche law's traction is the material's stress).
+pub const MATERIAL_ROLE: &str = "material";
+
+/// A compiled unit as it runs with the material `material`: as compiled, unless it imports
+/// the material's role and the run binds another file to it, which compiles it again, at run
+/// time, with that file.
+fn with_roles(u: &'static Unit, material: &FormSource, roles: &[(String, PathBuf)]) -> Result<FormSource, CaseError> {
+    let as_compiled = u.forms.is_none_or(|f| {
+        f.roles.iter().all(|(role, default)| {
+            *role != MATERIAL_ROLE || matches!(material, FormSource::Compiled(m) if m.name == *default)
+        })
+    });
+    if as_compiled {
+        return Ok(FormSource::Compiled(u));
+    }
+    let mut i = interpret_bound(Path::new(u.file), material, roles)?;
+    i.rebound = Some(material.file().to_string());
+    Ok(FormSource::Interpreted(Box::new(i)))
+}
+
+/// A form file read and compiled at run time with the run's files bound to its roles.
+fn interpret_bound(
+    path: &Path,
+    material: &FormSource,
+    roles: &[(String, PathBuf)],
+) -> Result<sources::Interpreted, CaseError> {
+    sources::interpret(path, roles).map_err(|e| {
+        CaseError::CaseFile(format!(
+            "{} with the run's material `{}` bound to its `import {MATERIAL_ROLE} = ...`:\n{e}",
+            path.display(),
+            material.file()
+        ))
+    })
+}
+
 /// The form files of a run's methods (material, contact law, extras; the contact law's index).
 pub fn form_units(methods: &Methods) -> Result<(Vec<FormSource>, usize), CaseError> {
     let form_files: Vec<&str> = units(methods).filter(|u| u.forms.is_some()).map(|u| u.name).collect();
+    let material = match &methods.material {
+        name if is_path(name) => match library_file(Path::new(name)) {
+            Some(u) => FormSource::Compiled(u),
+            None => sources::interpret(Path::new(name), &[])
+                .map(|i| FormSource::Interpreted(Box::new(i)))
+                .map_err(CaseError::CaseFile)?,
+        },
+        name => library_forms(methods, name, "")
+            .map(FormSource::Compiled)
+            .ok_or_else(|| unknown("form file", name, &form_files))?,
+    };
+    let roles = vec![(MATERIAL_ROLE.to_string(), PathBuf::from(material.file()))];
     let pick = |name: &str, prefix: &str, what: &str, known: &[&str]| -> Result<FormSource, CaseError> {
         if is_path(name) {
             let path = Path::new(name);
             if let Some(u) = library_file(path) {
-                return Ok(FormSource::Compiled(u));
+                return with_roles(u, &material, &roles);
             }
-            return sources::interpret(path).map(|i| FormSource::Interpreted(Box::new(i))).map_err(CaseError::CaseFile);
+            return sources::interpret(path, &roles)
+                .map(|i| FormSource::Interpreted(Box::new(i)))
+                .map_err(CaseError::CaseFile);
         }
-        library_forms(methods, name, prefix).map(FormSource::Compiled).ok_or_else(|| unknown(what, name, known))
+        let u = library_forms(methods, name, prefix).ok_or_else(|| unknown(what, name, known))?;
+        with_roles(u, &material, &roles)
     };
-    let mut units = vec![pick(&methods.material, "", "form file", &form_files)?];
     let contact = pick(&methods.contact, "contact_", "contact law", &contact_names())?;
+    let extras: Vec<FormSource> = methods
+        .forms
+        .iter()
+        .map(|f| pick(&f.display().to_string(), "", "form file", &form_files))
+        .collect::<Result<_, _>>()?;
+    let mut units = vec![material];
     let mut contact_index = units.len();
     match units.iter().position(|u| u.name() == contact.name() && u.file() == contact.file()) {
         Some(i) => contact_index = i,
         None => units.push(contact),
     }
-    for f in &methods.forms {
-        let u = pick(&f.display().to_string(), "", "form file", &form_files)?;
+    for u in extras {
         if !units.iter().any(|v| v.name() == u.name() && v.file() == u.file()) {
             units.push(u);
         }
@@ -327,9 +382,19 @@ impl FilesInUse {
             SchemeSource::Interpreted(i) => Some(i.file.clone()),
             SchemeSource::Compiled(_) => None,
         };
-        let written = |u: &FormSource| matches!(u, FormSource::Interpreted(i) if i.generated);
-        let forms = self.forms.units.iter().filter(|u| u.interpreted() && !written(u)).map(|u| u.file().to_string());
+        let own = |u: &FormSource| matches!(u, FormSource::Interpreted(i) if !i.generated && i.rebound.is_none());
+        let forms = self.forms.units.iter().filter(|u| own(u)).map(|u| u.file().to_string());
         scheme.into_iter().chain(forms).collect()
+    }
+
+    /// The library's files compiled again at run time for the run's material (`import material
+    /// = ...` bound to another file than the one compiled in): the file and the material.
+    pub fn rebound(&self) -> Vec<(String, String)> {
+        let rebound = |u: &FormSource| match u {
+            FormSource::Interpreted(i) => i.rebound.clone().map(|m| (i.file.clone(), m)),
+            FormSource::Compiled(_) => None,
+        };
+        self.forms.units.iter().filter_map(rebound).collect()
     }
 
     pub fn scheme_name(&self) -> &str {

@@ -2,7 +2,7 @@
 //! evaluated on the runtime's tabulations, `crate::interpret`). Both describe themselves with
 //! the same param, coef and slot data and instantiate the same bound forms.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::compiler::{check_path, describe, module_name};
 use crate::interpret::Library;
@@ -24,12 +24,17 @@ pub struct Interpreted {
     pub slots: Vec<SlotInfo>,
     /// Written by the run itself (a problem's loads), not a file of the user's.
     pub generated: bool,
+    /// The roles its files import: role and default file stem.
+    pub roles: Vec<(String, String)>,
+    /// A file of the library compiled again for the run's material (the file bound to its
+    /// `import material = ...`), which is named here.
+    pub rebound: Option<String>,
     lib: Library,
 }
 
-/// Checks and lowers a form file given by path.
-pub fn interpret(path: &Path) -> Result<Interpreted, String> {
-    let (prog, warnings) = check_path(path, &LibraryLoader).map_err(|f| f.rendered)?;
+/// Checks and lowers a form file given by path, with `roles` bound to files (role, path).
+pub fn interpret(path: &Path, roles: &[(String, PathBuf)]) -> Result<Interpreted, String> {
+    let (prog, warnings) = check_path(path, &BoundLoader { roles }).map_err(|f| f.rendered)?;
     if !warnings.is_empty() {
         eprint!("{warnings}");
     }
@@ -39,8 +44,14 @@ pub fn interpret(path: &Path) -> Result<Interpreted, String> {
         params: describe::params(&prog),
         slots: describe::slots(&prog),
         generated: false,
+        roles: roles_of(&prog),
+        rebound: None,
         lib: Library::new(&prog),
     })
+}
+
+fn roles_of(prog: &crate::compiler::Program) -> Vec<(String, String)> {
+    prog.roles.iter().map(|r| (r.name.clone(), r.read.clone())).collect()
 }
 
 /// Checks and lowers a form file the run writes itself (`name` is how messages name it).
@@ -54,6 +65,8 @@ pub fn interpret_text(name: &str, text: &str) -> Result<Interpreted, String> {
         params: describe::params(&prog),
         slots: describe::slots(&prog),
         generated: true,
+        roles: roles_of(&prog),
+        rebound: None,
         lib: Library::new(&prog),
     })
 }
@@ -118,6 +131,16 @@ impl FormSource {
         matches!(self, FormSource::Interpreted(_))
     }
 
+    /// The roles its files import (`import material = elasticity`): role and default file stem.
+    pub fn roles(&self) -> Vec<(String, String)> {
+        match self {
+            FormSource::Compiled(u) => {
+                u.forms.map_or(Vec::new(), |f| f.roles.iter().map(|(r, d)| (r.to_string(), d.to_string())).collect())
+            }
+            FormSource::Interpreted(i) => i.roles.clone(),
+        }
+    }
+
     /// The coefs the file's forms read (its own and its imports'): name and tensor rank.
     pub fn coefs(&self) -> Vec<(String, u32)> {
         match self {
@@ -142,6 +165,22 @@ impl FormSource {
             },
             FormSource::Interpreted(i) => i.make(values, coefs, binding),
         }
+    }
+}
+
+/// [`LibraryLoader`] with files bound to roles (`import material = elasticity` reads the run's
+/// material).
+struct BoundLoader<'a> {
+    roles: &'a [(String, PathBuf)],
+}
+
+impl crate::compiler::Loader for BoundLoader<'_> {
+    fn load(&self, path: &Path) -> std::io::Result<String> {
+        LibraryLoader.load(path)
+    }
+
+    fn role(&self, role: &str) -> Option<PathBuf> {
+        self.roles.iter().find(|(r, _)| r == role).map(|(_, p)| p.clone())
     }
 }
 

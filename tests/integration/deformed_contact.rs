@@ -6,7 +6,7 @@
 //! plane, where g(x + u) = g − u·nc, the residual of the law of small strain.
 
 use signorini::runtime::fem::element::ElementKind;
-use signorini::runtime::fem::kernel::{Coef, FacetTabulation, OnFacet, facet_matrix, facet_vector};
+use signorini::runtime::fem::kernel::{Coef, FacetTabulation, FormKernel, OnFacet, facet_matrix, facet_vector};
 
 use crate::tangents::Rng;
 
@@ -76,7 +76,7 @@ const H: f64 = 1.0;
 
 /// The tangent with respect to u and its largest difference from central differences of the
 /// residual, relative to the tangent's largest entry; fields [u, w] (w the previous level).
-fn fd_error(k: &contact_penalty_deformed::Contact, u: &[[f64; 2]; 6], w: &[[f64; 2]; 6]) -> (Vec<Vec<f64>>, f64) {
+fn fd_error<K: FormKernel<2, 6>>(k: &K, u: &[[f64; 2]; 6], w: &[[f64; 2]; 6]) -> (Vec<Vec<f64>>, f64) {
     let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 8).unwrap();
     let (x, at) = (cell(), OnFacet { region: 0, facet: 0, h: H });
     let jac = facet_matrix(k, &tab, at, &x, &[u, w], 0, 0.0);
@@ -105,8 +105,8 @@ fn state(rng: &mut Rng, slide: f64) -> [[f64; 2]; 6] {
 }
 
 /// The contact switches at the facet's quadrature points: (active, inactive).
-fn switches(k: &contact_penalty_deformed::Contact, u: &[[f64; 2]; 6]) -> (usize, usize) {
-    use signorini::runtime::fem::kernel::{FacetCtx, FormKernel};
+fn switches<K: FormKernel<2, 6>>(k: &K, u: &[[f64; 2]; 6]) -> (usize, usize) {
+    use signorini::runtime::fem::kernel::FacetCtx;
     let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 8).unwrap();
     let (ftab, normal) = &tab.facets[0];
     let x = cell();
@@ -176,5 +176,94 @@ fn against_a_plane_it_is_the_law_of_small_strain() {
         let scale = b.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
         let diff = a.iter().flatten().zip(b.iter().flatten()).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
         assert!(scale > 0.0 && diff <= 1e-14 * scale, "differ by {diff:e} of {scale:e}");
+    }
+}
+
+// Nitsche's method on the deformed configuration (`forms/contact_nitsche_deformed.wf`), its
+// traction the material's first Piola–Kirchhoff stress: compiled with the neo-Hookean material
+// bound to its `import material = elasticity`, and with that default.
+signorini::forms!(mod nitsche_neo_hookean = "forms/contact_nitsche_deformed.wf", material = "forms/neo_hookean.wf");
+signorini::forms!("forms/contact_nitsche_deformed.wf");
+signorini::forms!("forms/contact_nitsche.wf");
+
+fn nitsche_neo_hookean(theta: f64, g: Coef, nc: Coef) -> nitsche_neo_hookean::Contact {
+    let p = nitsche_neo_hookean::Params::default();
+    let p = p.with("gamma0", 50.0).and_then(|p| p.with("theta", theta)).and_then(|p| p.with("E", 10.0)).unwrap();
+    let p = p.with("nu", 0.3).unwrap();
+    nitsche_neo_hookean::Contact::new(&p, &nitsche_neo_hookean::Coefficients { f: Coef::constant(vec![0.0; 2]), g, nc })
+}
+
+#[test]
+fn the_nitsche_tangent_at_finite_strain_matches_finite_differences_and_is_symmetric_for_theta_one() {
+    let (g, nc) = disc([0.5, -1.02], 1.0);
+    let mut rng = Rng(0x5851_f42d_4c95_7f2d);
+    for theta in [1.0, 0.0, -1.0] {
+        let k = nitsche_neo_hookean(theta, g.clone(), nc.clone());
+        for trial in 0..3 {
+            let u = state(&mut rng, 0.05 * trial as f64);
+            let (jac, err) = fd_error(&k, &u, &u);
+            assert!(err < 1e-6, "theta {theta}, trial {trial}: tangent differs from finite differences by {err:e}");
+            let (on, off) = switches(&k, &u);
+            assert!(
+                on > 0 && off > 0,
+                "theta {theta}, trial {trial}: the active set is not mixed ({on} on, {off} off)"
+            );
+            if theta == 1.0 {
+                // The variation of an energy: its tangent is that energy's Hessian.
+                let scale = jac.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+                let skew = (0..12)
+                    .flat_map(|i| (0..12).map(move |j| (i, j)))
+                    .fold(0.0f64, |m, (i, j)| m.max((jac[i][j] - jac[j][i]).abs()));
+                assert!(skew <= 1e-10 * scale, "trial {trial}: the tangent is not symmetric ({skew:e} of {scale:e})");
+            }
+        }
+    }
+}
+
+#[test]
+fn against_a_plane_with_a_linear_material_the_nitsche_law_is_that_of_small_strain() {
+    let g = Coef::function(1, |y, _, out| out[0] = y[1] + 0.1).with_derivatives(|_, _, order, out| {
+        out.fill(0.0);
+        if order == 1 {
+            out[1] = 1.0;
+        }
+    });
+    let nc = Coef::constant(vec![0.0, -1.0]);
+    let f = Coef::constant(vec![0.0, 0.0]);
+    let tab = FacetTabulation::<2, 6>::new(ElementKind::TriangleP2, 8).unwrap();
+    let (x, at) = (cell(), OnFacet { region: 0, facet: 0, h: H });
+    let mut rng = Rng(0x0bad_5eed_1234_5678);
+    for theta in [1.0, 0.0, -1.0] {
+        let set = |name: &str, v: f64| (name.to_string(), v);
+        let values = [set("gamma0", 50.0), set("theta", theta), set("E", 10.0), set("nu", 0.3)];
+        let mut p = contact_nitsche_deformed::Params::default();
+        let mut q = contact_nitsche::Params::default();
+        for (name, v) in &values {
+            p = p.with(name, *v).unwrap();
+            q = q.with(name, *v).unwrap();
+        }
+        let coefs = contact_nitsche_deformed::Coefficients { f: f.clone(), g: g.clone(), nc: nc.clone() };
+        let deformed = contact_nitsche_deformed::Contact::new(&p, &coefs);
+        let small = contact_nitsche::Contact::new(
+            &q,
+            &contact_nitsche::Coefficients { f: f.clone(), g: g.clone(), nc: nc.clone() },
+        );
+        for _ in 0..3 {
+            let u: [[f64; 2]; 6] = std::array::from_fn(|j| [0.02 * rng.next(), -0.1 + 0.2 * (x[j][0] - 0.5)]);
+            let (on, off) = switches(&small, &u);
+            assert!(on > 0 && off > 0, "theta {theta}: the active set is not mixed ({on} on, {off} off)");
+            let a = facet_vector(&deformed, &tab, at, &x, &[&u], 0.0);
+            let b = facet_vector(&small, &tab, at, &x, &[&u], 0.0);
+            let scale = b.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            let diff = a.iter().flatten().zip(b.iter().flatten()).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+            assert!(scale > 0.0 && diff <= 1e-13 * scale, "theta {theta}: residuals differ by {diff:e} of {scale:e}");
+            let (ka, kb) = (
+                facet_matrix(&deformed, &tab, at, &x, &[&u], 0, 0.0),
+                facet_matrix(&small, &tab, at, &x, &[&u], 0, 0.0),
+            );
+            let scale = kb.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            let diff = ka.iter().flatten().zip(kb.iter().flatten()).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+            assert!(diff <= 1e-13 * scale, "theta {theta}: tangents differ by {diff:e} of {scale:e}");
+        }
     }
 }

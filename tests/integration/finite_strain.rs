@@ -150,3 +150,56 @@ fn at_small_loads_the_neo_hookean_contact_approaches_the_linear_one_at_first_ord
     }
     assert!(gaps[2] < 3e-3, "{gaps:?}");
 }
+
+/// The pressed block's run with a material, a contact law and params.
+fn pressed(material: &str, contact: &str, params: &[(&str, f64)]) -> signorini::problem::run::Run {
+    let mut o = Options::new("pressed_block");
+    o.methods.material = material.into();
+    o.chosen.material = true;
+    o.methods.contact = contact.into();
+    o.chosen.contact = true;
+    o.methods.params.extend(params.iter().map(|(k, v)| setting(k, *v)));
+    run(&o).unwrap()
+}
+
+#[test]
+fn nitsche_on_the_deformed_configuration_is_consistent_at_finite_strain() {
+    for material in ["neo_hookean", "saint_venant_kirchhoff"] {
+        for theta in [1.0, 0.0, -1.0] {
+            for (press, cells) in [(0.3, 2.0), (0.05, 3.0)] {
+                let r = pressed(material, "nitsche_deformed", &[("press", press), ("cells", cells), ("theta", theta)]);
+                let key = |k: &str| r.summary.number(k).unwrap();
+                let (l1, l2) = (key("lateral_stretch"), 1.0 - press);
+                let (p11, p22, _) = closed_form(material, l1, l2);
+                let scale = p22.abs() + 100.0;
+                let what = format!("{material}, θ = {theta}, press {press}");
+                // The sides are free and the bottom slides: P₁₁ = 0 fixes λ₁.
+                assert!(p11.abs() < 1e-11 * scale, "{what}: P₁₁ = {p11:e} at λ₁ = {l1}");
+                // The plane pushes with the material's traction, as the top is pushed.
+                for k in ["top_force", "contact_force"] {
+                    assert!((key(k) + p22).abs() < 1e-11 * scale, "{what}: {k} {} vs −P₂₂ {}", key(k), -p22);
+                }
+                assert!(key("iterations") <= 12.0);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_traction_of_small_strain_misses_the_finite_strain_equilibrium() {
+    // The exact equilibrium: λ₁ where P₁₁(λ₁, 0.7) = 0, by bisection (P₁₁ grows with λ₁).
+    let (mut lo, mut hi) = (0.5, 2.0);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if closed_form("neo_hookean", mid, 0.7).0 > 0.0 { hi = mid } else { lo = mid }
+    }
+    let (_, p22, _) = closed_form("neo_hookean", lo, 0.7);
+    // Hooke's σ_N on the reference configuration: the plane does not push with the material's
+    // traction, and the equilibrium found is another (6.6 % off at λ₂ = 0.7).
+    let r = pressed("neo_hookean", "nitsche", &[("press", 0.3)]);
+    let force = r.summary.number("contact_force").unwrap();
+    assert!((force + p22).abs() > 0.05 * p22.abs(), "{force} vs −P₂₂ {}", -p22);
+    let r = pressed("neo_hookean", "nitsche_deformed", &[("press", 0.3)]);
+    let force = r.summary.number("contact_force").unwrap();
+    assert!((force + p22).abs() < 1e-11 * (p22.abs() + 100.0), "{force} vs −P₂₂ {}", -p22);
+}

@@ -1,5 +1,7 @@
 //! `forms!("path/to/file.wf")`: compiles a .wf file (and its imports) at build time into a
-//! module of kernels named after the file stem; `forms!(pub mod name = "path")` names it.
+//! module of kernels named after the file stem; `forms!(pub mod name = "path")` names it, and
+//! `forms!(mod name = "law.wf", material = "neo_hookean.wf")` binds a file to a role the unit
+//! imports (`import material = elasticity`).
 //! Paths are relative to the using crate's manifest directory. Errors become
 //! `compile_error!` with the rendered diagnostics; editing any of the files triggers a
 //! rebuild. The macro never panics: a compiler bug is reported as an error too.
@@ -20,19 +22,44 @@ struct Input {
     vis: Visibility,
     name: Option<Ident>,
     path: LitStr,
+    /// Files bound to roles: `material = "forms/neo_hookean.wf"`.
+    roles: Vec<(Ident, LitStr)>,
 }
 
 impl Parse for Input {
     fn parse(input: ParseStream) -> syn::Result<Self> {
-        if input.peek(LitStr) {
-            return Ok(Input { vis: Visibility::Inherited, name: None, path: input.parse()? });
-        }
-        let vis: Visibility = input.parse()?;
-        input.parse::<Token![mod]>()?;
-        let name: Ident = input.parse()?;
-        input.parse::<Token![=]>()?;
+        let (vis, name) = if input.peek(LitStr) {
+            (Visibility::Inherited, None)
+        } else {
+            let vis: Visibility = input.parse()?;
+            input.parse::<Token![mod]>()?;
+            let name: Ident = input.parse()?;
+            input.parse::<Token![=]>()?;
+            (vis, Some(name))
+        };
         let path = input.parse()?;
-        Ok(Input { vis, name: Some(name), path })
+        let mut roles = Vec::new();
+        while input.parse::<Option<Token![,]>>()?.is_some() && !input.is_empty() {
+            let role: Ident = input.parse()?;
+            input.parse::<Token![=]>()?;
+            roles.push((role, input.parse()?));
+        }
+        Ok(Input { vis, name, path, roles })
+    }
+}
+
+/// Reads the file system, with files bound to roles.
+struct Bound {
+    roles: Vec<(String, PathBuf)>,
+}
+
+impl signorini_compiler::Loader for Bound {
+    fn load(&self, path: &Path) -> std::io::Result<String> {
+        signorini_compiler::Loader::load(&FsLoader, path)
+    }
+
+    fn role(&self, role: &str) -> Option<PathBuf> {
+        self.roles.iter().find(|(r, _)| r == role).map(|(_, p)| p.clone())
     }
 }
 
@@ -68,8 +95,9 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
         None => signorini_compiler::module_name(Path::new(&rel)),
     };
     let opts = codegen::Options { runtime: codegen::DEFAULT_RUNTIME.to_string(), module, source_name: rel.clone() };
+    let loader = Bound { roles: input.roles.iter().map(|(r, p)| (r.to_string(), manifest.join(p.value()))).collect() };
     let signorini_compiler::Expansion { mut file, sources } =
-        signorini_compiler::expand(&manifest.join(&rel), &FsLoader, &opts)?;
+        signorini_compiler::expand(&manifest.join(&rel), &loader, &opts)?;
     if let Some(syn::Item::Mod(m)) = file.items.first_mut() {
         if input.name.is_some() {
             m.vis = input.vis.clone();

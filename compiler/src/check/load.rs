@@ -12,6 +12,8 @@ pub struct Loaded {
     pub sources: SourceMap,
     pub files: Vec<(FileId, ast::File)>,
     pub root: FileId,
+    /// The roles imported, with the file read for each.
+    pub roles: Vec<super::Role>,
 }
 
 /// Reads and parses `root` and everything it imports. Syntax errors do not stop loading.
@@ -21,18 +23,20 @@ pub fn load(root: &Path, loader: &dyn Loader, diags: &mut Vec<Diagnostic>) -> Re
         std::io::ErrorKind::InvalidData => format!("{}:{e}", root.display()),
         _ => format!("cannot read {}: {e}", root.display()),
     })?;
-    let mut l = Loader_ { loader, sources: SourceMap::default(), files: Vec::new(), stack: Vec::new() };
+    let mut l =
+        Loader_ { loader, sources: SourceMap::default(), files: Vec::new(), stack: Vec::new(), roles: Vec::new() };
     let root_id = l.sources.add(root.clone(), text);
     l.visit(root_id, diags);
-    Ok(Loaded { sources: l.sources, files: l.files, root: root_id })
+    Ok(Loaded { sources: l.sources, files: l.files, root: root_id, roles: l.roles })
 }
 
 /// Parses a single in-memory text as a unit whose imports resolve through `loader`.
 pub fn load_text(path: &Path, text: &str, loader: &dyn Loader, diags: &mut Vec<Diagnostic>) -> Loaded {
-    let mut l = Loader_ { loader, sources: SourceMap::default(), files: Vec::new(), stack: Vec::new() };
+    let mut l =
+        Loader_ { loader, sources: SourceMap::default(), files: Vec::new(), stack: Vec::new(), roles: Vec::new() };
     let root_id = l.sources.add(normalize(path), text.to_string());
     l.visit(root_id, diags);
-    Loaded { sources: l.sources, files: l.files, root: root_id }
+    Loaded { sources: l.sources, files: l.files, root: root_id, roles: l.roles }
 }
 
 struct Loader_<'a> {
@@ -41,6 +45,7 @@ struct Loader_<'a> {
     files: Vec<(FileId, ast::File)>,
     /// Files being visited, with the span of the import that led to each.
     stack: Vec<(PathBuf, Option<Span>)>,
+    roles: Vec<super::Role>,
 }
 
 impl Loader_<'_> {
@@ -51,10 +56,21 @@ impl Loader_<'_> {
         diags.append(&mut d);
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         for item in &file.items {
-            let ast::Item::Import { path: rel, span } = item else {
+            let ast::Item::Import { path: rel, span, role } = item else {
                 continue;
             };
-            let target = normalize(&dir.join(rel));
+            let bound = role.as_ref().and_then(|r| self.loader.role(&r.name));
+            let target = normalize(&bound.unwrap_or_else(|| dir.join(rel)));
+            if let Some(r) = role
+                && !self.roles.iter().any(|o| o.name == r.name)
+            {
+                let stem = |p: &Path| p.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+                self.roles.push(super::Role {
+                    name: r.name.clone(),
+                    default: stem(Path::new(rel)),
+                    read: stem(&target),
+                });
+            }
             if let Some(pos) = self.stack.iter().position(|(p, _)| *p == target) {
                 let mut d =
                     Diagnostic::error("E0702", "cyclic import", *span, format!("`{}` is already being imported", rel))

@@ -43,6 +43,19 @@ pub struct Unit {
     pub globals: HashMap<String, Global>,
     /// Warnings (errors make `check` return `Err`).
     pub warnings: Vec<Diagnostic>,
+    /// The roles its files import (`import material = elasticity`), each once, in the order
+    /// of loading (set by the loader, which resolves them).
+    pub roles: Vec<Role>,
+}
+
+/// A role a unit imports (`import material = elasticity`): the run may bind a file to it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Role {
+    pub name: String,
+    /// The stem of the file the import names, read when nothing is bound to the role.
+    pub default: String,
+    /// The stem of the file read for it in this unit.
+    pub read: String,
 }
 
 #[derive(Clone, Debug)]
@@ -157,6 +170,7 @@ pub fn check(
         problems: Vec::new(),
         globals: HashMap::new(),
         warnings: Vec::new(),
+        roles: Vec::new(),
     };
     let broken = broken_names(files);
     declare(&mut prog, files, &mut diags);

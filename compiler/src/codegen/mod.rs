@@ -263,7 +263,8 @@ fn items(prog: &Program, irs: &[&DimIr], opts: &Options) -> (String, Coefficient
     } else {
         let own_names: Vec<(usize, &str)> = own.iter().map(|&fi| (fi, struct_names[fi].as_str())).collect();
         s.push_str(&library::forms_items(prog, &own_names));
-        "Some(FormUnit { params: PARAMS, coefs: COEFS, slots: SLOTS, make })".to_string()
+        let roles: Vec<String> = prog.roles.iter().map(|r| format!("({:?}, {:?})", r.name, r.read)).collect();
+        format!("Some(FormUnit {{ params: PARAMS, coefs: COEFS, slots: SLOTS, roles: &[{}], make }})", roles.join(", "))
     };
     let _ = writeln!(
         s,

@@ -146,6 +146,9 @@ pub enum Item {
     Import {
         path: String,
         span: Span,
+        /// `import material = elasticity`: a role the run may bind to another file (`path` is
+        /// the default).
+        role: Option<Ident>,
     },
     Param {
         name: Ident,

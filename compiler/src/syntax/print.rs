@@ -11,7 +11,8 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
         let (line, col) = sources.line_col(span.file, span.start);
         let head = format!("{line}:{col} ");
         match item {
-            Item::Import { path, .. } => out.push_str(&format!("{head}import {path:?}\n")),
+            Item::Import { path, role: None, .. } => out.push_str(&format!("{head}import {path:?}\n")),
+            Item::Import { path, role: Some(r), .. } => out.push_str(&format!("{head}import {} = {path:?}\n", r.name)),
             Item::Param { name, default, range, .. } => {
                 out.push_str(&format!("{head}param {} = {}", name.name, expr(default)));
                 if let Some(r) = range {

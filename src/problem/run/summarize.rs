@@ -38,6 +38,7 @@ fn what_ran(req: &Request, ran: &Ran, put: &mut Put) {
     put("scheme", if statics { "static".into() } else { in_use.scheme_name().into() });
     put("contact", in_use.forms.contact_name().into());
     put("interpreted", json(&in_use.interpreted()));
+    put("compiled_for_material", json(&in_use.rebound()));
     put("params", json(&all_params(in_use, req.params, pf)));
     put("mass", json(&opts.mass));
     put("cell_size", json(&opts.cell_size));

@@ -48,7 +48,15 @@ impl Builder {
         let mut next = || it.next().expect("grammar guarantees the child");
         Ok(match rule {
             Rule::import => {
-                let target = next();
+                let mut target = next();
+                let role = match target.as_rule() {
+                    Rule::import_role => {
+                        let role = self.ident(target.into_inner().next().expect("a role names itself"));
+                        target = next();
+                        Some(role)
+                    }
+                    _ => None,
+                };
                 let path = match target.as_rule() {
                     Rule::string => {
                         let s = target.as_str();
@@ -56,7 +64,7 @@ impl Builder {
                     }
                     _ => format!("{}.wf", target.as_str()),
                 };
-                Item::Import { path, span }
+                Item::Import { path, span, role }
             }
             Rule::param => {
                 let name = self.ident(next());
