@@ -76,6 +76,13 @@ pub enum CaseError {
         points: usize,
         mass: String,
     },
+    /// An explicit scheme's step beyond the critical step of the current tangent: a
+    /// finite-strain material stiffened along the run.
+    #[error(
+        "stopped at t = {at}: Δt = {dt} is now beyond the stable step of scheme `{scheme}`: Δt_c ≈ {stable:.6e} = cfl {cfl} / ω_max {omega_max:.6e}, with ω_max² the largest eigenvalue of M⁻¹(K_T(u) + the contact stiffness) at this state, K_T the material's tangent, which has stiffened (Δt_c is {initial:.6e} for the body at rest, u = 0). Results up to here are written; use --dt {stable:.3e} or smaller, or --allow-unstable-dt to run it anyway (the energy guard still watches)",
+        at = at(.t)
+    )]
+    Stiffened { t: f64, dt: f64, scheme: String, stable: f64, cfl: f64, omega_max: f64, initial: f64 },
     /// SIGINT or SIGTERM.
     #[error("interrupted at t = {at}: results up to there are written", at = at(.t))]
     Interrupted { t: f64 },

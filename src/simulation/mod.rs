@@ -89,6 +89,8 @@ pub struct Simulation<'m> {
     law: Option<EnergyLaw>,
     /// The critical step of a scheme that claims `cfl` (an explicit one).
     pub stable: Option<stability::StableStep>,
+    /// Its estimate along the run, from the current tangent, for a nonlinear stiffness.
+    pub tracker: Option<stability::Tracker>,
     /// Whether the scheme applies a mass: without, each step is an equilibrium of its own and
     /// no energy is watched.
     pub inertia: bool,
@@ -166,11 +168,13 @@ impl<'m> Simulation<'m> {
             guard.energy_tolerance = 0.0;
         }
         let (claims, law) = in_use.scheme_claims_and_law()?;
-        let stable = match claims.into_iter().find(|(c, _)| c == "cfl") {
-            Some((_, cfl)) => Some(stability::estimate(&ops, coefs, &held, cfl)?),
-            None => None,
+        let (stable, tracker) = match claims.into_iter().find(|(c, _)| c == "cfl") {
+            Some((_, cfl)) => {
+                (Some(stability::estimate(&ops, coefs, &held, cfl)?), stability::Tracker::new(&ops, coefs, &held, cfl)?)
+            }
+            None => (None, None),
         };
-        Ok(Simulation { stepper, ops, states, v_index, guard, params, law, stable, inertia })
+        Ok(Simulation { stepper, ops, states, v_index, guard, params, law, stable, tracker, inertia })
     }
 
     /// Sets the displacement and solves the scheme's initial problem (the acceleration).
@@ -235,6 +239,10 @@ impl<'m> Simulation<'m> {
         if let Some((saved, _)) = &control.resume {
             (at, energy) = self.resume(saved, &mut outcome)?;
         }
+        // A nonlinear stiffness's tangent at the first state, which may be strained.
+        if let Some(refused) = self.check_current_tangent(span.dt, span.t0 + at.first as f64 * span.dt)? {
+            return Err(refused);
+        }
         'steps: for k in at.first..span.steps {
             bar.tick(k);
             let mut done: u64 = 0;
@@ -266,6 +274,13 @@ impl<'m> Simulation<'m> {
                     break 'steps;
                 }
                 at.accept(done, units);
+                if whole
+                    && self.tracker.as_mut().is_some_and(stability::Tracker::due)
+                    && let Some(stop) = self.check_current_tangent(span.dt, t_end)?
+                {
+                    outcome.stopped = Some(stop);
+                    break 'steps;
+                }
             }
         }
         bar.finish();
@@ -372,6 +387,25 @@ impl<'m> Simulation<'m> {
             self.stepper.forget();
         }
         Ok(())
+    }
+
+    /// Why the run stops after this step, if the next would step beyond the critical step of
+    /// the current tangent (a nonlinear stiffness, when [`stability::Tracker::due`]).
+    fn check_current_tangent(&mut self, dt: f64, t: f64) -> Result<Option<CaseError>, CaseError> {
+        let (Some(tracker), Some(initial)) = (&mut self.tracker, self.stable) else { return Ok(None) };
+        let now = tracker.at(&self.ops, &self.states[0], t, dt)?;
+        if dt <= now.dt || self.guard.allow_unstable_dt {
+            return Ok(None);
+        }
+        Ok(Some(CaseError::Stiffened {
+            t,
+            dt,
+            scheme: self.stepper.desc().name.to_string(),
+            stable: now.dt,
+            cfl: now.cfl,
+            omega_max: now.omega_max,
+            initial: initial.dt,
+        }))
     }
 
     /// Refuses a Δt beyond an explicit scheme's critical step, unless the guard allows it.

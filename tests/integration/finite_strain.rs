@@ -203,3 +203,38 @@ fn a_traction_of_small_strain_misses_the_finite_strain_equilibrium() {
     let force = r.summary.number("contact_force").unwrap();
     assert!((force + p22).abs() < 1e-11 * (p22.abs() + 100.0), "{force} vs −P₂₂ {}", -p22);
 }
+
+/// The bar of `bar.wf` (E = ρ = 1, ν = 0, h = 1/20, released from u₀ = (1 − x)/2, so F = 1/2)
+/// of neo-Hookean material under central differences with steps of `dt`.
+fn central_bar(dt: f64) -> Result<signorini::problem::run::Run, signorini::error::CaseError> {
+    let mut o = Options::new("bar");
+    o.methods.material = "neo_hookean".into();
+    o.chosen.material = true;
+    o.methods.scheme = "central".into();
+    o.chosen.scheme = true;
+    o.dt = Some(dt);
+    o.t_end = Some(3.0);
+    run(&o)
+}
+
+#[test]
+fn central_differences_follow_the_critical_step_of_the_current_tangent() {
+    use signorini::error::CaseError;
+    // At F = 1/2 the 1D neo-Hookean modulus ∂P/∂F = μ(1 + F⁻²) is 5/2 of E = 2μ: the bulk's
+    // ω_max = 2√3 c/h grows by √(5/2), and the contact's stiffness (in the estimate too) only
+    // raises it. Δt = 0.02 is below Δt_c at rest but above it at the start.
+    let bulk = 2.0 / (2.0 * 3f64.sqrt() * 2.5f64.sqrt() / 0.05);
+    match central_bar(0.02) {
+        Err(CaseError::Stiffened { t, stable, initial, .. }) => {
+            assert_eq!(t, 0.0);
+            assert!(stable < 0.02 && 0.02 < initial, "Δt_c {stable} now, {initial} at rest");
+            assert!(stable <= bulk && stable > 0.95 * bulk, "Δt_c {stable} against the bulk's {bulk}");
+        }
+        other => panic!("expected a refusal at the start, got {:?}", other.map(|r| r.summary.number("stable_dt"))),
+    }
+    // Below it, the run goes through and reports the smallest Δt_c it met.
+    let r = central_bar(0.005).unwrap();
+    let least = r.summary.number("stable_dt_least").unwrap();
+    let rest = r.summary.number("stable_dt").unwrap();
+    assert!(least < bulk && least > 0.005, "least Δt_c {least}, at rest {rest}");
+}

@@ -75,6 +75,11 @@ fn cost(req: &Request, ran: &Ran, put: &mut Put) {
     if let Some(stable) = sim.and_then(|s| s.stable) {
         put("stable_dt", json(&stable.dt));
         put("omega_max", json(&stable.omega_max));
+        // Along a run whose stiffness is nonlinear: the smallest estimate from the current tangent.
+        if let Some((least, at)) = sim.and_then(|s| s.tracker.as_ref()).and_then(|t| t.least) {
+            put("stable_dt_least", json(&least));
+            put("stable_dt_least_at", json(&at));
+        }
     }
     put("solver", json(&req.opts.newton.solver));
     put("krylov_iterations", counters.iterations.into());
