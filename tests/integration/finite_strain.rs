@@ -238,3 +238,22 @@ fn central_differences_follow_the_critical_step_of_the_current_tangent() {
     let rest = r.summary.number("stable_dt").unwrap();
     assert!(least < bulk && least > 0.005, "least Δt_c {least}, at rest {rest}");
 }
+
+#[test]
+fn nitsche_at_finite_strain_with_theta_below_one_is_solved_as_the_nonsymmetric_system_it_is() {
+    // Its tangent is nonsymmetric only in contact, where the material is finite only near its
+    // rest: the stepper's probe must find both at once (a rigid translation into the obstacle),
+    // or Cholesky, reading half the matrix, meets the first contact as a singular matrix.
+    for theta in [0.0, -1.0] {
+        let mut o = Options::new("disc");
+        o.methods.material = "neo_hookean".into();
+        o.chosen.material = true;
+        o.methods.contact = "nitsche_deformed".into();
+        o.chosen.contact = true;
+        o.methods.params.push(setting("theta", theta));
+        o.t_start = Some(6.2);
+        o.t_end = Some(6.6);
+        let r = run(&o).unwrap_or_else(|e| panic!("θ = {theta}: {e}"));
+        assert!(r.summary.number("first_contact").is_some_and(|t| t < 6.6), "θ = {theta}: no contact");
+    }
+}

@@ -91,7 +91,9 @@ pub(super) fn zero_sum_groups(coefs: &[f64]) -> Vec<Vec<usize>> {
 /// pseudo-random states ±s, larger than the mesh, so that a switched term (a contact law's
 /// active set) is active at each point in one of them, and at states a thousandth of the mesh's
 /// cells in size, where a finite-strain material is defined (J = det F > 0; at the large states
-/// its ln J is NaN). A tangent that is not finite says nothing and is passed over; a form with no
+/// its ln J is NaN), and at a large rigid translation plus such a small state, where a contact
+/// law that reads the material's stress (Nitsche's at finite strain) is both defined and
+/// active. A tangent that is not finite says nothing and is passed over; a form with no
 /// finite probe at all is taken as nonsymmetric. In a split run every process probes its cells,
 /// and one nonsymmetric part decides for all.
 pub(super) fn probe_structure(
@@ -133,10 +135,13 @@ fn probe_here(
             continue;
         }
         let mut finite = false;
-        for scale in [large, large, small] {
-            // The fields, and the previous time level when the form reads it.
+        let d = asm.mesh().dim();
+        for (scale, translated) in [(large, false), (large, false), (small, false), (small, true)] {
+            // The fields, and the previous time level when the form reads it; dofs node by node.
             let count = form.fields() + usize::from(form.previous());
-            let state: Vec<Vec<f64>> = (0..count).map(|_| (0..n).map(|_| random(scale)).collect()).collect();
+            let shift: Vec<f64> = (0..d).map(|_| if translated { random(large) } else { 0.0 }).collect();
+            let state: Vec<Vec<f64>> =
+                (0..count).map(|_| (0..n).map(|i| shift[i % d] + random(scale)).collect()).collect();
             for sign in [1.0, -1.0] {
                 let fields: Vec<Vec<f64>> = state.iter().map(|f| f.iter().map(|x| sign * x).collect()).collect();
                 let refs: Vec<&[f64]> = fields.iter().map(Vec::as_slice).collect();
