@@ -34,7 +34,22 @@ GetFEM pieces (no hand-written weak form in the dynamics):
     Nitsche brick's) projection, with its own derivative; Previous_u is the Newmark scheme's
     previous displacement, as signorini's prev(u). Its contact terms use IM_TRIANGLE(8), whose
     face rule has 5 Gauss points per edge, as the law's `degree = 8`. --vx gives the disc a
-    horizontal velocity (the oblique impact, forms/problems/oblique_disc.wf).
+    horizontal velocity (the oblique impact, forms/problems/oblique_disc.wf), --omega a spin
+    (v = (vx, 0) + omega e_z x (x - c), c = (0, 12), from u = 0: scripts/getfem/thrown_disc.wf).
+  - contact on the deformed configuration (IM_TRIANGLE(8) on the contact zone; --contact-zone
+    boundary for a spinning disc), against the plane g(x) = x_y, nc = -e_y read at X + u, with the
+    run's material's nominal traction P(u)N (sigma(u)n for the linear material):
+    --contact penalty-deformed: forms/contact_penalty_deformed.wf with F = 0, eps [-g(X+u)]_+ v.nc;
+    --contact nitsche-deformed: forms/contact_nitsche_deformed.wf, P_N = P(u)N.nc,
+    -theta/gamma P_N DP_N[v] + 1/gamma [P_N + gamma g(X+u)]_- (theta DP_N[v] - gamma v.nc), with
+    DP_N[v] = Diff(P_N, u, Test_u);
+    --contact nitsche-piola: GetFEM's Nitsche brick with P(u)N as its Neumann term (its theta term
+    is the full traction's, -theta/gamma P(u)N.D(P(u)N)[v]: the same law as nitsche-deformed for
+    theta = 0 only);
+    --contact nitsche-raytracing: the rigid-obstacle term of GetFEM's large-sliding Nitsche brick,
+    -Interpolate_filter(trans, CFCP(P(u)N, n_x, u, (Interpolate(X,trans) - X - u).n_x, 0, gamma).v, 2)
+    with GetFEM's raytracing transformation and n_x = Transformed_unit_vector(Grad_u, Normal), written
+    out because the brick fails in 5.4.2 (see the code); it has no theta term (theta = 0).
   - --contact nitsche-normal: signorini's normal form (forms/contact_nitsche.wf, compared with
     `signorini run disc --contact nitsche`) as an add_nonlinear_term in GWFL:
     -theta/gamma sigma_N(u) sigma_N(v) + 1/gamma [P_1,gamma(u)]_- (theta sigma_N(v) - gamma v.n_c),
@@ -42,7 +57,7 @@ GetFEM pieces (no hand-written weak form in the dynamics):
     obstacle normal, P_1,gamma(u) = sigma_N(u) + gamma (g - u.n_c), gamma = gamma0/element_size.
   - --material neo_hookean: forms/neo_hookean.wf in place of the elasticity brick, an
     add_nonlinear_term P(u):Grad_Test_u with F = Id(2) + Grad_u, P = mu (F - F^-T) + lambda ln(det F) F^-T
-    (plane strain); GetFEM derives the tangent. The contact laws keep the LINEAR Hooke stress
+    (plane strain); GetFEM derives the tangent. The small-strain contact laws keep the LINEAR Hooke stress
     sigma(u) = lambda div u I + 2 mu sym grad u in sigma(u)n, written out (a nonlinear term declares
     no Neumann term), as signorini's laws do (they import elasticity.wf). --polish 1 adds one
     Newton iteration after GetFEM's solve, whose criterion min(|R|_1/load estimate, |du|_1/|u|_1)
@@ -67,7 +82,11 @@ Measures (per step, t = 0 first), the columns of signorini's series.csv:
                 (nitsche-normal: sigma_N(u)^2 in place of |sigma(u)n|^2, the normal form's E_Theta)
   uy_mean     = e_y.M u / e_y.M e_y (centre of mass), uy_mean_nodal = plain mean of nodal u_y
   fy_contact  = the vertical resultant of the contact term = -int_GC [P_1,gamma(u)]_-
-  (penalty: energy_aug = energy + 1/2 int_GC eps [u_N - g]_+^2, fy_contact = int_GC eps [u_N - g]_+)
+  (penalty: energy_aug = energy + 1/2 int_GC eps [u_N - g]_+^2, fy_contact = int_GC eps [u_N - g]_+;
+  the deformed laws: the same with P(u)N, g(X + u); nitsche-raytracing: energy_aug takes
+  1/(2 gamma) [P(u)N.n_x + gamma g]_-^2, (fx, fy)_contact = int_GC [P(u)N.n_x + gamma g]_- n_x)
+  kinetic     = 1/2 v.M v, vx_mean, vy_mean = e.M v / e.M e (centre of mass),
+  momentum    = (x + u)^perp.M v - m x_c x v_c, the angular momentum about the centre of mass
 """
 import argparse
 import sys
@@ -81,17 +100,32 @@ GC = 10  # region number of the contact zone
 
 p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
 p.add_argument("--mesh", required=True, help="the benchmark mesh, disc_r10_h1_v22.msh (Gmsh 2.2)")
-p.add_argument("--contact", choices=["nitsche", "nitsche-normal", "nitsche-coulomb", "penalty"], default="nitsche",
+p.add_argument("--contact", choices=["nitsche", "nitsche-normal", "nitsche-coulomb", "penalty", "penalty-deformed",
+                                     "nitsche-deformed", "nitsche-piola", "nitsche-raytracing"],
+               default="nitsche",
                help="nitsche: GetFEM's Nitsche brick (full-traction theta term); nitsche-normal: signorini's "
                     "normal form (forms/contact_nitsche.wf) as a GWFL term; penalty: a GWFL term, "
-                    "eps = gamma0/element_size (GetFEM's penalized contact brick takes a constant r, not gamma0/h)")
+                    "eps = gamma0/element_size (GetFEM's penalized contact brick takes a constant r, not gamma0/h). "
+                    "On the deformed configuration, IM_TRIANGLE(8) on the contact zone: penalty-deformed: "
+                    "forms/contact_penalty_deformed.wf with F = 0 (GWFL); nitsche-deformed: "
+                    "forms/contact_nitsche_deformed.wf (GWFL, P_N = P(u)N.nc, test terms by Diff); nitsche-piola: "
+                    "GetFEM's Nitsche brick with the Neumann term P(u)N; nitsche-raytracing: the rigid-obstacle term of "
+                    "GetFEM's Nitsche large-sliding brick (raytracing, biased, frictionless), written out")
+p.add_argument("--release-distance", type=float, default=1.0,
+               help="nitsche-raytracing: the raytracing transformation's release distance")
+p.add_argument("--contact-zone", choices=["lower", "boundary"], default="lower",
+               help="lower: the boundary facets facing down (n_y < 0 at the facet centre); boundary: all of them "
+                    "(a spinning disc lands on facets that started elsewhere)")
 p.add_argument("--material", choices=["elasticity", "neo_hookean"], default="elasticity",
                help="elasticity: GetFEM's linearized elasticity brick; neo_hookean: forms/neo_hookean.wf as a "
-                    "GWFL term (the contact laws keep the linear Hooke stress, as signorini's do)")
+                    "GWFL term (the small-strain contact laws keep the linear Hooke stress, as signorini's do; the "
+                    "deformed ones take its P(u)N)")
 p.add_argument("--theta", type=float, default=1.0)
 p.add_argument("--friction", type=float, default=0.3, help="nitsche-coulomb: the friction coefficient F")
 p.add_argument("--slip-scale", type=float, default=1.0, help="nitsche-coulomb: GetFEM's alpha")
 p.add_argument("--vx", type=float, default=0.0, help="the initial horizontal velocity")
+p.add_argument("--omega", type=float, default=0.0,
+               help="the initial spin, counter-clockwise: v = (vx, 0) + omega e_z x (x - c), c = (0, 12), from u = 0")
 p.add_argument("--gamma0", type=float, default=1000.0)
 p.add_argument("--dt", type=float, default=0.02)
 p.add_argument("--t-end", type=float, default=20.0)
@@ -131,14 +165,16 @@ mf.set_classical_fem(2)  # FEM_PK(2,2), isoparametric on the GT_PK(2,2) cells
 mfs = gf.MeshFem(m, 1)
 mfs.set_classical_fem(2)
 mim = gf.MeshIm(m, gf.Integ(args.integ))
-# The frictional law's facet rule: 5 Gauss points per edge (its `degree = 8`).
-mim_c = gf.MeshIm(m, gf.Integ("IM_TRIANGLE(8)")) if coulomb else mim
+# The frictional and deformed laws' facet rule: 5 Gauss points per edge (their `degree = 8`).
+deformed = args.contact in ("penalty-deformed", "nitsche-deformed", "nitsche-piola", "nitsche-raytracing")
+mim_c = gf.MeshIm(m, gf.Integ("IM_TRIANGLE(8)")) if coulomb or deformed else mim
 
 faces = m.outer_faces()
 normals = m.normal_of_faces(faces)  # at face centres: on a P2 edge, the chord normal
-m.set_region(GC, faces[:, normals[1, :] < 0])
+zone = faces if args.contact_zone == "boundary" else faces[:, normals[1, :] < 0]
+m.set_region(GC, zone)
 print(f"# {m.nbcvs()} cells, {mf.nbdof()} dofs, {faces.shape[1]} boundary facets, "
-      f"{int(np.sum(normals[1, :] < 0))} in contact zone, min |n_y| on the boundary "
+      f"{zone.shape[1]} in contact zone, min |n_y| on the boundary "
       f"{np.min(np.abs(normals[1, :])):.3e}", file=sys.stderr)
 
 # Model --------------------------------------------------------------------------------------
@@ -181,8 +217,52 @@ sigma_v_n = "((lambda*Div_Test_u*Id(2) + 2*mu*Sym(Grad_Test_u))*Normal)"
 # The frictional contact stress lambda_N n_c + lambda_t (Previous_u: the step's start).
 stress = (f"Coulomb_friction_coupled_projection({neumann}, {nc}, slip_scale*(u - Previous_u), "
           f"obs - u.{nc}, F, {gamma})")
+# Contact on the deformed configuration, against the plane: its gap g(x) = x_y and normal
+# nc = -grad g = -e_y read at the deformed point X + u (a plane's normal is constant), and the
+# run's material's nominal traction P(u)N on the reference boundary (Hooke's sigma(u)n for the
+# linear material), as forms/contact_{penalty,nitsche}_deformed.wf read them.
+nc_d = "[0,-1]"
+gap_d = "(X(2) + u(2))"
+traction = f"({piola}*Normal)" if args.material == "neo_hookean" else f"({neumann})"
+pn = f"(({traction}).{nc_d})"  # P_N(u)
+dpn = f"Diff({pn}, u, Test_u)"  # DP_N(u)[v]
+P1d = f"({pn} + {gamma}*{gap_d})"  # P_1,gamma(u)
+P1p = f"(({traction}).{nc} + {gamma}*(obs - u.{nc}))"  # the same, as GetFEM's Nitsche brick writes it
+# GetFEM's large-sliding Nitsche brick, rigid obstacle: n_x = F^-T N/|F^-T N| the deformed body's
+# unit normal, g the distance from X + u to the obstacle along n_x (raytracing), and the contact
+# stress [P(u)N.n_x + gamma g]_- along n_x (its Coulomb_friction_coupled_projection with F = 0).
+nx = "Transformed_unit_vector(Grad_u, Normal)"
 if coulomb:
     pass  # added with the time scheme, which declares Previous_u
+elif args.contact == "penalty-deformed":
+    # forms/contact_penalty_deformed.wf, F = 0: eps [-g(X + u)]_+ v.nc(X + u).
+    md.add_nonlinear_term(mim_c, f"{gamma}*pos_part(-{gap_d})*(Test_u.{nc_d})", GC)
+elif args.contact == "nitsche-deformed":
+    # forms/contact_nitsche_deformed.wf: -theta/gamma P_N DP_N[v] + 1/gamma [P_1,gamma]_- (theta DP_N[v] + gamma Dg[v]),
+    # Dg[v] = -nc.v; GWFL's neg_part(x) = -[x]_-.
+    md.add_nonlinear_term(mim_c, f"-{theta}/{gamma}*{pn}*{dpn}"
+                                 f" - 1/{gamma}*neg_part({P1d})*({theta}*{dpn} - {gamma}*(Test_u.{nc_d}))", GC)
+elif args.contact == "nitsche-piola":
+    # The brick takes the derivative of its Neumann term itself (extract_order1_term); its theta term
+    # is the full traction's, -theta/gamma P(u)N.D(P(u)N)[v].
+    md.add_Nitsche_contact_with_rigid_obstacle_brick(mim_c, "u", traction, "obs", "gamma0", GC, args.theta)
+elif args.contact == "nitsche-raytracing":
+    # add_Nitsche_large_sliding_contact_brick_raytracing's term for a rigid obstacle (biased: the
+    # disc is the slave), written out with the brick's own pieces, because the brick cannot be
+    # assembled in 5.4.2 once a point sees the obstacle: its rigid term
+    #   -Interpolate_filter(trans, CFCP.Test_u, 2) + Interpolate_filter(trans, CFCP.Interpolate(Test_ug, trans), 2)
+    # interpolates the master's test functions on the obstacle, which has no element ("No valid
+    # element for the transformation"); the unbiased version has no rigid term at all. The second
+    # term is zero for a rigid obstacle; the first is added here, with the brick's raytracing
+    # transformation, its gap (Interpolate(X,trans) - X - u).n_x and CFCP with F = 0, alpha = 1.
+    trans = "raytrace"
+    md.add_raytracing_transformation(trans, args.release_distance)
+    md.add_rigid_obstacle_to_raytracing_transformation(trans, "y", 2)
+    md.add_slave_contact_boundary_to_raytracing_transformation(trans, m, "u", GC)
+    gap_rt = f"((Interpolate(X,{trans}) - X - u).{nx})"
+    cfcp_rt = f"Coulomb_friction_coupled_projection({traction}, {nx}, (u)*1, {gap_rt}, 0, {gamma})"
+    md.add_nonlinear_term(mim_c, f"-Interpolate_filter({trans}, {cfcp_rt}.Test_u, 2)", GC)
+    lam_rt = f"neg_part(({traction}).{nx} + {gamma}*{gap_rt})"  # -[P(u)N.n_x + gamma g]_-
 elif args.contact == "nitsche":
     md.add_Nitsche_contact_with_rigid_obstacle_brick(mim, "u", neumann, "obs", "gamma0", GC, args.theta)
 elif args.contact == "nitsche-normal":
@@ -197,7 +277,9 @@ else:
 n = mf.nbdof()
 U0 = np.zeros(n)
 V0 = np.zeros(n)
-V0[0::2] = args.vx
+dof_x = mf.basic_dof_nodes()  # the dofs' nodes (exact on the isoparametric P2 mesh)
+V0[0::2] = args.vx - args.omega * (dof_x[1, 0::2] - 12.0)
+V0[1::2] = args.omega * dof_x[0, 1::2]
 Mmat = gf.asm_generic(mim, 2, "rho*u.Test_u", -1, "rho", 0, [rho], "u", 1, mf, U0)
 Kmat = gf.asm_generic(mim, 2, "(lambda*Div_u*Id(2)+2*mu*Sym(Grad_u)):Grad_Test_u", -1,
                       "lambda", 0, [lam], "mu", 0, [mu], "u", 1, mf, U0)
@@ -233,11 +315,36 @@ def boundary(expr, U, W=None):
                           "F", 0, [args.friction], "slip_scale", 0, [args.slip_scale])
 
 
+def model_boundary(expr, U):
+    """A contact functional at U assembled with the model (its raytracing transformation); the
+    model's u is put back, so the next Newton starts where it would have."""
+    keep = md.variable("u")
+    md.set_variable("u", U)
+    val = gf.asm_generic(mim_c, 0, expr, GC, md)
+    md.set_variable("u", keep)
+    return val
+
+
 def measure(t, U, V, W):
     """The row at (U, V), W the step's start (U at the first row)."""
     energy = 0.5 * V @ Mmat.mult(V) + strain_energy_of(U) - Fvec @ U
     fx = 0.0
-    if args.contact.startswith("nitsche"):
+    if args.contact == "penalty-deformed":
+        ce = boundary(f"{gamma}/2*sqr(pos_part(-{gap_d}))", U)
+        fy = boundary(f"{gamma}*pos_part(-{gap_d})", U)
+    elif args.contact == "nitsche-deformed":
+        ce = boundary(f"-{theta}/(2*{gamma})*sqr({pn}) + 1/(2*{gamma})*sqr(neg_part({P1d}))", U)
+        fy = boundary(f"neg_part({P1d})", U)
+    elif args.contact == "nitsche-piola":
+        ce = boundary(f"-{theta}/(2*{gamma})*Norm_sqr({traction}) + 1/(2*{gamma})*sqr(neg_part({P1p}))", U)
+        fy = boundary(f"neg_part({P1p})", U)
+    elif args.contact == "nitsche-raytracing":
+        # The brick's term is lam_rt n_x.v (on the side of the internal forces): the obstacle pushes
+        # the body by -lam_rt n_x, along the body's normal, not the plane's.
+        ce = model_boundary(f"Interpolate_filter({trans}, 1/(2*{gamma})*sqr({lam_rt}), 2)", U)
+        fx = -model_boundary(f"Interpolate_filter({trans}, {lam_rt}*({nx})(1), 2)", U)
+        fy = -model_boundary(f"Interpolate_filter({trans}, {lam_rt}*({nx})(2), 2)", U)
+    elif args.contact.startswith("nitsche"):
         theta_term = f"sqr({sn_u})" if args.contact == "nitsche-normal" else f"Norm_sqr({neumann})"
         ce = boundary(f"-{theta}/(2*{gamma})*{theta_term}"
                       f" + 1/(2*{gamma})*sqr(neg_part({P1}))", U)
@@ -247,7 +354,16 @@ def measure(t, U, V, W):
     else:
         ce = boundary(f"{gamma}/2*sqr({pen})", U)
         fy = boundary(f"{gamma}*{pen}", U)
-    return (t, energy, energy + ce, (Mex @ U) / total_mass, (Mey @ U) / total_mass, np.mean(U[1::2]), fx, fy)
+    ux, uy = (Mex @ U) / total_mass, (Mey @ U) / total_mass
+    MV = Mmat.mult(V)
+    vx, vy = (ex @ MV) / total_mass, (ey @ MV) / total_mass
+    # The angular momentum about the current centre of mass: (x + u)^perp.M v - m x_c x v_c.
+    perp = np.zeros(n)
+    perp[0::2] = -(dof_x[1, 0::2] + U[1::2])
+    perp[1::2] = dof_x[0, 1::2] + U[0::2]
+    momentum = perp @ MV - total_mass * (ux * vy - (12.0 + uy) * vx)
+    return (t, energy, energy + ce, ux, uy, np.mean(U[1::2]), fx, fy,
+            0.5 * V @ MV, vx, vy, momentum)
 
 
 # Initial acceleration: M a0 = F - K u0 - C(u0), the rhs of the model before the mass brick.
@@ -397,7 +513,7 @@ if args.check_residual:
     print(f"# largest |R(u)|_2/(|F|_2 + |f_int(u)|_2) after a solve: {worst_residual[0]:.3e} "
           f"(t = {worst_residual[1]:g})", file=sys.stderr)
 out = sys.stdout if args.out == "-" else open(args.out, "w")
-out.write("t,energy,energy_aug,ux_mean,uy_mean,uy_mean_nodal,fx_contact,fy_contact\n")
+out.write("t,energy,energy_aug,ux_mean,uy_mean,uy_mean_nodal,fx_contact,fy_contact,kinetic,vx_mean,vy_mean,momentum\n")
 for r in rows:
     out.write(",".join(repr(float(x)) for x in r) + "\n")
 if out is not sys.stdout:
