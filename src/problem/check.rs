@@ -9,7 +9,8 @@ use crate::runtime::fem::mesh::CellSize;
 
 /// Binds a problem with the library's defaults without running it: its params, the files in use
 /// and their coefs, the mesh with its regions, the coefs' and initial fields' expressions in the
-/// problem's dimension (`signorini check` on a problem file). Returns one line saying what was
+/// problem's dimension, the conditions of its `expect` lines (`signorini check` on a problem
+/// file). Returns one line saying what was
 /// checked and bound: the mesh, the regions with their facets, the unknowns, the files in use.
 pub fn check(problem: &str) -> Result<String, CaseError> {
     let opts = Options::new(problem);
@@ -23,6 +24,8 @@ pub fn check(problem: &str) -> Result<String, CaseError> {
         super::bind::coef_vals(pf, ex)?;
         super::bind::initial(pf, ex, &mesh, "u", 0.0)?;
         super::bind::initial(pf, ex, &mesh, "v", 0.0)?;
+        // The names an `expect ... when` reads, as a run resolves them.
+        super::summary::applies(pf, ex, &in_use.forms.params)?;
         let regions: Vec<String> = p
             .regions
             .iter()

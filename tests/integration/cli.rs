@@ -412,3 +412,21 @@ fn check_says_what_it_bound() {
         assert!(line.contains(part), "{part} in {line}");
     }
 }
+
+/// `check` on a problem file resolves the names its `expect ... when` lines read, as a run does:
+/// a misspelt one is an error at it, not a surprise at the end of a run.
+#[test]
+fn check_finds_an_unknown_name_in_an_expectation_s_condition() {
+    let dir = std::env::temp_dir().join(format!("signorini-check-when-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let disc = std::fs::read_to_string("forms/problems/disc.wf").unwrap();
+    let bad =
+        disc.replacen("    summary", "    expect first_contact = 6.34 within 0.01 when thetaa == 1\n    summary", 1);
+    assert_ne!(bad, disc, "disc.wf has a summary line");
+    let path = dir.join("disc_when.wf");
+    std::fs::write(&path, bad).unwrap();
+    let (code, _, err) = signorini(&["check", path.to_str().unwrap()]);
+    assert_ne!(code, 0, "{err}");
+    assert!(err.contains("unknown param `thetaa`") && err.contains("did you mean `theta`?"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
