@@ -389,45 +389,6 @@ impl<'m> Simulation<'m> {
         Ok(())
     }
 
-    /// Why the run stops after this step, if the next would step beyond the critical step of
-    /// the current tangent (a nonlinear stiffness, when [`stability::Tracker::due`]).
-    fn check_current_tangent(&mut self, dt: f64, t: f64) -> Result<Option<CaseError>, CaseError> {
-        let (Some(tracker), Some(initial)) = (&mut self.tracker, self.stable) else { return Ok(None) };
-        let now = tracker.at(&self.ops, &self.states[0], t, dt)?;
-        if dt <= now.dt || self.guard.allow_unstable_dt {
-            return Ok(None);
-        }
-        Ok(Some(CaseError::Stiffened {
-            t,
-            dt,
-            scheme: self.stepper.desc().name.to_string(),
-            stable: now.dt,
-            cfl: now.cfl,
-            omega_max: now.omega_max,
-            initial: initial.dt,
-        }))
-    }
-
-    /// Refuses a Δt beyond an explicit scheme's critical step, unless the guard allows it.
-    fn check_stable(&self, dt: f64) -> Result<(), CaseError> {
-        if let Some(stable) = self.stable
-            && dt > stable.dt
-            && !self.guard.allow_unstable_dt
-        {
-            return Err(CaseError::UnstableStep {
-                dt,
-                scheme: self.stepper.desc().name.to_string(),
-                stable: stable.dt,
-                cfl: stable.cfl,
-                omega_max: stable.omega_max,
-                active: stable.active,
-                points: stable.points,
-                mass: self.ops.mass_choice.name().to_string(),
-            });
-        }
-        Ok(())
-    }
-
     /// Restores a checkpoint's states (and the previous level, when a law reads it), its
     /// counters and its energy watch.
     fn resume(

@@ -232,3 +232,46 @@ pub(crate) fn pushed_into_obstacle(ops: &Operators, coefs: &dyn Fn(&str) -> Opti
     }
     (0..n).map(|i| s * direction.get(i % d).copied().unwrap_or(0.0)).collect()
 }
+
+/// The checks of an explicit scheme's step against its critical step, at the start and along
+/// the run.
+impl super::Simulation<'_> {
+    /// Why the run stops after this step, if the next would step beyond the critical step of
+    /// the current tangent (a nonlinear stiffness, when [`stability::Tracker::due`]).
+    pub(super) fn check_current_tangent(&mut self, dt: f64, t: f64) -> Result<Option<CaseError>, CaseError> {
+        let (Some(tracker), Some(initial)) = (&mut self.tracker, self.stable) else { return Ok(None) };
+        let now = tracker.at(&self.ops, &self.states[0], t, dt)?;
+        if dt <= now.dt || self.guard.allow_unstable_dt {
+            return Ok(None);
+        }
+        Ok(Some(CaseError::Stiffened {
+            t,
+            dt,
+            scheme: self.stepper.desc().name.to_string(),
+            stable: now.dt,
+            cfl: now.cfl,
+            omega_max: now.omega_max,
+            initial: initial.dt,
+        }))
+    }
+
+    /// Refuses a Δt beyond an explicit scheme's critical step, unless the guard allows it.
+    pub(super) fn check_stable(&self, dt: f64) -> Result<(), CaseError> {
+        if let Some(stable) = self.stable
+            && dt > stable.dt
+            && !self.guard.allow_unstable_dt
+        {
+            return Err(CaseError::UnstableStep {
+                dt,
+                scheme: self.stepper.desc().name.to_string(),
+                stable: stable.dt,
+                cfl: stable.cfl,
+                omega_max: stable.omega_max,
+                active: stable.active,
+                points: stable.points,
+                mass: self.ops.mass_choice.name().to_string(),
+            });
+        }
+        Ok(())
+    }
+}

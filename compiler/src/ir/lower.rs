@@ -7,6 +7,7 @@ use std::collections::HashMap;
 mod coef_at;
 mod derivative;
 mod jets;
+mod levels;
 mod tensor;
 
 use super::graph::{Func, Graph, NodeId, Sym};
@@ -404,32 +405,6 @@ impl<'p> Lowerer<'p> {
             return Ok(self.previous_level(&args[0], previous));
         }
         Ok(self.builtin(f, args))
-    }
-
-    /// `a` with every field argument, value and gradient, read at the previous time level: the
-    /// form's field `previous`.
-    /// A seed of a `derivative` being lowered is 0 there: the previous level does not vary with
-    /// the unknown.
-    fn previous_level(&mut self, a: &Val, previous: u8) -> Val {
-        let map = |g: &mut Graph, s: Sym| match s {
-            Sym::Field { comp, .. } => Some(g.sym(Sym::Field { arg: previous, comp })),
-            Sym::FieldGrad { comp, dir, .. } => Some(g.sym(Sym::FieldGrad { arg: previous, comp, dir })),
-            Sym::Seed(_) => Some(g.zero()),
-            _ => None,
-        };
-        self.map_nodes(a, |g, x| g.replace(x, &map))
-    }
-
-    /// `a` with `f` applied to every node of its components, values and gradients.
-    fn map_nodes(&mut self, a: &Val, mut f: impl FnMut(&mut Graph, NodeId) -> NodeId) -> Val {
-        let c =
-            a.c.iter()
-                .map(|j| Jet {
-                    v: f(&mut self.g, j.v),
-                    g: j.g.as_ref().map(|g| g.iter().map(|&x| f(&mut self.g, x)).collect()),
-                })
-                .collect();
-        Val { shape: a.shape, c }
     }
 
     fn builtin(&mut self, f: &str, args: Vec<Val>) -> Val {
