@@ -40,6 +40,15 @@ const LINEAR_TOLERANCE: f64 = 1e-6;
 /// solves to go unchecked (ten times it bounds theirs).
 const TRUSTED_ACCURACY: f64 = 1e-12;
 
+/// Largest contraction ‖R_{k+1}‖∞ / ‖R_k‖∞ for which the operator of a tangent that is not
+/// piecewise (a finite-strain material) is kept at the next iterate instead of refactored:
+/// simplified (chord) Newton, whose error contracts by about ‖J̃⁻¹(J − J̃)‖ per step. Its
+/// iterations cost a residual and a solve pair; a refactorization costs the tangent's assembly
+/// and the factor. While the contraction is at most this, keeping it costs at most one more
+/// iteration per four decades of residual than Newton's (`bench disc` with
+/// `--material neo_hookean`, docs/mathematics.md §8).
+const CHORD_RATE: f64 = 0.1;
+
 /// η of an iterative solve whose iteration is expected to change the active set (the step's
 /// first, when the last step's first did). On the 47k-unknown ball through impact (50 steps),
 /// 1e-3 saved more Krylov iterations than 1e-2 or 1e-4.
@@ -158,6 +167,12 @@ pub struct Newton {
     /// The last solve's first iteration changed the active set: the next one's first solve is
     /// expected to as well, and is loose ([`LOOSE`]).
     first_changed: bool,
+    /// The operator of a tangent that is not piecewise may be kept at the next iterate (chord
+    /// Newton): it was last rebuilt by a refactorization, not a cheap correction, and its last
+    /// step contracted the residual by at most [`CHORD_RATE`].
+    chord: bool,
+    /// The operator was last rebuilt by refactoring a direct factorization.
+    refactored: bool,
 }
 
 /// Newton's vectors, kept between solves.
@@ -261,7 +276,14 @@ struct Solved {
 
 impl Newton {
     pub fn new(options: NewtonOptions) -> Self {
-        Newton { options, reuse: JacobianReuse::default(), scratch: Scratch::default(), first_changed: false }
+        Newton {
+            options,
+            reuse: JacobianReuse::default(),
+            scratch: Scratch::default(),
+            first_changed: false,
+            chord: false,
+            refactored: false,
+        }
     }
 
     /// Starts from `other`'s symbolic analysis and takes its factor's storage, if this Newton
@@ -280,6 +302,7 @@ impl Newton {
     /// Forgets the factorization's validity (the linear part of the problem changed).
     pub fn invalidate(&mut self) {
         self.reuse.invalidate();
+        self.chord = false;
     }
 
     /// Drops every factorization and correction (their counters are kept): the next solve
@@ -288,6 +311,7 @@ impl Newton {
     pub fn forget(&mut self) {
         self.reuse.forget();
         self.first_changed = false;
+        self.chord = false;
     }
 
     /// Stored values of the current Cholesky factor, if there is one.
@@ -363,12 +387,16 @@ impl Newton {
                 return Err(NewtonError::Linear { source, report });
             }
             self.trust(&solved, linear, refactor);
+            let before = s.res;
             let step = if piecewise && !self.options.line_search {
                 self.affine_step(p, w, scratch, &solved, &mut s)
             } else {
-                self.full_step(p, w, scratch, &mut s)
+                self.full_step(p, w, scratch, &mut s, !piecewise && !refactor && !updated)
             };
             s.note_best(piecewise);
+            if !piecewise {
+                self.keep_for_chord(refactor, updated, s.res / before);
+            }
             let it = Iteration { residual: s.res, active, refactored: refactor, updated, step, tolerance: solved.eta };
             debug!(
                 iteration = report.history.len() + 1,
@@ -389,8 +417,9 @@ impl Newton {
     }
 
     /// The operator for the active set `set`: kept while `set` is the one it was factored for
-    /// (and the tangent piecewise), else a new one, corrected or refactored. Returns whether it
-    /// was refactored, and whether corrected.
+    /// and the tangent piecewise, or not piecewise but kept by chord Newton (`chord`), else a
+    /// new one, corrected or refactored. Returns whether it was refactored, and whether
+    /// corrected.
     fn operator_for(
         &mut self,
         p: &mut impl NonlinearProblem,
@@ -398,14 +427,15 @@ impl Newton {
         set: &[bool],
         piecewise: bool,
     ) -> Result<(bool, bool), LinalgError> {
-        let changed = !piecewise || self.reuse.force_refactor || self.reuse.factored_for.as_deref() != Some(set);
+        let changed =
+            (!piecewise && !self.chord) || self.reuse.force_refactor || self.reuse.factored_for.as_deref() != Some(set);
         if !changed {
             return Ok((false, false));
         }
         self.reuse.factored_for = None;
         let full = self.reuse.new_operator(p, w, self.options.solver, self.options.max_rank)?;
         let (refactor, updated) = (full, !full);
-        self.reuse.factored_for = piecewise.then(|| set.to_vec());
+        self.reuse.factored_for = Some(set.to_vec());
         self.reuse.jacobian_norm = match (updated, &self.reuse.low_rank) {
             (true, Some(lr)) => self.reuse.reference_norm + lr.change_norm(),
             _ => {
@@ -415,6 +445,18 @@ impl Newton {
         };
         self.reuse.solve_accuracy = None;
         Ok((refactor, updated))
+    }
+
+    /// Whether the next iterate of a tangent that is not piecewise keeps this operator: if its
+    /// last rebuild refactored a direct factorization (a correction is cheap to make again:
+    /// a frictional law's, on the contact dofs), and this step contracted the residual by at
+    /// most [`CHORD_RATE`].
+    fn keep_for_chord(&mut self, refactor: bool, updated: bool, contraction: f64) {
+        let direct = self.reuse.factorization.as_ref().is_some_and(Factorization::is_direct);
+        if refactor || updated {
+            self.refactored = refactor && direct;
+        }
+        self.chord = self.refactored && contraction <= CHORD_RATE;
     }
 
     /// Solves J δ = −R into `delta`, asking an iterative solve for what this iteration needs,
@@ -438,7 +480,8 @@ impl Newton {
         let plain = piecewise && !self.options.line_search;
         let loose = iterative && plain && first && self.first_changed;
         let eta = iterative.then(|| f.set_tolerance(forcing(norm2_r, s.threshold, loose, superlinear)));
-        let trusted = if plain { self.reuse.solve_accuracy } else { None };
+        // (A kept operator's solves are trusted whether or not the tangent is piecewise.)
+        let trusted = self.reuse.solve_accuracy;
         // A correction of a reference whose solves are trusted reports the residual it
         // leaves itself (`LowRank::solve`): its first solve needs no product J δ then.
         let defect = trusted.is_none() && plain && self.reuse.reference_accuracy.is_some();
@@ -576,13 +619,26 @@ impl Newton {
 
     /// A step with line search, or of a tangent that is not piecewise: R evaluated at the new
     /// iterate, into `scratch.r`.
-    fn full_step(&self, p: &mut impl NonlinearProblem, w: &mut [f64], scratch: &mut Scratch, s: &mut Progress) -> f64 {
+    /// `stale`: the operator was kept from an earlier iterate (chord Newton).
+    fn full_step(
+        &self,
+        p: &mut impl NonlinearProblem,
+        w: &mut [f64],
+        scratch: &mut Scratch,
+        s: &mut Progress,
+        stale: bool,
+    ) -> f64 {
         let Scratch { r, delta, set, after, .. } = &mut *scratch;
         let step = self.step(p, w, delta, r, s.search);
         after.clear();
         p.active_set(w, after);
-        s.small_step = after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w);
-        s.res = norm_inf(r);
+        let res = norm_inf(r);
+        // A step is the error it leaves only where Newton converges faster than linearly; a
+        // chord step (`stale`) contracting by θ leaves about θ/(1 − θ) of itself, at most
+        // itself for θ ≤ 1/2.
+        s.small_step =
+            after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w) && (!stale || res <= 0.5 * s.res);
+        s.res = res;
         s.norm_r = s.res;
         s.carried = 0.0;
         step
