@@ -3,7 +3,50 @@
 //! whole job of adding a scheme or a contact law.
 
 use std::fmt::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+use signorini_compiler::{Compiled, FsLoader, Loader, compile};
+
+/// Reads the file system, with one file bound to one role.
+struct Bound<'a> {
+    role: &'a str,
+    file: PathBuf,
+}
+
+impl Loader for Bound<'_> {
+    fn load(&self, path: &Path) -> std::io::Result<String> {
+        FsLoader.load(path)
+    }
+    fn role(&self, role: &str) -> Option<PathBuf> {
+        (role == self.role).then(|| self.file.clone())
+    }
+}
+
+/// The bindings compiled in: for each form file that imports a role (`import material =
+/// elasticity`), each other form file of the library that does not import the role's default
+/// file itself (a law built on `elasticity` is not a stand-in for it) and with which the
+/// importing file checks (role, bound file stem, importing file stem). A run that binds such a
+/// file (`--material neo_hookean`) runs the law compiled; any other binding (a user's
+/// material) compiles it at run time, interpreted.
+fn bindings(forms: &[String]) -> Vec<(String, String, String)> {
+    let path = |f: &str| PathBuf::from(format!("forms/{f}.wf"));
+    let units: Vec<(&String, Compiled)> =
+        forms.iter().filter_map(|f| Some((f, compile(&path(f), &FsLoader).ok()?))).collect();
+    let imports = |c: &Compiled, stem: &str| c.source_paths().iter().any(|p| p.file_stem().is_some_and(|s| s == stem));
+    let mut out = Vec::new();
+    for (law, unit) in &units {
+        for role in &unit.program.roles {
+            for (file, candidate) in &units {
+                let stands_in = file != law && **file != role.default && !imports(candidate, &role.default);
+                if stands_in && compile(&path(law), &Bound { role: &role.name, file: path(file) }).is_ok() {
+                    out.push((role.name.clone(), file.to_string(), law.to_string()));
+                }
+            }
+        }
+    }
+    out.sort();
+    out
+}
 
 fn wf_files(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
@@ -37,6 +80,28 @@ fn main() {
         let _ = writeln!(out, "crate::forms!(pub mod {s} = \"forms/schemes/{s}.wf\");");
     }
     out.push_str("}\n");
+    // The role bindings compiled in, one module per bound file.
+    let bound = bindings(&forms);
+    out.push_str(
+        "/// The library's laws compiled with another of its files bound to a role they import, by\n/// role and bound file: `bound::material_neo_hookean::contact_nitsche_deformed`.\npub mod bound {\n",
+    );
+    let mut groups: Vec<(&str, &str)> = bound.iter().map(|(r, f, _)| (r.as_str(), f.as_str())).collect();
+    groups.dedup();
+    for (role, file) in groups {
+        let _ = writeln!(out, "pub mod {role}_{file} {{");
+        for (_, _, law) in bound.iter().filter(|(r, f, _)| r == role && f == file) {
+            let _ = writeln!(out, "crate::forms!(pub mod {law} = \"forms/{law}.wf\", {role} = \"forms/{file}.wf\");");
+        }
+        out.push_str("}\n");
+    }
+    out.push_str("}\n");
+    let bound_units: Vec<String> =
+        bound.iter().map(|(role, file, law)| format!("&bound::{role}_{file}::{law}::UNIT")).collect();
+    let _ = writeln!(
+        out,
+        "/// Every unit of `bound`: a law of the library as compiled for a file bound to its role.\npub static BOUND: &[&crate::runtime::library::Unit] = &[{}];",
+        bound_units.join(", ")
+    );
     let units: Vec<String> = forms
         .iter()
         .map(|f| format!("&{f}::UNIT"))

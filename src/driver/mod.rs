@@ -209,16 +209,20 @@ pub fn scheme(methods: &Methods) -> Result<SchemeSource, CaseError> {
 pub const MATERIAL_ROLE: &str = "material";
 
 /// A compiled unit as it runs with the material `material`: as compiled, unless it imports
-/// the material's role and the run binds another file to it, which compiles it again, at run
-/// time, with that file.
+/// the material's role and the run binds another file to it. Then as compiled for that file,
+/// if the library's build did (`forms::BOUND`: its laws with each of its files that can stand
+/// in for their roles), else compiled again, at run time, with that file.
 fn with_roles(u: &'static Unit, material: &FormSource, roles: &[(String, PathBuf)]) -> Result<FormSource, CaseError> {
-    let as_compiled = u.forms.is_none_or(|f| {
-        f.roles.iter().all(|(role, default)| {
-            *role != MATERIAL_ROLE || matches!(material, FormSource::Compiled(m) if m.name == *default)
+    let compiled_for = |v: &Unit| {
+        v.forms.is_none_or(|f| {
+            f.roles.iter().all(|(role, read)| {
+                *role != MATERIAL_ROLE || matches!(material, FormSource::Compiled(m) if m.name == *read)
+            })
         })
-    });
-    if as_compiled {
-        return Ok(FormSource::Compiled(u));
+    };
+    if let Some(v) = std::iter::once(u).chain(crate::forms::BOUND.iter().copied()).find(|v| *v == u && compiled_for(v))
+    {
+        return Ok(FormSource::Compiled(v));
     }
     let mut i = interpret_bound(Path::new(u.file), material, roles)?;
     i.rebound = Some(material.file().to_string());
