@@ -26,6 +26,15 @@ pub struct Bench {
     /// factorizations and low-rank updates per 1000 steps: an unsymmetric tangent that turns
     /// with the slip).
     pub disc_friction: String,
+    /// `bench disc`: the finite-strain run timed beside the default one, (material, contact
+    /// law): same mesh, scheme and Δt, and its cost per step over the linear one's.
+    pub disc_finite_strain: (String, String),
+    /// `bench assemble`: the finite-strain material whose stiffness (residual and tangent at a
+    /// small random state) is timed per cell, and the quadrature degrees it is timed at.
+    pub assemble_material: String,
+    pub assemble_degrees: Vec<u32>,
+    /// Its params set for the timing (the others at their defaults).
+    pub assemble_params: std::collections::BTreeMap<String, f64>,
     /// `bench sphere`: the problem timed against its size, and the options of each run.
     pub sphere: String,
     pub sphere_options: Vec<String>,

@@ -47,9 +47,25 @@ pub struct FactorTiming {
     pub relative_residual: f64,
 }
 
+/// The finite-strain material of forms/library.toml `[bench]` on the same mesh (its largest N):
+/// its stiffness's residual and tangent at a small random state, per cell, one thread, at a
+/// quadrature degree of the triangle.
+#[derive(Clone, Debug, Serialize)]
+pub struct MaterialTiming {
+    pub material: String,
+    pub n: usize,
+    pub cells: usize,
+    pub degree: u32,
+    pub residual_us_per_cell: f64,
+    pub tangent_us_per_cell: f64,
+    /// The tangent's Frobenius norm (for comparing runs, as `stiffness_frobenius`).
+    pub tangent_frobenius: f64,
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct Report {
     pub assembly: Vec<AssemblyTiming>,
+    pub material: Vec<MaterialTiming>,
     pub factor: Option<FactorTiming>,
     pub repeats: usize,
 }
@@ -183,5 +199,94 @@ pub fn assemble(sizes: &[usize], factor_n: Option<usize>, repeats: usize, progre
         ));
         t
     });
-    Report { assembly, factor, repeats }
+    let material = match sizes.iter().max() {
+        Some(&n) => material_timings(n, repeats, progress),
+        None => Vec::new(),
+    };
+    Report { assembly, material, factor, repeats }
+}
+
+/// The stiffness of forms/library.toml's `[bench] assemble_material` (with `assemble_params`) on the N×N mesh at the state u = 0.01 ξ / N, ξ uniform in [−1/2, 1/2)
+/// per dof (a random field whose gradient is of order 0.01: J > 0 everywhere), at each of
+/// `[bench] assemble_degrees`. Medians of `repeats` assemblies each.
+fn material_timings(n: usize, repeats: usize, progress: &mut dyn FnMut(&str)) -> Vec<MaterialTiming> {
+    use crate::runtime::library::{Binding, SlotForm};
+    let bench = &crate::settings::get().bench;
+    let name = &bench.assemble_material;
+    let Some(forms) = crate::forms::LIBRARY.iter().find(|u| u.name == name.as_str()).and_then(|u| u.forms) else {
+        progress(&format!("bench assemble: no form file `{name}` in the library: its stiffness is not timed"));
+        return Vec::new();
+    };
+    if let Some(unknown) = bench.assemble_params.keys().find(|k| !forms.params.iter().any(|p| *p.name == **k)) {
+        progress(&format!("bench assemble: `{name}` declares no param `{unknown}` (forms/library.toml [bench])"));
+        return Vec::new();
+    }
+    let values: Vec<f64> =
+        forms.params.iter().map(|p| bench.assemble_params.get(&*p.name).copied().unwrap_or(p.default)).collect();
+    let mesh = structured::rectangle(n, n, [0.0, 1.0], [0.0, 1.0], Diagonal::Right, 2);
+    let asm = Assembler::new(&mesh);
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let u: Vec<f64> = (0..asm.size())
+        .map(|_| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            0.01 * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) / n as f64
+        })
+        .collect();
+    let coefs = |name: &str| (name == "f").then(|| Coef::constant(vec![0.0, 0.0]));
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a thread pool");
+    let mut out = Vec::new();
+    for &degree in &bench.assemble_degrees {
+        let binding =
+            Binding { quadrature: Quadrature { cell: Some(degree), facet: None }, regions: Vec::new(), dim: 2 };
+        // Made in the one-thread pool: a bound form is not shared between threads.
+        let timed = pool.install(|| {
+            let made = (forms.make)(&values, &coefs, &binding).map_err(|e| e.to_string())?;
+            let form = made
+                .into_iter()
+                .find_map(|(slot, f)| match f {
+                    SlotForm::Form(f) if slot == "stiffness" => Some(f),
+                    _ => None,
+                })
+                .ok_or("provides no `stiffness`")?;
+            let mut r = vec![0.0; asm.size()];
+            let mut m = asm.zero_matrix();
+            let (mut tr, mut tt) = (Vec::new(), Vec::new());
+            for _ in 0..repeats {
+                r.fill(0.0);
+                let t = Instant::now();
+                form.residual(&asm, &[&u], 0.0, &mut r);
+                tr.push(t.elapsed().as_secs_f64());
+                m.values.fill(0.0);
+                let t = Instant::now();
+                form.tangent(&asm, &[&u], 0, 0.0, &mut m);
+                tt.push(t.elapsed().as_secs_f64());
+            }
+            Ok::<_, String>((median(tr), median(tt), m.frobenius()))
+        });
+        let (residual, tangent, frobenius) = match timed {
+            Ok(t) => t,
+            Err(e) => {
+                progress(&format!("bench assemble: `{name}`: {e}"));
+                return out;
+            }
+        };
+        let cells = mesh.num_cells();
+        let t = MaterialTiming {
+            material: name.clone(),
+            n,
+            cells,
+            degree,
+            residual_us_per_cell: residual * 1e6 / cells as f64,
+            tangent_us_per_cell: tangent * 1e6 / cells as f64,
+            tangent_frobenius: frobenius,
+        };
+        progress(&format!(
+            "N = {n}: {name} stiffness at degree {degree}, one thread: residual {:.3} µs/cell, tangent {:.3} µs/cell; ‖K_T‖_F = {:.6}",
+            t.residual_us_per_cell, t.tangent_us_per_cell, t.tangent_frobenius
+        ));
+        out.push(t);
+    }
+    out
 }

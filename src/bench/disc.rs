@@ -73,6 +73,26 @@ pub struct DiscTiming {
     /// low-rank corrections per 1000 steps.
     #[serde(default)]
     pub friction: Option<FrictionTiming>,
+    /// The finite-strain run of forms/library.toml on the same disc, scheme and Δt: with
+    /// Newton's tangent at every iteration, and with chord Newton (`--chord`).
+    #[serde(default)]
+    pub finite_strain: Vec<FiniteStrainTiming>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FiniteStrainTiming {
+    pub material: String,
+    pub contact: String,
+    /// Chord Newton (`--chord`).
+    pub chord: bool,
+    pub ms_per_step: f64,
+    pub median_step_ms: f64,
+    pub newton_total: usize,
+    pub factorizations_per_1000: f64,
+    /// `ms_per_step` over the linear run's, and the same per Newton iteration (the step's cost
+    /// is its iterations times what each assembles and solves).
+    pub over_linear: f64,
+    pub over_linear_per_iteration: f64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -142,6 +162,10 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
         let cache_model_ms = 1e3 * model_bytes / cache;
         let explicit = explicit_timing(&opts, s.dt, repeats)?;
         let friction = friction_timing(&opts, repeats)?;
+        let finite_strain = [false, true]
+            .into_iter()
+            .map(|chord| finite_strain_timing(&opts, chord, repeats, median(mean.clone()), s.newton_total))
+            .collect::<Result<Vec<_>, _>>()?;
         let fastest = mean.iter().copied().fold(f64::INFINITY, f64::min);
         let slowest = mean.iter().copied().fold(0.0, f64::max);
         let ms_per_step = median(mean);
@@ -170,6 +194,7 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             measured_over_cache_model: ms_per_step / cache_model_ms,
             explicit,
             friction,
+            finite_strain,
         };
         progress(&format!(
             "{}: {} dofs, {} steps, {} Newton iterations, {} factorizations, {} low-rank updates; {:.3} ms/step stepping (runs {:.3}–{:.3}; median step {:.3} ms), {:.3} ms/step whole run; model {:.3} ms ({:.2} MB at STREAM's {:.1} GB/s), measured/model {:.2} (median step/model {:.2}); in cache {:.3} ms (at {:.1} GB/s), measured/model {:.2}",
@@ -214,6 +239,21 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
                 f.newton_total,
                 f.factorizations_per_1000,
                 f.low_rank_updates_per_1000
+            ));
+        }
+        for f in &t.finite_strain {
+            progress(&format!(
+                "{}: {} with {}{}: {:.3} ms/step stepping (median step {:.3} ms), {} Newton iterations, {:.0} factorizations per 1000 steps; {:.2}× the linear step, {:.2}× per Newton iteration",
+                t.mesh,
+                f.material,
+                f.contact,
+                if f.chord { ", chord Newton" } else { "" },
+                f.ms_per_step,
+                f.median_step_ms,
+                f.newton_total,
+                f.factorizations_per_1000,
+                f.over_linear,
+                f.over_linear_per_iteration
             ));
         }
         out.push(t);
@@ -278,6 +318,46 @@ fn friction_timing(opts: &Options, repeats: usize) -> Result<Option<FrictionTimi
         factorizations_per_1000: per_1000(s.factorizations),
         low_rank_updates_per_1000: per_1000(s.low_rank_updates),
     }))
+}
+
+/// The finite-strain run of forms/library.toml (material, contact law) on the same disc, with the
+/// default scheme and the disc's Δt, with chord Newton or not, against the linear run's `linear_ms` per step and its
+/// `linear_newton` iterations.
+fn finite_strain_timing(
+    opts: &Options,
+    chord: bool,
+    repeats: usize,
+    linear_ms: f64,
+    linear_newton: usize,
+) -> Result<FiniteStrainTiming, CaseError> {
+    let (material, contact) = &crate::settings::get().bench.disc_finite_strain;
+    let methods =
+        crate::driver::Methods { material: material.clone(), contact: contact.clone(), ..opts.methods.clone() };
+    let newton = crate::runtime::nonlinear::newton::NewtonOptions { chord, ..opts.newton };
+    let mut opts = Options { methods, newton, ..opts.clone() };
+    (opts.chosen.material, opts.chosen.contact) = (true, true);
+    let (mut per_step, mut med) = (Vec::new(), Vec::new());
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let run = disc::run(&opts)?;
+        per_step.push(run.summary.stepping_seconds / run.summary.steps.max(1) as f64 * 1e3);
+        med.push(run.summary.step_median_seconds * 1e3);
+        last = Some(run.summary);
+    }
+    let s = last.expect("at least one run");
+    let ms_per_step = median(per_step);
+    let over_linear = ms_per_step / linear_ms;
+    Ok(FiniteStrainTiming {
+        material: material.clone(),
+        contact: contact.clone(),
+        chord,
+        ms_per_step,
+        median_step_ms: median(med),
+        newton_total: s.newton_total,
+        factorizations_per_1000: 1000.0 * s.factorizations as f64 / s.steps.max(1) as f64,
+        over_linear,
+        over_linear_per_iteration: over_linear * linear_newton.max(1) as f64 / s.newton_total.max(1) as f64,
+    })
 }
 
 /// The last run's `dir/bench_disc.json`, if there is one.

@@ -174,6 +174,12 @@ pub struct MethodArgs {
     /// Backtracking line search in Newton (halving the step while ‖R‖ does not decrease).
     #[arg(long)]
     pub(super) line_search: bool,
+    /// Chord Newton for a tangent that is not piecewise (a finite-strain material): the
+    /// factored tangent is kept, across steps, while each iteration contracts the residual at
+    /// least tenfold. Fewer factorizations; each stage ends at Newton's tolerance, where
+    /// Newton's last step usually overshoots it to round-off (docs/mathematics.md §8)
+    #[arg(long)]
+    pub(super) chord: bool,
 }
 
 /// `--max-step-cuts`: a whole number in the range the case files accept too.
@@ -207,6 +213,7 @@ impl MethodArgs {
             || !self.forms.is_empty()
             || !self.params.is_empty()
             || self.line_search
+            || self.chord
     }
 
     pub(super) fn to_methods(&self) -> Result<Methods, String> {

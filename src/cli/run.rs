@@ -52,6 +52,7 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
         newton: crate::runtime::nonlinear::newton::NewtonOptions {
             solver: a.solver,
             line_search: a.methods.line_search,
+            chord: a.methods.chord,
             ..Default::default()
         },
         petsc_options: a.petsc_options,

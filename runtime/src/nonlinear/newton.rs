@@ -75,6 +75,11 @@ pub struct NewtonOptions {
     /// that is not piecewise (frictional) backtracks without it once three full steps have not
     /// lowered its residual.
     pub line_search: bool,
+    /// Chord Newton for a tangent that is not piecewise: its factored operator is kept while
+    /// it contracts the residual fast enough ([`CHORD_RATE`]). For a problem solved again and
+    /// again (a time stepper's stages) whose refactorization costs more than a few iterations;
+    /// not with `line_search`.
+    pub chord: bool,
     /// How the Jacobian systems are solved.
     pub solver: Solver,
     /// Cap on the number of dofs on which a new Jacobian may differ from the factored one and
@@ -89,7 +94,14 @@ pub const MAX_RANK: usize = 1024;
 
 impl Default for NewtonOptions {
     fn default() -> Self {
-        NewtonOptions { tol: 1e-10, max_iterations: 25, line_search: false, solver: Solver::Auto, max_rank: MAX_RANK }
+        NewtonOptions {
+            tol: 1e-10,
+            max_iterations: 25,
+            line_search: false,
+            chord: false,
+            solver: Solver::Auto,
+            max_rank: MAX_RANK,
+        }
     }
 }
 
@@ -208,6 +220,8 @@ struct Progress {
     search: bool,
     best: f64,
     stalled: usize,
+    /// The last step was a chord step (its operator kept from an earlier iterate).
+    stale: bool,
     /// ‖r‖∞ of the r the next solve is given.
     norm_r: f64,
 }
@@ -225,6 +239,7 @@ impl Progress {
             search: line_search,
             best: r0,
             stalled: 0,
+            stale: false,
             norm_r: r0,
         }
     }
@@ -388,10 +403,11 @@ impl Newton {
             }
             self.trust(&solved, linear, refactor);
             let before = s.res;
+            s.stale = !piecewise && !refactor && !updated;
             let step = if piecewise && !self.options.line_search {
                 self.affine_step(p, w, scratch, &solved, &mut s)
             } else {
-                self.full_step(p, w, scratch, &mut s, !piecewise && !refactor && !updated)
+                self.full_step(p, w, scratch, &mut s)
             };
             s.note_best(piecewise);
             if !piecewise {
@@ -456,7 +472,7 @@ impl Newton {
         if refactor || updated {
             self.refactored = refactor && direct;
         }
-        self.chord = self.refactored && contraction <= CHORD_RATE;
+        self.chord = self.options.chord && !self.options.line_search && self.refactored && contraction <= CHORD_RATE;
     }
 
     /// Solves J δ = −R into `delta`, asking an iterative solve for what this iteration needs,
@@ -619,25 +635,18 @@ impl Newton {
 
     /// A step with line search, or of a tangent that is not piecewise: R evaluated at the new
     /// iterate, into `scratch.r`.
-    /// `stale`: the operator was kept from an earlier iterate (chord Newton).
-    fn full_step(
-        &self,
-        p: &mut impl NonlinearProblem,
-        w: &mut [f64],
-        scratch: &mut Scratch,
-        s: &mut Progress,
-        stale: bool,
-    ) -> f64 {
+    fn full_step(&self, p: &mut impl NonlinearProblem, w: &mut [f64], scratch: &mut Scratch, s: &mut Progress) -> f64 {
         let Scratch { r, delta, set, after, .. } = &mut *scratch;
         let step = self.step(p, w, delta, r, s.search);
         after.clear();
         p.active_set(w, after);
         let res = norm_inf(r);
         // A step is the error it leaves only where Newton converges faster than linearly; a
-        // chord step (`stale`) contracting by θ leaves about θ/(1 − θ) of itself, at most
-        // itself for θ ≤ 1/2.
-        s.small_step =
-            after == set && step * norm_inf(delta) <= self.options.tol * norm_inf(w) && (!stale || res <= 0.5 * s.res);
+        // chord step contracting by θ leaves about θ/(1 − θ) of itself, at most itself for
+        // θ ≤ 1/2.
+        s.small_step = after == set
+            && step * norm_inf(delta) <= self.options.tol * norm_inf(w)
+            && (!s.stale || res <= 0.5 * s.res);
         s.res = res;
         s.norm_r = s.res;
         s.carried = 0.0;
@@ -684,26 +693,4 @@ fn norm2(v: &[f64]) -> f64 {
         return scale;
     }
     scale * v.iter().map(|x| (x / scale) * (x / scale)).sum::<f64>().sqrt()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::norm_inf;
-
-    #[test]
-    fn norm_inf_finds_the_largest_magnitude_and_any_nan() {
-        // Lengths around the eight lanes, the largest entry in every position, either sign.
-        for n in [0usize, 1, 7, 8, 9, 17, 100] {
-            for at in 0..n {
-                let mut v: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
-                v[at] = if at % 2 == 0 { -100.0 } else { 100.0 };
-                assert_eq!(norm_inf(&v), 100.0);
-                v[at] = f64::NAN;
-                assert!(norm_inf(&v).is_nan(), "NaN at {at} of {n}");
-                v[at] = f64::NEG_INFINITY;
-                assert_eq!(norm_inf(&v), f64::INFINITY);
-            }
-        }
-        assert_eq!(norm_inf(&[]), 0.0);
-    }
 }
