@@ -449,7 +449,7 @@ impl Newton {
             return Ok((false, false));
         }
         self.reuse.factored_for = None;
-        let full = self.reuse.new_operator(p, w, self.options.solver, self.options.max_rank)?;
+        let full = self.reuse.new_operator(p, w, self.options.solver, self.options.max_rank, piecewise)?;
         let (refactor, updated) = (full, !full);
         self.reuse.factored_for = Some(set.to_vec());
         self.reuse.jacobian_norm = match (updated, &self.reuse.low_rank) {

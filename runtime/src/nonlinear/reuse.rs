@@ -34,6 +34,12 @@ pub(super) struct JacobianReuse {
     /// has grown past the cost of refactoring.
     pub(super) overhead: usize,
     pub(super) force_refactor: bool,
+    /// The Jacobian of a tangent that is not piecewise was found to differ from the reference
+    /// on more than half the dofs, and more than a correction may have (a finite-strain
+    /// material's changes everywhere): no
+    /// correction is attempted again until the operator is invalidated, since comparing and
+    /// recording for one cost a tenth of such a step (the neo-Hookean disc).
+    corrections_off: bool,
     /// The reference before the last refactorization, with its correction.
     previous: Option<Reference>,
     /// Counters of factorizations no longer kept.
@@ -61,6 +67,7 @@ impl Default for JacobianReuse {
             updates: 0,
             overhead: 0,
             force_refactor: false,
+            corrections_off: false,
             previous: None,
             retired: Counters::default(),
             jacobian_norm: f64::INFINITY,
@@ -111,6 +118,7 @@ impl JacobianReuse {
         self.low_rank = None;
         self.overhead = 0;
         self.force_refactor = false;
+        self.corrections_off = false;
         self.retire_previous();
     }
 
@@ -209,13 +217,15 @@ impl JacobianReuse {
     /// (which becomes the new reference). Returns whether it refactored. The correction is of
     /// the Jacobian's values where they changed, so a problem that is not piecewise (a
     /// frictional law, whose tangent turns with the slip) is corrected as exactly as one whose
-    /// tangent changes only with its active set.
+    /// tangent changes only with its active set. `piecewise`: the tangent at w is decided by
+    /// the active set.
     pub(super) fn new_operator(
         &mut self,
         p: &mut impl NonlinearProblem,
         w: &[f64],
         solver: Solver,
         max_rank: usize,
+        piecewise: bool,
     ) -> Result<bool, LinalgError> {
         let mut assembled = false;
         if !self.force_refactor && self.low_rank.is_some() {
@@ -225,6 +235,8 @@ impl JacobianReuse {
             self.jacobian_current = true;
             let entries = p.varying_entries();
             let mut dofs = self.low_rank.as_ref().map(|lr| lr.changed_dofs(&j, entries)).unwrap_or_default();
+            self.corrections_off =
+                !piecewise && 2 * dofs.len() > j.size() && dofs.len() > self.rank_limit(j.size(), max_rank);
             // The previous reference, if the active set has come back near it.
             let budget = self.overhead_budget(j.size());
             if let Some(other) = self
@@ -279,7 +291,7 @@ impl JacobianReuse {
         self.reference_accuracy = None;
         self.refactor(p, w, assembled, solver)?;
         let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
-        if direct && max_rank > 0 {
+        if direct && max_rank > 0 && !self.corrections_off {
             let mut lr = LowRank::new(self.jacobian.as_ref().expect("assembled by refactor"));
             lr.set_elements(p.tangent_elements(w));
             self.low_rank = Some(lr);
