@@ -44,9 +44,8 @@ const TRUSTED_ACCURACY: f64 = 1e-12;
 /// piecewise (a finite-strain material) is kept at the next iterate instead of refactored:
 /// simplified (chord) Newton, whose error contracts by about ‖J̃⁻¹(J − J̃)‖ per step. Its
 /// iterations cost a residual and a solve pair; a refactorization costs the tangent's assembly
-/// and the factor. While the contraction is at most this, keeping it costs at most one more
-/// iteration per four decades of residual than Newton's (`bench disc` with
-/// `--material neo_hookean`, docs/mathematics.md §8).
+/// and the factor. On the neo-Hookean disc (h = 1, 1000 steps) thresholds of 0.001, 0.01, 0.1
+/// and 0.3 gave 5.25, 3.77, 3.17 and 3.18 ms per step (docs/mathematics.md §8).
 const CHORD_RATE: f64 = 0.1;
 
 /// η of an iterative solve whose iteration is expected to change the active set (the step's
@@ -182,7 +181,7 @@ pub struct Newton {
     /// The operator of a tangent that is not piecewise may be kept at the next iterate (chord
     /// Newton): it was last rebuilt by a refactorization, not a cheap correction, and its last
     /// step contracted the residual by at most [`CHORD_RATE`].
-    chord: bool,
+    keep_operator: bool,
     /// The operator was last rebuilt by refactoring a direct factorization.
     refactored: bool,
 }
@@ -296,7 +295,7 @@ impl Newton {
             reuse: JacobianReuse::default(),
             scratch: Scratch::default(),
             first_changed: false,
-            chord: false,
+            keep_operator: false,
             refactored: false,
         }
     }
@@ -317,7 +316,7 @@ impl Newton {
     /// Forgets the factorization's validity (the linear part of the problem changed).
     pub fn invalidate(&mut self) {
         self.reuse.invalidate();
-        self.chord = false;
+        self.keep_operator = false;
     }
 
     /// Drops every factorization and correction (their counters are kept): the next solve
@@ -326,7 +325,7 @@ impl Newton {
     pub fn forget(&mut self) {
         self.reuse.forget();
         self.first_changed = false;
-        self.chord = false;
+        self.keep_operator = false;
     }
 
     /// Stored values of the current Cholesky factor, if there is one.
@@ -433,7 +432,7 @@ impl Newton {
     }
 
     /// The operator for the active set `set`: kept while `set` is the one it was factored for
-    /// and the tangent piecewise, or not piecewise but kept by chord Newton (`chord`), else a
+    /// and the tangent piecewise, or not piecewise but kept by chord Newton (`keep_operator`), else a
     /// new one, corrected or refactored. Returns whether it was refactored, and whether
     /// corrected.
     fn operator_for(
@@ -443,8 +442,9 @@ impl Newton {
         set: &[bool],
         piecewise: bool,
     ) -> Result<(bool, bool), LinalgError> {
-        let changed =
-            (!piecewise && !self.chord) || self.reuse.force_refactor || self.reuse.factored_for.as_deref() != Some(set);
+        let changed = (!piecewise && !self.keep_operator)
+            || self.reuse.force_refactor
+            || self.reuse.factored_for.as_deref() != Some(set);
         if !changed {
             return Ok((false, false));
         }
@@ -472,7 +472,8 @@ impl Newton {
         if refactor || updated {
             self.refactored = refactor && direct;
         }
-        self.chord = self.options.chord && !self.options.line_search && self.refactored && contraction <= CHORD_RATE;
+        self.keep_operator =
+            self.options.chord && !self.options.line_search && self.refactored && contraction <= CHORD_RATE;
     }
 
     /// Solves J δ = −R into `delta`, asking an iterative solve for what this iteration needs,
