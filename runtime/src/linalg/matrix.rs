@@ -139,6 +139,22 @@ impl Matrix {
         })
     }
 
+    /// A with each pair a_ij, a_ji that differ by more than tol·max|a| replaced by their
+    /// mean: the symmetric part of A where A is not symmetric to the tolerance
+    /// [`Matrix::is_symmetric`] takes, and A itself bit for bit elsewhere (a Cholesky
+    /// factorization reads one triangle of it).
+    pub fn symmetrized(&self, tol: f64) -> Matrix {
+        let scale = self.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let t = self.pattern.transposed();
+        let values = (self.values.iter().zip(t))
+            .map(|(&a, &k)| {
+                let b = self.values[k];
+                if (a - b).abs() > tol * scale { 0.5 * (a + b) } else { a }
+            })
+            .collect();
+        Matrix { pattern: self.pattern.clone(), values }
+    }
+
     /// Frobenius norm.
     pub fn frobenius(&self) -> f64 {
         self.values.iter().map(|v| v * v).sum::<f64>().sqrt()
@@ -175,4 +191,35 @@ pub enum LinalgError {
     Petsc { function: &'static str, code: i32, message: String },
     #[error("solve requested before a successful factorization")]
     NotFactored,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fem::mesh::structured::interval;
+
+    #[test]
+    fn symmetrized_averages_only_the_pairs_that_differ() {
+        let mesh = interval(4, 0.0, 1.0);
+        let pattern = Arc::new(Pattern::new(&mesh.connectivity()));
+        let mut a = Matrix::zeros(pattern.clone());
+        let t = pattern.transposed();
+        for (k, v) in a.values.iter_mut().enumerate() {
+            *v = 1.0 + (k.min(t[k]) as f64).sqrt();
+        }
+        assert!(t.iter().enumerate().all(|(k, &kt)| t[kt] == k), "an involution");
+        // One pair made nonsymmetric, one by less than the tolerance.
+        let off = (0..t.len()).filter(|&k| t[k] != k).collect::<Vec<_>>();
+        a.values[off[0]] += 0.5;
+        a.values[off[2]] += 1e-15;
+        let s = a.symmetrized(1e-12);
+        for k in 0..t.len() {
+            let expected = if k == off[0] || k == t[off[0]] {
+                0.5 * (a.values[off[0]] + a.values[t[off[0]]])
+            } else {
+                a.values[k]
+            };
+            assert_eq!(s.values[k].to_bits(), expected.to_bits(), "entry {k}");
+        }
+    }
 }

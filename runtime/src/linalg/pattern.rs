@@ -69,6 +69,8 @@ pub struct Pattern {
     /// In a run split across processes, who owns which rows: this process's rows are complete,
     /// the others partial, and products make their result whole ([`Owners::complete`]).
     ownership: Option<Arc<dyn Owners>>,
+    /// The position of each stored entry's transpose, once asked for.
+    transposed: std::sync::OnceLock<Vec<usize>>,
 }
 
 /// Some entries of a pattern: their indices among the stored values, and their columns.
@@ -158,7 +160,16 @@ impl Pattern {
                 }
             }
         }
-        Pattern { dim: d, col_ptr, row_idx, node_ptr: adj_ptr, node_adj: adj, cell_offsets, ownership: None }
+        Pattern {
+            dim: d,
+            col_ptr,
+            row_idx,
+            node_ptr: adj_ptr,
+            node_adj: adj,
+            cell_offsets,
+            ownership: None,
+            transposed: Default::default(),
+        }
     }
 
     /// This pattern, of one process's cells in a run split across processes.
@@ -181,6 +192,23 @@ impl Pattern {
     }
 
     /// Number of rows (= columns).
+    /// For each stored entry (i, j), the position of (j, i) (the pattern is symmetric): one
+    /// pass over the columns, each column's cursor moving down its rows as j grows.
+    pub fn transposed(&self) -> &[usize] {
+        self.transposed.get_or_init(|| {
+            let mut cursor = self.col_ptr[..self.col_ptr.len() - 1].to_vec();
+            let mut at = vec![0; self.row_idx.len()];
+            for j in 0..cursor.len() {
+                for (k, &i) in self.row_idx[self.col_ptr[j]..self.col_ptr[j + 1]].iter().enumerate() {
+                    debug_assert_eq!(self.row_idx[cursor[i]], j, "symmetric pattern");
+                    at[self.col_ptr[j] + k] = cursor[i];
+                    cursor[i] += 1;
+                }
+            }
+            at
+        })
+    }
+
     pub fn size(&self) -> usize {
         self.col_ptr.len() - 1
     }

@@ -29,6 +29,9 @@ struct Membrane {
     /// it did.
     on_support: bool,
     support_residuals: usize,
+    /// A drag pulling each active dof towards its right neighbour, `drag (w_{i+1} − w_i)`:
+    /// the Jacobian is nonsymmetric on the contact zone only, as a frictional law's is.
+    drag: f64,
 }
 
 impl Membrane {
@@ -56,6 +59,9 @@ impl NonlinearProblem for Membrane {
         }
         for i in self.contact.clone() {
             r[i] += self.eps * (w[i] - PSI).min(0.0);
+            if w[i] < PSI && i + 1 < w.len() {
+                r[i] += self.drag * (w[i + 1] - w[i]);
+            }
         }
         self.constraints.zero(r);
     }
@@ -82,7 +88,13 @@ impl NonlinearProblem for Membrane {
         for (i, x) in w.iter().enumerate().filter(|(i, _)| self.contact.contains(i)) {
             if *x < PSI {
                 let k = diagonal_index(j, i);
-                j.values[k] += self.eps;
+                j.values[k] += self.eps - self.drag;
+                if self.drag != 0.0 && i + 1 < j.size() {
+                    let p = &j.pattern;
+                    let rows = &p.row_idx[p.col_ptr[i + 1]..p.col_ptr[i + 2]];
+                    let right = p.col_ptr[i + 1] + rows.binary_search(&i).expect("neighbours in the pattern");
+                    j.values[right] += self.drag;
+                }
             }
         }
         self.constraints.apply(j);
@@ -91,7 +103,7 @@ impl NonlinearProblem for Membrane {
         Matrix::zeros(self.k.pattern.clone())
     }
     fn structure(&self) -> Structure {
-        Structure::SymmetricPositiveDefinite
+        if self.drag == 0.0 { Structure::SymmetricPositiveDefinite } else { Structure::General }
     }
 }
 
@@ -101,17 +113,21 @@ fn solve(piecewise: bool) -> (Vec<f64>, usize, Membrane) {
 }
 
 fn solve_with(piecewise: bool, options: NewtonOptions) -> (Vec<f64>, usize, Membrane, Counters) {
-    solve_on(piecewise, options, None, false)
+    let (u, iterations, problem, (counters, _)) = solve_on(piecewise, options, None, false, 0.0);
+    (u, iterations, problem, counters)
 }
 
 /// With the obstacle on `contact` only (everywhere if None; else under half the load and then
-/// the whole), its residual evaluated there alone when Newton asks if `on_support`.
+/// the whole), its residual evaluated there alone when Newton asks if `on_support`, with a
+/// `drag` on the active dofs. Returns Newton's counters and its Cholesky factor's size, if its
+/// last factor is one.
 fn solve_on(
     piecewise: bool,
     options: NewtonOptions,
     contact: Option<std::ops::Range<usize>>,
     on_support: bool,
-) -> (Vec<f64>, usize, Membrane, Counters) {
+    drag: f64,
+) -> (Vec<f64>, usize, Membrane, (Counters, Option<usize>)) {
     let n_el = 64;
     let mesh = interval(n_el, 0.0, 1.0);
     let asm = Assembler::new(&mesh);
@@ -130,7 +146,7 @@ fn solve_on(
     let contact = contact.unwrap_or(0..n);
     // A milder penalty in the two-load runs: its solves are accurate enough to be trusted.
     let eps = if twice { 1e2 } else { EPS };
-    let mut problem = Membrane { k, f, constraints, piecewise, contact, eps, on_support, support_residuals: 0 };
+    let mut problem = Membrane { k, f, constraints, piecewise, contact, eps, on_support, support_residuals: 0, drag };
     if twice {
         problem.f.iter_mut().for_each(|x| *x *= 0.5);
     }
@@ -144,7 +160,7 @@ fn solve_on(
         problem.f.iter_mut().for_each(|x| *x *= 2.0);
         iterations += newton.solve(&mut problem, &mut u).unwrap().iterations();
     }
-    (u, iterations, problem, newton.counters())
+    (u, iterations, problem, (newton.counters(), newton.factor_nnz()))
 }
 
 #[test]
@@ -193,6 +209,25 @@ fn low_rank_corrections_replace_refactorizations_without_changing_the_answer() {
     assert!(with.updates > 0, "{with:?}");
     assert_eq!(with.numeric + with.updates, without.numeric, "each change of the active set: one or the other");
     assert!(with.numeric < without.numeric / 2, "{with:?} against {without:?}");
+}
+
+#[test]
+fn a_nonsymmetric_tangent_is_solved_by_correcting_its_factored_symmetric_part() {
+    // The drag makes J nonsymmetric where the membrane touches: the symmetric part of J is
+    // factored by Cholesky at the first iterate (J = K there) and every later operator is that
+    // factor corrected, nonsymmetric part included; without corrections every one is an LU.
+    let direct = NewtonOptions { solver: Solver::Direct, ..NewtonOptions::default() };
+    let (a, ia, problem, (with, cholesky)) = solve_on(true, direct, Some(24..41), false, 1.0);
+    let (b, ib, _, (without, _)) = solve_on(true, NewtonOptions { max_rank: 0, ..direct }, Some(24..41), false, 1.0);
+    assert_eq!(ia, ib, "the same Newton iterates");
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let diff = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    assert!(diff < 1e-12 * scale, "the answers differ by {diff:.1e}");
+    let active = a.iter().filter(|x| **x < PSI).count();
+    assert!(active > 2 && problem.drag > 0.0, "in contact on {active} dofs");
+    assert_eq!(with.numeric, 1, "one factorization, corrected since: {with:?}");
+    assert!(cholesky.is_some(), "a Cholesky factor");
+    assert_eq!(with.updates, without.numeric, "a correction for each LU: {with:?} against {without:?}");
 }
 
 /// R(w) = (cM + K) w − (cM w̃ + f), an implicit step with c = 1/(βΔt²) for Δt ≈ 1e-7: the
@@ -267,10 +302,10 @@ fn a_residual_on_the_contact_dofs_alone_gives_the_same_answer() {
     // elsewhere in its bounds.
     let direct = NewtonOptions { solver: Solver::Direct, ..NewtonOptions::default() };
     let contact = Some(16..49);
-    let (a, ia, mut problem, _) = solve_on(true, direct, contact.clone(), true);
+    let (a, ia, mut problem, _) = solve_on(true, direct, contact.clone(), true, 0.0);
     assert!(problem.support_residuals > 0, "residuals on the contact dofs were asked for");
     problem.on_support = false;
-    let (b, ib, _, _) = solve_on(true, direct, contact, false);
+    let (b, ib, _, _) = solve_on(true, direct, contact, false, 0.0);
     assert_eq!(ia, ib, "the same Newton iterations");
     let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let diff = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
@@ -297,7 +332,7 @@ fn norm(v: &[f64]) -> f64 {
 fn iterative_solves_are_as_loose_as_their_newton_iteration_allows() {
     let run = |solver| {
         let options = NewtonOptions { solver, ..NewtonOptions::default() };
-        let (_, _, mut problem, _) = solve_on(true, options, Some(16..49), false);
+        let (_, _, mut problem, _) = solve_on(true, options, Some(16..49), false, 0.0);
         let full = problem.f.clone();
         let mut u = vec![0.0; full.len()];
         let mut newton = Newton::new(options);

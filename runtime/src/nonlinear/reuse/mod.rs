@@ -9,6 +9,8 @@ use crate::linalg::lowrank::LowRank;
 use crate::linalg::{Counters, Factorization, LinalgError, Matrix, Solver, Structure};
 use crate::nonlinear::problem::NonlinearProblem;
 
+mod symmetric;
+
 /// Bytes of cached correction columns (current and previous reference together).
 const COLUMN_BYTES: usize = 256 << 20;
 /// A previous reference is kept only if its factor is at most this large.
@@ -42,6 +44,9 @@ pub(super) struct JacobianReuse {
     corrections_off: bool,
     /// The reference before the last refactorization, with its correction.
     previous: Option<Reference>,
+    /// The symmetric part of a nonsymmetric Jacobian was found no reference ([`symmetric`]):
+    /// not positive definite, or too far from J.
+    symmetric_failed: bool,
     /// Counters of factorizations no longer kept.
     retired: Counters,
     /// ‖J‖∞ of the current operator, for the round-off of its solves, and their relative
@@ -69,6 +74,7 @@ impl Default for JacobianReuse {
             force_refactor: false,
             corrections_off: false,
             previous: None,
+            symmetric_failed: false,
             retired: Counters::default(),
             jacobian_norm: f64::INFINITY,
             solve_accuracy: None,
@@ -76,6 +82,11 @@ impl Default for JacobianReuse {
             reference_accuracy: None,
         }
     }
+}
+
+/// A factor's mean column count nnz(L)/n (see [`JacobianReuse::mean_column_count`]).
+fn mean_column_count(f: &Factorization, n: usize) -> Option<usize> {
+    f.factor_nnz().map(|nnz| nnz / n.max(1))
 }
 
 /// A factored Jacobian, its correction towards the current one, and the correction's cost so far.
@@ -120,6 +131,7 @@ impl JacobianReuse {
         self.force_refactor = false;
         self.corrections_off = false;
         self.retire_previous();
+        self.symmetric_failed = false;
     }
 
     /// Drops every factorization and correction (their counters are kept): the next solve
@@ -159,21 +171,32 @@ impl JacobianReuse {
     /// k×k system costs no more than a factorization (k³ ≲ n·c²), and until the corrections
     /// since the factorization have read c/2 solve pairs' worth (Σ entries ≈ n·c²).
     fn mean_column_count(&self, n: usize) -> Option<usize> {
-        let nnz = self.factorization.as_ref().and_then(Factorization::factor_nnz)?;
-        Some(nnz / n.max(1))
+        self.factorization.as_ref().and_then(|f| mean_column_count(f, n))
     }
 
     /// Largest correction size accepted instead of a refactorization.
     fn rank_limit(&self, n: usize, max_rank: usize) -> usize {
-        let c = self.mean_column_count(n).unwrap_or(0).max(32);
-        let sparse = self.factorization.as_ref().is_some_and(|f| f.block().is_some());
-        let k = if sparse { ((n * c * c) as f64).cbrt() as usize } else { c };
+        match &self.factorization {
+            Some(f) => self.rank_limit_for(f, n, max_rank),
+            None => max_rank.min(32).min(self.column_limit(n)),
+        }
+    }
+
+    /// [`JacobianReuse::rank_limit`] with `f` as the reference.
+    fn rank_limit_for(&self, f: &Factorization, n: usize, max_rank: usize) -> usize {
+        let c = mean_column_count(f, n).unwrap_or(0).max(32);
+        let k = if f.block().is_some() { ((n * c * c) as f64).cbrt() as usize } else { c };
         max_rank.min(k).min(self.column_limit(n))
     }
 
     /// Values a correction may read per solve.
     fn entries_limit(&self, n: usize) -> usize {
         self.mean_column_count(n).unwrap_or(0).max(32) * n
+    }
+
+    /// [`JacobianReuse::entries_limit`] with `f` as the reference.
+    fn entries_limit_for(&self, f: &Factorization, n: usize) -> usize {
+        mean_column_count(f, n).unwrap_or(0).max(32) * n
     }
 
     /// Columns the corrections may cache in all (current and previous reference).
@@ -214,7 +237,8 @@ impl JacobianReuse {
 
     /// Makes the operator the Jacobian at w: a low-rank correction of the factored reference
     /// when the factorization is direct and the change small enough, else a refactorization
-    /// (which becomes the new reference). Returns whether it refactored. The correction is of
+    /// (which becomes the new reference; for a nonsymmetric J, its symmetric part corrected
+    /// where that works: [`symmetric`]). Returns whether it factored J. The correction is of
     /// the Jacobian's values where they changed, so a problem that is not piecewise (a
     /// frictional law, whose tangent turns with the slip) is corrected as exactly as one whose
     /// tangent changes only with its active set. `piecewise`: the tangent at w is decided by
@@ -264,7 +288,13 @@ impl JacobianReuse {
             self.jacobian = Some(j);
             if updated {
                 let lr = self.low_rank.as_ref().expect("updated");
-                debug!(rank = lr.rank(), entries = lr.entries(), cached = lr.cached(), "low-rank update");
+                debug!(
+                    rank = lr.rank(),
+                    terms = lr.terms(),
+                    entries = lr.entries(),
+                    cached = lr.cached(),
+                    "low-rank update"
+                );
                 self.updates += 1;
                 return Ok(false);
             }
@@ -289,7 +319,11 @@ impl JacobianReuse {
         self.low_rank = None;
         self.overhead = 0;
         self.reference_accuracy = None;
-        self.refactor(p, w, assembled, solver)?;
+        if self.symmetric_reference(p, w, assembled, solver, max_rank)? {
+            return Ok(false);
+        }
+        // (J at w is assembled now.)
+        self.refactor(p, w, true, solver)?;
         let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
         if direct && max_rank > 0 && !self.corrections_off {
             let mut lr = LowRank::new(self.jacobian.as_ref().expect("assembled by refactor"));
