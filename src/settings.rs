@@ -22,10 +22,10 @@ pub struct Bench {
     pub disc: String,
     /// `bench disc`: the explicit run timed beside the default one, (scheme, mass matrix).
     pub disc_explicit: (String, String),
-    /// `bench disc`: the frictional contact law timed beside the default one (its
-    /// factorizations and low-rank updates per 1000 steps: an unsymmetric tangent that turns
-    /// with the slip).
-    pub disc_friction: String,
+    /// `bench disc`: the frictional contact laws timed beside the default one (their cost
+    /// over the frictionless step, factorizations and low-rank updates per 1000 steps: an
+    /// unsymmetric tangent that turns with the slip).
+    pub disc_friction: Vec<String>,
     /// `bench disc`: the finite-strain run timed beside the default one, (material, contact
     /// law): same mesh, scheme and Δt, and its cost per step over the linear one's.
     pub disc_finite_strain: (String, String),

@@ -69,10 +69,10 @@ pub struct DiscTiming {
     /// median ms/step, its factorizations, and its estimated critical step.
     #[serde(default)]
     pub explicit: Option<ExplicitTiming>,
-    /// The frictional law of forms/library.toml on the same disc: its LU factorizations and
-    /// low-rank corrections per 1000 steps.
+    /// The frictional laws of forms/library.toml on the same disc: their time per step over
+    /// the frictionless one's, factorizations and low-rank corrections per 1000 steps.
     #[serde(default)]
-    pub friction: Option<FrictionTiming>,
+    pub frictional: Vec<FrictionTiming>,
     /// The finite-strain run of forms/library.toml on the same disc, scheme and Δt: with
     /// Newton's tangent at every iteration, and with chord Newton (`--chord`).
     #[serde(default)]
@@ -99,6 +99,8 @@ pub struct FiniteStrainTiming {
 pub struct FrictionTiming {
     pub contact: String,
     pub ms_per_step: f64,
+    /// `ms_per_step` over the frictionless (default) run's.
+    pub over_frictionless: f64,
     pub newton_total: usize,
     pub factorizations_per_1000: f64,
     pub low_rank_updates_per_1000: f64,
@@ -140,17 +142,7 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
     let (mut scheme, mut contact, mut contact_params) = (None, None, Vec::new());
     for path in meshes {
         let opts = Options { mesh: Some(path.clone()), ..base.clone() };
-        let (mut mean, mut med, mut whole) = (Vec::new(), Vec::new(), Vec::new());
-        let mut last = None;
-        for _ in 0..repeats.max(1) {
-            let s = disc::run(&opts)?.summary;
-            let steps = s.steps.max(1) as f64;
-            mean.push(s.stepping_seconds / steps * 1e3);
-            med.push(s.step_median_seconds * 1e3);
-            whole.push(s.seconds_per_step * 1e3);
-            last = Some(s);
-        }
-        let s = last.expect("at least one run");
+        let Timed { per_step: mean, median_step: med, whole, summary: s } = timed(&opts, repeats)?;
         (dt, t_end) = (s.dt, s.t_end);
         contact_params = crate::driver::params::declared_by(&s.params, &s.contact);
         (scheme, contact) = (Some(s.scheme.clone()), Some(s.contact.clone()));
@@ -161,10 +153,13 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
         let cache = triad_bandwidth(model_bytes as usize);
         let cache_model_ms = 1e3 * model_bytes / cache;
         let explicit = explicit_timing(&opts, s.dt, repeats)?;
-        let friction = friction_timing(&opts, repeats)?;
+        let linear_ms = median(mean.clone());
+        let frictional = (crate::settings::get().bench.disc_friction.iter())
+            .map(|contact| friction_timing(&opts, contact, repeats, linear_ms))
+            .collect::<Result<Vec<_>, _>>()?;
         let finite_strain = [false, true]
             .into_iter()
-            .map(|chord| finite_strain_timing(&opts, chord, repeats, median(mean.clone()), s.newton_total))
+            .map(|chord| finite_strain_timing(&opts, chord, repeats, linear_ms, s.newton_total))
             .collect::<Result<Vec<_>, _>>()?;
         let fastest = mean.iter().copied().fold(f64::INFINITY, f64::min);
         let slowest = mean.iter().copied().fold(0.0, f64::max);
@@ -193,7 +188,7 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
             cache_model_ms,
             measured_over_cache_model: ms_per_step / cache_model_ms,
             explicit,
-            friction,
+            frictional,
             finite_strain,
         };
         progress(&format!(
@@ -230,12 +225,13 @@ pub fn disc(meshes: &[PathBuf], repeats: usize, progress: &mut dyn FnMut(&str)) 
                 e.stable_dt.map_or("—".into(), |d| format!("{d:.4}"))
             ));
         }
-        if let Some(f) = &t.friction {
+        for f in &t.frictional {
             progress(&format!(
-                "{}: contact {}: {:.3} ms/step stepping, {} Newton iterations, per 1000 steps {:.0} factorizations and {:.0} low-rank updates",
+                "{}: contact {}: {:.3} ms/step stepping ({:.2}× the frictionless step), {} Newton iterations, per 1000 steps {:.0} factorizations and {:.0} low-rank updates",
                 t.mesh,
                 f.contact,
                 f.ms_per_step,
+                f.over_frictionless,
                 f.newton_total,
                 f.factorizations_per_1000,
                 f.low_rank_updates_per_1000
@@ -279,45 +275,34 @@ fn explicit_timing(opts: &Options, dt: f64, repeats: usize) -> Result<Option<Exp
         dt = (0.8 * stable / scale).floor() * scale;
     }
     opts.dt = Some(dt);
-    let mut per_step = Vec::new();
-    let mut last = None;
-    for _ in 0..repeats.max(1) {
-        let run = disc::run(&opts)?;
-        per_step.push(run.summary.stepping_seconds / run.summary.steps.max(1) as f64 * 1e3);
-        last = Some(run);
-    }
-    let run = last.expect("at least one run");
+    let Timed { per_step, summary, .. } = timed(&opts, repeats)?;
     Ok(Some(ExplicitTiming {
         dt,
         scheme: scheme.clone(),
         mass: mass.name().into(),
         ms_per_step: median(per_step),
-        factorizations: run.summary.factorizations,
-        stable_dt: run.summary.stable_dt,
+        factorizations: summary.factorizations,
+        stable_dt: summary.stable_dt,
     }))
 }
 
-/// The frictional law of forms/library.toml on the same disc, with the default scheme.
-fn friction_timing(opts: &Options, repeats: usize) -> Result<Option<FrictionTiming>, CaseError> {
-    let contact = &crate::settings::get().bench.disc_friction;
-    let methods = crate::driver::Methods { contact: contact.clone(), ..opts.methods.clone() };
-    let opts = Options { methods, ..opts.clone() };
-    let mut per_step = Vec::new();
-    let mut last = None;
-    for _ in 0..repeats.max(1) {
-        let run = disc::run(&opts)?;
-        per_step.push(run.summary.stepping_seconds / run.summary.steps.max(1) as f64 * 1e3);
-        last = Some(run.summary);
-    }
-    let s = last.expect("at least one run");
+/// A frictional law of forms/library.toml on the same disc, with the default scheme, against
+/// the frictionless run's `linear_ms` per step.
+fn friction_timing(opts: &Options, contact: &str, repeats: usize, linear_ms: f64) -> Result<FrictionTiming, CaseError> {
+    let methods = crate::driver::Methods { contact: contact.to_string(), ..opts.methods.clone() };
+    let mut opts = Options { methods, ..opts.clone() };
+    opts.chosen.contact = true;
+    let Timed { per_step, summary: s, .. } = timed(&opts, repeats)?;
     let per_1000 = |count: usize| 1000.0 * count as f64 / s.steps.max(1) as f64;
-    Ok(Some(FrictionTiming {
-        contact: contact.clone(),
-        ms_per_step: median(per_step),
+    let ms_per_step = median(per_step);
+    Ok(FrictionTiming {
+        contact: contact.to_string(),
+        ms_per_step,
+        over_frictionless: ms_per_step / linear_ms,
         newton_total: s.newton_total,
         factorizations_per_1000: per_1000(s.factorizations),
         low_rank_updates_per_1000: per_1000(s.low_rank_updates),
-    }))
+    })
 }
 
 /// The finite-strain run of forms/library.toml (material, contact law) on the same disc, with the
@@ -336,15 +321,7 @@ fn finite_strain_timing(
     let newton = crate::runtime::nonlinear::newton::NewtonOptions { chord, ..opts.newton };
     let mut opts = Options { methods, newton, ..opts.clone() };
     (opts.chosen.material, opts.chosen.contact) = (true, true);
-    let (mut per_step, mut med) = (Vec::new(), Vec::new());
-    let mut last = None;
-    for _ in 0..repeats.max(1) {
-        let run = disc::run(&opts)?;
-        per_step.push(run.summary.stepping_seconds / run.summary.steps.max(1) as f64 * 1e3);
-        med.push(run.summary.step_median_seconds * 1e3);
-        last = Some(run.summary);
-    }
-    let s = last.expect("at least one run");
+    let Timed { per_step, median_step: med, summary: s, .. } = timed(&opts, repeats)?;
     let ms_per_step = median(per_step);
     let over_linear = ms_per_step / linear_ms;
     Ok(FiniteStrainTiming {
@@ -358,6 +335,29 @@ fn finite_strain_timing(
         over_linear,
         over_linear_per_iteration: over_linear * linear_newton.max(1) as f64 / s.newton_total.max(1) as f64,
     })
+}
+
+/// A disc run's times per step over repeated runs, in ms (the mean over its steps, its median
+/// step, and the whole run's mean), and its last run's summary.
+struct Timed {
+    per_step: Vec<f64>,
+    median_step: Vec<f64>,
+    whole: Vec<f64>,
+    summary: disc::Summary,
+}
+
+fn timed(opts: &Options, repeats: usize) -> Result<Timed, CaseError> {
+    let (mut per_step, mut median_step, mut whole) = (Vec::new(), Vec::new(), Vec::new());
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let s = disc::run(opts)?.summary;
+        let steps = s.steps.max(1) as f64;
+        per_step.push(s.stepping_seconds / steps * 1e3);
+        median_step.push(s.step_median_seconds * 1e3);
+        whole.push(s.seconds_per_step * 1e3);
+        last = Some(s);
+    }
+    Ok(Timed { per_step, median_step, whole, summary: last.expect("at least one run") })
 }
 
 /// The last run's `dir/bench_disc.json`, if there is one.

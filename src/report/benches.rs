@@ -72,6 +72,64 @@ pub(super) fn sphere(out: &Path) -> String {
     md
 }
 
+/// The runs `bench disc` times beside the default one on each mesh (forms/library.toml's
+/// `[bench]`): the explicit scheme, the frictional laws and the finite-strain material, each
+/// against the default step.
+fn beside_default(bench: &crate::bench::disc::Report) -> String {
+    let mut table = Table::new(&[
+        "mesh",
+        "run",
+        "ms per step (mean)",
+        "× the default step",
+        "Newton iterations",
+        "factorizations per 1000 steps",
+    ]);
+    let mut rows = 0;
+    for m in &bench.meshes {
+        let name =
+            std::path::Path::new(&m.mesh).file_name().map_or(m.mesh.clone(), |f| f.to_string_lossy().into_owned());
+        let mut row = |run: String, ms: f64, newton: String, factorizations: f64| {
+            rows += 1;
+            table.row([
+                name.clone(),
+                run,
+                format!("{ms:.3}"),
+                format!("{:.2}", ms / m.ms_per_step),
+                newton,
+                format!("{factorizations:.0}"),
+            ]);
+        };
+        if let Some(e) = &m.explicit {
+            let per_1000 = 1000.0 * e.factorizations as f64 / m.steps.max(1) as f64;
+            row(
+                format!("{} ({} mass, Δt = {})", e.scheme, e.mass, readable(e.dt)),
+                e.ms_per_step,
+                "—".into(),
+                per_1000,
+            );
+        }
+        for f in &m.frictional {
+            row(format!("contact {}", f.contact), f.ms_per_step, f.newton_total.to_string(), f.factorizations_per_1000);
+        }
+        for f in &m.finite_strain {
+            let chord = if f.chord { ", chord Newton" } else { "" };
+            row(
+                format!("{} with {}{chord}", f.material, f.contact),
+                f.ms_per_step,
+                f.newton_total.to_string(),
+                f.factorizations_per_1000,
+            );
+        }
+    }
+    if rows == 0 {
+        return String::new();
+    }
+    format!(
+        "Beside the default run, on the same meshes (Δt as above, except an explicit scheme's above its critical step):\n\n{}\n",
+        table.markdown()
+    )
+}
+
 /// The last `bench disc` run in this directory.
 pub(super) fn disc(out: &Path) -> String {
     let mut md = String::new();
@@ -127,6 +185,7 @@ pub(super) fn disc(out: &Path) -> String {
             }
             md.push_str(&table.markdown());
             md.push('\n');
+            md.push_str(&beside_default(&bench));
         }
         Some(Err(e)) => {
             let _ = writeln!(md, "`bench_disc.json` in this directory cannot be read: {e}\n");

@@ -27,7 +27,9 @@ fn library_settings_name_library_files() {
     }
     // verify binds the damping slot itself: it must be named.
     assert!(!s.verify.damping_slot.is_empty());
-    assert!(laws.contains(&s.bench.disc_friction.as_str()), "unknown contact law `{}`", s.bench.disc_friction);
+    for law in &s.bench.disc_friction {
+        assert!(laws.contains(&law.as_str()), "unknown contact law `{law}`");
+    }
     let table = &s.report.friction_table;
     let pf = signorini::problem::load(&table.problem).expect("the friction table's problem loads");
     for key in &table.keys {

@@ -5,6 +5,10 @@ use std::sync::Arc;
 
 use crate::linalg::pattern::Pattern;
 
+/// The relative asymmetry |a_ij − a_ji| ≤ tol·max|a| below which a matrix is taken as
+/// symmetric: factored by Cholesky, multiplied from its lower half.
+pub const SYMMETRY_TOLERANCE: f64 = 1e-12;
+
 /// Stored entries from which a matrix–vector product is split over threads.
 const PARALLEL_NNZ: usize = 1 << 20;
 

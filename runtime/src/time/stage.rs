@@ -9,6 +9,7 @@ use crate::fem::assembly::Assembler;
 use crate::fem::bound::BoundForm;
 use crate::linalg::element_matrices::ElementMatrices;
 use crate::linalg::lower_half::{HalfPattern, LowerHalf};
+use crate::linalg::matrix::SYMMETRY_TOLERANCE;
 use crate::linalg::pattern::Entries;
 use crate::linalg::{Matrix, Structure};
 use crate::nonlinear::problem::NonlinearProblem;
@@ -114,7 +115,7 @@ fn probe_here(
     forms: &HashMap<String, Box<dyn BoundForm + '_>>,
     matrices: &HashMap<String, Vec<Matrix>>,
 ) -> Structure {
-    if matrices.values().flatten().any(|m| !m.is_symmetric(1e-12)) {
+    if matrices.values().flatten().any(|m| !m.is_symmetric(SYMMETRY_TOLERANCE)) {
         return Structure::General;
     }
     let n = asm.size();
@@ -152,7 +153,7 @@ fn probe_here(
                         continue;
                     }
                     finite = true;
-                    if !m.is_symmetric(1e-12) {
+                    if !m.is_symmetric(SYMMETRY_TOLERANCE) {
                         return Structure::General;
                     }
                 }

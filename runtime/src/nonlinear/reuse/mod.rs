@@ -6,6 +6,7 @@
 use tracing::debug;
 
 use crate::linalg::lowrank::LowRank;
+use crate::linalg::matrix::SYMMETRY_TOLERANCE;
 use crate::linalg::{Counters, Factorization, LinalgError, Matrix, Solver, Structure};
 use crate::nonlinear::problem::NonlinearProblem;
 
@@ -349,7 +350,7 @@ impl JacobianReuse {
         }
         self.jacobian_current = true;
         let want = match p.structure() {
-            Structure::Auto if self.spd_failed || !j.is_symmetric_everywhere(1e-12) => Structure::General,
+            Structure::Auto if self.spd_failed || !j.is_symmetric_everywhere(SYMMETRY_TOLERANCE) => Structure::General,
             Structure::Auto => Structure::SymmetricPositiveDefinite,
             s => s,
         };

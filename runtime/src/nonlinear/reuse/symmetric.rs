@@ -15,11 +15,9 @@ use tracing::debug;
 
 use super::JacobianReuse;
 use crate::linalg::lowrank::LowRank;
+use crate::linalg::matrix::SYMMETRY_TOLERANCE;
 use crate::linalg::{Factorization, LinalgError, Solver, Structure};
 use crate::nonlinear::problem::NonlinearProblem;
-
-/// The relative asymmetry below which J is taken as symmetric (as in choosing Cholesky).
-const SYMMETRY_TOLERANCE: f64 = 1e-12;
 
 impl JacobianReuse {
     /// Makes the operator the symmetric part of the Jacobian at w, factored, corrected towards

@@ -31,6 +31,7 @@ use signorini_descriptors::{Borrowed, Level, SchemeDesc, StageDesc};
 use crate::fem::assembly::Assembler;
 use crate::fem::bound::BoundForm;
 use crate::linalg::lower_half::{HalfPattern, LowerHalf};
+use crate::linalg::matrix::SYMMETRY_TOLERANCE;
 use crate::linalg::{Matrix, Structure};
 use crate::nonlinear::newton::{Newton, NewtonError, NewtonOptions, NewtonReport};
 use crate::nonlinear::statics::Constraints;
@@ -187,8 +188,12 @@ impl<'a> Stepper<'a> {
             Structure::Auto => probe_structure(asm, &forms, &matrices),
             s => s,
         };
-        let half_pattern =
-            (structure == Structure::SymmetricPositiveDefinite).then(|| Arc::new(HalfPattern::new(asm.pattern())));
+        // The linear forms' matrices are read in lower halves (half the values per product)
+        // wherever they are all symmetric, whatever the nonlinear forms' tangents are (a
+        // frictional law's is not).
+        let symmetric = structure == Structure::SymmetricPositiveDefinite
+            || matrices.values().flatten().all(|m| m.is_symmetric(SYMMETRY_TOLERANCE));
+        let half_pattern = symmetric.then(|| Arc::new(HalfPattern::new(asm.pattern())));
         let stages = (0..desc.stages.len() + 1)
             .map(|_| StageCache {
                 newton: Newton::new(newton_options),
