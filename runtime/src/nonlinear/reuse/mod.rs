@@ -300,7 +300,8 @@ impl JacobianReuse {
                 return Ok(false);
             }
         }
-        self.force_refactor = false;
+        // A correction whose solve proved inaccurate asks for J itself, not another correction.
+        let forced = std::mem::take(&mut self.force_refactor);
         // The factored reference becomes the previous one, if it is worth keeping; the new
         // factorization shares its symbolic analysis.
         let keep = self.low_rank.is_some()
@@ -320,11 +321,11 @@ impl JacobianReuse {
         self.low_rank = None;
         self.overhead = 0;
         self.reference_accuracy = None;
-        if self.symmetric_reference(p, w, assembled, solver, max_rank)? {
+        if !forced && self.symmetric_reference(p, w, assembled, solver, max_rank)? {
             return Ok(false);
         }
-        // (J at w is assembled now.)
-        self.refactor(p, w, true, solver)?;
+        // (`symmetric_reference` assembles J at w whether or not it applies.)
+        self.refactor(p, w, assembled || !forced, solver)?;
         let direct = self.factorization.as_ref().is_some_and(Factorization::is_direct);
         if direct && max_rank > 0 && !self.corrections_off {
             let mut lr = LowRank::new(self.jacobian.as_ref().expect("assembled by refactor"));
