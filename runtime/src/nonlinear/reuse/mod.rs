@@ -39,9 +39,9 @@ pub(super) struct JacobianReuse {
     pub(super) force_refactor: bool,
     /// The Jacobian of a tangent that is not piecewise was found to differ from the reference
     /// on more than half the dofs, and more than a correction may have (a finite-strain
-    /// material's changes everywhere): no
-    /// correction is attempted again until the operator is invalidated, since comparing and
-    /// recording for one cost a tenth of such a step (the neo-Hookean disc).
+    /// material's changes everywhere): no correction is attempted again until the operator is
+    /// invalidated, since comparing and recording for one cost a tenth of such a step (the
+    /// neo-Hookean disc).
     corrections_off: bool,
     /// The reference before the last refactorization, with its correction.
     previous: Option<Reference>,
