@@ -191,7 +191,6 @@ impl Pattern {
         }
     }
 
-    /// Number of rows (= columns).
     /// For each stored entry (i, j), the position of (j, i) (the pattern is symmetric): one
     /// pass over the columns, each column's cursor moving down its rows as j grows.
     pub fn transposed(&self) -> &[usize] {
@@ -209,6 +208,7 @@ impl Pattern {
         })
     }
 
+    /// Number of rows (= columns).
     pub fn size(&self) -> usize {
         self.col_ptr.len() - 1
     }

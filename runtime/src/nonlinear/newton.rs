@@ -432,8 +432,8 @@ impl Newton {
     }
 
     /// The operator for the active set `set`: kept while `set` is the one it was factored for
-    /// and the tangent piecewise, or not piecewise but kept by chord Newton (`keep_operator`), else a
-    /// new one, corrected or refactored. Returns whether it was refactored, and whether
+    /// and the tangent piecewise, or not piecewise but kept by chord Newton (`keep_operator`),
+    /// else a new one, corrected or refactored. Returns whether it was refactored, and whether
     /// corrected.
     fn operator_for(
         &mut self,

@@ -192,7 +192,7 @@ impl JacobianReuse {
 
     /// Values a correction may read per solve.
     fn entries_limit(&self, n: usize) -> usize {
-        self.mean_column_count(n).unwrap_or(0).max(32) * n
+        self.factorization.as_ref().map_or(32 * n, |f| self.entries_limit_for(f, n))
     }
 
     /// [`JacobianReuse::entries_limit`] with `f` as the reference.

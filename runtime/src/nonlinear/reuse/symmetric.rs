@@ -1,13 +1,14 @@
-//! The symmetric part of a nonsymmetric Jacobian as the factored reference, for a frictional
-//! contact law (Coulomb, Tresca): its tangent is nonsymmetric only in the rows of the contact
-//! zone, on an elastic body whose inertia and stiffness are symmetric positive definite.
-//! Factoring J itself means LU there, whose corrections have dense columns J⁻¹eᵢ, so only
-//! about nnz(L)/n of them pay for themselves: a sliding contact zone wider than that made
+//! The symmetric part of a nonsymmetric Jacobian as the factored reference, for a contact law
+//! whose tangent is nonsymmetric only in the rows of the contact zone (Coulomb friction,
+//! Nitsche with θ ≠ 1), on an elastic body whose inertia and stiffness are symmetric positive
+//! definite. Factoring J itself means LU there, whose corrections have dense columns J⁻¹eᵢ, so
+//! only about nnz(L)/n of them pay for themselves: a sliding contact zone wider than that made
 //! Newton refactor at almost every iteration (155 LU factorizations per 1000 steps on the disc
-//! at h = 1). Instead S, J with its nonsymmetric entries replaced by (J + Jᵀ)/2, is factored by Cholesky in node blocks and J = S + (J − S)
-//! is solved with the correction on the dofs where J − S has entries, whose columns L⁻¹eᵢ are
-//! sparse; later iterates correct the same S as a frictionless law's do its reference, and a
-//! new S is factored only when their change outgrows a correction. Where S is not positive
+//! at h = 1). Instead S, J with its nonsymmetric pairs replaced by their mean, is factored by
+//! Cholesky in node blocks, and J = S + (J − S) is solved with the correction on the dofs where
+//! J − S has entries, whose columns L⁻¹eᵢ are sparse; later iterates correct the same S as a
+//! frictionless law's do its reference, and a new S is factored only when their change
+//! outgrows a correction. Where S is not positive
 //! definite, or the first correction is too large (a nonsymmetric part spread over the whole
 //! body), J is factored by LU as before.
 
