@@ -66,6 +66,26 @@ impl ElementMatrices {
 /// two matrices sum the same quadrature points in the same order except those switched.
 const ROUNDOFF: f64 = 1e-12;
 
+/// A change of a tangent's entry (of J, or of an element matrix) below this fraction of the
+/// entry's size is round-off, not a change: a law whose tangent is constant in exact arithmetic
+/// while its arguments move changes by such amounts at every step (Tresca's while sliding in
+/// 2D, (s/|x|)(I − x̂x̂ᵀ) applied to a tangential vector: 1e-16 to 1e-15 of the entry on the
+/// disc, where the changes of a switched point are 1e-10 and more). Newton's tangent needs
+/// nothing near this accuracy; a correction that counted them would cover all of a sliding Γ_C.
+pub const CHANGE_ROUNDOFF: f64 = 1e-13;
+
+/// Whether `after` differs from `before` by more than round-off ([`CHANGE_ROUNDOFF`]).
+pub fn changed(before: f64, after: f64) -> bool {
+    (after - before).abs() > CHANGE_ROUNDOFF * after.abs().max(before.abs())
+}
+
+/// Whether an element matrix changed by more than round-off, measured against its largest
+/// entry (an entry of an element can be small by cancellation where J's is not).
+fn changed_element(before: &[f64], after: &[f64]) -> bool {
+    let size = before.iter().chain(after).fold(0.0f64, |m, v| m.max(v.abs()));
+    before.iter().zip(after).any(|(b, a)| (a - b).abs() > CHANGE_ROUNDOFF * size)
+}
+
 /// Splits the changes of element matrices from a reference into rank-one terms, remembering
 /// each element's split while its matrix stays the same (an element switched at one update
 /// usually is at the next ones too: only newly switched ones are decomposed).
@@ -95,7 +115,8 @@ impl ChangeSplitter {
 
     /// The change from the reference to `current` (the same elements, at other arguments) as
     /// rank-one terms: the eigenpairs of each differing element's change, those above
-    /// round-off. None if the lists do not match or a change is not symmetric.
+    /// round-off (an element whose entries differ by round-off only has none). None if the
+    /// lists do not match or a change is not symmetric.
     pub fn split(&mut self, current: &ElementMatrices) -> Option<RankOneTerms> {
         let s = self.reference.size;
         if current.size != s || current.dofs != self.reference.dofs || s == 0 {
@@ -104,7 +125,7 @@ impl ChangeSplitter {
         let mut terms = RankOneTerms { size: s, ..Default::default() };
         let pairs = self.reference.values.chunks_exact(s * s).zip(current.values.chunks_exact(s * s));
         for (e, (before, after)) in pairs.enumerate() {
-            if before == after {
+            if !changed_element(before, after) {
                 continue;
             }
             if self.splits[e].as_ref().is_none_or(|split| split.matrix != after) {
@@ -189,6 +210,12 @@ mod tests {
         // The same change again: the remembered split, the same ids.
         let again = splitter.split(&current).expect("symmetric");
         assert_eq!((again.lambdas, again.ids), (terms.lambdas.clone(), terms.ids.clone()));
+        // An element whose entries differ by round-off only, nonsymmetrically, adds no term.
+        let mut noisy = current.clone();
+        noisy.values[1] *= 1.0 + 2.0 * f64::EPSILON;
+        noisy.values[5] *= 1.0 - 3.0 * f64::EPSILON;
+        let split = splitter.split(&noisy).expect("round-off is no change");
+        assert_eq!(split.ids, terms.ids, "the second element's terms only");
         // A nonsymmetric change is not split.
         current.values[9 + 1] += 1.0;
         assert!(splitter.split(&current).is_none());

@@ -170,7 +170,7 @@ fn a_low_rank_correction_solves_the_changed_matrix() {
             nodes.iter().for_each(|&n| flags[n] = true);
             assert_eq!(lr.changed_dofs(&changed, Some(&changed.pattern.entries_among(&flags))), dofs);
             assert!(dofs.len() <= nodes.len() * d && !dofs.is_empty(), "changed dofs {dofs:?}");
-            lr.update(&changed, dofs, &mut f, None).expect("updates");
+            assert!(lr.update(&changed, dofs, &mut f, None, usize::MAX).expect("updates"), "within the limit");
             let mut x = b.clone();
             let defect = lr.solve(&mut f, &mut x, true).expect("solves");
             let (exact, _) = solve(&changed, Structure::General, Solver::Direct, &b);

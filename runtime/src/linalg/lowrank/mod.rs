@@ -29,7 +29,7 @@ use faer::Mat;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 
 use crate::linalg::block_factor::SparseColumn;
-use crate::linalg::element_matrices::{ChangeSplitter, ElementMatrices, RankOneTerms};
+use crate::linalg::element_matrices::{CHANGE_ROUNDOFF, ChangeSplitter, ElementMatrices, RankOneTerms, changed};
 use crate::linalg::factorization::Factorization;
 use crate::linalg::matrix::{LinalgError, Matrix};
 use crate::linalg::pattern::Entries;
@@ -168,45 +168,51 @@ impl LowRank {
         self.column_entries
     }
 
-    /// The dofs on which `j` differs from the reference (rows and columns), sorted; only
-    /// `entries` are compared if given (the only ones that can differ).
+    /// The dofs on which `j` differs from the reference by more than round-off (rows and
+    /// columns), sorted; only `entries` are compared if given (the only ones that can differ).
+    /// The correction leaves J₀'s values where they differ by round-off.
     pub fn changed_dofs(&self, j: &Matrix, entries: Option<&Entries>) -> Vec<usize> {
         let p = &j.pattern;
-        let mut changed = vec![false; j.size()];
+        let mut differs = vec![false; j.size()];
         let mut compare = |k: usize, col: usize| {
-            if j.values[k] != self.reference[k] {
-                changed[col] = true;
-                changed[p.row_idx[k]] = true;
+            if changed(self.reference[k], j.values[k]) {
+                differs[col] = true;
+                differs[p.row_idx[k]] = true;
             }
         };
         match entries {
             Some(e) => e.indices.iter().zip(&e.columns).for_each(|(&k, &col)| compare(k, col as usize)),
             None => (0..j.size()).for_each(|col| (p.col_ptr[col]..p.col_ptr[col + 1]).for_each(|k| compare(k, col))),
         }
-        (0..j.size()).filter(|&i| changed[i]).collect()
+        (0..j.size()).filter(|&i| differs[i]).collect()
     }
 
     /// Makes the correction the one from the reference to `j`, whose differing dofs are `dofs`
     /// (from [`LowRank::changed_dofs`]); `reference` is J₀'s factorization. Given `elements`,
     /// the varying part of `j` as element matrices (see [`LowRank::set_elements`]), a Cholesky
     /// reference is corrected by the rank-one terms of their change, if those make up J − J₀.
+    /// Returns false, making no correction, if its small system would have more than
+    /// `max_system` rows (k for a correction by E, the terms' count r for one by terms): that
+    /// system's factorization, and its Gram matrix's products, would cost more than J's. After
+    /// a refusal or an error, the correction is updated again before it is solved with.
     pub fn update(
         &mut self,
         j: &Matrix,
         dofs: Vec<usize>,
         reference: &mut Factorization,
         elements: Option<&ElementMatrices>,
-    ) -> Result<(), LinalgError> {
+        max_system: usize,
+    ) -> Result<bool, LinalgError> {
         let n = j.size();
         let mut scratch = std::mem::take(&mut self.scratch);
         let d = reference.block().map_or(1, |b| b.dim());
         if scratch.position.len() != n || scratch.work.len() < d * n || scratch.seen.len() < n / d {
             scratch = Scratch { work: vec![0.0; d * n], position: vec![usize::MAX; n], seen: vec![false; n / d] };
         }
-        let result = self.update_with(j, dofs, reference, elements, &mut scratch);
+        let result = self.update_with(j, dofs, reference, elements, max_system, &mut scratch);
         match result {
-            Ok(()) => self.dofs.iter().for_each(|&i| scratch.position[i] = usize::MAX),
-            Err(_) => {
+            Ok(true) => self.dofs.iter().for_each(|&i| scratch.position[i] = usize::MAX),
+            Ok(false) | Err(_) => {
                 scratch.work.fill(0.0);
                 scratch.position.fill(usize::MAX);
                 scratch.seen.fill(false);
@@ -222,8 +228,9 @@ impl LowRank {
         dofs: Vec<usize>,
         reference: &mut Factorization,
         elements: Option<&ElementMatrices>,
+        max_system: usize,
         scratch: &mut Scratch,
-    ) -> Result<(), LinalgError> {
+    ) -> Result<bool, LinalgError> {
         let n = j.size();
         if matches!(self.columns, Columns::Unknown) {
             self.columns = match reference.block() {
@@ -232,6 +239,10 @@ impl LowRank {
             };
         }
         let k = dofs.len();
+        let by_terms = elements.is_some() && self.elements.is_some() && matches!(self.columns, Columns::Sparse { .. });
+        if k > max_system && !by_terms {
+            return Ok(false);
+        }
         // The previous correction's dense columns' memory, reused for the new ones.
         let mut spare = self.dense.take().map(|d| d.values).unwrap_or_default();
         let mut e = Mat::<f64>::zeros(k, k);
@@ -314,7 +325,7 @@ impl LowRank {
             (Some(now), Some(splitter)) if k > 0 => splitter.split(now),
             _ => None,
         };
-        if let Some(terms) = terms
+        if let Some(terms) = terms.filter(|t| t.len() <= max_system)
             && let Some(factored) = self.factored(&dofs, scratch, &e, &g, &terms, &mut spare)
         {
             self.column_entries = factored.dense.values.len();
@@ -322,7 +333,10 @@ impl LowRank {
             (self.term_vectors, self.term_size) = (factored.x, terms.size);
             self.terms = terms.len();
             self.dofs = dofs;
-            return Ok(());
+            return Ok(true);
+        }
+        if k > max_system {
+            return Ok(false);
         }
         let m = Mat::<f64>::identity(k, k) + &g * &e;
         let lu = m.partial_piv_lu();
@@ -351,7 +365,7 @@ impl LowRank {
         (self.term_vectors, self.term_size) = (Vec::new(), 0);
         self.terms = k;
         self.dofs = dofs;
-        Ok(())
+        Ok(true)
     }
 
     /// The correction by rank-one terms λ v vᵀ that make up E on `dofs` (with G = Wᵀ W there):
@@ -375,11 +389,13 @@ impl LowRank {
         let Columns::Sparse { of_dof, columns, d, .. } = &self.columns else { return None };
         let d = *d;
         let (k, r, s) = (dofs.len(), terms.len(), terms.size);
-        // X as (position in D, value) per term; a term reaching outside D does not make up E.
+        // X as (position in D, value) per term; a term reaching outside D does not make up E,
+        // unless only by round-off (D leaves out dofs whose entries changed by no more: the
+        // unit vector's component is then of that order, and the sum is checked below).
         let mut x: Vec<(usize, f64)> = Vec::with_capacity(r * s);
         for (&dof, &v) in terms.dofs.iter().zip(&terms.vectors) {
             match position[dof] {
-                usize::MAX if v != 0.0 => return None,
+                usize::MAX if v.abs() > CHANGE_ROUNDOFF => return None,
                 usize::MAX => x.push((0, 0.0)),
                 a => x.push((a, v)),
             }

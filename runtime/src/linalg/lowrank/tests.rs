@@ -63,10 +63,15 @@ fn rank_one_terms_of_element_changes_correct_the_factor() {
     }
     let mut f = Factorization::new(Structure::SymmetricPositiveDefinite);
     f.factor(&a).unwrap();
+    // A system larger than allowed is refused: three terms, more dofs.
+    let mut small = LowRank::new(&a);
+    small.set_elements(Some(reference.clone()));
+    let changed = small.changed_dofs(&j, None);
+    assert!(!small.update(&j, changed, &mut f, Some(&current), 2).unwrap(), "three terms, at most two");
     let mut lr = LowRank::new(&a);
     lr.set_elements(Some(reference));
     let changed = lr.changed_dofs(&j, None);
-    lr.update(&j, changed.clone(), &mut f, Some(&current)).unwrap();
+    assert!(lr.update(&j, changed.clone(), &mut f, Some(&current), usize::MAX).unwrap());
     assert_eq!(lr.terms(), 3, "three rank-one terms for {} changed dofs", changed.len());
     assert!(changed.len() > 3);
     let b: Vec<f64> = (0..n).map(|i| ((i * 13) % 23) as f64 / 23.0 - 0.5).collect();
@@ -80,12 +85,31 @@ fn rank_one_terms_of_element_changes_correct_the_factor() {
     assert!(defect < 1e-12, "defect {defect:.1e}");
     // Without the elements, the correction by E on the changed dofs solves alike.
     let mut by_dofs = LowRank::new(&a);
-    by_dofs.update(&j, changed.clone(), &mut f, None).unwrap();
+    assert!(by_dofs.update(&j, changed.clone(), &mut f, None, usize::MAX).unwrap());
     assert_eq!(by_dofs.terms(), changed.len());
     let mut y = b.clone();
     by_dofs.solve(&mut f, &mut y, false).unwrap();
     let diff = x.iter().zip(&y).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
     assert!(diff < 1e-12, "the two corrections differ by {diff:.1e}");
+}
+
+#[test]
+fn entries_that_differ_by_round_off_are_no_change() {
+    let unit = [0.0, 1.0];
+    let mesh = rectangle(6, 5, unit, unit, Diagonal::Right, 2);
+    let a = diagonally_dominant(&Assembler::new(&mesh));
+    let lr = LowRank::new(&a);
+    let (col, k) = (7, a.pattern.col_ptr[7]);
+    let row = a.pattern.row_idx[k + 1];
+    let at = |relative: f64| {
+        let mut j = a.clone();
+        j.values[k + 1] *= 1.0 + relative;
+        lr.changed_dofs(&j, None)
+    };
+    assert!(at(4.0 * f64::EPSILON).is_empty(), "a few ulps");
+    let mut both = vec![col, row];
+    both.sort_unstable();
+    assert_eq!(at(1e-10), both, "a change of 1e-10 is one");
 }
 
 #[test]

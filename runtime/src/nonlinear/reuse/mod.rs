@@ -276,12 +276,16 @@ impl JacobianReuse {
                 dofs = other;
             }
             let new_columns = self.low_rank.as_ref().map_or(0, |lr| lr.missing(&dofs));
-            let updated = dofs.len() <= self.rank_limit(j.size(), max_rank)
+            // The limit on the correction's small system applies to its rank-one terms, if the
+            // problem gives its elements (a few per switched point, where the dofs are a cell's).
+            let limit = self.rank_limit(j.size(), max_rank);
+            let by_terms = self.low_rank.as_ref().is_some_and(LowRank::has_elements);
+            let updated = (by_terms || dofs.len() <= limit)
                 && self.cached_columns() + new_columns <= self.column_limit(j.size())
                 && match (self.low_rank.as_mut(), self.factorization.as_mut()) {
                     (Some(lr), Some(f)) => {
-                        let elements = if lr.has_elements() { p.tangent_elements(w) } else { None };
-                        lr.update(&j, dofs, f, elements.as_ref()).is_ok()
+                        let elements = if by_terms { p.tangent_elements(w) } else { None };
+                        lr.update(&j, dofs, f, elements.as_ref(), limit).is_ok_and(|made| made)
                             && lr.entries() <= self.entries_limit(j.size())
                     }
                     _ => false,

@@ -72,9 +72,10 @@ impl JacobianReuse {
         let j = self.jacobian.as_ref().expect("assembled above");
         let dofs = lr.changed_dofs(j, None);
         let rank = dofs.len();
+        let limit = self.rank_limit_for(&f, j.size(), max_rank);
         let corrected = factored
-            && rank <= self.rank_limit_for(&f, j.size(), max_rank)
-            && lr.update(j, dofs, &mut f, None).is_ok()
+            && rank <= limit
+            && lr.update(j, dofs, &mut f, None, limit).is_ok_and(|made| made)
             && lr.entries() <= self.entries_limit_for(&f, j.size());
         if !corrected {
             debug!(factored, rank, "the symmetric part is no reference: J is factored");
