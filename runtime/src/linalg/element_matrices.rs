@@ -115,8 +115,9 @@ impl ChangeSplitter {
 
     /// The change from the reference to `current` (the same elements, at other arguments) as
     /// rank-one terms: the eigenpairs of each differing element's change, those above
-    /// round-off (an element whose entries differ by round-off only has none). None if the
-    /// lists do not match or a change is not symmetric.
+    /// round-off (an element whose entries differ by round-off only has none; one that differs
+    /// so from its last split keeps that split's terms). None if the lists do not match or a
+    /// change is not symmetric.
     pub fn split(&mut self, current: &ElementMatrices) -> Option<RankOneTerms> {
         let s = self.reference.size;
         if current.size != s || current.dofs != self.reference.dofs || s == 0 {
@@ -128,7 +129,7 @@ impl ChangeSplitter {
             if !changed_element(before, after) {
                 continue;
             }
-            if self.splits[e].as_ref().is_none_or(|split| split.matrix != after) {
+            if self.splits[e].as_ref().is_none_or(|split| changed_element(&split.matrix, after)) {
                 let mut split = split_change(before, after, s)?;
                 split.id = self.next_id;
                 self.next_id += split.lambdas.len() as u32;

@@ -69,13 +69,14 @@ pub struct LowRank {
 }
 
 /// Work vectors of an update, kept at rest between updates: `work` zero (d·n), `position`
-/// usize::MAX (n), `seen` false (nodes). An update that ends in an error leaves them reset
+/// usize::MAX (n), `seen` false (nodes), `entries` zero (J's entries). An update that ends in an error leaves them reset
 /// whole.
 #[derive(Default)]
 struct Scratch {
     work: Vec<f64>,
     position: Vec<usize>,
     seen: Vec<bool>,
+    entries: Vec<f64>,
 }
 
 /// Columns kept per rank-one term until the reference changes: a term that persists from one
@@ -207,7 +208,12 @@ impl LowRank {
         let mut scratch = std::mem::take(&mut self.scratch);
         let d = reference.block().map_or(1, |b| b.dim());
         if scratch.position.len() != n || scratch.work.len() < d * n || scratch.seen.len() < n / d {
-            scratch = Scratch { work: vec![0.0; d * n], position: vec![usize::MAX; n], seen: vec![false; n / d] };
+            scratch = Scratch {
+                work: vec![0.0; d * n],
+                position: vec![usize::MAX; n],
+                seen: vec![false; n / d],
+                entries: Vec::new(),
+            };
         }
         let result = self.update_with(j, dofs, reference, elements, max_system, &mut scratch);
         match result {
@@ -216,6 +222,7 @@ impl LowRank {
                 scratch.work.fill(0.0);
                 scratch.position.fill(usize::MAX);
                 scratch.seen.fill(false);
+                scratch.entries.fill(0.0);
             }
         }
         self.scratch = scratch;
@@ -245,15 +252,18 @@ impl LowRank {
         }
         // The previous correction's dense columns' memory, reused for the new ones.
         let mut spare = self.dense.take().map(|d| d.values).unwrap_or_default();
-        let mut e = Mat::<f64>::zeros(k, k);
+        // E's nonzero entries (row and column in D, value), from J's pattern among D: a
+        // correction by rank-one terms needs no k×k matrix.
+        let mut e_entries: Vec<(usize, usize, f64, usize)> = Vec::new();
         let position = &mut scratch.position;
         dofs.iter().enumerate().for_each(|(a, &d)| position[d] = a);
         let p = &j.pattern;
         for (b, &col) in dofs.iter().enumerate() {
             for idx in p.col_ptr[col]..p.col_ptr[col + 1] {
                 let a = position[p.row_idx[idx]];
-                if a != usize::MAX {
-                    e[(a, b)] = j.values[idx] - self.reference[idx];
+                let change = j.values[idx] - self.reference[idx];
+                if a != usize::MAX && change != 0.0 {
+                    e_entries.push((a, b, change, idx));
                 }
             }
         }
@@ -306,7 +316,28 @@ impl LowRank {
                 }
             }
         }
-        self.change_norm = (0..k).map(|a| (0..k).map(|b| e[(a, b)].abs()).sum::<f64>()).fold(0.0, f64::max);
+        let mut row_sums = vec![0.0; k];
+        e_entries.iter().for_each(|&(a, _, v, _)| row_sums[a] += v.abs());
+        self.change_norm = row_sums.iter().copied().fold(0.0, f64::max);
+        let terms = match (elements, &mut self.elements) {
+            (Some(now), Some(splitter)) if k > 0 => splitter.split(now),
+            _ => None,
+        };
+        if let Some(terms) = terms.filter(|t| t.len() <= max_system)
+            && let Some(factored) = self.factored(j, &dofs, scratch, &e_entries, &terms, &mut spare)
+        {
+            self.column_entries = factored.dense.values.len();
+            (self.dense, self.e, self.lu) = (Some(factored.dense), factored.s, Some(factored.lu));
+            (self.term_vectors, self.term_size) = (factored.x, terms.size);
+            self.terms = terms.len();
+            self.dofs = dofs;
+            return Ok(true);
+        }
+        if k > max_system {
+            return Ok(false);
+        }
+        let mut e = Mat::<f64>::zeros(k, k);
+        e_entries.iter().for_each(|&(a, b, v, _)| e[(a, b)] = v);
         // G, k×k: Wᵀ W or Uᵀ Z.
         let g = match &self.columns {
             Columns::Unknown => unreachable!("decided above"),
@@ -321,23 +352,6 @@ impl LowRank {
                 Mat::from_fn(k, k, |a, c| columns[dofs[c]].as_ref().expect("computed above")[dofs[a]])
             }
         };
-        let terms = match (elements, &mut self.elements) {
-            (Some(now), Some(splitter)) if k > 0 => splitter.split(now),
-            _ => None,
-        };
-        if let Some(terms) = terms.filter(|t| t.len() <= max_system)
-            && let Some(factored) = self.factored(&dofs, scratch, &e, &g, &terms, &mut spare)
-        {
-            self.column_entries = factored.dense.values.len();
-            (self.dense, self.e, self.lu) = (Some(factored.dense), factored.s, Some(factored.lu));
-            (self.term_vectors, self.term_size) = (factored.x, terms.size);
-            self.terms = terms.len();
-            self.dofs = dofs;
-            return Ok(true);
-        }
-        if k > max_system {
-            return Ok(false);
-        }
         let m = Mat::<f64>::identity(k, k) + &g * &e;
         let lu = m.partial_piv_lu();
         let u = lu.U();
@@ -377,18 +391,18 @@ impl LowRank {
     /// them), for each of the n dofs; `spare` is memory for Ŵ.
     fn factored(
         &mut self,
+        j: &Matrix,
         dofs: &[usize],
         scratch: &mut Scratch,
-        e: &Mat<f64>,
-        g: &Mat<f64>,
+        e: &[(usize, usize, f64, usize)],
         terms: &RankOneTerms,
         spare: &mut Vec<f64>,
     ) -> Option<Factored> {
-        let Scratch { work, position, seen } = scratch;
+        let Scratch { work, position, seen, entries } = scratch;
         let n = position.len();
-        let Columns::Sparse { of_dof, columns, d, .. } = &self.columns else { return None };
+        let Columns::Sparse { of_dof, columns, gram, d } = &self.columns else { return None };
         let d = *d;
-        let (k, r, s) = (dofs.len(), terms.len(), terms.size);
+        let (r, s) = (terms.len(), terms.size);
         // X as (position in D, value) per term; a term reaching outside D does not make up E,
         // unless only by round-off (D leaves out dofs whose entries changed by no more: the
         // unit vector's component is then of that order, and the sum is checked below).
@@ -401,35 +415,63 @@ impl LowRank {
             }
         }
         let term = |t: usize| &x[t * s..(t + 1) * s];
-        // Σ λ v vᵀ (column-major) against E, column by column.
-        let mut sum = vec![0.0; k * k];
+        // Σ λ v vᵀ − E, summed in J's entries (`entries`, zero at rest).
+        if entries.len() != j.values.len() {
+            *entries = vec![0.0; j.values.len()];
+        }
+        let p = &j.pattern;
+        let mut touched: Vec<usize> = e.iter().map(|&(.., idx)| idx).collect();
+        e.iter().for_each(|&(_, _, v, idx)| entries[idx] -= v);
+        let mut outside = false;
         for t in 0..r {
-            for &(a, va) in term(t) {
-                for &(b, vb) in term(t) {
-                    sum[b * k + a] += terms.lambdas[t] * va * vb;
+            for &(b, vb) in term(t).iter().filter(|(_, v)| *v != 0.0) {
+                let col = dofs[b];
+                let rows = &p.row_idx[p.col_ptr[col]..p.col_ptr[col + 1]];
+                for &(a, va) in term(t).iter().filter(|(_, v)| *v != 0.0) {
+                    match rows.binary_search(&dofs[a]) {
+                        Ok(at) => {
+                            let idx = p.col_ptr[col] + at;
+                            entries[idx] += terms.lambdas[t] * va * vb;
+                            touched.push(idx);
+                        }
+                        Err(_) => outside = true,
+                    }
                 }
             }
         }
-        let (mut scale, mut error, mut nan) = (0.0f64, 0.0f64, false);
-        for (b, column) in sum.chunks_exact(k).enumerate() {
-            for (&x, &v) in e.col_as_slice(b).iter().zip(column) {
-                scale = scale.max(x.abs());
-                error = error.max((x - v).abs());
-                nan |= x.is_nan() || v.is_nan();
-            }
+        let scale = e.iter().fold(0.0f64, |m, &(_, _, v, _)| m.max(v.abs()));
+        let (mut error, mut nan) = (0.0f64, false);
+        for &idx in &touched {
+            error = error.max(entries[idx].abs());
+            nan |= entries[idx].is_nan();
+            entries[idx] = 0.0;
         }
-        if nan || error > TERMS_ACCURACY * scale {
+        if outside || nan || error > TERMS_ACCURACY * scale {
             return None;
         }
-        // Xᵀ G X through H = G X (k×r, column-major).
-        let mut h = vec![0.0; k * r];
-        for (t, ht) in h.chunks_exact_mut(k).enumerate() {
+        // M̃ = I + Xᵀ G X S, through H = G X on the terms' support (rows) only, r columns;
+        // G's entries Wᵀ W from the Gram matrix, by the support's and the terms' column slots.
+        let slot = |a: usize| of_dof[dofs[a]].expect("computed") as usize;
+        let mut row_of = vec![usize::MAX; dofs.len()];
+        let mut support = Vec::new();
+        for &(a, v) in &x {
+            if v != 0.0 && row_of[a] == usize::MAX {
+                row_of[a] = support.len();
+                support.push(slot(a));
+            }
+        }
+        let u = support.len();
+        let mut h = vec![0.0; u * r];
+        for (t, ht) in h.chunks_exact_mut(u).enumerate() {
             for &(b, v) in term(t).iter().filter(|(_, v)| *v != 0.0) {
-                ht.iter_mut().zip(g.col(b).iter()).for_each(|(x, gb)| *x += v * gb);
+                let q = slot(b);
+                for (hi, &p) in ht.iter_mut().zip(&support) {
+                    *hi += v * if p >= q { gram[p][q] } else { gram[q][p] };
+                }
             }
         }
         let m = Mat::from_fn(r, r, |p, q| {
-            let gpq: f64 = term(p).iter().map(|&(a, v)| v * h[q * k + a]).sum();
+            let gpq: f64 = term(p).iter().filter(|(_, v)| *v != 0.0).map(|&(a, v)| v * h[q * u + row_of[a]]).sum();
             f64::from(u8::from(p == q)) + gpq * terms.lambdas[q]
         });
         // Each new term's column W v = Σ v_i W e_i, over the union of its dofs' columns' nodes.
