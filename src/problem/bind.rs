@@ -14,13 +14,19 @@ use crate::error::CaseError;
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::fem::mesh::{CellSize, Mesh};
 
-/// The dimension of the problem's mesh: its generator's, or the file's (read here). `params`
-/// are the problem's, for a file name that names them (`"ball_{level}.msh"`).
-pub fn dimension(pf: &ProblemFile, mesh_file: Option<&Path>, params: &[(String, f64)]) -> Result<usize, CaseError> {
+/// The dimension of the problem's mesh: its generator's, or the file's (read here, and
+/// returned for [`mesh`]). `params` are the problem's, for a file name that names them
+/// (`"ball_{level}.msh"`).
+pub fn dimension(
+    pf: &ProblemFile,
+    mesh_file: Option<&Path>,
+    params: &[(String, f64)],
+) -> Result<(usize, Option<ReadMesh>), CaseError> {
     let value = |name: &str| params.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
     match (&pf.problem().mesh[0], mesh_file) {
         (MeshSource::Generator(call), Some(path)) => {
-            let d = read(path)?.dim();
+            let mesh = read(path)?;
+            let d = mesh.dim();
             let g = crate::compiler::check::problem::GENERATORS.iter().find(|g| g.name == call.name.name);
             match g {
                 Some(g) if g.dim != d => Err(CaseError::Option(format!(
@@ -30,15 +36,36 @@ pub fn dimension(pf: &ProblemFile, mesh_file: Option<&Path>, params: &[(String, 
                     g.name,
                     path.display()
                 ))),
-                _ => Ok(d),
+                _ => Ok((d, Some(ReadMesh { path: path.to_path_buf(), mesh }))),
             }
         }
-        (_, Some(path)) => Ok(read(path)?.dim()),
+        (_, Some(path)) => {
+            let mesh = read(path)?;
+            Ok((mesh.dim(), Some(ReadMesh { path: path.to_path_buf(), mesh })))
+        }
         (MeshSource::Generator(call), None) => {
             let g = crate::compiler::check::problem::GENERATORS.iter().find(|g| g.name == call.name.name);
-            Ok(g.map_or(0, |g| g.dim))
+            Ok((g.map_or(0, |g| g.dim), None))
         }
-        (MeshSource::File { path, span }, None) => Ok(read_own(pf, &fill(pf, path, *span, &value)?, *span)?.dim()),
+        (MeshSource::File { path, span }, None) => {
+            let path = fill(pf, path, *span, &value)?;
+            let mesh = read_own(pf, &path, *span)?;
+            Ok((mesh.dim(), Some(ReadMesh { path: path.into(), mesh })))
+        }
+    }
+}
+
+/// A mesh file [`dimension`] read, handed to [`mesh`] so that the file is read (and its
+/// warnings shown) once: `path` as given (a problem's own file: relative to it).
+pub struct ReadMesh {
+    path: std::path::PathBuf,
+    mesh: Mesh,
+}
+
+impl ReadMesh {
+    /// The mesh, if it was read from `path`.
+    fn of(read: &mut Option<ReadMesh>, path: &Path) -> Option<Mesh> {
+        read.take_if(|r| r.path == path).map(|r| r.mesh)
     }
 }
 
@@ -92,22 +119,34 @@ fn fill(
     Ok(out)
 }
 
-/// The mesh: `mesh_file` (`--mesh`) or the problem's, with the problem's regions, validated.
-/// The label says what it is in summaries.
+/// The mesh: `mesh_file` (`--mesh`) or the problem's, with the problem's regions, validated;
+/// `read_already` if it is that file ([`dimension`]'s read). The label says what it is in
+/// summaries.
 pub fn mesh(
     pf: &ProblemFile,
     ex: &mut Exprs,
     mesh_file: Option<&Path>,
     cell_size: CellSize,
+    mut read_already: Option<ReadMesh>,
 ) -> Result<(Mesh, String), CaseError> {
     let p = pf.problem();
     let name = pf.name();
     let d = ex.dim();
     let (mut mesh, label) = match (&p.mesh[0], mesh_file) {
-        (_, Some(path)) => (read(path)?, path.display().to_string()),
+        (_, Some(path)) => {
+            let mesh = match ReadMesh::of(&mut read_already, path) {
+                Some(mesh) => mesh,
+                None => read(path)?,
+            };
+            (mesh, path.display().to_string())
+        }
         (MeshSource::File { path, span }, None) => {
             let path = fill(pf, path, *span, &|name| ex.constant(name))?;
-            (read_own(pf, &path, *span)?, pf.dir.join(&path).display().to_string())
+            let mesh = match ReadMesh::of(&mut read_already, Path::new(&path)) {
+                Some(mesh) => mesh,
+                None => read_own(pf, &path, *span)?,
+            };
+            (mesh, pf.dir.join(&path).display().to_string())
         }
         (MeshSource::Generator(call), None) => generate(pf, ex, call)?,
     };

@@ -14,12 +14,12 @@ use crate::runtime::fem::mesh::CellSize;
 /// checked and bound: the mesh, the regions with their facets, the unknowns, the files in use.
 pub fn check(problem: &str) -> Result<String, CaseError> {
     let opts = Options::new(problem);
-    bound(&opts, |pf, _, ex, in_use| {
+    bound(&opts, |pf, _, ex, in_use, read_mesh| {
         let p = pf.problem();
         reference(pf, ex.dim())?;
         super::bind::settings(pf, ex, &p.run)?;
         super::bind::settings(pf, ex, &p.quadrature)?;
-        let (mesh, label) = super::bind::mesh(pf, ex, None, CellSize::Diameter)?;
+        let (mesh, label) = super::bind::mesh(pf, ex, None, CellSize::Diameter, read_mesh)?;
         super::bind::coefs(pf, ex)?;
         super::bind::coef_vals(pf, ex)?;
         super::bind::initial(pf, ex, &mesh, "u", 0.0)?;
@@ -66,5 +66,5 @@ pub fn check(problem: &str) -> Result<String, CaseError> {
 pub fn params_in_use(
     opts: &Options,
 ) -> Result<std::collections::BTreeMap<String, crate::driver::ParamValue>, CaseError> {
-    bound(opts, |_, _, _, in_use| Ok(in_use.forms.params.values()))
+    bound(opts, |_, _, _, in_use, _| Ok(in_use.forms.params.values()))
 }

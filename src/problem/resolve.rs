@@ -3,7 +3,7 @@
 //! files' defaults, the user's over them), and the checks the driver needs before it binds.
 
 use super::ProblemFile;
-use super::bind::unset_coefs;
+use super::bind::{ReadMesh, unset_coefs};
 use super::expr::Exprs;
 use super::options::{Chosen, Options};
 use crate::driver::{FilesInUse, Methods};
@@ -11,10 +11,10 @@ use crate::error::CaseError;
 
 /// Loads the problem, resolves its params and the files in use (the problem's `set` values as
 /// the case's overrides, the user's settings over them), checks what the driver needs of it,
-/// and hands the bound pieces to `f`.
+/// and hands the bound pieces to `f`, with the mesh file read to learn the dimension.
 pub(super) fn bound<R>(
     opts: &Options,
-    f: impl FnOnce(&ProblemFile, &[super::ProblemParam], &mut Exprs, &FilesInUse) -> Result<R, CaseError>,
+    f: impl FnOnce(&ProblemFile, &[super::ProblemParam], &mut Exprs, &FilesInUse, Option<ReadMesh>) -> Result<R, CaseError>,
 ) -> Result<R, CaseError> {
     let pf = super::load(&opts.problem)?;
     let (params, rest) = super::params(&pf, &opts.methods.params)?;
@@ -22,7 +22,7 @@ pub(super) fn bound<R>(
     bind_files(&pf, &mut methods, opts.chosen);
     methods.generated.extend(super::neumann::forms(&pf));
     let values: Vec<(String, f64)> = params.iter().map(|p| (p.name.clone(), p.value)).collect();
-    let d = super::bind::dimension(&pf, opts.mesh.as_deref(), &values)?;
+    let (d, read_mesh) = super::bind::dimension(&pf, opts.mesh.as_deref(), &values)?;
     let p = pf.problem();
     let mut ex = Exprs::new(&pf.program.unit, d, &values, &p.lets).map_err(|e| pf.render(*e))?;
     let mut sets = Vec::new();
@@ -45,7 +45,7 @@ pub(super) fn bound<R>(
     };
     let in_use = FilesInUse::resolve_located(&methods, &overrides, &locate)?;
     unset_coefs(&pf, &in_use)?;
-    f(&pf, &params, &mut ex, &in_use)
+    f(&pf, &params, &mut ex, &in_use, read_mesh)
 }
 
 /// The problem's `bind` lines, for the roles the user did not choose; a path is relative to the

@@ -41,7 +41,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     if let Some(options) = &opts.petsc_options {
         crate::runtime::linalg::set_petsc_options(options).map_err(|e| CaseError::Option(e.to_string()))?;
     }
-    bound(opts, |pf, params, ex, in_use| {
+    bound(opts, |pf, params, ex, in_use, read_mesh| {
         if pf.problem().run_static.is_some() {
             if opts.dt.is_some() || opts.t_end.is_some() || opts.t_start.is_some() {
                 return Err(CaseError::Option(format!(
@@ -50,7 +50,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
                 )));
             }
             let times = Times { dt: f64::NAN, t_start: 0.0, t_end: 0.0 };
-            return simulate(opts, pf, params, ex, in_use, &times);
+            return simulate(opts, pf, params, ex, in_use, &times, read_mesh);
         }
         let given = super::bind::settings(pf, ex, &pf.problem().run)?;
         let setting = |name: &str, over: Option<f64>, default: f64| {
@@ -71,7 +71,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         if !(times.t_start >= 0.0 && times.t_start < times.t_end) {
             return Err(CaseError::Option(format!("--t-start must be in [0, t_end), not {}", times.t_start)));
         }
-        simulate(opts, pf, params, ex, in_use, &times)
+        simulate(opts, pf, params, ex, in_use, &times, read_mesh)
     })
 }
 
@@ -82,11 +82,12 @@ fn simulate(
     ex: &mut Exprs,
     in_use: &FilesInUse,
     times: &Times,
+    read_mesh: Option<super::bind::ReadMesh>,
 ) -> Result<Run, CaseError> {
     let clock = Instant::now();
     let writes = crate::runtime::linalg::ranks::writes();
     let req = Request { opts, pf, params, in_use, times, writes };
-    let (mesh, mesh_label) = super::bind::mesh(pf, ex, opts.mesh.as_deref(), opts.cell_size)?;
+    let (mesh, mesh_label) = super::bind::mesh(pf, ex, opts.mesh.as_deref(), opts.cell_size, read_mesh)?;
     // Under mpirun each process assembles the cells around the nodes it owns, where it can.
     let ownership = match split(opts, pf, in_use)? {
         true => crate::runtime::linalg::ownership::Ownership::of(&mesh).map_err(mpi)?,
