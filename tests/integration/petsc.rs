@@ -134,6 +134,24 @@ fn a_static_stiffness_turns_to_multigrid_unless_the_user_chose() {
     let _ = std::fs::remove_dir_all(&tmp);
 }
 
+/// A factorization through PETSc (`-ksp_type preonly`) is the solve itself: it is set up
+/// again for every new tangent, never kept like a Krylov method's preconditioner (kept, the
+/// Hertz ball's second Newton iteration solved with its first tangent and failed).
+#[test]
+fn a_factorization_through_petsc_is_never_kept_for_a_new_tangent() {
+    let tmp = std::env::temp_dir().join(format!("signorini-petsc-preonly-{}", std::process::id()));
+    let args = ["hertz_ball", "--param", "level=0"];
+    series(&args, "direct", &tmp.join("direct"));
+    let with: Vec<&str> = [&args[..], &["--petsc-options", "-ksp_type preonly -pc_type lu"]].concat();
+    series(&with, "petsc", &tmp.join("petsc"));
+    let (direct, petsc) = (read_summary(&tmp.join("direct")), read_summary(&tmp.join("petsc")));
+    for key in ["contact_radius", "peak_pressure", "contact_force"] {
+        let (d, p) = (direct[key].as_f64().expect(key), petsc[key].as_f64().expect(key));
+        assert!((d - p).abs() <= 1e-10 * d.abs(), "{key}: {p} against {d}");
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}
+
 #[test]
 fn bad_petsc_options_are_an_error_with_petscs_message() {
     let out = Command::new(BIN)

@@ -232,6 +232,9 @@ pub struct PetscSolver {
     /// The preconditioner is still the first choice, block Jacobi, and may become GAMG (see
     /// [`ONE_LEVEL_LIMIT`]); false once it has, or when the user chose one (`-pc_type`).
     adaptive: bool,
+    /// The KSP applies its preconditioner once (`-ksp_type preonly`, a factorization through
+    /// PETSc): the preconditioner is the solve, so it is never kept for new values.
+    preonly: bool,
     /// Krylov iterations of the last solve.
     pub iterations: usize,
     /// Preconditioners set up so far.
@@ -397,6 +400,11 @@ impl PetscSolver {
         // `-ksp_rtol` given by the user stands, otherwise each solve's is Newton's; `-pc_type`
         // given by the user is kept.
         let (user_rtol, user_pc) = (given(c"-ksp_rtol")?, given(c"-pc_type")?);
+        let mut kind: *const c_char = std::ptr::null();
+        // SAFETY: a valid KSP; the type string is PETSc's own, read here only.
+        call("KSPGetType", unsafe { sys::KSPGetType(ksp.0, &mut kind) })?;
+        // SAFETY: PETSc returns a NUL-terminated name (or null before a type is set).
+        let preonly = !kind.is_null() && unsafe { CStr::from_ptr(kind) } == c"preonly";
         let split = match layout {
             Some(layout) => {
                 let (mut gather, mut all) = (OwnedScatter(std::ptr::null_mut()), OwnedVec(std::ptr::null_mut()));
@@ -422,6 +430,7 @@ impl PetscSolver {
             tolerances,
             user_rtol,
             adaptive: !user_pc,
+            preonly,
             iterations: 0,
             setups: 0,
         };
@@ -472,11 +481,12 @@ impl PetscSolver {
     }
 
     /// Whether the next solve keeps the preconditioner it has (the Krylov method always applies
-    /// the matrix's current values).
+    /// the matrix's current values; with `preonly` there is none, and it is never kept).
     fn reuse(&mut self, keep: bool) -> Result<(), LinalgError> {
         if !keep {
             (self.baseline, self.stale) = (None, false);
         }
+        let keep = keep && !self.preonly;
         // SAFETY: a valid KSP; the flag only decides whether KSPSolve sets the PC up again.
         call("KSPSetReusePreconditioner", unsafe { sys::KSPSetReusePreconditioner(self.ksp.0, keep.into()) })
     }

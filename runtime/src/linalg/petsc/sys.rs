@@ -154,6 +154,7 @@ unsafe extern "C" {
     pub fn KSPCreate(comm: MPI_Comm, ksp: *mut KSP) -> PetscErrorCode;
     pub fn KSPSetOperators(ksp: KSP, a: Mat, p: Mat) -> PetscErrorCode;
     pub fn KSPSetType(ksp: KSP, kind: *const c_char) -> PetscErrorCode;
+    pub fn KSPGetType(ksp: KSP, kind: *mut *const c_char) -> PetscErrorCode;
     pub fn KSPGetPC(ksp: KSP, pc: *mut PC) -> PetscErrorCode;
     pub fn PCSetType(pc: PC, kind: *const c_char) -> PetscErrorCode;
     pub fn PCSetFromOptions(pc: PC) -> PetscErrorCode;
