@@ -11,7 +11,7 @@ use signorini_descriptors::{CoefInfo, ParamError, ParamInfo, SchemeDesc, SlotInf
 use crate::fem::assembly::{Functional, Kernel, Quadrature};
 use crate::fem::bound::{Bound, BoundForm, BoundFunctional, BoundValue};
 use crate::fem::kernel::{Coef, FormMeta};
-use crate::fem::mesh::Facet;
+use crate::fem::mesh::{Body, Facet};
 use crate::time::scheme::TimeScheme;
 
 /// What a form file's forms are bound to: the quadrature, and the mesh facets of every boundary
@@ -21,6 +21,25 @@ pub struct Binding<'m> {
     pub regions: Vec<(String, &'m [Facet])>,
     /// The space dimension (coef sizes are checked against it).
     pub dim: usize,
+    /// The cells of the forms' volume integrals, if not all (a body's: per cell, whether it is
+    /// one).
+    pub cells: Option<&'m [bool]>,
+    /// The mesh's bodies, when it has several: the files' forms are then bound to each body
+    /// with its own param values ([`Binding::body`]) and summed.
+    pub bodies: &'m [Body],
+}
+
+impl<'m> Binding<'m> {
+    /// A binding of the whole mesh (one body) to `regions`.
+    pub fn new(quadrature: Quadrature, regions: Vec<(String, &'m [Facet])>, dim: usize) -> Self {
+        Binding { quadrature, regions, dim, cells: None, bodies: &[] }
+    }
+
+    /// This binding cut to `body`: its cells, and the facets they carry.
+    pub fn body(&self, body: &'m Body) -> Binding<'m> {
+        let regions = self.regions.clone();
+        Binding { quadrature: self.quadrature, regions, dim: self.dim, cells: Some(&body.cells), bodies: &[] }
+    }
 }
 
 /// A form or functional bound to a mesh.
@@ -160,7 +179,7 @@ impl<'m> Binding<'m> {
         let meta = kernel.meta();
         self.tangent_space(meta)?;
         let regions = self.regions_of(&meta.name, &meta.facets, &meta.facet_sites)?;
-        Ok(SlotForm::Form(Box::new(Bound { kernel, quadrature: self.quadrature, regions })))
+        Ok(SlotForm::Form(Box::new(Bound { kernel, quadrature: self.quadrature, regions, cells: self.cells })))
     }
 
     /// A functional kernel bound to this mesh.
@@ -168,7 +187,8 @@ impl<'m> Binding<'m> {
         let meta = kernel.meta();
         self.tangent_space(meta)?;
         let regions = self.regions_of(&meta.name, &meta.facets, &meta.facet_sites)?;
-        Ok(SlotForm::Functional(Box::new(BoundValue { kernel, quadrature: self.quadrature, regions })))
+        let cells = self.cells;
+        Ok(SlotForm::Functional(Box::new(BoundValue { kernel, quadrature: self.quadrature, regions, cells })))
     }
 }
 
@@ -184,7 +204,7 @@ mod tests {
 
     #[test]
     fn an_unknown_region_is_reported_at_its_source_with_a_suggestion() {
-        let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 2 };
+        let binding = Binding::new(Quadrature::default(), vec![("Gamma_C".into(), &[])], 2);
         let Err(e) = binding.regions_of("contact", &[("Gamma_c", [1, 2])], &["contact.wf:3:26"]) else {
             panic!("bound an unknown region");
         };

@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use crate::forms::elasticity::{Coefficients, Mass, Params, Stiffness};
 use crate::resources::median;
-use crate::runtime::fem::assembly::{Assembler, Quadrature};
+use crate::runtime::fem::assembly::{Assembler, CellIntegral, Quadrature};
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::fem::mesh::structured::{self, Diagonal};
 use crate::runtime::linalg::{Factorization, Structure};
@@ -107,11 +107,23 @@ pub fn assemble(sizes: &[usize], factor_n: Option<usize>, repeats: usize, progre
                 for _ in 0..repeats {
                     kmat.values.iter_mut().for_each(|v| *v = 0.0);
                     let t = Instant::now();
-                    asm.cell_tangent(&k, Quadrature { cell: Some(2), facet: None }, &[&zero], 0, 0.0, &mut kmat);
+                    asm.cell_tangent(
+                        CellIntegral::all(&k, Quadrature { cell: Some(2), facet: None }),
+                        &[&zero],
+                        0,
+                        0.0,
+                        &mut kmat,
+                    );
                     tk.push(t.elapsed().as_secs_f64());
                     mmat.values.iter_mut().for_each(|v| *v = 0.0);
                     let t = Instant::now();
-                    asm.cell_tangent(&m, Quadrature { cell: Some(4), facet: None }, &[&zero], 0, 0.0, &mut mmat);
+                    asm.cell_tangent(
+                        CellIntegral::all(&m, Quadrature { cell: Some(4), facet: None }),
+                        &[&zero],
+                        0,
+                        0.0,
+                        &mut mmat,
+                    );
                     tm.push(t.elapsed().as_secs_f64());
                 }
                 (median(tk), median(tm), kmat)
@@ -158,8 +170,8 @@ pub fn assemble(sizes: &[usize], factor_n: Option<usize>, repeats: usize, progre
         let zero = vec![0.0; asm.size()];
         let mut a = asm.zero_matrix();
         let mut mmat = asm.zero_matrix();
-        asm.cell_tangent(&k, Quadrature { cell: Some(2), facet: None }, &[&zero], 0, 0.0, &mut a);
-        asm.cell_tangent(&m, Quadrature { cell: Some(4), facet: None }, &[&zero], 0, 0.0, &mut mmat);
+        asm.cell_tangent(CellIntegral::all(&k, Quadrature { cell: Some(2), facet: None }), &[&zero], 0, 0.0, &mut a);
+        asm.cell_tangent(CellIntegral::all(&m, Quadrature { cell: Some(4), facet: None }), &[&zero], 0, 0.0, &mut mmat);
         let (beta, dt) = (0.25, 1e-3);
         a.add_scaled(1.0 / (beta * dt * dt), &mmat);
         let (mut ts, mut tn, mut tsol) = (Vec::new(), Vec::new(), Vec::new());
@@ -238,8 +250,7 @@ fn material_timings(n: usize, repeats: usize, progress: &mut dyn FnMut(&str)) ->
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a thread pool");
     let mut out = Vec::new();
     for &degree in &bench.assemble_degrees {
-        let binding =
-            Binding { quadrature: Quadrature { cell: Some(degree), facet: None }, regions: Vec::new(), dim: 2 };
+        let binding = Binding::new(Quadrature { cell: Some(degree), facet: None }, Vec::new(), 2);
         // Made in the one-thread pool: a bound form is not shared between threads.
         let timed = pool.install(|| {
             let made = (forms.make)(&values, &coefs, &binding).map_err(|e| e.to_string())?;

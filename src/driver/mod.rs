@@ -337,6 +337,9 @@ pub struct FormsInUse {
     /// Index of the contact law in `units`.
     pub contact: usize,
     pub params: params::Table,
+    /// The params of each body of a problem with several, by the body's name: its `set` values
+    /// over the problem's, the user's settings over both.
+    pub bodies: Vec<(String, params::Table)>,
 }
 
 impl FilesInUse {
@@ -358,7 +361,37 @@ impl FilesInUse {
         let mut table = params::Table::new(Some(&scheme), &units, contact);
         apply_overrides(&mut table, overrides, locate)?;
         table.apply_user(&methods.params)?;
-        Ok(FilesInUse { scheme, forms: FormsInUse { units, contact, params: table }, guard: methods.guard })
+        let forms = FormsInUse { units, contact, params: table, bodies: Vec::new() };
+        Ok(FilesInUse { scheme, forms, guard: methods.guard })
+    }
+
+    /// The params of each body (its name, and its `set` values as overrides): the files'
+    /// defaults, the problem's `overrides`, the body's, then the user's settings. A body's
+    /// values reach the form files' params; a scheme's param is the problem's (an error).
+    pub fn set_bodies(
+        &mut self,
+        methods: &Methods,
+        overrides: &[(&str, f64)],
+        bodies: &[(String, Vec<(&str, f64)>)],
+        locate: &dyn Fn(&str, &params::Unmatched) -> CaseError,
+    ) -> Result<(), CaseError> {
+        let (units, contact) = (&self.forms.units, self.forms.contact);
+        let mut tables = Vec::new();
+        for (name, own) in bodies {
+            for (index, (param, _)) in own.iter().enumerate() {
+                if self.forms.params.is_scheme_param(param) {
+                    let why = params::Unnamed::SchemeParam(self.scheme_name().to_string());
+                    return Err(locate(name, &params::Unmatched { index, name: param.to_string(), why }));
+                }
+            }
+            let mut table = params::Table::new(Some(&self.scheme), units, contact);
+            apply_overrides(&mut table, overrides, &unlocated)?;
+            apply_overrides(&mut table, own, &|a| locate(name, a))?;
+            table.apply_user(&methods.params)?;
+            tables.push((name.clone(), table));
+        }
+        self.forms.bodies = tables;
+        Ok(())
     }
 
     /// The form files of a run's methods and their params, without a scheme.
@@ -367,7 +400,7 @@ impl FilesInUse {
         let mut table = params::Table::new(None, &units, contact);
         apply_overrides(&mut table, overrides, &unlocated)?;
         table.apply_user(&methods.params)?;
-        Ok(FormsInUse { units, contact, params: table })
+        Ok(FormsInUse { units, contact, params: table, bodies: Vec::new() })
     }
 
     /// The scheme with its param values.
@@ -511,15 +544,34 @@ impl FormsInUse {
         self.units[self.contact].name()
     }
 
-    /// Every form and functional of the files in use, bound to a mesh.
+    /// Every form and functional of the files in use, bound to a mesh: to each of its bodies
+    /// with the body's params, and summed over them, when it has several.
     pub fn instantiate<'m>(
         &self,
         coefs: &dyn Fn(&str) -> Option<Coef>,
         binding: &Binding<'m>,
     ) -> Result<Instance<'m>, CaseError> {
+        if binding.bodies.is_empty() {
+            return self.instantiate_with(&self.params, coefs, binding);
+        }
+        let mut each = Vec::new();
+        for body in binding.bodies {
+            let params = self.bodies.iter().find(|(name, _)| *name == body.name).map_or(&self.params, |(_, t)| t);
+            each.push(self.instantiate_with(params, coefs, &binding.body(body))?);
+        }
+        Ok(Instance::over_bodies(each))
+    }
+
+    /// The files' forms with the param values of `params`.
+    fn instantiate_with<'m>(
+        &self,
+        params: &params::Table,
+        coefs: &dyn Fn(&str) -> Option<Coef>,
+        binding: &Binding<'m>,
+    ) -> Result<Instance<'m>, CaseError> {
         let mut slots: Vec<(String, SlotForm<'m>, String)> = Vec::new();
         for unit in &self.units {
-            let values = self.params.unit_values(unit.params());
+            let values = params.unit_values(unit.params());
             let made = unit.make(&values, coefs, binding).map_err(|e| {
                 let hint = match &e {
                     crate::runtime::library::LibraryError::MissingCoef { name, .. } => provided_coefs(coefs, name),
@@ -598,6 +650,35 @@ pub struct Instance<'m> {
 }
 
 impl<'m> Instance<'m> {
+    /// The instances of one set of files on each of several bodies, each slot summed over them
+    /// (every body's instance has the same slots, in the same order).
+    fn over_bodies(each: Vec<Instance<'m>>) -> Instance<'m> {
+        let mut slots: Vec<(String, Vec<SlotForm<'m>>, String)> = Vec::new();
+        for instance in each {
+            for (k, (name, form, file)) in instance.slots.into_iter().enumerate() {
+                match slots.get_mut(k) {
+                    Some((_, parts, _)) => parts.push(form),
+                    None => slots.push((name, vec![form], file)),
+                }
+            }
+        }
+        let summed = |parts: Vec<SlotForm<'m>>| {
+            let (mut forms, mut functionals) = (Vec::new(), Vec::new());
+            for part in parts {
+                match part {
+                    SlotForm::Form(f) => forms.push(f),
+                    SlotForm::Functional(f) => functionals.push(f),
+                }
+            }
+            use crate::runtime::fem::summed::{Summed, SummedFunctional};
+            match forms.is_empty() {
+                false => SlotForm::Form(Box::new(Summed::over_bodies(forms))),
+                true => SlotForm::Functional(Box::new(SummedFunctional::over_bodies(functionals))),
+            }
+        };
+        Instance { slots: slots.into_iter().map(|(name, parts, file)| (name, summed(parts), file)).collect() }
+    }
+
     /// Takes the form of a slot (a functional or a missing slot: `None`).
     pub fn take_form(&mut self, name: &str) -> Option<Box<dyn BoundForm + 'm>> {
         let i = self.slots.iter().position(|(n, f, _)| *n == name && matches!(f, SlotForm::Form(_)))?;

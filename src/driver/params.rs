@@ -110,6 +110,8 @@ pub enum Unnamed {
     Several(Vec<String>),
     /// Its qualifier is no role and no file (of the library or in use): the closest.
     UnknownQualifier(Option<String>),
+    /// A body's value of a param of the scheme (named), which is the problem's.
+    SchemeParam(String),
 }
 
 impl Unmatched {
@@ -126,6 +128,10 @@ impl Unmatched {
                 self.name,
                 ROLES.join(", "),
                 closest.as_ref().map_or(String::new(), |c| format!("; did you mean `{c}`?"))
+            ),
+            Unnamed::SchemeParam(scheme) => format!(
+                "`{}` is a param of scheme `{scheme}`, which steps every body at once: set it at the problem's level",
+                self.name
             ),
         }
     }
@@ -315,6 +321,11 @@ impl Table {
         } else {
             e.info.name.to_string()
         }
+    }
+
+    /// Whether `name` answers to a param of the scheme.
+    pub fn is_scheme_param(&self, name: &str) -> bool {
+        self.answering(name).iter().any(|&i| self.entries[i].scheme)
     }
 
     /// The value of the one param `name` answers to (none if no file in use declares it; the

@@ -8,7 +8,7 @@ use super::ProblemFile;
 use super::expr::{At, Exprs, PointFn};
 use crate::compiler::Diagnostic;
 use crate::compiler::ir::lower::Val;
-use crate::compiler::syntax::ast::{Condition, Expr, MeshSource, NamedCall, RegionSource};
+use crate::compiler::syntax::ast::{Condition, Expr, MeshSource, RegionSource};
 use crate::driver::FilesInUse;
 use crate::error::CaseError;
 use crate::runtime::fem::kernel::Coef;
@@ -23,7 +23,14 @@ pub fn dimension(
     params: &[(String, f64)],
 ) -> Result<(usize, Option<ReadMesh>), CaseError> {
     let value = |name: &str| params.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
-    match (&pf.problem().mesh[0], mesh_file) {
+    let primary = super::bodies::primary(pf.problem()).ok_or_else(|| no_mesh(pf))?;
+    if mesh_file.is_some() && pf.problem().mesh.is_empty() {
+        return Err(CaseError::Option(format!(
+            "--mesh replaces a problem's `mesh` line, and problem `{}` has none: its bodies are placed by generators",
+            pf.name()
+        )));
+    }
+    match (&primary, mesh_file) {
         (MeshSource::Generator(call), Some(path)) => {
             let mesh = read(path)?;
             let d = mesh.dim();
@@ -53,6 +60,11 @@ pub fn dimension(
             Ok((mesh.dim(), Some(ReadMesh { path: path.into(), mesh })))
         }
     }
+}
+
+/// A problem with no cells (the checker refuses it first).
+fn no_mesh(pf: &ProblemFile) -> CaseError {
+    CaseError::Option(format!("problem `{}` has no mesh", pf.name()))
 }
 
 /// A mesh file [`dimension`] read, handed to [`mesh`] so that the file is read (and its
@@ -132,7 +144,8 @@ pub fn mesh(
     let p = pf.problem();
     let name = pf.name();
     let d = ex.dim();
-    let (mut mesh, label) = match (&p.mesh[0], mesh_file) {
+    let primary = super::bodies::primary(p).ok_or_else(|| no_mesh(pf))?;
+    let (mut mesh, mut label) = match (&primary, mesh_file) {
         (_, Some(path)) => {
             let mesh = match ReadMesh::of(&mut read_already, path) {
                 Some(mesh) => mesh,
@@ -148,11 +161,12 @@ pub fn mesh(
             };
             (mesh, pf.dir.join(&path).display().to_string())
         }
-        (MeshSource::Generator(call), None) => generate(pf, ex, call)?,
+        (MeshSource::Generator(call), None) => super::generate::generate(pf, ex, call)?,
     };
-    if mesh_file.is_some() || matches!(p.mesh[0], MeshSource::File { .. }) {
+    if mesh_file.is_some() || matches!(primary, MeshSource::File { .. }) {
         crate::resources::check(name, (mesh.num_nodes() * mesh.dim()) as f64, mesh.dim(), None)?;
     }
+    let bodies = super::bodies::place(pf, ex, &mut mesh, &mut label)?;
     if mesh.dim() != d {
         return Err(CaseError::Option(format!("problem `{name}` is {d}D: {label} is {}D", mesh.dim())));
     }
@@ -163,6 +177,10 @@ pub fn mesh(
         for source in &r.sources {
             // A group the mesh has is the region, even empty (an error, not a fallback).
             if let Some(facets) = facets_of(pf, ex, &mesh, source, &r.name.name, &label)? {
+                let facets = match &r.body {
+                    Some(body) => super::bodies::cut(facets, &body.name, &bodies, mesh.num_cells()),
+                    None => facets,
+                };
                 found = !facets.is_empty();
                 if found || matches!(source, RegionSource::Group { .. }) {
                     mesh.regions.retain(|x| x.name != r.name.name);
@@ -195,6 +213,9 @@ pub fn mesh(
     mesh.validate()?;
     for r in &p.regions {
         mesh.region(&r.name.name)?;
+    }
+    if !bodies.is_empty() {
+        mesh.set_bodies(bodies);
     }
     Ok((mesh, label))
 }
@@ -278,103 +299,6 @@ fn predicate(
         });
         condition.holds(&mut holds)
     })
-}
-
-/// A built-in generator's mesh, after a check that it fits in memory; and its label, the
-/// arguments' values (`built-in disc(radius = 10, h = 1, centre = [0.0, 12.0])`).
-fn generate(pf: &ProblemFile, ex: &mut Exprs, call: &NamedCall) -> Result<(Mesh, String), CaseError> {
-    use crate::compiler::check::problem::Generator;
-    use crate::runtime::fem::mesh::{ball::ball, disc::disc, structured};
-    let generator = crate::compiler::check::problem::generator(call)
-        .map_err(|why| pf.render(Diagnostic::error("E0101", why, call.span, "not a generator this run knows")))?;
-    let mut values = Vec::new();
-    // A generator's numbers are constants: an expression of x or t is an error here.
-    let mut get = |ex: &mut Exprs, name: &str, e: Option<&Expr>, default: f64| -> Result<f64, CaseError> {
-        let v = match e {
-            Some(e) => ex.scalar(e).map_err(|d| pf.render(*d))?,
-            None => default,
-        };
-        values.push(format!("{name} = {v}"));
-        Ok(v)
-    };
-    let count = |name: &str, v: f64| -> Result<usize, CaseError> {
-        if (1.0..=1e7).contains(&v) && v.fract() == 0.0 {
-            Ok(v as usize)
-        } else {
-            Err(CaseError::Option(format!(
-                "{}: `{name}` must be a whole number of cells in [1, 10⁷], not {v}",
-                pf.file
-            )))
-        }
-    };
-    let positive = |name: &str, v: f64| -> Result<f64, CaseError> {
-        if v > 0.0 && v.is_finite() {
-            Ok(v)
-        } else {
-            Err(CaseError::Option(format!("{}: `{name}` must be positive, not {v}", pf.file)))
-        }
-    };
-    let vector = |ex: &mut Exprs, e: &Expr| ex.vector(e).map_err(|d| pf.render(*d));
-    let origin = |ex: &mut Exprs, e: Option<&Expr>, dim: usize| e.map_or(Ok(vec![0.0; dim]), |e| vector(ex, e));
-    let name = pf.name().to_string();
-    let mesh = match generator {
-        Generator::Interval { length, cells, start } => {
-            let (length, cells) = (get(ex, "length", Some(length), 0.0)?, get(ex, "cells", Some(cells), 0.0)?);
-            let start = get(ex, "start", start, 0.0)?;
-            let cells = count("cells", cells)?;
-            crate::resources::check(&name, cells as f64 + 1.0, 1, None)?;
-            structured::interval(cells, start, start + positive("length", length)?)
-        }
-        Generator::Disc { radius, centre, h } | Generator::Ball { radius, centre, h } => {
-            let radius = positive("radius", get(ex, "radius", Some(radius), 0.0)?)?;
-            let h = positive("h", get(ex, "h", Some(h), 0.0)?)?;
-            let centre = vector(ex, centre)?;
-            values.push(format!("centre = {centre:?}"));
-            if matches!(generator, Generator::Disc { .. }) {
-                // P2 nodes: 3m² vertices on m rings.
-                let dofs = 2.0 * 4.0 * 3.0 * (radius / h).ceil().powi(2);
-                crate::resources::check(&name, dofs, 2, Some(h))?;
-                disc(radius, [centre[0], centre[1]], h)
-            } else {
-                // P2 nodes: the (2n+1)³ lattice.
-                let dofs = 3.0 * (4.0 * (radius / h).round() + 1.0).powi(3);
-                crate::resources::check(&name, dofs, 3, Some(h))?;
-                ball(radius, [centre[0], centre[1], centre[2]], h)
-            }
-        }
-        Generator::Rectangle { width, height, nx, ny, degree, origin: at } => {
-            let w = positive("width", get(ex, "width", Some(width), 0.0)?)?;
-            let h = positive("height", get(ex, "height", Some(height), 0.0)?)?;
-            let (nx, ny) = (count("nx", get(ex, "nx", Some(nx), 0.0)?)?, count("ny", get(ex, "ny", Some(ny), 0.0)?)?);
-            let degree = if get(ex, "degree", degree, 1.0)? == 2.0 { 2 } else { 1 };
-            crate::resources::check(&name, 2.0 * ((degree * nx + 1) * (degree * ny + 1)) as f64, 2, None)?;
-            let o = origin(ex, at, 2)?;
-            values.push(format!("origin = {o:?}"));
-            structured::rectangle(
-                nx,
-                ny,
-                [o[0], o[0] + w],
-                [o[1], o[1] + h],
-                structured::Diagonal::Right,
-                degree as u32,
-            )
-        }
-        Generator::Box { size, nx, ny, nz, degree, origin: at } => {
-            let size = vector(ex, size)?;
-            let n = [
-                count("nx", get(ex, "nx", Some(nx), 0.0)?)?,
-                count("ny", get(ex, "ny", Some(ny), 0.0)?)?,
-                count("nz", get(ex, "nz", Some(nz), 0.0)?)?,
-            ];
-            let degree = if get(ex, "degree", degree, 1.0)? == 2.0 { 2 } else { 1 };
-            let nodes: usize = n.iter().map(|k| degree * k + 1).product();
-            crate::resources::check(&name, 3.0 * nodes as f64, 3, None)?;
-            let o = origin(ex, at, 3)?;
-            values.push(format!("origin = {o:?}"));
-            structured::cuboid(n, [o[0], o[0] + size[0]], [o[1], o[1] + size[1]], [o[2], o[2] + size[2]], degree as u32)
-        }
-    };
-    Ok((mesh, format!("built-in {}({})", call.name.name, values.join(", "))))
 }
 
 /// The coefs the problem sets, by name: its `coef` lines, then its obstacles' `g` and `nc`.
@@ -541,22 +465,34 @@ pub fn settings(
 }
 
 /// An initial field at the mesh's nodes at time `t0` (zeros if the problem gives none), with
-/// no negative zeros.
+/// no negative zeros; a body's own `initial` line holds at its nodes.
 pub fn initial(pf: &ProblemFile, ex: &mut Exprs, mesh: &Mesh, field: &str, t0: f64) -> Result<Vec<f64>, CaseError> {
     let d = mesh.dim();
     let mut values = vec![0.0; mesh.num_nodes() * d];
-    let Some(def) = pf.problem().initial.iter().find(|i| i.name.name == field) else { return Ok(values) };
-    // `settled(GUESS)`: the guess here; the run settles it (`settled`).
-    let value = match crate::compiler::check::problem::settled_guess(&def.value) {
-        Some([guess]) => guess,
-        _ => &def.value,
-    };
-    let v = ex.lower(value, &[]).map_err(|e| pf.render(*e))?;
-    let f = ex.function(&v, value).map_err(|e| pf.render(*e))?;
+    let p = pf.problem();
+    let of = |list: &[crate::compiler::syntax::ast::Defined]| list.iter().find(|i| i.name.name == field).cloned();
+    let mut defs: Vec<(Option<Vec<bool>>, Expr)> = Vec::new();
+    if let Some(def) = of(&p.initial) {
+        // `settled(GUESS)`: the guess here; the run settles it (`settled`).
+        let value = match crate::compiler::check::problem::settled_guess(&def.value) {
+            Some([guess]) => guess.clone(),
+            _ => def.value,
+        };
+        defs.push((None, value));
+    }
+    for body in &p.bodies {
+        if let (Some(def), Some(nodes)) = (of(&body.initial), mesh.body_nodes(&body.name.name)) {
+            defs.push((Some(nodes), def.value));
+        }
+    }
     let mut scratch = Vec::new();
-    for (i, out) in values.chunks_mut(d).enumerate() {
-        f.eval(&At { x: mesh.node(i), t: t0, ..At::default() }, &mut scratch, out);
-        out.iter_mut().for_each(|x| *x += 0.0);
+    for (nodes, value) in defs {
+        let v = ex.lower(&value, &[]).map_err(|e| pf.render(*e))?;
+        let f = ex.function(&v, &value).map_err(|e| pf.render(*e))?;
+        for (i, out) in values.chunks_mut(d).enumerate().filter(|(i, _)| nodes.as_ref().is_none_or(|n| n[*i])) {
+            f.eval(&At { x: mesh.node(i), t: t0, ..At::default() }, &mut scratch, out);
+            out.iter_mut().for_each(|x| *x += 0.0);
+        }
     }
     Ok(values)
 }

@@ -34,6 +34,15 @@ pub fn check(problem: &str) -> Result<String, CaseError> {
                 format!("{} ({n} facet{})", r.name.name, if n == 1 { "" } else { "s" })
             })
             .collect();
+        let bodies: Vec<String> = mesh
+            .bodies
+            .iter()
+            .map(|b| {
+                let n = b.cells.iter().filter(|&&c| c).count();
+                format!("{} ({n} cell{})", b.name, if n == 1 { "" } else { "s" })
+            })
+            .collect();
+        let bodies = if bodies.is_empty() { String::new() } else { format!("; bodies {}", bodies.join(", ")) };
         let forms = &in_use.forms;
         let files: Vec<String> = std::iter::once(format!("{} (scheme)", in_use.scheme_name()))
             .chain(forms.units.iter().enumerate().map(|(i, u)| {
@@ -48,7 +57,7 @@ pub fn check(problem: &str) -> Result<String, CaseError> {
             }))
             .collect();
         Ok(format!(
-            "{}: problem `{}` checked and bound: {}D mesh {label}, {} nodes, {} cells, {} unknowns; regions {}; files in use {}",
+            "{}: problem `{}` checked and bound: {}D mesh {label}, {} nodes, {} cells, {} unknowns{bodies}; regions {}; files in use {}",
             pf.file,
             pf.name(),
             mesh.dim(),

@@ -9,9 +9,11 @@
 //! the problem's own, [`outputs`] what a run writes and [`resume`] what its checkpoints keep.
 
 pub mod bind;
+mod bodies;
 mod check;
 mod dirichlet;
 pub mod expr;
+mod generate;
 mod neumann;
 pub mod observe;
 pub mod options;

@@ -30,22 +30,47 @@ pub(super) fn bound<R>(
         sets.push((s.name.name.clone(), ex.scalar(&s.value).map_err(|e| pf.render(*e))?));
     }
     let overrides: Vec<(&str, f64)> = sets.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    let locate = |a: &crate::driver::params::Unmatched| {
-        use crate::compiler::Diagnostic;
-        use crate::driver::params::Unnamed;
-        let name = &p.sets[a.index].name;
-        let span = name.span;
-        pf.render(match &a.why {
-            Unnamed::Several(choices) => crate::compiler::check::problem::ambiguous_param(name, choices),
-            Unnamed::UnknownQualifier(_) => {
-                Diagnostic::error("E0101", format!("unknown qualifier in `{}`", a.name), span, "no such role or file")
-                    .with_note(a.message())
+    let mut in_use = FilesInUse::resolve_located(&methods, &overrides, &|a| unmatched(&pf, &p.sets, a))?;
+    if !p.bodies.is_empty() {
+        let mut bodies = Vec::new();
+        for b in &p.bodies {
+            let mut own = Vec::new();
+            for s in &b.sets {
+                own.push((s.name.name.as_str(), ex.scalar(&s.value).map_err(|e| pf.render(*e))?));
             }
-        })
-    };
-    let in_use = FilesInUse::resolve_located(&methods, &overrides, &locate)?;
+            bodies.push((b.name.name.clone(), own));
+        }
+        let locate = |body: &str, a: &crate::driver::params::Unmatched| {
+            let sets = p.bodies.iter().find(|b| b.name.name == body).map_or(&[][..], |b| b.sets.as_slice());
+            unmatched(&pf, sets, a)
+        };
+        in_use.set_bodies(&methods, &overrides, &bodies, &locate)?;
+    }
     unset_coefs(&pf, &in_use)?;
     f(&pf, &params, &mut ex, &in_use, read_mesh)
+}
+
+/// A `set` (of `sets`) that names no one param, located at its name.
+fn unmatched(
+    pf: &ProblemFile,
+    sets: &[crate::compiler::syntax::ast::Defined],
+    a: &crate::driver::params::Unmatched,
+) -> CaseError {
+    use crate::compiler::Diagnostic;
+    use crate::driver::params::Unnamed;
+    let name = &sets[a.index].name;
+    let span = name.span;
+    pf.render(match &a.why {
+        Unnamed::Several(choices) => crate::compiler::check::problem::ambiguous_param(name, choices),
+        Unnamed::UnknownQualifier(_) => {
+            Diagnostic::error("E0101", format!("unknown qualifier in `{}`", a.name), span, "no such role or file")
+                .with_note(a.message())
+        }
+        Unnamed::SchemeParam(_) => {
+            Diagnostic::error("E0101", format!("`{}` is the scheme's", a.name), span, "not a param of a body")
+                .with_note(a.message())
+        }
+    })
 }
 
 /// The problem's `bind` lines, for the roles the user did not choose; a path is relative to the

@@ -245,9 +245,11 @@ impl Operators<'_> {
     }
 
     /// The mass-weighted mean along `axis` (of the displacement: the centre of mass's).
-    pub fn axis_mean(&self, axis: usize) -> AxisMean {
+    pub fn axis_mean(&self, axis: usize, nodes: Option<&[bool]>) -> AxisMean {
         let d = self.asm.mesh().dim();
-        let e: Vec<f64> = (0..self.mass.size()).map(|i| if i % d == axis { 1.0 } else { 0.0 }).collect();
+        // Bodies share no mass entry: M e over one body's nodes is its own mass.
+        let on = |i: usize| i % d == axis && nodes.is_none_or(|n| n[i / d]);
+        let e: Vec<f64> = (0..self.mass.size()).map(|i| if on(i) { 1.0 } else { 0.0 }).collect();
         let mut weights = vec![0.0; e.len()];
         self.mass.mul_vec(&e, &mut weights);
         let total = weights.iter().zip(&e).map(|(a, b)| a * b).sum();
@@ -298,7 +300,7 @@ impl<'m> Parts<'m> {
         for name in problem.regions {
             regions.push((name.clone(), asm.region(name)?));
         }
-        let binding = Binding { quadrature: problem.quadrature, regions, dim: mesh.dim() };
+        let binding = Binding { bodies: &mesh.bodies, ..Binding::new(problem.quadrature, regions, mesh.dim()) };
         let mut inst = in_use.forms.instantiate(problem.coefs, &binding)?;
         let mut forms: Vec<(String, Box<dyn BoundForm + 'm>)> =
             in_use.scheme_forms(&mut inst)?.into_iter().map(|(slot, f)| (slot.to_string(), f)).collect();

@@ -21,8 +21,8 @@ impl Snapshots {
         Snapshots { dir: out.filter(|_| every > 0).cloned(), every, name: name.to_string(), written: Vec::new() }
     }
 
-    /// The displacement and velocity at step `k`, and the cell-mean von Mises stress when the
-    /// files in use provide it. In a run split across processes each writes a piece (its cells),
+    /// The displacement and velocity at step `k`, the cell-mean von Mises stress when the files
+    /// in use provide it, and each cell's body. In a run split across processes each writes a piece (its cells),
     /// and rank 0 the PVTU file of the pieces: every process calls it, with the directory.
     pub fn write(&mut self, ops: &Operators, k: usize, t: f64, u: &[f64], v: &[f64]) -> Result<(), CaseError> {
         let Some(dir) = &self.dir else { return Ok(()) };
@@ -43,7 +43,13 @@ impl Snapshots {
             crate::vtu::Field { name: "velocity", components: d, values: v },
         ];
         let owned = ops.asm.owned_cells();
-        let cell = [crate::vtu::Field { name: "von_mises", components: 1, values: &vm[..owned] }];
+        // Each cell's body, numbered from 0 in the problem's order (0 for one body).
+        let body: Vec<f64> =
+            (0..owned).map(|c| mesh.bodies.iter().position(|b| b.cells[c]).unwrap_or(0) as f64).collect();
+        let cell = [
+            crate::vtu::Field { name: "von_mises", components: 1, values: &vm[..owned] },
+            crate::vtu::Field { name: "body", components: 1, values: &body },
+        ];
         let base = format!("{}_{k:06}", self.name);
         let written = |path: &std::path::Path| {
             let path = path.display().to_string();

@@ -66,8 +66,10 @@ pub fn solve<'m>(
     for name in problem.regions {
         regions.push((name.clone(), asm.region(name)?));
     }
-    let volume = Binding { quadrature: Quadrature::default(), regions: regions.clone(), dim: d };
-    let boundary = Binding { quadrature: Quadrature { cell: None, facet: problem.contact_degree }, regions, dim: d };
+    let bodies = &asm.mesh().bodies;
+    let volume = Binding { bodies, ..Binding::new(Quadrature::default(), regions.clone(), d) };
+    let boundary =
+        Binding { bodies, ..Binding::new(Quadrature { cell: None, facet: problem.contact_degree }, regions, d) };
     let missing = |what: &str| {
         CaseError::Option(format!("a static case needs a `{what}` form, which the files in use do not provide"))
     };

@@ -55,7 +55,7 @@ fn oscillator<R>(
         "nc" => Some(Coef::constant(vec![-1.0])),
         _ => None,
     };
-    let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
+    let binding = Binding::new(Quadrature::default(), vec![("Gamma_C".into(), &[])], 1);
     let mut inst = in_use.forms.instantiate(&coefs, &binding)?;
     // A scheme that applies the damping slot gets 2ζM there: ζ = 0 (undamped) unless asked.
     let slot = crate::settings::get().verify.damping_slot.as_str();

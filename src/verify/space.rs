@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use crate::error::CaseError;
 use crate::forms::elasticity;
-use crate::runtime::fem::assembly::{Assembler, Quadrature};
+use crate::runtime::fem::assembly::{Assembler, CellIntegral, Quadrature};
 use crate::runtime::fem::evaluate::errors;
 use crate::runtime::fem::kernel::Coef;
 use crate::runtime::fem::mesh::structured::{self, Diagonal};
@@ -59,9 +59,9 @@ fn solve(mesh: &Mesh, boundary: &[&str], nu: f64) -> Result<(f64, f64), CaseErro
     let degree = mesh.kind.degree();
     let quad = Quadrature { cell: Some(2 * degree + 2), facet: None };
     let mut k = asm.zero_matrix();
-    asm.cell_tangent(&elasticity::Stiffness::new(&p, &c), quad, &[&vec![0.0; n]], 0, 0.0, &mut k);
+    asm.cell_tangent(CellIntegral::all(&elasticity::Stiffness::new(&p, &c), quad), &[&vec![0.0; n]], 0, 0.0, &mut k);
     let mut b = vec![0.0; n];
-    asm.cell_residual(&elasticity::Load::new(&p, &c), quad, &[], 0.0, &mut b);
+    asm.cell_residual(CellIntegral::all(&elasticity::Load::new(&p, &c), quad), &[], 0.0, &mut b);
     let mut dirichlet = Constraints::none(n);
     let all: Vec<usize> = (0..d).collect();
     for region in boundary {

@@ -74,11 +74,7 @@ impl Noise {
 pub fn regimes(progress: &mut dyn FnMut(&str)) -> Result<Vec<RegimeRow>, CaseError> {
     let mesh = block();
     let region = mesh.region("Gamma_C").map_err(|e| CaseError::Option(e.to_string()))?;
-    let binding = Binding {
-        quadrature: Default::default(),
-        regions: vec![("Gamma_C".to_string(), region.facets.as_slice())],
-        dim: 2,
-    };
+    let binding = Binding::new(Default::default(), vec![("Gamma_C".to_string(), region.facets.as_slice())], 2);
     let coefs = |name: &str| match name {
         // With its derivatives, for a law that reads it at the displaced point.
         "g" => Some(Coef::function(1, |x, _, out| out[0] = x[1]).with_derivatives(|_, _, order, out| {

@@ -79,8 +79,9 @@ fn independent(contact: &dyn BoundForm, asm: &Assembler, rho: f64, steps: usize,
         form.tangent(asm, &[&vec![0.0; n]], 0, 0.0, &mut m);
         DMatrix::from_fn(n, n, |i, j| m.get(i, j))
     };
-    let mass = dense(&Bound { kernel: elasticity::Mass::new(&p, &c), quadrature: q, regions: vec![] });
-    let stiff = dense(&Bound { kernel: elasticity::Stiffness::new(&p, &c), quadrature: q, regions: vec![] });
+    let mass = dense(&Bound { kernel: elasticity::Mass::new(&p, &c), quadrature: q, regions: vec![], cells: None });
+    let stiff =
+        dense(&Bound { kernel: elasticity::Stiffness::new(&p, &c), quadrature: q, regions: vec![], cells: None });
     let fixed = n - 1; // u(1) = 0
     let c_res = |u: &DVector<f64>| {
         let mut r = vec![0.0; n];
@@ -161,12 +162,17 @@ fn by_path_compiled_and_independent_agree() {
         let contact: Box<dyn BoundForm> = if law == "penalty" {
             let c =
                 contact_penalty::Coefficients { f: Coef::constant(vec![0.0]), g: g(), nc: Coef::constant(vec![-1.0]) };
-            Box::new(Bound { kernel: contact_penalty::Contact::new(&Default::default(), &c), quadrature: q, regions })
+            Box::new(Bound {
+                kernel: contact_penalty::Contact::new(&Default::default(), &c),
+                quadrature: q,
+                regions,
+                cells: None,
+            })
         } else {
             let p = contact_nitsche::Params::default().with("theta", theta).unwrap();
             let c =
                 contact_nitsche::Coefficients { f: Coef::constant(vec![0.0]), g: g(), nc: Coef::constant(vec![-1.0]) };
-            Box::new(Bound { kernel: contact_nitsche::Contact::new(&p, &c), quadrature: q, regions })
+            Box::new(Bound { kernel: contact_nitsche::Contact::new(&p, &c), quadrature: q, regions, cells: None })
         };
         let reference = independent(contact.as_ref(), &asm, 0.8, steps, 0.01);
         let scale = reference.iter().fold(0.0f64, |m, x| m.max(x.abs()));

@@ -99,11 +99,8 @@ fn point_values_integrate_to_the_functional() {
     let forms = signorini::driver::FilesInUse::resolve_forms(&Methods::default(), &material).unwrap();
     let facets = asm.region("Gamma_C").unwrap();
     let degree = 7;
-    let binding = Binding {
-        quadrature: Quadrature { cell: None, facet: Some(degree) },
-        regions: vec![("Gamma_C".to_string(), facets)],
-        dim: 2,
-    };
+    let binding =
+        Binding::new(Quadrature { cell: None, facet: Some(degree) }, vec![("Gamma_C".to_string(), facets)], 2);
     let coefs = |name: &str| match name {
         "g" => Some(Coef::function(1, |x, _, out| out[0] = x[1])),
         "nc" => Some(Coef::constant(vec![0.0, -1.0])),

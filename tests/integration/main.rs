@@ -4,6 +4,7 @@
 mod assembly;
 mod bad_inputs;
 mod bar;
+mod bodies;
 mod case_files;
 mod checkpoint;
 mod cli;

@@ -75,7 +75,7 @@ fn record(scheme: &str, steps: usize) -> (Vec<(f64, f64)>, Vec<Step>) {
         "nc" => Some(Coef::constant(vec![-1.0])),
         _ => None,
     };
-    let binding = Binding { quadrature: Quadrature::default(), regions: vec![("Gamma_C".into(), &[])], dim: 1 };
+    let binding = Binding::new(Quadrature::default(), vec![("Gamma_C".into(), &[])], 1);
     let mut inst = in_use.forms.instantiate(&coefs, &binding).unwrap();
     let calls: Calls = Rc::default();
     let given: Vec<(&str, Box<dyn BoundForm>)> = vec![("contact", Box::new(Recorder(calls.clone())))];

@@ -2,7 +2,7 @@
 //! second moments are preserved to round-off, and the result is positive definite on the other
 //! dofs (1D P1 and the curved 2D P2 disc).
 
-use signorini::runtime::fem::assembly::{Assembler, Quadrature};
+use signorini::runtime::fem::assembly::{Assembler, CellIntegral, Quadrature};
 use signorini::runtime::fem::kernel::Coef;
 use signorini::runtime::fem::mesh::{Mesh, disc::disc, structured};
 use signorini::runtime::fem::redistribute::redistribute;
@@ -15,7 +15,13 @@ fn mass(mesh: &Mesh) -> (Assembler<'_>, Matrix) {
     let p = elasticity::Params::default();
     let c = elasticity::Coefficients { f: Coef::constant(vec![0.0; mesh.dim()]) };
     let mut m = asm.zero_matrix();
-    asm.cell_tangent(&elasticity::Mass::new(&p, &c), Quadrature::default(), &[&vec![0.0; asm.size()]], 0, 0.0, &mut m);
+    asm.cell_tangent(
+        CellIntegral::all(&elasticity::Mass::new(&p, &c), Quadrature::default()),
+        &[&vec![0.0; asm.size()]],
+        0,
+        0.0,
+        &mut m,
+    );
     (asm, m)
 }
 

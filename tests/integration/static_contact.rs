@@ -6,7 +6,7 @@
 use signorini::driver::{Methods, Setting};
 use signorini::forms::{contact_nitsche, elasticity};
 use signorini::problem::run::{Options, Run, run as run_problem};
-use signorini::runtime::fem::assembly::{Assembler, Quadrature};
+use signorini::runtime::fem::assembly::{Assembler, CellIntegral, Quadrature};
 use signorini::runtime::fem::bound::Bound;
 use signorini::runtime::fem::kernel::Coef;
 use signorini::runtime::fem::mesh::Facet;
@@ -186,8 +186,8 @@ fn elastic<'a>(asm: &Assembler) -> (Bound<'a, elasticity::Stiffness>, Vec<f64>) 
     let c = elasticity::Coefficients { f: Coef::constant(vec![0.0, -1.0]) };
     let q = Quadrature::default();
     let mut load = vec![0.0; asm.size()];
-    asm.cell_residual(&elasticity::Load::new(&p, &c), q, &[], 0.0, &mut load);
-    (Bound { kernel: elasticity::Stiffness::new(&p, &c), quadrature: q, regions: vec![] }, load)
+    asm.cell_residual(CellIntegral::all(&elasticity::Load::new(&p, &c), q), &[], 0.0, &mut load);
+    (Bound { kernel: elasticity::Stiffness::new(&p, &c), quadrature: q, regions: vec![], cells: None }, load)
 }
 
 /// Nitsche contact (θ = 1, γ0 = 5000, E = 100) with the obstacle below at gap `g`.
@@ -203,5 +203,6 @@ fn nitsche_contact(
         kernel: contact_nitsche::Contact::new(&p, &c),
         quadrature,
         regions: vec![("Gamma_C".into(), facets)],
+        cells: None,
     })
 }

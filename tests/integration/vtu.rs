@@ -45,7 +45,10 @@ fn snapshots_read_back_with_vtkio() {
             names(&piece.data.point),
             vec![("displacement".into(), 3 * mesh.num_nodes()), ("velocity".into(), 3 * mesh.num_nodes())]
         );
-        assert_eq!(names(&piece.data.cell), vec![("von_mises".into(), mesh.num_cells())]);
+        assert_eq!(
+            names(&piece.data.cell),
+            vec![("von_mises".into(), mesh.num_cells()), ("body".into(), mesh.num_cells())]
+        );
         // Free fall: the displacement is uniform, −½ g t² vertically.
         let Attribute::DataArray(u) = &piece.data.point[0] else { unreachable!() };
         let values: Vec<f64> = u.data.clone().cast_into::<f64>().unwrap();

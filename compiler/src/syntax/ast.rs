@@ -362,7 +362,33 @@ impl RegionSource {
 pub struct RegionDecl {
     pub name: Ident,
     pub sources: Vec<RegionSource>,
+    /// Declared in a body: the region is on that body's facets only (`boundary` is its
+    /// boundary).
+    pub body: Option<Ident>,
     pub span: Span,
+}
+
+/// `body NAME = group "g" { ... }` or `body NAME = GENERATOR(...) { ... }`: a part of the
+/// problem's cells with param values and initial fields of its own (its regions are in
+/// `Problem::regions`, with their body).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    pub name: Ident,
+    pub source: BodySource,
+    /// `set` in the body: its values of the files' params, over the problem's.
+    pub sets: Vec<Defined>,
+    /// `initial u = ...`, `initial v = ...` in the body: at its nodes, over the problem's.
+    pub initial: Vec<Defined>,
+    pub span: Span,
+}
+
+/// Where a body's cells come from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BodySource {
+    /// A physical group of cells of the problem's mesh file.
+    Group { name: String, span: Span },
+    /// A generator's mesh, placed beside the other bodies'.
+    Generator(NamedCall),
 }
 
 /// A file bound to a role of the run: `scheme = hybrid`, `contact = "my_law.wf"`.
@@ -455,6 +481,8 @@ pub struct Problem {
     pub name: Ident,
     pub params: Vec<SchemeParam>,
     pub mesh: Vec<MeshSource>,
+    /// The bodies, when the problem has more than one part (none: its mesh is one body).
+    pub bodies: Vec<Body>,
     pub regions: Vec<RegionDecl>,
     pub binds: Vec<Bind>,
     /// Param values of the scheme and form files (`set E = 50`).

@@ -167,9 +167,20 @@ fn problem(p: &Problem, out: &mut String) {
         let params: Vec<&str> = f.params.iter().map(|a| a.name.as_str()).collect();
         out.push_str(&format!("  fn {}({}) = {}\n", f.name.name, params.join(", "), expr(&f.body)));
     }
+    for b in &p.bodies {
+        let source = match &b.source {
+            BodySource::Group { name, .. } => format!("group {name:?}"),
+            BodySource::Generator(c) => named_call(c),
+        };
+        out.push_str(&format!("  body {} = {source}\n", b.name.name));
+        for d in b.sets.iter().map(|d| ("set", d)).chain(b.initial.iter().map(|d| ("initial", d))) {
+            out.push_str(&format!("    {} {} = {}\n", d.0, d.1.name.name, expr(&d.1.value)));
+        }
+    }
     for r in &p.regions {
         let sources: Vec<String> = r.sources.iter().map(region_source).collect();
-        out.push_str(&format!("  region {} = {}\n", r.name.name, sources.join(" else ")));
+        let body = r.body.as_ref().map_or(String::new(), |b| format!(" (in body {})", b.name));
+        out.push_str(&format!("  region {} = {}{body}\n", r.name.name, sources.join(" else ")));
     }
     for b in &p.binds {
         let target = if b.is_path { format!("{:?}", b.target) } else { b.target.clone() };

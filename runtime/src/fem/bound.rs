@@ -2,7 +2,7 @@
 //! facets of the boundary regions it integrates over, behind object-safe traits so that the
 //! forms of one scheme or problem may differ in type.
 
-use crate::fem::assembly::{Assembler, FacetIntegral, Functional, Kernel, PointValue, Quadrature};
+use crate::fem::assembly::{Assembler, CellIntegral, FacetIntegral, Functional, Kernel, PointValue, Quadrature};
 use crate::fem::mesh::Facet;
 use crate::fem::quadrature::Rule;
 use crate::linalg::Matrix;
@@ -69,12 +69,20 @@ pub struct Bound<'m, K: Kernel> {
     pub quadrature: Quadrature,
     /// For each boundary region of the form (by its name in the .wf file), the mesh facets.
     pub regions: Vec<(String, &'m [Facet])>,
+    /// The cells of its volume integral, if not all of them (a body's: per cell, whether it is
+    /// one).
+    pub cells: Option<&'m [bool]>,
 }
 
 impl<K: Kernel> Bound<'_, K> {
     /// The form's integral over `region` on `facets`.
     fn on<'a>(&'a self, region: &'a str, facets: &'a [Facet]) -> FacetIntegral<'a, K> {
-        FacetIntegral { kernel: &self.kernel, region, facets, quadrature: self.quadrature }
+        FacetIntegral { kernel: &self.kernel, region, facets, quadrature: self.quadrature, cells: self.cells }
+    }
+
+    /// Its volume integral.
+    fn over_cells(&self) -> CellIntegral<'_, K> {
+        CellIntegral { kernel: &self.kernel, quadrature: self.quadrature, cells: self.cells }
     }
 }
 
@@ -96,7 +104,7 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
     }
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {
         if self.kernel.meta().cell_degree.is_some() {
-            asm.cell_residual(&self.kernel, self.quadrature, fields, t, out);
+            asm.cell_residual(self.over_cells(), fields, t, out);
         }
         for (region, facets) in &self.regions {
             asm.facet_residual(self.on(region, facets), fields, t, out);
@@ -104,7 +112,7 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
     }
     fn tangent(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
         if self.kernel.meta().cell_degree.is_some() {
-            asm.cell_tangent(&self.kernel, self.quadrature, fields, wrt, t, m);
+            asm.cell_tangent(self.over_cells(), fields, wrt, t, m);
         }
         for (region, facets) in &self.regions {
             asm.facet_tangent(self.on(region, facets), fields, wrt, t, m);
@@ -124,7 +132,8 @@ impl<K: Kernel> BoundForm for Bound<'_, K> {
         if self.kernel.meta().cell_degree.is_some() {
             return None;
         }
-        Some(self.regions.iter().flat_map(|(_, facets)| facets.iter().map(|f| f.cell)).collect())
+        let mine = |c: &u32| self.cells.is_none_or(|cells| cells[*c as usize]);
+        Some(self.regions.iter().flat_map(|(_, facets)| facets.iter().map(|f| f.cell)).filter(mine).collect())
     }
     fn tangent_elements(
         &self,
@@ -201,6 +210,18 @@ pub struct BoundValue<'m, K: Functional> {
     pub kernel: K,
     pub quadrature: Quadrature,
     pub regions: Vec<(String, &'m [Facet])>,
+    /// As [`Bound::cells`].
+    pub cells: Option<&'m [bool]>,
+}
+
+impl<K: Functional> BoundValue<'_, K> {
+    fn on<'a>(&'a self, region: &'a str, facets: &'a [Facet]) -> FacetIntegral<'a, K> {
+        FacetIntegral { kernel: &self.kernel, region, facets, quadrature: self.quadrature, cells: self.cells }
+    }
+
+    fn over_cells(&self) -> CellIntegral<'_, K> {
+        CellIntegral { kernel: &self.kernel, quadrature: self.quadrature, cells: self.cells }
+    }
 }
 
 impl<K: Functional> BoundFunctional for BoundValue<'_, K> {
@@ -213,21 +234,20 @@ impl<K: Functional> BoundFunctional for BoundValue<'_, K> {
     fn value(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> f64 {
         let mut v = 0.0;
         if self.kernel.meta().cell_degree.is_some() {
-            v += asm.cell_value(&self.kernel, self.quadrature, fields, t);
+            v += asm.cell_value(self.over_cells(), fields, t);
         }
         for (region, facets) in &self.regions {
-            let on = FacetIntegral { kernel: &self.kernel, region, facets, quadrature: self.quadrature };
-            v += asm.facet_value(on, fields, t);
+            v += asm.facet_value(self.on(region, facets), fields, t);
         }
         v
     }
     fn cell_values(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> Vec<f64> {
-        asm.cell_values(&self.kernel, self.quadrature, fields, t)
+        asm.cell_values(self.over_cells(), fields, t)
     }
     fn facet_point_values(&self, asm: &Assembler, rule: &Rule, fields: &[&[f64]], t: f64) -> Vec<PointValue> {
         let mut out = Vec::new();
         for (region, facets) in &self.regions {
-            out.extend(asm.facet_point_values(&self.kernel, region, facets, rule, fields, t));
+            out.extend(asm.facet_point_values(self.on(region, facets), rule, fields, t));
         }
         out
     }

@@ -5,7 +5,7 @@
 //! of a mesh (a run split across processes) assembles its rows whole.
 
 use crate::common::{MassStiffness, pseudo_random};
-use signorini_runtime::fem::assembly::{Assembler, CellOrder, Quadrature};
+use signorini_runtime::fem::assembly::{Assembler, CellIntegral, CellOrder, Quadrature};
 use signorini_runtime::fem::mesh::Mesh;
 use signorini_runtime::fem::mesh::ball::ball;
 use signorini_runtime::fem::mesh::structured::{Diagonal, cuboid, interval, rectangle};
@@ -36,9 +36,21 @@ fn mass_and_stiffness_on_every_element_kind() {
         let n = asm.size();
         let zero = vec![0.0; n];
         let mut m = asm.zero_matrix();
-        asm.cell_tangent(&MassStiffness { rho: 2.0, k: 0.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut m);
+        asm.cell_tangent(
+            CellIntegral::all(&MassStiffness { rho: 2.0, k: 0.0 }, Quadrature::default()),
+            &[&zero],
+            0,
+            0.0,
+            &mut m,
+        );
         let mut k = asm.zero_matrix();
-        asm.cell_tangent(&MassStiffness { rho: 0.0, k: 1.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut k);
+        asm.cell_tangent(
+            CellIntegral::all(&MassStiffness { rho: 0.0, k: 1.0 }, Quadrature::default()),
+            &[&zero],
+            0,
+            0.0,
+            &mut k,
+        );
         assert!(m.is_symmetric(1e-14) && k.is_symmetric(1e-14), "{name}");
         for a in 0..d {
             // The unit field of component a: mass ρ|Ω|, no strain energy.
@@ -54,10 +66,10 @@ fn mass_and_stiffness_on_every_element_kind() {
         // A linear form's residual is its tangent times the field.
         let form = MassStiffness { rho: 1.5, k: 0.7 };
         let mut t = asm.zero_matrix();
-        asm.cell_tangent(&form, Quadrature::default(), &[&zero], 0, 0.0, &mut t);
+        asm.cell_tangent(CellIntegral::all(&form, Quadrature::default()), &[&zero], 0, 0.0, &mut t);
         let u = pseudo_random(n, 7);
         let mut r = vec![0.0; n];
-        asm.cell_residual(&form, Quadrature::default(), &[&u], 0.0, &mut r);
+        asm.cell_residual(CellIntegral::all(&form, Quadrature::default()), &[&u], 0.0, &mut r);
         let mut tu = vec![0.0; n];
         t.mul_vec(&u, &mut tu);
         let scale = tu.iter().fold(0.0f64, |s, x| s.max(x.abs()));
@@ -73,7 +85,7 @@ fn the_curved_ball_has_the_mass_of_its_volume() {
     let mut m = asm.zero_matrix();
     // Degree 6: the curved cells' Jacobians are polynomials of degree 6 in the reference cell.
     let q = Quadrature { cell: Some(6), facet: None };
-    asm.cell_tangent(&MassStiffness { rho: 1.0, k: 0.0 }, q, &[&vec![0.0; n]], 0, 0.0, &mut m);
+    asm.cell_tangent(CellIntegral::all(&MassStiffness { rho: 1.0, k: 0.0 }, q), &[&vec![0.0; n]], 0, 0.0, &mut m);
     let e: Vec<f64> = (0..n).map(|i| if i % 3 == 0 { 1.0 } else { 0.0 }).collect();
     let volume = 4.0 / 3.0 * std::f64::consts::PI;
     assert!((quad(&m, &e, &e) - mesh.measure()).abs() < 1e-12 * volume);
@@ -121,9 +133,9 @@ fn threaded_assembly_has_the_same_bits_on_one_and_two_threads() {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a pool");
         pool.install(|| {
             let mut m = asm.zero_matrix();
-            asm.cell_tangent(&form, Quadrature::default(), &[&u], 0, 0.0, &mut m);
+            asm.cell_tangent(CellIntegral::all(&form, Quadrature::default()), &[&u], 0, 0.0, &mut m);
             let mut r = vec![0.0; n];
-            asm.cell_residual(&form, Quadrature::default(), &[&u], 0.0, &mut r);
+            asm.cell_residual(CellIntegral::all(&form, Quadrature::default()), &[&u], 0.0, &mut r);
             (m.values, r)
         })
     };
@@ -157,8 +169,8 @@ fn each_process_part_holds_its_rows_whole_and_the_parts_own_every_cell_once() {
         let form = MassStiffness { rho: 1.5, k: 0.7 };
         let u = pseudo_random(n, 11);
         let (mut m, mut r) = (whole.zero_matrix(), vec![0.0; n]);
-        whole.cell_tangent(&form, Quadrature::default(), &[&u], 0, 0.0, &mut m);
-        whole.cell_residual(&form, Quadrature::default(), &[&u], 0.0, &mut r);
+        whole.cell_tangent(CellIntegral::all(&form, Quadrature::default()), &[&u], 0, 0.0, &mut m);
+        whole.cell_residual(CellIntegral::all(&form, Quadrature::default()), &[&u], 0.0, &mut r);
         let mut mu = vec![0.0; n];
         m.mul_vec(&u, &mut mu);
         let scale = r.iter().chain(&mu).fold(0.0f64, |s, x| s.max(x.abs()));
@@ -183,8 +195,8 @@ fn each_process_part_holds_its_rows_whole_and_the_parts_own_every_cell_once() {
             // Assembled on the part alone, the rows of its nodes are the whole mesh's.
             let asm = Assembler::new(&part);
             let (mut mp, mut rp) = (asm.zero_matrix(), vec![0.0; n]);
-            asm.cell_tangent(&form, Quadrature::default(), &[&u], 0, 0.0, &mut mp);
-            asm.cell_residual(&form, Quadrature::default(), &[&u], 0.0, &mut rp);
+            asm.cell_tangent(CellIntegral::all(&form, Quadrature::default()), &[&u], 0, 0.0, &mut mp);
+            asm.cell_residual(CellIntegral::all(&form, Quadrature::default()), &[&u], 0.0, &mut rp);
             let mut mpu = vec![0.0; n];
             mp.mul_vec(&u, &mut mpu);
             let d = mesh.dim();

@@ -6,7 +6,7 @@
 //! changes are solved by a low-rank correction of the factorization or by refactoring.
 
 use crate::common::{MassStiffness, pseudo_random};
-use signorini_runtime::fem::assembly::{Assembler, Quadrature};
+use signorini_runtime::fem::assembly::{Assembler, CellIntegral, Quadrature};
 use signorini_runtime::fem::mesh::structured::interval;
 use signorini_runtime::linalg::{Counters, Matrix, Solver, Structure};
 use signorini_runtime::nonlinear::newton::{Newton, NewtonOptions};
@@ -134,10 +134,21 @@ fn solve_on(
     let n = asm.size();
     let zero = vec![0.0; n];
     let mut k = asm.zero_matrix();
-    asm.cell_tangent(&MassStiffness { rho: 0.0, k: 1.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut k);
+    asm.cell_tangent(
+        CellIntegral::all(&MassStiffness { rho: 0.0, k: 1.0 }, Quadrature::default()),
+        &[&zero],
+        0,
+        0.0,
+        &mut k,
+    );
     // F = M (−8): a uniform load pushing the membrane down (alone it would reach −1).
     let mut f = vec![0.0; n];
-    asm.cell_residual(&MassStiffness { rho: 1.0, k: 0.0 }, Quadrature::default(), &[&vec![-8.0; n]], 0.0, &mut f);
+    asm.cell_residual(
+        CellIntegral::all(&MassStiffness { rho: 1.0, k: 0.0 }, Quadrature::default()),
+        &[&vec![-8.0; n]],
+        0.0,
+        &mut f,
+    );
     let mut constraints = Constraints::none(n);
     constraints.fix(0);
     constraints.fix(n_el);
@@ -269,8 +280,20 @@ fn an_inertial_right_hand_side_does_not_set_the_stopping_scale() {
     let zero = vec![0.0; n];
     let c = 1e15;
     let (mut m, mut k) = (asm.zero_matrix(), asm.zero_matrix());
-    asm.cell_tangent(&MassStiffness { rho: 1.0, k: 0.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut m);
-    asm.cell_tangent(&MassStiffness { rho: 0.0, k: 1.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut k);
+    asm.cell_tangent(
+        CellIntegral::all(&MassStiffness { rho: 1.0, k: 0.0 }, Quadrature::default()),
+        &[&zero],
+        0,
+        0.0,
+        &mut m,
+    );
+    asm.cell_tangent(
+        CellIntegral::all(&MassStiffness { rho: 0.0, k: 1.0 }, Quadrature::default()),
+        &[&zero],
+        0,
+        0.0,
+        &mut k,
+    );
     let mut a = k.clone();
     a.add_scaled(c, &m);
     // A rough predictor w̃ (so K w̃ is not small) and a unit load.

@@ -5,7 +5,7 @@
 //! correction of a factorization solves the changed matrix.
 
 use crate::common::{MassStiffness, pseudo_random};
-use signorini_runtime::fem::assembly::{Assembler, Quadrature};
+use signorini_runtime::fem::assembly::{Assembler, CellIntegral, Quadrature};
 use signorini_runtime::fem::mesh::Mesh;
 use signorini_runtime::fem::mesh::structured::{Diagonal, cuboid, interval, rectangle};
 use signorini_runtime::linalg::lowrank::LowRank;
@@ -32,7 +32,13 @@ pub(crate) fn step_matrix(mesh: &Mesh) -> Matrix {
     let asm = Assembler::new(mesh);
     let zero = vec![0.0; asm.size()];
     let mut a = asm.zero_matrix();
-    asm.cell_tangent(&MassStiffness { rho: 400.0, k: 1.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut a);
+    asm.cell_tangent(
+        CellIntegral::all(&MassStiffness { rho: 400.0, k: 1.0 }, Quadrature::default()),
+        &[&zero],
+        0,
+        0.0,
+        &mut a,
+    );
     let d = mesh.dim();
     let scale = (0..asm.size()).map(|i| a.get(i, i)).fold(0.0, f64::max);
     let n: Vec<f64> = (0..d).map(|k| 1.0 + k as f64).collect();
@@ -197,7 +203,13 @@ fn a_stalled_solve_gives_up_with_its_cause() {
     let asm = Assembler::new(&mesh);
     let zero = vec![0.0; asm.size()];
     let mut k = asm.zero_matrix();
-    asm.cell_tangent(&MassStiffness { rho: 1e-9, k: 1.0 }, Quadrature::default(), &[&zero], 0, 0.0, &mut k);
+    asm.cell_tangent(
+        CellIntegral::all(&MassStiffness { rho: 1e-9, k: 1.0 }, Quadrature::default()),
+        &[&zero],
+        0,
+        0.0,
+        &mut k,
+    );
     let mut f = Factorization::new(Structure::SymmetricPositiveDefinite).with_solver(Solver::Iterative);
     f.factor(&k).expect("the preconditioner's blocks invert");
     let mut x = pseudo_random(k.size(), 5);

@@ -140,7 +140,12 @@ fn stepper_with<'a>(
     more: Vec<(&'static str, Box<dyn BoundForm>)>,
 ) -> Stepper<'a> {
     let bound = |rho, k| -> Box<dyn BoundForm> {
-        Box::new(Bound { kernel: MassStiffness { rho, k }, quadrature: Quadrature::default(), regions: Vec::new() })
+        Box::new(Bound {
+            kernel: MassStiffness { rho, k },
+            quadrature: Quadrature::default(),
+            regions: Vec::new(),
+            cells: None,
+        })
     };
     let mut forms = vec![("mass", bound(3.0, 0.0)), ("stiffness", bound(0.0, 1.0))];
     forms.extend(more);

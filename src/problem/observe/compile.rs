@@ -302,7 +302,7 @@ impl Compiling<'_, '_, '_> {
     }
 }
 
-/// `mean(u[k])`, `nodal_mean(u[k])` and `at_min(u[k], KEY)`.
+/// `mean(u[k])`, `nodal_mean(u[k])` (over a body: `mean(u[k], BODY)`) and `at_min(u[k], KEY)`.
 fn pointwise_reducer(c: &mut Compiling, kind: R, args: &[Expr]) -> Result<Measure, CaseError> {
     let d = c.ops.asm.mesh().dim();
     let ExprKind::Index(f, k) = &args[0].kind else { unreachable!("checked: u[k] or v[k]") };
@@ -312,9 +312,14 @@ fn pointwise_reducer(c: &mut Compiling, kind: R, args: &[Expr]) -> Result<Measur
         let why = format!("component {axis} of a field in a {d}D problem");
         return Err(c.pf.render(Diagnostic::error("E0302", "wrong dimension", args[0].span, why)));
     }
+    // A body's name, checked: the mesh has its nodes.
+    let nodes = match args.get(1).map(|a| &a.kind) {
+        Some(ExprKind::Name(body)) if kind != R::AtMin => c.ops.asm.mesh().body_nodes(&body.name),
+        _ => None,
+    };
     Ok(match kind {
-        R::Mean => Measure::Mean { field, weights: c.ops.axis_mean(axis) },
-        R::NodalMean => Measure::NodalMean { field, axis },
+        R::Mean => Measure::Mean { field, weights: c.ops.axis_mean(axis, nodes.as_deref()) },
+        R::NodalMean => Measure::NodalMean { field, axis, nodes },
         _ => {
             let val = c.ex.lower(&args[1], &[]).map_err(|e| c.pf.render(*e))?;
             let key = c.ex.function(&val, &args[1]).map_err(|e| c.pf.render(*e))?;

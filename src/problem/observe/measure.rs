@@ -134,9 +134,14 @@ impl Observer<'_> {
             Measure::StatusKept => f64::from(u8::from(self.last_switches.borrow().as_ref() == Some(&r.switches))),
             Measure::Column(i) => r.columns[*i],
             Measure::Mean { field, weights, .. } => r.field(*field).map_or(f64::NAN, |x| weights.of(x)),
-            Measure::NodalMean { field, axis } => {
+            Measure::NodalMean { field, axis, nodes: None } => {
                 r.field(*field).map_or(f64::NAN, |x| x.iter().skip(*axis).step_by(d).sum::<f64>() / (n / d) as f64)
             }
+            Measure::NodalMean { field, axis, nodes: Some(nodes) } => r.field(*field).map_or(f64::NAN, |x| {
+                let mine = x.iter().skip(*axis).step_by(d).zip(nodes).filter(|(_, m)| **m);
+                let (sum, count) = mine.fold((0.0, 0usize), |(s, k), (v, _)| (s + v, k + 1));
+                sum / count as f64
+            }),
             Measure::AtMin { field: 1, axis, node, massless: true } if s.before.is_some() => {
                 let (before, dt) = s.before.expect("a step");
                 let i = d * node + axis;

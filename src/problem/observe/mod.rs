@@ -39,6 +39,8 @@ enum Measure {
     NodalMean {
         field: u8,
         axis: usize,
+        /// A body's nodes (all nodes: none).
+        nodes: Option<Vec<bool>>,
     },
     AtMin {
         field: u8,

@@ -320,7 +320,8 @@ impl<'m> Observing<'m> {
         for name in bound.others {
             regions.push((name.clone(), asm.region(name)?));
         }
-        let binding = Binding { quadrature: bound.quadrature, regions, dim: asm.mesh().dim() };
+        let binding =
+            Binding { bodies: &asm.mesh().bodies, ..Binding::new(bound.quadrature, regions, asm.mesh().dim()) };
         let reference = bound_reference(pf, ex, in_use, asm.mesh(), ops.contact_facets, t0)?;
         let sources = Sources {
             ops,

@@ -153,10 +153,15 @@ pub const ROW_REDUCERS: &[RowReducerInfo] = {
         r(
             Mean,
             "mean",
-            "mean(u[k])",
-            "mass-weighted mean of a component of u or v over the body (the centre of mass's)",
+            "mean(u[k][, BODY])",
+            "mass-weighted mean of a component of u or v over the bodies, or over one (the centre of mass's)",
         ),
-        r(NodalMean, "nodal_mean", "nodal_mean(u[k])", "plain mean of a component of u or v over the nodes"),
+        r(
+            NodalMean,
+            "nodal_mean",
+            "nodal_mean(u[k][, BODY])",
+            "plain mean of a component of u or v over the nodes (of a body)",
+        ),
         r(AtMin, "at_min", "at_min(u[k], EXPR)", "a component of u or v at the node where EXPR (of x) is least"),
         r(
             Force,

@@ -8,7 +8,7 @@ use std::collections::HashMap;
 
 use crate::diagnostic::Diagnostic;
 use crate::source::Span;
-use crate::syntax::ast::{Condition, Expr, ExprKind, HeldAt, MeshSource, Problem, ProblemFn, RegionSource};
+use crate::syntax::ast::{BodySource, Condition, Expr, ExprKind, HeldAt, MeshSource, Problem, ProblemFn, RegionSource};
 
 /// Calls nested deeper than this are taken for a recursion.
 const MAX_DEPTH: usize = 32;
@@ -133,6 +133,12 @@ fn exprs_mut(p: &mut Problem) -> Vec<&mut Expr> {
         if let MeshSource::Generator(call) = m {
             out.extend(call.args.iter_mut().map(|a| &mut a.value));
         }
+    }
+    for b in &mut p.bodies {
+        if let BodySource::Generator(call) = &mut b.source {
+            out.extend(call.args.iter_mut().map(|a| &mut a.value));
+        }
+        out.extend(b.sets.iter_mut().chain(&mut b.initial).map(|d| &mut d.value));
     }
     for r in &mut p.regions {
         for s in &mut r.sources {

@@ -12,6 +12,7 @@ pub(super) struct RowScope<'a> {
     pub(super) constants: &'a [(String, Shape)],
     pub(super) pointwise: &'a [(String, Shape)],
     pub(super) regions: &'a [&'a str],
+    pub(super) bodies: &'a [&'a str],
     pub(super) earlier: &'a [&'a str],
 }
 
@@ -104,7 +105,20 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
             }
         }
         Some(R::Mean | R::NodalMean) => {
-            if arity(1, diags) {
+            // mean(u[k]) over every body, mean(u[k], BODY) over one.
+            if args.len() == 2 {
+                match &args[1].kind {
+                    K::Name(id) if s.bodies.contains(&id.name.as_str()) => {}
+                    K::Name(id) => diags.push(unknown_among(id, s.bodies.iter().copied(), "body")),
+                    _ => diags.push(Diagnostic::error(
+                        "E0301",
+                        "shape mismatch",
+                        args[1].span,
+                        "a body's name is needed here",
+                    )),
+                }
+                component(&args[0], diags);
+            } else if arity(1, diags) {
                 component(&args[0], diags);
             }
         }

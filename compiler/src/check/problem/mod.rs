@@ -8,6 +8,7 @@
 //! `catalogue` is the vocabulary a problem may use, `measures` the checks of its series and
 //! summary.
 
+mod bodies;
 mod catalogue;
 mod fns;
 mod measures;
@@ -33,6 +34,7 @@ type Names = [(String, Shape)];
 pub(in crate::check) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) {
     let constants = params_and_lets(c, p, diags);
     mesh(c, p, &constants, diags);
+    bodies::check(c, p, &constants, diags);
     region_predicates(c, p, &constants, diags);
     bindings(p, diags);
     settings_of_the_run(c, p, &constants, diags);
@@ -41,12 +43,27 @@ pub(in crate::check) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diag
     for d in &p.coefs {
         expression(c, &d.value, fields, diags, false);
     }
-    distinct(p.initial.iter().map(|d| &d.name), "initial field", diags);
-    for d in &p.initial {
+    initial_fields(c, &p.initial, fields, true, diags);
+    let regions: Vec<&str> = p.regions.iter().map(|r| r.name.name.as_str()).collect();
+    dirichlet(c, p, fields, &regions, diags);
+    neumann(c, p, fields, &regions, diags);
+    obstacles(c, p, fields, &regions, diags);
+    measures(c, p, &constants, &regions, diags);
+}
+
+/// `initial u = ...`, `initial v = ...`: known fields, each once, vectors of `x` and `t`; the
+/// displacement may be `settled(GUESS)` where `settles` (the problem's, not a body's).
+fn initial_fields(c: &mut Checker, list: &[Defined], fields: &Names, settles: bool, diags: &mut Vec<Diagnostic>) {
+    distinct(list.iter().map(|d| &d.name), "initial field", diags);
+    for d in list {
         if !INITIAL_FIELDS.contains(&d.name.name.as_str()) {
             diags.push(unknown_among(&d.name, INITIAL_FIELDS.iter().copied(), "initial field"));
         }
         match catalogue::settled_guess(&d.value) {
+            Some(_) if !settles => diags.push(
+                Diagnostic::error("E0301", "a body's displacement does not settle alone", d.value.span, "in a body")
+                    .with_help("write `initial u = settled(GUESS)` at the problem's level: the bodies settle together"),
+            ),
             Some([guess]) if d.name.name == "u" => vector(c, guess, fields, diags),
             Some(args) if d.name.name == "u" => diags.push(
                 Diagnostic::error(
@@ -64,11 +81,6 @@ pub(in crate::check) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diag
             None => vector(c, &d.value, fields, diags),
         }
     }
-    let regions: Vec<&str> = p.regions.iter().map(|r| r.name.name.as_str()).collect();
-    dirichlet(c, p, fields, &regions, diags);
-    neumann(c, p, fields, &regions, diags);
-    obstacles(c, p, fields, &regions, diags);
-    measures(c, p, &constants, &regions, diags);
 }
 
 /// The params (constants with a default in their range, as a scheme's) and the lets, in order,
@@ -98,9 +110,12 @@ fn params_and_lets(c: &mut Checker, p: &Problem, diags: &mut Vec<Diagnostic>) ->
     names
 }
 
-/// One mesh: a file, or a known generator with its arguments.
+/// One mesh: a file, or a known generator with its arguments (or none, when every body is a
+/// generator's).
 fn mesh(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut Vec<Diagnostic>) {
     match p.mesh.as_slice() {
+        // A body that is a group needs a file: the bodies' check says so.
+        [] if !p.bodies.is_empty() => {}
         [] => diags.push(
             Diagnostic::error("E0901", format!("problem `{}` has no mesh", p.name.name), p.name.span, "no `mesh` line")
                 .with_help("add `mesh \"body.msh\"` (a Gmsh file beside the problem) or a generator such as `mesh disc(radius = 10, centre = [0, 12], h = 1)`"),
@@ -336,8 +351,9 @@ fn measures(c: &mut Checker, p: &Problem, constants: &Names, regions: &[&str], d
         pointwise.extend([("g".to_string(), Scalar), ("nc".to_string(), Vector)]);
     }
     let mut earlier: Vec<&str> = Vec::new();
+    let bodies: Vec<&str> = p.bodies.iter().map(|b| b.name.name.as_str()).collect();
     for (d, _) in &p.series {
-        let scope = RowScope { constants, pointwise: &pointwise, regions, earlier: &earlier };
+        let scope = RowScope { constants, pointwise: &pointwise, regions, bodies: &bodies, earlier: &earlier };
         row(c, &d.value, &scope, diags);
         earlier.push(&d.name.name);
     }
@@ -508,7 +524,12 @@ pub fn unknown_among<'a>(id: &Ident, known: impl Iterator<Item = &'a str> + Clon
     if list.is_empty() {
         return d.with_note(format!("there is no {what}"));
     }
-    d.with_note(format!("the {what}s: {}", list.join(", ")))
+    // `body` → `bodies`, `key` → `keys`.
+    let plural = match what.strip_suffix('y') {
+        Some(stem) if !stem.ends_with(['a', 'e', 'i', 'o', 'u']) => format!("{stem}ies"),
+        _ => format!("{what}s"),
+    };
+    d.with_note(format!("the {plural}: {}", list.join(", ")))
 }
 
 /// W0004: coef `name` of a problem is read by none of `files` (the files of the run).

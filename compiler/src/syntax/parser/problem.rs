@@ -21,6 +21,7 @@ impl Builder {
             name: self.ident(name),
             params: Vec::new(),
             mesh: Vec::new(),
+            bodies: Vec::new(),
             regions: Vec::new(),
             binds: Vec::new(),
             sets: Vec::new(),
@@ -44,6 +45,10 @@ impl Builder {
             span,
         };
         for p in rest {
+            if p.as_rule() == Rule::region_decl {
+                pb.regions.push(self.region(p, None)?);
+                continue;
+            }
             let span = self.span(&p);
             let rule = p.as_rule();
             let mut it = p.into_inner();
@@ -57,10 +62,30 @@ impl Builder {
                         _ => MeshSource::Generator(self.named_call(q)?),
                     });
                 }
-                Rule::region_decl => {
+                Rule::body_decl => {
+                    next(); // the word `body`
                     let name = self.ident(next());
-                    let sources = it.map(|q| self.region_source(q)).collect::<Result<Vec<_>, _>>()?;
-                    pb.regions.push(RegionDecl { name, sources, span });
+                    let q = next();
+                    let source = match q.as_rule() {
+                        Rule::body_group => {
+                            let g = q.into_inner().next().expect("group name");
+                            BodySource::Group { name: unquote(g.as_str()), span: self.span(&g) }
+                        }
+                        _ => BodySource::Generator(self.named_call(q)?),
+                    };
+                    let mut body = Body { name, source, sets: Vec::new(), initial: Vec::new(), span };
+                    for q in it {
+                        let span = self.span(&q);
+                        match q.as_rule() {
+                            Rule::region_decl => pb.regions.push(self.region(q, Some(body.name.clone()))?),
+                            Rule::set_decl => body.sets.extend(self.sets(q)?),
+                            _ => {
+                                let mut parts = q.into_inner();
+                                body.initial.push(self.defined(span, parts.next().expect("field"), parts.next())?);
+                            }
+                        }
+                    }
+                    pb.bodies.push(body);
                 }
                 Rule::bind_decl => {
                     for q in it {
@@ -75,10 +100,7 @@ impl Builder {
                 }
                 Rule::set_decl => {
                     for q in it {
-                        let span = self.span(&q);
-                        let mut parts = q.into_inner();
-                        let name = self.ident(parts.next().expect("param path"));
-                        pb.sets.push(Defined { name, value: self.expr(parts.next().expect("value"))?, span });
+                        pb.sets.push(self.set_arg(q)?);
                     }
                 }
                 Rule::run_decl => {
@@ -173,6 +195,28 @@ impl Builder {
             }
         }
         Ok(pb)
+    }
+
+    /// A `region` line, in a body or not.
+    fn region(&self, p: Pair<Rule>, body: Option<Ident>) -> Result<RegionDecl, Box<Diagnostic>> {
+        let span = self.span(&p);
+        let mut it = p.into_inner();
+        let name = self.ident(it.next().expect("region name"));
+        let sources = it.map(|q| self.region_source(q)).collect::<Result<Vec<_>, _>>()?;
+        Ok(RegionDecl { name, sources, body, span })
+    }
+
+    /// A `set` line's assignments.
+    fn sets(&self, p: Pair<Rule>) -> Result<Vec<Defined>, Box<Diagnostic>> {
+        p.into_inner().map(|q| self.set_arg(q)).collect()
+    }
+
+    /// `NAME = VALUE` of a `set` line.
+    fn set_arg(&self, q: Pair<Rule>) -> Result<Defined, Box<Diagnostic>> {
+        let span = self.span(&q);
+        let mut parts = q.into_inner();
+        let name = self.ident(parts.next().expect("param path"));
+        Ok(Defined { name, value: self.expr(parts.next().expect("value"))?, span })
     }
 
     /// A region's source: a union of parts (one part is itself).

@@ -7,6 +7,12 @@ use crate::fem::kernel::{CellCtx, FormKernel, FunctionalKernel, LocalMatrix, Tab
 use crate::linalg::pattern::Pattern;
 
 impl<K> Job<'_, K> {
+    /// Whether a loop visits cell `c` (or the facets it carries).
+    #[inline]
+    pub(super) fn visits(&self, c: usize) -> bool {
+        self.cells.is_none_or(|cells| cells[c])
+    }
+
     fn tabulation<const D: usize, const N: usize>(&self) -> Tabulation<D, N> {
         Tabulation::<D, N>::cell(self.mesh.kind, self.degree).expect("kind matches D and N")
     }
@@ -24,7 +30,7 @@ pub(super) fn cell_residual<const D: usize, const N: usize, K: FormKernel<D, N> 
     order.for_each_block(
         || locals::<D, N>(job.fields.len()),
         |local, cells| {
-            for c in cells {
+            for c in cells.filter(|&c| job.visits(c)) {
                 let cell = mesh.cell(c);
                 let coords = mesh.cell_coords::<D, N>(c);
                 gather(cell, job.fields, local);
@@ -60,7 +66,7 @@ pub(super) fn cell_tangent<const D: usize, const N: usize, K: FormKernel<D, N> +
     order.for_each_block(
         || (locals::<D, N>(job.fields.len()), Box::new([[[[0.0; D]; N]; D]; N])),
         |(local, ke): &mut (_, Box<LocalMatrix<D, N>>), cells| {
-            for c in cells {
+            for c in cells.filter(|&c| job.visits(c)) {
                 let cell = mesh.cell(c);
                 let coords = mesh.cell_coords::<D, N>(c);
                 gather(cell, job.fields, local);
@@ -85,6 +91,9 @@ pub(super) fn cell_values<const D: usize, const N: usize, K: FunctionalKernel<D,
     let mut local = locals::<D, N>(job.fields.len());
     (0..mesh.num_cells())
         .map(|c| {
+            if !job.visits(c) {
+                return 0.0;
+            }
             let coords = mesh.cell_coords::<D, N>(c);
             gather(mesh.cell(c), job.fields, &mut local);
             with_refs(&local, |refs| job.kernel.cell_value(&CellCtx { tab: &tab, coords: &coords, t }, refs))

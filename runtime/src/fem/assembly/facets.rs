@@ -21,8 +21,8 @@ pub(super) struct FacetJob<'a, K> {
 }
 
 impl<K> FacetJob<'_, K> {
-    /// Calls `each(facet, its cell's nodes, context, local fields)` on each facet in order,
-    /// with the tabulations `tabs`.
+    /// Calls `each(facet, its cell's nodes, context, local fields)` on each facet in order (of
+    /// the job's cells), with the tabulations `tabs`.
     fn visit<const D: usize, const N: usize>(
         &self,
         tabs: &FacetTabulation<D, N>,
@@ -30,7 +30,7 @@ impl<K> FacetJob<'_, K> {
     ) {
         let mesh = self.job.mesh;
         let mut local = locals::<D, N>(self.job.fields.len());
-        for &f in self.facets {
+        for &f in self.facets.iter().filter(|f| self.job.visits(f.cell as usize)) {
             let c = f.cell as usize;
             let cell = mesh.cell(c);
             let coords = mesh.cell_coords::<D, N>(c);

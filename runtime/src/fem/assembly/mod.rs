@@ -70,6 +70,23 @@ pub struct FacetIntegral<'a, K> {
     pub region: &'a str,
     pub facets: &'a [Facet],
     pub quadrature: Quadrature,
+    /// Only the facets of these cells, if given (a body's: per cell, whether it is one).
+    pub cells: Option<&'a [bool]>,
+}
+
+/// A form's volume integral: over every cell of the mesh, or over a body's (`cells`: per cell,
+/// whether it is one).
+pub struct CellIntegral<'a, K> {
+    pub kernel: &'a K,
+    pub quadrature: Quadrature,
+    pub cells: Option<&'a [bool]>,
+}
+
+impl<'a, K> CellIntegral<'a, K> {
+    /// Over every cell.
+    pub fn all(kernel: &'a K, quadrature: Quadrature) -> Self {
+        CellIntegral { kernel, quadrature, cells: None }
+    }
 }
 
 /// Assembles forms on one mesh into vectors and matrices sharing one pattern.
@@ -90,6 +107,8 @@ pub struct Assembler<'m> {
 /// quadrature degree, on a mesh.
 pub(crate) struct Job<'a, K> {
     mesh: &'a Mesh,
+    /// The cells a cell loop visits, if not all (a body's).
+    cells: Option<&'a [bool]>,
     kernel: &'a K,
     degree: u32,
     fields: &'a [&'a [f64]],
@@ -140,8 +159,9 @@ impl<'m> Assembler<'m> {
         Matrix::zeros(self.pattern.clone())
     }
 
-    fn cell_job<'a, K: Form>(&'a self, k: &'a K, q: Quadrature, fields: &'a [&'a [f64]], t: f64) -> Job<'a, K> {
-        Job { mesh: self.mesh, kernel: k, degree: q.cell_degree(k.meta(), self.mesh.kind), fields, t }
+    fn cell_job<'a, K: Form>(&'a self, on: CellIntegral<'a, K>, fields: &'a [&'a [f64]], t: f64) -> Job<'a, K> {
+        let (k, q) = (on.kernel, on.quadrature);
+        Job { mesh: self.mesh, cells: on.cells, kernel: k, degree: q.cell_degree(k.meta(), self.mesh.kind), fields, t }
     }
 
     /// The loop over `on`'s facets, or `None` if its kernel has no such region.
@@ -154,19 +174,27 @@ impl<'m> Assembler<'m> {
         let (k, kind) = (on.kernel, self.mesh.kind);
         let region = region_index(k.meta(), on.region)?;
         let degree = on.quadrature.facet_degree(k.meta(), kind, region);
-        Some(FacetJob { job: Job { mesh: self.mesh, kernel: k, degree, fields, t }, region, facets: on.facets })
+        let job = Job { mesh: self.mesh, cells: on.cells, kernel: k, degree, fields, t };
+        Some(FacetJob { job, region, facets: on.facets })
     }
 
-    /// Adds the volume part of `k`'s residual at `fields` to `out`.
-    pub fn cell_residual<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64, out: &mut [f64]) {
-        let job = self.cell_job(k, q, fields, t);
+    /// Adds the volume part of `on`'s residual at `fields` to `out`.
+    pub fn cell_residual<K: Kernel>(&self, on: CellIntegral<'_, K>, fields: &[&[f64]], t: f64, out: &mut [f64]) {
+        let job = self.cell_job(on, fields, t);
         dispatch!(self.mesh.kind, cell_residual::<K>(&job, self.cell_order(), out));
         self.pattern.complete(out);
     }
 
-    /// Adds the volume part of `k`'s tangent with respect to field `wrt` to `m`.
-    pub fn cell_tangent<K: Kernel>(&self, k: &K, q: Quadrature, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
-        let job = self.cell_job(k, q, fields, t);
+    /// Adds the volume part of `on`'s tangent with respect to field `wrt` to `m`.
+    pub fn cell_tangent<K: Kernel>(
+        &self,
+        on: CellIntegral<'_, K>,
+        fields: &[&[f64]],
+        wrt: usize,
+        t: f64,
+        m: &mut Matrix,
+    ) {
+        let job = self.cell_job(on, fields, t);
         dispatch!(self.mesh.kind, cell_tangent::<K>(&job, self.cell_order(), &self.pattern, wrt, &mut m.values))
     }
 
@@ -221,8 +249,8 @@ impl<'m> Assembler<'m> {
     }
 
     /// The volume integral of a functional at `fields` (collective in a split run).
-    pub fn cell_value<K: Functional>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64) -> f64 {
-        let mine: f64 = self.cell_values(k, q, fields, t)[..self.owned].iter().sum();
+    pub fn cell_value<K: Functional>(&self, on: CellIntegral<'_, K>, fields: &[&[f64]], t: f64) -> f64 {
+        let mine: f64 = self.cell_values(on, fields, t)[..self.owned].iter().sum();
         match self.pattern.ownership() {
             Some(o) => o.sum(mine),
             None => mine,
@@ -230,9 +258,9 @@ impl<'m> Assembler<'m> {
     }
 
     /// The volume integral of a functional on each cell (of this process's part, in a split
-    /// run).
-    pub fn cell_values<K: Functional>(&self, k: &K, q: Quadrature, fields: &[&[f64]], t: f64) -> Vec<f64> {
-        let job = self.cell_job(k, q, fields, t);
+    /// run; zero on the cells `on` does not visit).
+    pub fn cell_values<K: Functional>(&self, on: CellIntegral<'_, K>, fields: &[&[f64]], t: f64) -> Vec<f64> {
+        let job = self.cell_job(on, fields, t);
         dispatch!(self.mesh.kind, cell_values::<K>(&job))
     }
 
@@ -247,17 +275,15 @@ impl<'m> Assembler<'m> {
     /// weight that integrates over the physical facet: a contact pressure profile, say.
     pub fn facet_point_values<K: Functional>(
         &self,
-        k: &K,
-        region: &str,
-        facets: &[Facet],
+        on: FacetIntegral<'_, K>,
         rule: &Rule,
         fields: &[&[f64]],
         t: f64,
     ) -> Vec<PointValue> {
-        let Some(region) = region_index(k.meta(), region) else { return Vec::new() };
+        let Some(region) = region_index(on.kernel.meta(), on.region) else { return Vec::new() };
         // The degree is unused: `rule` gives the points.
-        let job = FacetJob { job: Job { mesh: self.mesh, kernel: k, degree: 0, fields, t }, region, facets };
-        dispatch!(self.mesh.kind, facet_point_values::<K>(&job, rule))
+        let job = Job { mesh: self.mesh, cells: on.cells, kernel: on.kernel, degree: 0, fields, t };
+        dispatch!(self.mesh.kind, facet_point_values::<K>(&FacetJob { job, region, facets: on.facets }, rule))
     }
 
     /// Facets of a named mesh region.

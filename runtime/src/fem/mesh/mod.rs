@@ -36,6 +36,15 @@ pub struct Region {
     pub facets: Vec<Facet>,
 }
 
+/// One body of a problem with several: its cells. A form bound to a body integrates over these
+/// and the facets they carry alone, with the body's values of its params.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    pub name: String,
+    /// Per cell of the mesh, whether it is the body's.
+    pub cells: Vec<bool>,
+}
+
 /// Moves a point in place (a new boundary node onto the true boundary).
 pub type Projection<'a> = dyn Fn(&mut [f64]) + 'a;
 
@@ -50,6 +59,8 @@ pub struct Mesh {
     pub regions: Vec<Region>,
     /// Named groups of cells (Gmsh physical groups of the cell dimension).
     pub cell_groups: Vec<(String, Vec<u32>)>,
+    /// Its bodies, when a problem has several (`set_bodies`); none: the mesh is one body.
+    pub bodies: Vec<Body>,
     /// What the reader skipped or doubted (e.g. element types it does not use), for the user.
     pub warnings: Vec<String>,
     /// What `h`, the size of the cell carrying a facet, means in the forms (`set_cell_size`).
@@ -92,6 +103,7 @@ impl Mesh {
             cells,
             regions: Vec::new(),
             cell_groups: Vec::new(),
+            bodies: Vec::new(),
             warnings: Vec::new(),
             cell_size: CellSize::Diameter,
             sizes: Vec::new(),
@@ -100,6 +112,60 @@ impl Mesh {
 
     pub fn dim(&self) -> usize {
         self.kind.dim()
+    }
+
+    /// Shares the cells out among bodies (name, cells; each cell in one, which the caller
+    /// checks).
+    pub fn set_bodies(&mut self, bodies: Vec<(String, Vec<u32>)>) {
+        let cells = self.num_cells();
+        self.bodies = bodies
+            .into_iter()
+            .map(|(name, list)| {
+                let mut mine = vec![false; cells];
+                list.iter().for_each(|&c| mine[c as usize] = true);
+                Body { name, cells: mine }
+            })
+            .collect();
+    }
+
+    /// The nodes of body `name` (per node, whether one of its cells has it); none if the mesh
+    /// has no such body.
+    pub fn body_nodes(&self, name: &str) -> Option<Vec<bool>> {
+        let body = self.bodies.iter().find(|b| b.name == name)?;
+        let mut nodes = vec![false; self.num_nodes()];
+        (0..self.num_cells()).filter(|&c| body.cells[c]).for_each(|c| {
+            self.cell(c).iter().for_each(|&n| nodes[n as usize] = true);
+        });
+        Some(nodes)
+    }
+
+    /// Places `other`'s nodes and cells after this mesh's (the two share no node): its cells
+    /// are numbered from this mesh's count on, its regions and cell groups join those of the
+    /// same name. Returns the range of its cells here. Both must be of one element kind.
+    pub fn append(&mut self, other: &Mesh) -> std::ops::Range<u32> {
+        debug_assert_eq!(self.kind, other.kind, "checked by the caller");
+        let (first_node, first_cell) = (self.num_nodes() as u32, self.num_cells() as u32);
+        self.coords.extend_from_slice(&other.coords);
+        self.cells.extend(other.cells.iter().map(|&n| n + first_node));
+        let shifted = |f: &Facet| Facet { cell: f.cell + first_cell, local: f.local };
+        for r in &other.regions {
+            let facets = r.facets.iter().map(shifted);
+            match self.regions.iter_mut().find(|own| own.name == r.name) {
+                Some(own) => own.facets.extend(facets),
+                None => self.regions.push(Region { name: r.name.clone(), facets: facets.collect() }),
+            }
+        }
+        for (name, group) in &other.cell_groups {
+            let cells = group.iter().map(|&c| c + first_cell);
+            match self.cell_groups.iter_mut().find(|(own, _)| own == name) {
+                Some((_, own)) => own.extend(cells),
+                None => self.cell_groups.push((name.clone(), cells.collect())),
+            }
+        }
+        self.warnings.extend(other.warnings.iter().cloned());
+        let cell_size = self.cell_size;
+        self.set_cell_size(cell_size);
+        first_cell..self.num_cells() as u32
     }
 
     pub fn num_nodes(&self) -> usize {
@@ -386,6 +452,7 @@ impl Mesh {
             cells,
             regions: self.regions.clone(),
             cell_groups: self.cell_groups.clone(),
+            bodies: self.bodies.clone(),
             warnings: self.warnings.clone(),
             cell_size: CellSize::Diameter,
             sizes: Vec::new(),

@@ -1,6 +1,6 @@
 //! One process's part of a mesh, in a run split across processes.
 
-use super::{Facet, Mesh, Region};
+use super::{Body, Facet, Mesh, Region};
 
 impl Mesh {
     /// The cells process `rank` assembles when node i belongs to process `owner[i]`: the cells
@@ -44,12 +44,18 @@ impl Mesh {
                 (name.clone(), mine)
             })
             .collect();
+        let bodies = self
+            .bodies
+            .iter()
+            .map(|b| Body { name: b.name.clone(), cells: kept.iter().map(|&c| b.cells[c]).collect() })
+            .collect();
         let part = Mesh {
             kind: self.kind,
             coords: self.coords.clone(),
             cells: kept.iter().flat_map(|&c| self.cell(c).iter().copied()).collect(),
             regions,
             cell_groups,
+            bodies,
             warnings: self.warnings.clone(),
             cell_size: self.cell_size,
             sizes: if self.sizes.is_empty() { Vec::new() } else { kept.iter().map(|&c| self.sizes[c]).collect() },

@@ -88,6 +88,7 @@ pub(super) fn build(mut raw: Raw, file: &str) -> Result<Mesh, MeshError> {
         cells: cells_flat,
         regions: Vec::new(),
         cell_groups: Vec::new(),
+        bodies: Vec::new(),
         warnings,
         cell_size: CellSize::Diameter,
         sizes: Vec::new(),
