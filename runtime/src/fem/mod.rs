@@ -6,6 +6,7 @@ pub mod assembly;
 pub mod bound;
 pub mod element;
 pub mod evaluate;
+pub mod facing;
 pub mod geometry;
 pub mod kernel;
 pub mod lumping;
