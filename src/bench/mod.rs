@@ -3,6 +3,7 @@
 pub mod assemble;
 pub mod bandwidth;
 pub mod disc;
+pub mod search;
 pub mod sphere;
 
 pub use assemble::assemble;

@@ -130,6 +130,15 @@ pub enum BenchCommand {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
+    /// The facing-point search of contact between bodies against the number of facets (about
+    /// 10³, 10⁴, 10⁵ in 2D and 3D): building its R-tree and the queries, per n log n.
+    Search {
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Directory for bench_search.json.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
 }
 
 #[derive(Subcommand)]

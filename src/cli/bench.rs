@@ -1,4 +1,5 @@
-//! `bench assemble`, `bench disc`, `bench sphere`: the benchmarks run and their JSON written.
+//! `bench assemble`, `bench disc`, `bench sphere`, `bench search`: the benchmarks run and their JSON
+//! written.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -48,6 +49,11 @@ pub(super) fn disc(meshes: &[PathBuf], repeats: usize, out: &Path) -> ExitCode {
         }
     };
     write_bench(&out.join("bench_disc.json"), &report)
+}
+
+pub(super) fn search(repeats: usize, out: &Path) -> ExitCode {
+    let report = crate::bench::search::search(repeats, &mut |line| println!("{line}"));
+    write_bench(&out.join("bench_search.json"), &report)
 }
 
 /// Writes a benchmark's JSON and says where.

@@ -174,6 +174,7 @@ fn dispatch(cli: Cli) -> ExitCode {
         Command::Bench { what: BenchCommand::Sphere { max_dofs, solvers, ranks, out } } => {
             bench::sphere(max_dofs, &solvers, &ranks.iter().map(|&r| r as usize).collect::<Vec<_>>(), &out)
         }
+        Command::Bench { what: BenchCommand::Search { repeats, out } } => bench::search(repeats, &out),
     }
 }
 

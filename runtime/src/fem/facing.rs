@@ -11,7 +11,7 @@
 //! on its boundary).
 
 use rstar::primitives::{GeomWithData, Rectangle};
-use rstar::{AABB, RTree};
+use rstar::{AABB, PointDistance, RTree};
 
 use crate::fem::mesh::{Facet, Mesh};
 
@@ -37,12 +37,97 @@ pub struct Surface<'m> {
     /// The displacement of the configuration (node-major, the mesh's dimension).
     u: Vec<f64>,
     tree: RTree<Boxed>,
+    /// Per local facet of the element: its nodes and its map into the reference cell.
+    frames: Vec<Frame>,
+}
+
+/// A local facet of the element: its own Lagrange basis on the reference facet (the interval
+/// [0, 1] or the triangle), with λ0 = 1 − Σ s_j and λ_{j+1} = s_j its barycentric coordinates,
+/// and its map into the reference cell ξ(s) = ξ0 + Σ_j s_j e_j.
+struct Frame {
+    /// The cell's local nodes at the facet's vertices, in the order of λ.
+    vertices: Vec<usize>,
+    /// The edge nodes (P2): the local node and the positions in `vertices` of its edge's ends.
+    mids: Vec<(usize, usize, usize)>,
+    xi0: Vec<f64>,
+    edges: Vec<Vec<f64>>,
+}
+
+impl Frame {
+    fn new(kind: crate::fem::element::ElementKind, facet: usize) -> Frame {
+        let d = kind.dim();
+        let (xi0, _) = kind.facet_point(facet, &vec![0.0; d - 1]);
+        let edges = (0..d - 1)
+            .map(|j| {
+                let mut s = vec![0.0; d - 1];
+                s[j] = 1.0;
+                let (xi, _) = kind.facet_point(facet, &s);
+                xi.iter().zip(&xi0).map(|(a, b)| a - b).collect()
+            })
+            .collect();
+        let local = kind.facet_nodes(facet);
+        let vertices = local[..d].to_vec();
+        let reference = kind.reference_nodes();
+        let mids = local[d..]
+            .iter()
+            .map(|&m| {
+                let ends: Vec<usize> = (0..d).filter(|&i| is_end(&reference[vertices[i]], &reference[m])).collect();
+                (m, ends[0], ends[1])
+            })
+            .collect();
+        Frame { vertices, mids, xi0, edges }
+    }
+
+    /// The point x(s) = Σ ψ_b(s) y_b of the facet whose nodes are at `y` (vertices, then
+    /// edge nodes), and with `tangents` its derivatives ∂x/∂s_j.
+    fn point(&self, y: &[[f64; 3]; 6], s: &[f64], tangents: Option<&mut [[f64; 3]; 2]>) -> [f64; 3] {
+        let n = self.vertices.len();
+        let mut l = [0.0; 3];
+        l[0] = 1.0 - s.iter().sum::<f64>();
+        l[1..n].copy_from_slice(s);
+        // ∂λ_i/∂s_j: −1 for λ0, δ_{i, j+1} otherwise.
+        let dl = |i: usize, j: usize| -> f64 {
+            if i == 0 {
+                -1.0
+            } else if i == j + 1 {
+                1.0
+            } else {
+                0.0
+            }
+        };
+        let quadratic = !self.mids.is_empty();
+        let mut x = [0.0; 3];
+        let mut t = [[0.0; 3]; 2];
+        for i in 0..n {
+            let (w, dw) = if quadratic { (l[i] * (2.0 * l[i] - 1.0), 4.0 * l[i] - 1.0) } else { (l[i], 1.0) };
+            for r in 0..3 {
+                x[r] += w * y[i][r];
+                for (j, tj) in t.iter_mut().enumerate().take(n - 1) {
+                    tj[r] += dw * dl(i, j) * y[i][r];
+                }
+            }
+        }
+        for (k, &(_, a, b)) in self.mids.iter().enumerate() {
+            let yk = y[n + k];
+            for r in 0..3 {
+                x[r] += 4.0 * l[a] * l[b] * yk[r];
+                for (j, tj) in t.iter_mut().enumerate().take(n - 1) {
+                    tj[r] += 4.0 * (dl(a, j) * l[b] + l[a] * dl(b, j)) * yk[r];
+                }
+            }
+        }
+        if let Some(out) = tangents {
+            *out = t;
+        }
+        x
+    }
 }
 
 impl<'m> Surface<'m> {
     /// The facets on the configuration x + u.
     pub fn new(mesh: &'m Mesh, facets: &'m [Facet], u: &[f64]) -> Surface<'m> {
-        let mut surface = Surface { mesh, facets, u: u.to_vec(), tree: RTree::new() };
+        let frames = (0..mesh.kind.facets().len()).map(|facet| Frame::new(mesh.kind, facet)).collect();
+        let mut surface = Surface { mesh, facets, u: u.to_vec(), tree: RTree::new(), frames };
         let boxes = (0..facets.len()).map(|k| surface.bounding_box(k)).collect();
         surface.tree = RTree::bulk_load(boxes);
         surface
@@ -61,18 +146,12 @@ impl<'m> Surface<'m> {
     /// The box of facet `k`'s Bézier control points.
     fn bounding_box(&self, k: usize) -> Boxed {
         let f = self.facets[k];
-        let kind = self.mesh.kind;
+        let frame = &self.frames[f.local as usize];
         let cell = self.mesh.cell(f.cell as usize);
-        let local = kind.facet_nodes(f.local as usize);
-        let vertices = kind.dim();
-        let mut points: Vec<[f64; 3]> = local[..vertices].iter().map(|&a| self.position(cell[a] as usize)).collect();
+        let mut points: Vec<[f64; 3]> = frame.vertices.iter().map(|&a| self.position(cell[a] as usize)).collect();
         // Edge nodes (P2): the control point 2m − (a + b)/2 of their edge.
-        let reference = kind.reference_nodes();
-        for &e in &local[vertices..] {
-            let m = self.position(cell[e] as usize);
-            let ends: Vec<usize> =
-                local[..vertices].iter().copied().filter(|&a| is_end(&reference[a], &reference[e])).collect();
-            let (a, b) = (self.position(cell[ends[0]] as usize), self.position(cell[ends[1]] as usize));
+        for &(m, a, b) in &frame.mids {
+            let (m, a, b) = (self.position(cell[m] as usize), points[a], points[b]);
             points.push(std::array::from_fn(|r| 2.0 * m[r] - 0.5 * (a[r] + b[r])));
         }
         let lower = std::array::from_fn(|r| points.iter().map(|p| p[r]).fold(f64::INFINITY, f64::min));
@@ -85,9 +164,20 @@ impl<'m> Surface<'m> {
         let at: [f64; 3] = std::array::from_fn(|r| p.get(r).copied().unwrap_or(0.0));
         let around =
             AABB::from_corners(std::array::from_fn(|r| at[r] - radius), std::array::from_fn(|r| at[r] + radius));
+        // Nearest boxes first: a facet whose box is further than the best point found so far
+        // cannot hold a closer one.
+        let mut candidates: Vec<(f64, usize)> = self
+            .tree
+            .locate_in_envelope_intersecting(&around)
+            .map(|c| (c.geom().distance_2(&at), c.data as usize))
+            .collect();
+        candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut best: Option<Facing> = None;
-        for candidate in self.tree.locate_in_envelope_intersecting(&around) {
-            let facing = self.project(candidate.data as usize, p);
+        for (box_distance_2, k) in candidates {
+            if best.as_ref().is_some_and(|b| box_distance_2 > b.distance * b.distance) {
+                break;
+            }
+            let facing = self.project(k, p);
             if facing.distance <= radius && best.as_ref().is_none_or(|b| facing.distance < b.distance) {
                 best = Some(facing);
             }
@@ -103,58 +193,35 @@ impl<'m> Surface<'m> {
     /// The closest point of facet `k` to `p`.
     pub fn project(&self, k: usize, p: &[f64]) -> Facing {
         let (mesh, f) = (self.mesh, self.facets[k]);
-        let (kind, d) = (mesh.kind, mesh.dim());
-        let cell: Vec<[f64; 3]> = mesh.cell(f.cell as usize).iter().map(|&n| self.position(n as usize)).collect();
-        // ξ(s) = ξ0 + E s on the reference facet; x(s) = Σ φ_a(ξ) y_a.
-        let facet = f.local as usize;
-        let (xi0, _) = kind.facet_point(facet, &vec![0.0; d - 1]);
-        let edges: Vec<Vec<f64>> = (0..d - 1)
-            .map(|j| {
-                let mut s = vec![0.0; d - 1];
-                s[j] = 1.0;
-                let (xi, _) = kind.facet_point(facet, &s);
-                xi.iter().zip(&xi0).map(|(a, b)| a - b).collect()
-            })
-            .collect();
-        let xi_at = |s: &[f64]| -> Vec<f64> {
-            (0..d).map(|r| xi0[r] + (0..d - 1).map(|j| edges[j][r] * s[j]).sum::<f64>()).collect()
-        };
-        let x_at = |xi: &[f64]| -> [f64; 3] {
-            let phi = kind.basis(xi);
-            std::array::from_fn(|r| phi.iter().zip(&cell).map(|(w, y)| w * y[r]).sum())
-        };
-        let mut s = vec![1.0 / d as f64; d - 1];
+        let d = mesh.dim();
+        let frame = &self.frames[f.local as usize];
+        let cell = mesh.cell(f.cell as usize);
+        // The facet's nodes on the configuration: vertices, then edge nodes (P2).
+        let mut y = [[0.0; 3]; 6];
+        for (slot, &a) in y.iter_mut().zip(frame.vertices.iter().chain(frame.mids.iter().map(|(m, _, _)| m))) {
+            *slot = self.position(cell[a] as usize);
+        }
+        let at: [f64; 3] = std::array::from_fn(|r| p.get(r).copied().unwrap_or(0.0));
+        let mut s = [1.0 / d as f64; 2];
+        let mut x = frame.point(&y, &s[..d - 1], None);
         for _ in 0..MAX_STEPS {
-            let xi = xi_at(&s);
-            let x = x_at(&xi);
-            let grads = kind.basis_gradients(&xi);
-            // T = ∂x/∂s (d × (d − 1)): the tangents of the facet at s.
-            let tangents: Vec<[f64; 3]> = (0..d - 1)
-                .map(|j| {
-                    std::array::from_fn(|r| {
-                        grads
-                            .iter()
-                            .zip(&cell)
-                            .map(|(g, y)| y[r] * (0..d).map(|c| g[c] * edges[j][c]).sum::<f64>())
-                            .sum()
-                    })
-                })
-                .collect();
-            let residual: [f64; 3] = std::array::from_fn(|r| p.get(r).copied().unwrap_or(0.0) - x[r]);
-            let step = gauss_newton_step(&tangents, &residual);
-            let before = s.clone();
-            for (sj, dj) in s.iter_mut().zip(&step) {
+            let mut tangents = [[0.0; 3]; 2];
+            x = frame.point(&y, &s[..d - 1], Some(&mut tangents));
+            let residual: [f64; 3] = std::array::from_fn(|r| at[r] - x[r]);
+            let step = gauss_newton_step(&tangents[..d - 1], &residual);
+            let before = s;
+            for (sj, dj) in s.iter_mut().zip(&step[..d - 1]) {
                 *sj += dj;
             }
-            keep_in_facet(&mut s);
+            keep_in_facet(&mut s[..d - 1]);
             let moved = s.iter().zip(&before).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
             if moved < 1e-14 {
                 break;
             }
+            x = frame.point(&y, &s[..d - 1], None);
         }
-        let xi = xi_at(&s);
-        let x = x_at(&xi);
-        let distance = (0..d).map(|r| (p[r] - x[r]).powi(2)).sum::<f64>().sqrt();
+        let xi = (0..d).map(|r| frame.xi0[r] + (0..d - 1).map(|j| frame.edges[j][r] * s[j]).sum::<f64>()).collect();
+        let distance = (0..d).map(|r| (at[r] - x[r]).powi(2)).sum::<f64>().sqrt();
         Facing { facet: k, xi, point: x[..d].to_vec(), distance }
     }
 
@@ -177,17 +244,17 @@ fn is_end(a: &[f64], m: &[f64]) -> bool {
 }
 
 /// δ solving (TᵀT) δ = Tᵀ r for one or two tangents.
-fn gauss_newton_step(t: &[[f64; 3]], r: &[f64; 3]) -> Vec<f64> {
+fn gauss_newton_step(t: &[[f64; 3]], r: &[f64; 3]) -> [f64; 2] {
     let dot = |a: &[f64; 3], b: &[f64; 3]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     match t {
-        [t0] => vec![dot(t0, r) / dot(t0, t0)],
+        [t0] => [dot(t0, r) / dot(t0, t0), 0.0],
         [t0, t1] => {
             let (a, b, c) = (dot(t0, t0), dot(t0, t1), dot(t1, t1));
             let (f, g) = (dot(t0, r), dot(t1, r));
             let det = a * c - b * b;
-            vec![(c * f - b * g) / det, (a * g - b * f) / det]
+            [(c * f - b * g) / det, (a * g - b * f) / det]
         }
-        _ => Vec::new(),
+        _ => [0.0; 2],
     }
 }
 
@@ -242,6 +309,27 @@ mod tests {
         }
         // Nothing within a radius that reaches no facet.
         assert!(surface.closest(&[0.0, 0.0], 5.0).is_none());
+    }
+
+    /// The same on a curved P2 ball: its boundary triangles are quadratic patches.
+    #[test]
+    fn the_closest_point_of_a_curved_ball_lies_on_the_sphere() {
+        let mesh = crate::fem::mesh::ball::ball(1.0, [0.0, 0.0, 0.0], 0.5);
+        let facets = mesh.boundary_facets();
+        let u = vec![0.0; mesh.num_nodes() * 3];
+        let surface = Surface::new(&mesh, &facets, &u);
+        let mut worst: f64 = 0.0;
+        for k in 0..100 {
+            let (theta, phi) = (0.37 * k as f64, 0.11 + 0.029 * k as f64);
+            let r = 1.0 + 0.05 * ((k % 5) as f64 - 2.0);
+            let p = [r * phi.sin() * theta.cos(), r * phi.sin() * theta.sin(), r * phi.cos()];
+            let found = surface.closest(&p, 0.5).expect("within 0.5 of the surface");
+            let every = surface.closest_by_every_facet(&p).unwrap();
+            assert!((found.distance - every.distance).abs() < 1e-14, "at {p:?}");
+            worst = worst.max((found.distance - (r - 1.0).abs()).abs());
+        }
+        // P2 patches of a unit sphere at h = 0.5 lie within about 3e-4 of it.
+        assert!(worst < 1e-3, "{worst}");
     }
 
     /// On a displaced configuration the facing point moves with the surface, and a straight
