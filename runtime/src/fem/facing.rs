@@ -168,7 +168,7 @@ impl<'m> Surface<'m> {
         // cannot hold a closer one.
         let mut candidates: Vec<(f64, usize)> = self
             .tree
-            .locate_in_envelope_intersecting(&around)
+            .locate_in_envelope_intersecting(around)
             .map(|c| (c.geom().distance_2(&at), c.data as usize))
             .collect();
         candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
