@@ -83,6 +83,29 @@ pub struct Entries {
 /// Each node's neighbours (the nodes it shares a cell with, and itself), sorted: node
 /// i's are `adj[ptr[i]..ptr[i + 1]]`.
 pub fn node_adjacency(mesh: &Connectivity) -> (Vec<usize>, Vec<u32>) {
+    node_adjacency_with(mesh, &[])
+}
+
+/// As [`node_adjacency`], with the node pairs `extra` coupled too (both ways): nodes of two
+/// bodies that may come into contact.
+fn node_adjacency_with(mesh: &Connectivity, extra: &[(u32, u32)]) -> (Vec<usize>, Vec<u32>) {
+    // The extra neighbours of each node (CSR).
+    let mut extra_ptr = vec![0usize; mesh.num_nodes + 1];
+    for &(a, b) in extra {
+        extra_ptr[a as usize + 1] += 1;
+        extra_ptr[b as usize + 1] += 1;
+    }
+    for i in 0..mesh.num_nodes {
+        extra_ptr[i + 1] += extra_ptr[i];
+    }
+    let mut fill = extra_ptr.clone();
+    let mut extra_adj = vec![0u32; 2 * extra.len()];
+    for &(a, b) in extra {
+        extra_adj[fill[a as usize]] = b;
+        fill[a as usize] += 1;
+        extra_adj[fill[b as usize]] = a;
+        fill[b as usize] += 1;
+    }
     let (inc_ptr, inc) = cells_of_nodes(mesh);
     let mut adj_ptr = Vec::with_capacity(mesh.num_nodes + 1);
     adj_ptr.push(0usize);
@@ -96,6 +119,7 @@ pub fn node_adjacency(mesh: &Connectivity) -> (Vec<usize>, Vec<u32>) {
         for &c in &inc[inc_ptr[n]..inc_ptr[n + 1]] {
             scratch.extend_from_slice(mesh.cell(c as usize));
         }
+        scratch.extend_from_slice(&extra_adj[extra_ptr[n]..extra_ptr[n + 1]]);
         scratch.sort_unstable();
         scratch.dedup();
         adj.extend_from_slice(&scratch);
@@ -128,11 +152,17 @@ pub(crate) fn cells_of_nodes(mesh: &Connectivity) -> (Vec<usize>, Vec<u32>) {
 impl Pattern {
     /// Couples every pair of nodes sharing a cell.
     pub fn new(mesh: &Connectivity) -> Pattern {
+        Pattern::with_couplings(mesh, &[])
+    }
+
+    /// Couples every pair of nodes sharing a cell, and the node pairs `extra` (both ways): the
+    /// nodes of two bodies' facets that face each other, whose contact couples them.
+    pub fn with_couplings(mesh: &Connectivity, extra: &[(u32, u32)]) -> Pattern {
         let d = mesh.dim;
         let npc = mesh.nodes_per_cell;
         let nodes = mesh.num_nodes;
         let cells = mesh.num_cells();
-        let (adj_ptr, adj) = node_adjacency(mesh);
+        let (adj_ptr, adj) = node_adjacency_with(mesh, extra);
         // Columns: node j's d columns each hold rows (i, k) for i adjacent to j.
         let size = nodes * d;
         let mut col_ptr = Vec::with_capacity(size + 1);
@@ -249,6 +279,41 @@ impl Pattern {
         out
     }
 
+    /// The position among the values of entry (row `i`, column `j`), if stored.
+    pub fn position(&self, i: usize, j: usize) -> Option<usize> {
+        let d = self.dim;
+        let t = self.neighbours(j / d).binary_search(&((i / d) as u32)).ok()?;
+        Some(self.col_ptr[j] + t * d + i % d)
+    }
+
+    /// Calls `add(position, v)` for each entry of an element matrix over any `nodes` (a pair
+    /// element: the nodes of two cells facing each other), `ke` row-major over the nodes'
+    /// dofs, `ke[(a·d + k)·n·d + b·d + m]` coupling dof k of `nodes[a]` to dof m of `nodes[b]`.
+    /// Nothing is added if two of the nodes are not coupled: the pair is returned.
+    pub fn scatter_nodes(&self, nodes: &[u32], ke: &[f64], mut add: impl FnMut(usize, f64)) -> Result<(), (u32, u32)> {
+        let (d, n) = (self.dim, nodes.len());
+        debug_assert_eq!(ke.len(), n * d * n * d);
+        let mut blocks = Vec::with_capacity(n * n);
+        for &nb in nodes {
+            let neighbours = self.neighbours(nb as usize);
+            for &na in nodes {
+                blocks.push(neighbours.binary_search(&na).map_err(|_| (na, nb))? * d);
+            }
+        }
+        for (b, &nb) in nodes.iter().enumerate() {
+            for m in 0..d {
+                let base = self.col_ptr[nb as usize * d + m];
+                for a in 0..n {
+                    let o = base + blocks[b * n + a];
+                    for k in 0..d {
+                        add(o + k, ke[(a * d + k) * n * d + b * d + m]);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Adds an element matrix of cell `c` with nodes `cell` into `values`.
     #[inline]
     pub(crate) fn scatter<const D: usize, const N: usize>(
@@ -284,5 +349,51 @@ impl Pattern {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two triangles sharing no node (two bodies): their nodes are coupled only where asked,
+    /// both ways, and a pair element over nodes of both lands where a dense matrix puts it.
+    #[test]
+    fn couplings_between_cells_are_stored_both_ways_and_receive_pair_elements() {
+        let cells = [0, 1, 2, 3, 4, 5];
+        let mesh = Connectivity { dim: 2, num_nodes: 6, nodes_per_cell: 3, cells: &cells };
+        let plain = Pattern::new(&mesh);
+        assert_eq!(plain.position(2 * 1, 2 * 4), None, "the bodies are not coupled");
+        let coupled = Pattern::with_couplings(&mesh, &[(1, 4), (2, 4)]);
+        // Two pairs, each both ways, a 2 × 2 block each.
+        assert_eq!(coupled.nnz(), plain.nnz() + 2 * 2 * 2 * 2);
+        for (a, b) in [(1, 4), (4, 1), (2, 4), (4, 2)] {
+            for (k, m) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                assert!(coupled.position(2 * a + k, 2 * b + m).is_some(), "({a}, {b})");
+            }
+        }
+        assert!(coupled.position(0, 2 * 5).is_none());
+        // The transpose of every entry is stored (the pattern stays symmetric).
+        let t = coupled.transposed();
+        assert!(t.iter().enumerate().all(|(e, &f)| t[f] == e));
+        // A pair element over nodes 1, 2 (one body) and 4 (the other).
+        let nodes = [1u32, 2, 4];
+        let ke: Vec<f64> = (0..36).map(|x| x as f64 + 1.0).collect();
+        let mut values = vec![0.0; coupled.nnz()];
+        coupled.scatter_nodes(&nodes, &ke, |i, v| values[i] += v).unwrap();
+        for a in 0..3 {
+            for b in 0..3 {
+                for (k, m) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                    let (row, col) = (2 * nodes[a] as usize + k, 2 * nodes[b] as usize + m);
+                    let at = coupled.position(row, col).unwrap();
+                    assert_eq!(values[at], ke[(a * 2 + k) * 6 + b * 2 + m]);
+                }
+            }
+        }
+        assert_eq!(values.iter().filter(|v| **v != 0.0).count(), 36);
+        // Nodes the pattern does not couple: nothing added, the pair named.
+        let mut untouched = vec![0.0; coupled.nnz()];
+        assert_eq!(coupled.scatter_nodes(&[0, 5], &[1.0; 16], |i, v| untouched[i] += v), Err((5, 0)));
+        assert!(untouched.iter().all(|v| *v == 0.0));
     }
 }
