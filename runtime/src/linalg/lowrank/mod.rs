@@ -69,8 +69,8 @@ pub struct LowRank {
 }
 
 /// Work vectors of an update, kept at rest between updates: `work` zero (d·n), `position`
-/// usize::MAX (n), `seen` false (nodes), `entries` zero (J's entries). An update that ends in an error leaves them reset
-/// whole.
+/// usize::MAX (n), `seen` false (nodes), `entries` zero (J's entries). An update that ends in
+/// an error leaves them reset whole.
 #[derive(Default)]
 struct Scratch {
     work: Vec<f64>,
@@ -254,7 +254,7 @@ impl LowRank {
         let mut spare = self.dense.take().map(|d| d.values).unwrap_or_default();
         // E's nonzero entries (row and column in D, value), from J's pattern among D: a
         // correction by rank-one terms needs no k×k matrix.
-        let mut e_entries: Vec<(usize, usize, f64, usize)> = Vec::new();
+        let mut e_entries: Vec<EEntry> = Vec::new();
         let position = &mut scratch.position;
         dofs.iter().enumerate().for_each(|(a, &d)| position[d] = a);
         let p = &j.pattern;
@@ -263,7 +263,7 @@ impl LowRank {
                 let a = position[p.row_idx[idx]];
                 let change = j.values[idx] - self.reference[idx];
                 if a != usize::MAX && change != 0.0 {
-                    e_entries.push((a, b, change, idx));
+                    e_entries.push(EEntry { row: a, column: b, value: change, index: idx });
                 }
             }
         }
@@ -317,7 +317,7 @@ impl LowRank {
             }
         }
         let mut row_sums = vec![0.0; k];
-        e_entries.iter().for_each(|&(a, _, v, _)| row_sums[a] += v.abs());
+        e_entries.iter().for_each(|x| row_sums[x.row] += x.value.abs());
         self.change_norm = row_sums.iter().copied().fold(0.0, f64::max);
         let terms = match (elements, &mut self.elements) {
             (Some(now), Some(splitter)) if k > 0 => splitter.split(now),
@@ -337,16 +337,13 @@ impl LowRank {
             return Ok(false);
         }
         let mut e = Mat::<f64>::zeros(k, k);
-        e_entries.iter().for_each(|&(a, b, v, _)| e[(a, b)] = v);
+        e_entries.iter().for_each(|x| e[(x.row, x.column)] = x.value);
         // G, k×k: Wᵀ W or Uᵀ Z.
         let g = match &self.columns {
             Columns::Unknown => unreachable!("decided above"),
             Columns::Sparse { of_dof, gram, .. } => {
                 let slots: Vec<usize> = dofs.iter().map(|&dof| of_dof[dof].expect("computed above") as usize).collect();
-                Mat::from_fn(k, k, |a, c| {
-                    let (x, y) = (slots[a], slots[c]);
-                    gram[x.max(y)][x.min(y)]
-                })
+                Mat::from_fn(k, k, |a, c| gram_entry(gram, slots[a], slots[c]))
             }
             Columns::Dense(columns) => {
                 Mat::from_fn(k, k, |a, c| columns[dofs[c]].as_ref().expect("computed above")[dofs[a]])
@@ -394,7 +391,7 @@ impl LowRank {
         j: &Matrix,
         dofs: &[usize],
         scratch: &mut Scratch,
-        e: &[(usize, usize, f64, usize)],
+        e: &[EEntry],
         terms: &RankOneTerms,
         spare: &mut Vec<f64>,
     ) -> Option<Factored> {
@@ -420,8 +417,8 @@ impl LowRank {
             *entries = vec![0.0; j.values.len()];
         }
         let p = &j.pattern;
-        let mut touched: Vec<usize> = e.iter().map(|&(.., idx)| idx).collect();
-        e.iter().for_each(|&(_, _, v, idx)| entries[idx] -= v);
+        let mut touched: Vec<usize> = e.iter().map(|x| x.index).collect();
+        e.iter().for_each(|x| entries[x.index] -= x.value);
         let mut outside = false;
         for t in 0..r {
             for &(b, vb) in term(t).iter().filter(|(_, v)| *v != 0.0) {
@@ -439,7 +436,7 @@ impl LowRank {
                 }
             }
         }
-        let scale = e.iter().fold(0.0f64, |m, &(_, _, v, _)| m.max(v.abs()));
+        let scale = e.iter().fold(0.0f64, |m, x| m.max(x.value.abs()));
         let (mut error, mut nan) = (0.0f64, false);
         for &idx in &touched {
             error = error.max(entries[idx].abs());
@@ -466,7 +463,7 @@ impl LowRank {
             for &(b, v) in term(t).iter().filter(|(_, v)| *v != 0.0) {
                 let q = slot(b);
                 for (hi, &p) in ht.iter_mut().zip(&support) {
-                    *hi += v * if p >= q { gram[p][q] } else { gram[q][p] };
+                    *hi += v * gram_entry(gram, p, q);
                 }
             }
         }
@@ -589,6 +586,21 @@ struct Factored {
 
 /// Rank-one terms must make up the change of J to this fraction of its largest entry.
 const TERMS_ACCURACY: f64 = 1e-12;
+
+/// A nonzero entry of E = J − J₀ among the correction's dofs D: its row and column in D, its
+/// value, and its index among J's values.
+#[derive(Clone, Copy, Debug)]
+struct EEntry {
+    row: usize,
+    column: usize,
+    value: f64,
+    index: usize,
+}
+
+/// Entry (x, y) of the symmetric Gram matrix of the columns, stored as its lower triangle.
+fn gram_entry(gram: &[Vec<f64>], x: usize, y: usize) -> f64 {
+    gram[x.max(y)][x.min(y)]
+}
 
 #[cfg(test)]
 mod tests;
