@@ -306,8 +306,8 @@ pub fn identity(case: &str, in_use: &FilesInUse, mesh: &Mesh, more: &[(&str, Str
         ("step guard", format!("{:?}", in_use.guard)),
         ("mesh", mesh_fingerprint(mesh)),
     ];
-    let params =
-        in_use.forms.params.values().into_iter().map(|(name, p)| (format!("param {name}"), format!("{:?}", p.value)));
+    let values = in_use.forms.params.values().into_iter().chain(in_use.forms.body_values());
+    let params = values.map(|(name, p)| (format!("param {name}"), format!("{:?}", p.value)));
     // A file run by path may be edited between the stop and the resume: its text counts.
     let texts = in_use.interpreted().into_iter().map(|file| {
         let text = std::fs::read(&file).map_or_else(|e| format!("unreadable ({e})"), |b| format!("{:016x}", fnv(&b)));

@@ -539,6 +539,26 @@ impl FilesInUse {
 }
 
 impl FormsInUse {
+    /// Each body's params whose values differ from the problem's, by `BODY.name`.
+    pub fn body_values(&self) -> std::collections::BTreeMap<String, params::ParamValue> {
+        let problem = self.params.values();
+        let mut out = std::collections::BTreeMap::new();
+        for (body, table) in &self.bodies {
+            for (name, p) in table.values() {
+                if problem.get(&name).is_none_or(|q| q.value.to_bits() != p.value.to_bits()) {
+                    out.insert(format!("{body}.{name}"), p);
+                }
+            }
+        }
+        out
+    }
+
+    /// The params in effect, `name = value, ...`, then the bodies' own.
+    pub fn params_text(&self) -> String {
+        let all = self.params.values().into_iter().chain(self.body_values());
+        all.map(|(name, p)| format!("{name} = {}", p.value)).collect::<Vec<_>>().join(", ")
+    }
+
     /// The contact law's name (its file stem).
     pub fn contact_name(&self) -> &str {
         self.units[self.contact].name()

@@ -88,13 +88,15 @@ pub(super) fn json<T: Serialize + ?Sized>(v: &T) -> serde_json::Value {
     serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
 }
 
-/// Every param in effect: the problem's, the scheme's and the form files'.
+/// Every param in effect: the problem's, the scheme's and the form files', and each body's own
+/// (`BODY.name`).
 pub(super) fn all_params(
     in_use: &FilesInUse,
     params: &[ProblemParam],
     pf: &ProblemFile,
 ) -> BTreeMap<String, ParamValue> {
     let mut out = in_use.forms.params.values();
+    out.extend(in_use.forms.body_values());
     for q in params {
         let declared = pf.problem().params.iter().find(|d| d.name.name == q.name).map(|d| d.span);
         let line = declared.map_or(0, |s| pf.program.unit.sources.line_col(s.file, s.start).0);

@@ -154,14 +154,7 @@ impl<'m> Simulation<'m> {
         let names = &stepper.desc().states;
         let states = names.iter().map(|_| vec![0.0; n]).collect();
         let v_index = names.iter().position(|s| *s == "v");
-        let params = in_use
-            .forms
-            .params
-            .values()
-            .iter()
-            .map(|(name, p)| format!("{name} = {}", p.value))
-            .collect::<Vec<_>>()
-            .join(", ");
+        let params = in_use.forms.params_text();
         // Without inertia each step is an equilibrium of its own: no energy accumulates to watch.
         let mut guard = in_use.guard;
         if !inertia {

@@ -1,5 +1,5 @@
-//! Runs under `mpirun` (feature `petsc`): the disc and the sphere through their first impact on
-//! 1, 2 and 3 processes agree with the serial direct run to 1e-8 of each column's scale; a run
+//! Runs under `mpirun` (feature `petsc`): the disc, the sphere and two discs of a problem of two
+//! bodies through their first impact on 1, 2 and 3 processes agree with the serial direct run to 1e-8 of each column's scale; a run
 //! resumed from its checkpoint (one part per process) on the same 2 processes has the bits of
 //! the uninterrupted one, and on 3 or 1 agrees with it; a
 //! split run's snapshots are pieces, one per process, that cover the mesh once; a process that
@@ -93,6 +93,12 @@ fn the_disc_on_one_two_and_three_processes_agrees_with_the_serial_run() {
 #[test]
 fn the_sphere_on_one_two_and_three_processes_agrees_with_the_serial_run() {
     agree(&["sphere", "--t-start", "6.3", "--t-end", "6.45"], "sphere");
+}
+
+#[test]
+fn two_bodies_on_one_two_and_three_processes_agree_with_the_serial_run() {
+    let problem = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/problems/two_discs.wf");
+    agree(&[problem, "--t-end", "2.5"], "two_discs");
 }
 
 #[test]
