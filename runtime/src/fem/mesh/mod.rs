@@ -43,6 +43,9 @@ pub struct Body {
     pub name: String,
     /// Per cell of the mesh, whether it is the body's.
     pub cells: Vec<bool>,
+    /// Per node, whether one of the body's cells has it: of the whole mesh's cells, also in one
+    /// process's part of it (which keeps every node but only some cells).
+    pub nodes: Vec<bool>,
 }
 
 /// Moves a point in place (a new boundary node onto the true boundary).
@@ -122,8 +125,12 @@ impl Mesh {
             .into_iter()
             .map(|(name, list)| {
                 let mut mine = vec![false; cells];
-                list.iter().for_each(|&c| mine[c as usize] = true);
-                Body { name, cells: mine }
+                let mut nodes = vec![false; self.num_nodes()];
+                for &c in &list {
+                    mine[c as usize] = true;
+                    self.cell(c as usize).iter().for_each(|&n| nodes[n as usize] = true);
+                }
+                Body { name, cells: mine, nodes }
             })
             .collect();
     }
@@ -131,12 +138,7 @@ impl Mesh {
     /// The nodes of body `name` (per node, whether one of its cells has it); none if the mesh
     /// has no such body.
     pub fn body_nodes(&self, name: &str) -> Option<Vec<bool>> {
-        let body = self.bodies.iter().find(|b| b.name == name)?;
-        let mut nodes = vec![false; self.num_nodes()];
-        (0..self.num_cells()).filter(|&c| body.cells[c]).for_each(|c| {
-            self.cell(c).iter().for_each(|&n| nodes[n as usize] = true);
-        });
-        Some(nodes)
+        Some(self.bodies.iter().find(|b| b.name == name)?.nodes.clone())
     }
 
     /// Places `other`'s nodes and cells after this mesh's (the two share no node): its cells

@@ -47,7 +47,11 @@ impl Mesh {
         let bodies = self
             .bodies
             .iter()
-            .map(|b| Body { name: b.name.clone(), cells: kept.iter().map(|&c| b.cells[c]).collect() })
+            .map(|b| Body {
+                name: b.name.clone(),
+                cells: kept.iter().map(|&c| b.cells[c]).collect(),
+                nodes: b.nodes.clone(),
+            })
             .collect();
         let part = Mesh {
             kind: self.kind,
