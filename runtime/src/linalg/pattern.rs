@@ -363,7 +363,7 @@ mod tests {
         let cells = [0, 1, 2, 3, 4, 5];
         let mesh = Connectivity { dim: 2, num_nodes: 6, nodes_per_cell: 3, cells: &cells };
         let plain = Pattern::new(&mesh);
-        assert_eq!(plain.position(2 * 1, 2 * 4), None, "the bodies are not coupled");
+        assert_eq!(plain.position(2, 2 * 4), None, "the bodies are not coupled");
         let coupled = Pattern::with_couplings(&mesh, &[(1, 4), (2, 4)]);
         // Two pairs, each both ways, a 2 × 2 block each.
         assert_eq!(coupled.nnz(), plain.nnz() + 2 * 2 * 2 * 2);
