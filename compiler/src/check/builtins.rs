@@ -110,6 +110,13 @@ pub const BUILTINS: &[Builtin] = {
         row("tangential", 2, Tangential, false, "tangential(a, nc): a − (a·nc) nc"),
         row("prev", 1, Same, false, "prev(e): e at the previous time level"),
         row(
+            "opposite",
+            1,
+            Same,
+            false,
+            "opposite(e): e on the other surface of a contact pair, at the point facing the quadrature point",
+        ),
+        row(
             "derivative",
             3,
             Derivative,

@@ -45,6 +45,57 @@ pub enum Sym {
     /// `e` is lowered at u + s·d, differentiated in s and read at s = 0, so no seed outlives
     /// the lowering of its call.
     Seed(u8),
+    /// A value read on the other surface of a contact pair, at the point facing the quadrature
+    /// point (`opposite(e)`).
+    Opposite(Facing),
+}
+
+/// The leaves `opposite(e)` reads on the facing surface: those of the quadrature point's own
+/// side, there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Facing {
+    Field { arg: u8, comp: u8 },
+    FieldGrad { arg: u8, comp: u8, dir: u8 },
+    Test { comp: u8 },
+    TestGrad { comp: u8, dir: u8 },
+    /// The facing body's outward unit normal.
+    Normal(u8),
+    /// The facing point.
+    Coord(u8),
+    /// The diameter of the cell carrying the facing facet.
+    CellDiameter,
+}
+
+impl Facing {
+    /// The leaf of the own side that reads, on the facing side, as this one.
+    pub fn own(self) -> Sym {
+        match self {
+            Facing::Field { arg, comp } => Sym::Field { arg, comp },
+            Facing::FieldGrad { arg, comp, dir } => Sym::FieldGrad { arg, comp, dir },
+            Facing::Test { comp } => Sym::Test { comp },
+            Facing::TestGrad { comp, dir } => Sym::TestGrad { comp, dir },
+            Facing::Normal(k) => Sym::Normal(k),
+            Facing::Coord(k) => Sym::Coord(k),
+            Facing::CellDiameter => Sym::CellDiameter,
+        }
+    }
+}
+
+impl Sym {
+    /// This leaf read on the facing surface, if it has a value there (a param, the time or a
+    /// seed is the same on both sides; a coef is read at the facing point by the caller).
+    pub fn facing(self) -> Option<Facing> {
+        Some(match self {
+            Sym::Field { arg, comp } => Facing::Field { arg, comp },
+            Sym::FieldGrad { arg, comp, dir } => Facing::FieldGrad { arg, comp, dir },
+            Sym::Test { comp } => Facing::Test { comp },
+            Sym::TestGrad { comp, dir } => Facing::TestGrad { comp, dir },
+            Sym::Normal(k) => Facing::Normal(k),
+            Sym::Coord(k) => Facing::Coord(k),
+            Sym::CellDiameter => Facing::CellDiameter,
+            _ => return None,
+        })
+    }
 }
 
 /// A smooth function of one scalar: the language's `sin`, `cos`, `tan`, `exp` and `ln`.

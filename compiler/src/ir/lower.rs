@@ -75,6 +75,9 @@ pub struct Lowerer<'p> {
     /// displacement as an n+1-th field, which no tangent differentiates. None outside forms
     /// (functionals, a problem's expressions).
     previous: Option<u8>,
+    /// Lowering a facet integral of a form or functional, where `opposite(e)` reads the facing
+    /// surface of a contact pair.
+    facing: bool,
 }
 
 impl<'p> Lowerer<'p> {
@@ -90,6 +93,7 @@ impl<'p> Lowerer<'p> {
             form_name: String::new(),
             seeds: 0,
             previous: None,
+            facing: false,
         }
     }
 
@@ -148,7 +152,10 @@ impl<'p> Lowerer<'p> {
         self.scope = scope;
         let mut integrands: Vec<Integrand> = Vec::new();
         for integral in &form.integrals {
-            let v = match self.expr(&integral.integrand) {
+            self.facing = integral.region.name != crate::check::CELL_REGION;
+            let v = self.expr(&integral.integrand);
+            self.facing = false;
+            let v = match v {
                 Ok(v) => v.c[0].v,
                 Err(d) => {
                     self.scope.clear();
@@ -403,6 +410,16 @@ impl<'p> Lowerer<'p> {
                 ));
             };
             return Ok(self.previous_level(&args[0], previous));
+        }
+        if f == "opposite" {
+            if !self.facing {
+                return Err(Box::new(
+                    Diagnostic::error("E0407", "`opposite` outside a facet integral", span, "no facing surface here")
+                        .with_note("`opposite(e)` is `e` on the other surface of a contact pair, at the point facing the quadrature point: it is read in the integrals over a pair's surface, `int(Gamma_C)`")
+                        .with_help("integrate over the contact surface: `form contact(u; v) = int(Gamma_C) ...`"),
+                ));
+            }
+            return Ok(self.opposite_side(&args[0]));
         }
         Ok(self.builtin(f, args))
     }

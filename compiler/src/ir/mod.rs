@@ -48,6 +48,9 @@ pub struct FormIr {
     /// The form reads the previous time level's displacement (`prev`), as field argument
     /// `fields.len()`, which the driver supplies and no tangent differentiates (forms only).
     pub previous: bool,
+    /// In a contact pair's law: its facet integrals are evaluated at facing points
+    /// ([`IntegralIr::pair`]).
+    pub pair: bool,
 }
 
 pub struct IntegralIr {
@@ -68,6 +71,21 @@ pub struct IntegralIr {
     /// The estimated degree (exact on affine cells when the integrand is polynomial), which
     /// `check` reports.
     pub estimated: [u32; 2],
+    /// In a contact pair's law (a file that reads `opposite`): the facing side's part.
+    pub pair: Option<PairIr>,
+}
+
+/// The facing side of a facet integral of a contact pair's law: the coefficients of the facing
+/// test function, and the tangent blocks that couple the two sides.
+pub struct PairIr {
+    /// Coefficient of opposite(v)_k: `h0[k]`.
+    pub h0: Vec<NodeId>,
+    /// Coefficient of ∂_l opposite(v)_k: `h1[k*d + l]`.
+    pub h1: Vec<NodeId>,
+    /// Per field argument: the blocks (own test, facing trial), (facing test, own trial) and
+    /// (facing test, facing trial), in [`TangentIr`]'s conventions; the own block is the
+    /// integral's `tangents`.
+    pub tangents: Vec<[TangentIr; 3]>,
 }
 
 /// Index conventions: k = test component, l = test derivative direction, m = trial component,
@@ -119,6 +137,13 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
         return Err(diags);
     }
     let mut g = lowerer.g;
+    // A file that reads the facing side anywhere is a contact pair's law: each of its facet
+    // integrals is evaluated at facing points, and it has no volume integral.
+    let reads_facing = |g: &Graph, n: NodeId| g.reachable([n]).into_iter().any(|m| matches!(g.node(m), Node::Sym(Sym::Opposite(_))));
+    let pair_law = lowered.iter().any(|lf| lf.integrands.iter().any(|i| reads_facing(&g, i.value)));
+    if pair_law && let Some(e) = pair_volume_error(prog, &lowered) {
+        return Err(vec![e]);
+    }
     let mut forms = Vec::new();
     for lf in lowered {
         let mut integrals = Vec::new();
@@ -136,6 +161,7 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
                     value: Some(integrand.value),
                     degree,
                     estimated,
+                    pair: None,
                 });
                 continue;
             }
@@ -148,8 +174,10 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
                 })
                 .collect();
             let previous = lf.fields.len() as u8;
-            let tangents =
-                (0..lf.fields.len()).map(|a| tangent(&mut g, d, a as u8, previous, &f0, &f1)).collect::<Vec<_>>();
+            let tangents = (0..lf.fields.len())
+                .map(|a| tangent(&mut g, d, a as u8, previous, (&f0, &f1), Side::Own))
+                .collect::<Vec<_>>();
+            let pair = pair_law.then(|| pair(&mut g, d, lf.fields.len(), integrand.value, (&f0, &f1)));
             let estimated = [1, 2].map(|p| integral_degree(&g, p, &f0, &f1, &tangents));
             let degree = integrand.degree.map_or(estimated, |k| [k, k]);
             integrals.push(IntegralIr {
@@ -161,6 +189,7 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
                 value: None,
                 degree,
                 estimated,
+                pair,
             });
         }
         let tangent_nodes = integrals.iter().flat_map(|i| i.tangents.iter().flat_map(TangentIr::nodes));
@@ -172,11 +201,12 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
         let is_previous = |n: NodeId| matches!(g.node(n), Node::Sym(Sym::Field { arg, .. } | Sym::FieldGrad { arg, .. }) if arg == prev);
         let values = integrals.iter().flat_map(|i| i.f0.iter().chain(&i.f1).chain(&i.value)).copied();
         let previous = g.reachable(values).into_iter().any(is_previous);
-        let linear = constant_tangent && !previous;
+        // A pair's tangent moves with the facing points even where its coefficients are constant.
+        let linear = constant_tangent && !previous && !pair_law;
         if let Some(e) = degree_error(prog, &lf.name, &integrals) {
             diags.push(e);
         }
-        forms.push(FormIr { name: lf.name, fields: lf.fields, test: lf.test, integrals, linear, previous });
+        forms.push(FormIr { name: lf.name, fields: lf.fields, test: lf.test, integrals, linear, previous, pair: pair_law });
     }
     if !diags.is_empty() {
         return Err(diags);
@@ -256,13 +286,72 @@ fn degree_error(prog: &Unit, name: &str, integrals: &[IntegralIr]) -> Option<Dia
     )
 }
 
-/// The tangent of `f0`, `f1` with respect to field argument `arg`; the switches and the
-/// piecewise test count the previous level (field `previous`, never differentiated) as state
-/// too, so that a changed previous level is never taken for an unchanged tangent.
-fn tangent(g: &mut Graph, d: usize, arg: u8, previous: u8, f0: &[NodeId], f1: &[NodeId]) -> TangentIr {
-    let val: Vec<Sym> = (0..d).map(|m| Sym::Field { arg, comp: m as u8 }).collect();
+/// Which side of a contact pair a trial function is read on.
+#[derive(Clone, Copy, PartialEq)]
+enum Side {
+    Own,
+    Facing,
+}
+
+impl Side {
+    fn of(self, s: Sym) -> Sym {
+        match (self, s.facing()) {
+            (Side::Facing, Some(f)) => Sym::Opposite(f),
+            _ => s,
+        }
+    }
+}
+
+/// The facing side of a pair law's integrand `value`, whose own test coefficients are `own`.
+fn pair(g: &mut Graph, d: usize, fields: usize, value: NodeId, own: (&[NodeId], &[NodeId])) -> PairIr {
+    use graph::Facing;
+    let h0: Vec<NodeId> =
+        (0..d).map(|k| Derivative::new(Sym::Opposite(Facing::Test { comp: k as u8 })).of(g, value)).collect();
+    let h1: Vec<NodeId> = (0..d * d)
+        .map(|kl| {
+            let s = Sym::Opposite(Facing::TestGrad { comp: (kl / d) as u8, dir: (kl % d) as u8 });
+            Derivative::new(s).of(g, value)
+        })
+        .collect();
+    let previous = fields as u8;
+    let tangents = (0..fields as u8)
+        .map(|a| {
+            [
+                tangent(g, d, a, previous, own, Side::Facing),
+                tangent(g, d, a, previous, (&h0, &h1), Side::Own),
+                tangent(g, d, a, previous, (&h0, &h1), Side::Facing),
+            ]
+        })
+        .collect();
+    PairIr { h0, h1, tangents }
+}
+
+/// E0408: a volume integral in a contact pair's law.
+fn pair_volume_error(prog: &Unit, lowered: &[lower::LoweredForm]) -> Option<Diagnostic> {
+    let lf = lowered.iter().find(|lf| lf.integrands.iter().any(|i| i.region == CELL_REGION))?;
+    let form = prog.forms.iter().find(|f| f.name == lf.name)?;
+    let integral = form.integrals.iter().find(|i| i.region.name == CELL_REGION)?;
+    Some(
+        Diagnostic::error(
+            "E0408",
+            format!("volume integral in `{}`, in a contact pair's law", lf.name),
+            integral.integrand.span,
+            "a pair's law integrates over the pair's surfaces",
+        )
+        .with_note("the file reads `opposite`, so its integrals are evaluated at the points facing each other on two surfaces")
+        .with_help("move the volume terms to the material's file"),
+    )
+}
+
+/// The tangent of the test coefficients `test` (f0, f1) with respect to field argument `arg`
+/// read on `side`; the switches and the piecewise test count the previous level (field
+/// `previous`, never differentiated) and both sides' fields as state, so that a changed
+/// previous level or facing side is never taken for an unchanged tangent.
+fn tangent(g: &mut Graph, d: usize, arg: u8, previous: u8, test: (&[NodeId], &[NodeId]), side: Side) -> TangentIr {
+    let (f0, f1) = test;
+    let val: Vec<Sym> = (0..d).map(|m| side.of(Sym::Field { arg, comp: m as u8 })).collect();
     let grad: Vec<Sym> =
-        (0..d * d).map(|mn| Sym::FieldGrad { arg, comp: (mn / d) as u8, dir: (mn % d) as u8 }).collect();
+        (0..d * d).map(|mn| side.of(Sym::FieldGrad { arg, comp: (mn / d) as u8, dir: (mn % d) as u8 })).collect();
     let mut dval: Vec<Derivative> = val.iter().map(|s| Derivative::new(*s)).collect();
     let mut dgrad: Vec<Derivative> = grad.iter().map(|s| Derivative::new(*s)).collect();
     let mut c00 = Vec::new();
@@ -286,8 +375,13 @@ fn tangent(g: &mut Graph, d: usize, arg: u8, previous: u8, f0: &[NodeId], f1: &[
         }
     }
     let mut t = TangentIr { c00, c01, c10, c11, switches: Vec::new(), piecewise: true, gates: None };
-    let is_field =
-        |s: Sym| matches!(s, Sym::Field { arg: x, .. } | Sym::FieldGrad { arg: x, .. } if x == arg || x == previous);
+    let is_field = |s: Sym| {
+        let own = match s {
+            Sym::Opposite(f) => f.own(),
+            s => s,
+        };
+        matches!(own, Sym::Field { arg: x, .. } | Sym::FieldGrad { arg: x, .. } if x == arg || x == previous)
+    };
     let roots: Vec<NodeId> = t.nodes().collect();
     for n in g.reachable(roots.iter().copied()) {
         if let Node::Heaviside(a) = g.node(n)
@@ -372,7 +466,10 @@ fn gates(g: &Graph, roots: &[NodeId], is_field: impl Fn(Sym) -> bool + Copy) -> 
 /// a positive power or root of one. A sum with a term that stays (`|a| + (1 − H(|a|))`, the
 /// guard `proj_ball` and the derivative of `sqrt` write) does not vanish.
 fn vanishes_with_a_clip(g: &Graph, id: NodeId) -> bool {
-    let field = |s: Sym| matches!(s, Sym::Field { .. } | Sym::FieldGrad { .. });
+    let field = |s: Sym| {
+        let own = if let Sym::Opposite(f) = s { f.own() } else { s };
+        matches!(own, Sym::Field { .. } | Sym::FieldGrad { .. })
+    };
     let mut vanishes: std::collections::HashMap<NodeId, bool> = std::collections::HashMap::new();
     for n in g.reachable([id]) {
         let v = |m: NodeId| vanishes[&m];
@@ -411,6 +508,14 @@ pub fn node_degrees(
                 Sym::FieldGrad { .. } | Sym::TestGrad { .. } => p - 1,
                 Sym::Coord(_) => 1,
                 Sym::Param(_) | Sym::Normal(_) | Sym::CellDiameter | Sym::Time | Sym::Dt | Sym::Seed(_) => 0,
+                // The facing side's functions, as functions of the point: non-polynomial on
+                // the own facet, counted as their own degree.
+                Sym::Opposite(f) => match f.own() {
+                    Sym::Field { .. } | Sym::Test { .. } => p,
+                    Sym::FieldGrad { .. } | Sym::TestGrad { .. } => p - 1,
+                    Sym::Coord(_) => 1,
+                    _ => 0,
+                },
             },
             Node::Add(a, b) => dg(a).max(dg(b)),
             // Saturating: deep products overflow u32; the cap on the degree reports them.

@@ -85,6 +85,7 @@ impl Leaf {
             }
             Sym::CellDiameter | Sym::Dt | Sym::Test { .. } | Sym::TestGrad { .. } => Leaf::Zero,
             Sym::Seed(_) => unreachable!("a derivative's seed is set to 0 where the derivative is lowered"),
+            Sym::Opposite(_) => unreachable!("a pair law's integrals are planned by `ir::pair`"),
         }
     }
 }

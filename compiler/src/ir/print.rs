@@ -111,5 +111,6 @@ pub fn sym(s: Sym, params: &[String], coefs: &[String]) -> String {
         Sym::Dt => "dt".into(),
         Sym::Seed(k) => format!("seed{k}"),
         Sym::Coef { id, comp } => format!("{}[{comp}]", coefs.get(id as usize).map_or("coef", String::as_str)),
+        Sym::Opposite(f) => format!("opposite({})", sym(f.own(), params, coefs)),
     }
 }

@@ -185,6 +185,12 @@ impl<'m> Surface<'m> {
         best
     }
 
+    /// The facets whose boxes meet the box from `lower` to `upper` (coordinates past the mesh's
+    /// dimension are 0).
+    pub fn within(&self, lower: [f64; 3], upper: [f64; 3]) -> Vec<usize> {
+        self.tree.locate_in_envelope_intersecting(AABB::from_corners(lower, upper)).map(|c| c.data as usize).collect()
+    }
+
     /// The closest point of the surface to `p` by trying every facet (for checks).
     pub fn closest_by_every_facet(&self, p: &[f64]) -> Option<Facing> {
         (0..self.facets.len()).map(|k| self.project(k, p)).min_by(|a, b| a.distance.total_cmp(&b.distance))

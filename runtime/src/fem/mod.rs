@@ -11,6 +11,7 @@ pub mod geometry;
 pub mod kernel;
 pub mod lumping;
 pub mod mesh;
+pub mod pair;
 pub mod quadrature;
 pub mod redistribute;
 pub mod summed;

@@ -121,6 +121,13 @@ impl<'m> Assembler<'m> {
         Assembler { mesh, pattern, order: OnceLock::new(), owned: mesh.num_cells() }
     }
 
+    /// As `new`, with the node pairs `extra` coupled too: the cells of two bodies' surfaces that
+    /// may touch (`PairForm::couplings`).
+    pub fn with_couplings(mesh: &'m Mesh, extra: &[(u32, u32)]) -> Self {
+        let pattern = Arc::new(Pattern::with_couplings(&mesh.connectivity(), extra));
+        Assembler { mesh, pattern, order: OnceLock::new(), owned: mesh.num_cells() }
+    }
+
     /// One process's assembler in a run split across processes: `mesh` is its part of the
     /// whole (`Mesh::part`), whose first `owned` cells it owns. Residuals and products are then
     /// whole on every process (`Owners::complete`), volume integrals sum the owned cells of

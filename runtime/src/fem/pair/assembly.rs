@@ -1,0 +1,325 @@
+//! A pair law's form bound to two surfaces of a mesh: at each quadrature point of its own
+//! surface, the facing point on the other surface's deformed configuration, the kernel's
+//! coefficients there, and their contraction with the basis functions of both cells into an
+//! element of both cells' nodes.
+
+use std::sync::Mutex;
+
+use super::{FieldAt, MAX_DIM, PairKernel, PairPoint, SideAt, layout};
+use crate::fem::assembly::Assembler;
+use crate::fem::bound::BoundForm;
+use crate::fem::element::ElementKind;
+use crate::fem::facing::Surface;
+use crate::fem::mesh::{Facet, Mesh};
+use crate::fem::quadrature::simplex_rule;
+use crate::linalg::Matrix;
+
+/// The basis of a cell at a reference point: values and reference gradients.
+struct Tabulated {
+    weight: f64,
+    phi: Vec<f64>,
+    dref: Vec<Vec<f64>>,
+}
+
+/// A pair law's form on a pair of surfaces.
+pub struct PairForm<'m> {
+    kernel: Box<dyn PairKernel + 'm>,
+    /// The index of the law's integral among its facet regions (`meta().facets`).
+    region: usize,
+    own: &'m [Facet],
+    facing: &'m [Facet],
+    /// The farthest a facing point is looked for: points with no facet of the other surface
+    /// within it face nothing.
+    reach: f64,
+    /// The quadrature points of each local facet of the element (weights on the reference
+    /// facet, times its measure), with its reference normal.
+    rule: Vec<(Vec<Tabulated>, Vec<f64>)>,
+    /// A coupling the matrix pattern lacks, met by the last tangent: the two nodes.
+    missing: Mutex<Option<(u32, u32)>>,
+}
+
+/// Where a quadrature point's facing point is, and both cells' basis functions there.
+struct PairElement {
+    point: PairPoint,
+    /// The quadrature weight times the own facet's measure ratio.
+    weight: f64,
+    /// The own cell's nodes, then the facing cell's.
+    nodes: Vec<u32>,
+    phi: Vec<f64>,
+    /// Physical gradients, per node.
+    dphi: Vec<[f64; MAX_DIM]>,
+}
+
+impl<'m> PairForm<'m> {
+    /// The law's integral over region `region` of its facets, on the facets `own`, facing
+    /// `facing`, with quadrature `degree` on the own facets.
+    pub fn new(
+        kernel: Box<dyn PairKernel + 'm>,
+        region: usize,
+        kind: ElementKind,
+        own: &'m [Facet],
+        facing: &'m [Facet],
+        degree: u32,
+        reach: f64,
+    ) -> Self {
+        let d = kind.dim();
+        let rule = simplex_rule(d - 1, degree);
+        let rule = (0..kind.facets().len())
+            .map(|f| {
+                let points = rule
+                    .points
+                    .iter()
+                    .zip(&rule.weights)
+                    .map(|(s, w)| {
+                        let (xi, scale) = kind.facet_point(f, s);
+                        Tabulated { weight: w * scale, phi: kind.basis(&xi), dref: kind.basis_gradients(&xi) }
+                    })
+                    .collect();
+                (points, kind.reference_normal(f))
+            })
+            .collect();
+        PairForm { kernel, region, own, facing, reach, rule, missing: Mutex::new(None) }
+    }
+
+    /// The node pairs of the two surfaces' cells that may couple: those of facets within
+    /// `reach` of each other on the reference configuration (the matrix pattern's couplings).
+    pub fn couplings(&self, mesh: &Mesh) -> Vec<(u32, u32)> {
+        let surface = Surface::new(mesh, self.facing, &vec![0.0; mesh.num_nodes() * mesh.dim()]);
+        let mut out = Vec::new();
+        for f in self.own {
+            let own_nodes = mesh.cell(f.cell as usize);
+            let (mut lower, mut upper) = ([0.0; 3], [0.0; 3]);
+            for r in 0..mesh.dim() {
+                let along = mesh.kind.facet_nodes(f.local as usize).into_iter().map(|a| mesh.node(own_nodes[a] as usize)[r]);
+                let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+                (lower[r], upper[r]) = (lo - self.reach, hi + self.reach);
+            }
+            for k in surface.within(lower, upper) {
+                let other = mesh.cell(self.facing[k].cell as usize);
+                out.extend(own_nodes.iter().flat_map(|&a| other.iter().map(move |&b| (a, b))));
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The coupling the pattern lacked at the last tangent, if any: a facing point farther on
+    /// the reference configuration than the pair's reach.
+    pub fn missing_coupling(&self) -> Option<(u32, u32)> {
+        self.missing.lock().ok().and_then(|m| *m)
+    }
+
+    /// Calls `each` at every quadrature point of the own surface that faces the other one.
+    fn each_point(&self, mesh: &Mesh, fields: &[&[f64]], t: f64, mut each: impl FnMut(&PairElement)) {
+        let d = mesh.dim();
+        let moving = fields.get(self.kernel.meta().fields.len().saturating_sub(1)).copied().unwrap_or(&[]);
+        let surface = Surface::new(mesh, self.facing, moving);
+        for f in self.own {
+            let (points, ref_normal) = &self.rule[f.local as usize];
+            for q in points {
+                let own = side(mesh, f.cell as usize, &q.phi, &q.dref, ref_normal, fields);
+                let mut at = [0.0; MAX_DIM];
+                for k in 0..d {
+                    at[k] = own.side.x[k] + own.side.fields.first().map_or(0.0, |u| u.value[k]);
+                }
+                let Some(facing) = surface.closest(&at[..d], self.reach) else { continue };
+                let g = self.facing[facing.facet];
+                let kind = mesh.kind;
+                let (phi, dref) = (kind.basis(&facing.xi), kind.basis_gradients(&facing.xi));
+                let other = side(mesh, g.cell as usize, &phi, &dref, &kind.reference_normal(g.local as usize), fields);
+                let nodes = mesh.cell(f.cell as usize).iter().chain(mesh.cell(g.cell as usize)).copied().collect();
+                let element = PairElement {
+                    weight: q.weight * own.scale,
+                    nodes,
+                    phi: q.phi.iter().chain(&phi).copied().collect(),
+                    dphi: own.dphi.into_iter().chain(other.dphi).collect(),
+                    point: PairPoint { dim: d, t, own: own.side, facing: other.side },
+                };
+                each(&element);
+            }
+        }
+    }
+}
+
+/// One side's data at a point of a cell, its basis' physical gradients, and the facet measure
+/// ratio (Nanson).
+struct Side {
+    side: SideAt,
+    dphi: Vec<[f64; MAX_DIM]>,
+    scale: f64,
+}
+
+fn side(mesh: &Mesh, cell: usize, phi: &[f64], dref: &[Vec<f64>], ref_normal: &[f64], fields: &[&[f64]]) -> Side {
+    let d = mesh.dim();
+    let nodes = mesh.cell(cell);
+    let mut j = [[0.0; MAX_DIM]; MAX_DIM];
+    let mut x = [0.0; MAX_DIM];
+    for (a, &n) in nodes.iter().enumerate() {
+        let p = mesh.node(n as usize);
+        for r in 0..d {
+            x[r] += phi[a] * p[r];
+            for c in 0..d {
+                j[r][c] += p[r] * dref[a][c];
+            }
+        }
+    }
+    let (det, inv) = invert(&j, d);
+    // ∇φ = J⁻ᵀ ∇_ξ φ; n ∝ J⁻ᵀ N.
+    let dphi: Vec<[f64; MAX_DIM]> = dref
+        .iter()
+        .map(|g| std::array::from_fn(|l| if l < d { (0..d).map(|b| inv[b][l] * g[b]).sum() } else { 0.0 }))
+        .collect();
+    let mut normal: [f64; MAX_DIM] =
+        std::array::from_fn(|l| if l < d { (0..d).map(|b| inv[b][l] * ref_normal[b]).sum() } else { 0.0 });
+    let size = normal.iter().map(|v| v * v).sum::<f64>().sqrt();
+    normal.iter_mut().for_each(|v| *v /= size);
+    let fields = fields
+        .iter()
+        .map(|u| {
+            let mut at = FieldAt::default();
+            for (a, &n) in nodes.iter().enumerate() {
+                for k in 0..d {
+                    let ua = u.get(n as usize * d + k).copied().unwrap_or(f64::NAN);
+                    at.value[k] += phi[a] * ua;
+                    for l in 0..d {
+                        at.grad[k][l] += dphi[a][l] * ua;
+                    }
+                }
+            }
+            at
+        })
+        .collect();
+    Side { side: SideAt { x, normal, h: mesh.cell_size(cell), fields }, dphi, scale: size * det.abs() }
+}
+
+/// The determinant and inverse of the leading d×d block.
+fn invert(j: &[[f64; MAX_DIM]; MAX_DIM], d: usize) -> (f64, [[f64; MAX_DIM]; MAX_DIM]) {
+    let mut inv = [[0.0; MAX_DIM]; MAX_DIM];
+    match d {
+        1 => {
+            inv[0][0] = 1.0 / j[0][0];
+            (j[0][0], inv)
+        }
+        2 => {
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            inv[0][0] = j[1][1] / det;
+            inv[0][1] = -j[0][1] / det;
+            inv[1][0] = -j[1][0] / det;
+            inv[1][1] = j[0][0] / det;
+            (det, inv)
+        }
+        _ => {
+            let c = |r: usize, s: usize| {
+                let (r1, r2, s1, s2) = ((r + 1) % 3, (r + 2) % 3, (s + 1) % 3, (s + 2) % 3);
+                j[r1][s1] * j[r2][s2] - j[r1][s2] * j[r2][s1]
+            };
+            let det = (0..3).map(|s| j[0][s] * c(0, s)).sum::<f64>();
+            for r in 0..3 {
+                for s in 0..3 {
+                    inv[s][r] = c(r, s) / det;
+                }
+            }
+            (det, inv)
+        }
+    }
+}
+
+impl BoundForm for PairForm<'_> {
+    fn name(&self) -> &str {
+        &self.kernel.meta().name
+    }
+    fn fields(&self) -> usize {
+        self.kernel.meta().fields.len()
+    }
+    fn previous(&self) -> bool {
+        self.kernel.meta().previous
+    }
+    fn linear(&self) -> bool {
+        false
+    }
+    fn piecewise(&self) -> bool {
+        false
+    }
+
+    fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {
+        let mesh = asm.mesh();
+        let d = mesh.dim();
+        let mut r = vec![0.0; layout::residual(d)];
+        self.each_point(mesh, fields, t, |e| {
+            r.fill(0.0);
+            if !self.kernel.residual_at(self.region, &e.point, &mut r) {
+                return;
+            }
+            let half = e.nodes.len() / 2;
+            for (a, &node) in e.nodes.iter().enumerate() {
+                let off = if a < half { 0 } else { d + d * d };
+                for k in 0..d {
+                    let mut v = r[off + k] * e.phi[a];
+                    for l in 0..d {
+                        v += r[off + d + k * d + l] * e.dphi[a][l];
+                    }
+                    out[node as usize * d + k] += e.weight * v;
+                }
+            }
+        });
+    }
+
+    fn tangent(&self, asm: &Assembler, fields: &[&[f64]], wrt: usize, t: f64, m: &mut Matrix) {
+        let mesh = asm.mesh();
+        let d = mesh.dim();
+        let mut c = vec![0.0; layout::tangent(d)];
+        let block = layout::block(d);
+        let mut missing = None;
+        let pattern = m.pattern.clone();
+        self.each_point(mesh, fields, t, |e| {
+            c.fill(0.0);
+            if !self.kernel.tangent_at(self.region, &e.point, wrt, &mut c) {
+                return;
+            }
+            let (n, half) = (e.nodes.len(), e.nodes.len() / 2);
+            let mut ke = vec![0.0; n * d * n * d];
+            for a in 0..n {
+                for b in 0..n {
+                    let at = (2 * usize::from(a >= half) + usize::from(b >= half)) * block;
+                    let (c00, c01) = (&c[at..], &c[at + d * d..]);
+                    let (c10, c11) = (&c[at + d * d + d * d * d..], &c[at + d * d + 2 * d * d * d..]);
+                    let (pa, pb, ga, gb) = (e.phi[a], e.phi[b], &e.dphi[a], &e.dphi[b]);
+                    for k in 0..d {
+                        for mm in 0..d {
+                            let mut v = c00[k * d + mm] * pa * pb;
+                            for nn in 0..d {
+                                v += c01[(k * d + mm) * d + nn] * pa * gb[nn];
+                            }
+                            for l in 0..d {
+                                v += c10[(k * d + l) * d + mm] * ga[l] * pb;
+                                for nn in 0..d {
+                                    v += c11[((k * d + l) * d + mm) * d + nn] * ga[l] * gb[nn];
+                                }
+                            }
+                            ke[(a * d + k) * n * d + b * d + mm] += e.weight * v;
+                        }
+                    }
+                }
+            }
+            if let Err(pair) = pattern.scatter_nodes(&e.nodes, &ke, |pos, v| m.values[pos] += v) {
+                missing = Some(pair);
+            }
+        });
+        if let Ok(mut slot) = self.missing.lock() {
+            *slot = missing;
+        }
+    }
+
+    /// The facing points move with the fields: the tangent is never decided by switches.
+    fn switches(&self, _: &Assembler, _: &[&[f64]], _: usize, _: f64, _: &mut Vec<bool>) -> bool {
+        false
+    }
+}
+
+/// The integral of a pair law's functional over its own surface.
+pub fn pair_value(form: &PairForm<'_>, mesh: &Mesh, fields: &[&[f64]], t: f64) -> f64 {
+    let mut sum = 0.0;
+    form.each_point(mesh, fields, t, |e| sum += e.weight * form.kernel.value_at(form.region, &e.point));
+    sum
+}

@@ -1,0 +1,77 @@
+//! Contact between two surfaces of the mesh (two bodies): the interface a pair law's kernels
+//! implement, pointwise, and the assembly that finds the facing points and contracts the
+//! kernels' coefficients with both cells' basis functions.
+//!
+//! A pair law is evaluated at the quadrature points of its own surface. At each, the facing
+//! point is the closest point of the other surface on the deformed configuration
+//! ([`crate::fem::facing::Surface`]); the kernel reads both sides' fields there and returns
+//! the coefficients of both sides' test functions and of the tangent's four blocks. The facing
+//! point is held fixed in the reference cell while the tangent is taken (its motion with the
+//! displacements is not differentiated: docs/mathematics.md, "Two bodies").
+
+pub mod assembly;
+
+use crate::fem::kernel::Form;
+
+/// The most space dimensions a pair point holds.
+pub const MAX_DIM: usize = 3;
+
+/// A field's value and gradient at a point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FieldAt {
+    pub value: [f64; MAX_DIM],
+    /// `grad[k][l]` = ∂_l u_k.
+    pub grad: [[f64; MAX_DIM]; MAX_DIM],
+}
+
+/// One side of a pair at a point: its reference position, the outward unit normal of its body
+/// there, the diameter of the cell carrying the facet, and the fields (the form's arguments,
+/// then the previous level if it reads it).
+#[derive(Clone, Debug, Default)]
+pub struct SideAt {
+    pub x: [f64; MAX_DIM],
+    pub normal: [f64; MAX_DIM],
+    pub h: f64,
+    pub fields: Vec<FieldAt>,
+}
+
+/// A quadrature point of a pair's own surface and the point facing it.
+#[derive(Clone, Debug, Default)]
+pub struct PairPoint {
+    pub dim: usize,
+    pub t: f64,
+    pub own: SideAt,
+    pub facing: SideAt,
+}
+
+/// Sizes of a kernel's outputs in dimension `d`.
+pub mod layout {
+    /// The residual's coefficients: f0 (d), f1 (d²) of the own test function, then h0, h1 of
+    /// the facing one (`IntegralIr` and `PairIr` conventions of the compiler).
+    pub fn residual(d: usize) -> usize {
+        2 * (d + d * d)
+    }
+
+    /// One tangent block: c00 (d²), c01 (d³), c10 (d³), c11 (d⁴).
+    pub fn block(d: usize) -> usize {
+        d * d + 2 * d * d * d + d * d * d * d
+    }
+
+    /// The tangent's four blocks, (own test, own trial), (own, facing), (facing, own),
+    /// (facing, facing), one after the other.
+    pub fn tangent(d: usize) -> usize {
+        4 * block(d)
+    }
+}
+
+/// The kernels of a pair law's form: pointwise coefficients, which the assembly weights and
+/// contracts. `region` indexes `meta().facets`.
+pub trait PairKernel: Form + Send + Sync {
+    /// Writes the residual's coefficients ([`layout::residual`]); false if the form has no
+    /// residual on `region` (a functional, or an integrand that is zero).
+    fn residual_at(&self, region: usize, p: &PairPoint, out: &mut [f64]) -> bool;
+    /// Writes the tangent's blocks with respect to field `wrt` ([`layout::tangent`]).
+    fn tangent_at(&self, region: usize, p: &PairPoint, wrt: usize, out: &mut [f64]) -> bool;
+    /// A functional's integrand.
+    fn value_at(&self, region: usize, p: &PairPoint) -> f64;
+}
