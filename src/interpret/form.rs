@@ -101,6 +101,17 @@ impl InterpretedForm {
         assert!(D == self.dim, "interpreted form `{}` is bound for dimension {}, not {D}", self.meta().name, self.dim);
         &self.unit.forms[self.form].dims[D - 1]
     }
+
+    /// A contact pair's law: the pointwise programs of its facet integrals in the bound
+    /// dimension.
+    pub(super) fn pair_integrals(&self) -> Option<&[signorini_compiler::ir::pair::PairIntegral]> {
+        self.unit.forms[self.form].pairs.as_ref().map(|dims| dims[self.dim - 1].as_slice())
+    }
+
+    /// Whether the form is one of a contact pair's law.
+    pub fn is_pair(&self) -> bool {
+        self.unit.forms[self.form].pairs.is_some()
+    }
 }
 
 impl std::fmt::Debug for InterpretedForm {

@@ -21,6 +21,7 @@
 
 mod form;
 mod kernels;
+mod pair;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -115,6 +116,8 @@ struct FormEntry {
     meta: FormMeta,
     /// Kernels for dimensions 1, 2, 3.
     dims: Vec<plan::FormPlan>,
+    /// A contact pair's law: its pointwise programs for dimensions 1, 2, 3.
+    pairs: Option<Vec<Vec<signorini_compiler::ir::pair::PairIntegral>>>,
 }
 
 impl Library {
@@ -154,6 +157,7 @@ impl Library {
             .map(|fi| FormEntry {
                 meta: meta(prog, irs, fi),
                 dims: irs.iter().map(|ir| plan::form(prog, ir, &ir.forms[fi])).collect(),
+                pairs: irs.iter().map(|ir| signorini_compiler::ir::pair::plan(ir, &ir.forms[fi])).collect(),
             })
             .collect();
         let file = prog.sources.path(prog.root).display().to_string();
@@ -163,6 +167,11 @@ impl Library {
     /// The checker's rendered warnings (empty for [`Library::new`]).
     pub fn warnings(&self) -> &str {
         &self.warnings
+    }
+
+    /// Whether the file is a contact pair's law (it reads `opposite`).
+    pub fn is_pair_law(&self) -> bool {
+        self.unit.forms.iter().any(|f| f.pairs.is_some())
     }
 
     /// Names of the forms and functionals, in declaration order.

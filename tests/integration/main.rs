@@ -23,6 +23,7 @@ mod interpreted_forms;
 mod interpreted_schemes;
 #[cfg(feature = "petsc")]
 mod mpi;
+mod pairs;
 #[cfg(feature = "petsc")]
 mod petsc;
 mod previous_level;

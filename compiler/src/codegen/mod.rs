@@ -100,6 +100,12 @@ pub fn pretty(prog: &Program, irs: &[&DimIr], opts: &Options) -> Result<String, 
 type CoefficientUses = Vec<(String, Vec<Vec<String>>)>;
 
 fn module(prog: &Program, irs: &[&DimIr], opts: &Options) -> Result<(syn::File, CoefficientUses), String> {
+    if irs.iter().any(|ir| ir.forms.iter().any(|f| f.pair)) {
+        return Err(format!(
+            "{} reads `opposite`: a contact pair's law is interpreted at run time, not compiled (keep it in forms/pairs/)",
+            opts.source_name
+        ));
+    }
     let (items, uses) = items(prog, irs, opts);
     let text = module_text(&items, opts)?;
     let file =

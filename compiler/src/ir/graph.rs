@@ -54,10 +54,22 @@ pub enum Sym {
 /// side, there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Facing {
-    Field { arg: u8, comp: u8 },
-    FieldGrad { arg: u8, comp: u8, dir: u8 },
-    Test { comp: u8 },
-    TestGrad { comp: u8, dir: u8 },
+    Field {
+        arg: u8,
+        comp: u8,
+    },
+    FieldGrad {
+        arg: u8,
+        comp: u8,
+        dir: u8,
+    },
+    Test {
+        comp: u8,
+    },
+    TestGrad {
+        comp: u8,
+        dir: u8,
+    },
     /// The facing body's outward unit normal.
     Normal(u8),
     /// The facing point.

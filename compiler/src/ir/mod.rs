@@ -10,6 +10,7 @@ pub mod derive;
 pub mod eval;
 pub mod graph;
 pub mod lower;
+pub mod pair;
 pub mod plan;
 pub mod print;
 
@@ -86,6 +87,12 @@ pub struct PairIr {
     /// (facing test, facing trial), in [`TangentIr`]'s conventions; the own block is the
     /// integral's `tangents`.
     pub tangents: Vec<[TangentIr; 3]>,
+    /// The derivative of each of f0, f1, h0, h1 (in that order, entry c) as the facing point
+    /// slides, y → y + s e_r, in the reference configuration of the facing body: at
+    /// `[c*d + r]`. The facing side's values move along their gradients there; their
+    /// gradients and normal are held (exact on P1 facets, whose gradients and normal are
+    /// constant on a cell).
+    pub sliding: Vec<NodeId>,
 }
 
 /// Index conventions: k = test component, l = test derivative direction, m = trial component,
@@ -139,7 +146,8 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
     let mut g = lowerer.g;
     // A file that reads the facing side anywhere is a contact pair's law: each of its facet
     // integrals is evaluated at facing points, and it has no volume integral.
-    let reads_facing = |g: &Graph, n: NodeId| g.reachable([n]).into_iter().any(|m| matches!(g.node(m), Node::Sym(Sym::Opposite(_))));
+    let reads_facing =
+        |g: &Graph, n: NodeId| g.reachable([n]).into_iter().any(|m| matches!(g.node(m), Node::Sym(Sym::Opposite(_))));
     let pair_law = lowered.iter().any(|lf| lf.integrands.iter().any(|i| reads_facing(&g, i.value)));
     if pair_law && let Some(e) = pair_volume_error(prog, &lowered) {
         return Err(vec![e]);
@@ -206,7 +214,15 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
         if let Some(e) = degree_error(prog, &lf.name, &integrals) {
             diags.push(e);
         }
-        forms.push(FormIr { name: lf.name, fields: lf.fields, test: lf.test, integrals, linear, previous, pair: pair_law });
+        forms.push(FormIr {
+            name: lf.name,
+            fields: lf.fields,
+            test: lf.test,
+            integrals,
+            linear,
+            previous,
+            pair: pair_law,
+        });
     }
     if !diags.is_empty() {
         return Err(diags);
@@ -323,7 +339,38 @@ fn pair(g: &mut Graph, d: usize, fields: usize, value: NodeId, own: (&[NodeId], 
             ]
         })
         .collect();
-    PairIr { h0, h1, tangents }
+    let coefficients: Vec<NodeId> = own.0.iter().chain(own.1).chain(&h0).chain(&h1).copied().collect();
+    let sliding = sliding(g, d, &coefficients);
+    PairIr { h0, h1, tangents, sliding }
+}
+
+/// The derivative of each of `roots` as the facing point slides along each axis r (see
+/// [`PairIr::sliding`]): its leaves read at y + s e_r to first order in s, differentiated in
+/// s at 0.
+fn sliding(g: &mut Graph, d: usize, roots: &[NodeId]) -> Vec<NodeId> {
+    use graph::Facing;
+    let s = Sym::Seed(u8::MAX);
+    let mut out = vec![0; roots.len() * d];
+    for r in 0..d as u8 {
+        let shifted = |g: &mut Graph, x: Sym| -> Option<NodeId> {
+            let Sym::Opposite(f) = x else { return None };
+            let along = match f {
+                Facing::Coord(k) if k == r => g.one(),
+                Facing::Field { arg, comp } => g.sym(Sym::Opposite(Facing::FieldGrad { arg, comp, dir: r })),
+                _ => return None,
+            };
+            let (at, seed) = (g.sym(x), g.sym(s));
+            let step = g.mul(seed, along);
+            Some(g.add(at, step))
+        };
+        let mut ds = Derivative::new(s);
+        for (c, &root) in roots.iter().enumerate() {
+            let moved = g.replace(root, &shifted);
+            let rate = ds.of(g, moved);
+            out[c * d + r as usize] = g.replace(rate, &|g: &mut Graph, x: Sym| (x == s).then(|| g.zero()));
+        }
+    }
+    out
 }
 
 /// E0408: a volume integral in a contact pair's law.
@@ -338,7 +385,9 @@ fn pair_volume_error(prog: &Unit, lowered: &[lower::LoweredForm]) -> Option<Diag
             integral.integrand.span,
             "a pair's law integrates over the pair's surfaces",
         )
-        .with_note("the file reads `opposite`, so its integrals are evaluated at the points facing each other on two surfaces")
+        .with_note(
+            "the file reads `opposite`, so its integrals are evaluated at the points facing each other on two surfaces",
+        )
         .with_help("move the volume terms to the material's file"),
     )
 }

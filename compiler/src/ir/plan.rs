@@ -213,8 +213,12 @@ pub struct FormPlan {
     pub facets: Vec<Integral>,
 }
 
-/// The plan of `form`, lowered in `ir`.
+/// The plan of `form`, lowered in `ir`: empty for a contact pair's law, whose integrals are
+/// evaluated pointwise at facing points (`ir::pair`).
 pub fn form(unit: &Unit, ir: &DimIr, form: &FormIr) -> FormPlan {
+    if form.pair {
+        return FormPlan { cell: None, facets: Vec::new() };
+    }
     let integral = |i: &IntegralIr| Integral {
         cell: i.cell,
         // A functional has no test function, so no residual.

@@ -13,7 +13,9 @@ impl Lowerer<'_> {
         let map = |g: &mut Graph, s: Sym| match s {
             Sym::Field { comp, .. } => Some(g.sym(Sym::Field { arg: previous, comp })),
             Sym::FieldGrad { comp, dir, .. } => Some(g.sym(Sym::FieldGrad { arg: previous, comp, dir })),
-            Sym::Opposite(Facing::Field { comp, .. }) => Some(g.sym(Sym::Opposite(Facing::Field { arg: previous, comp }))),
+            Sym::Opposite(Facing::Field { comp, .. }) => {
+                Some(g.sym(Sym::Opposite(Facing::Field { arg: previous, comp })))
+            }
             Sym::Opposite(Facing::FieldGrad { comp, dir, .. }) => {
                 Some(g.sym(Sym::Opposite(Facing::FieldGrad { arg: previous, comp, dir })))
             }

@@ -34,6 +34,8 @@ pub struct PairForm<'m> {
     /// The quadrature points of each local facet of the element (weights on the reference
     /// facet, times its measure), with its reference normal.
     rule: Vec<(Vec<Tabulated>, Vec<f64>)>,
+    /// Per local facet, its edge vectors e_α in the reference cell (ξ(s) = ξ0 + Σ s_α e_α).
+    edges: Vec<Vec<[f64; MAX_DIM]>>,
     /// A coupling the matrix pattern lacks, met by the last tangent: the two nodes.
     missing: Mutex<Option<(u32, u32)>>,
 }
@@ -48,6 +50,8 @@ struct PairElement {
     phi: Vec<f64>,
     /// Physical gradients, per node.
     dphi: Vec<[f64; MAX_DIM]>,
+    /// The facing facet's tangents T_α = ∂y/∂s_α on the reference configuration.
+    tangents: Vec<[f64; MAX_DIM]>,
 }
 
 impl<'m> PairForm<'m> {
@@ -78,7 +82,20 @@ impl<'m> PairForm<'m> {
                 (points, kind.reference_normal(f))
             })
             .collect();
-        PairForm { kernel, region, own, facing, reach, rule, missing: Mutex::new(None) }
+        let edges = (0..kind.facets().len())
+            .map(|f| {
+                let (xi0, _) = kind.facet_point(f, &vec![0.0; d - 1]);
+                (0..d - 1)
+                    .map(|a| {
+                        let mut s = vec![0.0; d - 1];
+                        s[a] = 1.0;
+                        let (xi, _) = kind.facet_point(f, &s);
+                        std::array::from_fn(|r| if r < d { xi[r] - xi0[r] } else { 0.0 })
+                    })
+                    .collect()
+            })
+            .collect();
+        PairForm { kernel, region, own, facing, reach, rule, edges, missing: Mutex::new(None) }
     }
 
     /// The node pairs of the two surfaces' cells that may couple: those of facets within
@@ -90,7 +107,8 @@ impl<'m> PairForm<'m> {
             let own_nodes = mesh.cell(f.cell as usize);
             let (mut lower, mut upper) = ([0.0; 3], [0.0; 3]);
             for r in 0..mesh.dim() {
-                let along = mesh.kind.facet_nodes(f.local as usize).into_iter().map(|a| mesh.node(own_nodes[a] as usize)[r]);
+                let along =
+                    mesh.kind.facet_nodes(f.local as usize).into_iter().map(|a| mesh.node(own_nodes[a] as usize)[r]);
                 let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
                 (lower[r], upper[r]) = (lo - self.reach, hi + self.reach);
             }
@@ -128,12 +146,17 @@ impl<'m> PairForm<'m> {
                 let kind = mesh.kind;
                 let (phi, dref) = (kind.basis(&facing.xi), kind.basis_gradients(&facing.xi));
                 let other = side(mesh, g.cell as usize, &phi, &dref, &kind.reference_normal(g.local as usize), fields);
+                let tangents = self.edges[g.local as usize]
+                    .iter()
+                    .map(|e| std::array::from_fn(|r| (0..d).map(|c| other.jacobian[r][c] * e[c]).sum()))
+                    .collect();
                 let nodes = mesh.cell(f.cell as usize).iter().chain(mesh.cell(g.cell as usize)).copied().collect();
                 let element = PairElement {
                     weight: q.weight * own.scale,
                     nodes,
                     phi: q.phi.iter().chain(&phi).copied().collect(),
                     dphi: own.dphi.into_iter().chain(other.dphi).collect(),
+                    tangents,
                     point: PairPoint { dim: d, t, own: own.side, facing: other.side },
                 };
                 each(&element);
@@ -148,6 +171,8 @@ struct Side {
     side: SideAt,
     dphi: Vec<[f64; MAX_DIM]>,
     scale: f64,
+    /// J = ∂x/∂ξ on the reference configuration.
+    jacobian: [[f64; MAX_DIM]; MAX_DIM],
 }
 
 fn side(mesh: &Mesh, cell: usize, phi: &[f64], dref: &[Vec<f64>], ref_normal: &[f64], fields: &[&[f64]]) -> Side {
@@ -190,7 +215,7 @@ fn side(mesh: &Mesh, cell: usize, phi: &[f64], dref: &[Vec<f64>], ref_normal: &[
             at
         })
         .collect();
-    Side { side: SideAt { x, normal, h: mesh.cell_size(cell), fields }, dphi, scale: size * det.abs() }
+    Side { side: SideAt { x, normal, h: mesh.cell_size(cell), fields }, dphi, scale: size * det.abs(), jacobian: j }
 }
 
 /// The determinant and inverse of the leading d×d block.
@@ -272,6 +297,7 @@ impl BoundForm for PairForm<'_> {
         let block = layout::block(d);
         let mut missing = None;
         let pattern = m.pattern.clone();
+        let moving = self.fields().saturating_sub(1);
         self.each_point(mesh, fields, t, |e| {
             c.fill(0.0);
             if !self.kernel.tangent_at(self.region, &e.point, wrt, &mut c) {
@@ -302,6 +328,9 @@ impl BoundForm for PairForm<'_> {
                     }
                 }
             }
+            if wrt == moving {
+                self.add_sliding(e, &c[4 * block..], d, &mut ke);
+            }
             if let Err(pair) = pattern.scatter_nodes(&e.nodes, &ke, |pos, v| m.values[pos] += v) {
                 missing = Some(pair);
             }
@@ -314,6 +343,90 @@ impl BoundForm for PairForm<'_> {
     /// The facing points move with the fields: the tangent is never decided by switches.
     fn switches(&self, _: &Assembler, _: &[&[f64]], _: usize, _: f64, _: &mut Vec<bool>) -> bool {
         false
+    }
+}
+
+impl PairForm<'_> {
+    /// Adds to `ke` the tangent's part through the facing point's motion. The facing point y
+    /// is where (p_s − p_m(y))·t_α = 0, with p = x + u the deformed positions and
+    /// t_α = (I + ∇u_m) T_α the deformed facet's tangents; its variation gives
+    /// G δξ = (δu_s(x) − δu_m(y))·t_α + (p_s − p_m)·∇δu_m T_α, G_αβ = t_α·t_β (the facing
+    /// facet's curvature, a P2 term times the gap, is left out), and δy = T_α δξ_α. The
+    /// residual's rate along δy is the kernel's sliding rates plus, on the facing nodes, the
+    /// coefficients times the basis functions' gradients (their second derivatives, zero on
+    /// P1, are left out). `rates` holds the residual's coefficients then their sliding rates.
+    fn add_sliding(&self, e: &PairElement, rates: &[f64], d: usize, ke: &mut [f64]) {
+        let (n, half) = (e.nodes.len(), e.nodes.len() / 2);
+        let moving = self.fields().saturating_sub(1);
+        let (own_u, facing_u) = (&e.point.own.fields[moving], &e.point.facing.fields[moving]);
+        let gap: [f64; MAX_DIM] =
+            std::array::from_fn(|r| (e.point.own.x[r] + own_u.value[r]) - (e.point.facing.x[r] + facing_u.value[r]));
+        let q = d - 1;
+        let big_t = &e.tangents;
+        let t: Vec<[f64; MAX_DIM]> = big_t
+            .iter()
+            .map(|ta| std::array::from_fn(|r| ta[r] + (0..d).map(|c| facing_u.grad[r][c] * ta[c]).sum::<f64>()))
+            .collect();
+        let dot = |a: &[f64; MAX_DIM], b: &[f64; MAX_DIM]| (0..d).map(|r| a[r] * b[r]).sum::<f64>();
+        // G⁻¹, (d − 1) × (d − 1).
+        let ginv: [[f64; 2]; 2] = match q {
+            0 => return,
+            1 => [[1.0 / dot(&t[0], &t[0]), 0.0], [0.0, 0.0]],
+            _ => {
+                let (a, b, c) = (dot(&t[0], &t[0]), dot(&t[0], &t[1]), dot(&t[1], &t[1]));
+                let det = a * c - b * b;
+                [[c / det, -b / det], [-b / det, a / det]]
+            }
+        };
+        // Y[r][(b, m)]: the rate of y_r with dof m of node b.
+        let mut y = vec![0.0; d * n * d];
+        for b in 0..n {
+            for mm in 0..d {
+                // The right-hand side's α entries for this dof.
+                let mut rhs = [0.0; 2];
+                for (alpha, slot) in rhs.iter_mut().enumerate().take(q) {
+                    *slot = if b < half {
+                        t[alpha][mm] * e.phi[b]
+                    } else {
+                        let along = (0..d).map(|c| e.dphi[b][c] * big_t[alpha][c]).sum::<f64>();
+                        -t[alpha][mm] * e.phi[b] + gap[mm] * along
+                    };
+                }
+                for r in 0..d {
+                    let mut v = 0.0;
+                    for alpha in 0..q {
+                        let dxi = (0..q).map(|beta| ginv[alpha][beta] * rhs[beta]).sum::<f64>();
+                        v += big_t[alpha][r] * dxi;
+                    }
+                    y[(r * n + b) * d + mm] = v;
+                }
+            }
+        }
+        let side = d + d * d;
+        let (coefficients, sliding) = (&rates[..2 * side], &rates[2 * side..]);
+        for a in 0..n {
+            let off = if a < half { 0 } else { side };
+            for k in 0..d {
+                // ∂R_(a,k)/∂y_r.
+                let mut along = [0.0; MAX_DIM];
+                for (r, slot) in along.iter_mut().enumerate().take(d) {
+                    let mut v = sliding[(off + k) * d + r] * e.phi[a];
+                    for l in 0..d {
+                        v += sliding[(off + d + k * d + l) * d + r] * e.dphi[a][l];
+                    }
+                    if a >= half {
+                        v += coefficients[off + k] * e.dphi[a][r];
+                    }
+                    *slot = v;
+                }
+                for b in 0..n {
+                    for mm in 0..d {
+                        let v = (0..d).map(|r| along[r] * y[(r * n + b) * d + mm]).sum::<f64>();
+                        ke[(a * d + k) * n * d + b * d + mm] += e.weight * v;
+                    }
+                }
+            }
+        }
     }
 }
 

@@ -6,8 +6,10 @@
 //! point is the closest point of the other surface on the deformed configuration
 //! ([`crate::fem::facing::Surface`]); the kernel reads both sides' fields there and returns
 //! the coefficients of both sides' test functions and of the tangent's four blocks. The facing
-//! point is held fixed in the reference cell while the tangent is taken (its motion with the
-//! displacements is not differentiated: docs/mathematics.md, "Two bodies").
+//! point moves with both sides' displacements, and the tangent follows it: the closest-point
+//! condition's linearization gives the facing point's rate, which the kernel's sliding rates
+//! and the facing basis functions' gradients turn into the tangent's third part
+//! (docs/mathematics.md, "Two bodies").
 
 pub mod assembly;
 
@@ -58,9 +60,11 @@ pub mod layout {
     }
 
     /// The tangent's four blocks, (own test, own trial), (own, facing), (facing, own),
-    /// (facing, facing), one after the other.
+    /// (facing, facing), one after the other; then the residual's coefficients, and their rates
+    /// as the facing point slides along each axis (`[c·d + r]`), for the part of the tangent
+    /// through the facing point's motion.
     pub fn tangent(d: usize) -> usize {
-        4 * block(d)
+        4 * block(d) + residual(d) * (1 + d)
     }
 }
 
