@@ -42,6 +42,8 @@ pub const CODES: &[(&str, &str)] = &[
         "E0407",
         "`derivative(e, u, d)` with respect to something that is not a field of the form or an argument of the function",
     ),
+    ("E0408", "`opposite` outside a facet integral (only a contact pair's surface has a facing side)"),
+    ("E0409", "a volume integral in a contact pair's law (a file that reads `opposite`)"),
     ("E0501", "`n` or `h` in a volume integral"),
     ("E0502", "derivative of something that has none"),
     ("E0503", "form needs a quadrature degree above the cap (20)"),

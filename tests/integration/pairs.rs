@@ -45,18 +45,17 @@ fn pair<'m>(mesh: &'m Mesh, form: &str) -> PairForm<'m> {
 }
 
 /// Elasticity (E = 10, ν = 0.3) and its load: the block's weight, 1 per unit area.
-fn material(mesh: &Mesh) -> (Box<dyn BoundForm + '_>, Box<dyn BoundForm + '_>) {
+fn material() -> (Box<dyn BoundForm>, Box<dyn BoundForm>) {
     let lib = Library::load(Path::new("forms/elasticity.wf")).unwrap();
     let weight = Coef::of_position(2, |x, out| {
         out[0] = 0.0;
         out[1] = if x[1] > 1.0 { -1.0 } else { 0.0 };
     });
     let coefs = [("f", weight)];
-    let bound = |name: &str| -> Box<dyn BoundForm + '_> {
+    let bound = |name: &str| -> Box<dyn BoundForm> {
         let kernel = lib.form(name, 2, &[("E", 10.0), ("nu", 0.3)], &coefs).unwrap();
         Box::new(Bound { kernel, quadrature: Quadrature::default(), regions: vec![], cells: None })
     };
-    let _ = mesh;
     (bound("stiffness"), bound("load"))
 }
 
@@ -86,7 +85,7 @@ fn a_block_pressed_on_a_foundation_puts_its_weight_on_it() {
         let mesh = blocks(degree, 0.0);
         let contact = pair(&mesh, "contact");
         let asm = Assembler::with_couplings(&mesh, &contact.couplings(&mesh));
-        let (stiffness, load) = material(&mesh);
+        let (stiffness, load) = material();
         let n = asm.size();
         let mut weight = vec![0.0; n];
         load.residual(&asm, &[], 0.0, &mut weight);

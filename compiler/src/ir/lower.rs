@@ -414,7 +414,7 @@ impl<'p> Lowerer<'p> {
         if f == "opposite" {
             if !self.facing {
                 return Err(Box::new(
-                    Diagnostic::error("E0407", "`opposite` outside a facet integral", span, "no facing surface here")
+                    Diagnostic::error("E0408", "`opposite` outside a facet integral", span, "no facing surface here")
                         .with_note("`opposite(e)` is `e` on the other surface of a contact pair, at the point facing the quadrature point: it is read in the integrals over a pair's surface, `int(Gamma_C)`")
                         .with_help("integrate over the contact surface: `form contact(u; v) = int(Gamma_C) ...`"),
                 ));

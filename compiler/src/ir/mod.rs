@@ -373,14 +373,14 @@ fn sliding(g: &mut Graph, d: usize, roots: &[NodeId]) -> Vec<NodeId> {
     out
 }
 
-/// E0408: a volume integral in a contact pair's law.
+/// E0409: a volume integral in a contact pair's law.
 fn pair_volume_error(prog: &Unit, lowered: &[lower::LoweredForm]) -> Option<Diagnostic> {
     let lf = lowered.iter().find(|lf| lf.integrands.iter().any(|i| i.region == CELL_REGION))?;
     let form = prog.forms.iter().find(|f| f.name == lf.name)?;
     let integral = form.integrals.iter().find(|i| i.region.name == CELL_REGION)?;
     Some(
         Diagnostic::error(
-            "E0408",
+            "E0409",
             format!("volume integral in `{}`, in a contact pair's law", lf.name),
             integral.integrand.span,
             "a pair's law integrates over the pair's surfaces",
