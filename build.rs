@@ -130,6 +130,16 @@ fn main() {
         "/// The text of every scheme file of `forms/schemes/`, by file stem: `verify --scheme` reads\n/// the claims (`claim order = 2`) from it.\npub static SCHEME_SOURCES: &[(&str, &str)] = &[{}];",
         scheme_texts.join(", ")
     );
+    let pairs = wf_files(Path::new("forms/pairs"));
+    let pair_texts: Vec<String> = pairs
+        .iter()
+        .map(|s| format!("(\"{s}\", include_str!(concat!(env!(\"CARGO_MANIFEST_DIR\"), \"/forms/pairs/{s}.wf\")))"))
+        .collect();
+    let _ = writeln!(
+        out,
+        "/// The text of every contact pair law of `forms/pairs/`, by file stem: interpreted at run time\n/// (a law that reads `opposite` is evaluated at the facing points, not generated).\npub static PAIR_SOURCES: &[(&str, &str)] = &[{}];",
+        pair_texts.join(", ")
+    );
     let problems = wf_files(Path::new("forms/problems"));
     let problem_texts: Vec<String> = problems
         .iter()

@@ -45,6 +45,8 @@ pub struct Bench {
 pub struct Defaults {
     pub scheme: String,
     pub contact: String,
+    /// The contact law of a problem with contact pairs (a law of `forms/pairs/`).
+    pub pair: String,
     pub material: String,
 }
 

@@ -12,6 +12,9 @@ use crate::fem::assembly::{Functional, Kernel, Quadrature};
 use crate::fem::bound::{Bound, BoundForm, BoundFunctional, BoundValue};
 use crate::fem::kernel::{Coef, FormMeta};
 use crate::fem::mesh::{Body, Facet};
+use crate::fem::pair::assembly::PairForm;
+use crate::fem::pair::{PairKernel, Surfaces};
+use crate::fem::summed::{Summed, SummedFunctional};
 use crate::time::scheme::TimeScheme;
 
 /// What a form file's forms are bound to: the quadrature, and the mesh facets of every boundary
@@ -27,18 +30,24 @@ pub struct Binding<'m> {
     /// The mesh's bodies, when it has several: the files' forms are then bound to each body
     /// with its own param values ([`Binding::body`]) and summed.
     pub bodies: &'m [Body],
+    /// The contact pairs a pair law (a file that reads `opposite`) is bound to, each once.
+    pub pairs: Vec<Surfaces<'m>>,
 }
 
 impl<'m> Binding<'m> {
     /// A binding of the whole mesh (one body) to `regions`.
     pub fn new(quadrature: Quadrature, regions: Vec<(String, &'m [Facet])>, dim: usize) -> Self {
-        Binding { quadrature, regions, dim, cells: None, bodies: &[] }
+        Binding { quadrature, regions, dim, cells: None, bodies: &[], pairs: Vec::new() }
     }
 
-    /// This binding cut to `body`: its cells, and the facets they carry.
+    /// This binding cut to `body`: its cells, the facets they carry, and the pairs whose own
+    /// surface is its (a pair law reads the params of the body it integrates over; another
+    /// body binds the pair to no facet).
     pub fn body(&self, body: &'m Body) -> Binding<'m> {
         let regions = self.regions.clone();
-        Binding { quadrature: self.quadrature, regions, dim: self.dim, cells: Some(&body.cells), bodies: &[] }
+        let own = |p: &Surfaces<'m>| p.own.first().is_some_and(|f| body.cells[f.cell as usize]);
+        let pairs = self.pairs.iter().map(|p| if own(p) { *p } else { Surfaces { own: &[], ..*p } }).collect();
+        Binding { quadrature: self.quadrature, regions, dim: self.dim, cells: Some(&body.cells), bodies: &[], pairs }
     }
 }
 
@@ -129,6 +138,10 @@ pub enum LibraryError {
         "{at}: `{form}` takes a tangential part, across the obstacle normal, which a 1D problem does not have (its only direction is the normal): a frictional law needs a 2D or 3D problem"
     )]
     NoTangentSpace { form: String, at: String },
+    #[error(
+        "`{form}` reads `opposite`: it is a law between two bodies, and the problem declares no contact pair (`contact Gamma_a with Gamma_b`)"
+    )]
+    NoPairs { form: String },
 }
 
 impl<'m> Binding<'m> {
@@ -180,6 +193,34 @@ impl<'m> Binding<'m> {
         self.tangent_space(meta)?;
         let regions = self.regions_of(&meta.name, &meta.facets, &meta.facet_sites)?;
         Ok(SlotForm::Form(Box::new(Bound { kernel, quadrature: self.quadrature, regions, cells: self.cells })))
+    }
+
+    /// A pair law's form or functional bound to every pair of this binding, summed over them.
+    pub fn pair<K: PairKernel + Clone + 'm>(&self, kernel: K, functional: bool) -> Result<SlotForm<'m>, LibraryError> {
+        let meta = kernel.meta();
+        self.tangent_space(meta)?;
+        if self.pairs.is_empty() {
+            return Err(LibraryError::NoPairs { form: meta.name.to_string() });
+        }
+        let forms: Vec<PairForm<'m>> = self
+            .pairs
+            .iter()
+            .map(|p| {
+                let degree = self
+                    .quadrature
+                    .facet
+                    .unwrap_or_else(|| meta.facets.first().map_or(1, |(_, d)| d[p.kind.degree() as usize - 1]));
+                PairForm::new(Box::new(kernel.clone()), 0, p.kind, p.own, p.facing, degree, p.reach)
+            })
+            .collect();
+        Ok(match functional {
+            false => SlotForm::Form(Box::new(Summed::new(
+                forms.into_iter().map(|f| Box::new(f) as Box<dyn BoundForm + 'm>).collect(),
+            ))),
+            true => SlotForm::Functional(Box::new(SummedFunctional::over_bodies(
+                forms.into_iter().map(|f| Box::new(f) as Box<dyn BoundFunctional + 'm>).collect(),
+            ))),
+        })
     }
 
     /// A functional kernel bound to this mesh.

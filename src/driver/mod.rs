@@ -151,6 +151,11 @@ pub fn contact_names() -> Vec<&'static str> {
         .collect()
 }
 
+/// Names of the library's contact laws between two bodies (`forms/pairs/`, by file stem).
+pub fn pair_names() -> Vec<&'static str> {
+    sources::pair_names()
+}
+
 /// Names of the library's frictional contact laws (those that also provide `friction_work`),
 /// short form.
 pub fn frictional_contact_names() -> Vec<&'static str> {
@@ -272,8 +277,13 @@ pub fn form_units(methods: &Methods) -> Result<(Vec<FormSource>, usize), CaseErr
                 .map(|i| FormSource::Interpreted(Box::new(i)))
                 .map_err(CaseError::CaseFile);
         }
-        let u = library_forms(methods, name, prefix).ok_or_else(|| unknown(what, name, known))?;
-        with_roles(u, &material, &roles)
+        match library_forms(methods, name, prefix) {
+            Some(u) => with_roles(u, &material, &roles),
+            None => match sources::library_pair(name) {
+                Some(pair) => pair.map(|i| FormSource::Interpreted(Box::new(i))).map_err(CaseError::CaseFile),
+                None => Err(unknown(what, name, known)),
+            },
+        }
     };
     let contact = pick(&methods.contact, "contact_", "contact law", &contact_names())?;
     let extras: Vec<FormSource> = methods

@@ -56,6 +56,22 @@ fn roles_of(prog: &crate::compiler::Program) -> Vec<(String, String)> {
 
 /// Checks and lowers a form file the run writes itself (`name` is how messages name it).
 pub fn interpret_text(name: &str, text: &str) -> Result<Interpreted, String> {
+    interpret_source(name, text, true)
+}
+
+/// A contact pair law of the library (`forms/pairs/`) by its file stem (`pair_penalty`),
+/// checked and lowered from the text built in.
+pub fn library_pair(name: &str) -> Option<Result<Interpreted, String>> {
+    let (stem, text) = crate::forms::PAIR_SOURCES.iter().find(|(stem, _)| *stem == name)?;
+    Some(interpret_source(&format!("forms/pairs/{stem}.wf"), text, false))
+}
+
+/// The library's pair laws, by file stem.
+pub fn pair_names() -> Vec<&'static str> {
+    crate::forms::PAIR_SOURCES.iter().map(|(stem, _)| *stem).collect()
+}
+
+fn interpret_source(name: &str, text: &str, generated: bool) -> Result<Interpreted, String> {
     let path = Path::new(name);
     let prog = crate::compiler::pipeline::check_text(path, text, &LibraryLoader)
         .map_err(|(diags, sources)| crate::compiler::render_all(&diags, &sources))?;
@@ -64,7 +80,7 @@ pub fn interpret_text(name: &str, text: &str) -> Result<Interpreted, String> {
         file: name.to_string(),
         params: describe::params(&prog),
         slots: describe::slots(&prog),
-        generated: true,
+        generated,
         roles: roles_of(&prog),
         rebound: None,
         lib: Library::new(&prog),
@@ -91,7 +107,11 @@ impl Interpreted {
                 .lib
                 .form(&slot.name, binding.dim, &params, &data)
                 .map_err(|e| LibraryError::Coef(e.to_string()))?;
-            let bound = if slot.functional { binding.functional(form)? } else { binding.form(form)? };
+            let bound = match (self.lib.is_pair_law(), slot.functional) {
+                (true, functional) => binding.pair(form, functional)?,
+                (false, true) => binding.functional(form)?,
+                (false, false) => binding.form(form)?,
+            };
             made.push((&*slot.name, bound));
         }
         Ok(made)

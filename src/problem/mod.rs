@@ -18,6 +18,7 @@ mod neumann;
 pub mod observe;
 pub mod options;
 pub mod outputs;
+mod pairs;
 mod reference;
 mod resolve;
 mod resume;

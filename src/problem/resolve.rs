@@ -76,6 +76,10 @@ fn unmatched(
 /// The problem's `bind` lines, for the roles the user did not choose; a path is relative to the
 /// problem file.
 fn bind_files(pf: &ProblemFile, methods: &mut Methods, chosen: Chosen) {
+    // Contact between bodies takes a pair law unless the problem or the user names one.
+    if !pf.problem().pairs.is_empty() && !chosen.contact {
+        methods.contact = crate::settings::get().defaults.pair.clone();
+    }
     for b in &pf.problem().binds {
         let target = if b.is_path { pf.dir.join(&b.target).display().to_string() } else { b.target.clone() };
         match b.role.name.as_str() {

@@ -42,6 +42,8 @@ pub struct Problem<'p> {
     pub contact: Option<&'p str>,
     /// Other mesh regions the forms may integrate over, bound by their names.
     pub regions: &'p [String],
+    /// The contact pairs a pair law integrates over.
+    pub pairs: &'p [crate::runtime::fem::pair::PairRegions],
     /// Dirichlet conditions of the dynamics.
     pub constraints: Constraints,
     /// Held displacements that move (among the constraints' fixed dofs).

@@ -300,7 +300,11 @@ impl<'m> Parts<'m> {
         for name in problem.regions {
             regions.push((name.clone(), asm.region(name)?));
         }
-        let binding = Binding { bodies: &mesh.bodies, ..Binding::new(problem.quadrature, regions, mesh.dim()) };
+        let binding = Binding {
+            bodies: &mesh.bodies,
+            pairs: problem.pairs.iter().map(|p| p.on(mesh)).collect(),
+            ..Binding::new(problem.quadrature, regions, mesh.dim())
+        };
         let mut inst = in_use.forms.instantiate(problem.coefs, &binding)?;
         let mut forms: Vec<(String, Box<dyn BoundForm + 'm>)> =
             in_use.scheme_forms(&mut inst)?.into_iter().map(|(slot, f)| (slot.to_string(), f)).collect();

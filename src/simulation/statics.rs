@@ -23,6 +23,8 @@ pub struct StaticProblem<'p> {
     pub contact: Option<&'p str>,
     /// The other regions the forms may integrate over (a load's), bound by their names.
     pub regions: &'p [String],
+    /// The contact pairs a pair law integrates over.
+    pub pairs: &'p [crate::runtime::fem::pair::PairRegions],
     /// Degree of the contact term's facet rule (None: the form's own choice).
     pub contact_degree: Option<u32>,
     pub constraints: Constraints,
@@ -67,9 +69,10 @@ pub fn solve<'m>(
         regions.push((name.clone(), asm.region(name)?));
     }
     let bodies = &asm.mesh().bodies;
-    let volume = Binding { bodies, ..Binding::new(Quadrature::default(), regions.clone(), d) };
+    let pairs: Vec<_> = problem.pairs.iter().map(|p| p.on(asm.mesh())).collect();
+    let volume = Binding { bodies, pairs: pairs.clone(), ..Binding::new(Quadrature::default(), regions.clone(), d) };
     let boundary =
-        Binding { bodies, ..Binding::new(Quadrature { cell: None, facet: problem.contact_degree }, regions, d) };
+        Binding { bodies, pairs, ..Binding::new(Quadrature { cell: None, facet: problem.contact_degree }, regions, d) };
     let missing = |what: &str| {
         CaseError::Option(format!("a static case needs a `{what}` form, which the files in use do not provide"))
     };

@@ -177,3 +177,29 @@ fn the_pair_tangent_is_the_derivative_of_its_residual() {
         assert!(error < tolerance * scale, "P{degree}: tangent against differences: {error} of {scale}");
     }
 }
+
+fn problem(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/problems").join(name).display().to_string()
+}
+
+/// The same block on its foundation posed in a problem file: two bodies of two generators,
+/// each with its own E, the pair `contact bottom with top`. The pair carries the block's weight
+/// to round-off, on P1 and P2, in a few Newton iterations.
+#[test]
+fn a_problem_file_poses_the_pair() {
+    use signorini::driver::Setting;
+    use signorini::problem::run::{Options, run};
+    let line = signorini::problem::run::check(&problem("block_on_foundation.wf")).unwrap();
+    assert!(line.contains("pair_penalty (contact)"), "{line}");
+    for degree in [1.0, 2.0] {
+        let mut o = Options::new(&problem("block_on_foundation.wf"));
+        o.methods.params.push(Setting { name: "degree".into(), value: degree, origin: "test".into() });
+        let r = run(&o).unwrap();
+        let force = r.column("force").unwrap()[0];
+        assert!((force + 1.0).abs() < 1e-10, "P{degree}: contact force {force}");
+        let sunk = r.column("sunk").unwrap()[0];
+        assert!(sunk < 0.0, "P{degree}: the block rests on the foundation ({sunk})");
+        let newton = r.column("newton").unwrap()[0];
+        assert!(newton <= 8.0, "P{degree}: {newton} Newton iterations");
+    }
+}

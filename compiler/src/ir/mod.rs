@@ -227,6 +227,9 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
     if !diags.is_empty() {
         return Err(diags);
     }
+    if pair_law {
+        one_rule(&mut forms);
+    }
     Ok(DimIr { dim: d, graph: g, forms })
 }
 
@@ -371,6 +374,20 @@ fn sliding(g: &mut Graph, d: usize, roots: &[NodeId]) -> Vec<NodeId> {
         }
     }
     out
+}
+
+/// A pair law integrates every form with one rule, the largest of their estimates, so that its
+/// functionals (the force it measures) sum what its forms impose, point by point. A degree the
+/// file sets stays.
+fn one_rule(forms: &mut [FormIr]) {
+    let estimated = |i: &&mut IntegralIr| i.degree == i.estimated;
+    let mut largest = [0, 0];
+    for i in forms.iter_mut().flat_map(|f| f.integrals.iter_mut()).filter(|i| i.degree == i.estimated) {
+        largest = [largest[0].max(i.degree[0]), largest[1].max(i.degree[1])];
+    }
+    for i in forms.iter_mut().flat_map(|f| f.integrals.iter_mut()).filter(estimated) {
+        (i.degree, i.estimated) = (largest, largest);
+    }
 }
 
 /// E0409: a volume integral in a contact pair's law.

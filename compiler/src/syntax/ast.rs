@@ -454,6 +454,16 @@ pub struct Obstacle {
     pub span: Span,
 }
 
+/// `contact Gamma_a with Gamma_b within 2`: the run's pair law integrates over `own`, facing
+/// `facing`, looking for facing points as far as `reach`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactPair {
+    pub own: Ident,
+    pub facing: Ident,
+    pub reach: Option<Expr>,
+    pub span: Span,
+}
+
 /// `plot "title": col, col`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Plot {
@@ -489,6 +499,8 @@ pub struct Problem {
     pub sets: Vec<Defined>,
     pub coefs: Vec<Defined>,
     pub obstacles: Vec<Obstacle>,
+    /// Contact between two bodies' regions.
+    pub pairs: Vec<ContactPair>,
     pub initial: Vec<Defined>,
     pub dirichlet: Vec<Dirichlet>,
     /// Loads on regions: tractions and pressures.

@@ -206,6 +206,10 @@ fn problem(p: &Problem, out: &mut String) {
         let on = o.region.as_ref().map_or(String::new(), |r| format!(" on {}", r.name));
         out.push_str(&format!("  obstacle {}{on}\n", named_call(&o.shape)));
     }
+    for pair in &p.pairs {
+        let within = pair.reach.as_ref().map_or(String::new(), |r| format!(" within {}", expr(r)));
+        out.push_str(&format!("  contact {} with {}{within}\n", pair.own.name, pair.facing.name));
+    }
     for d in &p.dirichlet {
         let k = d.component.as_ref().map_or(String::new(), |k| format!("[{}]", expr(k)));
         let on = match &d.on {

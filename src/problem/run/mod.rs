@@ -96,6 +96,13 @@ fn simulate(
     // Every process integrates over the problem's regions whole (the contact law's among them).
     let whole: Vec<&str> =
         pf.problem().regions.iter().map(|r| r.name.name.as_str()).chain(contact_region(pf)).collect();
+    let pairs = super::pairs::surfaces(pf, ex, &mesh)?;
+    if ownership.is_some() && !pairs.is_empty() {
+        return Err(CaseError::Option(format!(
+            "{}: contact pairs in a run split across processes are not supported yet: run it on one process",
+            pf.file
+        )));
+    }
     let part = ownership.as_ref().map(|o| (mesh.part(o.owners(), o.rank() as u32, &whole), o));
     let asm = match &part {
         Some(((local, owned), o)) => {
@@ -103,7 +110,11 @@ fn simulate(
             tracing::info!(rank, owned, cells, whole = mesh.num_cells(), "this process's part of the mesh");
             Assembler::split(local, (*o).clone(), *owned)
         }
-        None => Assembler::new(&mesh),
+        None if pairs.is_empty() => Assembler::new(&mesh),
+        None => Assembler::with_couplings(
+            &mesh,
+            &pairs.iter().flat_map(|p| p.on(&mesh).couplings(&mesh)).collect::<Vec<_>>(),
+        ),
     };
     // Collective in a split run: counted now, while every process runs the same code (rank 0
     // alone may stop early, on a failed write).
@@ -120,6 +131,7 @@ fn simulate(
         others: &others,
         constraints: &constraints,
         held: held.as_ref(),
+        pairs: &pairs,
     };
     let mut runner = Runner::bind(&req, &asm, &bound)?;
     let (u0, v0) = initial_fields(pf, ex, &mesh, &bound, times.t_start)?;
@@ -202,6 +214,8 @@ pub(super) struct Bound<'a> {
     pub others: &'a [String],
     pub constraints: &'a Constraints,
     pub held: Option<&'a Held>,
+    /// The contact pairs.
+    pub pairs: &'a [crate::runtime::fem::pair::PairRegions],
 }
 
 impl Bound<'_> {
@@ -211,6 +225,7 @@ impl Bound<'_> {
             quadrature: self.quadrature,
             contact: self.contact,
             regions: self.others,
+            pairs: self.pairs,
             constraints: self.constraints.clone(),
             prescribed: self.held.map(|h| h.prescribed(mesh)),
             mass: opts.mass,
@@ -225,6 +240,7 @@ impl Bound<'_> {
             coefs: self.coefs,
             contact,
             regions: self.others,
+            pairs: self.pairs,
             contact_degree: self.quadrature.facet,
             constraints: self.constraints.clone(),
             newton: opts.newton,
@@ -320,8 +336,11 @@ impl<'m> Observing<'m> {
         for name in bound.others {
             regions.push((name.clone(), asm.region(name)?));
         }
-        let binding =
-            Binding { bodies: &asm.mesh().bodies, ..Binding::new(bound.quadrature, regions, asm.mesh().dim()) };
+        let binding = Binding {
+            bodies: &asm.mesh().bodies,
+            pairs: bound.pairs.iter().map(|p| p.on(asm.mesh())).collect(),
+            ..Binding::new(bound.quadrature, regions, asm.mesh().dim())
+        };
         let reference = bound_reference(pf, ex, in_use, asm.mesh(), ops.contact_facets, t0)?;
         let sources = Sources {
             ops,

@@ -151,6 +151,7 @@ fn exprs_mut(p: &mut Problem) -> Vec<&mut Expr> {
     for o in &mut p.obstacles {
         out.extend(o.shape.args.iter_mut().map(|a| &mut a.value));
     }
+    out.extend(p.pairs.iter_mut().filter_map(|pair| pair.reach.as_mut()));
     for d in &mut p.dirichlet {
         if let HeldAt::Nearest { point, .. } = &mut d.on {
             out.push(point);

@@ -12,6 +12,7 @@ mod bodies;
 mod catalogue;
 mod fns;
 mod measures;
+mod pairs;
 
 use std::collections::HashMap;
 
@@ -48,6 +49,7 @@ pub(in crate::check) fn check(c: &mut Checker, p: &Problem, diags: &mut Vec<Diag
     dirichlet(c, p, fields, &regions, diags);
     neumann(c, p, fields, &regions, diags);
     obstacles(c, p, fields, &regions, diags);
+    pairs::check(c, p, &constants, diags);
     measures(c, p, &constants, &regions, diags);
 }
 

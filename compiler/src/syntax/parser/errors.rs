@@ -290,6 +290,7 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::scheme_params | Rule::scheme_param => "parameters",
         Rule::mesh_decl
         | Rule::body_decl
+        | Rule::contact_pair
         | Rule::region_decl
         | Rule::bind_decl
         | Rule::set_decl

@@ -27,6 +27,7 @@ impl Builder {
             sets: Vec::new(),
             coefs: Vec::new(),
             obstacles: Vec::new(),
+            pairs: Vec::new(),
             initial: Vec::new(),
             dirichlet: Vec::new(),
             series: Vec::new(),
@@ -140,6 +141,14 @@ impl Builder {
                         }
                     }
                     pb.fns.push(ProblemFn { name, params, body: body.expect("fn has a body"), span });
+                }
+                Rule::contact_pair => {
+                    next(); // the word `contact`
+                    let own = self.ident(next());
+                    next(); // the word `with`
+                    let facing = self.ident(next());
+                    let reach = it.next().map(|q| self.expr(q)).transpose()?;
+                    pb.pairs.push(ContactPair { own, facing, reach, span });
                 }
                 Rule::obstacle_decl => {
                     let shape = self.named_call(next())?;

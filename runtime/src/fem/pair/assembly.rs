@@ -5,12 +5,14 @@
 
 use std::sync::Mutex;
 
-use super::{FieldAt, MAX_DIM, PairKernel, PairPoint, SideAt, layout};
+use super::{FieldAt, MAX_DIM, PairKernel, PairPoint, SideAt, Surfaces, layout};
 use crate::fem::assembly::Assembler;
-use crate::fem::bound::BoundForm;
+use crate::fem::assembly::PointValue;
+use crate::fem::bound::{BoundForm, BoundFunctional};
 use crate::fem::element::ElementKind;
 use crate::fem::facing::Surface;
 use crate::fem::mesh::{Facet, Mesh};
+use crate::fem::quadrature::Rule;
 use crate::fem::quadrature::simplex_rule;
 use crate::linalg::Matrix;
 
@@ -98,28 +100,9 @@ impl<'m> PairForm<'m> {
         PairForm { kernel, region, own, facing, reach, rule, edges, missing: Mutex::new(None) }
     }
 
-    /// The node pairs of the two surfaces' cells that may couple: those of facets within
-    /// `reach` of each other on the reference configuration (the matrix pattern's couplings).
+    /// The node pairs its tangent may couple ([`Surfaces::couplings`]).
     pub fn couplings(&self, mesh: &Mesh) -> Vec<(u32, u32)> {
-        let surface = Surface::new(mesh, self.facing, &vec![0.0; mesh.num_nodes() * mesh.dim()]);
-        let mut out = Vec::new();
-        for f in self.own {
-            let own_nodes = mesh.cell(f.cell as usize);
-            let (mut lower, mut upper) = ([0.0; 3], [0.0; 3]);
-            for r in 0..mesh.dim() {
-                let along =
-                    mesh.kind.facet_nodes(f.local as usize).into_iter().map(|a| mesh.node(own_nodes[a] as usize)[r]);
-                let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
-                (lower[r], upper[r]) = (lo - self.reach, hi + self.reach);
-            }
-            for k in surface.within(lower, upper) {
-                let other = mesh.cell(self.facing[k].cell as usize);
-                out.extend(own_nodes.iter().flat_map(|&a| other.iter().map(move |&b| (a, b))));
-            }
-        }
-        out.sort_unstable();
-        out.dedup();
-        out
+        Surfaces { own: self.own, facing: self.facing, reach: self.reach, kind: mesh.kind }.couplings(mesh)
     }
 
     /// The coupling the pattern lacked at the last tangent, if any: a facing point farther on
@@ -297,7 +280,7 @@ impl BoundForm for PairForm<'_> {
         let block = layout::block(d);
         let mut missing = None;
         let pattern = m.pattern.clone();
-        let moving = self.fields().saturating_sub(1);
+        let moving = self.kernel.meta().fields.len().saturating_sub(1);
         self.each_point(mesh, fields, t, |e| {
             c.fill(0.0);
             if !self.kernel.tangent_at(self.region, &e.point, wrt, &mut c) {
@@ -357,7 +340,7 @@ impl PairForm<'_> {
     /// P1, are left out). `rates` holds the residual's coefficients then their sliding rates.
     fn add_sliding(&self, e: &PairElement, rates: &[f64], d: usize, ke: &mut [f64]) {
         let (n, half) = (e.nodes.len(), e.nodes.len() / 2);
-        let moving = self.fields().saturating_sub(1);
+        let moving = self.kernel.meta().fields.len().saturating_sub(1);
         let (own_u, facing_u) = (&e.point.own.fields[moving], &e.point.facing.fields[moving]);
         let gap: [f64; MAX_DIM] =
             std::array::from_fn(|r| (e.point.own.x[r] + own_u.value[r]) - (e.point.facing.x[r] + facing_u.value[r]));
@@ -427,6 +410,27 @@ impl PairForm<'_> {
                 }
             }
         }
+    }
+}
+
+impl BoundFunctional for PairForm<'_> {
+    fn name(&self) -> &str {
+        &self.kernel.meta().name
+    }
+    fn fields(&self) -> usize {
+        self.kernel.meta().fields.len()
+    }
+    fn value(&self, asm: &Assembler, fields: &[&[f64]], t: f64) -> f64 {
+        pair_value(self, asm.mesh(), fields, t)
+    }
+    /// A pair law has no volume integral.
+    fn cell_values(&self, asm: &Assembler, _: &[&[f64]], _: f64) -> Vec<f64> {
+        vec![0.0; asm.mesh().num_cells()]
+    }
+    /// Not given per facet point: a pair's points are its own surface's quadrature points,
+    /// not those of a rule the caller picks.
+    fn facet_point_values(&self, _: &Assembler, _: &Rule, _: &[&[f64]], _: f64) -> Vec<PointValue> {
+        Vec::new()
     }
 }
 

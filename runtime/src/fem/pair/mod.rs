@@ -13,7 +13,62 @@
 
 pub mod assembly;
 
+use crate::fem::element::ElementKind;
+use crate::fem::facing::Surface;
 use crate::fem::kernel::Form;
+use crate::fem::mesh::{Facet, Mesh};
+
+/// A contact pair of a mesh: the surface a pair law integrates over, the surface it faces, and
+/// how far a facing point is looked for.
+#[derive(Clone, Copy, Debug)]
+pub struct Surfaces<'m> {
+    pub own: &'m [Facet],
+    pub facing: &'m [Facet],
+    pub reach: f64,
+    pub kind: ElementKind,
+}
+
+/// A contact pair by its regions' names, as a problem declares it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairRegions {
+    pub own: String,
+    pub facing: String,
+    pub reach: f64,
+}
+
+impl PairRegions {
+    /// The pair's facets on `mesh` (none for a region it lacks: the problem checked them).
+    pub fn on<'m>(&self, mesh: &'m Mesh) -> Surfaces<'m> {
+        let facets = |name: &str| mesh.region(name).map(|r| r.facets.as_slice()).unwrap_or(&[]);
+        Surfaces { own: facets(&self.own), facing: facets(&self.facing), reach: self.reach, kind: mesh.kind }
+    }
+}
+
+impl Surfaces<'_> {
+    /// The node pairs of the two surfaces' cells that may couple: those of facets within
+    /// `reach` of each other on the reference configuration (the matrix pattern's couplings).
+    pub fn couplings(&self, mesh: &Mesh) -> Vec<(u32, u32)> {
+        let surface = Surface::new(mesh, self.facing, &vec![0.0; mesh.num_nodes() * mesh.dim()]);
+        let mut out = Vec::new();
+        for f in self.own {
+            let own_nodes = mesh.cell(f.cell as usize);
+            let (mut lower, mut upper) = ([0.0; 3], [0.0; 3]);
+            for r in 0..mesh.dim() {
+                let along =
+                    mesh.kind.facet_nodes(f.local as usize).into_iter().map(|a| mesh.node(own_nodes[a] as usize)[r]);
+                let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+                (lower[r], upper[r]) = (lo - self.reach, hi + self.reach);
+            }
+            for k in surface.within(lower, upper) {
+                let other = mesh.cell(self.facing[k].cell as usize);
+                out.extend(own_nodes.iter().flat_map(|&a| other.iter().map(move |&b| (a, b))));
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+}
 
 /// The most space dimensions a pair point holds.
 pub const MAX_DIM: usize = 3;

@@ -1,0 +1,92 @@
+//! A problem's contact pairs bound to its mesh: `contact Gamma_a with Gamma_b within R`, two
+//! regions of two bodies, and how far the facing points are looked for.
+
+use super::ProblemFile;
+use super::expr::Exprs;
+use crate::compiler::Diagnostic;
+use crate::compiler::syntax::ast::ContactPair;
+use crate::error::CaseError;
+use crate::runtime::fem::mesh::{Facet, Mesh};
+use crate::runtime::fem::pair::PairRegions;
+
+/// How far a pair looks for facing points when its problem does not say: this many times the
+/// largest cell of its two surfaces.
+const REACH_IN_CELLS: f64 = 3.0;
+
+/// The problem's pairs on `mesh`, each region a body's, the two bodies distinct.
+pub fn surfaces(pf: &ProblemFile, ex: &mut Exprs, mesh: &Mesh) -> Result<Vec<PairRegions>, CaseError> {
+    let mut out = Vec::new();
+    for pair in &pf.problem().pairs {
+        let own = side(pf, mesh, pair, true)?;
+        let facing = side(pf, mesh, pair, false)?;
+        let largest = own.iter().chain(facing).map(|f| mesh.cell_size(f.cell as usize)).fold(0.0, f64::max);
+        let reach = match &pair.reach {
+            Some(e) => {
+                let r = ex.scalar(e).map_err(|d| pf.render(*d))?;
+                if !(r > 0.0 && r.is_finite()) {
+                    return Err(pf.render(Diagnostic::error(
+                        "E0103",
+                        format!("a pair's reach of {r}"),
+                        e.span,
+                        "not a positive distance",
+                    )));
+                }
+                r
+            }
+            None => REACH_IN_CELLS * largest,
+        };
+        out.push(PairRegions { own: pair.own.name.clone(), facing: pair.facing.name.clone(), reach });
+    }
+    Ok(out)
+}
+
+/// The facets of one side of `pair`, all of one body, not the other side's body.
+fn side<'m>(pf: &ProblemFile, mesh: &'m Mesh, pair: &ContactPair, own: bool) -> Result<&'m [Facet], CaseError> {
+    let (name, other) = if own { (&pair.own, &pair.facing) } else { (&pair.facing, &pair.own) };
+    let located = |what: String, label: &str, help: &str| {
+        pf.render(Diagnostic::error("E0103", what, name.span, label).with_help(help.to_string()))
+    };
+    let facets = mesh.region(&name.name).map(|r| r.facets.as_slice()).unwrap_or(&[]);
+    if facets.is_empty() {
+        return Err(located(
+            format!("region `{}` of a contact pair has no facet", name.name),
+            "empty on the mesh",
+            "a pair joins two boundary regions that hold facets",
+        ));
+    }
+    if mesh.bodies.is_empty() {
+        return Err(located(
+            "a contact pair in a problem of one body".into(),
+            "no body to pair with another",
+            "declare the bodies: `body NAME = group \"...\"` (or a generator), one for each side",
+        ));
+    }
+    let body_of = |facets: &[Facet]| {
+        let first = facets[0].cell as usize;
+        let body = mesh.bodies.iter().position(|b| b.cells[first])?;
+        facets.iter().all(|f| mesh.bodies[body].cells[f.cell as usize]).then_some(body)
+    };
+    let Some(body) = body_of(facets) else {
+        return Err(located(
+            format!("region `{}` of a contact pair spans several bodies (or none)", name.name),
+            "not one body's",
+            "cut the region to one body: declare it inside the body's braces",
+        ));
+    };
+    let other_facets = mesh.region(&other.name).map(|r| r.facets.as_slice()).unwrap_or(&[]);
+    if !other_facets.is_empty() && body_of(other_facets) == Some(body) {
+        return Err(pf.render(
+            Diagnostic::error(
+                "E0103",
+                format!("both regions of a contact pair are body `{}`'s", mesh.bodies[body].name),
+                pair.span,
+                "one body",
+            )
+            .with_note(
+                "self-contact needs a search that skips the point's own neighbourhood, which pairs do not have yet",
+            )
+            .with_help("pair two bodies' regions"),
+        ));
+    }
+    Ok(facets)
+}
