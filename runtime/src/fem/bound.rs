@@ -51,6 +51,12 @@ pub trait BoundForm {
     fn time_dependent(&self) -> bool {
         true
     }
+    /// False where the tangent is known to be unsymmetric where it matters, though it may not
+    /// be at a probe's random states (a contact pair's, zero until the bodies touch); true
+    /// otherwise, the probe deciding.
+    fn may_be_symmetric(&self) -> bool {
+        true
+    }
 }
 
 /// `fields`, with `previous` after them when the form reads the previous time level (`reads`):

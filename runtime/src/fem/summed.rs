@@ -60,6 +60,9 @@ impl BoundForm for Summed<'_> {
     fn piecewise(&self) -> bool {
         self.parts.iter().all(|p| p.piecewise())
     }
+    fn may_be_symmetric(&self) -> bool {
+        self.parts.iter().all(|p| p.may_be_symmetric())
+    }
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {
         for p in &self.parts {
             p.residual(asm, &self.args(p.as_ref(), fields), t, out);

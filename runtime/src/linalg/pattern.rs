@@ -289,29 +289,28 @@ impl Pattern {
     /// Calls `add(position, v)` for each entry of an element matrix over any `nodes` (a pair
     /// element: the nodes of two cells facing each other), `ke` row-major over the nodes'
     /// dofs, `ke[(a·d + k)·n·d + b·d + m]` coupling dof k of `nodes[a]` to dof m of `nodes[b]`.
-    /// Nothing is added if two of the nodes are not coupled: the pair is returned.
+    /// The blocks of two nodes the pattern does not couple are left out, and the first such pair
+    /// is returned.
     pub fn scatter_nodes(&self, nodes: &[u32], ke: &[f64], mut add: impl FnMut(usize, f64)) -> Result<(), (u32, u32)> {
         let (d, n) = (self.dim, nodes.len());
         debug_assert_eq!(ke.len(), n * d * n * d);
-        let mut blocks = Vec::with_capacity(n * n);
-        for &nb in nodes {
-            let neighbours = self.neighbours(nb as usize);
-            for &na in nodes {
-                blocks.push(neighbours.binary_search(&na).map_err(|_| (na, nb))? * d);
-            }
-        }
+        let mut missing = None;
         for (b, &nb) in nodes.iter().enumerate() {
-            for m in 0..d {
-                let base = self.col_ptr[nb as usize * d + m];
-                for a in 0..n {
-                    let o = base + blocks[b * n + a];
+            let neighbours = self.neighbours(nb as usize);
+            for (a, &na) in nodes.iter().enumerate() {
+                let Ok(t) = neighbours.binary_search(&na) else {
+                    missing = missing.or(Some((na, nb)));
+                    continue;
+                };
+                for m in 0..d {
+                    let o = self.col_ptr[nb as usize * d + m] + t * d;
                     for k in 0..d {
                         add(o + k, ke[(a * d + k) * n * d + b * d + m]);
                     }
                 }
             }
         }
-        Ok(())
+        missing.map_or(Ok(()), Err)
     }
 
     /// Adds an element matrix of cell `c` with nodes `cell` into `values`.
@@ -391,9 +390,10 @@ mod tests {
             }
         }
         assert_eq!(values.iter().filter(|v| **v != 0.0).count(), 36);
-        // Nodes the pattern does not couple: nothing added, the pair named.
-        let mut untouched = vec![0.0; coupled.nnz()];
-        assert_eq!(coupled.scatter_nodes(&[0, 5], &[1.0; 16], |i, v| untouched[i] += v), Err((5, 0)));
-        assert!(untouched.iter().all(|v| *v == 0.0));
+        // Nodes the pattern does not couple: their blocks left out, the pair named; each node's
+        // own block added.
+        let mut partial = vec![0.0; coupled.nnz()];
+        assert_eq!(coupled.scatter_nodes(&[0, 5], &[1.0; 16], |i, v| partial[i] += v), Err((5, 0)));
+        assert_eq!(partial.iter().filter(|v| **v != 0.0).count(), 8);
     }
 }

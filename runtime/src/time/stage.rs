@@ -135,6 +135,9 @@ fn probe_here(
         if form.fields() == 0 {
             continue;
         }
+        if !form.may_be_symmetric() {
+            return Structure::General;
+        }
         let mut finite = false;
         let d = asm.mesh().dim();
         for (scale, translated) in [(large, false), (large, false), (small, false), (small, true)] {

@@ -249,6 +249,11 @@ impl BoundForm for PairForm<'_> {
     fn piecewise(&self) -> bool {
         false
     }
+    /// The facing point's motion (and a master–slave law's one-sided test functions) make the
+    /// tangent unsymmetric once the bodies touch.
+    fn may_be_symmetric(&self) -> bool {
+        false
+    }
 
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {
         let mesh = asm.mesh();
@@ -314,10 +319,23 @@ impl BoundForm for PairForm<'_> {
             if wrt == moving {
                 self.add_sliding(e, &c[4 * block..], d, &mut ke);
             }
+            // Points apart (a zero element) need no coupling.
+            if ke.iter().all(|v| *v == 0.0) {
+                return;
+            }
             if let Err(pair) = pattern.scatter_nodes(&e.nodes, &ke, |pos, v| m.values[pos] += v) {
                 missing = Some(pair);
             }
         });
+        if let Some((a, b)) = missing {
+            // The residual stays exact: Newton converges to the same state with this Jacobian,
+            // only more slowly, as it does in a step's first, far-off iterates.
+            tracing::warn!(
+                "contact pair `{}`: nodes {a} and {b} face each other but were farther apart than the pair's reach ({}) on the reference configuration, so the Jacobian leaves out their coupling (Newton may converge slowly): raise `within` on the problem's `contact` line",
+                self.kernel.meta().name,
+                self.reach
+            );
+        }
         if let Ok(mut slot) = self.missing.lock() {
             *slot = missing;
         }
