@@ -193,7 +193,8 @@ fn problem(name: &str) -> String {
 
 /// The same block on its foundation posed in a problem file: two bodies of two generators,
 /// each with its own E, the pair `contact bottom with top`. The pair carries the block's weight
-/// to round-off, on P1 and P2. P2 takes up to a dozen Newton iterations (measured 11): its
+/// to round-off, on P1 and P2, by penalty and by Nitsche's method at every θ. P2 takes up to a
+/// dozen Newton iterations (measured 11–13): its
 /// tangent holds the facing normal as the facing point slides, and under the block's corners
 /// the foundation's deformed normal turns fast.
 #[test]
@@ -202,17 +203,33 @@ fn a_problem_file_poses_the_pair() {
     use signorini::problem::run::{Options, run};
     let line = signorini::problem::run::check(&problem("block_on_foundation.wf")).unwrap();
     assert!(line.contains("pair_penalty (contact)"), "{line}");
-    for degree in [1.0, 2.0] {
-        let mut o = Options::new(&problem("block_on_foundation.wf"));
-        o.methods.params.push(Setting { name: "degree".into(), value: degree, origin: "test".into() });
-        let r = run(&o).unwrap();
-        let force = r.column("force").unwrap()[0];
-        assert!((force.abs() - 1.0).abs() < 1e-10, "P{degree}: the force on the block {force}, against its weight 1");
-        let sunk = r.column("sunk").unwrap()[0];
-        assert!(sunk < 0.0, "P{degree}: the block rests on the foundation ({sunk})");
-        let newton = r.column("newton").unwrap()[0];
-        let most = if degree == 1.0 { 6.0 } else { 15.0 };
-        assert!(newton <= most, "P{degree}: {newton} Newton iterations");
+    // The penalty law, then Nitsche's at θ = 1, 0, −1 (whose residual reaches the own cells'
+    // inner nodes too: the body's resultant is the identity).
+    let laws = [
+        ("pair_penalty", None),
+        ("pair_nitsche", Some(1.0)),
+        ("pair_nitsche", Some(0.0)),
+        ("pair_nitsche", Some(-1.0)),
+    ];
+    for (law, theta) in laws {
+        for degree in [1.0, 2.0] {
+            let mut o = Options::new(&problem("block_on_foundation.wf"));
+            o.methods.params.push(Setting { name: "degree".into(), value: degree, origin: "test".into() });
+            o.methods.contact = law.into();
+            o.chosen.contact = true;
+            if let Some(theta) = theta {
+                o.methods.params.push(Setting { name: "theta".into(), value: theta, origin: "test".into() });
+            }
+            let r = run(&o).unwrap();
+            let at = format!("{law} θ = {theta:?}, P{degree}");
+            let force = r.column("force").unwrap()[0];
+            assert!((force - 1.0).abs() < 1e-10, "{at}: the force on the block {force}, against its weight 1");
+            let sunk = r.column("sunk").unwrap()[0];
+            assert!(sunk < 0.0, "{at}: the block rests on the foundation ({sunk})");
+            let newton = r.column("newton").unwrap()[0];
+            let most = if degree == 1.0 { 6.0 } else { 15.0 };
+            assert!(newton <= most, "{at}: {newton} Newton iterations");
+        }
     }
 }
 

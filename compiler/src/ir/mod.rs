@@ -148,12 +148,17 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
     // integrals is evaluated at facing points, and it has no volume integral.
     let reads_facing =
         |g: &Graph, n: NodeId| g.reachable([n]).into_iter().any(|m| matches!(g.node(m), Node::Sym(Sym::Opposite(_))));
-    let pair_law = lowered.iter().any(|lf| lf.integrands.iter().any(|i| reads_facing(&g, i.value)));
-    if pair_law && let Some(e) = pair_volume_error(prog, &lowered) {
+    // The file's own forms (an imported material's are as they are in their file).
+    let own: Vec<bool> = prog.forms.iter().map(|f| f.span.file == prog.root).collect();
+    let pair_law =
+        lowered.iter().zip(&own).any(|(lf, own)| *own && lf.integrands.iter().any(|i| reads_facing(&g, i.value)));
+    let own_forms: Vec<&lower::LoweredForm> = lowered.iter().zip(&own).filter(|(_, o)| **o).map(|(lf, _)| lf).collect();
+    if pair_law && let Some(e) = pair_volume_error(prog, &own_forms) {
         return Err(vec![e]);
     }
     let mut forms = Vec::new();
-    for lf in lowered {
+    for (lf, own) in lowered.into_iter().zip(own) {
+        let pair_form = pair_law && own;
         let mut integrals = Vec::new();
         for integrand in &lf.integrands {
             if lf.test.is_none() {
@@ -185,7 +190,7 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
             let tangents = (0..lf.fields.len())
                 .map(|a| tangent(&mut g, d, a as u8, previous, (&f0, &f1), Side::Own))
                 .collect::<Vec<_>>();
-            let pair = pair_law.then(|| pair(&mut g, d, lf.fields.len(), integrand.value, (&f0, &f1)));
+            let pair = pair_form.then(|| pair(&mut g, d, lf.fields.len(), integrand.value, (&f0, &f1)));
             let estimated = [1, 2].map(|p| integral_degree(&g, p, &f0, &f1, &tangents));
             let degree = integrand.degree.map_or(estimated, |k| [k, k]);
             integrals.push(IntegralIr {
@@ -210,7 +215,7 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
         let values = integrals.iter().flat_map(|i| i.f0.iter().chain(&i.f1).chain(&i.value)).copied();
         let previous = g.reachable(values).into_iter().any(is_previous);
         // A pair's tangent moves with the facing points even where its coefficients are constant.
-        let linear = constant_tangent && !previous && !pair_law;
+        let linear = constant_tangent && !previous && !pair_form;
         if let Some(e) = degree_error(prog, &lf.name, &integrals) {
             diags.push(e);
         }
@@ -221,7 +226,7 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
             integrals,
             linear,
             previous,
-            pair: pair_law,
+            pair: pair_form,
         });
     }
     if !diags.is_empty() {
@@ -382,16 +387,16 @@ fn sliding(g: &mut Graph, d: usize, roots: &[NodeId]) -> Vec<NodeId> {
 fn one_rule(forms: &mut [FormIr]) {
     let estimated = |i: &&mut IntegralIr| i.degree == i.estimated;
     let mut largest = [0, 0];
-    for i in forms.iter_mut().flat_map(|f| f.integrals.iter_mut()).filter(|i| i.degree == i.estimated) {
+    for i in forms.iter_mut().filter(|f| f.pair).flat_map(|f| f.integrals.iter_mut()).filter(estimated) {
         largest = [largest[0].max(i.degree[0]), largest[1].max(i.degree[1])];
     }
-    for i in forms.iter_mut().flat_map(|f| f.integrals.iter_mut()).filter(estimated) {
+    for i in forms.iter_mut().filter(|f| f.pair).flat_map(|f| f.integrals.iter_mut()).filter(estimated) {
         (i.degree, i.estimated) = (largest, largest);
     }
 }
 
 /// E0409: a volume integral in a contact pair's law.
-fn pair_volume_error(prog: &Unit, lowered: &[lower::LoweredForm]) -> Option<Diagnostic> {
+fn pair_volume_error(prog: &Unit, lowered: &[&lower::LoweredForm]) -> Option<Diagnostic> {
     let lf = lowered.iter().find(|lf| lf.integrands.iter().any(|i| i.region == CELL_REGION))?;
     let form = prog.forms.iter().find(|f| f.name == lf.name)?;
     let integral = form.integrals.iter().find(|i| i.region.name == CELL_REGION)?;

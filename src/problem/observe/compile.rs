@@ -345,6 +345,10 @@ fn region_dofs(c: &Compiling, region: Option<&Expr>) -> Result<Option<Vec<usize>
     let Some(ExprKind::Name(region)) = region.map(|a| &a.kind) else { return Ok(None) };
     let mesh = c.ops.asm.mesh();
     let d = mesh.dim();
-    let nodes = mesh.region_nodes(mesh.region(&region.name)?);
+    // A body's nodes, else a region's.
+    let nodes: Vec<u32> = match mesh.body_nodes(&region.name) {
+        Some(of) => (0..of.len() as u32).filter(|&n| of[n as usize]).collect(),
+        None => mesh.region_nodes(mesh.region(&region.name)?),
+    };
     Ok(Some(nodes.iter().flat_map(|&n| (0..d).map(move |k| n as usize * d + k)).collect()))
 }

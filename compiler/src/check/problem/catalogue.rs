@@ -166,8 +166,8 @@ pub const ROW_REDUCERS: &[RowReducerInfo] = {
         r(
             Force,
             "force",
-            "force(SLOT[, REGION])",
-            "the resultant of a slot's residual on the body, or at a region's nodes (a vector): force(contact), force(stiffness, Gamma_D)",
+            "force(SLOT[, REGION or BODY])",
+            "the resultant of a slot's residual on the mesh, at a region's nodes or on a body's (a vector): force(contact), force(stiffness, Gamma_D), force(contact, block)",
         ),
         r(
             InnerMass,

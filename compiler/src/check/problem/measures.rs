@@ -129,9 +129,13 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
             }
         }
         Some(R::Force) => {
-            // force(SLOT) over the body, force(SLOT, REGION) over the region's nodes.
+            // force(SLOT) over the mesh, force(SLOT, REGION) over the region's nodes,
+            // force(SLOT, BODY) over the body's.
             if args.len() == 2 {
-                region(&args[1], diags);
+                match &args[1].kind {
+                    K::Name(id) if s.bodies.contains(&id.name.as_str()) => {}
+                    _ => region(&args[1], diags),
+                }
             } else if !arity(1, diags) {
                 return;
             }
