@@ -579,14 +579,10 @@ pub fn node_degrees(
                 Sym::FieldGrad { .. } | Sym::TestGrad { .. } => p - 1,
                 Sym::Coord(_) => 1,
                 Sym::Param(_) | Sym::Normal(_) | Sym::CellDiameter | Sym::Time | Sym::Dt | Sym::Seed(_) => 0,
-                // The facing side's functions, as functions of the point: non-polynomial on
-                // the own facet, counted as their own degree.
-                Sym::Opposite(f) => match f.own() {
-                    Sym::Field { .. } | Sym::Test { .. } => p,
-                    Sym::FieldGrad { .. } | Sym::TestGrad { .. } => p - 1,
-                    Sym::Coord(_) => 1,
-                    _ => 0,
-                },
+                // The facing side's values: piecewise smooth along the own facet, across the
+                // facing facets, so no rule integrates them exactly; the rule follows the own
+                // side's degree (a pair law's forms share the largest, `one_rule`).
+                Sym::Opposite(_) => 0,
             },
             Node::Add(a, b) => dg(a).max(dg(b)),
             // Saturating: deep products overflow u32; the cap on the degree reports them.
