@@ -70,6 +70,6 @@ mod tests {
             e.contains("1.00e9 unknowns need about 10000.0 GB of memory") && e.contains("--h 0.008 or coarser"),
             "{e}"
         );
-        assert!(super::check_against("disc", 12_490.0, 2, Some(0.5), 24e9).is_ok());
+        assert!(super::check_against("a-case", 12_490.0, 2, Some(0.5), 24e9).is_ok());
     }
 }

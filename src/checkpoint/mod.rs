@@ -371,7 +371,7 @@ mod tests {
     }
 
     fn ident(dt: &str) -> Identity {
-        vec![("case".into(), "disc".into()), ("dt".into(), dt.into())]
+        vec![("case".into(), "a_run".into()), ("dt".into(), dt.into())]
     }
 
     #[test]

@@ -113,6 +113,10 @@ impl<'m> PairForm<'m> {
 
     /// Calls `each` at every quadrature point of the own surface that faces the other one.
     fn each_point(&self, mesh: &Mesh, fields: &[&[f64]], t: f64, mut each: impl FnMut(&PairElement)) {
+        // Bound to a body that does not own the pair: no point, so no search to build.
+        if self.own.is_empty() {
+            return;
+        }
         let d = mesh.dim();
         let moving = fields.get(self.kernel.meta().fields.len().saturating_sub(1)).copied().unwrap_or(&[]);
         let surface = Surface::new(mesh, self.facing, moving);
