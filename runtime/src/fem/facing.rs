@@ -9,6 +9,10 @@
 //! their convex hull, so their box bounds it. The projection minimises |x(s) − p|² over the
 //! reference facet by Gauss–Newton steps kept inside it (the closest point of a facet may be
 //! on its boundary).
+//!
+//! A point past the surface's border (its closest point on an end of the surface, reached
+//! along a direction that is not the surface's normal there) faces no point of it: the gap
+//! along the facing normal would measure a penetration that is not there.
 
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{AABB, PointDistance, RTree};
@@ -26,6 +30,9 @@ pub struct Facing {
     pub point: Vec<f64>,
     /// Its distance to the point.
     pub distance: f64,
+    /// Whether the point lies past the surface's border: its closest point is on the border
+    /// and not straight along the normal there.
+    pub beyond: bool,
 }
 
 type Boxed = GeomWithData<Rectangle<[f64; 3]>, u32>;
@@ -39,6 +46,9 @@ pub struct Surface<'m> {
     tree: RTree<Boxed>,
     /// Per local facet of the element: its nodes and its map into the reference cell.
     frames: Vec<Frame>,
+    /// The surface's border: in 2D its end nodes (a vertex of one facet), in 3D its edges of
+    /// one facet (sorted vertex pairs), sorted for search.
+    border: Vec<[u32; 2]>,
 }
 
 /// A local facet of the element: its own Lagrange basis on the reference facet (the interval
@@ -126,8 +136,9 @@ impl Frame {
 impl<'m> Surface<'m> {
     /// The facets on the configuration x + u.
     pub fn new(mesh: &'m Mesh, facets: &'m [Facet], u: &[f64]) -> Surface<'m> {
-        let frames = (0..mesh.kind.facets().len()).map(|facet| Frame::new(mesh.kind, facet)).collect();
-        let mut surface = Surface { mesh, facets, u: u.to_vec(), tree: RTree::new(), frames };
+        let frames: Vec<Frame> = (0..mesh.kind.facets().len()).map(|facet| Frame::new(mesh.kind, facet)).collect();
+        let border = border(mesh, facets, &frames);
+        let mut surface = Surface { mesh, facets, u: u.to_vec(), tree: RTree::new(), frames, border };
         let boxes = (0..facets.len()).map(|k| surface.bounding_box(k)).collect();
         surface.tree = RTree::bulk_load(boxes);
         surface
@@ -182,7 +193,7 @@ impl<'m> Surface<'m> {
                 best = Some(facing);
             }
         }
-        best
+        best.filter(|b| !b.beyond)
     }
 
     /// The facets whose boxes meet the box from `lower` to `upper` (coordinates past the mesh's
@@ -228,7 +239,34 @@ impl<'m> Surface<'m> {
         }
         let xi = (0..d).map(|r| frame.xi0[r] + (0..d - 1).map(|j| frame.edges[j][r] * s[j]).sum::<f64>()).collect();
         let distance = (0..d).map(|r| (at[r] - x[r]).powi(2)).sum::<f64>().sqrt();
-        Facing { facet: k, xi, point: x[..d].to_vec(), distance }
+        let beyond = self.on_border(frame, cell, &s[..d - 1]) && {
+            // The residual's part along the facet, T (TᵀT)⁻¹ Tᵀ r: zero where r is normal.
+            let mut tangents = [[0.0; 3]; 2];
+            frame.point(&y, &s[..d - 1], Some(&mut tangents));
+            let residual: [f64; 3] = std::array::from_fn(|r| at[r] - x[r]);
+            let step = gauss_newton_step(&tangents[..d - 1], &residual);
+            let along: f64 =
+                (0..3).map(|r| (0..d - 1).map(|j| tangents[j][r] * step[j]).sum::<f64>().powi(2)).sum::<f64>().sqrt();
+            along > ALONG_TOLERANCE * distance
+        };
+        Facing { facet: k, xi, point: x[..d].to_vec(), distance, beyond }
+    }
+
+    /// Whether the facet point at `s` lies on the surface's border: the vertices it does not
+    /// weigh span a border node (2D) or lie on a border edge (3D).
+    fn on_border(&self, frame: &Frame, cell: &[u32], s: &[f64]) -> bool {
+        let n = frame.vertices.len();
+        let mut l = [0.0; 3];
+        l[0] = 1.0 - s.iter().sum::<f64>();
+        l[1..n].copy_from_slice(s);
+        let held: Vec<u32> = (0..n).filter(|&i| l[i] > 0.0).map(|i| cell[frame.vertices[i]]).collect();
+        let is_border = |e: [u32; 2]| self.border.binary_search(&e).is_ok();
+        match (n, held.as_slice()) {
+            (2, &[a]) => is_border([a, a]),
+            (3, &[a, b]) => is_border([a.min(b), a.max(b)]),
+            (3, &[a]) => self.border.iter().any(|e| e.contains(&a)),
+            _ => false,
+        }
     }
 
     /// The facets, as given.
@@ -240,6 +278,36 @@ impl<'m> Surface<'m> {
 /// Gauss–Newton iterations of a projection: enough for a P2 facet from its centre (each step
 /// gains digits quadratically once near, for a point near the facet).
 const MAX_STEPS: usize = 40;
+
+/// The part of the residual along the facet, relative to its length, past which a point on the
+/// border is off the surface: round-off leaves about 1e-16 where the residual is normal.
+const ALONG_TOLERANCE: f64 = 1e-8;
+
+/// The border of the surface of `facets`: in 2D its nodes of one facet, as `[a, a]`; in 3D its
+/// edges of one facet, as sorted `[a, b]`.
+fn border(mesh: &Mesh, facets: &[Facet], frames: &[Frame]) -> Vec<[u32; 2]> {
+    let mut pieces: Vec<[u32; 2]> = Vec::new();
+    for f in facets {
+        let cell = mesh.cell(f.cell as usize);
+        let v: Vec<u32> = frames[f.local as usize].vertices.iter().map(|&a| cell[a]).collect();
+        match v.as_slice() {
+            &[a, b] => pieces.extend([[a, a], [b, b]]),
+            &[a, b, c] => pieces.extend([[a, b], [b, c], [a, c]].map(|[p, q]| [p.min(q), p.max(q)])),
+            _ => {}
+        }
+    }
+    pieces.sort_unstable();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < pieces.len() {
+        let j = (i..pieces.len()).find(|&j| pieces[j] != pieces[i]).unwrap_or(pieces.len());
+        if j - i == 1 {
+            out.push(pieces[i]);
+        }
+        i = j;
+    }
+    out
+}
 
 /// Whether reference vertex `a` is an end of the edge whose midpoint is `m`: its mirror
 /// 2m − a is a reference vertex too.
@@ -361,6 +429,34 @@ mod tests {
         // Off a corner: the corner itself.
         let corner = surface.closest(&[1.2, 0.0], 0.5).unwrap();
         assert!((corner.point[0] - 1.0).abs() < 1e-15 && (corner.point[1] - lift).abs() < 1e-15, "{corner:?}");
+    }
+
+    /// An open surface (a rectangle's top, P1 and P2, and a box's top in 3D): a point beyond
+    /// its end faces nothing, a point straight above or below its end faces the end, and a
+    /// point inside faces the point above it.
+    #[test]
+    fn a_point_past_the_border_faces_nothing() {
+        use crate::fem::mesh::structured::{Diagonal, rectangle};
+        for degree in [1, 2] {
+            let mesh = rectangle(4, 2, [0.0, 1.0], [0.0, 0.5], Diagonal::Right, degree);
+            let top: Vec<Facet> =
+                mesh.boundary_facets().into_iter().filter(|&f| mesh.facet_normal_and_centroid(f).0[1] > 0.5).collect();
+            let surface = Surface::new(&mesh, &top, &vec![0.0; mesh.num_nodes() * 2]);
+            assert!(surface.closest(&[1.2, 0.49], 0.5).is_none(), "degree {degree}: past the right end");
+            assert!(surface.closest(&[-0.1, 0.55], 0.5).is_none(), "degree {degree}: past the left end");
+            let end = surface.closest(&[1.0, 0.45], 0.5).expect("below the end");
+            assert!((end.point[0] - 1.0).abs() < 1e-15 && (end.distance - 0.05).abs() < 1e-15);
+            let inside = surface.closest(&[0.3, 0.45], 0.5).expect("inside");
+            assert!(!inside.beyond && (inside.point[0] - 0.3).abs() < 1e-14);
+        }
+        let mesh = crate::fem::mesh::structured::cuboid([2, 2, 1], [0.0, 1.0], [0.0, 1.0], [0.0, 0.5], 1);
+        let top: Vec<Facet> =
+            mesh.boundary_facets().into_iter().filter(|&f| mesh.facet_normal_and_centroid(f).0[2] > 0.5).collect();
+        let surface = Surface::new(&mesh, &top, &vec![0.0; mesh.num_nodes() * 3]);
+        assert!(surface.closest(&[1.1, 0.5, 0.45], 0.5).is_none(), "past an edge");
+        assert!(surface.closest(&[1.1, 1.1, 0.45], 0.5).is_none(), "past a corner");
+        let inside = surface.closest(&[0.7, 0.4, 0.45], 0.5).expect("inside");
+        assert!((inside.distance - 0.05).abs() < 1e-14, "{inside:?}");
     }
 
     #[test]
