@@ -44,6 +44,8 @@ pub const CODES: &[(&str, &str)] = &[
     ),
     ("E0408", "`opposite` outside a facet integral (only a contact pair's surface has a facing side)"),
     ("E0409", "a volume integral in a contact pair's law (a file that reads `opposite`)"),
+    ("E0410", "`int(REGION, both_sides)` in a law that reads no facing side (not a contact pair's law)"),
+    ("E0411", "a contact pair's law with `both_sides` in some integrals and not in others"),
     ("E0501", "`n` or `h` in a volume integral"),
     ("E0502", "derivative of something that has none"),
     ("E0503", "form needs a quadrature degree above the cap (20)"),

@@ -30,7 +30,8 @@ pub struct Binding<'m> {
     /// The mesh's bodies, when it has several: the files' forms are then bound to each body
     /// with its own param values ([`Binding::body`]) and summed.
     pub bodies: &'m [Body],
-    /// The contact pairs a pair law (a file that reads `opposite`) is bound to, each once.
+    /// The contact pairs a pair law (a file that reads `opposite`) is bound to: each once, by
+    /// the body whose surface the law integrates over ([`Binding::body`]).
     pub pairs: Vec<Surfaces<'m>>,
 }
 
@@ -40,14 +41,30 @@ impl<'m> Binding<'m> {
         Binding { quadrature, regions, dim, cells: None, bodies: &[], pairs: Vec::new() }
     }
 
-    /// This binding cut to `body`: its cells, the facets they carry, and the pairs whose own
-    /// surface is its (a pair law reads the params of the body it integrates over; another
-    /// body binds the pair to no facet).
+    /// This binding cut to `body`: its cells, the facets they carry, and the pairs (a pair law
+    /// binds those whose surface it integrates over is this body's, [`Binding::pair`]).
     pub fn body(&self, body: &'m Body) -> Binding<'m> {
-        let regions = self.regions.clone();
-        let own = |p: &Surfaces<'m>| p.own.first().is_some_and(|f| body.cells[f.cell as usize]);
-        let pairs = self.pairs.iter().map(|p| if own(p) { *p } else { Surfaces { own: &[], ..*p } }).collect();
+        let (regions, pairs) = (self.regions.clone(), self.pairs.clone());
         Binding { quadrature: self.quadrature, regions, dim: self.dim, cells: Some(&body.cells), bodies: &[], pairs }
+    }
+
+    /// The pairs a pair law integrates over in this binding, each as (own, facing) surfaces:
+    /// those whose own surface is in the binding's cells, and with `both_sides` the reversed
+    /// pairs whose facing surface is (a pair law reads the params of the body it integrates
+    /// over). A pair this binding integrates over in neither direction is kept with no own
+    /// facet, so that every body binds the law's slots.
+    fn sides(&self, both_sides: bool) -> Vec<Surfaces<'m>> {
+        let mine = |s: &[Facet]| s.first().is_some_and(|f| self.cells.is_none_or(|c| c[f.cell as usize]));
+        let mut out = Vec::new();
+        for p in &self.pairs {
+            let forward = mine(p.own).then_some(*p);
+            let backward = (both_sides && mine(p.facing)).then_some(Surfaces { own: p.facing, facing: p.own, ..*p });
+            match (forward, backward) {
+                (None, None) => out.push(Surfaces { own: &[], ..*p }),
+                (f, b) => out.extend(f.into_iter().chain(b)),
+            }
+        }
+        out
     }
 }
 
@@ -203,7 +220,7 @@ impl<'m> Binding<'m> {
             return Err(LibraryError::NoPairs { form: meta.name.to_string() });
         }
         let forms: Vec<PairForm<'m>> = self
-            .pairs
+            .sides(kernel.both_sides())
             .iter()
             .map(|p| {
                 let degree = self

@@ -108,6 +108,11 @@ impl InterpretedForm {
         self.unit.forms[self.form].pairs.as_ref().map(|dims| dims[self.dim - 1].as_slice())
     }
 
+    /// Whether the form is one of a pair law integrated over both surfaces of its pair.
+    pub(super) fn over_both_sides(&self) -> bool {
+        self.unit.forms[self.form].both_sides
+    }
+
     /// Whether the form is one of a contact pair's law.
     pub fn is_pair(&self) -> bool {
         self.unit.forms[self.form].pairs.is_some()

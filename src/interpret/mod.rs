@@ -118,6 +118,8 @@ struct FormEntry {
     dims: Vec<plan::FormPlan>,
     /// A contact pair's law: its pointwise programs for dimensions 1, 2, 3.
     pairs: Option<Vec<Vec<signorini_compiler::ir::pair::PairIntegral>>>,
+    /// A pair law integrated over each surface of its pair in turn (`both_sides`).
+    both_sides: bool,
 }
 
 impl Library {
@@ -158,6 +160,7 @@ impl Library {
                 meta: meta(prog, irs, fi),
                 dims: irs.iter().map(|ir| plan::form(prog, ir, &ir.forms[fi])).collect(),
                 pairs: irs.iter().map(|ir| signorini_compiler::ir::pair::plan(ir, &ir.forms[fi])).collect(),
+                both_sides: irs.iter().any(|ir| ir.forms[fi].both_sides),
             })
             .collect();
         let file = prog.sources.path(prog.root).display().to_string();

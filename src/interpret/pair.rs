@@ -70,6 +70,10 @@ impl InterpretedForm {
 }
 
 impl PairKernel for InterpretedForm {
+    fn both_sides(&self) -> bool {
+        self.over_both_sides()
+    }
+
     fn residual_at(&self, region: usize, p: &PairPoint, out: &mut [f64]) -> bool {
         let Some(prog) = self.pair_integrals().and_then(|i| i.get(region)).and_then(|i| i.residual.as_ref()) else {
             return false;

@@ -199,8 +199,7 @@ fn problem(name: &str) -> String {
 /// the foundation's deformed normal turns fast.
 #[test]
 fn a_problem_file_poses_the_pair() {
-    use signorini::driver::Setting;
-    use signorini::problem::run::{Options, run};
+    use signorini::problem::run::run;
     let line = signorini::problem::run::check(&problem("block_on_foundation.wf")).unwrap();
     assert!(line.contains("pair_penalty (contact)"), "{line}");
     // The penalty law, then Nitsche's at θ = 1, 0, −1 (whose residual reaches the own cells'
@@ -210,17 +209,13 @@ fn a_problem_file_poses_the_pair() {
         ("pair_nitsche", Some(1.0)),
         ("pair_nitsche", Some(0.0)),
         ("pair_nitsche", Some(-1.0)),
+        ("pair_nitsche_unbiased", Some(1.0)),
+        ("pair_nitsche_unbiased", Some(0.0)),
+        ("pair_nitsche_unbiased", Some(-1.0)),
     ];
     for (law, theta) in laws {
         for degree in [1.0, 2.0] {
-            let mut o = Options::new(&problem("block_on_foundation.wf"));
-            o.methods.params.push(Setting { name: "degree".into(), value: degree, origin: "test".into() });
-            o.methods.contact = law.into();
-            o.chosen.contact = true;
-            if let Some(theta) = theta {
-                o.methods.params.push(Setting { name: "theta".into(), value: theta, origin: "test".into() });
-            }
-            let r = run(&o).unwrap();
+            let r = run(&block_on_foundation(&problem("block_on_foundation.wf"), law, theta, degree)).unwrap();
             let at = format!("{law} θ = {theta:?}, P{degree}");
             let force = r.column("force").unwrap()[0];
             assert!((force - 1.0).abs() < 1e-10, "{at}: the force on the block {force}, against its weight 1");
@@ -231,6 +226,58 @@ fn a_problem_file_poses_the_pair() {
             assert!(newton <= most, "{at}: {newton} Newton iterations");
         }
     }
+}
+
+/// The options of a run of the block on its foundation (`path`) with `law`, θ and `degree`.
+fn block_on_foundation(path: &str, law: &str, theta: Option<f64>, degree: f64) -> signorini::problem::run::Options {
+    use signorini::driver::Setting;
+    let mut o = signorini::problem::run::Options::new(path);
+    o.methods.params.push(Setting { name: "degree".into(), value: degree, origin: "test".into() });
+    o.methods.contact = law.into();
+    o.chosen.contact = true;
+    if let Some(theta) = theta {
+        o.methods.params.push(Setting { name: "theta".into(), value: theta, origin: "test".into() });
+    }
+    o
+}
+
+/// The unbiased law integrates over both surfaces with half weights: the block on its
+/// foundation with the pair's regions swapped (`contact top with bottom`) gives the same
+/// columns to round-off, at every θ on P1 and P2. The master–slave law does not (its gap is
+/// measured from the other surface): the test can tell.
+#[test]
+fn an_unbiased_pair_is_the_same_with_its_regions_swapped() {
+    use signorini::problem::run::run;
+    let dir = std::env::temp_dir().join(format!("signorini-swapped-pair-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(problem("block_on_foundation.wf")).unwrap();
+    let swapped_text = text.replace("contact bottom with top", "contact top with bottom");
+    assert_ne!(text, swapped_text, "the problem declares the pair `contact bottom with top`");
+    let swapped = dir.join("block_on_foundation.wf");
+    std::fs::write(&swapped, swapped_text).unwrap();
+    let columns = ["force", "pressure", "sunk"];
+    let differs = |law: &str, theta: Option<f64>, degree: f64| {
+        let a = run(&block_on_foundation(&problem("block_on_foundation.wf"), law, theta, degree)).unwrap();
+        let b = run(&block_on_foundation(&swapped.display().to_string(), law, theta, degree)).unwrap();
+        let at = format!("{law} θ = {theta:?}, P{degree}");
+        assert_eq!(a.column("newton"), b.column("newton"), "{at}: Newton iterations");
+        columns
+            .iter()
+            .map(|c| {
+                let (x, y) = (a.column(c).unwrap()[0], b.column(c).unwrap()[0]);
+                (x - y).abs() / x.abs()
+            })
+            .fold(0.0, f64::max)
+    };
+    for theta in [1.0, 0.0, -1.0] {
+        for degree in [1.0, 2.0] {
+            let gap = differs("pair_nitsche_unbiased", Some(theta), degree);
+            assert!(gap < 1e-12, "θ = {theta}, P{degree}: swapped regions differ by {gap}");
+        }
+    }
+    let biased = differs("pair_nitsche", Some(1.0), 1.0);
+    assert!(biased > 1e-6, "the master–slave law is biased: {biased}");
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The tangent against differences on two curved P2 discs pressed into each other. The

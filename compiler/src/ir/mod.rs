@@ -52,6 +52,9 @@ pub struct FormIr {
     /// In a contact pair's law: its facet integrals are evaluated at facing points
     /// ([`IntegralIr::pair`]).
     pub pair: bool,
+    /// A pair law integrated over each surface of its pair in turn (`int(REGION, both_sides)`):
+    /// the runtime binds it a second time with the surfaces' roles swapped.
+    pub both_sides: bool,
 }
 
 pub struct IntegralIr {
@@ -156,6 +159,10 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
     if pair_law && let Some(e) = pair_volume_error(prog, &own_forms) {
         return Err(vec![e]);
     }
+    let both_sides = match sides(prog, pair_law) {
+        Ok(both) => both,
+        Err(e) => return Err(vec![*e]),
+    };
     let mut forms = Vec::new();
     for (lf, own) in lowered.into_iter().zip(own) {
         let pair_form = pair_law && own;
@@ -227,6 +234,7 @@ pub fn build(prog: &Unit, d: usize) -> Result<DimIr, Vec<Diagnostic>> {
             linear,
             previous,
             pair: pair_form,
+            both_sides: pair_form && both_sides,
         });
     }
     if !diags.is_empty() {
@@ -392,6 +400,39 @@ fn one_rule(forms: &mut [FormIr]) {
     }
     for i in forms.iter_mut().filter(|f| f.pair).flat_map(|f| f.integrals.iter_mut()).filter(estimated) {
         (i.degree, i.estimated) = (largest, largest);
+    }
+}
+
+/// Whether a pair law's integrals are taken over both surfaces (`int(REGION, both_sides)`): all
+/// of its own integrals say so or none (E0411), and only a pair law's (E0410).
+fn sides(prog: &Unit, pair_law: bool) -> Result<bool, Box<Diagnostic>> {
+    let integrals = || prog.forms.iter().filter(|f| f.span.file == prog.root).flat_map(|f| &f.integrals);
+    let first = integrals().find_map(|i| i.both_sides);
+    let Some(first) = first else { return Ok(false) };
+    if !pair_law {
+        return Err(Box::new(
+            Diagnostic::error(
+                "E0410",
+                "`both_sides` in a law that reads no facing side",
+                first,
+                "only a contact pair's law has two sides",
+            )
+            .with_help("a pair's law reads the other surface with `opposite(e)`; elsewhere drop `both_sides`"),
+        ));
+    }
+    match integrals().find(|i| i.both_sides.is_none()) {
+        None => Ok(true),
+        Some(one) => Err(Box::new(
+            Diagnostic::error(
+                "E0411",
+                "a pair law over both surfaces in some integrals and over its own surface in others",
+                one.span,
+                "over the own surface only",
+            )
+            .with_label(first, "over both surfaces")
+            .with_note("the law is bound once for each direction of its pair, all its forms together")
+            .with_help("write `both_sides` in every integral of the file, or in none"),
+        )),
     }
 }
 

@@ -90,6 +90,9 @@ pub struct Integral {
     pub region: Ident,
     /// `int(REGION, degree = k)`: the quadrature degree the author sets, and where.
     pub degree: Option<(f64, Span)>,
+    /// `int(REGION, both_sides)`: a pair law integrated over each surface of its pair in turn,
+    /// and where.
+    pub both_sides: Option<Span>,
     pub integrand: Expr,
     pub span: Span,
 }

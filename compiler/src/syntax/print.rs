@@ -92,7 +92,8 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 for i in integrals {
                     let sign = if i.sign < 0.0 { "-" } else { "+" };
                     let degree = i.degree.map_or(String::new(), |(k, _)| format!(", degree = {k}"));
-                    out.push_str(&format!("  {sign} int({}{degree}) {}\n", i.region.name, expr(&i.integrand)));
+                    let sides = if i.both_sides.is_some() { ", both_sides" } else { "" };
+                    out.push_str(&format!("  {sign} int({}{degree}{sides}) {}\n", i.region.name, expr(&i.integrand)));
                 }
             }
         }

@@ -290,9 +290,9 @@ fn border(mesh: &Mesh, facets: &[Facet], frames: &[Frame]) -> Vec<[u32; 2]> {
     for f in facets {
         let cell = mesh.cell(f.cell as usize);
         let v: Vec<u32> = frames[f.local as usize].vertices.iter().map(|&a| cell[a]).collect();
-        match v.as_slice() {
-            &[a, b] => pieces.extend([[a, a], [b, b]]),
-            &[a, b, c] => pieces.extend([[a, b], [b, c], [a, c]].map(|[p, q]| [p.min(q), p.max(q)])),
+        match *v.as_slice() {
+            [a, b] => pieces.extend([[a, a], [b, b]]),
+            [a, b, c] => pieces.extend([[a, b], [b, c], [a, c]].map(|[p, q]| [p.min(q), p.max(q)])),
             _ => {}
         }
     }

@@ -381,15 +381,21 @@ impl Builder {
                     let mut it = q.into_inner();
                     let region = self.ident(it.next().expect("integral region"));
                     let mut next = it.next().expect("integrand");
-                    let mut degree = None;
-                    if next.as_rule() == Rule::degree_arg {
-                        let number = next.into_inner().next().expect("degree");
-                        let value = number.as_str().parse::<f64>().unwrap_or(f64::NAN);
-                        degree = Some((value, self.span(&number)));
+                    let (mut degree, mut both_sides) = (None, None);
+                    loop {
+                        match next.as_rule() {
+                            Rule::degree_arg => {
+                                let number = next.into_inner().next().expect("degree");
+                                let value = number.as_str().parse::<f64>().unwrap_or(f64::NAN);
+                                degree = Some((value, self.span(&number)));
+                            }
+                            Rule::both_sides => both_sides = Some(self.span(&next)),
+                            _ => break,
+                        }
                         next = it.next().expect("integrand");
                     }
                     let integrand = self.expr(next)?;
-                    out.push(Integral { sign, region, degree, integrand, span });
+                    out.push(Integral { sign, region, degree, both_sides, integrand, span });
                     sign = 1.0;
                 }
             }

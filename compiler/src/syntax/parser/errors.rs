@@ -274,6 +274,7 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::sign => "`+` or `-`",
         Rule::integral => "`int(REGION)`",
         Rule::degree_arg => "`degree = K`",
+        Rule::both_sides => "`both_sides`",
         Rule::integrals => "an integral `int(REGION) ...`",
         Rule::form_args | Rule::ident_list => "argument names",
         Rule::state_decl

@@ -126,6 +126,11 @@ pub mod layout {
 /// The kernels of a pair law's form: pointwise coefficients, which the assembly weights and
 /// contracts. `region` indexes `meta().facets`.
 pub trait PairKernel: Form + Send + Sync {
+    /// Whether the law integrates over each surface of its pair in turn (the facing one as its
+    /// own, with the facing body's params), not over the pair's own surface only.
+    fn both_sides(&self) -> bool {
+        false
+    }
     /// Writes the residual's coefficients ([`layout::residual`]); false if the form has no
     /// residual on `region` (a functional, or an integrand that is zero).
     fn residual_at(&self, region: usize, p: &PairPoint, out: &mut [f64]) -> bool;
