@@ -432,7 +432,7 @@ impl FilesInUse {
             SchemeSource::Interpreted(i) => Some(i.file.clone()),
             SchemeSource::Compiled(_) => None,
         };
-        let own = |u: &FormSource| matches!(u, FormSource::Interpreted(i) if !i.generated && i.rebound.is_none());
+        let own = |u: &FormSource| matches!(u, FormSource::Interpreted(i) if !i.generated && !i.library && i.rebound.is_none());
         let forms = self.forms.units.iter().filter(|u| own(u)).map(|u| u.file().to_string());
         scheme.into_iter().chain(forms).collect()
     }

@@ -24,6 +24,9 @@ pub struct Interpreted {
     pub slots: Vec<SlotInfo>,
     /// Written by the run itself (a problem's loads), not a file of the user's.
     pub generated: bool,
+    /// A file of the library that the library itself interprets (a pair law: the code
+    /// generator does not compile them yet), not a file of the user's.
+    pub library: bool,
     /// The roles its files import: role and default file stem.
     pub roles: Vec<(String, String)>,
     /// A file of the library compiled again for the run's material (the file bound to its
@@ -44,10 +47,18 @@ pub fn interpret(path: &Path, roles: &[(String, PathBuf)]) -> Result<Interpreted
         params: describe::params(&prog),
         slots: describe::slots(&prog),
         generated: false,
+        library: false,
         roles: roles_of(&prog),
         rebound: None,
         lib: Library::new(&prog),
     })
+}
+
+impl Interpreted {
+    /// Its lowered forms.
+    pub fn library(&self) -> &Library {
+        &self.lib
+    }
 }
 
 fn roles_of(prog: &crate::compiler::Program) -> Vec<(String, String)> {
@@ -63,7 +74,7 @@ pub fn interpret_text(name: &str, text: &str) -> Result<Interpreted, String> {
 /// checked and lowered from the text built in.
 pub fn library_pair(name: &str) -> Option<Result<Interpreted, String>> {
     let (stem, text) = crate::forms::PAIR_SOURCES.iter().find(|(stem, _)| *stem == name)?;
-    Some(interpret_source(&format!("forms/pairs/{stem}.wf"), text, false))
+    Some(interpret_source(&format!("forms/pairs/{stem}.wf"), text, false).map(|i| Interpreted { library: true, ..i }))
 }
 
 /// The library's pair laws, by file stem.
@@ -81,6 +92,7 @@ fn interpret_source(name: &str, text: &str, generated: bool) -> Result<Interpret
         params: describe::params(&prog),
         slots: describe::slots(&prog),
         generated,
+        library: false,
         roles: roles_of(&prog),
         rebound: None,
         lib: Library::new(&prog),

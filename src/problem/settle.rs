@@ -7,15 +7,19 @@ use crate::driver::FilesInUse;
 use crate::error::CaseError;
 use crate::runtime::fem::assembly::Assembler;
 
-/// The contact `settled(GUESS)` rests on, after the checks that it can: a contact region, and
+/// The contact region `settled(GUESS)` rests on (none when the bodies rest on each other through
+/// the problem's pairs), after the checks that it can: a contact region or a pair, and
 /// Dirichlet values that are zero at the start (they are held at zero while settling).
 pub(super) fn contact<'p>(
     pf: &ProblemFile,
     contact: Option<&'p str>,
+    pairs: bool,
     held_nonzero: bool,
-) -> Result<&'p str, CaseError> {
+) -> Result<Option<&'p str>, CaseError> {
     let why = |what: &str| CaseError::Settle(format!("{}: `initial u = settled(...)` {what}", pf.file));
-    let contact = contact.ok_or_else(|| why("needs the problem's contact (an obstacle, or `Gamma_C`) to rest on"))?;
+    if contact.is_none() && !pairs {
+        return Err(why("needs the problem's contact (an obstacle, `Gamma_C` or a contact pair) to rest on"));
+    }
     if held_nonzero {
         return Err(why(
             "holds the Dirichlet values at zero: a value held away from zero at the start needs an initial u of its own",

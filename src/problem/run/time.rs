@@ -99,8 +99,8 @@ fn settle(req: &Request, sim: &Simulation, bound: &Bound, start: &Start) -> Resu
         return Ok(start.u0.clone());
     }
     let held_nonzero = bound.held.is_some_and(|h| !h.zero_at(start.mesh, t0));
-    let contact = crate::problem::settle::contact(pf, bound.contact, held_nonzero)?;
-    let problem = bound.statics(Some(contact), req.opts, t0);
+    let contact = crate::problem::settle::contact(pf, bound.contact, !bound.pairs.is_empty(), held_nonzero)?;
+    let problem = bound.statics(contact, req.opts, t0);
     crate::problem::settle::settle(pf, sim.ops.asm, problem, req.in_use, start.u0.clone())
 }
 
