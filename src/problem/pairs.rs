@@ -40,6 +40,39 @@ pub fn surfaces(pf: &ProblemFile, ex: &mut Exprs, mesh: &Mesh) -> Result<Vec<Pai
     Ok(out)
 }
 
+/// How deep, in cells, a surface may start inside the body it faces: a law's penalty carries a
+/// load at a small overlap (a fraction of a cell), a misplaced body overlaps by much more.
+const OVERLAP_IN_CELLS: f64 = 0.5;
+
+/// Refuses a start with the bodies of a pair overlapping by more than [`OVERLAP_IN_CELLS`] of
+/// a cell on the configuration x + `u0`, at the pair and with where.
+pub fn check_overlap(pf: &ProblemFile, mesh: &Mesh, pairs: &[PairRegions], u0: &[f64]) -> Result<(), CaseError> {
+    for (pair, regions) in pf.problem().pairs.iter().zip(pairs) {
+        let Some(o) = regions.on(mesh).deepest_overlap(mesh, u0) else { continue };
+        if o.depth > OVERLAP_IN_CELLS * o.cell_size {
+            let at: Vec<String> = o.point.iter().map(|c| format!("{c:.6}")).collect();
+            return Err(pf.render(
+                Diagnostic::error(
+                    "E0103",
+                    format!(
+                        "the bodies of this pair overlap at the start: a node of `{}` at ({}) is {:.3e} inside the body of `{}`",
+                        pair.own.name,
+                        at.join(", "),
+                        o.depth,
+                        pair.facing.name
+                    ),
+                    pair.span,
+                    format!("more than half its cell ({:.3e}) deep", o.cell_size),
+                )
+                .with_help(
+                    "place the bodies apart or touching (and the initial u): a law carries a load at an overlap of a fraction of a cell, not more",
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The facets of one side of `pair`, all of one body, not the other side's body.
 fn side<'m>(pf: &ProblemFile, mesh: &'m Mesh, pair: &ContactPair, own: bool) -> Result<&'m [Facet], CaseError> {
     let (name, other) = if own { (&pair.own, &pair.facing) } else { (&pair.facing, &pair.own) };

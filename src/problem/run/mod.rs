@@ -135,6 +135,7 @@ fn simulate(
     };
     let mut runner = Runner::bind(&req, &asm, &bound)?;
     let (u0, v0) = initial_fields(pf, ex, &mesh, &bound, times.t_start)?;
+    super::pairs::check_overlap(pf, &mesh, &pairs, &u0)?;
     let observing = Observing::new(&req, ex, &runner, &asm, &bound, times.t_start)?;
     // Bound: the run starts, and only now makes its output directory.
     let out = if writes { prepared(opts)? } else { None };

@@ -70,6 +70,41 @@ impl Surfaces<'_> {
     }
 }
 
+/// Where one surface's node lies deepest inside the other body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Overlap {
+    /// The node's position on the configuration.
+    pub point: Vec<f64>,
+    /// How far inside the other body, along its outward normal at the facing point.
+    pub depth: f64,
+    /// The size of the node's cell.
+    pub cell_size: f64,
+}
+
+impl Surfaces<'_> {
+    /// The own surface's node deepest inside the facing body on the configuration x + `u`,
+    /// measured along the facing facet's outward normal (none: no node is inside).
+    pub fn deepest_overlap(&self, mesh: &Mesh, u: &[f64]) -> Option<Overlap> {
+        let d = mesh.dim();
+        let surface = Surface::new(mesh, self.facing, u);
+        let mut deepest: Option<Overlap> = None;
+        for f in self.own {
+            let cell = mesh.cell(f.cell as usize);
+            for a in mesh.kind.facet_nodes(f.local as usize) {
+                let node = cell[a] as usize;
+                let p: Vec<f64> = (0..d).map(|r| mesh.node(node)[r] + u[node * d + r]).collect();
+                let Some(facing) = surface.closest(&p, self.reach) else { continue };
+                let (normal, _) = mesh.facet_normal_and_centroid(self.facing[facing.facet]);
+                let depth = -(0..d).map(|r| (p[r] - facing.point[r]) * normal[r]).sum::<f64>();
+                if depth > 0.0 && deepest.as_ref().is_none_or(|o| depth > o.depth) {
+                    deepest = Some(Overlap { point: p, depth, cell_size: mesh.cell_size(f.cell as usize) });
+                }
+            }
+        }
+        deepest
+    }
+}
+
 /// The most space dimensions a pair point holds.
 pub const MAX_DIM: usize = 3;
 
