@@ -40,7 +40,7 @@ pub(super) fn finish(result: Result<crate::problem::run::Run, crate::error::Case
                 .unwrap_or_default();
             let set = if set.is_empty() { String::new() } else { format!(" ({})", set.join(", ")) };
             println!(
-                "{}: {} {}{set}, {} dofs, {} steps: {}; Newton {} (max {}), {:.2} s ({:.3} ms/step){}",
+                "{}: {} {}{set}, {} dofs, {} steps: {}; Newton {} (max {}), {:.2} s ({:.3} ms/step){}{}",
                 text("case"),
                 text("scheme"),
                 text("contact"),
@@ -51,6 +51,7 @@ pub(super) fn finish(result: Result<crate::problem::run::Run, crate::error::Case
                 text("newton_max"),
                 s.number("wall_seconds").unwrap_or(f64::NAN),
                 1e3 * s.number("seconds_per_step").unwrap_or(f64::NAN),
+                pairs(s),
                 s.number("peak_memory_bytes").map_or(String::new(), |b| format!(", peak memory {:.0} MB", b / 1e6))
             );
             expectations(s);
@@ -75,6 +76,20 @@ fn expectations(s: &crate::problem::outputs::Summary) {
         let met = if x.met { "met" } else { "NOT MET" };
         println!("  expect {} = {expected} (is {value}, difference {difference}, within {within}): {met}", x.key);
     }
+}
+
+/// The contact pairs' cost, if the run has pairs: their assembly's share of the stepping time,
+/// and the search's.
+fn pairs(s: &crate::problem::outputs::Summary) -> String {
+    let Some(p) = s.get("pair_search") else { return String::new() };
+    let number = |k: &str| p.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
+    format!(
+        ", pairs {:.0} % of the stepping (search {:.2} s, {} indexes, {} queries)",
+        100.0 * number("share_of_stepping"),
+        number("search_seconds"),
+        number("builds"),
+        number("queries")
+    )
 }
 
 /// Says which files ran interpreted, and how to compile them.

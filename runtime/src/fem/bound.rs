@@ -57,6 +57,10 @@ pub trait BoundForm {
     fn may_be_symmetric(&self) -> bool {
         true
     }
+    /// What its contact pairs' search and assembly have cost so far (none for other forms).
+    fn search_cost(&self) -> crate::fem::search_cost::SearchCost {
+        Default::default()
+    }
 }
 
 /// `fields`, with `previous` after them when the form reads the previous time level (`reads`):

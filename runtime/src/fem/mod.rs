@@ -14,5 +14,6 @@ pub mod mesh;
 pub mod pair;
 pub mod quadrature;
 pub mod redistribute;
+pub mod search_cost;
 pub mod summed;
 pub mod test_matrices;

@@ -63,6 +63,9 @@ impl BoundForm for Summed<'_> {
     fn may_be_symmetric(&self) -> bool {
         self.parts.iter().all(|p| p.may_be_symmetric())
     }
+    fn search_cost(&self) -> crate::fem::search_cost::SearchCost {
+        self.parts.iter().map(|p| p.search_cost()).fold(Default::default(), |a, c| a + c)
+    }
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {
         for p in &self.parts {
             p.residual(asm, &self.args(p.as_ref(), fields), t, out);

@@ -71,6 +71,21 @@ fn cost(req: &Request, ran: &Ran, put: &mut Put) {
         Runner::Static(_) => None,
     };
     put("factor_nnz", json(&sim.and_then(|s| s.stepper.factor_nnz())));
+    // The contact pairs' search and assembly in the steps (the observers' functionals aside),
+    // and their share of the stepping time.
+    if let Some(c) = sim.map(|s| s.stepper.search_cost()).filter(|c| c.builds > 0) {
+        let stepping: f64 = outcome.step_seconds.iter().sum();
+        put(
+            "pair_search",
+            serde_json::json!({
+                "builds": c.builds,
+                "queries": c.queries,
+                "search_seconds": c.search_seconds,
+                "assembly_seconds": c.assembly_seconds,
+                "share_of_stepping": c.assembly_seconds / stepping,
+            }),
+        );
+    }
     // An explicit scheme's critical step, estimated at the start (docs/language.md).
     if let Some(stable) = sim.and_then(|s| s.stable) {
         put("stable_dt", json(&stable.dt));

@@ -14,6 +14,8 @@ use crate::fem::facing::Surface;
 use crate::fem::mesh::{Facet, Mesh};
 use crate::fem::quadrature::Rule;
 use crate::fem::quadrature::simplex_rule;
+use crate::fem::search_cost::{Meter, SearchCost};
+use std::time::Instant;
 use crate::linalg::Matrix;
 
 /// The basis of a cell at a reference point: values and reference gradients.
@@ -40,6 +42,8 @@ pub struct PairForm<'m> {
     edges: Vec<Vec<[f64; MAX_DIM]>>,
     /// A coupling the matrix pattern lacks, met by the last tangent: the two nodes.
     missing: Mutex<Option<(u32, u32)>>,
+    /// What its search and assembly have cost.
+    meter: Meter,
 }
 
 /// Where a quadrature point's facing point is, and both cells' basis functions there.
@@ -97,7 +101,7 @@ impl<'m> PairForm<'m> {
                     .collect()
             })
             .collect();
-        PairForm { kernel, region, own, facing, reach, rule, edges, missing: Mutex::new(None) }
+        PairForm { kernel, region, own, facing, reach, rule, edges, missing: Mutex::new(None), meter: Meter::default() }
     }
 
     /// The node pairs its tangent may couple ([`Surfaces::couplings`]).
@@ -117,9 +121,11 @@ impl<'m> PairForm<'m> {
         if self.own.is_empty() {
             return;
         }
+        let started = Instant::now();
         let d = mesh.dim();
         let moving = fields.get(self.kernel.meta().fields.len().saturating_sub(1)).copied().unwrap_or(&[]);
         let surface = Surface::new(mesh, self.facing, moving);
+        self.meter.built(started);
         for f in self.own {
             let (points, ref_normal) = &self.rule[f.local as usize];
             for q in points {
@@ -128,7 +134,10 @@ impl<'m> PairForm<'m> {
                 for k in 0..d {
                     at[k] = own.side.x[k] + own.side.fields.first().map_or(0.0, |u| u.value[k]);
                 }
-                let Some(facing) = surface.closest(&at[..d], self.reach) else { continue };
+                let asked = Instant::now();
+                let found = surface.closest(&at[..d], self.reach);
+                self.meter.queried(asked);
+                let Some(facing) = found else { continue };
                 let g = self.facing[facing.facet];
                 let kind = mesh.kind;
                 let (phi, dref) = (kind.basis(&facing.xi), kind.basis_gradients(&facing.xi));
@@ -149,6 +158,7 @@ impl<'m> PairForm<'m> {
                 each(&element);
             }
         }
+        self.meter.evaluated(started);
     }
 }
 
@@ -257,6 +267,9 @@ impl BoundForm for PairForm<'_> {
     /// tangent unsymmetric once the bodies touch.
     fn may_be_symmetric(&self) -> bool {
         false
+    }
+    fn search_cost(&self) -> SearchCost {
+        self.meter.cost()
     }
 
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {

@@ -248,6 +248,11 @@ impl<'a> Stepper<'a> {
         self.stages.iter().map(|s| s.newton.counters()).fold(Default::default(), |a, c| a + c)
     }
 
+    /// What the contact pairs' search and assembly have cost so far, over the scheme's forms.
+    pub fn search_cost(&self) -> crate::fem::search_cost::SearchCost {
+        self.forms.values().map(|f| f.search_cost()).fold(Default::default(), |a, c| a + c)
+    }
+
     /// The largest stage's Cholesky factor (stored values), if the stages factor by Cholesky.
     pub fn factor_nnz(&self) -> Option<usize> {
         self.stages.iter().filter_map(|s| s.newton.factor_nnz()).max()
