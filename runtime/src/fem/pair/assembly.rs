@@ -3,20 +3,20 @@
 //! coefficients there, and their contraction with the basis functions of both cells into an
 //! element of both cells' nodes.
 
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex, OnceLock};
 
 use super::{FieldAt, MAX_DIM, PairKernel, PairPoint, SideAt, Surfaces, layout};
 use crate::fem::assembly::Assembler;
 use crate::fem::assembly::PointValue;
 use crate::fem::bound::{BoundForm, BoundFunctional};
 use crate::fem::element::ElementKind;
-use crate::fem::facing::Surface;
+use crate::fem::facing::{Facing, Surface};
 use crate::fem::mesh::{Facet, Mesh};
 use crate::fem::quadrature::Rule;
 use crate::fem::quadrature::simplex_rule;
 use crate::fem::search_cost::{Meter, SearchCost};
-use std::time::Instant;
 use crate::linalg::Matrix;
+use std::time::Instant;
 
 /// The basis of a cell at a reference point: values and reference gradients.
 struct Tabulated {
@@ -44,7 +44,22 @@ pub struct PairForm<'m> {
     missing: Mutex<Option<(u32, u32)>>,
     /// What its search and assembly have cost.
     meter: Meter,
+    /// The nodes whose displacement moves its facing points: those of the own and the facing
+    /// facets' cells (found at the first evaluation).
+    moved_by: OnceLock<Vec<u32>>,
+    /// The facing points of the last evaluation, per quadrature point of the own surface in
+    /// order, with the displacement of `moved_by` they were found at: a tangent or functional
+    /// at the residual's state (each Newton iterate's) searches no more.
+    found: Mutex<Option<Found>>,
 }
+
+/// Facing points, with the displacement they were found at.
+type Found = (Vec<f64>, Arc<Vec<Option<Facing>>>);
+
+/// The field whose displacement places both surfaces, so that the facing points and the
+/// tangent's sliding part follow it: the law's first (`u` of `contact(u; v)`, the step's end u
+/// of `friction_work(u, w)`).
+const CONFIGURATION: usize = 0;
 
 /// Where a quadrature point's facing point is, and both cells' basis functions there.
 struct PairElement {
@@ -101,7 +116,19 @@ impl<'m> PairForm<'m> {
                     .collect()
             })
             .collect();
-        PairForm { kernel, region, own, facing, reach, rule, edges, missing: Mutex::new(None), meter: Meter::default() }
+        PairForm {
+            kernel,
+            region,
+            own,
+            facing,
+            reach,
+            rule,
+            edges,
+            missing: Mutex::new(None),
+            meter: Meter::default(),
+            moved_by: OnceLock::new(),
+            found: Mutex::new(None),
+        }
     }
 
     /// The node pairs its tangent may couple ([`Surfaces::couplings`]).
@@ -123,21 +150,14 @@ impl<'m> PairForm<'m> {
         }
         let started = Instant::now();
         let d = mesh.dim();
-        let moving = fields.get(self.kernel.meta().fields.len().saturating_sub(1)).copied().unwrap_or(&[]);
-        let surface = Surface::new(mesh, self.facing, moving);
-        self.meter.built(started);
+        let moving = fields.get(CONFIGURATION).copied().unwrap_or(&[]);
+        let found = self.facing_points(mesh, moving);
+        let mut found = found.iter();
         for f in self.own {
             let (points, ref_normal) = &self.rule[f.local as usize];
             for q in points {
+                let Some(Some(facing)) = found.next() else { continue };
                 let own = side(mesh, f.cell as usize, &q.phi, &q.dref, ref_normal, fields);
-                let mut at = [0.0; MAX_DIM];
-                for k in 0..d {
-                    at[k] = own.side.x[k] + own.side.fields.first().map_or(0.0, |u| u.value[k]);
-                }
-                let asked = Instant::now();
-                let found = surface.closest(&at[..d], self.reach);
-                self.meter.queried(asked);
-                let Some(facing) = found else { continue };
                 let g = self.facing[facing.facet];
                 let kind = mesh.kind;
                 let (phi, dref) = (kind.basis(&facing.xi), kind.basis_gradients(&facing.xi));
@@ -302,7 +322,7 @@ impl BoundForm for PairForm<'_> {
         let block = layout::block(d);
         let mut missing = None;
         let pattern = m.pattern.clone();
-        let moving = self.kernel.meta().fields.len().saturating_sub(1);
+        let moving = CONFIGURATION;
         self.each_point(mesh, fields, t, |e| {
             c.fill(0.0);
             if !self.kernel.tangent_at(self.region, &e.point, wrt, &mut c) {
@@ -365,6 +385,52 @@ impl BoundForm for PairForm<'_> {
 }
 
 impl PairForm<'_> {
+    /// The facing point of each quadrature point of the own surface, in order, on the
+    /// configuration x + `moving`: the last evaluation's if the displacement that moves them
+    /// is the same, else searched anew.
+    fn facing_points(&self, mesh: &Mesh, moving: &[f64]) -> Arc<Vec<Option<Facing>>> {
+        let d = mesh.dim();
+        let moved_by = self.moved_by.get_or_init(|| {
+            let mut nodes: Vec<u32> =
+                self.own.iter().chain(self.facing).flat_map(|f| mesh.cell(f.cell as usize)).copied().collect();
+            nodes.sort_unstable();
+            nodes.dedup();
+            nodes
+        });
+        let at = |n: u32, k: usize| moving.get(n as usize * d + k).copied().unwrap_or(0.0);
+        let key: Vec<f64> = moved_by.iter().flat_map(|&n| (0..d).map(move |k| at(n, k))).collect();
+        let mut last = self.found.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((k, found)) = last.as_ref()
+            && k.iter().zip(&key).all(|(a, b)| a.to_bits() == b.to_bits())
+        {
+            return found.clone();
+        }
+        let started = Instant::now();
+        let surface = Surface::new(mesh, self.facing, moving);
+        self.meter.built(started);
+        let mut found = Vec::new();
+        for f in self.own {
+            let cell = mesh.cell(f.cell as usize);
+            for q in &self.rule[f.local as usize].0 {
+                // The quadrature point on the configuration, x + u summed as `side` sums them.
+                let (mut x, mut u) = ([0.0; MAX_DIM], [0.0; MAX_DIM]);
+                for (a, &n) in cell.iter().enumerate() {
+                    for k in 0..d {
+                        x[k] += q.phi[a] * mesh.node(n as usize)[k];
+                        u[k] += q.phi[a] * at(n, k);
+                    }
+                }
+                let p: [f64; MAX_DIM] = std::array::from_fn(|k| x[k] + u[k]);
+                let asked = Instant::now();
+                found.push(surface.closest(&p[..d], self.reach));
+                self.meter.queried(asked);
+            }
+        }
+        let found = Arc::new(found);
+        *last = Some((key, found.clone()));
+        found
+    }
+
     /// Adds to `ke` the tangent's part through the facing point's motion. The facing point y
     /// is where (p_s − p_m(y))·t_α = 0, with p = x + u the deformed positions and
     /// t_α = (I + ∇u_m) T_α the deformed facet's tangents; its variation gives
@@ -375,7 +441,7 @@ impl PairForm<'_> {
     /// P1, are left out). `rates` holds the residual's coefficients then their sliding rates.
     fn add_sliding(&self, e: &PairElement, rates: &[f64], d: usize, ke: &mut [f64]) {
         let (n, half) = (e.nodes.len(), e.nodes.len() / 2);
-        let moving = self.kernel.meta().fields.len().saturating_sub(1);
+        let moving = CONFIGURATION;
         let (own_u, facing_u) = (&e.point.own.fields[moving], &e.point.facing.fields[moving]);
         let gap: [f64; MAX_DIM] =
             std::array::from_fn(|r| (e.point.own.x[r] + own_u.value[r]) - (e.point.facing.x[r] + facing_u.value[r]));
