@@ -45,7 +45,8 @@ pub fn surfaces(pf: &ProblemFile, ex: &mut Exprs, mesh: &Mesh) -> Result<Vec<Pai
 const OVERLAP_IN_CELLS: f64 = 0.5;
 
 /// Refuses a start with the bodies of a pair overlapping by more than [`OVERLAP_IN_CELLS`] of
-/// a cell on the configuration x + `u0`, at the pair and with where.
+/// a cell on the configuration x + `u0` (a time run's initial u; zero where it is a guess), at
+/// the pair and with where.
 pub fn check_overlap(pf: &ProblemFile, mesh: &Mesh, pairs: &[PairRegions], u0: &[f64]) -> Result<(), CaseError> {
     for (pair, regions) in pf.problem().pairs.iter().zip(pairs) {
         let Some(o) = regions.on(mesh).deepest_overlap(mesh, u0) else { continue };

@@ -53,6 +53,10 @@ const ARGS: &[(&str, &str)] = &[
     ("radius", "R, the body's radius"),
     ("force", "F, the load on the whole body (per unit length in 2D)"),
     ("copies", "how many copies of the model make the body (2: a half cylinder, 4: a quarter ball; default 1)"),
+    (
+        "modulus",
+        "E*, the contact modulus (default E/(1 − ν²), the run's material on the rigid plane; two bodies: 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂, with 1/R = 1/R₁ + 1/R₂ for `radius`)",
+    ),
 ];
 
 impl Reference for Hertz {
@@ -79,9 +83,12 @@ impl Reference for Hertz {
     fn bind(&self, run: &RunFacts) -> Result<Box<dyn BoundReference>, String> {
         let (radius, force) = (run.positive("radius", None)?, run.positive("force", None)?);
         let copies = run.positive("copies", Some(1.0))?;
-        let material = closed_form::Material::of(run)?;
+        let modulus = match run.args.iter().any(|(n, _)| n == "modulus") {
+            true => run.positive("modulus", None)?,
+            false => closed_form::Material::of(run)?.contact_modulus(),
+        };
         let dim = run.mesh.dim();
-        let (a, p0) = closed_form::static_contact(dim, radius, material.contact_modulus(), force);
+        let (a, p0) = closed_form::static_contact(dim, radius, modulus, force);
         let cell_size =
             run.contact.iter().map(|f| run.mesh.cell_diameter(f.cell as usize)).fold(f64::INFINITY, f64::min);
         Ok(Box::new(BoundHertz { dim, copies, a, p0, cell_size, samples: Sampler::default() }))

@@ -25,6 +25,28 @@ struct Tabulated {
     dref: Vec<Vec<f64>>,
 }
 
+/// A local facet's points (weights on the reference facet, times its measure) with the basis
+/// there, and its reference normal.
+type Points = (Vec<Tabulated>, Vec<f64>);
+
+/// `rule`'s points on each local facet of `kind`'s element.
+fn tabulate(kind: ElementKind, rule: &Rule) -> Vec<Points> {
+    (0..kind.facets().len())
+        .map(|f| {
+            let points = rule
+                .points
+                .iter()
+                .zip(&rule.weights)
+                .map(|(s, w)| {
+                    let (xi, scale) = kind.facet_point(f, s);
+                    Tabulated { weight: w * scale, phi: kind.basis(&xi), dref: kind.basis_gradients(&xi) }
+                })
+                .collect();
+            (points, kind.reference_normal(f))
+        })
+        .collect()
+}
+
 /// A pair law's form on a pair of surfaces.
 pub struct PairForm<'m> {
     kernel: Box<dyn PairKernel + 'm>,
@@ -35,9 +57,8 @@ pub struct PairForm<'m> {
     /// The farthest a facing point is looked for: points with no facet of the other surface
     /// within it face nothing.
     reach: f64,
-    /// The quadrature points of each local facet of the element (weights on the reference
-    /// facet, times its measure), with its reference normal.
-    rule: Vec<(Vec<Tabulated>, Vec<f64>)>,
+    /// The quadrature points of each local facet of the element.
+    rule: Vec<Points>,
     /// Per local facet, its edge vectors e_α in the reference cell (ξ(s) = ξ0 + Σ s_α e_α).
     edges: Vec<Vec<[f64; MAX_DIM]>>,
     /// A coupling the matrix pattern lacks, met by the last tangent: the two nodes.
@@ -88,21 +109,7 @@ impl<'m> PairForm<'m> {
         reach: f64,
     ) -> Self {
         let d = kind.dim();
-        let rule = simplex_rule(d - 1, degree);
-        let rule = (0..kind.facets().len())
-            .map(|f| {
-                let points = rule
-                    .points
-                    .iter()
-                    .zip(&rule.weights)
-                    .map(|(s, w)| {
-                        let (xi, scale) = kind.facet_point(f, s);
-                        Tabulated { weight: w * scale, phi: kind.basis(&xi), dref: kind.basis_gradients(&xi) }
-                    })
-                    .collect();
-                (points, kind.reference_normal(f))
-            })
-            .collect();
+        let rule = tabulate(kind, &simplex_rule(d - 1, degree));
         let edges = (0..kind.facets().len())
             .map(|f| {
                 let (xi0, _) = kind.facet_point(f, &vec![0.0; d - 1]);
@@ -143,7 +150,20 @@ impl<'m> PairForm<'m> {
     }
 
     /// Calls `each` at every quadrature point of the own surface that faces the other one.
-    fn each_point(&self, mesh: &Mesh, fields: &[&[f64]], t: f64, mut each: impl FnMut(&PairElement)) {
+    fn each_point(&self, mesh: &Mesh, fields: &[&[f64]], t: f64, each: impl FnMut(&PairElement)) {
+        self.each_point_of(&self.rule, mesh, fields, t, each);
+    }
+
+    /// [`PairForm::each_point`] at the points of `rule` (per local facet: the points, and the
+    /// reference normal); the facing points are kept for the form's own rule only.
+    fn each_point_of(
+        &self,
+        rule: &[Points],
+        mesh: &Mesh,
+        fields: &[&[f64]],
+        t: f64,
+        mut each: impl FnMut(&PairElement),
+    ) {
         // Bound to a body that does not own the pair: no point, so no search to build.
         if self.own.is_empty() {
             return;
@@ -151,10 +171,10 @@ impl<'m> PairForm<'m> {
         let started = Instant::now();
         let d = mesh.dim();
         let moving = fields.get(CONFIGURATION).copied().unwrap_or(&[]);
-        let found = self.facing_points(mesh, moving);
+        let found = self.facing_points(rule, mesh, moving);
         let mut found = found.iter();
         for f in self.own {
-            let (points, ref_normal) = &self.rule[f.local as usize];
+            let (points, ref_normal) = &rule[f.local as usize];
             for q in points {
                 let Some(Some(facing)) = found.next() else { continue };
                 let own = side(mesh, f.cell as usize, &q.phi, &q.dref, ref_normal, fields);
@@ -388,7 +408,8 @@ impl PairForm<'_> {
     /// The facing point of each quadrature point of the own surface, in order, on the
     /// configuration x + `moving`: the last evaluation's if the displacement that moves them
     /// is the same, else searched anew.
-    fn facing_points(&self, mesh: &Mesh, moving: &[f64]) -> Arc<Vec<Option<Facing>>> {
+    fn facing_points(&self, rule: &[Points], mesh: &Mesh, moving: &[f64]) -> Arc<Vec<Option<Facing>>> {
+        let own_rule = std::ptr::eq(rule, self.rule.as_slice());
         let d = mesh.dim();
         let moved_by = self.moved_by.get_or_init(|| {
             let mut nodes: Vec<u32> =
@@ -400,7 +421,8 @@ impl PairForm<'_> {
         let at = |n: u32, k: usize| moving.get(n as usize * d + k).copied().unwrap_or(0.0);
         let key: Vec<f64> = moved_by.iter().flat_map(|&n| (0..d).map(move |k| at(n, k))).collect();
         let mut last = self.found.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((k, found)) = last.as_ref()
+        if own_rule
+            && let Some((k, found)) = last.as_ref()
             && k.iter().zip(&key).all(|(a, b)| a.to_bits() == b.to_bits())
         {
             return found.clone();
@@ -411,7 +433,7 @@ impl PairForm<'_> {
         let mut found = Vec::new();
         for f in self.own {
             let cell = mesh.cell(f.cell as usize);
-            for q in &self.rule[f.local as usize].0 {
+            for q in &rule[f.local as usize].0 {
                 // The quadrature point on the configuration, x + u summed as `side` sums them.
                 let (mut x, mut u) = ([0.0; MAX_DIM], [0.0; MAX_DIM]);
                 for (a, &n) in cell.iter().enumerate() {
@@ -427,7 +449,9 @@ impl PairForm<'_> {
             }
         }
         let found = Arc::new(found);
-        *last = Some((key, found.clone()));
+        if own_rule {
+            *last = Some((key, found.clone()));
+        }
         found
     }
 
@@ -528,10 +552,21 @@ impl BoundFunctional for PairForm<'_> {
     fn cell_values(&self, asm: &Assembler, _: &[&[f64]], _: f64) -> Vec<f64> {
         vec![0.0; asm.mesh().num_cells()]
     }
-    /// Not given per facet point: a pair's points are its own surface's quadrature points,
-    /// not those of a rule the caller picks.
-    fn facet_point_values(&self, _: &Assembler, _: &Rule, _: &[&[f64]], _: f64) -> Vec<PointValue> {
-        Vec::new()
+    /// The integrand at the points of `rule` on the own surface's facets that face the other
+    /// surface (a point facing nothing is left out), at their reference positions.
+    fn facet_point_values(&self, asm: &Assembler, rule: &Rule, fields: &[&[f64]], t: f64) -> Vec<PointValue> {
+        let mesh = asm.mesh();
+        let d = mesh.dim();
+        let mut out = Vec::new();
+        self.each_point_of(&tabulate(mesh.kind, rule), mesh, fields, t, |e| {
+            out.push(PointValue {
+                x: e.point.own.x[..d].to_vec(),
+                normal: e.point.own.normal[..d].to_vec(),
+                weight: e.weight,
+                value: self.kernel.value_at(self.region, &e.point),
+            })
+        });
+        out
     }
 }
 
