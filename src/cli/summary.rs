@@ -78,14 +78,14 @@ fn expectations(s: &crate::problem::outputs::Summary) {
     }
 }
 
-/// The contact pairs' cost, if the run has pairs: their assembly's share of the stepping time,
+/// The contact pairs' cost, if the run has pairs: their assembly's share of the run's time,
 /// and the search's.
 fn pairs(s: &crate::problem::outputs::Summary) -> String {
     let Some(p) = s.get("pair_search") else { return String::new() };
     let number = |k: &str| p.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
     format!(
-        ", pairs {:.0} % of the stepping (search {:.2} s, {} indexes, {} queries)",
-        100.0 * number("share_of_stepping"),
+        ", pairs {:.0} % of it (search {:.2} s, {} indexes, {} queries)",
+        100.0 * number("share_of_run"),
         number("search_seconds"),
         number("builds"),
         number("queries")

@@ -71,10 +71,10 @@ fn cost(req: &Request, ran: &Ran, put: &mut Put) {
         Runner::Static(_) => None,
     };
     put("factor_nnz", json(&sim.and_then(|s| s.stepper.factor_nnz())));
-    // The contact pairs' search and assembly in the steps (the observers' functionals aside),
-    // and their share of the stepping time.
+    // The contact pairs' search and assembly by the scheme's forms (the steps, the initial
+    // acceleration and the start's probes; the observers' functionals aside), and their share
+    // of the run's time.
     if let Some(c) = sim.map(|s| s.stepper.search_cost()).filter(|c| c.builds > 0) {
-        let stepping: f64 = outcome.step_seconds.iter().sum();
         put(
             "pair_search",
             serde_json::json!({
@@ -82,7 +82,7 @@ fn cost(req: &Request, ran: &Ran, put: &mut Put) {
                 "queries": c.queries,
                 "search_seconds": c.search_seconds,
                 "assembly_seconds": c.assembly_seconds,
-                "share_of_stepping": c.assembly_seconds / stepping,
+                "share_of_run": c.assembly_seconds / ran.wall,
             }),
         );
     }
