@@ -140,6 +140,18 @@ fn main() {
         "/// The text of every contact pair law of `forms/pairs/`, by file stem: interpreted at run time\n/// (a law that reads `opposite` is evaluated at the facing points, not generated).\npub static PAIR_SOURCES: &[(&str, &str)] = &[{}];",
         pair_texts.join(", ")
     );
+    let shared = wf_files(Path::new("forms/pairs/shared"));
+    let shared_texts: Vec<String> = shared
+        .iter()
+        .map(|s| {
+            format!("(\"{s}.wf\", include_str!(concat!(env!(\"CARGO_MANIFEST_DIR\"), \"/forms/pairs/shared/{s}.wf\")))")
+        })
+        .collect();
+    let _ = writeln!(
+        out,
+        "/// The text of the files the pair laws import (`forms/pairs/shared/`), by file name, so that\n/// their imports resolve wherever the binary runs.\npub static PAIR_SHARED_SOURCES: &[(&str, &str)] = &[{}];",
+        shared_texts.join(", ")
+    );
     let problems = wf_files(Path::new("forms/problems"));
     let problem_texts: Vec<String> = problems
         .iter()

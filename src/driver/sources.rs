@@ -225,7 +225,8 @@ impl crate::compiler::Loader for LibraryLoader {
         match crate::compiler::Loader::load(&crate::compiler::FsLoader, path) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-                crate::forms::SOURCES.iter().find(|(n, _)| *n == name).map(|(_, text)| text.to_string()).ok_or(e)
+                let mut library = crate::forms::SOURCES.iter().chain(crate::forms::PAIR_SHARED_SOURCES);
+                library.find(|(n, _)| *n == name).map(|(_, text)| text.to_string()).ok_or(e)
             }
             other => other,
         }
