@@ -101,6 +101,14 @@ fn two_bodies_on_one_two_and_three_processes_agree_with_the_serial_run() {
     agree(&[problem, "--t-end", "2.5"], "two_discs");
 }
 
+/// Two discs colliding through a contact pair: every process keeps both surfaces whole and
+/// finds the facing points itself, and the matrix couples the facing cells across processes.
+#[test]
+fn two_colliding_bodies_on_one_two_and_three_processes_agree_with_the_serial_run() {
+    let problem = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/problems/two_discs_collide.wf");
+    agree(&[problem, "--t-start", "0.8", "--t-end", "3"], "two_discs_collide");
+}
+
 #[test]
 fn a_run_resumed_on_the_same_two_processes_has_the_bits_of_an_uninterrupted_one() {
     let root = scratch("resume");

@@ -93,28 +93,27 @@ fn simulate(
         true => crate::runtime::linalg::ownership::Ownership::of(&mesh).map_err(mpi)?,
         false => None,
     };
-    // Every process integrates over the problem's regions whole (the contact law's among them).
-    let whole: Vec<&str> =
-        pf.problem().regions.iter().map(|r| r.name.name.as_str()).chain(contact_region(pf)).collect();
     let pairs = super::pairs::surfaces(pf, ex, &mesh)?;
-    if ownership.is_some() && !pairs.is_empty() {
-        return Err(CaseError::Option(format!(
-            "{}: contact pairs in a run split across processes are not supported yet: run it on one process",
-            pf.file
-        )));
-    }
+    // Every process integrates over the problem's regions whole (the contact law's and the
+    // pairs' among them: a pair's facing points may be anywhere on the other surface).
+    let whole: Vec<&str> = pf
+        .problem()
+        .regions
+        .iter()
+        .map(|r| r.name.name.as_str())
+        .chain(contact_region(pf))
+        .chain(pairs.iter().flat_map(|p| [p.own.as_str(), p.facing.as_str()]))
+        .collect();
     let part = ownership.as_ref().map(|o| (mesh.part(o.owners(), o.rank() as u32, &whole), o));
+    let couplings = |m: &Mesh| pairs.iter().flat_map(|p| p.on(m).couplings(m)).collect::<Vec<_>>();
     let asm = match &part {
         Some(((local, owned), o)) => {
             let (cells, rank) = (local.num_cells(), o.rank());
             tracing::info!(rank, owned, cells, whole = mesh.num_cells(), "this process's part of the mesh");
-            Assembler::split(local, (*o).clone(), *owned)
+            Assembler::split_with_couplings(local, (*o).clone(), *owned, &couplings(local))
         }
         None if pairs.is_empty() => Assembler::new(&mesh),
-        None => Assembler::with_couplings(
-            &mesh,
-            &pairs.iter().flat_map(|p| p.on(&mesh).couplings(&mesh)).collect::<Vec<_>>(),
-        ),
+        None => Assembler::with_couplings(&mesh, &couplings(&mesh)),
     };
     // Collective in a split run: counted now, while every process runs the same code (rank 0
     // alone may stop early, on a failed write).

@@ -133,7 +133,18 @@ impl<'m> Assembler<'m> {
     /// whole on every process (`Owners::complete`), volume integrals sum the owned cells of
     /// every process, and facet integrals are computed whole by each.
     pub fn split(mesh: &'m Mesh, ownership: Arc<dyn Owners>, owned: usize) -> Self {
-        let pattern = Arc::new(Pattern::new(&mesh.connectivity()).owned_by(ownership));
+        Assembler::split_with_couplings(mesh, ownership, owned, &[])
+    }
+
+    /// As `split`, with the node pairs `extra` coupled too (`with_couplings`): a contact pair's
+    /// surfaces, which every process keeps whole.
+    pub fn split_with_couplings(
+        mesh: &'m Mesh,
+        ownership: Arc<dyn Owners>,
+        owned: usize,
+        extra: &[(u32, u32)],
+    ) -> Self {
+        let pattern = Arc::new(Pattern::with_couplings(&mesh.connectivity(), extra).owned_by(ownership));
         Assembler { mesh, pattern, order: OnceLock::new(), owned }
     }
 
