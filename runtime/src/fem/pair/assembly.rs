@@ -343,29 +343,45 @@ impl BoundForm for PairForm<'_> {
         let mut missing = None;
         let pattern = m.pattern.clone();
         let moving = CONFIGURATION;
+        let mut ke = Vec::new();
         self.each_point(mesh, fields, t, |e| {
             c.fill(0.0);
             if !self.kernel.tangent_at(self.region, &e.point, wrt, &mut c) {
                 return;
             }
             let (n, half) = (e.nodes.len(), e.nodes.len() / 2);
-            let mut ke = vec![0.0; n * d * n * d];
+            ke.clear();
+            ke.resize(n * d * n * d, 0.0);
+            // Per block (own/facing test × own/facing trial), which of its gradient parts are
+            // not zero: a law that reads no gradient on a side skips their products (adding
+            // zeros changes no sum).
+            let parts: [[bool; 2]; 4] = std::array::from_fn(|blk| {
+                let at = blk * block;
+                let nonzero = |r: std::ops::Range<usize>| c[r].iter().any(|v| *v != 0.0);
+                [nonzero(at + d * d..at + d * d + d * d * d), nonzero(at + d * d + d * d * d..at + block)]
+            });
             for a in 0..n {
                 for b in 0..n {
-                    let at = (2 * usize::from(a >= half) + usize::from(b >= half)) * block;
+                    let blk = 2 * usize::from(a >= half) + usize::from(b >= half);
+                    let at = blk * block;
+                    let [trial_gradient, test_gradient] = parts[blk];
                     let (c00, c01) = (&c[at..], &c[at + d * d..]);
                     let (c10, c11) = (&c[at + d * d + d * d * d..], &c[at + d * d + 2 * d * d * d..]);
                     let (pa, pb, ga, gb) = (e.phi[a], e.phi[b], &e.dphi[a], &e.dphi[b]);
                     for k in 0..d {
                         for mm in 0..d {
                             let mut v = c00[k * d + mm] * pa * pb;
-                            for nn in 0..d {
-                                v += c01[(k * d + mm) * d + nn] * pa * gb[nn];
-                            }
-                            for l in 0..d {
-                                v += c10[(k * d + l) * d + mm] * ga[l] * pb;
+                            if trial_gradient {
                                 for nn in 0..d {
-                                    v += c11[((k * d + l) * d + mm) * d + nn] * ga[l] * gb[nn];
+                                    v += c01[(k * d + mm) * d + nn] * pa * gb[nn];
+                                }
+                            }
+                            if test_gradient {
+                                for l in 0..d {
+                                    v += c10[(k * d + l) * d + mm] * ga[l] * pb;
+                                    for nn in 0..d {
+                                        v += c11[((k * d + l) * d + mm) * d + nn] * ga[l] * gb[nn];
+                                    }
                                 }
                             }
                             ke[(a * d + k) * n * d + b * d + mm] += e.weight * v;
