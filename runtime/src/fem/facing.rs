@@ -220,10 +220,9 @@ impl<'m> Surface<'m> {
         }
         let at: [f64; 3] = std::array::from_fn(|r| p.get(r).copied().unwrap_or(0.0));
         let mut s = [1.0 / d as f64; 2];
-        let mut x = frame.point(&y, &s[..d - 1], None);
         for _ in 0..MAX_STEPS {
             let mut tangents = [[0.0; 3]; 2];
-            x = frame.point(&y, &s[..d - 1], Some(&mut tangents));
+            let x = frame.point(&y, &s[..d - 1], Some(&mut tangents));
             let residual: [f64; 3] = std::array::from_fn(|r| at[r] - x[r]);
             let step = gauss_newton_step(&tangents[..d - 1], &residual);
             let before = s;
@@ -235,14 +234,14 @@ impl<'m> Surface<'m> {
             if moved < 1e-14 {
                 break;
             }
-            x = frame.point(&y, &s[..d - 1], None);
         }
+        // The point and its tangents where the steps ended.
+        let mut tangents = [[0.0; 3]; 2];
+        let x = frame.point(&y, &s[..d - 1], Some(&mut tangents));
         let xi = (0..d).map(|r| frame.xi0[r] + (0..d - 1).map(|j| frame.edges[j][r] * s[j]).sum::<f64>()).collect();
         let distance = (0..d).map(|r| (at[r] - x[r]).powi(2)).sum::<f64>().sqrt();
         let beyond = self.on_border(frame, cell, &s[..d - 1]) && {
             // The residual's part along the facet, T (TᵀT)⁻¹ Tᵀ r: zero where r is normal.
-            let mut tangents = [[0.0; 3]; 2];
-            frame.point(&y, &s[..d - 1], Some(&mut tangents));
             let residual: [f64; 3] = std::array::from_fn(|r| at[r] - x[r]);
             let step = gauss_newton_step(&tangents[..d - 1], &residual);
             let along: f64 =
