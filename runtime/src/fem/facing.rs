@@ -258,9 +258,14 @@ impl<'m> Surface<'m> {
         let mut l = [0.0; 3];
         l[0] = 1.0 - s.iter().sum::<f64>();
         l[1..n].copy_from_slice(s);
-        let held: Vec<u32> = (0..n).filter(|&i| l[i] > 0.0).map(|i| cell[frame.vertices[i]]).collect();
+        // The vertices it weighs (at most three), without allocating: this runs per projection.
+        let (mut held, mut count) = ([0u32; 3], 0);
+        for i in (0..n).filter(|&i| l[i] > 0.0) {
+            held[count] = cell[frame.vertices[i]];
+            count += 1;
+        }
         let is_border = |e: [u32; 2]| self.border.binary_search(&e).is_ok();
-        match (n, held.as_slice()) {
+        match (n, &held[..count]) {
             (2, &[a]) => is_border([a, a]),
             (3, &[a, b]) => is_border([a.min(b), a.max(b)]),
             (3, &[a]) => self.border.iter().any(|e| e.contains(&a)),
