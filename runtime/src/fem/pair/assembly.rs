@@ -360,31 +360,54 @@ impl BoundForm for PairForm<'_> {
                 let nonzero = |r: std::ops::Range<usize>| c[r].iter().any(|v| *v != 0.0);
                 [nonzero(at + d * d..at + d * d + d * d * d), nonzero(at + d * d + d * d * d..at + block)]
             });
+            // By stages: each test function's coefficients against a trial value and gradient
+            // (p, q), then against each trial function: O(n d⁴ + n² d³), not O(n² d⁴).
             for a in 0..n {
-                for b in 0..n {
-                    let blk = 2 * usize::from(a >= half) + usize::from(b >= half);
+                let (pa, ga) = (e.weight * e.phi[a], e.dphi[a].map(|g| e.weight * g));
+                for trial_side in 0..2 {
+                    let blk = 2 * usize::from(a >= half) + trial_side;
                     let at = blk * block;
                     let [trial_gradient, test_gradient] = parts[blk];
                     let (c00, c01) = (&c[at..], &c[at + d * d..]);
                     let (c10, c11) = (&c[at + d * d + d * d * d..], &c[at + d * d + 2 * d * d * d..]);
-                    let (pa, pb, ga, gb) = (e.phi[a], e.phi[b], &e.dphi[a], &e.dphi[b]);
+                    let mut p = [[0.0; MAX_DIM]; MAX_DIM];
+                    let mut q = [[[0.0; MAX_DIM]; MAX_DIM]; MAX_DIM];
                     for k in 0..d {
                         for mm in 0..d {
-                            let mut v = c00[k * d + mm] * pa * pb;
-                            if trial_gradient {
-                                for nn in 0..d {
-                                    v += c01[(k * d + mm) * d + nn] * pa * gb[nn];
-                                }
-                            }
+                            let mut v = c00[k * d + mm] * pa;
                             if test_gradient {
                                 for l in 0..d {
-                                    v += c10[(k * d + l) * d + mm] * ga[l] * pb;
-                                    for nn in 0..d {
-                                        v += c11[((k * d + l) * d + mm) * d + nn] * ga[l] * gb[nn];
-                                    }
+                                    v += c10[(k * d + l) * d + mm] * ga[l];
                                 }
                             }
-                            ke[(a * d + k) * n * d + b * d + mm] += e.weight * v;
+                            p[k][mm] = v;
+                            if trial_gradient || test_gradient {
+                                for nn in 0..d {
+                                    let mut w = c01[(k * d + mm) * d + nn] * pa;
+                                    if test_gradient {
+                                        for l in 0..d {
+                                            w += c11[((k * d + l) * d + mm) * d + nn] * ga[l];
+                                        }
+                                    }
+                                    q[k][mm][nn] = w;
+                                }
+                            }
+                        }
+                    }
+                    let gradients = trial_gradient || test_gradient;
+                    for b in trial_side * half..(trial_side + 1) * half {
+                        let (pb, gb) = (e.phi[b], &e.dphi[b]);
+                        for k in 0..d {
+                            let row = &mut ke[(a * d + k) * n * d + b * d..][..d];
+                            for (mm, slot) in row.iter_mut().enumerate() {
+                                let mut v = p[k][mm] * pb;
+                                if gradients {
+                                    for nn in 0..d {
+                                        v += q[k][mm][nn] * gb[nn];
+                                    }
+                                }
+                                *slot += v;
+                            }
                         }
                     }
                 }
