@@ -97,6 +97,42 @@ fn held(mesh: &Mesh) -> Vec<usize> {
     dofs
 }
 
+/// A point of the block's bottom that faced the foundation's top and, one evaluation later,
+/// faces nothing within the pair's reach (the block pushed 0.8 into the foundation, reach 0.5)
+/// is lost, not parted: its force would vanish without the bodies having parted, so the form
+/// says where (a stage's Newton then answers with a step cut). Found again, nothing is lost;
+/// and a form that never saw the point face the other surface loses nothing.
+#[test]
+fn a_facing_point_lost_between_two_evaluations_is_told_where() {
+    let mesh = blocks(1, 0.0);
+    let asm = Assembler::with_couplings(&mesh, &pair(&mesh, "contact").couplings(&mesh));
+    let first_block_node = foundation_nodes(1);
+    let sunk = |depth: f64| -> Vec<f64> {
+        (0..mesh.num_nodes()).flat_map(|i| [0.0, if i >= first_block_node { -depth } else { 0.0 }]).collect()
+    };
+    let force = |form: &PairForm, u: &[f64]| {
+        let mut r = vec![0.0; asm.size()];
+        form.residual(&asm, &[u], 0.0, &mut r);
+        r.iter().map(|v| v.abs()).sum::<f64>()
+    };
+    let contact = pair(&mesh, "contact");
+    let (pressed, through) = (sunk(0.01), sunk(0.8));
+    assert!(force(&contact, &pressed) > 0.0);
+    assert_eq!(contact.lost_facing(), None);
+    // Through the foundation: no facet of its top within the reach, so no force at all.
+    assert_eq!(force(&contact, &through), 0.0);
+    let lost = contact.lost_facing().expect("a point that faced the top 0.01 away is lost");
+    assert!((lost.distance - 0.01).abs() < 1e-12, "{lost:?}");
+    assert!(lost.point[0] >= 0.5 - 1e-12 && lost.point[0] <= 1.5 + 1e-12, "{lost:?}");
+    assert!((lost.point[1] - 0.2).abs() < 1e-12, "{lost:?}");
+    assert!(lost.to_string().contains("faces nothing within the pair's reach (0.5)"), "{lost}");
+    force(&contact, &pressed);
+    assert_eq!(contact.lost_facing(), None, "found again");
+    let fresh = pair(&mesh, "contact");
+    force(&fresh, &through);
+    assert_eq!(fresh.lost_facing(), None, "never seen facing");
+}
+
 #[test]
 fn a_block_pressed_on_a_foundation_puts_its_weight_on_it() {
     // P1, whose tangent is exact; P2 through the problem file below (its plain Newton iterates

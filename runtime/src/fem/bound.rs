@@ -61,6 +61,15 @@ pub trait BoundForm {
     fn search_cost(&self) -> crate::fem::search_cost::SearchCost {
         Default::default()
     }
+    /// Whether it searches for facing points (a contact pair's form): then [`Self::lost_facing`]
+    /// is asked after each stage's Newton.
+    fn searches(&self) -> bool {
+        false
+    }
+    /// A point that faced the other surface and faces nothing at the last evaluation, if any.
+    fn lost_facing(&self) -> Option<crate::fem::pair::LostFacing> {
+        None
+    }
 }
 
 /// `fields`, with `previous` after them when the form reads the previous time level (`reads`):

@@ -170,8 +170,14 @@ impl<'m> Surface<'m> {
         GeomWithData::new(Rectangle::from_corners(lower, upper), k as u32)
     }
 
-    /// The closest point of the surface to `p` within `radius` (none: no facet within it).
+    /// The closest point of the surface to `p` within `radius` (none: no facet within it, or
+    /// the point is past the border of an open surface).
     pub fn closest(&self, p: &[f64], radius: f64) -> Option<Facing> {
+        self.nearest(p, radius).filter(|b| !b.beyond)
+    }
+
+    /// The closest point of the surface to `p` within `radius`, past the border or not.
+    pub fn nearest(&self, p: &[f64], radius: f64) -> Option<Facing> {
         let at: [f64; 3] = std::array::from_fn(|r| p.get(r).copied().unwrap_or(0.0));
         let around =
             AABB::from_corners(std::array::from_fn(|r| at[r] - radius), std::array::from_fn(|r| at[r] + radius));
@@ -193,7 +199,7 @@ impl<'m> Surface<'m> {
                 best = Some(facing);
             }
         }
-        best.filter(|b| !b.beyond)
+        best
     }
 
     /// The facets whose boxes meet the box from `lower` to `upper` (coordinates past the mesh's

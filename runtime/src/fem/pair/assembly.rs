@@ -5,7 +5,7 @@
 
 use std::sync::{Arc, Mutex, OnceLock};
 
-use super::{FieldAt, MAX_DIM, PairKernel, PairPoint, SideAt, Surfaces, layout};
+use super::{FieldAt, LostFacing, MAX_DIM, PairKernel, PairPoint, SideAt, Surfaces, layout};
 use crate::fem::assembly::Assembler;
 use crate::fem::assembly::PointValue;
 use crate::fem::bound::{BoundForm, BoundFunctional};
@@ -72,6 +72,11 @@ pub struct PairForm<'m> {
     /// order, with the displacement of `moved_by` they were found at: a tangent or functional
     /// at the residual's state (each Newton iterate's) searches no more.
     found: Mutex<Option<Found>>,
+    /// Per quadrature point of the own surface, how far the facing surface was when the point
+    /// last faced it (NaN: never), and the first point of the last search that faced it within
+    /// half the reach and now faces nothing: lost, not parted.
+    seen: Mutex<Vec<f64>>,
+    lost: Mutex<Option<LostFacing>>,
 }
 
 /// Facing points, with the displacement they were found at.
@@ -135,6 +140,8 @@ impl<'m> PairForm<'m> {
             meter: Meter::default(),
             moved_by: OnceLock::new(),
             found: Mutex::new(None),
+            seen: Mutex::new(Vec::new()),
+            lost: Mutex::new(None),
         }
     }
 
@@ -311,6 +318,12 @@ impl BoundForm for PairForm<'_> {
     fn search_cost(&self) -> SearchCost {
         self.meter.cost()
     }
+    fn searches(&self) -> bool {
+        true
+    }
+    fn lost_facing(&self) -> Option<LostFacing> {
+        self.lost.lock().ok().and_then(|l| l.clone())
+    }
 
     fn residual(&self, asm: &Assembler, fields: &[&[f64]], t: f64, out: &mut [f64]) {
         let mesh = asm.mesh();
@@ -470,6 +483,8 @@ impl PairForm<'_> {
         let surface = Surface::new(mesh, self.facing, moving);
         self.meter.built(started);
         let mut found = Vec::new();
+        let mut seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+        let mut lost = None;
         for f in self.own {
             let cell = mesh.cell(f.cell as usize);
             for q in &rule[f.local as usize].0 {
@@ -483,13 +498,33 @@ impl PairForm<'_> {
                 }
                 let p: [f64; MAX_DIM] = std::array::from_fn(|k| x[k] + u[k]);
                 let asked = Instant::now();
-                found.push(surface.closest(&p[..d], self.reach));
+                let nearest = surface.nearest(&p[..d], self.reach);
                 self.meter.queried(asked);
+                if own_rule {
+                    let i = found.len();
+                    if seen.len() <= i {
+                        seen.resize(i + 1, f64::NAN);
+                    }
+                    match &nearest {
+                        Some(facing) => seen[i] = facing.distance,
+                        None if seen[i] <= 0.5 * self.reach && lost.is_none() => {
+                            lost = Some(LostFacing {
+                                form: self.kernel.meta().name.to_string(),
+                                point: p[..d].to_vec(),
+                                distance: seen[i],
+                                reach: self.reach,
+                            })
+                        }
+                        None => {}
+                    }
+                }
+                found.push(nearest.filter(|b| !b.beyond));
             }
         }
         let found = Arc::new(found);
         if own_rule {
             *last = Some((key, found.clone()));
+            *self.lost.lock().unwrap_or_else(|e| e.into_inner()) = lost;
         }
         found
     }

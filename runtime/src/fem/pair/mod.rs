@@ -18,6 +18,34 @@ use crate::fem::facing::Surface;
 use crate::fem::kernel::Form;
 use crate::fem::mesh::{Facet, Mesh};
 
+/// A quadrature point of a pair's own surface that faced the other surface and, at a later
+/// evaluation, faces nothing within the pair's reach: its force would vanish without the
+/// bodies having parted.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LostFacing {
+    /// The pair law's form.
+    pub form: String,
+    /// The point on the configuration where it faces nothing.
+    pub point: Vec<f64>,
+    /// How far the facing surface was when the point last faced it, and the pair's reach.
+    pub distance: f64,
+    pub reach: f64,
+}
+
+impl std::fmt::Display for LostFacing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let point: Vec<String> = self.point.iter().map(|x| format!("{x:.4}")).collect();
+        write!(
+            f,
+            "contact pair `{}`: the point ({}) of its own surface faced the other surface {:.3e} away and now faces nothing within the pair's reach ({}): it moved by more than half the reach in one Newton iterate, through the other body or past it",
+            self.form,
+            point.join(", "),
+            self.distance,
+            self.reach
+        )
+    }
+}
+
 /// A contact pair of a mesh: the surface a pair law integrates over, the surface it faces, and
 /// how far a facing point is looked for.
 #[derive(Clone, Copy, Debug)]

@@ -60,6 +60,8 @@ pub enum StepError {
         "stage `{stage}` at t = {t}: {at}: a finite-strain material's stress is not defined there (ln J, F⁻¹); a smaller Δt, or a stiffer or better-shaped mesh where the body is compressed hardest, keeps it positive"
     )]
     Inverted { stage: String, t: f64, at: crate::fem::mesh::inverted::Inverted },
+    #[error("stage `{stage}` at t = {t}: {at}")]
+    FacingLost { stage: String, t: f64, at: crate::fem::pair::LostFacing },
     #[error(
         "stage `{stage}` of scheme `{scheme}` has no displacement quantity (u', um, ...) that depends on its unknown (a nonzero coefficient at this Δt): a moving held displacement cannot be imposed there"
     )]

@@ -11,6 +11,7 @@ use super::{LOAD_CACHE, StageCache, StepError, Stepper};
 use crate::fem::assembly::Assembler;
 use crate::fem::bound::BoundForm;
 use crate::fem::mesh::inverted::{self, Inverted};
+use crate::fem::pair::LostFacing;
 use crate::linalg::Matrix;
 use crate::linalg::lower_half::{LowerHalf, MAX_FUSED};
 use crate::nonlinear::newton::{Newton, NewtonError, NewtonReport};
@@ -222,6 +223,9 @@ impl Stepper<'_> {
         (*args, *term, *recorded) = (problem.args, problem.term, problem.recorded);
         self.pool.give(problem.rhs);
         problem.terms.into_iter().flat_map(|t| t.bases).for_each(|b| self.pool.give(b));
+        if let Some(at) = self.lost_facing() {
+            return Err(StepError::FacingLost { stage: stage.name.to_string(), t: stage_t, at });
+        }
         // A NaN in a failed Newton (its residual, or a tangent) is explained by a cell turned
         // inside out where there is one (answered by a step cut), else it is a law's derivative
         // that is not finite (at any Δt). Both are decided alike by every process.
@@ -240,6 +244,27 @@ impl Stepper<'_> {
 }
 
 impl Stepper<'_> {
+    /// A contact pair's point that faces nothing at the stage's last iterate though it faced
+    /// the other surface (its force gone without the bodies parting): answered by a step cut.
+    /// In a split run every process says so when one saw it.
+    fn lost_facing(&self) -> Option<LostFacing> {
+        let mut searching = self.forms.values().filter(|f| f.searches()).peekable();
+        searching.peek()?;
+        let here = searching.find_map(|f| f.lost_facing());
+        let anywhere = match self.asm.pattern().ownership() {
+            Some(o) => o.any(here.is_some()),
+            None => here.is_some(),
+        };
+        anywhere.then(|| {
+            here.unwrap_or_else(|| LostFacing {
+                form: "(seen by another process)".into(),
+                point: Vec::new(),
+                distance: f64::NAN,
+                reach: f64::NAN,
+            })
+        })
+    }
+
     /// After a failed Newton, the most inverted cell of the stage's displacement quantity (u',
     /// um, ...) at its last iterate, if one is inverted. In a split run every process says so
     /// when one saw it (each decides alike what follows: a step cut).
