@@ -38,6 +38,9 @@ pub struct Bench {
     /// `bench sphere`: the problem timed against its size, and the options of each run.
     pub sphere: String,
     pub sphere_options: Vec<String>,
+    /// `bench balls`: the two-body problem timed against its size, and the options of each run.
+    pub balls: String,
+    pub balls_options: Vec<String>,
 }
 
 #[derive(Debug, Deserialize)]

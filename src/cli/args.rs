@@ -130,6 +130,16 @@ pub enum BenchCommand {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
+    /// Two balls colliding (the problem of two bodies in forms/library.toml's `[bench]`) at
+    /// 4.4k, 29k, 94k and 146k unknowns up to --max-dofs, each in its own process: the contact
+    /// pairs' search and assembly against the impact steps' time. Up to 100k: about 10 minutes.
+    Balls {
+        #[arg(long, default_value_t = 100_000)]
+        max_dofs: usize,
+        /// Directory for bench_balls.json and the runs.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
     /// The facing-point search of contact between bodies against the number of facets (about
     /// 10³, 10⁴, 10⁵ in 2D and 3D): building its R-tree and the queries, per n log n.
     Search {

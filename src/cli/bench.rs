@@ -1,4 +1,4 @@
-//! `bench assemble`, `bench disc`, `bench sphere`, `bench search`: the benchmarks run and their JSON
+//! `bench assemble`, `bench disc`, `bench sphere`, `bench balls`, `bench search`: the benchmarks run and their JSON
 //! written.
 
 use std::path::{Path, PathBuf};
@@ -49,6 +49,13 @@ pub(super) fn disc(meshes: &[PathBuf], repeats: usize, out: &Path) -> ExitCode {
         }
     };
     write_bench(&out.join("bench_disc.json"), &report)
+}
+
+pub(super) fn balls(max_dofs: usize, out: &Path) -> ExitCode {
+    match crate::bench::balls::balls(max_dofs, out, &mut |line| println!("{line}")) {
+        Ok(report) => write_bench(&out.join("bench_balls.json"), &report),
+        Err(e) => fail(e),
+    }
 }
 
 pub(super) fn search(repeats: usize, out: &Path) -> ExitCode {

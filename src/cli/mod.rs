@@ -175,6 +175,7 @@ fn dispatch(cli: Cli) -> ExitCode {
             bench::sphere(max_dofs, &solvers, &ranks.iter().map(|&r| r as usize).collect::<Vec<_>>(), &out)
         }
         Command::Bench { what: BenchCommand::Search { repeats, out } } => bench::search(repeats, &out),
+        Command::Bench { what: BenchCommand::Balls { max_dofs, out } } => bench::balls(max_dofs, &out),
     }
 }
 

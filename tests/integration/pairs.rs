@@ -549,7 +549,7 @@ fn two_cylinders_pressed_together_are_hertz_s() {
 #[test]
 fn two_balls_collide_as_one_ball_on_a_wall() {
     use signorini::problem::run::{Options, run};
-    let pair = run(&Options::new(&problem("two_balls_collide.wf"))).unwrap();
+    let pair = run(&Options::new("two_balls_collide")).unwrap();
     let wall = run(&Options::new(&problem("ball_on_wall.wf"))).unwrap();
     let column = |r: &signorini::problem::run::Run, name: &str| r.column(name).unwrap().to_vec();
     let (vl, vr) = (column(&pair, "vx_left"), column(&pair, "vx_right"));
