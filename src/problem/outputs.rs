@@ -23,6 +23,9 @@ pub struct Run {
     pub switches: Vec<Vec<bool>>,
     /// Multi-stage schemes: (stage name, time, values) at every intermediate stage.
     pub stages: Vec<(String, f64, Vec<f64>)>,
+    /// Newton's report (each stage's residuals) of every step this process took: none for the
+    /// initial row, nor for the steps before a resume.
+    pub newton: Vec<crate::runtime::time::stepper::StepReport>,
 }
 
 impl Run {

@@ -172,8 +172,14 @@ fn simulate(
 fn finish(req: &Request, ran: Ran, observing: Observing, out: Option<&PathBuf>) -> Result<Run, CaseError> {
     let summary = summarize::summary(req, &ran, &observing);
     let Stepped { rows, outcome, last, .. } = ran.stepped;
-    let run =
-        Run { summary, columns: observing.columns, rows: rows.series, switches: rows.switches, stages: rows.stages };
+    let run = Run {
+        summary,
+        columns: observing.columns,
+        rows: rows.series,
+        switches: rows.switches,
+        stages: rows.stages,
+        newton: rows.newton,
+    };
     if let Some(dir) = out {
         write_outputs(dir, req.pf, &run, &observing.shown)?;
         // The reference's figures of the last state (Hertz's pressure profile): rank 0 alone
@@ -388,6 +394,8 @@ pub(super) struct Rows {
     pub iterations: Vec<usize>,
     /// (stage, time, values) at every intermediate stage.
     pub stages: Vec<(String, f64, Vec<f64>)>,
+    /// Newton's report of each step this process took (not kept by checkpoints).
+    pub newton: Vec<crate::runtime::time::stepper::StepReport>,
 }
 
 /// What stepping (or the static solve) gave.

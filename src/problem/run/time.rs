@@ -39,7 +39,7 @@ pub(super) fn run(
             let u0 = &sim.states[0];
             let first = State { v: sim.velocity(), ..State::new(t0, u0, u0) };
             let (values, switches) = row(observer, &sim.ops, first);
-            rows = Rows { series: vec![values], switches: vec![switches], iterations: vec![0], stages: Vec::new() };
+            rows = Rows { series: vec![values], switches: vec![switches], iterations: vec![0], ..Rows::default() };
             let v = velocity(&sim.states, sim.v_index, &sim.states[0], dt);
             snapshots.write(&sim.ops, 0, t0, &sim.states[0], &v)?;
         }
@@ -76,6 +76,7 @@ pub(super) fn run(
         rows.series.push(values);
         rows.switches.push(active);
         rows.iterations.push(step.report.iterations());
+        rows.newton.push(step.report.clone());
         let v = velocity(step.states, v_index, step.before, step.dt);
         snapshots.write(ops, step.k, step.t, &step.states[0], &v)?;
         if let Some(record) = record {
