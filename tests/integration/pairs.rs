@@ -97,6 +97,21 @@ fn held(mesh: &Mesh) -> Vec<usize> {
     dofs
 }
 
+/// The block settled on its foundation (`initial u = settled(...)`) and left to rest in a time
+/// run: the pair carries its weight at every step (measured to 2.4e-12, asserted 1e-9) and it
+/// stays at rest (measured |v| ≤ 4e-14, asserted 1e-10).
+#[test]
+fn a_settled_block_rests_on_its_foundation() {
+    use signorini::problem::run::{Options, run};
+    let r = run(&Options::new(&problem("block_settled_on_foundation.wf"))).unwrap();
+    let (force, vy) = (r.column("force").unwrap(), r.column("vy").unwrap());
+    assert!(force.len() > 20);
+    for (k, (f, v)) in force.iter().zip(vy).enumerate() {
+        assert!((f - 1.0).abs() < 1e-9, "step {k}: the pair carries {f} of the weight 1");
+        assert!(v.abs() < 1e-10, "step {k}: the block moves at {v}");
+    }
+}
+
 /// A point of the block's bottom that faced the foundation's top and, one evaluation later,
 /// faces nothing within the pair's reach (the block pushed 0.8 into the foundation, reach 0.5)
 /// is lost, not parted: its force would vanish without the bodies having parted, so the form
