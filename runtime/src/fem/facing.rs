@@ -2,7 +2,9 @@
 //! deformed configuration: the closest point of the surface's facets, curved P2 facets
 //! included. A broad phase keeps the facets whose bounding box meets a box about the point
 //! (an R-tree of the boxes, `rstar`, rebuilt in O(n log n) whenever the surface moves); a narrow
-//! phase projects the point onto each of them.
+//! phase projects the point onto each of them. Against bvh's hierarchy (`cargo bench -p
+//! signorini-runtime --bench spatial_index`, docs/mathematics.md §9) its queries are slower
+//! alone but it builds faster, and the two runs cost the same.
 //!
 //! A curved facet is a quadratic Bézier curve (a triangular patch in 3D) whose control points
 //! are its vertices and, for each edge, 2m − (a + b)/2 with m the edge node: the facet lies in
