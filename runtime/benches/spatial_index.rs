@@ -38,9 +38,12 @@ impl BHShape<f64, 3> for Boxed {
     }
 }
 
+/// A box: its lower and upper corners.
+type Corners = ([f64; 3], [f64; 3]);
+
 /// The boxes of the 2 m² triangles of [0, 0.1 m]² bent by a wave, and one query point per
 /// triangle, 0.03 below its centroid.
-fn surface(m: usize) -> (Vec<([f64; 3], [f64; 3])>, Vec<[f64; 3]>) {
+fn surface(m: usize) -> (Vec<Corners>, Vec<[f64; 3]>) {
     let wave = |x: f64, y: f64| 0.02 * (std::f64::consts::TAU * x).sin() * (1.0 + y).cos();
     let at = |i: usize, j: usize| {
         let (x, y) = (0.1 * i as f64, 0.1 * j as f64);
@@ -65,14 +68,19 @@ fn surface(m: usize) -> (Vec<([f64; 3], [f64; 3])>, Vec<[f64; 3]>) {
 /// The half side of the query's cube: about two triangles.
 const REACH: f64 = 0.2;
 
-fn rtree(boxes: &[([f64; 3], [f64; 3])]) -> RTree<GeomWithData<Rectangle<[f64; 3]>, u32>> {
+fn rtree(boxes: &[Corners]) -> RTree<GeomWithData<Rectangle<[f64; 3]>, u32>> {
     RTree::bulk_load(
-        boxes.iter().enumerate().map(|(k, (lo, hi))| GeomWithData::new(Rectangle::from_corners(*lo, *hi), k as u32)).collect(),
+        boxes
+            .iter()
+            .enumerate()
+            .map(|(k, (lo, hi))| GeomWithData::new(Rectangle::from_corners(*lo, *hi), k as u32))
+            .collect(),
     )
 }
 
-fn bvh_of(boxes: &[([f64; 3], [f64; 3])]) -> (Bvh<f64, 3>, Vec<Boxed>) {
-    let mut shapes: Vec<Boxed> = boxes.iter().map(|(lower, upper)| Boxed { lower: *lower, upper: *upper, node: 0 }).collect();
+fn bvh_of(boxes: &[Corners]) -> (Bvh<f64, 3>, Vec<Boxed>) {
+    let mut shapes: Vec<Boxed> =
+        boxes.iter().map(|(lower, upper)| Boxed { lower: *lower, upper: *upper, node: 0 }).collect();
     let bvh = Bvh::build(&mut shapes);
     (bvh, shapes)
 }
@@ -82,7 +90,7 @@ fn distance_2(lower: &[f64; 3], upper: &[f64; 3], p: &[f64; 3]) -> f64 {
     (0..3).map(|r| (lower[r] - p[r]).max(p[r] - upper[r]).max(0.0).powi(2)).sum()
 }
 
-fn cube(p: &[f64; 3]) -> ([f64; 3], [f64; 3]) {
+fn cube(p: &[f64; 3]) -> Corners {
     (std::array::from_fn(|r| p[r] - REACH), std::array::from_fn(|r| p[r] + REACH))
 }
 
@@ -99,7 +107,8 @@ fn bench(c: &mut Criterion) {
         // Both find the same candidates for every query.
         for p in points.iter().step_by(97) {
             let (lo, hi) = cube(p);
-            let mut a: Vec<u32> = tree.locate_in_envelope_intersecting(AABB::from_corners(lo, hi)).map(|g| g.data).collect();
+            let mut a: Vec<u32> =
+                tree.locate_in_envelope_intersecting(AABB::from_corners(lo, hi)).map(|g| g.data).collect();
             let query = Aabb::with_bounds(Point3::from(lo), Point3::from(hi));
             let mut b: Vec<u32> = bvh
                 .traverse(&query, &shapes)
@@ -131,8 +140,10 @@ fn bench(c: &mut Criterion) {
                 for p in &points {
                     let (lo, hi) = cube(p);
                     let query = Aabb::with_bounds(Point3::from(lo), Point3::from(hi));
-                    let mut near: Vec<(f64, &Boxed)> =
-                        bvh.traverse_iterator(&query, &shapes).map(|s| (distance_2(&s.lower, &s.upper, p), s)).collect();
+                    let mut near: Vec<(f64, &Boxed)> = bvh
+                        .traverse_iterator(&query, &shapes)
+                        .map(|s| (distance_2(&s.lower, &s.upper, p), s))
+                        .collect();
                     near.sort_by(|a, b| a.0.total_cmp(&b.0));
                     found += near.len();
                 }

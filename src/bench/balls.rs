@@ -103,7 +103,10 @@ fn run_one(exe: &Path, half: usize, dir: &Path) -> Result<BallsTiming, CaseError
     let num = |v: &serde_json::Value, k: &str| v.get(k).and_then(serde_json::Value::as_f64).unwrap_or(f64::NAN);
     let int = |v: &serde_json::Value, k: &str| v.get(k).and_then(serde_json::Value::as_u64).unwrap_or(0);
     let Some(pairs) = s.get("pair_search") else {
-        return Err(CaseError::Option(format!("{}: no `pair_search` (a problem without contact pairs?)", path.display())));
+        return Err(CaseError::Option(format!(
+            "{}: no `pair_search` (a problem without contact pairs?)",
+            path.display()
+        )));
     };
     let stepping_seconds = num(&s, "stepping_seconds");
     let (search_seconds, pair_seconds) = (num(pairs, "search_seconds"), num(pairs, "assembly_seconds"));
