@@ -43,6 +43,8 @@ pub struct StaticSolution<'m> {
     /// Contact quadrature points whose switch is on.
     pub active_points: usize,
     pub contact_facets: &'m [Facet],
+    /// What the contact pairs' search and assembly cost the solve (none without pairs).
+    pub search: crate::runtime::fem::search_cost::SearchCost,
     /// `contact_pressure` and `contact_trial` of the contact law, bound on the contact region.
     pub contact_pressure: Option<Box<dyn BoundFunctional + 'm>>,
     pub contact_trial: Option<Box<dyn BoundFunctional + 'm>>,
@@ -115,6 +117,7 @@ pub fn solve<'m>(
         counters: newton.counters(),
         contact_force,
         active_points: set.iter().filter(|b| **b).count(),
+        search: static_problem.contact.search_cost(),
         contact_facets: facets,
         contact_pressure: on_boundary.take_functional("contact_pressure"),
         contact_trial: on_boundary.take_functional("contact_trial"),

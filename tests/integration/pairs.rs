@@ -585,6 +585,9 @@ fn two_cylinders_pressed_together_are_hertz_s() {
         let (force, load) = (key("contact_force"), key("applied_force"));
         // To Newton's tolerance (1e-8 of the residual), measured 5e-12.
         assert!((force / load - 1.0).abs() < 1e-8, "level {level}: the pair carries {force} of {load}");
+        // The static solve's pair search is in the summary, as a time run's is.
+        let search = r.summary.get("pair_search").expect("a static run with a pair reports its search");
+        assert!(search["builds"].as_u64().unwrap() > 0 && search["queries"].as_u64().unwrap() > 0, "{search}");
     }
 }
 

@@ -406,6 +406,8 @@ pub(super) struct Stepped {
     pub steps: usize,
     /// The time and displacement of the last state (the reference's figures read it).
     pub last: (f64, Vec<f64>),
+    /// What the contact pairs' search and assembly cost the solves.
+    pub search: crate::runtime::fem::search_cost::SearchCost,
 }
 
 /// A finished run, before its summary.

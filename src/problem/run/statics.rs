@@ -35,5 +35,12 @@ pub(super) fn run(
     snapshots.write(ops, 0, t0, &solution.u, &vec![0.0; asm.size()])?;
     let outcome = Outcome { step_seconds: vec![seconds], cuts: 0, stopped: None, resumed: None, energy_growth: 0.0 };
     let rows = Rows { series: vec![first], switches: vec![switches], iterations: vec![newton], ..Rows::default() };
-    Ok(Stepped { rows, outcome, counters: solution.counters, steps: 0, last: (t0, solution.u) })
+    Ok(Stepped {
+        rows,
+        outcome,
+        counters: solution.counters,
+        steps: 0,
+        last: (t0, solution.u),
+        search: solution.search,
+    })
 }

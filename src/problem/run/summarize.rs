@@ -72,9 +72,9 @@ fn cost(req: &Request, ran: &Ran, put: &mut Put) {
     };
     put("factor_nnz", json(&sim.and_then(|s| s.stepper.factor_nnz())));
     // The contact pairs' search and assembly by the scheme's forms (the steps, the initial
-    // acceleration and the start's probes; the observers' functionals aside), and their share
-    // of the run's time.
-    if let Some(c) = sim.map(|s| s.stepper.search_cost()).filter(|c| c.builds > 0) {
+    // acceleration and the start's probes) or a static run's contact form (its solve); the
+    // observers' functionals aside; and their share of the run's time.
+    if let Some(c) = Some(ran.stepped.search).filter(|c| c.builds > 0) {
         put(
             "pair_search",
             serde_json::json!({

@@ -89,7 +89,8 @@ pub(super) fn run(
     let outcome = sim.run(span, req.opts.progress && req.writes, control, watch)?;
     rows.stages = stages.into_inner();
     let last = (rows.series.last().map_or(t0, |r| r.0), sim.states[0].clone());
-    Ok(Stepped { rows, outcome, counters: sim.stepper.counters(), steps, last })
+    let search = sim.stepper.search_cost();
+    Ok(Stepped { rows, outcome, counters: sim.stepper.counters(), steps, last, search })
 }
 
 /// The displacement the run starts from: u₀, or with `initial u = settled(GUESS)` the static
