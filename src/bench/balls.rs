@@ -82,30 +82,19 @@ fn run_one(exe: &Path, half: usize, dir: &Path) -> Result<BallsTiming, CaseError
     let bench = &crate::settings::get().bench;
     let problem = &bench.balls;
     let out = dir.join(format!("{problem}-{}", dofs(half)));
-    let status = Command::new(exe)
+    let mut command = Command::new(exe);
+    command
         .args(["run", problem.as_str(), "--param", &format!("h={h}")])
         .args(&bench.balls_options)
         .args(["--force", "--out"])
-        .arg(&out)
-        .output()
-        .map_err(|e| CaseError::Option(format!("cannot run {}: {e}", exe.display())))?;
-    if !status.status.success() {
-        return Err(CaseError::Option(format!(
-            "run {problem} --param h={h} failed: {}",
-            String::from_utf8_lossy(&status.stderr).trim()
-        )));
-    }
-    let path = out.join("summary.json");
-    let text = std::fs::read_to_string(&path)
-        .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
-    let s: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| CaseError::Option(format!("{}: {e}", path.display())))?;
+        .arg(&out);
+    let s = super::run_summary(&mut command, &format!("run {problem} --param h={h}"), &out)?;
     let num = |v: &serde_json::Value, k: &str| v.get(k).and_then(serde_json::Value::as_f64).unwrap_or(f64::NAN);
     let int = |v: &serde_json::Value, k: &str| v.get(k).and_then(serde_json::Value::as_u64).unwrap_or(0);
     let Some(pairs) = s.get("pair_search") else {
         return Err(CaseError::Option(format!(
             "{}: no `pair_search` (a problem without contact pairs?)",
-            path.display()
+            out.join("summary.json").display()
         )));
     };
     let stepping_seconds = num(&s, "stepping_seconds");

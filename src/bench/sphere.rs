@@ -135,24 +135,14 @@ fn run_one(
     let problem = &bench.sphere;
     let label = if ranks == 1 { solver.to_string() } else { format!("{solver}-{ranks}ranks") };
     let out = dir.join(format!("{problem}-{}-{label}", dofs(half)));
-    let status = launch(exe, ranks)
+    let mut command = launch(exe, ranks);
+    command
         .args(["run", problem.as_str(), "--h", &h.to_string()])
         .args(&bench.sphere_options)
         .args(["--solver", solver, "--out"])
-        .arg(&out)
-        .output()
-        .map_err(|e| CaseError::Option(format!("cannot run {}: {e}", exe.display())))?;
-    if !status.status.success() {
-        return Err(CaseError::Option(format!(
-            "run {problem} --h {h} --solver {solver} on {ranks} process(es) failed: {}",
-            String::from_utf8_lossy(&status.stderr).trim()
-        )));
-    }
-    let path = out.join("summary.json");
-    let text = std::fs::read_to_string(&path)
-        .map_err(|source| CaseError::Write { path: path.display().to_string(), source })?;
-    let s: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| CaseError::Option(format!("{}: {e}", path.display())))?;
+        .arg(&out);
+    let what = format!("run {problem} --h {h} --solver {solver} on {ranks} process(es)");
+    let s = super::run_summary(&mut command, &what, &out)?;
     let num = |k: &str| s.get(k).and_then(serde_json::Value::as_f64).unwrap_or(f64::NAN);
     let int = |k: &str| s.get(k).and_then(serde_json::Value::as_u64).unwrap_or(0) as usize;
     let contact = s.get("contact").and_then(|v| v.as_str()).map(str::to_string);
