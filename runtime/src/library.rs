@@ -228,6 +228,7 @@ impl<'m> Binding<'m> {
                     .facet
                     .unwrap_or_else(|| meta.facets.first().map_or(1, |(_, d)| d[p.kind.degree() as usize - 1]));
                 PairForm::new(Box::new(kernel.clone()), 0, p.kind, p.own, p.facing, degree, p.reach)
+                    .segmented(p.segmented)
             })
             .collect();
         Ok(match functional {

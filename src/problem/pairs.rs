@@ -1,5 +1,6 @@
-//! A problem's contact pairs bound to its mesh: `contact Gamma_a with Gamma_b within R`, two
-//! regions of two bodies, and how far the facing points are looked for.
+//! A problem's contact pairs bound to its mesh: `contact Gamma_a with Gamma_b within R by
+//! segments`, two regions of two bodies, how far the facing points are looked for, and how the
+//! law is integrated.
 
 use super::ProblemFile;
 use super::expr::Exprs;
@@ -35,7 +36,16 @@ pub fn surfaces(pf: &ProblemFile, ex: &mut Exprs, mesh: &Mesh) -> Result<Vec<Pai
             }
             None => REACH_IN_CELLS * largest,
         };
-        out.push(PairRegions { own: pair.own.name.clone(), facing: pair.facing.name.clone(), reach });
+        let segmented = pair.by.as_ref().is_some_and(|b| b.name == "segments");
+        if segmented && mesh.dim() != 2 {
+            let by = pair.by.as_ref().map_or(pair.span, |b| b.span);
+            return Err(pf.render(
+                Diagnostic::error("E0103", "a pair integrated by segments in 3D", by, "2D only")
+                    .with_note("in 3D the pieces of a facet are the polygons where the facing facets overlap it, which pairs do not clip yet")
+                    .with_help("drop `by segments`: the pair is then integrated facet by facet"),
+            ));
+        }
+        out.push(PairRegions { own: pair.own.name.clone(), facing: pair.facing.name.clone(), reach, segmented });
     }
     Ok(out)
 }

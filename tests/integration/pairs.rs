@@ -112,6 +112,53 @@ fn a_settled_block_rests_on_its_foundation() {
     }
 }
 
+/// The contact patch test (Taylor and Papadopoulos): a block on a foundation as wide as it,
+/// on non-matching meshes, under its weight with ν = 0 (tests/problems/block_on_column.wf),
+/// whose exact stress is uniaxial and linear in y, so that P2 holds the exact solution. By
+/// segments, each side's normal stress is the block's weight, −1, at every sampled point of
+/// both surfaces, and the contact stress λ too (measured 3e-13 at 8 cells, asserted 1e-10):
+/// the pressure is continuous across the pair. By elements the rule misses the kinks of the
+/// facing basis inside the own facets (measured 1.1 % at 8 cells). On P1, whose stress is
+/// constant per cell, the two sides part by O(h): the spread halves with the cells (measured
+/// 0.266, 0.132, 0.065 at 4, 8, 16).
+#[test]
+fn the_pressure_is_continuous_across_a_pair_by_segments() {
+    use signorini::driver::Setting;
+    use signorini::problem::run::{Options, run};
+    let path = problem("block_on_column.wf");
+    let sampled = |path: &str, degree: f64, cells: f64| {
+        let mut o = Options::new(path);
+        for (name, value) in [("degree", degree), ("cells", cells)] {
+            o.methods.params.push(Setting { name: name.into(), value, origin: "test".into() });
+        }
+        let r = run(&o).unwrap();
+        let at = |c: &str| r.column(c).unwrap()[0];
+        assert!((at("force") - 1.0).abs() < 1e-10, "P{degree}, {cells} cells: the pair carries {}", at("force"));
+        // λ/2 on each side: the unbiased law weighs each side by half.
+        [at("least"), at("most"), 2.0 * at("contact_least"), 2.0 * at("contact_most")]
+    };
+    for cells in [4.0, 8.0] {
+        let stresses = sampled(&path, 2.0, cells);
+        for s in stresses {
+            assert!((s + 1.0).abs() < 1e-10, "P2, {cells} cells: stresses {stresses:?}, not the weight −1");
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("signorini-by-elements-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let by_elements = dir.join("block_on_column.wf");
+    std::fs::write(&by_elements, text.replace(" by segments", " by elements")).unwrap();
+    let [least, most, ..] = sampled(&by_elements.display().to_string(), 2.0, 8.0);
+    assert!(most - least > 1e-3, "by elements the kinks inside a facet show: {least} to {most}");
+    std::fs::remove_dir_all(&dir).ok();
+    let spread = |cells: f64| {
+        let [least, most, ..] = sampled(&path, 1.0, cells);
+        most - least
+    };
+    let (coarse, fine) = (spread(8.0), spread(16.0));
+    assert!(coarse < 0.2 && (1.7..2.3).contains(&(coarse / fine)), "P1: spread {coarse} then {fine}, not O(h)");
+}
+
 /// A point of the block's bottom that faced the foundation's top and, one evaluation later,
 /// faces nothing within the pair's reach (the block pushed 0.8 into the foundation, reach 0.5)
 /// is lost, not parted: its force would vanish without the bodies having parted, so the form

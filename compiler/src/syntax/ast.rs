@@ -457,13 +457,16 @@ pub struct Obstacle {
     pub span: Span,
 }
 
-/// `contact Gamma_a with Gamma_b within 2`: the run's pair law integrates over `own`, facing
-/// `facing`, looking for facing points as far as `reach`.
+/// `contact Gamma_a with Gamma_b within 2 by segments`: the run's pair law integrates over
+/// `own`, facing `facing`, looking for facing points as far as `reach`, facet by facet or
+/// (`by segments`) piece by piece.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactPair {
     pub own: Ident,
     pub facing: Ident,
     pub reach: Option<Expr>,
+    /// `by segments` or `by elements` (the default).
+    pub by: Option<Ident>,
     pub span: Span,
 }
 

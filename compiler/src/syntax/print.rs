@@ -209,7 +209,8 @@ fn problem(p: &Problem, out: &mut String) {
     }
     for pair in &p.pairs {
         let within = pair.reach.as_ref().map_or(String::new(), |r| format!(" within {}", expr(r)));
-        out.push_str(&format!("  contact {} with {}{within}\n", pair.own.name, pair.facing.name));
+        let by = pair.by.as_ref().map_or(String::new(), |b| format!(" by {}", b.name));
+        out.push_str(&format!("  contact {} with {}{within}{by}\n", pair.own.name, pair.facing.name));
     }
     for d in &p.dirichlet {
         let k = d.component.as_ref().map_or(String::new(), |k| format!("[{}]", expr(k)));

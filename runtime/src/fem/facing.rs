@@ -281,6 +281,24 @@ impl<'m> Surface<'m> {
         }
     }
 
+    /// In 2D, facet `k`'s two ends on the configuration, each with the facet's tangent ∂x/∂s
+    /// there (s from its first vertex to its second): a point's closest point leaves the facet
+    /// at an end where the point crosses the line through it normal to that tangent.
+    pub fn ends(&self, k: usize) -> [([f64; 3], [f64; 3]); 2] {
+        let f = self.facets[k];
+        let frame = &self.frames[f.local as usize];
+        let cell = self.mesh.cell(f.cell as usize);
+        let mut y = [[0.0; 3]; 6];
+        for (slot, &a) in y.iter_mut().zip(frame.vertices.iter().chain(frame.mids.iter().map(|(m, _, _)| m))) {
+            *slot = self.position(cell[a] as usize);
+        }
+        [0.0, 1.0].map(|s| {
+            let mut tangents = [[0.0; 3]; 2];
+            let x = frame.point(&y, &[s], Some(&mut tangents));
+            (x, tangents[0])
+        })
+    }
+
     /// The facets, as given.
     pub fn facets(&self) -> &'m [Facet] {
         self.facets

@@ -130,10 +130,15 @@ impl<'m> Observer<'m> {
                 (Measure::OverRows { column, sum, value }, 1)
             }
             R::InnerMass => (Measure::InnerMass { a: c.pointwise(&args[0])?, b: c.pointwise(&args[1])? }, 1),
-            R::DensityMin | R::DensitySupport => {
+            R::DensityMin | R::DensityMax | R::DensitySupport => {
                 let ExprKind::Call(name, _) = &args[0].kind else { unreachable!("checked: a functional") };
                 let index = self.facet_functional(c, name)?;
-                (Measure::Density { index, min: kind == R::DensityMin }, 1)
+                let of = match kind {
+                    R::DensityMin => Density::Min,
+                    R::DensityMax => Density::Max,
+                    _ => Density::Support,
+                };
+                (Measure::Density { index, of }, 1)
             }
             R::Measure | R::Peak => {
                 let ExprKind::Name(region) = &args[0].kind else { unreachable!("checked: a region name") };
@@ -180,7 +185,8 @@ impl<'m> Observer<'m> {
         Ok(self.regions.len() - 1)
     }
 
-    /// The index of a functional over boundary facets, for `density_min` and `density_support`
+    /// The index of a functional over boundary facets, for `density_min`, `density_max` and
+    /// `density_support`
     /// (a cell functional has no facet to sample).
     fn facet_functional(&mut self, c: &mut Compiling<'_, '_, 'm>, name: &Ident) -> Result<usize, CaseError> {
         let index = match self.functionals.iter().position(|(n, _)| *n == name.name) {
@@ -210,7 +216,7 @@ impl<'m> Observer<'m> {
                     "no facet to sample",
                 )
                 .with_help(
-                    "density_min and density_support read a functional over a boundary region: `int(Gamma_C) ...`",
+                    "density_min, density_max and density_support read a functional over a boundary region: `int(Gamma_C) ...`",
                 ),
             ));
         }

@@ -154,12 +154,13 @@ impl Observer<'_> {
             Measure::Peak { region, f } => self.sampled(*region, f, r, scratch, false),
             Measure::Functional { index, at } => self.functional_value(*index, at, r),
             Measure::Reference { which, mid } => self.reference_value(*which, *mid, r),
-            Measure::Density { index, min } => {
+            Measure::Density { index, of } => {
                 let rule = crate::runtime::fem::quadrature::sampling_rule(d - 1, if d == 3 { 8 } else { 16 });
                 let points = self.functionals[*index].1.facet_point_values(ops.asm, &rule, &[s.u], s.t);
-                match min {
-                    true => points.iter().map(|p| p.value).fold(f64::INFINITY, f64::min),
-                    false => points.iter().filter(|p| p.value != 0.0).map(|p| p.weight).sum(),
+                match of {
+                    Density::Min => points.iter().map(|p| p.value).fold(f64::INFINITY, f64::min),
+                    Density::Max => points.iter().map(|p| p.value).fold(f64::NEG_INFINITY, f64::max),
+                    Density::Support => points.iter().filter(|p| p.value != 0.0).map(|p| p.weight).sum(),
                 }
             }
             Measure::OverRows { column, sum, value } => {

@@ -22,6 +22,14 @@ use crate::runtime::fem::mesh::Facet;
 use crate::runtime::library::Binding;
 use crate::simulation::{AxisMean, Operators, resultant};
 
+/// What `density_*` reduces a functional's sampled integrand to.
+#[derive(Clone, Copy)]
+enum Density {
+    Min,
+    Max,
+    Support,
+}
+
 /// One measured value of a row.
 enum Measure {
     Time,
@@ -79,11 +87,12 @@ enum Measure {
         which: usize,
         mid: bool,
     },
-    /// `density_min(F(u))` (`min`) or `density_support(F(u))`: the least value of functional
-    /// `index`'s integrand over its region's sample points, or the measure where it is not zero.
+    /// `density_min(F(u))`, `density_max(F(u))` or `density_support(F(u))`: the least or
+    /// largest value of functional `index`'s integrand over its region's sample points, or the
+    /// measure where it is not zero.
     Density {
         index: usize,
-        min: bool,
+        of: Density,
     },
     /// `inner_mass(A, B)`: aᵀ M b with the scheme's mass, A and B evaluated at the nodes.
     InnerMass {

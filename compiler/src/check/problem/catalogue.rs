@@ -128,6 +128,7 @@ pub enum RowReducer {
     Measure,
     Peak,
     DensityMin,
+    DensityMax,
     DensitySupport,
     Work,
     Cumulative,
@@ -187,6 +188,12 @@ pub const ROW_REDUCERS: &[RowReducerInfo] = {
             "density_min",
             "density_min(NAME(u))",
             "the least value of a boundary functional's integrand over 16 points per edge of its region: -density_min(contact_pressure(u)) is the peak contact pressure",
+        ),
+        r(
+            DensityMax,
+            "density_max",
+            "density_max(NAME(u))",
+            "the largest value of a boundary functional's integrand over those points: with density_min, the spread of a stress that should be one value",
         ),
         r(
             DensitySupport,

@@ -180,7 +180,7 @@ fn reducer(c: &mut Checker, e: &Expr, f: &Ident, args: &[Expr], s: &RowScope, di
                 }
             }
         }
-        Some(R::DensityMin | R::DensitySupport) => {
+        Some(R::DensityMin | R::DensityMax | R::DensitySupport) => {
             let functional = |a: &Expr| {
                 matches!(&a.kind, K::Call(_, xs) if xs.len() == 1
                 && matches!(&xs[0].kind, K::Name(n) if n.name == "u"))

@@ -1,9 +1,14 @@
-//! Contact pairs: `contact Gamma_a with Gamma_b within R`, two known regions of two bodies.
+//! Contact pairs: `contact Gamma_a with Gamma_b within R by segments`, two known regions of two
+//! bodies.
 
 use super::{Names, scalar, unknown_among};
 use crate::check::types::Checker;
 use crate::diagnostic::Diagnostic;
 use crate::syntax::ast::Problem;
+
+/// How a pair's law is integrated: `by elements` (each own facet whole, the default) or
+/// `by segments`.
+pub const PAIR_INTEGRATION: &[&str] = &["elements", "segments"];
 
 pub(super) fn check(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut Vec<Diagnostic>) {
     let regions: Vec<&str> = p.regions.iter().map(|r| r.name.name.as_str()).collect();
@@ -23,6 +28,13 @@ pub(super) fn check(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut
         }
         if let Some(reach) = &pair.reach {
             scalar(c, reach, constants, diags, false);
+        }
+        if let Some(by) = &pair.by
+            && !PAIR_INTEGRATION.contains(&by.name.as_str())
+        {
+            diags.push(unknown_among(by, PAIR_INTEGRATION.iter().copied(), "pair integration").with_note(
+                "`by elements` integrates over each own facet with the law's rule; `by segments` (2D) cuts each facet where its points' facing point crosses an end of a facing facet, and passes the contact patch test on non-matching meshes",
+            ));
         }
     }
     if let (Some(o), Some(pair)) = (p.obstacles.first(), p.pairs.first()) {

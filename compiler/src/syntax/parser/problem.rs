@@ -147,8 +147,14 @@ impl Builder {
                     let own = self.ident(next());
                     next(); // the word `with`
                     let facing = self.ident(next());
-                    let reach = it.next().map(|q| self.expr(q)).transpose()?;
-                    pb.pairs.push(ContactPair { own, facing, reach, span });
+                    let (mut reach, mut by) = (None, None);
+                    for q in it {
+                        match q.as_rule() {
+                            Rule::pair_by => by = q.into_inner().nth(1).map(|i| self.ident(i)),
+                            _ => reach = Some(self.expr(q)?),
+                        }
+                    }
+                    pb.pairs.push(ContactPair { own, facing, reach, by, span });
                 }
                 Rule::obstacle_decl => {
                     let shape = self.named_call(next())?;

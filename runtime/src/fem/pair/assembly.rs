@@ -47,6 +47,21 @@ fn tabulate(kind: ElementKind, rule: &Rule) -> Vec<Points> {
         .collect()
 }
 
+/// A quadrature point of the own surface: its facet (index in the own facets), its basis,
+/// and what it faces.
+struct OwnPoint {
+    facet: u32,
+    at: At,
+    facing: Option<Facing>,
+}
+
+/// An own point's basis: a point of the rule on its local facet, or a point of one piece of
+/// a segmented facet, tabulated for it.
+enum At {
+    Rule(u32),
+    Piece(Tabulated),
+}
+
 /// A pair law's form on a pair of surfaces.
 pub struct PairForm<'m> {
     kernel: Box<dyn PairKernel + 'm>,
@@ -59,6 +74,10 @@ pub struct PairForm<'m> {
     reach: f64,
     /// The quadrature points of each local facet of the element.
     rule: Vec<Points>,
+    /// The rule on the reference facet, and whether (2D) each own facet is integrated piece
+    /// by piece: cut where its points' facing point crosses an end of a facing facet.
+    base: Rule,
+    segmented: bool,
     /// Per local facet, its edge vectors e_α in the reference cell (ξ(s) = ξ0 + Σ s_α e_α).
     edges: Vec<Vec<[f64; MAX_DIM]>>,
     /// A coupling the matrix pattern lacks, met by the last tangent: the two nodes.
@@ -79,8 +98,8 @@ pub struct PairForm<'m> {
     lost: Mutex<Option<LostFacing>>,
 }
 
-/// Facing points, with the displacement they were found at.
-type Found = (Vec<f64>, Arc<Vec<Option<Facing>>>);
+/// The own points and their facing points, with the displacement they were found at.
+type Found = (Vec<f64>, Arc<Vec<OwnPoint>>);
 
 /// The field whose displacement places both surfaces, so that the facing points and the
 /// tangent's sliding part follow it: the law's first (`u` of `contact(u; v)`, the step's end u
@@ -114,7 +133,8 @@ impl<'m> PairForm<'m> {
         reach: f64,
     ) -> Self {
         let d = kind.dim();
-        let rule = tabulate(kind, &simplex_rule(d - 1, degree));
+        let base = simplex_rule(d - 1, degree);
+        let rule = tabulate(kind, &base);
         let edges = (0..kind.facets().len())
             .map(|f| {
                 let (xi0, _) = kind.facet_point(f, &vec![0.0; d - 1]);
@@ -135,6 +155,8 @@ impl<'m> PairForm<'m> {
             facing,
             reach,
             rule,
+            base,
+            segmented: false,
             edges,
             missing: Mutex::new(None),
             meter: Meter::default(),
@@ -145,9 +167,19 @@ impl<'m> PairForm<'m> {
         }
     }
 
+    /// Integrated segment by segment when `on` (2D; 3D facets are integrated whole): each own
+    /// facet cut where its points' facing point crosses an end of a facing facet, where the
+    /// integrand has a kink (the facing basis) or a jump (the facing normal), the rule on each
+    /// piece. Non-matching meshes then pass the contact patch test.
+    pub fn segmented(mut self, on: bool) -> Self {
+        self.segmented = on && self.base.points.first().is_some_and(|p| p.len() == 1);
+        self
+    }
+
     /// The node pairs its tangent may couple ([`Surfaces::couplings`]).
     pub fn couplings(&self, mesh: &Mesh) -> Vec<(u32, u32)> {
-        Surfaces { own: self.own, facing: self.facing, reach: self.reach, kind: mesh.kind }.couplings(mesh)
+        let segmented = self.segmented;
+        Surfaces { own: self.own, facing: self.facing, reach: self.reach, kind: mesh.kind, segmented }.couplings(mesh)
     }
 
     /// The coupling the pattern lacked at the last tangent, if any: a facing point farther on
@@ -178,32 +210,34 @@ impl<'m> PairForm<'m> {
         let started = Instant::now();
         let d = mesh.dim();
         let moving = fields.get(CONFIGURATION).copied().unwrap_or(&[]);
-        let found = self.facing_points(rule, mesh, moving);
-        let mut found = found.iter();
-        for f in self.own {
+        let placed = self.facing_points(rule, mesh, moving);
+        for point in placed.iter() {
+            let Some(facing) = &point.facing else { continue };
+            let f = self.own[point.facet as usize];
             let (points, ref_normal) = &rule[f.local as usize];
-            for q in points {
-                let Some(Some(facing)) = found.next() else { continue };
-                let own = side(mesh, f.cell as usize, &q.phi, &q.dref, ref_normal, fields);
-                let g = self.facing[facing.facet];
-                let kind = mesh.kind;
-                let (phi, dref) = (kind.basis(&facing.xi), kind.basis_gradients(&facing.xi));
-                let other = side(mesh, g.cell as usize, &phi, &dref, &kind.reference_normal(g.local as usize), fields);
-                let tangents = self.edges[g.local as usize]
-                    .iter()
-                    .map(|e| std::array::from_fn(|r| (0..d).map(|c| other.jacobian[r][c] * e[c]).sum()))
-                    .collect();
-                let nodes = mesh.cell(f.cell as usize).iter().chain(mesh.cell(g.cell as usize)).copied().collect();
-                let element = PairElement {
-                    weight: q.weight * own.scale,
-                    nodes,
-                    phi: q.phi.iter().chain(&phi).copied().collect(),
-                    dphi: own.dphi.into_iter().chain(other.dphi).collect(),
-                    tangents,
-                    point: PairPoint { dim: d, t, own: own.side, facing: other.side },
-                };
-                each(&element);
-            }
+            let q = match &point.at {
+                At::Rule(i) => &points[*i as usize],
+                At::Piece(q) => q,
+            };
+            let own = side(mesh, f.cell as usize, &q.phi, &q.dref, ref_normal, fields);
+            let g = self.facing[facing.facet];
+            let kind = mesh.kind;
+            let (phi, dref) = (kind.basis(&facing.xi), kind.basis_gradients(&facing.xi));
+            let other = side(mesh, g.cell as usize, &phi, &dref, &kind.reference_normal(g.local as usize), fields);
+            let tangents = self.edges[g.local as usize]
+                .iter()
+                .map(|e| std::array::from_fn(|r| (0..d).map(|c| other.jacobian[r][c] * e[c]).sum()))
+                .collect();
+            let nodes = mesh.cell(f.cell as usize).iter().chain(mesh.cell(g.cell as usize)).copied().collect();
+            let element = PairElement {
+                weight: q.weight * own.scale,
+                nodes,
+                phi: q.phi.iter().chain(&phi).copied().collect(),
+                dphi: own.dphi.into_iter().chain(other.dphi).collect(),
+                tangents,
+                point: PairPoint { dim: d, t, own: own.side, facing: other.side },
+            };
+            each(&element);
         }
         self.meter.evaluated(started);
     }
@@ -457,10 +491,10 @@ impl BoundForm for PairForm<'_> {
 }
 
 impl PairForm<'_> {
-    /// The facing point of each quadrature point of the own surface, in order, on the
+    /// The quadrature points of the own surface, in order, each with its facing point on the
     /// configuration x + `moving`: the last evaluation's if the displacement that moves them
-    /// is the same, else searched anew.
-    fn facing_points(&self, rule: &[Points], mesh: &Mesh, moving: &[f64]) -> Arc<Vec<Option<Facing>>> {
+    /// is the same, else placed and searched anew.
+    fn facing_points(&self, rule: &[Points], mesh: &Mesh, moving: &[f64]) -> Arc<Vec<OwnPoint>> {
         let own_rule = std::ptr::eq(rule, self.rule.as_slice());
         let d = mesh.dim();
         let moved_by = self.moved_by.get_or_init(|| {
@@ -482,51 +516,127 @@ impl PairForm<'_> {
         let started = Instant::now();
         let surface = Surface::new(mesh, self.facing, moving);
         self.meter.built(started);
-        let mut found = Vec::new();
+        let mut placed = Vec::new();
         let mut seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+        if own_rule {
+            seen.resize(self.own.len(), f64::NAN);
+        }
         let mut lost = None;
-        for f in self.own {
+        // Per point of the facet at hand: where it is, and how far it faces the surface (none:
+        // nothing within the reach).
+        let mut distances: Vec<([f64; MAX_DIM], Option<f64>)> = Vec::new();
+        for (i, f) in self.own.iter().enumerate() {
             let cell = mesh.cell(f.cell as usize);
-            for q in &rule[f.local as usize].0 {
-                // The quadrature point on the configuration, x + u summed as `side` sums them.
-                let (mut x, mut u) = ([0.0; MAX_DIM], [0.0; MAX_DIM]);
+            // A point of the facet on the configuration, x + u summed as `side` sums them.
+            let position = |phi: &[f64]| -> [f64; MAX_DIM] {
+                let mut p = [0.0; MAX_DIM];
                 for (a, &n) in cell.iter().enumerate() {
-                    for k in 0..d {
-                        x[k] += q.phi[a] * mesh.node(n as usize)[k];
-                        u[k] += q.phi[a] * at(n, k);
+                    for (k, pk) in p.iter_mut().enumerate().take(d) {
+                        *pk += phi[a] * (mesh.node(n as usize)[k] + at(n, k));
                     }
                 }
-                let p: [f64; MAX_DIM] = std::array::from_fn(|k| x[k] + u[k]);
+                p
+            };
+            distances.clear();
+            let mut place = |at: At, phi: &[f64]| {
+                let p = position(phi);
                 let asked = Instant::now();
                 let nearest = surface.nearest(&p[..d], self.reach);
                 self.meter.queried(asked);
-                if own_rule {
-                    let i = found.len();
-                    if seen.len() <= i {
-                        seen.resize(i + 1, f64::NAN);
-                    }
-                    match &nearest {
-                        Some(facing) => seen[i] = facing.distance,
-                        None if seen[i] <= 0.5 * self.reach && lost.is_none() => {
-                            lost = Some(LostFacing {
-                                form: self.kernel.meta().name.to_string(),
-                                point: p[..d].to_vec(),
-                                distance: seen[i],
-                                reach: self.reach,
-                            })
-                        }
-                        None => {}
+                distances.push((p, nearest.as_ref().map(|b| b.distance)));
+                placed.push(OwnPoint { facet: i as u32, at, facing: nearest.filter(|b| !b.beyond) });
+            };
+            if own_rule && self.segmented {
+                for (a, b) in self.pieces(*f, mesh, &position, &surface) {
+                    for (s, w) in self.base.points.iter().zip(&self.base.weights) {
+                        let (xi, scale) = mesh.kind.facet_point(f.local as usize, &[a + (b - a) * s[0]]);
+                        let q = Tabulated {
+                            weight: w * (b - a) * scale,
+                            phi: mesh.kind.basis(&xi),
+                            dref: mesh.kind.basis_gradients(&xi),
+                        };
+                        let phi = q.phi.clone();
+                        place(At::Piece(q), &phi);
                     }
                 }
-                found.push(nearest.filter(|b| !b.beyond));
+            } else {
+                for (k, q) in rule[f.local as usize].0.iter().enumerate() {
+                    place(At::Rule(k as u32), &q.phi);
+                }
+            }
+            if own_rule {
+                // Lost: every point of the facet faced the surface within half the reach, and
+                // one of them now faces nothing.
+                if lost.is_none()
+                    && seen[i] <= 0.5 * self.reach
+                    && let Some((p, _)) = distances.iter().find(|(_, r)| r.is_none())
+                {
+                    lost = Some(LostFacing {
+                        form: self.kernel.meta().name.to_string(),
+                        point: p[..d].to_vec(),
+                        distance: seen[i],
+                        reach: self.reach,
+                    });
+                }
+                seen[i] =
+                    distances.iter().try_fold(0.0, |most: f64, (_, r)| r.map(|r| most.max(r))).unwrap_or(f64::NAN);
             }
         }
-        let found = Arc::new(found);
+        let placed = Arc::new(placed);
         if own_rule {
-            *last = Some((key, found.clone()));
+            *last = Some((key, placed.clone()));
             *self.lost.lock().unwrap_or_else(|e| e.into_inner()) = lost;
         }
-        found
+        placed
+    }
+
+    /// The pieces [a, b] of own facet `f` (2D, s ∈ [0, 1] along it) between the points where
+    /// their facing point crosses an end of a facing facet: where x(s), on the configuration,
+    /// crosses the line through a facet's end normal to the facet there, within the reach.
+    /// The facet on the configuration is x(s) = x0 + c1 s + c2 s², a straight (P1) or
+    /// quadratic (P2) curve, so each line cuts it at the roots of a quadratic.
+    fn pieces(
+        &self,
+        f: Facet,
+        mesh: &Mesh,
+        position: &dyn Fn(&[f64]) -> [f64; MAX_DIM],
+        surface: &Surface,
+    ) -> Vec<(f64, f64)> {
+        let at = |s: f64| position(&mesh.kind.basis(&mesh.kind.facet_point(f.local as usize, &[s]).0));
+        let (x0, xm, x1) = (at(0.0), at(0.5), at(1.0));
+        let c1: [f64; 2] = std::array::from_fn(|r| -3.0 * x0[r] + 4.0 * xm[r] - x1[r]);
+        let c2: [f64; 2] = std::array::from_fn(|r| 2.0 * x0[r] - 4.0 * xm[r] + 2.0 * x1[r]);
+        let x = |s: f64| -> [f64; 2] { std::array::from_fn(|r| x0[r] + s * (c1[r] + s * c2[r])) };
+        // The curve lies in the box of its Bézier control points x0, x1 and 2 xm − (x0 + x1)/2.
+        let control = |r: usize| [x0[r], x1[r], 2.0 * xm[r] - 0.5 * (x0[r] + x1[r])];
+        let lower = std::array::from_fn(|r| {
+            if r < 2 { control(r).into_iter().fold(f64::INFINITY, f64::min) - self.reach } else { 0.0 }
+        });
+        let upper = std::array::from_fn(|r| {
+            if r < 2 { control(r).into_iter().fold(f64::NEG_INFINITY, f64::max) + self.reach } else { 0.0 }
+        });
+        // Cuts closer than this to an end or to each other (in s) make no piece.
+        const APART: f64 = 1e-10;
+        let mut cuts = Vec::new();
+        for k in surface.within(lower, upper) {
+            for (p, t) in surface.ends(k) {
+                let dot = |a: [f64; 2]| a[0] * t[0] + a[1] * t[1];
+                let (a, b, c) = (dot(c2), dot(c1), dot([x0[0] - p[0], x0[1] - p[1]]));
+                for s in unit_roots(a, b, c) {
+                    let y = x(s);
+                    let near = (y[0] - p[0]).hypot(y[1] - p[1]) <= self.reach;
+                    if near && s > APART && s < 1.0 - APART {
+                        cuts.push(s);
+                    }
+                }
+            }
+        }
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup_by(|a, b| (*a - *b).abs() < APART);
+        let mut ends = vec![0.0];
+        ends.extend(cuts);
+        ends.push(1.0);
+        ends.windows(2).map(|w| (w[0], w[1])).collect()
     }
 
     /// Adds to `ke` the tangent's part through the facing point's motion. The facing point y
@@ -649,4 +759,22 @@ pub fn pair_value(form: &PairForm<'_>, mesh: &Mesh, fields: &[&[f64]], t: f64) -
     let mut sum = 0.0;
     form.each_point(mesh, fields, t, |e| sum += e.weight * form.kernel.value_at(form.region, &e.point));
     sum
+}
+
+/// The roots in [0, 1] of a s² + b s + c (a straight facet's a is round-off: the root of
+/// b s + c then).
+fn unit_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
+    let roots = if a.abs() <= 1e-12 * (b.abs() + c.abs()) {
+        if b == 0.0 { vec![] } else { vec![-c / b] }
+    } else {
+        let disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            vec![]
+        } else {
+            // The stable pair: q = −(b + sign(b) √disc)/2, roots q/a and c/q.
+            let q = -0.5 * (b + b.signum() * disc.sqrt());
+            if q == 0.0 { vec![0.0] } else { vec![q / a, c / q] }
+        }
+    };
+    roots.into_iter().filter(|s| (0.0..=1.0).contains(s)).collect()
 }

@@ -54,6 +54,8 @@ pub struct Surfaces<'m> {
     pub facing: &'m [Facet],
     pub reach: f64,
     pub kind: ElementKind,
+    /// Integrated segment by segment (2D, [`PairForm::segmented`]).
+    pub segmented: bool,
 }
 
 /// A contact pair by its regions' names, as a problem declares it.
@@ -62,13 +64,21 @@ pub struct PairRegions {
     pub own: String,
     pub facing: String,
     pub reach: f64,
+    /// Integrated segment by segment (2D, [`PairForm::segmented`]), not facet by facet.
+    pub segmented: bool,
 }
 
 impl PairRegions {
     /// The pair's facets on `mesh` (none for a region it lacks: the problem checked them).
     pub fn on<'m>(&self, mesh: &'m Mesh) -> Surfaces<'m> {
         let facets = |name: &str| mesh.region(name).map(|r| r.facets.as_slice()).unwrap_or(&[]);
-        Surfaces { own: facets(&self.own), facing: facets(&self.facing), reach: self.reach, kind: mesh.kind }
+        Surfaces {
+            own: facets(&self.own),
+            facing: facets(&self.facing),
+            reach: self.reach,
+            kind: mesh.kind,
+            segmented: self.segmented,
+        }
     }
 }
 
