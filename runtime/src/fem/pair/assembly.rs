@@ -591,8 +591,9 @@ impl PairForm<'_> {
     }
 
     /// The pieces [a, b] of own facet `f` (2D, s ∈ [0, 1] along it) between the points where
-    /// their facing point crosses an end of a facing facet: where x(s), on the configuration,
-    /// crosses the line through a facet's end normal to the facet there, within the reach.
+    /// their facing point crosses from one facing facet to another: where x(s), on the
+    /// configuration, crosses the line through a facet's end normal to the facet there,
+    /// within the reach, and where two facets face it equally far.
     /// The facet on the configuration is x(s) = x0 + c1 s + c2 s², a straight (P1) or
     /// quadratic (P2) curve, so each line cuts it at the roots of a quadratic.
     fn pieces(
@@ -636,7 +637,35 @@ impl PairForm<'_> {
         let mut ends = vec![0.0];
         ends.extend(cuts);
         ends.push(1.0);
-        ends.windows(2).map(|w| (w[0], w[1])).collect()
+        // Where the facing surface bends towards the facet, two facing facets both face the
+        // points between their ends' normal lines, and the closest switches where they are
+        // equally far: a piece whose two ends face two facets is cut there, found by bisection.
+        let facet_at = |s: f64| {
+            let asked = Instant::now();
+            let facing = surface.nearest(&x(s), self.reach).map(|b| b.facet);
+            self.meter.queried(asked);
+            facing
+        };
+        let mut pieces = Vec::with_capacity(ends.len());
+        for w in ends.windows(2) {
+            let (mut lo, mut hi) = (w[0] + APART, w[1] - APART);
+            match (facet_at(lo), facet_at(hi)) {
+                (Some(a), Some(b)) if a != b && hi > lo => {
+                    while hi - lo > APART {
+                        let mid = 0.5 * (lo + hi);
+                        if facet_at(mid) == Some(a) {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    let cut = 0.5 * (lo + hi);
+                    pieces.extend([(w[0], cut), (cut, w[1])]);
+                }
+                _ => pieces.push((w[0], w[1])),
+            }
+        }
+        pieces
     }
 
     /// Adds to `ke` the tangent's part through the facing point's motion. The facing point y
