@@ -35,7 +35,36 @@ pub struct Facing {
     /// Whether the point lies past the surface's border: its closest point is on the border
     /// and not straight along the normal there.
     pub beyond: bool,
+    /// How far the point lies past the facet's boundary along the facet (the part of p − y
+    /// along its tangents; zero where y is inside): of two facets equally near, through their
+    /// common end, the point faces the one it overshoots least.
+    pub overshoot: f64,
 }
+
+/// An end of a facet (2D), for the motion of the line through it normal to the facet.
+#[derive(Clone, Debug)]
+pub struct End {
+    pub point: [f64; 3],
+    pub tangent: [f64; 3],
+    pub node: u32,
+    pub weights: Vec<(u32, f64)>,
+}
+
+impl Facing {
+    /// Whether it is nearer than `other`; of two equally near (both at their common end, to
+    /// round-off), the one the point overshoots least, so that the choice changes on a line
+    /// (the bisector of the two facets' ends) and not where a search happens to break a tie.
+    fn nearer_than(&self, other: &Facing) -> bool {
+        let tie = TIE * self.distance.max(other.distance);
+        match self.distance < other.distance - tie {
+            true => true,
+            false => self.distance <= other.distance + tie && self.overshoot < other.overshoot,
+        }
+    }
+}
+
+/// Distances this close, relative, are equal.
+const TIE: f64 = 1e-12;
 
 type Boxed = GeomWithData<Rectangle<[f64; 3]>, u32>;
 
@@ -193,11 +222,12 @@ impl<'m> Surface<'m> {
         candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut best: Option<Facing> = None;
         for (box_distance_2, k) in candidates {
-            if best.as_ref().is_some_and(|b| box_distance_2 > b.distance * b.distance) {
+            // (With a margin: a facet through the best point's end ties with it.)
+            if best.as_ref().is_some_and(|b| box_distance_2 > b.distance * b.distance * (1.0 + 4.0 * TIE)) {
                 break;
             }
             let facing = self.project(k, p);
-            if facing.distance <= radius && best.as_ref().is_none_or(|b| facing.distance < b.distance) {
+            if facing.distance <= radius && best.as_ref().is_none_or(|b| facing.nearer_than(b)) {
                 best = Some(facing);
             }
         }
@@ -248,15 +278,13 @@ impl<'m> Surface<'m> {
         let x = frame.point(&y, &s[..d - 1], Some(&mut tangents));
         let xi = (0..d).map(|r| frame.xi0[r] + (0..d - 1).map(|j| frame.edges[j][r] * s[j]).sum::<f64>()).collect();
         let distance = (0..d).map(|r| (at[r] - x[r]).powi(2)).sum::<f64>().sqrt();
-        let beyond = self.on_border(frame, cell, &s[..d - 1]) && {
-            // The residual's part along the facet, T (TᵀT)⁻¹ Tᵀ r: zero where r is normal.
-            let residual: [f64; 3] = std::array::from_fn(|r| at[r] - x[r]);
-            let step = gauss_newton_step(&tangents[..d - 1], &residual);
-            let along: f64 =
-                (0..3).map(|r| (0..d - 1).map(|j| tangents[j][r] * step[j]).sum::<f64>().powi(2)).sum::<f64>().sqrt();
-            along > ALONG_TOLERANCE * distance
-        };
-        Facing { facet: k, xi, point: x[..d].to_vec(), distance, beyond }
+        // The residual's part along the facet, T (TᵀT)⁻¹ Tᵀ r: zero where r is normal.
+        let residual: [f64; 3] = std::array::from_fn(|r| at[r] - x[r]);
+        let step = gauss_newton_step(&tangents[..d - 1], &residual);
+        let along: f64 =
+            (0..3).map(|r| (0..d - 1).map(|j| tangents[j][r] * step[j]).sum::<f64>().powi(2)).sum::<f64>().sqrt();
+        let beyond = self.on_border(frame, cell, &s[..d - 1]) && along > ALONG_TOLERANCE * distance;
+        Facing { facet: k, xi, point: x[..d].to_vec(), distance, beyond, overshoot: along }
     }
 
     /// Whether the facet point at `s` lies on the surface's border: the vertices it does not
@@ -297,6 +325,28 @@ impl<'m> Surface<'m> {
             let x = frame.point(&y, &[s], Some(&mut tangents));
             (x, tangents[0])
         })
+    }
+
+    /// In 2D, facet `k`'s end `end` (0: its first vertex, 1: its second) on the configuration:
+    /// its point, the facet's tangent t = ∂x/∂s there, the vertex's node, and t's weights on
+    /// the facet's nodes (t = Σ_b w_b y_b over their positions y_b), for how t moves with them.
+    pub fn end(&self, k: usize, end: usize) -> End {
+        let f = self.facets[k];
+        let frame = &self.frames[f.local as usize];
+        let cell = self.mesh.cell(f.cell as usize);
+        let locals: Vec<usize> = frame.vertices.iter().copied().chain(frame.mids.iter().map(|(m, _, _)| *m)).collect();
+        let s = [end as f64];
+        let weights = (0..locals.len())
+            .map(|b| {
+                let mut unit = [[0.0; 3]; 6];
+                unit[b][0] = 1.0;
+                let mut tangents = [[0.0; 3]; 2];
+                frame.point(&unit, &s, Some(&mut tangents));
+                (cell[locals[b]], tangents[0][0])
+            })
+            .collect();
+        let (point, tangent) = self.ends(k)[end];
+        End { point, tangent, node: cell[frame.vertices[end]], weights }
     }
 
     /// The facets, as given.

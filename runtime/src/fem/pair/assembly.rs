@@ -55,6 +55,35 @@ struct OwnPoint {
     facing: Option<Facing>,
 }
 
+/// The own points of an evaluation, and where its facets are cut (by segments).
+struct Placed {
+    points: Vec<OwnPoint>,
+    cuts: Vec<Cut>,
+}
+
+/// A point s of own facet `facet` where it is cut: the integrand jumps there (the facing
+/// point changes facet), and the cut moves with the bodies by the rule that placed it.
+struct Cut {
+    facet: u32,
+    s: f64,
+    /// The facing point of x(s) on the facing facet before the cut and after it (none: facing
+    /// nothing on that side).
+    before: Option<Facing>,
+    after: Option<Facing>,
+    rule: CutRule,
+}
+
+enum CutRule {
+    /// (x(s) − p)·t = 0: x(s) crosses the line through a facing facet's end p normal to it.
+    Line(crate::fem::facing::End),
+    /// |x − y_A|² = |x − y_B|²: two facing facets equally far (`before` and `after`).
+    Equal,
+    /// (x − p)·(o_A − o_B) = 0: both facets' closest point is their common end p, and the
+    /// point faces the one it overshoots least; o = ±t/|t| their tangents there, pointing out
+    /// of each (the sign: +1 at a facet's second end).
+    Bisector { a: crate::fem::facing::End, b: crate::fem::facing::End, signs: [f64; 2] },
+}
+
 /// An own point's basis: a point of the rule on its local facet, or a point of one piece of
 /// a segmented facet, tabulated for it.
 enum At {
@@ -99,7 +128,11 @@ pub struct PairForm<'m> {
 }
 
 /// The own points and their facing points, with the displacement they were found at.
-type Found = (Vec<f64>, Arc<Vec<OwnPoint>>);
+type Found = (Vec<f64>, Arc<Placed>);
+
+/// A facing point overshoots its facet by more than this, relative to its distance, where it
+/// is held at the facet's end (round-off leaves about 1e-16 where it is inside).
+const HELD: f64 = 1e-8;
 
 /// The field whose displacement places both surfaces, so that the facing points and the
 /// tangent's sliding part follow it: the law's first (`u` of `contact(u; v)`, the step's end u
@@ -118,6 +151,9 @@ struct PairElement {
     dphi: Vec<[f64; MAX_DIM]>,
     /// The facing facet's tangents T_α = ∂y/∂s_α on the reference configuration.
     tangents: Vec<[f64; MAX_DIM]>,
+    /// Whether the facing point slides as the bodies move: not where it is held at a facet's
+    /// end (the point overshoots the facet, in the wedge between two facets' normals there).
+    slides: bool,
 }
 
 impl<'m> PairForm<'m> {
@@ -208,10 +244,9 @@ impl<'m> PairForm<'m> {
             return;
         }
         let started = Instant::now();
-        let d = mesh.dim();
         let moving = fields.get(CONFIGURATION).copied().unwrap_or(&[]);
         let placed = self.facing_points(rule, mesh, moving);
-        for point in placed.iter() {
+        for point in &placed.points {
             let Some(facing) = &point.facing else { continue };
             let f = self.own[point.facet as usize];
             let (points, ref_normal) = &rule[f.local as usize];
@@ -219,27 +254,60 @@ impl<'m> PairForm<'m> {
                 At::Rule(i) => &points[*i as usize],
                 At::Piece(q) => q,
             };
-            let own = side(mesh, f.cell as usize, &q.phi, &q.dref, ref_normal, fields);
-            let g = self.facing[facing.facet];
-            let kind = mesh.kind;
-            let (phi, dref) = (kind.basis(&facing.xi), kind.basis_gradients(&facing.xi));
-            let other = side(mesh, g.cell as usize, &phi, &dref, &kind.reference_normal(g.local as usize), fields);
-            let tangents = self.edges[g.local as usize]
-                .iter()
-                .map(|e| std::array::from_fn(|r| (0..d).map(|c| other.jacobian[r][c] * e[c]).sum()))
-                .collect();
-            let nodes = mesh.cell(f.cell as usize).iter().chain(mesh.cell(g.cell as usize)).copied().collect();
-            let element = PairElement {
-                weight: q.weight * own.scale,
-                nodes,
-                phi: q.phi.iter().chain(&phi).copied().collect(),
-                dphi: own.dphi.into_iter().chain(other.dphi).collect(),
-                tangents,
-                point: PairPoint { dim: d, t, own: own.side, facing: other.side },
-            };
-            each(&element);
+            each(&self.element(mesh, f, q, ref_normal, facing, fields, t));
         }
         self.meter.evaluated(started);
+    }
+
+    /// The element of own point `q` of facet `f` (reference normal `ref_normal`) facing
+    /// `facing`.
+    #[allow(clippy::too_many_arguments)]
+    fn element(
+        &self,
+        mesh: &Mesh,
+        f: Facet,
+        q: &Tabulated,
+        ref_normal: &[f64],
+        facing: &Facing,
+        fields: &[&[f64]],
+        t: f64,
+    ) -> PairElement {
+        let d = mesh.dim();
+        let own = side(mesh, f.cell as usize, &q.phi, &q.dref, ref_normal, fields);
+        let g = self.facing[facing.facet];
+        let kind = mesh.kind;
+        let (phi, dref) = (kind.basis(&facing.xi), kind.basis_gradients(&facing.xi));
+        let other = side(mesh, g.cell as usize, &phi, &dref, &kind.reference_normal(g.local as usize), fields);
+        let tangents = self.edges[g.local as usize]
+            .iter()
+            .map(|e| std::array::from_fn(|r| (0..d).map(|c| other.jacobian[r][c] * e[c]).sum()))
+            .collect();
+        let nodes = mesh.cell(f.cell as usize).iter().chain(mesh.cell(g.cell as usize)).copied().collect();
+        PairElement {
+            weight: q.weight * own.scale,
+            nodes,
+            phi: q.phi.iter().chain(&phi).copied().collect(),
+            dphi: own.dphi.into_iter().chain(other.dphi).collect(),
+            tangents,
+            slides: facing.overshoot <= HELD * facing.distance,
+            point: PairPoint { dim: d, t, own: own.side, facing: other.side },
+        }
+    }
+
+    /// The weighted residual of element `e` from the kernel's coefficients `r`, per node of the
+    /// element and component (`each(a, k, value)`).
+    fn contract(e: &PairElement, r: &[f64], d: usize, mut each: impl FnMut(usize, usize, f64)) {
+        let half = e.nodes.len() / 2;
+        for a in 0..e.nodes.len() {
+            let off = if a < half { 0 } else { d + d * d };
+            for k in 0..d {
+                let mut v = r[off + k] * e.phi[a];
+                for l in 0..d {
+                    v += r[off + d + k * d + l] * e.dphi[a][l];
+                }
+                each(a, k, e.weight * v);
+            }
+        }
     }
 }
 
@@ -368,17 +436,7 @@ impl BoundForm for PairForm<'_> {
             if !self.kernel.residual_at(self.region, &e.point, &mut r) {
                 return;
             }
-            let half = e.nodes.len() / 2;
-            for (a, &node) in e.nodes.iter().enumerate() {
-                let off = if a < half { 0 } else { d + d * d };
-                for k in 0..d {
-                    let mut v = r[off + k] * e.phi[a];
-                    for l in 0..d {
-                        v += r[off + d + k * d + l] * e.dphi[a][l];
-                    }
-                    out[node as usize * d + k] += e.weight * v;
-                }
-            }
+            Self::contract(e, &r, d, |a, k, v| out[e.nodes[a] as usize * d + k] += v);
         });
     }
 
@@ -470,6 +528,12 @@ impl BoundForm for PairForm<'_> {
                 missing = Some(pair);
             }
         });
+        if wrt == moving && self.segmented {
+            let placed = self.facing_points(&self.rule, mesh, fields[moving]);
+            if let Some(pair) = self.add_cuts(mesh, &placed.cuts, fields, t, m) {
+                missing = Some(pair);
+            }
+        }
         if let Some((a, b)) = missing {
             // The residual stays exact: Newton converges to the same state with this Jacobian,
             // only more slowly, as it does in a step's first, far-off iterates.
@@ -494,7 +558,7 @@ impl PairForm<'_> {
     /// The quadrature points of the own surface, in order, each with its facing point on the
     /// configuration x + `moving`: the last evaluation's if the displacement that moves them
     /// is the same, else placed and searched anew.
-    fn facing_points(&self, rule: &[Points], mesh: &Mesh, moving: &[f64]) -> Arc<Vec<OwnPoint>> {
+    fn facing_points(&self, rule: &[Points], mesh: &Mesh, moving: &[f64]) -> Arc<Placed> {
         let own_rule = std::ptr::eq(rule, self.rule.as_slice());
         let d = mesh.dim();
         let moved_by = self.moved_by.get_or_init(|| {
@@ -517,6 +581,7 @@ impl PairForm<'_> {
         let surface = Surface::new(mesh, self.facing, moving);
         self.meter.built(started);
         let mut placed = Vec::new();
+        let mut cuts = Vec::new();
         let mut seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
         if own_rule {
             seen.resize(self.own.len(), f64::NAN);
@@ -547,7 +612,15 @@ impl PairForm<'_> {
                 placed.push(OwnPoint { facet: i as u32, at, facing: nearest.filter(|b| !b.beyond) });
             };
             if own_rule && self.segmented {
-                for (a, b) in self.pieces(*f, mesh, &position, &surface) {
+                let (pieces, facet_cuts) = self.pieces(*f, mesh, &position, &surface);
+                cuts.extend(facet_cuts.into_iter().map(|(s, before, after, rule)| Cut {
+                    facet: i as u32,
+                    s,
+                    before,
+                    after,
+                    rule,
+                }));
+                for (a, b) in pieces {
                     for (s, w) in self.base.points.iter().zip(&self.base.weights) {
                         let (xi, scale) = mesh.kind.facet_point(f.local as usize, &[a + (b - a) * s[0]]);
                         let q = Tabulated {
@@ -582,12 +655,134 @@ impl PairForm<'_> {
                     distances.iter().try_fold(0.0, |most: f64, (_, r)| r.map(|r| most.max(r))).unwrap_or(f64::NAN);
             }
         }
-        let placed = Arc::new(placed);
+        let placed = Arc::new(Placed { points: placed, cuts });
         if own_rule {
             *last = Some((key, placed.clone()));
             *self.lost.lock().unwrap_or_else(|e| e.into_inner()) = lost;
         }
         placed
+    }
+
+    /// Adds to `m` the tangent's part through the cuts' motion (by segments): at each cut s,
+    /// the integrand's jump there (before minus after) times the cut's rate
+    /// ds/du = −(∂φ/∂u)/(∂φ/∂s), φ = 0 the rule that placed it. The pair of nodes the pattern
+    /// lacked, if any.
+    fn add_cuts(&self, mesh: &Mesh, cuts: &[Cut], fields: &[&[f64]], t: f64, m: &mut Matrix) -> Option<(u32, u32)> {
+        let d = mesh.dim();
+        let moving = fields[CONFIGURATION];
+        let pattern = m.pattern.clone();
+        let mut missing = None;
+        let mut r = vec![0.0; layout::residual(d)];
+        let dot = |a: &[f64], b: &[f64]| (0..d).map(|k| a[k] * b[k]).sum::<f64>();
+        for cut in cuts {
+            let f = self.own[cut.facet as usize];
+            // The basis at the cut, weighted per unit of s.
+            let (xi, scale) = mesh.kind.facet_point(f.local as usize, &[cut.s]);
+            let q = Tabulated { weight: scale, phi: mesh.kind.basis(&xi), dref: mesh.kind.basis_gradients(&xi) };
+            let ref_normal = &self.rule[f.local as usize].1;
+            let mut jump: Vec<(u32, usize, f64)> = Vec::new();
+            for (facing, sign) in [(&cut.before, 1.0), (&cut.after, -1.0)] {
+                let Some(facing) = facing else { continue };
+                let e = self.element(mesh, f, &q, ref_normal, facing, fields, t);
+                r.fill(0.0);
+                if self.kernel.residual_at(self.region, &e.point, &mut r) {
+                    Self::contract(&e, &r, d, |a, k, v| jump.push((e.nodes[a], k, sign * v)));
+                }
+            }
+            if jump.iter().all(|j| j.2 == 0.0) {
+                continue;
+            }
+            // x(s) and x'(s) on the configuration.
+            let cell = mesh.cell(f.cell as usize);
+            let edge = &self.edges[f.local as usize][0];
+            let (mut x, mut dx) = ([0.0; MAX_DIM], [0.0; MAX_DIM]);
+            for (a, &n) in cell.iter().enumerate() {
+                let along: f64 = (0..d).map(|c| q.dref[a][c] * edge[c]).sum();
+                for k in 0..d {
+                    let position = mesh.node(n as usize)[k] + moving.get(n as usize * d + k).copied().unwrap_or(0.0);
+                    x[k] += q.phi[a] * position;
+                    dx[k] += along * position;
+                }
+            }
+            // ∂φ/∂u per (node, component), and ∂φ/∂s.
+            let mut grad: Vec<(u32, usize, f64)> = Vec::new();
+            let rate_s = match &cut.rule {
+                CutRule::Line(end) => {
+                    let (p, tangent) = (&end.point, &end.tangent);
+                    for (a, &n) in cell.iter().enumerate() {
+                        grad.extend((0..d).map(|k| (n, k, q.phi[a] * tangent[k])));
+                    }
+                    for k in 0..d {
+                        grad.push((end.node, k, -tangent[k]));
+                        grad.extend(end.weights.iter().map(|&(n, w)| (n, k, (x[k] - p[k]) * w)));
+                    }
+                    dot(&dx, tangent)
+                }
+                CutRule::Bisector { a, b, signs } => {
+                    let p = &a.point;
+                    let unit = |t: &[f64; 3]| {
+                        let size = dot(t, t).sqrt();
+                        (std::array::from_fn::<f64, 3, _>(|k| t[k] / size), size)
+                    };
+                    let ((ta, la), (tb, lb)) = (unit(&a.tangent), unit(&b.tangent));
+                    let o: [f64; 3] = std::array::from_fn(|k| signs[0] * ta[k] - signs[1] * tb[k]);
+                    let off: [f64; 3] = std::array::from_fn(|k| if k < d { x[k] - p[k] } else { 0.0 });
+                    for (c, &n) in cell.iter().enumerate() {
+                        grad.extend((0..d).map(|k| (n, k, q.phi[c] * o[k])));
+                    }
+                    for k in 0..d {
+                        grad.push((a.node, k, -o[k]));
+                    }
+                    // δo = ±(I − t̂t̂ᵀ) δt/|t|, δt = Σ w_b δu_b.
+                    for (end, t, size, sign) in [(a, ta, la, signs[0]), (b, tb, lb, -signs[1])] {
+                        let along = dot(&off, &t);
+                        for &(n, w) in &end.weights {
+                            grad.extend((0..d).map(|k| (n, k, sign / size * (off[k] - t[k] * along) * w)));
+                        }
+                    }
+                    dot(&dx, &o)
+                }
+                CutRule::Equal => {
+                    let (Some(a), Some(b)) = (&cut.before, &cut.after) else { continue };
+                    let apart: [f64; MAX_DIM] = std::array::from_fn(|k| if k < d { b.point[k] - a.point[k] } else { 0.0 });
+                    // Both facets' closest point is their common end (a tie): the cut is where
+                    // the search breaks it, with no rate.
+                    if dot(&apart, &apart).sqrt() <= 1e-12 * dot(&dx, &dx).sqrt() {
+                        continue;
+                    }
+                    for (a, &n) in cell.iter().enumerate() {
+                        grad.extend((0..d).map(|k| (n, k, 2.0 * apart[k] * q.phi[a])));
+                    }
+                    for (facing, sign) in [(a, -2.0), (b, 2.0)] {
+                        let phi = mesh.kind.basis(&facing.xi);
+                        for (c, &n) in mesh.cell(self.facing[facing.facet].cell as usize).iter().enumerate() {
+                            grad.extend((0..d).map(|k| (n, k, sign * (x[k] - facing.point[k]) * phi[c])));
+                        }
+                    }
+                    2.0 * dot(&apart, &dx)
+                }
+            };
+            let size_s = grad.iter().map(|g| g.2.abs()).fold(0.0, f64::max) * dot(&dx, &dx).sqrt();
+            if rate_s.abs() <= 1e-12 * size_s {
+                continue;
+            }
+            let mut nodes: Vec<u32> = jump.iter().map(|j| j.0).chain(grad.iter().map(|g| g.0)).collect();
+            nodes.sort_unstable();
+            nodes.dedup();
+            let at = |n: u32| nodes.binary_search(&n).unwrap_or_default();
+            let size = nodes.len() * d;
+            let mut ke = vec![0.0; size * size];
+            for &(row_node, row_k, jv) in &jump {
+                let row = at(row_node) * d + row_k;
+                for &(col_node, col_k, gv) in &grad {
+                    ke[row * size + at(col_node) * d + col_k] -= jv * gv / rate_s;
+                }
+            }
+            if let Err(pair) = pattern.scatter_nodes(&nodes, &ke, |pos, v| m.values[pos] += v) {
+                missing = Some(pair);
+            }
+        }
+        missing
     }
 
     /// The pieces [a, b] of own facet `f` (2D, s ∈ [0, 1] along it) between the points where
@@ -602,7 +797,7 @@ impl PairForm<'_> {
         mesh: &Mesh,
         position: &dyn Fn(&[f64]) -> [f64; MAX_DIM],
         surface: &Surface,
-    ) -> Vec<(f64, f64)> {
+    ) -> (Vec<(f64, f64)>, Vec<(f64, Option<Facing>, Option<Facing>, CutRule)>) {
         let at = |s: f64| position(&mesh.kind.basis(&mesh.kind.facet_point(f.local as usize, &[s]).0));
         let (x0, xm, x1) = (at(0.0), at(0.5), at(1.0));
         let c1: [f64; 2] = std::array::from_fn(|r| -3.0 * x0[r] + 4.0 * xm[r] - x1[r]);
@@ -620,22 +815,22 @@ impl PairForm<'_> {
         const APART: f64 = 1e-10;
         let mut cuts = Vec::new();
         for k in surface.within(lower, upper) {
-            for (p, t) in surface.ends(k) {
+            for (end, (p, t)) in surface.ends(k).into_iter().enumerate() {
                 let dot = |a: [f64; 2]| a[0] * t[0] + a[1] * t[1];
                 let (a, b, c) = (dot(c2), dot(c1), dot([x0[0] - p[0], x0[1] - p[1]]));
                 for s in unit_roots(a, b, c) {
                     let y = x(s);
                     let near = (y[0] - p[0]).hypot(y[1] - p[1]) <= self.reach;
                     if near && s > APART && s < 1.0 - APART {
-                        cuts.push(s);
+                        cuts.push((s, k, end));
                     }
                 }
             }
         }
-        cuts.sort_by(f64::total_cmp);
-        cuts.dedup_by(|a, b| (*a - *b).abs() < APART);
+        cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        cuts.dedup_by(|a, b| (a.0 - b.0).abs() < APART);
         let mut ends = vec![0.0];
-        ends.extend(cuts);
+        ends.extend(cuts.iter().map(|c| c.0));
         ends.push(1.0);
         // Where the facing surface bends towards the facet, two facing facets both face the
         // points between their ends' normal lines, and the closest switches where they are
@@ -647,6 +842,7 @@ impl PairForm<'_> {
             facing
         };
         let mut pieces = Vec::with_capacity(ends.len());
+        let mut equal = Vec::new();
         for w in ends.windows(2) {
             let (mut lo, mut hi) = (w[0] + APART, w[1] - APART);
             match (facet_at(lo), facet_at(hi)) {
@@ -661,11 +857,47 @@ impl PairForm<'_> {
                     }
                     let cut = 0.5 * (lo + hi);
                     pieces.extend([(w[0], cut), (cut, w[1])]);
+                    equal.push(cut);
                 }
                 _ => pieces.push((w[0], w[1])),
             }
         }
-        pieces
+        // What each cut's point faces on either side, projected onto the facet found there.
+        let sides = |s: f64| {
+            let y = x(s);
+            let on = |t: f64| {
+                let facet = facet_at(t)?;
+                Some(surface.project(facet, &y)).filter(|b| !b.beyond)
+            };
+            (on(s - APART), on(s + APART))
+        };
+        let mut placed: Vec<(f64, Option<Facing>, Option<Facing>, CutRule)> = cuts
+            .into_iter()
+            .map(|(s, k, end)| {
+                let (before, after) = sides(s);
+                (s, before, after, CutRule::Line(surface.end(k, end)))
+            })
+            .collect();
+        placed.extend(equal.into_iter().map(|s| {
+            let (before, after) = sides(s);
+            let rule = match (&before, &after) {
+                (Some(a), Some(b)) if (a.point[0] - b.point[0]).hypot(a.point[1] - b.point[1]) <= APART * a.distance => {
+                    // Their common end, and which end of each it is.
+                    let end_of = |facing: &Facing| {
+                        let ends = [surface.end(facing.facet, 0), surface.end(facing.facet, 1)];
+                        let off = |e: &crate::fem::facing::End| (e.point[0] - facing.point[0]).hypot(e.point[1] - facing.point[1]);
+                        let second = off(&ends[1]) < off(&ends[0]);
+                        let [first, last] = ends;
+                        if second { (last, 1.0) } else { (first, -1.0) }
+                    };
+                    let ((a, sa), (b, sb)) = (end_of(a), end_of(b));
+                    CutRule::Bisector { a, b, signs: [sa, sb] }
+                }
+                _ => CutRule::Equal,
+            };
+            (s, before, after, rule)
+        }));
+        (pieces, placed)
     }
 
     /// Adds to `ke` the tangent's part through the facing point's motion. The facing point y
@@ -677,6 +909,9 @@ impl PairForm<'_> {
     /// coefficients times the basis functions' gradients (their second derivatives, zero on
     /// P1, are left out). `rates` holds the residual's coefficients then their sliding rates.
     fn add_sliding(&self, e: &PairElement, rates: &[f64], d: usize, ke: &mut [f64]) {
+        if !e.slides {
+            return;
+        }
         let (n, half) = (e.nodes.len(), e.nodes.len() / 2);
         let moving = CONFIGURATION;
         let (own_u, facing_u) = (&e.point.own.fields[moving], &e.point.facing.fields[moving]);

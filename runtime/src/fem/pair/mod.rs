@@ -97,9 +97,17 @@ impl Surfaces<'_> {
                 let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
                 (lower[r], upper[r]) = (lo - self.reach, hi + self.reach);
             }
-            for k in surface.within(lower, upper) {
+            let near = surface.within(lower, upper);
+            for &k in &near {
                 let other = mesh.cell(self.facing[k].cell as usize);
                 out.extend(own_nodes.iter().flat_map(|&a| other.iter().map(move |&b| (a, b))));
+                // By segments, a cut moves with the facing facets on both of its sides.
+                if self.segmented {
+                    for &j in &near {
+                        let beside = mesh.cell(self.facing[j].cell as usize);
+                        out.extend(other.iter().flat_map(|&a| beside.iter().map(move |&b| (a, b))));
+                    }
+                }
             }
         }
         out.sort_unstable();
