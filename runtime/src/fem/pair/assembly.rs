@@ -76,8 +76,6 @@ struct Cut {
 enum CutRule {
     /// (x(s) − p)·t = 0: x(s) crosses the line through a facing facet's end p normal to it.
     Line(crate::fem::facing::End),
-    /// |x − y_A|² = |x − y_B|²: two facing facets equally far (`before` and `after`).
-    Equal,
     /// (x − p)·(o_A − o_B) = 0: both facets' closest point is their common end p, and the
     /// point faces the one it overshoots least; o = ±t/|t| their tangents there, pointing out
     /// of each (the sign: +1 at a facet's second end).
@@ -612,14 +610,8 @@ impl PairForm<'_> {
                 placed.push(OwnPoint { facet: i as u32, at, facing: nearest.filter(|b| !b.beyond) });
             };
             if own_rule && self.segmented {
-                let (pieces, facet_cuts) = self.pieces(*f, mesh, &position, &surface);
-                cuts.extend(facet_cuts.into_iter().map(|(s, before, after, rule)| Cut {
-                    facet: i as u32,
-                    s,
-                    before,
-                    after,
-                    rule,
-                }));
+                let (pieces, facet_cuts) = self.pieces(i as u32, *f, mesh, &position, &surface);
+                cuts.extend(facet_cuts);
                 for (a, b) in pieces {
                     for (s, w) in self.base.points.iter().zip(&self.base.weights) {
                         let (xi, scale) = mesh.kind.facet_point(f.local as usize, &[a + (b - a) * s[0]]);
@@ -742,25 +734,6 @@ impl PairForm<'_> {
                     }
                     dot(&dx, &o)
                 }
-                CutRule::Equal => {
-                    let (Some(a), Some(b)) = (&cut.before, &cut.after) else { continue };
-                    let apart: [f64; MAX_DIM] = std::array::from_fn(|k| if k < d { b.point[k] - a.point[k] } else { 0.0 });
-                    // Both facets' closest point is their common end (a tie): the cut is where
-                    // the search breaks it, with no rate.
-                    if dot(&apart, &apart).sqrt() <= 1e-12 * dot(&dx, &dx).sqrt() {
-                        continue;
-                    }
-                    for (a, &n) in cell.iter().enumerate() {
-                        grad.extend((0..d).map(|k| (n, k, 2.0 * apart[k] * q.phi[a])));
-                    }
-                    for (facing, sign) in [(a, -2.0), (b, 2.0)] {
-                        let phi = mesh.kind.basis(&facing.xi);
-                        for (c, &n) in mesh.cell(self.facing[facing.facet].cell as usize).iter().enumerate() {
-                            grad.extend((0..d).map(|k| (n, k, sign * (x[k] - facing.point[k]) * phi[c])));
-                        }
-                    }
-                    2.0 * dot(&apart, &dx)
-                }
             };
             let size_s = grad.iter().map(|g| g.2.abs()).fold(0.0, f64::max) * dot(&dx, &dx).sqrt();
             if rate_s.abs() <= 1e-12 * size_s {
@@ -785,19 +758,23 @@ impl PairForm<'_> {
         missing
     }
 
-    /// The pieces [a, b] of own facet `f` (2D, s ∈ [0, 1] along it) between the points where
-    /// their facing point crosses from one facing facet to another: where x(s), on the
-    /// configuration, crosses the line through a facet's end normal to the facet there,
-    /// within the reach, and where two facets face it equally far.
-    /// The facet on the configuration is x(s) = x0 + c1 s + c2 s², a straight (P1) or
-    /// quadratic (P2) curve, so each line cuts it at the roots of a quadratic.
+    /// The pieces [a, b] of own facet `f` (the `index`-th; 2D, s ∈ [0, 1] along it) between the points where
+    /// the integrand has a kink or a jump, within the reach: where x(s), on the configuration,
+    /// crosses the normal line through a facing facet's end (its facing point reaches the end)
+    /// or the line where the facing point passes from one facet to the next; and the cuts,
+    /// with what each faces on either side and the rule that places it. The facet on the
+    /// configuration is x(s) = x0 + c1 s + c2 s², a straight (P1) or quadratic (P2) curve, so
+    /// each line cuts it at the roots of a quadratic. On P2 the facets curve, and the point
+    /// where two facets that both face x are equally far lies off that line by the gap times
+    /// the curvature: the cut there is the line's.
     fn pieces(
         &self,
+        index: u32,
         f: Facet,
         mesh: &Mesh,
         position: &dyn Fn(&[f64]) -> [f64; MAX_DIM],
         surface: &Surface,
-    ) -> (Vec<(f64, f64)>, Vec<(f64, Option<Facing>, Option<Facing>, CutRule)>) {
+    ) -> (Vec<(f64, f64)>, Vec<Cut>) {
         let at = |s: f64| position(&mesh.kind.basis(&mesh.kind.facet_point(f.local as usize, &[s]).0));
         let (x0, xm, x1) = (at(0.0), at(0.5), at(1.0));
         let c1: [f64; 2] = std::array::from_fn(|r| -3.0 * x0[r] + 4.0 * xm[r] - x1[r]);
@@ -813,18 +790,44 @@ impl PairForm<'_> {
         });
         // Cuts closer than this to an end or to each other (in s) make no piece.
         const APART: f64 = 1e-10;
-        let mut cuts = Vec::new();
-        for k in surface.within(lower, upper) {
-            for (end, (p, t)) in surface.ends(k).into_iter().enumerate() {
-                let dot = |a: [f64; 2]| a[0] * t[0] + a[1] * t[1];
-                let (a, b, c) = (dot(c2), dot(c1), dot([x0[0] - p[0], x0[1] - p[1]]));
-                for s in unit_roots(a, b, c) {
-                    let y = x(s);
-                    let near = (y[0] - p[0]).hypot(y[1] - p[1]) <= self.reach;
-                    if near && s > APART && s < 1.0 - APART {
-                        cuts.push((s, k, end));
-                    }
+        // The facing facets' ends near the facet, by node. An end two facets share is where
+        // the facing point passes from one to the other, on the line through it along
+        // o_A − o_B (o = ±t/|t| each facet's tangent there, pointing out of it), whether the
+        // surface turns away (the point overshoots both, and faces the one it overshoots
+        // least) or towards it (the point faces both, and the nearer: on P1 the same line).
+        let mut found: Vec<(crate::fem::facing::End, f64)> = surface
+            .within(lower, upper)
+            .into_iter()
+            .flat_map(|k| [(surface.end(k, 0), -1.0), (surface.end(k, 1), 1.0)])
+            .collect();
+        found.sort_by_key(|(e, _)| e.node);
+        let unit = |t: &[f64; 3]| {
+            let size = t[0].hypot(t[1]);
+            [t[0] / size, t[1] / size]
+        };
+        let mut cuts: Vec<(f64, CutRule)> = Vec::new();
+        let mut cut_along = |p: [f64; 3], o: [f64; 2], rule: &dyn Fn() -> CutRule| {
+            let dot = |a: [f64; 2]| a[0] * o[0] + a[1] * o[1];
+            let (a, b, c) = (dot(c2), dot(c1), dot([x0[0] - p[0], x0[1] - p[1]]));
+            for s in unit_roots(a, b, c) {
+                let y = x(s);
+                let near = (y[0] - p[0]).hypot(y[1] - p[1]) <= self.reach;
+                if near && s > APART && s < 1.0 - APART {
+                    cuts.push((s, rule()));
                 }
+            }
+        };
+        for group in found.chunk_by(|a, b| a.0.node == b.0.node) {
+            // Each end's normal line: there the facing point reaches the end and stops (a kink
+            // of the integrand, which a rule across it would miss).
+            for (e, _) in group {
+                cut_along(e.point, [e.tangent[0], e.tangent[1]], &|| CutRule::Line(e.clone()));
+            }
+            if let [(a, sa), (b, sb)] = group {
+                let (ta, tb) = (unit(&a.tangent), unit(&b.tangent));
+                let o = [sa * ta[0] - sb * tb[0], sa * ta[1] - sb * tb[1]];
+                let rule = || CutRule::Bisector { a: a.clone(), b: b.clone(), signs: [*sa, *sb] };
+                cut_along(a.point, o, &rule);
             }
         }
         cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -832,36 +835,13 @@ impl PairForm<'_> {
         let mut ends = vec![0.0];
         ends.extend(cuts.iter().map(|c| c.0));
         ends.push(1.0);
-        // Where the facing surface bends towards the facet, two facing facets both face the
-        // points between their ends' normal lines, and the closest switches where they are
-        // equally far: a piece whose two ends face two facets is cut there, found by bisection.
         let facet_at = |s: f64| {
             let asked = Instant::now();
             let facing = surface.nearest(&x(s), self.reach).map(|b| b.facet);
             self.meter.queried(asked);
             facing
         };
-        let mut pieces = Vec::with_capacity(ends.len());
-        let mut equal = Vec::new();
-        for w in ends.windows(2) {
-            let (mut lo, mut hi) = (w[0] + APART, w[1] - APART);
-            match (facet_at(lo), facet_at(hi)) {
-                (Some(a), Some(b)) if a != b && hi > lo => {
-                    while hi - lo > APART {
-                        let mid = 0.5 * (lo + hi);
-                        if facet_at(mid) == Some(a) {
-                            lo = mid;
-                        } else {
-                            hi = mid;
-                        }
-                    }
-                    let cut = 0.5 * (lo + hi);
-                    pieces.extend([(w[0], cut), (cut, w[1])]);
-                    equal.push(cut);
-                }
-                _ => pieces.push((w[0], w[1])),
-            }
-        }
+        let pieces = ends.windows(2).map(|w| (w[0], w[1])).collect();
         // What each cut's point faces on either side, projected onto the facet found there.
         let sides = |s: f64| {
             let y = x(s);
@@ -871,32 +851,13 @@ impl PairForm<'_> {
             };
             (on(s - APART), on(s + APART))
         };
-        let mut placed: Vec<(f64, Option<Facing>, Option<Facing>, CutRule)> = cuts
+        let placed = cuts
             .into_iter()
-            .map(|(s, k, end)| {
+            .map(|(s, rule)| {
                 let (before, after) = sides(s);
-                (s, before, after, CutRule::Line(surface.end(k, end)))
+                Cut { facet: index, s, before, after, rule }
             })
             .collect();
-        placed.extend(equal.into_iter().map(|s| {
-            let (before, after) = sides(s);
-            let rule = match (&before, &after) {
-                (Some(a), Some(b)) if (a.point[0] - b.point[0]).hypot(a.point[1] - b.point[1]) <= APART * a.distance => {
-                    // Their common end, and which end of each it is.
-                    let end_of = |facing: &Facing| {
-                        let ends = [surface.end(facing.facet, 0), surface.end(facing.facet, 1)];
-                        let off = |e: &crate::fem::facing::End| (e.point[0] - facing.point[0]).hypot(e.point[1] - facing.point[1]);
-                        let second = off(&ends[1]) < off(&ends[0]);
-                        let [first, last] = ends;
-                        if second { (last, 1.0) } else { (first, -1.0) }
-                    };
-                    let ((a, sa), (b, sb)) = (end_of(a), end_of(b));
-                    CutRule::Bisector { a, b, signs: [sa, sb] }
-                }
-                _ => CutRule::Equal,
-            };
-            (s, before, after, rule)
-        }));
         (pieces, placed)
     }
 
