@@ -526,7 +526,7 @@ impl BoundForm for PairForm<'_> {
                 missing = Some(pair);
             }
         });
-        if wrt == moving && self.segmented {
+        if wrt == moving && self.segmented && !self.own.is_empty() {
             let placed = self.facing_points(&self.rule, mesh, fields[moving]);
             if let Some(pair) = self.add_cuts(mesh, &placed.cuts, fields, t, m) {
                 missing = Some(pair);
