@@ -457,9 +457,9 @@ pub struct Obstacle {
     pub span: Span,
 }
 
-/// `contact Gamma_a with Gamma_b within 2 by segments`: the run's pair law integrates over
-/// `own`, facing `facing`, looking for facing points as far as `reach`, facet by facet or
-/// (`by segments`) piece by piece.
+/// `contact Gamma_a with Gamma_b within 2 by segments { bind contact = LAW  set p = v }`: the
+/// pair's law (its block's, else the run's) integrates over `own`, facing `facing`, looking
+/// for facing points as far as `reach`, facet by facet or (`by segments`) piece by piece.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactPair {
     pub own: Ident,
@@ -467,6 +467,10 @@ pub struct ContactPair {
     pub reach: Option<Expr>,
     /// `by segments` or `by elements` (the default).
     pub by: Option<Ident>,
+    /// Its block's `bind contact = LAW`: the pair's own law.
+    pub binds: Vec<Bind>,
+    /// Its block's `set`: params of the pair's law, for this pair only.
+    pub sets: Vec<Defined>,
     pub span: Span,
 }
 

@@ -184,8 +184,7 @@ fn problem(p: &Problem, out: &mut String) {
         out.push_str(&format!("  region {} = {}{body}\n", r.name.name, sources.join(" else ")));
     }
     for b in &p.binds {
-        let target = if b.is_path { format!("{:?}", b.target) } else { b.target.clone() };
-        out.push_str(&format!("  bind {} = {target}\n", b.role.name));
+        out.push_str(&format!("  {}\n", bind(b)));
     }
     if p.run_static.is_some() {
         out.push_str("  run static\n");
@@ -211,6 +210,12 @@ fn problem(p: &Problem, out: &mut String) {
         let within = pair.reach.as_ref().map_or(String::new(), |r| format!(" within {}", expr(r)));
         let by = pair.by.as_ref().map_or(String::new(), |b| format!(" by {}", b.name));
         out.push_str(&format!("  contact {} with {}{within}{by}\n", pair.own.name, pair.facing.name));
+        for b in &pair.binds {
+            out.push_str(&format!("    {}\n", bind(b)));
+        }
+        for d in &pair.sets {
+            out.push_str(&format!("    set {} = {}\n", d.name.name, expr(&d.value)));
+        }
     }
     for d in &p.dirichlet {
         let k = d.component.as_ref().map_or(String::new(), |k| format!("[{}]", expr(k)));
@@ -248,4 +253,10 @@ fn problem(p: &Problem, out: &mut String) {
         let text = if p.reference_args.is_empty() { r.name.clone() } else { named_call(&call) };
         out.push_str(&format!("  reference {text}\n"));
     }
+}
+
+/// `bind ROLE = TARGET`, a path quoted.
+fn bind(b: &Bind) -> String {
+    let target = if b.is_path { format!("{:?}", b.target) } else { b.target.clone() };
+    format!("bind {} = {target}", b.role.name)
 }

@@ -82,3 +82,15 @@ fn library_problems_check_clean_and_print() {
         });
     }
 }
+
+/// A problem whose pairs have blocks of their own (a law, params): the printed AST keeps each
+/// block under its pair.
+#[test]
+fn pair_blocks_print() {
+    let f = PathBuf::from("../tests/problems/stack_on_foundation.wf");
+    let compiled = compile(&f, &FsLoader).unwrap_or_else(|e| panic!("{}:\n{e}", f.display()));
+    let ast = compiled.print(Stage::Ast, 2).unwrap();
+    insta::with_settings!({ snapshot_path => "../snapshots/problems", prepend_module_to_snapshot => false }, {
+        insta::assert_snapshot!("stack_on_foundation.ast", ast);
+    });
+}

@@ -151,7 +151,9 @@ fn exprs_mut(p: &mut Problem) -> Vec<&mut Expr> {
     for o in &mut p.obstacles {
         out.extend(o.shape.args.iter_mut().map(|a| &mut a.value));
     }
-    out.extend(p.pairs.iter_mut().filter_map(|pair| pair.reach.as_mut()));
+    for pair in &mut p.pairs {
+        out.extend(pair.reach.as_mut().into_iter().chain(pair.sets.iter_mut().map(|d| &mut d.value)));
+    }
     for d in &mut p.dirichlet {
         if let HeldAt::Nearest { point, .. } = &mut d.on {
             out.push(point);

@@ -1,10 +1,10 @@
 //! Contact pairs: `contact Gamma_a with Gamma_b within R by segments`, two known regions of two
 //! bodies.
 
-use super::{Names, scalar, unknown_among};
+use super::{Names, distinct, scalar, unknown_among};
 use crate::check::types::Checker;
 use crate::diagnostic::Diagnostic;
-use crate::syntax::ast::Problem;
+use crate::syntax::ast::{ContactPair, Problem};
 
 /// How a pair's law is integrated: `by elements` (each own facet whole, the default) or
 /// `by segments`.
@@ -29,6 +29,7 @@ pub(super) fn check(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut
         if let Some(reach) = &pair.reach {
             scalar(c, reach, constants, diags, false);
         }
+        block(c, pair, constants, diags);
         if let Some(by) = &pair.by
             && !PAIR_INTEGRATION.contains(&by.name.as_str())
         {
@@ -37,12 +38,25 @@ pub(super) fn check(c: &mut Checker, p: &Problem, constants: &Names, diags: &mut
             ));
         }
     }
-    if let (Some(o), Some(pair)) = (p.obstacles.first(), p.pairs.first()) {
-        diags.push(
-            Diagnostic::error("E0103", "an obstacle and a contact pair", o.span, "an obstacle")
-                .with_label(pair.span, "and a pair")
-                .with_note("the run's contact law is either an obstacle's law or a pair's law; both in one run is not supported yet")
-                .with_help("hold the foundation by a Dirichlet condition, or model the obstacle as a body"),
-        );
+}
+
+/// A pair's block: `bind contact = LAW` once, and its `set` values (params of that law, which
+/// the binding checks) numbers of the problem's.
+fn block(c: &mut Checker, pair: &ContactPair, constants: &Names, diags: &mut Vec<Diagnostic>) {
+    for (k, b) in pair.binds.iter().enumerate() {
+        if b.role.name != "contact" {
+            diags.push(unknown_among(&b.role, ["contact"].into_iter(), "pair role").with_note(
+                "a pair's block binds its own contact law; the other roles are the problem's: bind them at its top level",
+            ));
+        } else if let Some(first) = pair.binds[..k].iter().find(|f| f.role.name == "contact") {
+            diags.push(
+                Diagnostic::error("E0103", "`contact` bound twice", b.role.span, "again here")
+                    .with_label(first.role.span, "first here"),
+            );
+        }
+    }
+    distinct(pair.sets.iter().map(|d| &d.name), "`set` of a param", diags);
+    for d in &pair.sets {
+        scalar(c, &d.value, constants, diags, false);
     }
 }

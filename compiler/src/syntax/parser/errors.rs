@@ -307,7 +307,7 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         | Rule::run_decl
         | Rule::quadrature_decl
         | Rule::reference_decl => {
-            "a problem item (`mesh`, `body`, `region`, `bind`, `set`, `coef`, `obstacle`, `initial`, `dirichlet`, `series`, `observe`, `summary`, `expect`, `plot`, `run`, `quadrature`, `reference`, `let`)"
+            "a problem item (`mesh`, `body`, `contact`, `region`, `bind`, `set`, `coef`, `obstacle`, `initial`, `dirichlet`, `series`, `observe`, `summary`, `expect`, `plot`, `run`, `quadrature`, `reference`, `let`)"
         }
         Rule::named_arg | Rule::assignments => "`NAME = VALUE`",
         Rule::region_source | Rule::group_source | Rule::boundary_source => "`group \"NAME\"` or `boundary where ...`",

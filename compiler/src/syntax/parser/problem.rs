@@ -88,17 +88,7 @@ impl Builder {
                     }
                     pb.bodies.push(body);
                 }
-                Rule::bind_decl => {
-                    for q in it {
-                        let span = self.span(&q);
-                        let mut parts = q.into_inner();
-                        let role = self.ident(parts.next().expect("role"));
-                        let target = parts.next().expect("target");
-                        let is_path = target.as_rule() == Rule::string;
-                        let target = if is_path { unquote(target.as_str()) } else { target.as_str().to_string() };
-                        pb.binds.push(Bind { role, target, is_path, span });
-                    }
-                }
+                Rule::bind_decl => pb.binds.extend(it.map(|q| self.bound(q))),
                 Rule::set_decl => {
                     for q in it {
                         pb.sets.push(self.set_arg(q)?);
@@ -147,14 +137,16 @@ impl Builder {
                     let own = self.ident(next());
                     next(); // the word `with`
                     let facing = self.ident(next());
-                    let (mut reach, mut by) = (None, None);
+                    let (mut reach, mut by, mut binds, mut sets) = (None, None, Vec::new(), Vec::new());
                     for q in it {
                         match q.as_rule() {
                             Rule::pair_by => by = q.into_inner().nth(1).map(|i| self.ident(i)),
+                            Rule::bind_decl => binds.extend(q.into_inner().map(|b| self.bound(b))),
+                            Rule::set_decl => sets.extend(self.sets(q)?),
                             _ => reach = Some(self.expr(q)?),
                         }
                     }
-                    pb.pairs.push(ContactPair { own, facing, reach, by, span });
+                    pb.pairs.push(ContactPair { own, facing, reach, by, binds, sets, span });
                 }
                 Rule::obstacle_decl => {
                     let shape = self.named_call(next())?;
@@ -224,6 +216,17 @@ impl Builder {
     /// A `set` line's assignments.
     fn sets(&self, p: Pair<Rule>) -> Result<Vec<Defined>, Box<Diagnostic>> {
         p.into_inner().map(|q| self.set_arg(q)).collect()
+    }
+
+    /// `ROLE = TARGET` of a `bind` line.
+    fn bound(&self, q: Pair<Rule>) -> Bind {
+        let span = self.span(&q);
+        let mut parts = q.into_inner();
+        let role = self.ident(parts.next().expect("role"));
+        let target = parts.next().expect("target");
+        let is_path = target.as_rule() == Rule::string;
+        let target = if is_path { unquote(target.as_str()) } else { target.as_str().to_string() };
+        Bind { role, target, is_path, span }
     }
 
     /// `NAME = VALUE` of a `set` line.
