@@ -48,6 +48,13 @@ impl<'m> Binding<'m> {
         Binding { quadrature: self.quadrature, regions, dim: self.dim, cells: Some(&body.cells), bodies: &[], pairs }
     }
 
+    /// This binding with only the pairs `which` (indices into its pairs): a pair law of its
+    /// own for some of a problem's pairs.
+    pub fn with_pairs(&self, which: &[usize]) -> Binding<'m> {
+        let pairs = which.iter().map(|&i| self.pairs[i]).collect();
+        Binding { quadrature: self.quadrature, regions: self.regions.clone(), pairs, ..*self }
+    }
+
     /// The pairs a pair law integrates over in this binding, each as (own, facing) surfaces:
     /// those whose own surface is in the binding's cells, and with `both_sides` the reversed
     /// pairs whose facing surface is (a pair law reads the params of the body it integrates

@@ -243,6 +243,7 @@ fn methods(r: &Reader, parsed: &CaseFile, base: &Path) -> Result<Methods, CaseEr
         generated: Vec::new(),
         compiled: Vec::new(),
         params: Vec::new(),
+        pairs: Vec::new(),
         guard: crate::guard::Guard {
             allow_unstable_dt: parsed.allow_unstable_dt.as_ref().map_or(d.guard.allow_unstable_dt, |b| *b.get_ref()),
             max_step_cuts: match &parsed.max_step_cuts {

@@ -300,13 +300,14 @@ pub fn identity(case: &str, in_use: &FilesInUse, mesh: &Mesh, more: &[(&str, Str
     let common = [
         ("case", case.to_string()),
         ("scheme", in_use.scheme_name().to_string()),
-        ("contact law", in_use.forms.contact_name().to_string()),
+        ("contact law", in_use.forms.contact_name()),
         ("files run interpreted", in_use.interpreted().join(", ")),
         ("files compiled for the material", format!("{:?}", in_use.rebound())),
         ("step guard", format!("{:?}", in_use.guard)),
         ("mesh", mesh_fingerprint(mesh)),
     ];
-    let values = in_use.forms.params.values().into_iter().chain(in_use.forms.body_values());
+    let forms = &in_use.forms;
+    let values = forms.params.values().into_iter().chain(forms.body_values()).chain(forms.pair_values());
     let params = values.map(|(name, p)| (format!("param {name}"), format!("{:?}", p.value)));
     // A file run by path may be edited between the stop and the resume: its text counts.
     let texts = in_use.interpreted().into_iter().map(|file| {

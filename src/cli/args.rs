@@ -252,6 +252,7 @@ impl MethodArgs {
             generated: Vec::new(),
             compiled: Vec::new(),
             params,
+            pairs: Vec::new(),
             guard: Guard {
                 max_step_cuts: self.max_step_cuts,
                 energy_tolerance: self.energy_tolerance,

@@ -3,10 +3,12 @@
 //! overrides; the user's settings), and the binding of the scheme's slots to forms by name.
 //! Nothing here names a scheme, a contact law or a param.
 
+mod forms_in_use;
+pub use forms_in_use::FormsInUse;
 pub mod instance;
 pub use instance::Instance;
-use instance::add_to_slot;
 pub mod interpreted;
+pub mod pairs;
 pub mod params;
 pub mod sources;
 
@@ -16,8 +18,8 @@ use crate::error::CaseError;
 use crate::forms::LIBRARY;
 use crate::runtime::descriptors::{ParamInfo, SchemeDesc};
 use crate::runtime::fem::bound::BoundForm;
-use crate::runtime::fem::kernel::Coef;
-use crate::runtime::library::{Binding, SlotForm, Unit};
+
+use crate::runtime::library::Unit;
 use crate::runtime::time::scheme::TimeScheme;
 
 pub use params::{ParamValue, Setting};
@@ -47,6 +49,9 @@ pub struct Methods {
     pub compiled: Vec<&'static Unit>,
     /// Param values set by the user, in order (a later setting of a param wins).
     pub params: Vec<Setting>,
+    /// A problem's contact pairs grouped by law, when they are not all bound to `contact`
+    /// (a pair with a law or params of its own, or an obstacle's law in `contact`).
+    pub pairs: Vec<pairs::PairLaw>,
     /// Step cuts and the energy check.
     pub guard: crate::guard::Guard,
 }
@@ -62,6 +67,7 @@ impl Default for Methods {
             generated: Vec::new(),
             compiled: Vec::new(),
             params: Vec::new(),
+            pairs: Vec::new(),
             guard: Default::default(),
         }
     }
@@ -254,6 +260,11 @@ fn interpret_bound(
 
 /// The form files of a run's methods (material, contact law, extras; the contact law's index).
 pub fn form_units(methods: &Methods) -> Result<(Vec<FormSource>, usize), CaseError> {
+    form_units_with_pairs(methods).map(|(units, contact, _)| (units, contact))
+}
+
+/// As [`form_units`], with the index of each pair group's law.
+fn form_units_with_pairs(methods: &Methods) -> Result<(Vec<FormSource>, usize, Vec<usize>), CaseError> {
     let form_files: Vec<&str> = units(methods).filter(|u| u.forms.is_some()).map(|u| u.name).collect();
     let material = match &methods.material {
         name if is_path(name) => match library_file(Path::new(name)) {
@@ -291,22 +302,41 @@ pub fn form_units(methods: &Methods) -> Result<(Vec<FormSource>, usize), CaseErr
         .iter()
         .map(|f| pick(&f.display().to_string(), "", "form file", &form_files))
         .collect::<Result<_, _>>()?;
+    // Each group's law, read once.
+    let mut laws: Vec<(&str, Option<FormSource>)> = Vec::new();
+    for g in &methods.pairs {
+        let earlier = laws.iter().any(|(law, _)| *law == g.law);
+        laws.push((&g.law, if earlier { None } else { Some(pick(&g.law, "", "pair law", &pair_names())?) }));
+    }
     let mut units = vec![material];
-    let mut contact_index = units.len();
-    match units.iter().position(|u| u.name() == contact.name() && u.file() == contact.file()) {
-        Some(i) => contact_index = i,
-        None => units.push(contact),
+    // A file already in use (the material bound as a contact law too, a pair law twice) is
+    // one unit.
+    let place = |units: &mut Vec<FormSource>, u: FormSource| match units
+        .iter()
+        .position(|v| v.name() == u.name() && v.file() == u.file())
+    {
+        Some(i) => i,
+        None => {
+            units.push(u);
+            units.len() - 1
+        }
+    };
+    let contact_index = place(&mut units, contact);
+    let mut groups = Vec::new();
+    for (law, unit) in laws {
+        groups.push(match unit {
+            Some(u) => place(&mut units, u),
+            None => groups[methods.pairs.iter().position(|g| g.law == law).expect("an earlier group")],
+        });
     }
     for u in extras {
-        if !units.iter().any(|v| v.name() == u.name() && v.file() == u.file()) {
-            units.push(u);
-        }
+        place(&mut units, u);
     }
     for (name, text) in &methods.generated {
         let u = sources::interpret_text(name, text).map_err(CaseError::CaseFile)?;
         units.push(FormSource::Interpreted(Box::new(u)));
     }
-    Ok((units, contact_index))
+    Ok((units, contact_index, groups))
 }
 
 fn apply_overrides(
@@ -342,19 +372,6 @@ pub struct FilesInUse {
     pub guard: crate::guard::Guard,
 }
 
-/// The form files in use of a run (material, contact law, extras), with the value of every
-/// param (the scheme's included).
-pub struct FormsInUse {
-    /// Material, contact law, extra forms.
-    pub units: Vec<FormSource>,
-    /// Index of the contact law in `units`.
-    pub contact: usize,
-    pub params: params::Table,
-    /// The params of each body of a problem with several, by the body's name: its `set` values
-    /// over the problem's, the user's settings over both.
-    pub bodies: Vec<(String, params::Table)>,
-}
-
 impl FilesInUse {
     /// Resolves a run's methods: files, then params (file defaults < `overrides` of the case < the
     /// user's settings).
@@ -370,11 +387,8 @@ impl FilesInUse {
         locate: &dyn Fn(&params::Unmatched) -> CaseError,
     ) -> Result<FilesInUse, CaseError> {
         let scheme = scheme(methods)?;
-        let (units, contact) = form_units(methods)?;
-        let mut table = params::Table::new(Some(&scheme), &units, contact);
-        apply_overrides(&mut table, overrides, locate)?;
-        table.apply_user(&methods.params)?;
-        let forms = FormsInUse { units, contact, params: table, bodies: Vec::new() };
+        let forms = FormsInUse::new(Some(&scheme), methods, overrides, locate)?;
+        pairs::contact_slots_agree(&scheme, &forms)?;
         Ok(FilesInUse { scheme, forms, guard: methods.guard })
     }
 
@@ -388,7 +402,7 @@ impl FilesInUse {
         bodies: &[(String, Vec<(&str, f64)>)],
         locate: &dyn Fn(&str, &params::Unmatched) -> CaseError,
     ) -> Result<(), CaseError> {
-        let (units, contact) = (&self.forms.units, self.forms.contact);
+        let (units, contact) = (&self.forms.units, self.forms.contact_units());
         let mut tables = Vec::new();
         for (name, own) in bodies {
             for (index, (param, _)) in own.iter().enumerate() {
@@ -397,7 +411,7 @@ impl FilesInUse {
                     return Err(locate(name, &params::Unmatched { index, name: param.to_string(), why }));
                 }
             }
-            let mut table = params::Table::new(Some(&self.scheme), units, contact);
+            let mut table = params::Table::new(Some(&self.scheme), units, &contact);
             apply_overrides(&mut table, overrides, &unlocated)?;
             apply_overrides(&mut table, own, &|a| locate(name, a))?;
             table.apply_user(&methods.params)?;
@@ -409,11 +423,7 @@ impl FilesInUse {
 
     /// The form files of a run's methods and their params, without a scheme.
     pub fn resolve_forms(methods: &Methods, overrides: &[(&str, f64)]) -> Result<FormsInUse, CaseError> {
-        let (units, contact) = form_units(methods)?;
-        let mut table = params::Table::new(None, &units, contact);
-        apply_overrides(&mut table, overrides, &unlocated)?;
-        table.apply_user(&methods.params)?;
-        Ok(FormsInUse { units, contact, params: table, bodies: Vec::new() })
+        FormsInUse::new(None, methods, overrides, &unlocated)
     }
 
     /// The scheme with its param values.
@@ -549,98 +559,4 @@ impl FilesInUse {
         }
         Ok(out)
     }
-}
-
-impl FormsInUse {
-    /// Each body's params whose values differ from the problem's, by `BODY.name`.
-    pub fn body_values(&self) -> std::collections::BTreeMap<String, params::ParamValue> {
-        let problem = self.params.values();
-        let mut out = std::collections::BTreeMap::new();
-        for (body, table) in &self.bodies {
-            for (name, p) in table.values() {
-                if problem.get(&name).is_none_or(|q| q.value.to_bits() != p.value.to_bits()) {
-                    out.insert(format!("{body}.{name}"), p);
-                }
-            }
-        }
-        out
-    }
-
-    /// The params in effect, `name = value, ...`, then the bodies' own.
-    pub fn params_text(&self) -> String {
-        let all = self.params.values().into_iter().chain(self.body_values());
-        all.map(|(name, p)| format!("{name} = {}", p.value)).collect::<Vec<_>>().join(", ")
-    }
-
-    /// The contact law's name (its file stem).
-    pub fn contact_name(&self) -> &str {
-        self.units[self.contact].name()
-    }
-
-    /// Every form and functional of the files in use, bound to a mesh: to each of its bodies
-    /// with the body's params, and summed over them, when it has several.
-    pub fn instantiate<'m>(
-        &self,
-        coefs: &dyn Fn(&str) -> Option<Coef>,
-        binding: &Binding<'m>,
-    ) -> Result<Instance<'m>, CaseError> {
-        if binding.bodies.is_empty() {
-            return self.instantiate_with(&self.params, coefs, binding);
-        }
-        let mut each = Vec::new();
-        for body in binding.bodies {
-            let params = self.bodies.iter().find(|(name, _)| *name == body.name).map_or(&self.params, |(_, t)| t);
-            each.push(self.instantiate_with(params, coefs, &binding.body(body))?);
-        }
-        Ok(Instance::over_bodies(each))
-    }
-
-    /// The files' forms with the param values of `params`.
-    fn instantiate_with<'m>(
-        &self,
-        params: &params::Table,
-        coefs: &dyn Fn(&str) -> Option<Coef>,
-        binding: &Binding<'m>,
-    ) -> Result<Instance<'m>, CaseError> {
-        let mut slots: Vec<(String, SlotForm<'m>, String)> = Vec::new();
-        for unit in &self.units {
-            let values = params.unit_values(unit.params());
-            let made = unit.make(&values, coefs, binding).map_err(|e| {
-                let hint = match &e {
-                    crate::runtime::library::LibraryError::MissingCoef { name, .. } => provided_coefs(coefs, name),
-                    _ => String::new(),
-                };
-                // Errors located in the file already (a region, a tangential part) need no prefix.
-                match &e {
-                    crate::runtime::library::LibraryError::MissingRegion { .. } => {
-                        CaseError::Option(format!("{e}{hint}"))
-                    }
-                    crate::runtime::library::LibraryError::NoTangentSpace { .. } => {
-                        CaseError::NoTangentSpace(e.to_string())
-                    }
-                    _ => CaseError::Option(format!("{}: {e}{hint}", unit.file())),
-                }
-            })?;
-            for (name, form) in made {
-                add_to_slot(&mut slots, name, form, unit.file())?;
-            }
-        }
-        Ok(Instance { slots })
-    }
-}
-
-/// The coefs a case provides, among those the library's files declare, with the closest to
-/// `missing`: "; the case provides f, g, nc; did you mean `g`?".
-fn provided_coefs(coefs: &dyn Fn(&str) -> Option<Coef>, missing: &str) -> String {
-    let mut names: Vec<&str> =
-        LIBRARY.iter().filter_map(|u| u.forms).flat_map(|f| f.coefs.iter().map(|c| &*c.name)).collect();
-    names.sort_unstable();
-    names.dedup();
-    names.retain(|n| coefs(n).is_some());
-    if names.is_empty() {
-        return String::new();
-    }
-    let hint = crate::compiler::check::suggest_name(missing, names.iter().copied())
-        .map_or(String::new(), |s| format!("; did you mean `{s}`?"));
-    format!("; the case provides {}{hint}", names.join(", "))
 }

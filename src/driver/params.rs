@@ -55,6 +55,7 @@ pub fn declared_by(params: &BTreeMap<String, ParamValue>, stem: &str) -> Vec<(St
         .collect()
 }
 
+#[derive(Clone)]
 struct Entry {
     info: ParamInfo,
     scheme: bool,
@@ -74,10 +75,11 @@ impl Entry {
             })
     }
 
-    /// `owner.name` and the role's `role.name`, with the declaration: one choice of an
-    /// ambiguous name.
-    fn choice(&self) -> String {
-        let roles: Vec<String> = self.roles.iter().map(|r| format!("`{r}.{}`", self.info.name)).collect();
+    /// `owner.name` and the role's `role.name` (of the roles in `unique`), with the
+    /// declaration: one choice of an ambiguous name.
+    fn choice(&self, unique: &[&str]) -> String {
+        let roles = self.roles.iter().filter(|r| unique.contains(r));
+        let roles: Vec<String> = roles.map(|r| format!("`{r}.{}`", self.info.name)).collect();
         format!(
             "`{}.{}` ({}{}: {})",
             self.info.owner,
@@ -112,6 +114,8 @@ pub enum Unnamed {
     UnknownQualifier(Option<String>),
     /// A body's value of a param of the scheme (named), which is the problem's.
     SchemeParam(String),
+    /// A pair's value of a param its law (named) does not declare: the files that do.
+    NotTheLaw { law: String, owners: Vec<String> },
 }
 
 impl Unmatched {
@@ -133,6 +137,11 @@ impl Unmatched {
                 "`{}` is a param of scheme `{scheme}`, which steps every body at once: set it at the problem's level",
                 self.name
             ),
+            Unnamed::NotTheLaw { law, owners } => format!(
+                "`{}` is declared by {}, not by the pair's law `{law}`: a pair's `set` reaches its law's params; set it on a body or at the problem's level",
+                self.name,
+                owners.iter().map(|o| format!("`{o}`")).collect::<Vec<_>>().join(" and ")
+            ),
         }
     }
 }
@@ -148,6 +157,7 @@ pub enum CaseOverrideError {
 }
 
 /// Every param of a run's scheme and form files.
+#[derive(Clone)]
 pub struct Table {
     entries: Vec<Entry>,
 }
@@ -157,8 +167,9 @@ fn same(a: &ParamInfo, b: &ParamInfo) -> bool {
 }
 
 impl Table {
-    /// `units`: the material (first), the contact law (at `contact`) and the extra form files.
-    pub fn new(scheme: Option<&SchemeSource>, units: &[FormSource], contact: usize) -> Table {
+    /// `units`: the material (first), the contact laws (at `contact`: an obstacle's, each pair's)
+    /// and the extra form files.
+    pub fn new(scheme: Option<&SchemeSource>, units: &[FormSource], contact: &[usize]) -> Table {
         let mut entries: Vec<Entry> = scheme
             .map_or(&[][..], |s| s.params())
             .iter()
@@ -175,7 +186,7 @@ impl Table {
         let mut imported: Vec<(usize, &'static str)> = Vec::new();
         for (i, u) in units.iter().enumerate() {
             let roles: Vec<&'static str> =
-                [(i == 0, "material"), (i == contact, "contact"), (i != 0 && i != contact, "forms")]
+                [(i == 0, "material"), (contact.contains(&i), "contact"), (i != 0 && !contact.contains(&i), "forms")]
                     .into_iter()
                     .filter_map(|(holds, role)| holds.then_some(role))
                     .collect();
@@ -221,6 +232,15 @@ impl Table {
                 .iter()
                 .map(|&i| &self.entries[i])
                 .all(|e| !e.scheme && !first.scheme && !e.info.doc.is_empty() && e.info.doc == first.info.doc)
+    }
+
+    /// The qualified names of the params `hits`, a role offered only where it names one of
+    /// them (two contact laws both answer to `contact.gamma0`).
+    fn choices(&self, hits: &[usize]) -> Vec<String> {
+        let roles = hits.iter().flat_map(|&i| self.entries[i].roles.iter().copied());
+        let unique: Vec<&str> =
+            roles.filter(|r| hits.iter().filter(|&&i| self.entries[i].roles.contains(r)).count() == 1).collect();
+        hits.iter().map(|&i| self.entries[i].choice(&unique)).collect()
     }
 
     /// The params `name` (`rho`, `material.rho`, `elasticity.rho`) answers to.
@@ -271,9 +291,36 @@ impl Table {
                     }
                 }
                 many => {
-                    let why = Unnamed::Several(many.iter().map(|&i| self.entries[i].choice()).collect());
+                    let why = Unnamed::Several(self.choices(many));
                     return Err(CaseOverrideError::Unmatched(Unmatched { index, name: name.to_string(), why }));
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// A pair's `set` values: each reaches the params of that name its law (the file stem
+    /// `law`) declares; a name only other files declare is refused, a name no file declares is
+    /// left alone (as in [`Table::apply_case`]).
+    pub fn apply_scoped(&mut self, overrides: &[(&str, f64)], law: &str) -> Result<(), CaseOverrideError> {
+        for (index, &(name, value)) in overrides.iter().enumerate() {
+            let hits = self.answering(name);
+            let (own, other): (Vec<usize>, Vec<usize>) =
+                hits.into_iter().partition(|&i| !self.entries[i].scheme && self.entries[i].info.owner == law);
+            if own.is_empty() && !other.is_empty() {
+                let mut owners: Vec<String> = other.iter().map(|&i| self.entries[i].info.owner.to_string()).collect();
+                owners.dedup();
+                let why = match other.iter().any(|&i| self.entries[i].scheme) {
+                    true => Unnamed::SchemeParam(owners.join(", ")),
+                    false => Unnamed::NotTheLaw { law: law.to_string(), owners },
+                };
+                return Err(CaseOverrideError::Unmatched(Unmatched { index, name: name.to_string(), why }));
+            }
+            for i in own {
+                let e = &mut self.entries[i];
+                Self::check(e, value, "the pair's `set`").map_err(CaseOverrideError::Invalid)?;
+                e.value = value;
+                e.source = Source::Case;
             }
         }
         Ok(())
@@ -293,7 +340,7 @@ impl Table {
                     }
                 }
                 many => {
-                    let why = Unnamed::Several(many.iter().map(|&i| self.entries[i].choice()).collect());
+                    let why = Unnamed::Several(self.choices(many));
                     let a = Unmatched { index, name: s.name.clone(), why };
                     return Err(CaseError::Option(format!("{}: {}", s.origin, a.message())));
                 }
@@ -334,7 +381,7 @@ impl Table {
         match self.answering(name).as_slice() {
             [] => Ok(None),
             hits if self.one_quantity(hits) => Ok(Some(self.entries[hits[0]].value)),
-            many => Err(many.iter().map(|&i| self.entries[i].choice()).collect()),
+            many => Err(self.choices(many)),
         }
     }
 

@@ -542,8 +542,9 @@ pub fn unset_coefs(pf: &ProblemFile, in_use: &FilesInUse) -> Result<(), CaseErro
     let loads: Vec<String> = (0..p.neumann.len()).map(super::neumann::coef).collect();
     set.extend(loads.iter().map(String::as_str));
     let free = contact_free(pf);
+    let contact = in_use.forms.contact_units();
     for (i, unit) in in_use.forms.units.iter().enumerate() {
-        if free && i == in_use.forms.contact {
+        if free && contact.contains(&i) {
             continue; // integrates over no facet: its coefs are zero
         }
         for (c, _) in unit.coefs() {

@@ -46,12 +46,15 @@ pub fn check(problem: &str) -> Result<String, CaseError> {
         let forms = &in_use.forms;
         let files: Vec<String> = std::iter::once(format!("{} (scheme)", in_use.scheme_name()))
             .chain(forms.units.iter().enumerate().map(|(i, u)| {
+                let pairs: Vec<&str> = forms.pairs.iter().filter(|g| g.unit == i).map(|g| g.label.as_str()).collect();
                 let role = if i == 0 {
-                    "material"
+                    "material".to_string()
                 } else if i == forms.contact {
-                    "contact"
+                    "contact".to_string()
+                } else if !pairs.is_empty() {
+                    format!("contact: {}", pairs.join(", "))
                 } else {
-                    "forms"
+                    "forms".to_string()
                 };
                 format!("{} ({role})", u.name())
             }))

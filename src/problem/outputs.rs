@@ -100,6 +100,7 @@ pub(super) fn all_params(
 ) -> BTreeMap<String, ParamValue> {
     let mut out = in_use.forms.params.values();
     out.extend(in_use.forms.body_values());
+    out.extend(in_use.forms.pair_values());
     for q in params {
         let declared = pf.problem().params.iter().find(|d| d.name.name == q.name).map(|d| d.span);
         let line = declared.map_or(0, |s| pf.program.unit.sources.line_col(s.file, s.start).0);

@@ -47,9 +47,9 @@ pub(super) fn settle(
     Ok(solution.u)
 }
 
-/// Whether the contact law in use has friction (it provides `friction_work`).
+/// Whether a contact law in use has friction (it provides `friction_work`).
 fn frictional(forms: &crate::driver::FormsInUse) -> bool {
-    forms.units[forms.contact].slots().iter().any(|s| &*s.name == "friction_work")
+    forms.contact_units().into_iter().any(|i| forms.units[i].slots().iter().any(|s| &*s.name == "friction_work"))
 }
 
 /// Why `settled` found no equilibrium: Newton's residuals and active points, and what a

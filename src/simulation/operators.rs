@@ -402,8 +402,11 @@ impl<'m> Parts<'m> {
         };
         // A law that does no work of its own (Nitsche θ = 1: its factor 1 − θ is zero) costs the
         // energy guard nothing per step. Probed from rest to the body pushed into the obstacle
-        // and strained every way, where any other law's work is not zero.
-        if let Some(work) = &ops.contact_work {
+        // and strained every way, where any other law's work is not zero. Pairs that start
+        // apart do no work in that probe whatever their law: their work is kept.
+        if let Some(work) = &ops.contact_work
+            && problem.pairs.is_empty()
+        {
             let pushed = stability::pushed_into_obstacle(&ops, problem.coefs);
             let size = pushed.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1.0);
             let strained: Vec<f64> =

@@ -23,6 +23,7 @@ mod interpreted_forms;
 mod interpreted_schemes;
 #[cfg(feature = "petsc")]
 mod mpi;
+mod pair_laws;
 mod pairs;
 #[cfg(feature = "petsc")]
 mod petsc;

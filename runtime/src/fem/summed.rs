@@ -115,12 +115,18 @@ impl BoundForm for Summed<'_> {
     }
 }
 
-/// One functional bound to each of several bodies: its value is the sum of theirs.
+/// One functional bound to each of several bodies, or the functionals of one name of several
+/// contact laws (an obstacle's and a pair's `contact_energy`): its value is the sum of theirs.
 pub struct SummedFunctional<'m> {
     parts: Vec<Box<dyn BoundFunctional + 'm>>,
 }
 
 impl<'m> SummedFunctional<'m> {
+    /// `parts` take the same number of time levels (the caller checks it).
+    pub fn new(parts: Vec<Box<dyn BoundFunctional + 'm>>) -> SummedFunctional<'m> {
+        SummedFunctional { parts }
+    }
+
     pub fn over_bodies(parts: Vec<Box<dyn BoundFunctional + 'm>>) -> SummedFunctional<'m> {
         SummedFunctional { parts }
     }

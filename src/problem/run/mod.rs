@@ -272,9 +272,8 @@ impl CoefTable {
         let fns = super::bind::coefs(pf, ex)?;
         coef_shapes(pf, in_use, &fns, dim)?;
         let zeros = match super::bind::contact_free(pf) {
-            true => in_use.forms.units[in_use.forms.contact]
-                .coefs()
-                .into_iter()
+            true => (in_use.forms.contact_units().into_iter())
+                .flat_map(|i| in_use.forms.units[i].coefs())
                 .map(|(n, rank)| (n, dim.pow(rank)))
                 .collect(),
             false => Vec::new(),
