@@ -37,6 +37,10 @@ impl InterpretedForm {
             Sym::Normal(k) => side.normal[k as usize],
             Sym::Coord(k) => side.x[k as usize],
             Sym::CellDiameter => side.h,
+            Sym::FieldHess { arg, comp, dir, along } => {
+                side.fields.get(arg as usize).map_or(f64::NAN, |u| u.hess[comp as usize][dir as usize][along as usize])
+            }
+            Sym::NormalRate { comp, along } => side.normal_rate[comp as usize][along as usize],
             Sym::Coef { id, comp } => {
                 self.coefs.get(id as usize).map_or(f64::NAN, |c| c.at(&side.x[..p.dim], p.t, comp as usize, &[]))
             }

@@ -252,10 +252,9 @@ fn a_block_pressed_on_a_foundation_puts_its_weight_on_it() {
         // The block sinks into the foundation by about 1/ε: the gap is closed, not crossed.
         let sunk = -(0..mesh.num_nodes()).filter(|&k| mesh.node(k)[1] > 1.0).map(|k| u[2 * k + 1]).fold(0.0, f64::min);
         assert!(sunk > 0.0 && sunk < 1.0, "P{degree}: the block moved by {sunk}");
-        // Once the whole bottom is in contact, Newton converges quadratically on P1, whose
-        // tangent is exact: each residual below 1e-3 is at most a constant times the square of
-        // the one before. On P2 the tangent leaves out the basis functions' second derivatives
-        // at the sliding facing point (docs/mathematics.md, "Two bodies"): superlinear.
+        // Once the whole bottom is in contact, Newton converges quadratically, the tangent
+        // being exact on P1 and P2: each residual below 1e-3 is at most a constant times the
+        // square of the one before.
         let tail: Vec<f64> = norms.iter().copied().skip_while(|&r| r > 1e-3).collect();
         for w in tail.windows(2) {
             assert!(w[1] <= 10.0 * w[0] * w[0] + 1e-12, "P{degree}: not quadratic: {norms:?}");
@@ -266,17 +265,19 @@ fn a_block_pressed_on_a_foundation_puts_its_weight_on_it() {
 
 /// The pair's tangent is the derivative of its residual, the facing points' motion included:
 /// the block sunk 0.01 into the foundation on a non-matching mesh, every dof perturbed. Exact
-/// on P1 (measured 2e-10 of the tangent's size); on P2 up to the basis functions' second
-/// derivatives at the sliding facing point, which the tangent leaves out (measured 7e-4 here,
-/// up to 1.0e-3 for the Nitsche laws below).
+/// on P1 and P2 (measured 2e-10 of the tangent's size, for the Nitsche laws below too; on P2
+/// through the facing fields' second derivatives, the facing normal's curvature and the
+/// facing facet's bending as the facing point slides: 7e-4 to 1.0e-3 without them).
 #[test]
 fn the_pair_tangent_is_the_derivative_of_its_residual() {
     tangent_against_differences(&[], "pair_penalty", &[("gamma0", GAMMA0)], false);
 }
 
 /// The same by segments: the tangent adds, at each cut, the integrand's jump times the cut's
-/// rate, exact on P1 (measured 2e-10 of the tangent's size, as facet by facet), for the
-/// penalty law and Nitsche's at each θ.
+/// rate, exact on P1 (measured 5e-11 of the tangent's size), for the penalty law and
+/// Nitsche's at each θ. On P2, 2e-4 to 5e-4: the cut between two facets that both face the
+/// point lies on the line through their common end, off the point where the facing point
+/// switches by the gap times the curvature.
 #[test]
 fn the_pair_tangent_by_segments_is_the_derivative_of_its_residual() {
     tangent_against_differences(&[], "pair_penalty", &[("gamma0", GAMMA0)], true);
@@ -335,7 +336,10 @@ fn tangent_against_differences(previous: &[f64], stem: &str, params: &[(&str, f6
         let error = fd.iter().zip(&jd).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         let at = format!("{stem} {params:?}, previous {previous:?}, P{degree}, segmented {segmented}");
         assert!(scale > 1.0, "{at}: the contact is active ({scale})");
-        let tolerance = if degree == 1 { 1e-6 } else { 2e-3 };
+        // By segments on P2 a cut is placed on the line through the facing facets' common end
+        // (the bisector), off the point where the facing point switches by the gap times the
+        // facets' curvature: the residual jumps there, inside a piece.
+        let tolerance = if degree == 1 || !segmented { 1e-6 } else { 2e-3 };
         assert!(error < tolerance * scale, "{at}: tangent against differences: {error} of {scale}");
     }
 }
@@ -346,10 +350,9 @@ fn problem(name: &str) -> String {
 
 /// The same block on its foundation posed in a problem file: two bodies of two generators,
 /// each with its own E, the pair `contact bottom with top`. The pair carries the block's weight
-/// to round-off, on P1 and P2, by penalty and by Nitsche's method at every θ. P2 takes up to a
-/// dozen Newton iterations (measured 11–13): its
-/// tangent holds the facing normal as the facing point slides, and under the block's corners
-/// the foundation's deformed normal turns fast.
+/// to round-off, on P1 and P2, by penalty and by Nitsche's method at every θ, in 4 Newton
+/// iterations each (asserted 6; 11–13 on P2 before its tangent followed the facing normal's
+/// turn under the block's corners).
 #[test]
 fn a_problem_file_poses_the_pair() {
     use signorini::problem::run::run;
@@ -375,8 +378,7 @@ fn a_problem_file_poses_the_pair() {
             let sunk = r.column("sunk").unwrap()[0];
             assert!(sunk < 0.0, "{at}: the block rests on the foundation ({sunk})");
             let newton = r.column("newton").unwrap()[0];
-            let most = if degree == 1.0 { 6.0 } else { 15.0 };
-            assert!(newton <= most, "{at}: {newton} Newton iterations");
+            assert!(newton <= 6.0, "{at}: {newton} Newton iterations");
         }
     }
 }
@@ -433,11 +435,10 @@ fn an_unbiased_pair_is_the_same_with_its_regions_swapped() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The tangent against differences on two curved P2 discs pressed into each other. The
-/// tangent holds the facing surface's normal and gradients as the facing point slides (their
-/// rates need the P2 basis' second derivatives): on a curved surface that leaves out a term of
-/// the size of the gap times the curvature times the penalty, measured 1.7e-3 of the tangent
-/// here (overlap 0.02, radius 10).
+/// The tangent against differences on two curved P2 discs pressed into each other (overlap
+/// 0.02, radius 10): the facing surface's normal turns and its facets bend as the facing
+/// point slides, and the tangent follows them (measured 2e-11 of the tangent; 1.7e-3 when it
+/// held them).
 #[test]
 fn the_pair_tangent_on_curved_discs() {
     let mut mesh = signorini::runtime::fem::mesh::disc::disc(10.0, [-10.5, 0.0], 2.0);
@@ -475,7 +476,7 @@ fn the_pair_tangent_on_curved_discs() {
     let fd: Vec<f64> = plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * step)).collect();
     let scale = jd.iter().map(|v| v.abs()).fold(0.0, f64::max);
     let error = fd.iter().zip(&jd).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-    assert!(scale > 1.0 && error < 5e-3 * scale, "tangent against differences: {error} of {scale}");
+    assert!(scale > 1.0 && error < 1e-6 * scale, "tangent against differences: {error} of {scale}");
 }
 
 /// Two discs thrown at each other on mirrored meshes: the pair's forces are equal and opposite,
@@ -680,16 +681,16 @@ fn two_balls_collide_as_one_ball_on_a_wall() {
 }
 
 /// Newton along an impact (two discs colliding under the penalty pair law, the residuals
-/// relative to the one each stage starts from). On P1 (the GetFEM cross-check's mesh,
-/// scripts/getfem/two_discs.wf), whose pair tangent is exact, it converges quadratically once
-/// the contact points have stopped switching: each residual below 1e-4 gives the next below C
-/// times its square (measured C ≤ 0.53 over 94 iterations, asserted 10). Above 1e-4 a point
-/// crossing the kink of [g]₋ slows an iteration down to a factor 5–40. On the P2 discs the
-/// tangent leaves out the basis functions' second derivatives at the sliding facing point (the
-/// 1e-3 of the difference test above), and it converges linearly at about that rate (measured
-/// ≤ 6.9e-3 per iteration, asserted 2e-2). Both take at most 5 iterations a step.
+/// relative to the one each stage starts from), on P1 (the GetFEM cross-check's mesh,
+/// scripts/getfem/two_discs.wf) and on the curved P2 discs: the pair tangent is exact on both,
+/// and Newton converges quadratically once the contact points have stopped switching: each
+/// residual below 1e-4 gives the next below C times its square (measured C ≤ 0.53 over 94
+/// iterations on P1, ≤ 0.23 over 15 on P2; asserted 10). Above 1e-4 a point crossing the kink
+/// of [g]₋ slows an iteration down to a factor 5–40. Before the P2 tangent followed the facing
+/// side's second derivatives, P2 converged linearly at up to 6.9e-3 per iteration. Both take
+/// at most 5 iterations a step (measured 5 and 4).
 #[test]
-fn newton_converges_quadratically_along_an_impact_on_p1() {
+fn newton_converges_quadratically_along_an_impact() {
     use signorini::problem::run::{Options, run};
     let p1 = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/getfem/two_discs.wf").display().to_string();
     let tails = |file: &str| {
@@ -705,13 +706,11 @@ fn newton_converges_quadratically_along_an_impact_on_p1() {
         let most = run.newton.iter().map(|s| s.iterations()).max().unwrap_or(0);
         (pairs, most)
     };
-    let (p1_pairs, p1_most) = tails(&p1);
-    assert!(p1_pairs.len() > 50, "{} iterations near the solution", p1_pairs.len());
-    let worst = p1_pairs.iter().map(|(before, after)| after / (before * before)).fold(0.0, f64::max);
-    assert!(worst <= 10.0, "P1: r_(k+1) <= {worst} r_k^2: not quadratic");
-    assert!(p1_most <= 5, "P1: {p1_most} iterations in a step");
-    let (p2_pairs, p2_most) = tails(&problem("two_discs_collide.wf"));
-    let rate = p2_pairs.iter().map(|(before, after)| after / before).fold(0.0, f64::max);
-    assert!(rate <= 2e-2, "P2: rate {rate}");
-    assert!(p2_most <= 5, "P2: {p2_most} iterations in a step");
+    for (name, file, least) in [("P1", p1, 50), ("P2", problem("two_discs_collide.wf"), 10)] {
+        let (pairs, most) = tails(&file);
+        assert!(pairs.len() > least, "{name}: {} iterations near the solution", pairs.len());
+        let worst = pairs.iter().map(|(before, after)| after / (before * before)).fold(0.0, f64::max);
+        assert!(worst <= 10.0, "{name}: r_(k+1) <= {worst} r_k^2: not quadratic");
+        assert!(most <= 5, "{name}: {most} iterations in a step");
+    }
 }

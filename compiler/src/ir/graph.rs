@@ -48,6 +48,20 @@ pub enum Sym {
     /// A value read on the other surface of a contact pair, at the point facing the quadrature
     /// point (`opposite(e)`).
     Opposite(Facing),
+    /// ∂_along of [`Sym::FieldGrad`] (read on a pair's facing side only: the gradient's rate
+    /// as the facing point slides).
+    FieldHess {
+        arg: u8,
+        comp: u8,
+        dir: u8,
+        along: u8,
+    },
+    /// ∂_along of [`Sym::Normal`]`(comp)` along the surface (read on a pair's facing side only:
+    /// the normal's rate as the facing point slides, zero across the surface).
+    NormalRate {
+        comp: u8,
+        along: u8,
+    },
 }
 
 /// The leaves `opposite(e)` reads on the facing surface: those of the quadrature point's own
@@ -76,6 +90,17 @@ pub enum Facing {
     Coord(u8),
     /// The diameter of the cell carrying the facing facet.
     CellDiameter,
+    /// The facing point's rates as it slides ([`Sym::FieldHess`], [`Sym::NormalRate`]).
+    FieldHess {
+        arg: u8,
+        comp: u8,
+        dir: u8,
+        along: u8,
+    },
+    NormalRate {
+        comp: u8,
+        along: u8,
+    },
 }
 
 impl Facing {
@@ -89,6 +114,8 @@ impl Facing {
             Facing::Normal(k) => Sym::Normal(k),
             Facing::Coord(k) => Sym::Coord(k),
             Facing::CellDiameter => Sym::CellDiameter,
+            Facing::FieldHess { arg, comp, dir, along } => Sym::FieldHess { arg, comp, dir, along },
+            Facing::NormalRate { comp, along } => Sym::NormalRate { comp, along },
         }
     }
 }
@@ -105,6 +132,8 @@ impl Sym {
             Sym::Normal(k) => Facing::Normal(k),
             Sym::Coord(k) => Facing::Coord(k),
             Sym::CellDiameter => Facing::CellDiameter,
+            Sym::FieldHess { arg, comp, dir, along } => Facing::FieldHess { arg, comp, dir, along },
+            Sym::NormalRate { comp, along } => Facing::NormalRate { comp, along },
             _ => return None,
         })
     }

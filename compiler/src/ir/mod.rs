@@ -92,9 +92,9 @@ pub struct PairIr {
     pub tangents: Vec<[TangentIr; 3]>,
     /// The derivative of each of f0, f1, h0, h1 (in that order, entry c) as the facing point
     /// slides, y → y + s e_r, in the reference configuration of the facing body: at
-    /// `[c*d + r]`. The facing side's values move along their gradients there; their
-    /// gradients and normal are held (exact on P1 facets, whose gradients and normal are
-    /// constant on a cell).
+    /// `[c*d + r]`. The facing side's values move along their gradients there, their gradients
+    /// along their second derivatives, and its normal along the surface's curvature (both zero
+    /// on P1 facets).
     pub sliding: Vec<NodeId>,
 }
 
@@ -373,6 +373,10 @@ fn sliding(g: &mut Graph, d: usize, roots: &[NodeId]) -> Vec<NodeId> {
             let along = match f {
                 Facing::Coord(k) if k == r => g.one(),
                 Facing::Field { arg, comp } => g.sym(Sym::Opposite(Facing::FieldGrad { arg, comp, dir: r })),
+                Facing::FieldGrad { arg, comp, dir } => {
+                    g.sym(Sym::Opposite(Facing::FieldHess { arg, comp, dir, along: r }))
+                }
+                Facing::Normal(comp) => g.sym(Sym::Opposite(Facing::NormalRate { comp, along: r })),
                 _ => return None,
             };
             let (at, seed) = (g.sym(x), g.sym(s));
@@ -618,6 +622,8 @@ pub fn node_degrees(
             Node::Sym(s) => match s {
                 Sym::Field { .. } | Sym::Test { .. } | Sym::Coef { .. } => p,
                 Sym::FieldGrad { .. } | Sym::TestGrad { .. } => p - 1,
+                Sym::FieldHess { .. } => p.saturating_sub(2),
+                Sym::NormalRate { .. } => 0,
                 Sym::Coord(_) => 1,
                 Sym::Param(_) | Sym::Normal(_) | Sym::CellDiameter | Sym::Time | Sym::Dt | Sym::Seed(_) => 0,
                 // The facing side's values: piecewise smooth along the own facet, across the

@@ -84,6 +84,7 @@ impl Leaf {
                 Leaf::Coef { id, comp, at: (slot.at + comp as usize) as u32 }
             }
             Sym::CellDiameter | Sym::Dt | Sym::Test { .. } | Sym::TestGrad { .. } => Leaf::Zero,
+            Sym::FieldHess { .. } | Sym::NormalRate { .. } => unreachable!("read on a pair's facing side only"),
             Sym::Seed(_) => unreachable!("a derivative's seed is set to 0 where the derivative is lowered"),
             Sym::Opposite(_) => unreachable!("a pair law's integrals are planned by `ir::pair`"),
         }

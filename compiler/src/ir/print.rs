@@ -112,5 +112,7 @@ pub fn sym(s: Sym, params: &[String], coefs: &[String]) -> String {
         Sym::Seed(k) => format!("seed{k}"),
         Sym::Coef { id, comp } => format!("{}[{comp}]", coefs.get(id as usize).map_or("coef", String::as_str)),
         Sym::Opposite(f) => format!("opposite({})", sym(f.own(), params, coefs)),
+        Sym::FieldHess { arg, comp, dir, along } => format!("hess_u{arg}[{comp}][{dir}][{along}]"),
+        Sym::NormalRate { comp, along } => format!("dn[{comp}][{along}]"),
     }
 }

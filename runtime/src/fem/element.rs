@@ -240,6 +240,26 @@ impl ElementKind {
         }
     }
 
+    /// Reference second derivatives of all basis functions (constant on a cell: P1's are zero,
+    /// P2's quadratics have constant Hessians): `[node][b][c]` = ∂²φ/∂ξ_b∂ξ_c.
+    pub fn basis_hessians(self) -> Vec<Vec<Vec<f64>>> {
+        let d = self.dim();
+        let dl = barycentric_gradients(d);
+        match self.degree() {
+            1 => vec![vec![vec![0.0; d]; d]; d + 1],
+            _ => {
+                // (λ_i(2λ_i − 1))'' = 4 ∇λ_i ⊗ ∇λ_i; (4 λ_a λ_b)'' = 4 (∇λ_a ⊗ ∇λ_b + ∇λ_b ⊗ ∇λ_a).
+                let twice = |a: usize, b: usize, scale: f64| -> Vec<Vec<f64>> {
+                    (0..d)
+                        .map(|r| (0..d).map(|c| scale * (dl[a][r] * dl[b][c] + dl[b][r] * dl[a][c])).collect())
+                        .collect()
+                };
+                let vertices = (0..=d).map(|i| twice(i, i, 2.0));
+                vertices.chain(self.info().edge_nodes.iter().map(|&[a, b]| twice(a, b, 4.0))).collect()
+            }
+        }
+    }
+
     /// Maps a point of the reference facet (the interval \[0, 1\] or the triangle) into the reference cell,
     /// and returns it with the facet's measure scaling (reference facet → cell facet).
     pub fn facet_point(self, facet: usize, s: &[f64]) -> (Vec<f64>, f64) {
@@ -324,6 +344,27 @@ mod tests {
                 let grads = kind.basis_gradients(xi);
                 for k in 0..kind.dim() {
                     assert!(grads.iter().map(|g| g[k]).sum::<f64>().abs() < 1e-13);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn hessians_match_finite_differences_of_the_gradients() {
+        for kind in ElementKind::ALL {
+            let d = kind.dim();
+            let xi: Vec<f64> = (0..d).map(|k| 0.21 + 0.04 * k as f64).collect();
+            let h = kind.basis_hessians();
+            for c in 0..d {
+                let (mut p, mut m) = (xi.clone(), xi.clone());
+                p[c] += 1e-6;
+                m[c] -= 1e-6;
+                let (gp, gm) = (kind.basis_gradients(&p), kind.basis_gradients(&m));
+                for j in 0..kind.nodes() {
+                    for b in 0..d {
+                        let fd = (gp[j][b] - gm[j][b]) / 2e-6;
+                        assert!((fd - h[j][b][c]).abs() < 1e-7, "{kind:?} node {j}: {fd} against {}", h[j][b][c]);
+                    }
                 }
             }
         }

@@ -18,6 +18,7 @@ use crate::fem::search_cost::{Meter, SearchCost};
 use crate::linalg::Matrix;
 use std::time::Instant;
 
+mod curvature;
 mod segments;
 mod sliding;
 
@@ -136,6 +137,8 @@ struct PairElement {
     /// Whether the facing point slides as the bodies move: not where it is held at a facet's
     /// end (the point overshoots the facet, in the wedge between two facets' normals there).
     slides: bool,
+    /// The facing side's second-order data (P2 cells).
+    curvature: Option<curvature::Curvature>,
 }
 
 impl<'m> PairForm<'m> {
@@ -259,11 +262,13 @@ impl<'m> PairForm<'m> {
         let g = self.facing[facing.facet];
         let kind = mesh.kind;
         let (phi, dref) = (kind.basis(&facing.xi), kind.basis_gradients(&facing.xi));
-        let other = side(mesh, g.cell as usize, &phi, &dref, &kind.reference_normal(g.local as usize), fields);
-        let tangents = self.edges[g.local as usize]
-            .iter()
-            .map(|e| std::array::from_fn(|r| (0..d).map(|c| other.jacobian[r][c] * e[c]).sum()))
-            .collect();
+        let facing_normal = kind.reference_normal(g.local as usize);
+        let mut other = side(mesh, g.cell as usize, &phi, &dref, &facing_normal, fields);
+        let edges = &self.edges[g.local as usize];
+        let curvature = (kind.degree() > 1)
+            .then(|| curvature::curvature(mesh, g.cell as usize, &mut other, &facing_normal, edges, fields));
+        let tangents =
+            edges.iter().map(|e| std::array::from_fn(|r| (0..d).map(|c| other.jacobian[r][c] * e[c]).sum())).collect();
         let nodes = mesh.cell(f.cell as usize).iter().chain(mesh.cell(g.cell as usize)).copied().collect();
         PairElement {
             weight: q.weight * own.scale,
@@ -272,6 +277,7 @@ impl<'m> PairForm<'m> {
             dphi: own.dphi.into_iter().chain(other.dphi).collect(),
             tangents,
             slides: facing.overshoot <= HELD * facing.distance,
+            curvature,
             point: PairPoint { dim: d, t, own: own.side, facing: other.side },
         }
     }
@@ -343,7 +349,8 @@ fn side(mesh: &Mesh, cell: usize, phi: &[f64], dref: &[Vec<f64>], ref_normal: &[
             at
         })
         .collect();
-    Side { side: SideAt { x, normal, h: mesh.cell_size(cell), fields }, dphi, scale: size * det.abs(), jacobian: j }
+    let side = SideAt { x, normal, normal_rate: [[0.0; MAX_DIM]; MAX_DIM], h: mesh.cell_size(cell), fields };
+    Side { side, dphi, scale: size * det.abs(), jacobian: j }
 }
 
 /// The determinant and inverse of the leading d×d block.

@@ -154,12 +154,15 @@ impl Surfaces<'_> {
 /// The most space dimensions a pair point holds.
 pub const MAX_DIM: usize = 3;
 
-/// A field's value and gradient at a point.
+/// A field's value, gradient and (on the facing side of a P2 pair) second derivatives at a
+/// point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FieldAt {
     pub value: [f64; MAX_DIM],
     /// `grad[k][l]` = ∂_l u_k.
     pub grad: [[f64; MAX_DIM]; MAX_DIM],
+    /// `hess[k][l][m]` = ∂_l ∂_m u_k: the gradient's rate as the facing point slides.
+    pub hess: [[[f64; MAX_DIM]; MAX_DIM]; MAX_DIM],
 }
 
 /// One side of a pair at a point: its reference position, the outward unit normal of its body
@@ -169,6 +172,9 @@ pub struct FieldAt {
 pub struct SideAt {
     pub x: [f64; MAX_DIM],
     pub normal: [f64; MAX_DIM],
+    /// `normal_rate[k][r]` = ∂_r n_k along the surface (the facing side's curvature on curved
+    /// P2 facets; zero across the surface): the normal's rate as the facing point slides.
+    pub normal_rate: [[f64; MAX_DIM]; MAX_DIM],
     pub h: f64,
     pub fields: Vec<FieldAt>,
 }

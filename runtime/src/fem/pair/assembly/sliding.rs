@@ -6,11 +6,11 @@ impl PairForm<'_> {
     /// Adds to `ke` the tangent's part through the facing point's motion. The facing point y
     /// is where (p_s − p_m(y))·t_α = 0, with p = x + u the deformed positions and
     /// t_α = (I + ∇u_m) T_α the deformed facet's tangents; its variation gives
-    /// G δξ = (δu_s(x) − δu_m(y))·t_α + (p_s − p_m)·∇δu_m T_α, G_αβ = t_α·t_β (the facing
-    /// facet's curvature, a P2 term times the gap, is left out), and δy = T_α δξ_α. The
-    /// residual's rate along δy is the kernel's sliding rates plus, on the facing nodes, the
-    /// coefficients times the basis functions' gradients (their second derivatives, zero on
-    /// P1, are left out). `rates` holds the residual's coefficients then their sliding rates.
+    /// G δξ = (δu_s(x) − δu_m(y))·t_α + (p_s − p_m)·∇δu_m T_α, with
+    /// G_αβ = t_α·t_β − (p_s − p_m)·∂_β t_α (the deformed facet's curvature, P2 only), and
+    /// δy = T_α δξ_α. The residual's rate along δy is the kernel's sliding rates plus, on the
+    /// facing nodes, the coefficients times the basis functions' gradients and (P2) second
+    /// derivatives. `rates` holds the residual's coefficients then their sliding rates.
     pub(super) fn add_sliding(&self, e: &PairElement, rates: &[f64], d: usize, ke: &mut [f64]) {
         if !e.slides {
             return;
@@ -27,12 +27,29 @@ impl PairForm<'_> {
             .map(|ta| std::array::from_fn(|r| ta[r] + (0..d).map(|c| facing_u.grad[r][c] * ta[c]).sum::<f64>()))
             .collect();
         let dot = |a: &[f64; MAX_DIM], b: &[f64; MAX_DIM]| (0..d).map(|r| a[r] * b[r]).sum::<f64>();
+        // G_αβ = t_α·t_β − gap·∂_β t_α, ∂_β t_α = (I + ∇u_m) ∂_β T_α + ∇∇u_m : T_α ⊗ T_β.
+        let metric = |alpha: usize, beta: usize| {
+            let mut g = dot(&t[alpha], &t[beta]);
+            if let Some(c) = &e.curvature {
+                let dt = &c.dtangents[alpha][beta];
+                for r in 0..d {
+                    let mut bend = dt[r] + (0..d).map(|k| facing_u.grad[r][k] * dt[k]).sum::<f64>();
+                    for l in 0..d {
+                        for m in 0..d {
+                            bend += facing_u.hess[r][l][m] * big_t[alpha][l] * big_t[beta][m];
+                        }
+                    }
+                    g -= gap[r] * bend;
+                }
+            }
+            g
+        };
         // G⁻¹, (d − 1) × (d − 1).
         let ginv: [[f64; 2]; 2] = match q {
             0 => return,
-            1 => [[1.0 / dot(&t[0], &t[0]), 0.0], [0.0, 0.0]],
+            1 => [[1.0 / metric(0, 0), 0.0], [0.0, 0.0]],
             _ => {
-                let (a, b, c) = (dot(&t[0], &t[0]), dot(&t[0], &t[1]), dot(&t[1], &t[1]));
+                let (a, b, c) = (metric(0, 0), metric(0, 1), metric(1, 1));
                 let det = a * c - b * b;
                 [[c / det, -b / det], [-b / det, a / det]]
             }
@@ -75,6 +92,11 @@ impl PairForm<'_> {
                     }
                     if a >= half {
                         v += coefficients[off + k] * e.dphi[a][r];
+                        if let Some(c) = &e.curvature {
+                            v += (0..d)
+                                .map(|l| coefficients[off + d + k * d + l] * c.d2phi[a - half][l][r])
+                                .sum::<f64>();
+                        }
                     }
                     *slot = v;
                 }
