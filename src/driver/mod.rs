@@ -344,7 +344,7 @@ fn apply_overrides(
     overrides: &[(&str, f64)],
     locate: &dyn Fn(&params::Unmatched) -> CaseError,
 ) -> Result<(), CaseError> {
-    let files: Vec<&str> = LIBRARY.iter().map(|u| u.name).collect();
+    let files: Vec<&str> = LIBRARY.iter().map(|u| u.name).chain(pair_names()).collect();
     table.apply_case(overrides, &files).map_err(|e| match e {
         params::CaseOverrideError::Invalid(e) => e,
         params::CaseOverrideError::Unmatched(a) => locate(&a),

@@ -112,6 +112,14 @@ fn two_colliding_bodies_on_one_two_and_three_processes_agree_with_the_serial_run
     agree(&[&[problem][..], &rubbing, &["--t-start", "0.8", "--t-end", "3"]].concat(), "two_discs_collide");
 }
 
+/// A disc dropped on a block that stands on the ground: the ground's obstacle law and the
+/// pair's law in one split run, through the impact.
+#[test]
+fn an_obstacle_beside_a_pair_on_one_two_and_three_processes_agrees_with_the_serial_run() {
+    let problem = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/problems/disc_on_block_on_ground.wf");
+    agree(&[problem, "--param", "drop=0.02", "--t-end", "0.4"], "disc_on_block_on_ground");
+}
+
 #[test]
 fn a_run_resumed_on_the_same_two_processes_has_the_bits_of_an_uninterrupted_one() {
     let root = scratch("resume");
