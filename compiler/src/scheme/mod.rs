@@ -15,10 +15,12 @@
 mod affine;
 mod compiler;
 mod elimination;
+pub mod energy;
 mod ir;
 pub mod layout;
 mod pivots;
 pub mod print;
+mod rational;
 mod residual;
 pub mod simplify;
 mod stage;

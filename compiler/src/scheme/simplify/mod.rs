@@ -20,7 +20,7 @@
 //! original node in place.
 
 mod normal;
-mod rational;
+use super::rational;
 mod rebuild;
 #[cfg(test)]
 mod tests;

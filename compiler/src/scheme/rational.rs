@@ -1,4 +1,5 @@
-//! Exact rationals over i128, and the simplifier's way of giving up when they overflow.
+//! Exact rationals over i128, and the way of giving up when they overflow (the simplifier's,
+//! the energy identity's).
 
 /// The simplification gave up (rational overflow, or a node that is not scheme arithmetic).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
