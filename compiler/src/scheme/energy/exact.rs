@@ -66,34 +66,18 @@ impl Exact {
 mod tests {
     use super::*;
     use crate::scheme::affine::eval;
-    use crate::scheme::ir::SchemeIr;
-
-    fn library_scheme(name: &str) -> SchemeIr {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../forms/schemes");
-        let (prog, _) = crate::check_path(&dir.join(format!("{name}.wf")), &crate::source::FsLoader)
-            .unwrap_or_else(|f| panic!("{}", f.rendered));
-        prog.schemes.into_iter().next().expect("a scheme")
-    }
 
     /// Every scalar of every library scheme (the stages' values, the residuals' coefficients
     /// and times, the initial line's) is an exact rational function whose value is the
     /// graph's at random params in their ranges, dt and t.
     #[test]
     fn every_library_scalar_is_an_exact_rational_function() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../forms/schemes");
-        let mut names: Vec<String> = std::fs::read_dir(&dir)
-            .unwrap()
-            .filter_map(|e| e.ok()?.path().file_stem().map(|s| s.to_string_lossy().into_owned()))
-            .collect();
-        names.sort();
-        assert!(names.len() >= 9, "{names:?}");
         let mut seed = 3u64;
         let mut random = || {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        for name in &names {
-            let ir = library_scheme(name);
+        for (name, ir) in super::super::library_schemes() {
             let mut nodes = Vec::new();
             let affine = |a: &crate::scheme::affine::Affine, out: &mut Vec<NodeId>| {
                 out.push(a.unknown);

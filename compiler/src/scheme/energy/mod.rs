@@ -7,3 +7,24 @@
 pub mod exact;
 pub mod poly;
 pub mod ratfn;
+pub mod window;
+
+/// Every library scheme (`forms/schemes/`), compiled, by file stem.
+#[cfg(test)]
+fn library_schemes() -> Vec<(String, crate::scheme::ir::SchemeIr)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../forms/schemes");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("forms/schemes")
+        .filter_map(|e| e.ok()?.path().file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 9, "{names:?}");
+    names
+        .into_iter()
+        .map(|name| {
+            let (prog, _) = crate::check_path(&dir.join(format!("{name}.wf")), &crate::source::FsLoader)
+                .unwrap_or_else(|f| panic!("{}", f.rendered));
+            (name, prog.schemes.into_iter().next().expect("a scheme"))
+        })
+        .collect()
+}
