@@ -1,10 +1,17 @@
-//! A scheme's discrete energy identity (`emit --stage energy`), built on exact algebra: the
-//! scheme's scalars as rational functions of its params, dt and t ([`exact`]), over
-//! polynomials kept expanded ([`poly`]) so that a coefficient is zero exactly when it is the
-//! zero polynomial ([`ratfn`]). The derivation of the identity from a compiled scheme comes on
-//! top of these.
+//! A scheme's discrete energy identity (`emit --stage energy`, issue 55), built on exact
+//! algebra: the scheme's scalars as rational functions of its params, dt and t ([`exact`]),
+//! over polynomials kept expanded ([`poly`]) so that a coefficient is zero exactly when it is
+//! the zero polynomial ([`ratfn`]); its step with every level and residual argument an exact
+//! combination of the step's free variables ([`window`]); and the derivation by multipliers
+//! ([`engine`], over the quadratic forms of [`forms`]). Derived so far, for one step with the
+//! residuals at its ends: Newmark's (Krenk's kept energy and dissipation, at symbolic β, γ) and
+//! the midpoint family's (D ≡ 0). The α-methods need the previous step's levels, TR-BDF2 and
+//! central differences more of the ansatz's rules: still to come, as are the classification
+//! and the printing.
 
+pub mod engine;
 pub mod exact;
+pub mod forms;
 pub mod poly;
 pub mod ratfn;
 pub mod window;

@@ -20,11 +20,12 @@ pub enum Free {
 pub struct Lin(pub Vec<RatFn>);
 
 impl Lin {
-    fn zero(n: usize) -> Lin {
+    pub fn zero(n: usize) -> Lin {
         Lin(vec![RatFn::zero(); n])
     }
 
-    fn unit(n: usize, i: usize) -> Lin {
+    /// Free variable `i` alone.
+    pub fn unit(n: usize, i: usize) -> Lin {
         let mut l = Lin::zero(n);
         l.0[i] = RatFn::one();
         l
