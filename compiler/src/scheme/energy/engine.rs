@@ -45,6 +45,10 @@ pub enum NoIdentity {
     NoState(&'static str),
     /// The constraints contradict each other: no quadratic energy of this form is kept.
     Inconsistent,
+    /// The constraints leave a family of identities: none is chosen silently.
+    NotUnique,
+    /// A scalar of the scheme is no rational function of its params.
+    NotRational,
     /// Rational overflow.
     Overflow,
 }
@@ -53,6 +57,41 @@ impl From<GiveUp> for NoIdentity {
     fn from(_: GiveUp) -> NoIdentity {
         NoIdentity::Overflow
     }
+}
+
+/// The energy identity of one step of `ir`, with the residuals at the step's ends: the kept
+/// energy E if it closes, else E + q_a ½dt²‖a‖²_M. The ansatz's rules read the sign of a
+/// coefficient at samples of the params' ranges and of dt (they choose the multipliers; the
+/// identity holds exactly whatever they choose).
+pub fn derive(ir: &SchemeIr) -> Result<Ansatz, NoIdentity> {
+    let window = super::window::window(ir).map_err(|_| NoIdentity::NotRational)?;
+    let s = shift(ir, &window)?;
+    let samples: Vec<Vec<f64>> = (0..=4)
+        .map(|i| {
+            let along = |p: &crate::check::SchemeParamInfo| match &p.range {
+                Some(r) if r.lo.is_finite() && r.hi.is_finite() => r.lo + (r.hi - r.lo) * (0.1 + 0.2 * i as f64),
+                _ => p.default,
+            };
+            ir.params.iter().map(along).collect()
+        })
+        .chain([ir.params.iter().map(|p| p.default).collect()])
+        .collect();
+    // ≤ 0 at every sample and < 0 at one: a minor −s·L² with such an s asks L = 0 wherever
+    // s > 0 (at γ = ½ Newmark's s vanishes).
+    let negative = |r: &RatFn| {
+        let values: Vec<f64> = samples.iter().flat_map(|p| [1e-2, 1.0, 1e2].map(|dt| r.eval(p, dt, 0.0))).collect();
+        values.iter().all(|v| *v <= 0.0) && values.iter().any(|v| *v < 0.0)
+    };
+    let mut last = NoIdentity::Inconsistent;
+    for corrected in [false, true] {
+        let mut a = Ansatz::new(ir, window.clone(), corrected)?;
+        match a.solve(&s, &negative) {
+            Ok(()) if a.solved.iter().all(|v| v.as_ref().is_some_and(Unk::is_known)) => return Ok(a),
+            Ok(()) => last = NoIdentity::NotUnique,
+            Err(e) => last = e,
+        }
+    }
+    Err(last)
 }
 
 fn unit(n: usize, i: usize) -> Lin {
@@ -72,8 +111,9 @@ fn sub(a: &Lin, b: &Lin) -> Res<Lin> {
 }
 
 impl Ansatz {
-    /// The ansatz of the step `window` of `ir`.
-    pub fn new(ir: &SchemeIr, window: Window) -> Result<Ansatz, NoIdentity> {
+    /// The ansatz of the step `window` of `ir`; with `corrected`, the kept energy takes a term
+    /// q_a ½dt²‖a‖²_M besides E (where the scheme has an acceleration state).
+    pub fn new(ir: &SchemeIr, window: Window, corrected: bool) -> Result<Ansatz, NoIdentity> {
         let n = window.free.len();
         let velocity = ir.states.iter().position(|s| s == "v").ok_or(NoIdentity::NoState("velocity `v`"))?;
         let acceleration = ir.initial.as_ref().map(|i| i.state);
@@ -124,7 +164,7 @@ impl Ansatz {
                 Tested { stage, terms, nu }
             })
             .collect();
-        let q_a = acceleration.map(|_| {
+        let q_a = acceleration.filter(|_| corrected).map(|_| {
             unknowns += 1;
             unknowns - 1
         });
@@ -167,7 +207,7 @@ impl Ansatz {
 
     /// Fixes the unknowns: D blind to a uniform shift of the displacements (`shift`, over the
     /// free variables), and every row of D whose diagonal is zero zero, until nothing changes.
-    /// `negative(r)`: whether r < 0 for every param in range and dt > 0.
+    /// `negative(r)`: whether r ≤ 0 for every param in range and dt > 0, and not ≡ 0.
     pub fn solve(&mut self, shift: &Lin, negative: &dyn Fn(&RatFn) -> bool) -> Result<(), NoIdentity> {
         let n = self.d_m.n;
         let mut equations: Vec<Unk> = Vec::new();
@@ -236,8 +276,8 @@ impl Ansatz {
     }
 }
 
-/// A 2 × 2 principal minor of `form` that is −s·L², s > 0 (`negative(−s)`) and L affine in
-/// the unknowns not zero: D ⪰ 0 needs L = 0, returned.
+/// A 2 × 2 principal minor of `form` that is −s·L², s ≥ 0 (`negative(−s)`), L affine in the
+/// unknowns: D ⪰ 0 needs L = 0, returned.
 fn negative_square_minor(form: &Form, negative: &dyn Fn(&RatFn) -> bool) -> Res<Option<Unk>> {
     let n = form.n;
     let k = form.entries[0].c.len();
@@ -246,9 +286,6 @@ fn negative_square_minor(form: &Form, negative: &dyn Fn(&RatFn) -> bool) -> Res<
     for i in 0..n {
         for j in i + 1..n {
             let (a, b, c) = (vector(form.at(i, i)), vector(form.at(j, j)), vector(form.at(i, j)));
-            if c.iter().all(RatFn::is_zero) {
-                continue;
-            }
             // S = ½(a bᵀ + b aᵀ) − c cᵀ, the minor's matrix in z.
             let half = RatFn::constant(crate::scheme::rational::Rat::new(1, 2)?);
             let entry = |p: usize, q: usize| -> Res<RatFn> {
@@ -272,10 +309,9 @@ fn negative_square_minor(form: &Form, negative: &dyn Fn(&RatFn) -> bool) -> Res<
             if !rank_one {
                 continue;
             }
+            // L = 0, the row of S through p over S_pp; a constant L ≠ 0 makes D indefinite
+            // whatever the unknowns (an equation no unknown satisfies).
             let row: Vec<RatFn> = (0..=k).map(|q| entry(p, q)).collect::<Res<_>>()?;
-            if row[..k].iter().all(RatFn::is_zero) {
-                continue;
-            }
             return Ok(Some(Unk { c0: row[k].clone(), c: row[..k].to_vec() }));
         }
     }
@@ -332,22 +368,13 @@ mod tests {
 
     fn derived(name: &str) -> (SchemeIr, Ansatz) {
         let (_, ir) = super::super::library_schemes().into_iter().find(|(n, _)| n == name).expect("a library scheme");
-        let w = super::super::window::window(&ir).unwrap();
-        let s = shift(&ir, &w).unwrap();
-        let mut a = Ansatz::new(&ir, w).unwrap();
-        // Signs sampled over the params' ranges and dt.
-        let samples: Vec<Vec<f64>> = (0..6)
-            .map(|i| {
-                let along = |p: &crate::check::SchemeParamInfo| match &p.range {
-                    Some(r) if r.lo.is_finite() && r.hi.is_finite() => r.lo + (r.hi - r.lo) * (0.1 + 0.15 * i as f64),
-                    _ => p.default,
-                };
-                ir.params.iter().map(along).collect()
-            })
-            .collect();
-        let negative = |r: &RatFn| samples.iter().all(|p| [0.01, 1.0, 10.0].iter().all(|&dt| r.eval(p, dt, 0.0) < 0.0));
-        a.solve(&s, &negative).unwrap();
+        let a = derive(&ir).unwrap_or_else(|e| panic!("{name}: {e:?}"));
         (ir, a)
+    }
+
+    /// The value of unknown `k`, solved.
+    fn value(a: &Ansatz, k: usize) -> RatFn {
+        a.solved[k].as_ref().filter(|u| u.is_known()).map(|u| u.c0.clone()).expect("solved")
     }
 
     /// `form` equals Σ coef · l⊗l over `parts`, exactly, with no unknown left.
@@ -371,7 +398,7 @@ mod tests {
         let (ir, a) = derived("newmark");
         let (beta, gam, dt) = (RatFn::var(0), RatFn::var(1), RatFn::var(super::super::poly::DT));
         let half = RatFn::constant(Rat::new(1, 2).unwrap());
-        let value = |k: usize| a.solved[k].as_ref().filter(|u| u.is_known()).map(|u| u.c0.clone()).expect("solved");
+        let value = |k: usize| value(&a, k);
         let start = a.residuals.iter().position(|r| r.stage.is_none()).expect("the residual at t");
         let end = a.residuals.iter().position(|r| r.stage == Some(0)).expect("the residual at t + dt");
         assert!(value(a.residuals[start].nu[0]).sub(&RatFn::one().sub(&gam).unwrap()).unwrap().is_zero());
@@ -403,6 +430,76 @@ mod tests {
             for form in [&a.d_m, &a.d_k] {
                 assert!(form.entries.iter().all(Unk::is_zero), "{name}: D ≢ 0");
             }
+        }
+    }
+
+    fn r(n: i128, d: i128) -> RatFn {
+        RatFn::constant(Rat::new(n, d).unwrap())
+    }
+
+    /// Central differences (Newmark at β = 0, γ = ½): multipliers (½, ½), the kept energy
+    /// E − dt²/8 ‖a‖²_M (q_a = −¼), and no dissipation.
+    #[test]
+    fn central_differences_keep_e_less_an_eighth_of_dt2_a_m_a() {
+        let (_, a) = derived("central");
+        for t in &a.residuals {
+            assert_eq!(value(&a, t.nu[0]).as_constant(), Rat::new(1, 2).ok());
+        }
+        assert_eq!(value(&a, a.q_a.expect("a corrected energy")).as_constant(), Rat::new(-1, 4).ok());
+        assert!(a.d_m.entries.iter().chain(&a.d_k.entries).all(Unk::is_zero));
+    }
+
+    /// TR-BDF2 keeps E itself, for every gs: the residuals at t and at the trapezoidal stage
+    /// tested with w₁ = [(3 − 2gs)/2 δ₁ + (1 − gs) δ₂]/(2 − gs)², the BDF2 stage's with
+    /// w₂ = [(1 − gs)² δ₁ + (gs² − 2gs + 2) δ₂]/(2 − gs)² (δ₁ = u_m − u, δ₂ = u' − u_m), and
+    /// D = ‖(1 − gs)δ₁ − gs δ₂‖²_K/(2(2 − gs)²) + (gs(1 − gs)dt)²/(8(2 − gs)⁴) ‖a + a_m − 2a'‖²_M.
+    #[test]
+    fn trbdf2_keeps_e_with_a_dissipation_of_both_stages() {
+        let (ir, a) = derived("trbdf2");
+        assert!(a.q_a.is_none(), "the kept energy is E");
+        let gs = RatFn::var(0);
+        let one = RatFn::one();
+        let two_minus = r(2, 1).sub(&gs).unwrap();
+        let sq = two_minus.powi(2).unwrap();
+        let one_minus = one.sub(&gs).unwrap();
+        let w1 = [r(3, 2).sub(&gs).unwrap().div(&sq).unwrap(), one_minus.div(&sq).unwrap()];
+        let w2 = [
+            one_minus.powi(2).unwrap().div(&sq).unwrap(),
+            gs.powi(2).unwrap().sub(&gs.mul(&r(2, 1)).unwrap()).unwrap().add(&r(2, 1)).unwrap().div(&sq).unwrap(),
+        ];
+        for t in &a.residuals {
+            let want = if t.stage == Some(1) { &w2 } else { &w1 };
+            for (j, w) in want.iter().enumerate() {
+                assert!(value(&a, t.nu[j]).sub(w).unwrap().is_zero(), "stage {:?}, increment {j}", t.stage);
+            }
+        }
+        let n = a.window.free.len();
+        let (d1, d2) = (&a.increments[0], &a.increments[1]);
+        let combination = |x: &RatFn, l: &Lin, y: &RatFn, m: &Lin| -> Lin {
+            Lin(l.0.iter().zip(&m.0).map(|(p, q)| p.mul(x).unwrap().add(&q.mul(y).unwrap()).unwrap()).collect())
+        };
+        let k_row = combination(&one_minus, d1, &gs.neg().unwrap(), d2);
+        let k_coef = one.div(&sq.mul(&r(2, 1)).unwrap()).unwrap();
+        assert_form(&a.d_k, &[(k_coef, k_row)], "D on K");
+        // a + a_m − 2a': the start's acceleration, the trapezoidal stage's, the end's.
+        let acceleration = ir.initial.as_ref().unwrap().state;
+        let a_m = ir.stages[0].quantities.iter().position(|q| q == "am").expect("am");
+        let mut row = unit(n, acceleration);
+        row = combination(&one, &row, &one, &a.window.levels[0][a_m]);
+        row = combination(&one, &row, &r(-2, 1), &end_level(&ir, &a.window, acceleration));
+        let dt = RatFn::var(super::super::poly::DT);
+        let m_coef = gs.mul(&one_minus).unwrap().mul(&dt).unwrap().powi(2).unwrap();
+        let m_coef = m_coef.div(&sq.powi(2).unwrap().mul(&r(8, 1)).unwrap()).unwrap();
+        assert_form(&a.d_m, &[(m_coef, row)], "D on M");
+    }
+
+    /// The α-methods' residuals read the previous level too: no identity over one step with
+    /// the residuals at its ends alone (their kept energies need the step before).
+    #[test]
+    fn the_alpha_methods_need_the_step_before() {
+        for name in ["hht", "genalpha"] {
+            let (_, ir) = super::super::library_schemes().into_iter().find(|(n, _)| n == name).unwrap();
+            assert_eq!(derive(&ir).err(), Some(NoIdentity::Inconsistent), "{name}");
         }
     }
 }

@@ -3,11 +3,11 @@
 //! over polynomials kept expanded ([`poly`]) so that a coefficient is zero exactly when it is
 //! the zero polynomial ([`ratfn`]); its step with every level and residual argument an exact
 //! combination of the step's free variables ([`window`]); and the derivation by multipliers
-//! ([`engine`], over the quadratic forms of [`forms`]). Derived so far, for one step with the
-//! residuals at its ends: Newmark's (Krenk's kept energy and dissipation, at symbolic β, γ) and
-//! the midpoint family's (D ≡ 0). The α-methods need the previous step's levels, TR-BDF2 and
-//! central differences more of the ansatz's rules: still to come, as are the classification
-//! and the printing.
+//! ([`engine`], over the quadratic forms of [`forms`]). Derived exactly so far, for one step
+//! with the residuals at its ends and at its stages: Newmark's at symbolic β, γ (Krenk's kept
+//! energy and dissipation), central differences' (E − dt²/8‖a‖²_M kept), the midpoint family's
+//! (D ≡ 0) and TR-BDF2's (E kept, for every gs). The α-methods' kept energies need the step
+//! before: still to come, as are the classification, the printing and the claim's proof.
 
 pub mod engine;
 pub mod exact;

@@ -57,6 +57,7 @@ pub struct ExactTerm {
 }
 
 /// A step in exact form.
+#[derive(Clone)]
 pub struct Window {
     pub free: Vec<Free>,
     /// Per stage, its new quantities (the unknown first).
