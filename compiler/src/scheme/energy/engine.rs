@@ -23,6 +23,13 @@ pub struct Tested {
     pub nu: Vec<usize>,
 }
 
+/// The kept energy's terms besides E: q_a ½dt²‖a‖²_M, q_δ ½‖u − u⁻‖²_K.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Terms {
+    pub acceleration: bool,
+    pub step_before: bool,
+}
+
 /// The ansatz, built and (by [`Ansatz::solve`]) solved.
 pub struct Ansatz {
     pub window: Window,
@@ -31,6 +38,8 @@ pub struct Ansatz {
     pub residuals: Vec<Tested>,
     /// The kept energy's coefficient of ½dt²‖a‖²_M, when the scheme has an acceleration state.
     pub q_a: Option<usize>,
+    /// Its coefficient of ½‖u − u⁻‖²_K, with the previous step's displacement u⁻.
+    pub q_delta: Option<usize>,
     pub unknowns: usize,
     pub d_m: Form,
     pub d_k: Form,
@@ -65,7 +74,17 @@ impl From<GiveUp> for NoIdentity {
 /// identity holds exactly whatever they choose).
 pub fn derive(ir: &SchemeIr) -> Result<Ansatz, NoIdentity> {
     let window = super::window::window(ir).map_err(|_| NoIdentity::NotRational)?;
-    let s = shift(ir, &window)?;
+    // With the previous step's displacement and the states its residual reads at the start.
+    let read: Vec<usize> = (0..ir.states.len())
+        .filter(|&i| {
+            i == 0
+                || window.residuals.last().is_some_and(|r| {
+                    r.iter().flat_map(|t| &t.args).any(|l| l.0.iter().enumerate().any(|(j, c)| j == i && !c.is_zero()))
+                })
+        })
+        .collect();
+    let (history, variables) = window.with_previous(&read);
+    let previous: Vec<(usize, usize)> = read.iter().copied().zip(variables).collect();
     let samples: Vec<Vec<f64>> = (0..=4)
         .map(|i| {
             let along = |p: &crate::check::SchemeParamInfo| match &p.range {
@@ -83,8 +102,19 @@ pub fn derive(ir: &SchemeIr) -> Result<Ansatz, NoIdentity> {
         values.iter().all(|v| *v <= 0.0) && values.iter().any(|v| *v < 0.0)
     };
     let mut last = NoIdentity::Inconsistent;
-    for corrected in [false, true] {
-        let mut a = Ansatz::new(ir, window.clone(), corrected)?;
+    // One step first, E before its corrections.
+    let tries = [
+        (false, false, false),
+        (false, true, false),
+        (true, false, false),
+        (true, true, false),
+        (true, false, true),
+        (true, true, true),
+    ];
+    for (with_previous, acceleration, step_before) in tries {
+        let (w, previous) = if with_previous { (history.clone(), &previous[..]) } else { (window.clone(), &[][..]) };
+        let s = shift(ir, &w, previous)?;
+        let mut a = Ansatz::new(ir, w, Terms { acceleration, step_before }, previous)?;
         match a.solve(&s, &negative) {
             Ok(()) if a.solved.iter().all(|v| v.as_ref().is_some_and(Unk::is_known)) => return Ok(a),
             Ok(()) => last = NoIdentity::NotUnique,
@@ -111,21 +141,31 @@ fn sub(a: &Lin, b: &Lin) -> Res<Lin> {
 }
 
 impl Ansatz {
-    /// The ansatz of the step `window` of `ir`; with `corrected`, the kept energy takes a term
-    /// q_a ½dt²‖a‖²_M besides E (where the scheme has an acceleration state).
-    pub fn new(ir: &SchemeIr, window: Window, corrected: bool) -> Result<Ansatz, NoIdentity> {
+    /// The ansatz of the step `window` of `ir` with the kept energy's `terms` besides E; the
+    /// window's `previous` variables (the previous step's states, [`Window::with_previous`])
+    /// are where its start's own start levels go back to.
+    pub fn new(ir: &SchemeIr, window: Window, terms: Terms, previous: &[(usize, usize)]) -> Result<Ansatz, NoIdentity> {
         let n = window.free.len();
         let velocity = ir.states.iter().position(|s| s == "v").ok_or(NoIdentity::NoState("velocity `v`"))?;
         let acceleration = ir.initial.as_ref().map(|i| i.state);
         let end = |i: usize| end_level(ir, &window, i);
+        let before = |i: usize| previous.iter().find(|(s, _)| *s == i).map(|&(_, v)| unit(n, v));
         // The residuals: each stage's, and the last one's at the step's start where the state
-        // invariant holds (an initial line solves it at the start, each step at its end).
+        // invariant holds (an initial line solves it at the start, each step at its end): its
+        // end levels go back to the start, its start levels to the previous step's.
         let mut residuals: Vec<(Option<usize>, Vec<ExactTerm>)> =
             window.residuals.iter().enumerate().map(|(k, t)| (Some(k), t.clone())).collect();
         if acceleration.is_some()
             && let Some(last) = window.residuals.last()
         {
-            let back = |l: &Lin| (0..ir.states.len()).find(|&i| end(i) == *l).map(|i| unit(n, i));
+            let back = |l: &Lin| {
+                let states = 0..ir.states.len();
+                states
+                    .clone()
+                    .find(|&i| end(i) == *l)
+                    .map(|i| unit(n, i))
+                    .or_else(|| states.clone().find(|&i| unit(n, i) == *l).and_then(before))
+            };
             let shifted: Option<Vec<ExactTerm>> = last
                 .iter()
                 .map(|t| {
@@ -139,7 +179,7 @@ impl Ansatz {
         }
         // The displacement levels: the start's, each stage's stiffness argument that is one of
         // its levels, the end's.
-        let mut levels = vec![unit(n, 0)];
+        let mut levels: Vec<Lin> = before(0).into_iter().chain([unit(n, 0)]).collect();
         for (k, terms) in window.residuals.iter().enumerate() {
             for t in terms.iter().filter(|t| t.form == "stiffness") {
                 if let [arg] = t.args.as_slice()
@@ -164,7 +204,11 @@ impl Ansatz {
                 Tested { stage, terms, nu }
             })
             .collect();
-        let q_a = acceleration.filter(|_| corrected).map(|_| {
+        let q_a = acceleration.filter(|_| terms.acceleration).map(|_| {
+            unknowns += 1;
+            unknowns - 1
+        });
+        let q_delta = before(0).filter(|_| terms.step_before).map(|_| {
             unknowns += 1;
             unknowns - 1
         });
@@ -202,7 +246,14 @@ impl Ansatz {
             let dt2 = RatFn::var(super::poly::DT).powi(2)?;
             change(&mut d_m, &Unk::unknown(q, unknowns).scale(&dt2)?, a)?;
         }
-        Ok(Ansatz { window, increments, residuals, q_a, unknowns, d_m, d_k, solved: vec![None; unknowns] })
+        // q_δ ½‖u − u⁻‖²_K: ½‖u' − u‖² at the end, ½‖u − u⁻‖² at the start.
+        if let (Some(q), Some(u_before)) = (q_delta, before(0)) {
+            let s = Unk::unknown(q, unknowns);
+            let (now, then) = (sub(&end(0), &unit(n, 0))?, sub(&unit(n, 0), &u_before)?);
+            d_k.add_product(&s.scale(&minus_half)?, &now, &now)?;
+            d_k.add_product(&s.scale(&half)?, &then, &then)?;
+        }
+        Ok(Ansatz { window, increments, residuals, q_a, q_delta, unknowns, d_m, d_k, solved: vec![None; unknowns] })
     }
 
     /// Fixes the unknowns: D blind to a uniform shift of the displacements (`shift`, over the
@@ -321,9 +372,10 @@ fn negative_square_minor(form: &Form, negative: &dyn Fn(&RatFn) -> bool) -> Res<
 /// The uniform shift of the displacements over the step's free variables: 1 on the
 /// displacement state, 0 on the others, and on each stage's unknown what keeps every state's
 /// end value shifted as its start (the displacement by 1, the velocity and acceleration by 0).
-pub fn shift(ir: &SchemeIr, window: &Window) -> Result<Lin, NoIdentity> {
+pub fn shift(ir: &SchemeIr, window: &Window, previous: &[(usize, usize)]) -> Result<Lin, NoIdentity> {
     let states = ir.states.len();
     let n = window.free.len();
+    // The stages' unknowns (and the previous step's states, which no end level reads).
     let stages = n - states;
     let end = |i: usize| end_level(ir, window, i);
     // end(i)·s = [i = 0], with s = e_0 on the states: Σ_k end(i)[states + k] s_k = [i = 0] − end(i)[0].
@@ -357,6 +409,10 @@ pub fn shift(ir: &SchemeIr, window: &Window) -> Result<Lin, NoIdentity> {
     for (k, v) in value.into_iter().enumerate() {
         // Unknowns no equation fixes do not move.
         s.0[states + k] = v.map_or(RatFn::zero(), |v| v.c0);
+    }
+    // The previous step's displacement moves with the others.
+    if let Some(&(_, v)) = previous.iter().find(|(state, _)| *state == 0) {
+        s.0[v] = RatFn::one();
     }
     Ok(s)
 }
@@ -493,13 +549,36 @@ mod tests {
         assert_form(&a.d_m, &[(m_coef, row)], "D on M");
     }
 
-    /// The α-methods' residuals read the previous level too: no identity over one step with
-    /// the residuals at its ends alone (their kept energies need the step before).
+    /// HHT-α keeps E + ½dt²(α²/4)‖a‖²_M + ½α(½ − α)‖u − u⁻‖²_K, with the previous step's
+    /// displacement u⁻, and dissipates D = α³dt²/4 ‖Δa‖²_M + ½α(½ − α)‖(u' − u) − (u − u⁻)‖²_K,
+    /// exactly at symbolic α; so do its variants, which differ in the contact's levels only.
+    /// Generalized-α needs the previous step's kinematics too: refused.
     #[test]
-    fn the_alpha_methods_need_the_step_before() {
-        for name in ["hht", "genalpha"] {
-            let (_, ir) = super::super::library_schemes().into_iter().find(|(n, _)| n == name).unwrap();
-            assert_eq!(derive(&ir).err(), Some(NoIdentity::Inconsistent), "{name}");
+    fn hht_keeps_its_modified_energy() {
+        for name in ["hht", "hht_imex", "hht_unweighted"] {
+            hht_s_identity(name);
         }
+        let (_, ga) = super::super::library_schemes().into_iter().find(|(n, _)| n == "genalpha").unwrap();
+        assert!(derive(&ga).is_err(), "generalized-α over one step and its start");
+    }
+
+    /// HHT's identity for `name` (its variants differ in the contact's levels only).
+    fn hht_s_identity(name: &str) {
+        let (ir, a) = derived(name);
+        let alpha = RatFn::var(0);
+        let q_a = alpha.powi(2).unwrap().mul(&r(1, 4)).unwrap();
+        let q_delta = alpha.mul(&r(1, 2).sub(&alpha).unwrap()).unwrap();
+        assert!(value(&a, a.q_a.expect("q_a")).sub(&q_a).unwrap().is_zero());
+        assert!(value(&a, a.q_delta.expect("q_δ")).sub(&q_delta).unwrap().is_zero());
+        let n = a.window.free.len();
+        let previous = a.window.free.iter().position(|f| *f == super::super::window::Free::Previous(0)).unwrap();
+        let acceleration = ir.initial.as_ref().unwrap().state;
+        let da = sub(&end_level(&ir, &a.window, acceleration), &unit(n, acceleration)).unwrap();
+        let now = sub(&end_level(&ir, &a.window, 0), &unit(n, 0)).unwrap();
+        let then = sub(&unit(n, 0), &unit(n, previous)).unwrap();
+        let dt = RatFn::var(super::super::poly::DT);
+        let m = alpha.powi(3).unwrap().mul(&dt.powi(2).unwrap()).unwrap().mul(&r(1, 4)).unwrap();
+        assert_form(&a.d_m, &[(m, da)], "D on M");
+        assert_form(&a.d_k, &[(q_delta.mul(&r(1, 2)).unwrap(), sub(&now, &then).unwrap())], "D on K");
     }
 }

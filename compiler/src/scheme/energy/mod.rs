@@ -3,11 +3,12 @@
 //! over polynomials kept expanded ([`poly`]) so that a coefficient is zero exactly when it is
 //! the zero polynomial ([`ratfn`]); its step with every level and residual argument an exact
 //! combination of the step's free variables ([`window`]); and the derivation by multipliers
-//! ([`engine`], over the quadratic forms of [`forms`]). Derived exactly so far, for one step
-//! with the residuals at its ends and at its stages: Newmark's at symbolic β, γ (Krenk's kept
-//! energy and dissipation), central differences' (E − dt²/8‖a‖²_M kept), the midpoint family's
-//! (D ≡ 0) and TR-BDF2's (E kept, for every gs). The α-methods' kept energies need the step
-//! before: still to come, as are the classification, the printing and the claim's proof.
+//! ([`engine`], over the quadratic forms of [`forms`]). Derived exactly so far, from the
+//! residuals at a step's ends and stages (and at the previous step's start where they read
+//! it): Newmark's at symbolic β, γ (Krenk's kept energy and dissipation), central
+//! differences' (E − dt²/8‖a‖²_M kept), the midpoint family's (D ≡ 0), TR-BDF2's (E kept, for
+//! every gs) and HHT-α's (with ½α(½ − α)‖u − u⁻‖²_K). Generalized-α's needs the previous step's
+//! kinematics: still to come, as are the classification, the printing and the claim's proof.
 
 pub mod engine;
 pub mod exact;

@@ -8,11 +8,13 @@ use super::ratfn::RatFn;
 use crate::scheme::affine::{Affine, Quantity};
 use crate::scheme::ir::SchemeIr;
 
-/// A free variable of a step: a state at its start, or a stage's unknown.
+/// A free variable of a step: a state at its start, a stage's unknown, or a state at the
+/// previous step's start (what the α-methods' residuals read at the step's start).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Free {
     State(usize),
     Unknown(usize),
+    Previous(usize),
 }
 
 /// Σ coefficient · free variable, one coefficient per variable of the window.
@@ -66,6 +68,24 @@ pub struct Window {
     pub residuals: Vec<Vec<ExactTerm>>,
     /// Per stage, its time.
     pub times: Vec<RatFn>,
+}
+
+impl Window {
+    /// This step with the previous step's states `states` as free variables too (after the
+    /// others): their variables, in that order.
+    pub fn with_previous(&self, states: &[usize]) -> (Window, Vec<usize>) {
+        let n = self.free.len();
+        let grow = |l: &Lin| Lin(l.0.iter().cloned().chain(states.iter().map(|_| RatFn::zero())).collect());
+        let free = self.free.iter().copied().chain(states.iter().map(|&i| Free::Previous(i))).collect();
+        let levels = self.levels.iter().map(|s| s.iter().map(grow).collect()).collect();
+        let residuals = self
+            .residuals
+            .iter()
+            .map(|r| r.iter().map(|t| ExactTerm { args: t.args.iter().map(grow).collect(), ..t.clone() }).collect())
+            .collect();
+        let window = Window { free, levels, residuals, times: self.times.clone() };
+        (window, (n..n + states.len()).collect())
+    }
 }
 
 /// The step of `ir` in exact form, or the scalar that is no rational function of its params.
