@@ -152,27 +152,25 @@ impl FormsInUse {
         contact: bool,
         slots: &mut Vec<Provided<'m>>,
     ) -> Result<(), CaseError> {
-        {
-            let values = params.unit_values(unit.params());
-            let made = unit.make(&values, coefs, binding).map_err(|e| {
-                let hint = match &e {
-                    crate::runtime::library::LibraryError::MissingCoef { name, .. } => provided_coefs(coefs, name),
-                    _ => String::new(),
-                };
-                // Errors located in the file already (a region, a tangential part) need no prefix.
-                match &e {
-                    crate::runtime::library::LibraryError::MissingRegion { .. } => {
-                        CaseError::Option(format!("{label}{e}{hint}"))
-                    }
-                    crate::runtime::library::LibraryError::NoTangentSpace { .. } => {
-                        CaseError::NoTangentSpace(format!("{label}{e}"))
-                    }
-                    _ => CaseError::Option(format!("{label}{}: {e}{hint}", unit.file())),
+        let values = params.unit_values(unit.params());
+        let made = unit.make(&values, coefs, binding).map_err(|e| {
+            let hint = match &e {
+                crate::runtime::library::LibraryError::MissingCoef { name, .. } => provided_coefs(coefs, name),
+                _ => String::new(),
+            };
+            // Errors located in the file already (a region, a tangential part) need no prefix.
+            match &e {
+                crate::runtime::library::LibraryError::MissingRegion { .. } => {
+                    CaseError::Option(format!("{label}{e}{hint}"))
                 }
-            })?;
-            for (name, form) in made {
-                add_to_slot(slots, name, form, unit.file(), contact)?;
+                crate::runtime::library::LibraryError::NoTangentSpace { .. } => {
+                    CaseError::NoTangentSpace(format!("{label}{e}"))
+                }
+                _ => CaseError::Option(format!("{label}{}: {e}{hint}", unit.file())),
             }
+        })?;
+        for (name, form) in made {
+            add_to_slot(slots, name, form, unit.file(), contact)?;
         }
         Ok(())
     }

@@ -77,10 +77,7 @@ pub fn derive(ir: &SchemeIr) -> Result<Ansatz, NoIdentity> {
     // With the previous step's displacement and the states its residual reads at the start.
     let read: Vec<usize> = (0..ir.states.len())
         .filter(|&i| {
-            i == 0
-                || window.residuals.last().is_some_and(|r| {
-                    r.iter().flat_map(|t| &t.args).any(|l| l.0.iter().enumerate().any(|(j, c)| j == i && !c.is_zero()))
-                })
+            i == 0 || window.residuals.last().is_some_and(|r| r.iter().flat_map(|t| &t.args).any(|l| !l.0[i].is_zero()))
         })
         .collect();
     let (history, variables) = window.with_previous(&read);
@@ -301,14 +298,10 @@ impl Ansatz {
     /// Imposes `e` = 0: solves it for one of its unknowns and substitutes everywhere.
     fn impose(&mut self, e: Unk, rest: &mut [Unk]) -> Result<(), NoIdentity> {
         // A constant pivot first: no condition on the params.
-        let pivot = (0..self.unknowns)
-            .filter(|&k| !e.c[k].is_zero())
-            .min_by_key(|&k| e.c[k].as_constant().is_none())
-            .ok_or(if e.c0.is_zero() { NoIdentity::Overflow } else { NoIdentity::Inconsistent });
-        let k = match pivot {
-            Ok(k) => k,
-            Err(NoIdentity::Overflow) => return Ok(()), // 0 = 0
-            Err(other) => return Err(other),
+        let pivot = (0..self.unknowns).filter(|&k| !e.c[k].is_zero()).min_by_key(|&k| e.c[k].as_constant().is_none());
+        let Some(k) = pivot else {
+            // No unknown left: 0 = 0 holds, c0 = 0 with c0 ≠ 0 does not.
+            return if e.c0.is_zero() { Ok(()) } else { Err(NoIdentity::Inconsistent) };
         };
         // unknown_k = −(e − c_k unknown_k)/c_k.
         let mut others = e.clone();

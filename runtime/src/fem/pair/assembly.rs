@@ -92,6 +92,8 @@ pub struct PairForm<'m> {
     segmented: bool,
     /// Per local facet, its edge vectors e_α in the reference cell (ξ(s) = ξ0 + Σ s_α e_α).
     edges: Vec<Vec<[f64; MAX_DIM]>>,
+    /// The reference second derivatives of the element's basis (constant on a cell).
+    hessians: Vec<Vec<Vec<f64>>>,
     /// A coupling the matrix pattern lacks, met by the last tangent: the two nodes.
     missing: Mutex<Option<(u32, u32)>>,
     /// What its search and assembly have cost.
@@ -179,6 +181,7 @@ impl<'m> PairForm<'m> {
             base,
             segmented: false,
             edges,
+            hessians: kind.basis_hessians(),
             missing: Mutex::new(None),
             meter: Meter::default(),
             moved_by: OnceLock::new(),
@@ -210,8 +213,10 @@ impl<'m> PairForm<'m> {
     }
 
     /// Calls `each` at every quadrature point of the own surface that faces the other one.
-    fn each_point(&self, mesh: &Mesh, fields: &[&[f64]], t: f64, each: impl FnMut(&PairElement)) {
-        self.each_point_of(&self.rule, mesh, fields, t, each);
+    /// With `curved`, each element carries the facing side's second-order data (a tangent's
+    /// sliding part on P2 reads it; a residual or a value does not).
+    fn each_point(&self, mesh: &Mesh, fields: &[&[f64]], t: f64, curved: bool, each: impl FnMut(&PairElement)) {
+        self.each_point_of(&self.rule, mesh, fields, t, curved, each);
     }
 
     /// [`PairForm::each_point`] at the points of `rule` (per local facet: the points, and the
@@ -222,6 +227,7 @@ impl<'m> PairForm<'m> {
         mesh: &Mesh,
         fields: &[&[f64]],
         t: f64,
+        curved: bool,
         mut each: impl FnMut(&PairElement),
     ) {
         // Bound to a body that does not own the pair: no point, so no search to build.
@@ -239,13 +245,13 @@ impl<'m> PairForm<'m> {
                 At::Rule(i) => &points[*i as usize],
                 At::Piece(q) => q,
             };
-            each(&self.element(mesh, f, q, ref_normal, facing, fields, t));
+            each(&self.element(mesh, f, q, ref_normal, facing, fields, t, curved));
         }
         self.meter.evaluated(started);
     }
 
     /// The element of own point `q` of facet `f` (reference normal `ref_normal`) facing
-    /// `facing`.
+    /// `facing`; with `curved`, its facing side's second-order data on P2 cells.
     #[allow(clippy::too_many_arguments)]
     fn element(
         &self,
@@ -256,6 +262,7 @@ impl<'m> PairForm<'m> {
         facing: &Facing,
         fields: &[&[f64]],
         t: f64,
+        curved: bool,
     ) -> PairElement {
         let d = mesh.dim();
         let own = side(mesh, f.cell as usize, &q.phi, &q.dref, ref_normal, fields);
@@ -265,8 +272,9 @@ impl<'m> PairForm<'m> {
         let facing_normal = kind.reference_normal(g.local as usize);
         let mut other = side(mesh, g.cell as usize, &phi, &dref, &facing_normal, fields);
         let edges = &self.edges[g.local as usize];
-        let curvature = (kind.degree() > 1)
-            .then(|| curvature::curvature(mesh, g.cell as usize, &mut other, &facing_normal, edges, fields));
+        let curvature = (curved && kind.degree() > 1).then(|| {
+            curvature::curvature(mesh, g.cell as usize, &self.hessians, &mut other, &facing_normal, edges, fields)
+        });
         let tangents =
             edges.iter().map(|e| std::array::from_fn(|r| (0..d).map(|c| other.jacobian[r][c] * e[c]).sum())).collect();
         let nodes = mesh.cell(f.cell as usize).iter().chain(mesh.cell(g.cell as usize)).copied().collect();
@@ -420,7 +428,7 @@ impl BoundForm for PairForm<'_> {
         let mesh = asm.mesh();
         let d = mesh.dim();
         let mut r = vec![0.0; layout::residual(d)];
-        self.each_point(mesh, fields, t, |e| {
+        self.each_point(mesh, fields, t, false, |e| {
             r.fill(0.0);
             if !self.kernel.residual_at(self.region, &e.point, &mut r) {
                 return;
@@ -438,7 +446,7 @@ impl BoundForm for PairForm<'_> {
         let pattern = m.pattern.clone();
         let moving = CONFIGURATION;
         let mut ke = Vec::new();
-        self.each_point(mesh, fields, t, |e| {
+        self.each_point(mesh, fields, t, wrt == moving, |e| {
             c.fill(0.0);
             if !self.kernel.tangent_at(self.region, &e.point, wrt, &mut c) {
                 return;
@@ -667,7 +675,7 @@ impl BoundFunctional for PairForm<'_> {
         let mesh = asm.mesh();
         let d = mesh.dim();
         let mut out = Vec::new();
-        self.each_point_of(&tabulate(mesh.kind, rule), mesh, fields, t, |e| {
+        self.each_point_of(&tabulate(mesh.kind, rule), mesh, fields, t, false, |e| {
             out.push(PointValue {
                 x: e.point.own.x[..d].to_vec(),
                 normal: e.point.own.normal[..d].to_vec(),
@@ -682,6 +690,6 @@ impl BoundFunctional for PairForm<'_> {
 /// The integral of a pair law's functional over its own surface.
 pub fn pair_value(form: &PairForm<'_>, mesh: &Mesh, fields: &[&[f64]], t: f64) -> f64 {
     let mut sum = 0.0;
-    form.each_point(mesh, fields, t, |e| sum += e.weight * form.kernel.value_at(form.region, &e.point));
+    form.each_point(mesh, fields, t, false, |e| sum += e.weight * form.kernel.value_at(form.region, &e.point));
     sum
 }

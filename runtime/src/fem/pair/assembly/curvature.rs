@@ -15,10 +15,12 @@ pub(super) struct Curvature {
 
 /// Fills the facing side's fields' second derivatives and its normal's rate (`other`, at a
 /// point of `cell` with reference normal `ref_normal`), and returns the basis functions'
-/// second derivatives and the tangents' rates (the facet's reference edges `edges`).
+/// second derivatives and the tangents' rates (the facet's reference edges `edges`); `href`
+/// the basis' reference second derivatives.
 pub(super) fn curvature(
     mesh: &Mesh,
     cell: usize,
+    href: &[Vec<Vec<f64>>],
     other: &mut Side,
     ref_normal: &[f64],
     edges: &[[f64; MAX_DIM]],
@@ -26,7 +28,6 @@ pub(super) fn curvature(
 ) -> Curvature {
     let d = mesh.dim();
     let nodes = mesh.cell(cell);
-    let href = mesh.kind.basis_hessians();
     // x2[r][b][c] = ∂²x_r/∂ξ_b∂ξ_c, the geometry map's second derivatives.
     let mut x2 = [[[0.0; MAX_DIM]; MAX_DIM]; MAX_DIM];
     for (a, &n) in nodes.iter().enumerate() {

@@ -52,7 +52,7 @@ impl PairForm<'_> {
             let mut jump: Vec<(u32, usize, f64)> = Vec::new();
             for (facing, sign) in [(&cut.before, 1.0), (&cut.after, -1.0)] {
                 let Some(facing) = facing else { continue };
-                let e = self.element(mesh, f, &q, ref_normal, facing, fields, t);
+                let e = self.element(mesh, f, &q, ref_normal, facing, fields, t, false);
                 r.fill(0.0);
                 if self.kernel.residual_at(self.region, &e.point, &mut r) {
                     Self::contract(&e, &r, d, |a, k, v| jump.push((e.nodes[a], k, sign * v)));
