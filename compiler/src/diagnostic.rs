@@ -73,6 +73,8 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0818", "scheme: a stage time that is not finite for some parameter values"),
     ("E0819", "scheme: an unknown claim, or one that is not a function of the parameters"),
     ("E0820", "scheme: a state read at the start of a step that nothing sets at the start of the run"),
+    ("E0821", "scheme: an energy claim its derived energy identity refutes"),
+    ("E0822", "scheme: no energy identity can be derived for it"),
     ("E0901", "problem: no mesh"),
     ("E0905", "problem: a Dirichlet condition on a contact region"),
     ("E0906", "problem: a `set` name that more than one file in use declares (qualify it: `material.rho`)"),

@@ -43,6 +43,8 @@ pub enum Stage {
     Scheme,
     /// The generated Rust module, formatted.
     Rust,
+    /// Each scheme's discrete energy identity, and what it proves.
+    Energy,
 }
 
 /// Every stage of a unit that compiled.
@@ -105,6 +107,26 @@ impl Compiled {
                 Ok(ir::print::print(self.ir(dim), &params, &coefs))
             }
             Stage::Scheme => Ok(self.schemes().iter().map(scheme::print::print).collect::<Vec<_>>().join("\n")),
+            Stage::Energy => {
+                if self.schemes().is_empty() {
+                    return Err(Failure::internal(format!(
+                        "{} defines no scheme: the energy stage is a scheme's",
+                        display_name(prog.sources.path(prog.root))
+                    )));
+                }
+                let mut out = Vec::new();
+                for s in self.schemes() {
+                    match scheme::energy::print::print(s) {
+                        Ok(text) => out.push(text),
+                        Err(why) => {
+                            let message = format!("no energy identity for scheme `{}`", s.name);
+                            let d = Diagnostic::error("E0822", message, s.span, why);
+                            return Err(Failure { rendered: render_all(&[d], &prog.sources) });
+                        }
+                    }
+                }
+                Ok(out.join("\n"))
+            }
             Stage::Rust => {
                 let root = prog.sources.path(prog.root);
                 let opts = codegen::Options {

@@ -343,4 +343,7 @@ pub enum Stage {
     /// The schemes of the file, their relations solved.
     Scheme,
     Rust,
+    /// Each scheme's discrete energy identity (kept energy, work, dissipation) and what it
+    /// proves over the params' ranges and at the defaults.
+    Energy,
 }

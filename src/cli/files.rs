@@ -76,6 +76,7 @@ pub(super) fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
         Stage::Ir => compiler::Stage::Ir,
         Stage::Scheme => compiler::Stage::Scheme,
         Stage::Rust => compiler::Stage::Rust,
+        Stage::Energy => compiler::Stage::Energy,
     };
     let out = compiled.print(stage, dim);
     match out {

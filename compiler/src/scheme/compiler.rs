@@ -12,6 +12,9 @@ use crate::diagnostic::Diagnostic;
 use crate::ir::graph::{Graph, NodeId, Sym};
 use crate::syntax::ast::{Expr, Ident};
 
+/// A scheme's `claim energy`: the law, and where it is written.
+type EnergyClaim = (EnergyLaw, crate::source::Span);
+
 /// What a name means inside a scheme.
 #[derive(Clone, Debug)]
 pub(super) enum Value {
@@ -76,7 +79,7 @@ impl<'a> Compiler<'a> {
         if !self.diags.is_empty() {
             return Err(self.diags);
         }
-        Ok(SchemeIr {
+        let ir = SchemeIr {
             name: def.name.name.clone(),
             span: def.span,
             params: self.params,
@@ -87,8 +90,14 @@ impl<'a> Compiler<'a> {
             stages,
             updates,
             claims,
-            energy,
-        })
+            energy: energy.map(|(law, _)| law),
+        };
+        if let Some((law, span)) = energy
+            && let Some(d) = super::energy::claim::check(&ir, law, span)
+        {
+            return Err(vec![d]);
+        }
+        Ok(ir)
     }
 
     /// The parameters, the `uses` line, the states and the scheme's lets: their names in
@@ -195,7 +204,7 @@ impl<'a> Compiler<'a> {
 
     /// `claim NAME = EXPR`: a known property, a scalar of the params (not of t or dt); and
     /// `claim energy = LAW`.
-    fn claims(&mut self) -> (Vec<(String, NodeId)>, Option<EnergyLaw>) {
+    fn claims(&mut self) -> (Vec<(String, NodeId)>, Option<EnergyClaim>) {
         let mut out: Vec<(String, NodeId)> = Vec::new();
         let mut energy = None;
         for i in 0..self.def.claims.len() {
@@ -205,7 +214,7 @@ impl<'a> Compiler<'a> {
                     continue;
                 }
                 Ok(Claim::Energy(law)) => {
-                    energy = Some(law);
+                    energy = Some((law, self.def.claims[i].1.span));
                     continue;
                 }
                 Ok(Claim::Value(e)) => e,

@@ -77,6 +77,23 @@ impl Rat {
         Ok(r)
     }
 
+    /// −1, 0 or 1 (the derived order compares numerators first: no use for values).
+    pub(super) fn signum(self) -> i128 {
+        self.n.signum()
+    }
+
+    pub(super) fn sub(self, o: Rat) -> Res<Rat> {
+        self.add(Rat::new(o.n.checked_neg().ok_or(GiveUp)?, o.d)?)
+    }
+
+    pub(super) fn numer(self) -> i128 {
+        self.n
+    }
+
+    pub(super) fn denom(self) -> i128 {
+        self.d
+    }
+
     pub(super) fn to_f64(self) -> f64 {
         self.n as f64 / self.d as f64
     }

@@ -56,6 +56,9 @@ fn ast_ir_and_scheme_snapshots() {
             insta::assert_snapshot!(format!("{}.ir2d", stem(&f)), ir_text);
             if !compiled.schemes().is_empty() {
                 insta::assert_snapshot!(format!("{}.scheme", stem(&f)), schemes);
+                // The energy identity, or the located reason there is none.
+                let energy = compiled.print(Stage::Energy, 2).unwrap_or_else(|f| f.rendered);
+                insta::assert_snapshot!(format!("{}.energy", stem(&f)), energy);
             }
         });
     }

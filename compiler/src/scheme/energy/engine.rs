@@ -34,6 +34,7 @@ pub struct Terms {
 pub struct Ansatz {
     pub window: Window,
     /// The step's displacement levels in time order, and their increments.
+    pub levels: Vec<Lin>,
     pub increments: Vec<Lin>,
     pub residuals: Vec<Tested>,
     /// The kept energy's coefficient of ½dt²‖a‖²_M, when the scheme has an acceleration state.
@@ -57,7 +58,7 @@ pub enum NoIdentity {
     /// The constraints leave a family of identities: none is chosen silently.
     NotUnique,
     /// A scalar of the scheme is no rational function of its params.
-    NotRational,
+    NotRational(super::exact::Refusal),
     /// Rational overflow.
     Overflow,
 }
@@ -73,7 +74,7 @@ impl From<GiveUp> for NoIdentity {
 /// coefficient at samples of the params' ranges and of dt (they choose the multipliers; the
 /// identity holds exactly whatever they choose).
 pub fn derive(ir: &SchemeIr) -> Result<Ansatz, NoIdentity> {
-    let window = super::window::window(ir).map_err(|_| NoIdentity::NotRational)?;
+    let window = super::window::window(ir).map_err(NoIdentity::NotRational)?;
     // With the previous step's displacement and the states its residual reads at the start.
     let read: Vec<usize> = (0..ir.states.len())
         .filter(|&i| {
@@ -167,7 +168,9 @@ impl Ansatz {
                 .iter()
                 .map(|t| {
                     let args = t.args.iter().map(back).collect::<Option<Vec<_>>>()?;
-                    Some(ExactTerm { args, ..t.clone() })
+                    // The previous step's: its time one step back.
+                    let time = t.time.sub(&RatFn::var(super::poly::DT)).ok()?;
+                    Some(ExactTerm { args, time, ..t.clone() })
                 })
                 .collect();
             if let Some(terms) = shifted {
@@ -250,7 +253,18 @@ impl Ansatz {
             d_k.add_product(&s.scale(&minus_half)?, &now, &now)?;
             d_k.add_product(&s.scale(&half)?, &then, &then)?;
         }
-        Ok(Ansatz { window, increments, residuals, q_a, q_delta, unknowns, d_m, d_k, solved: vec![None; unknowns] })
+        Ok(Ansatz {
+            window,
+            levels,
+            increments,
+            residuals,
+            q_a,
+            q_delta,
+            unknowns,
+            d_m,
+            d_k,
+            solved: vec![None; unknowns],
+        })
     }
 
     /// Fixes the unknowns: D blind to a uniform shift of the displacements (`shift`, over the

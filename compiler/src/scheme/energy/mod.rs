@@ -10,12 +10,37 @@
 //! every gs) and HHT-α's (with ½α(½ − α)‖u − u⁻‖²_K). Generalized-α's needs the previous step's
 //! kinematics: still to come, as are the classification, the printing and the claim's proof.
 
+pub mod claim;
+pub mod classify;
 pub mod engine;
 pub mod exact;
+pub mod factor;
 pub mod forms;
+pub mod names;
 pub mod poly;
+pub mod print;
 pub mod ratfn;
+pub mod sign;
 pub mod window;
+
+/// Why `ir` has no energy identity, in its own terms.
+pub fn why(ir: &crate::scheme::ir::SchemeIr, e: &engine::NoIdentity) -> String {
+    use engine::NoIdentity::*;
+    match e {
+        NoState(what) => format!("the scheme has no {what} state: the energy ½v·M·v + ½u·K·u needs one"),
+        Inconsistent => "no quadratic energy of the states is kept or dissipated by its step: the conditions on \
+             the residuals' multipliers contradict each other (the energies tried: E, E + q·½dt²‖a‖²_M, and with \
+             q·½‖u - u⁻‖²_K of the previous step)"
+            .into(),
+        NotUnique => "the conditions leave a family of identities, and none is chosen silently".into(),
+        NotRational(r) => format!(
+            "the coefficient `{}` is no rational function of the params ({})",
+            crate::scheme::print::scalar(&ir.graph, r.node),
+            r.why
+        ),
+        Overflow => "its exact coefficients overflow 128-bit rationals".into(),
+    }
+}
 
 /// Every library scheme (`forms/schemes/`), compiled, by file stem.
 #[cfg(test)]

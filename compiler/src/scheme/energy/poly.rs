@@ -177,6 +177,72 @@ impl Poly {
         self.terms.keys().any(|m| m.iter().any(|&(w, _)| w == v))
     }
 
+    /// The variables it reads, sorted.
+    pub fn vars(&self) -> Vec<Var> {
+        let mut v: Vec<Var> = self.terms.keys().flat_map(|m| m.iter().map(|&(v, _)| v)).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
+
+    /// Its degree in `v`.
+    pub fn degree_in(&self, v: Var) -> u32 {
+        self.terms.keys().flat_map(|m| m.iter().filter(|&&(w, _)| w == v).map(|&(_, e)| e)).max().unwrap_or(0)
+    }
+
+    /// Its coefficients as a polynomial in `v` (index k: the coefficient of v^k).
+    pub fn coefficients_in(&self, v: Var) -> Res<Vec<Poly>> {
+        let mut out = vec![Poly::zero(); self.degree_in(v) as usize + 1];
+        for (m, c) in &self.terms {
+            let k = m.iter().find(|&&(w, _)| w == v).map_or(0, |&(_, e)| e);
+            let rest: Monomial = m.iter().copied().filter(|&(w, _)| w != v).collect();
+            out[k as usize].insert(rest, *c)?;
+        }
+        Ok(out)
+    }
+
+    /// The largest monomial dividing every term, and the quotient.
+    pub fn monomial_content(&self) -> (Vec<(Var, u32)>, Poly) {
+        let mut least: Option<BTreeMap<Var, u32>> = None;
+        for m in self.terms.keys() {
+            let here: BTreeMap<Var, u32> = m.iter().copied().collect();
+            least = Some(match least {
+                None => here,
+                Some(l) => l.into_iter().filter_map(|(v, e)| here.get(&v).map(|&f| (v, e.min(f)))).collect(),
+            });
+        }
+        let common: Monomial = least.unwrap_or_default().into_iter().collect();
+        let terms = self.terms.iter().map(|(m, c)| (over(m, &common).unwrap_or_default(), *c)).collect();
+        (common, Poly { terms })
+    }
+
+    /// It with `v` replaced by `by`.
+    pub fn substitute(&self, v: Var, by: &Poly) -> Res<Poly> {
+        let mut out = Poly::zero();
+        for (k, c) in self.coefficients_in(v)?.iter().enumerate() {
+            out = out.add(&c.mul(&by.pow(k as u32)?)?)?;
+        }
+        Ok(out)
+    }
+
+    /// Its exact value with every variable given by `value`.
+    pub fn eval_exact(&self, value: &dyn Fn(Var) -> Rat) -> Res<Rat> {
+        let mut sum = Rat::ZERO;
+        for (m, c) in &self.terms {
+            let mut term = *c;
+            for &(v, e) in m {
+                term = term.mul(value(v).powi(e as i32)?)?;
+            }
+            sum = sum.add(term)?;
+        }
+        Ok(sum)
+    }
+
+    /// The leading term's coefficient (grlex).
+    pub fn leading_coefficient(&self) -> Rat {
+        self.terms.iter().max_by(|a, b| grlex(a.0, b.0)).map_or(Rat::ZERO, |(_, c)| *c)
+    }
+
     /// The terms, each as its coefficient and (variable, exponent) list.
     pub fn terms(&self) -> impl Iterator<Item = (&[(Var, u32)], Rat)> {
         self.terms.iter().map(|(m, c)| (m.as_slice(), *c))

@@ -135,6 +135,23 @@ impl RatFn {
         self.num.eval(params, dt, t) / self.den.iter().map(|f| f.eval(params, dt, t)).product::<f64>()
     }
 
+    /// Its exact value with every variable given by `value`; none where the denominator is 0.
+    pub fn eval_exact(&self, value: &dyn Fn(super::poly::Var) -> Rat) -> Res<Option<Rat>> {
+        let mut d = Rat::ONE;
+        for f in &self.den {
+            d = d.mul(f.eval_exact(value)?)?;
+        }
+        if d.is_zero() {
+            return Ok(None);
+        }
+        Ok(Some(self.num.eval_exact(value)?.mul(d.inv()?)?))
+    }
+
+    /// num · Π den: of the same sign wherever it is defined.
+    pub fn sign_polynomial(&self) -> Res<Poly> {
+        self.num.mul(&self.den_product()?)
+    }
+
     /// Whether it reads variable `v`.
     pub fn reads(&self, v: Var) -> bool {
         self.num.reads(v) || self.den.iter().any(|f| f.reads(v))
