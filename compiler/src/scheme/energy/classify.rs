@@ -55,6 +55,8 @@ pub struct Identity {
     pub step_before: Option<RatFn>,
     /// Whether ½‖u‖²_K is in it (K applied by the `stiffness` slot, not an opaque force).
     pub elastic: bool,
+    /// The weight θ of its levels, x̂ = (1 − θ)·x + θ·x⁻ (generalized-α's α_m).
+    pub weight: Option<RatFn>,
 }
 
 /// Whether a claim holds by the identity, fails with a counterexample, or is not decided by it.
@@ -90,12 +92,13 @@ impl Identity {
             squares.extend(mine);
             cross = cross.or(c.map(|(p, q)| (block, p, q)));
         }
-        Ok(Identity { ansatz, dissipation: Dissipation { squares, cross }, acceleration, step_before, elastic })
+        let weight = ansatz.weight.clone();
+        Ok(Identity { ansatz, dissipation: Dissipation { squares, cross }, acceleration, step_before, elastic, weight })
     }
 
     /// Whether the kept energy is E itself at `params`.
     fn keeps_e_at(&self, params: &[f64]) -> Res<bool> {
-        for c in self.acceleration.iter().chain(&self.step_before) {
+        for c in self.acceleration.iter().chain(&self.step_before).chain(&self.weight) {
             if value_at(c, params)? != Value::Zero {
                 return Ok(false);
             }
@@ -134,6 +137,9 @@ impl Identity {
             }
             if self.step_before.is_some() {
                 parts.push("½‖u - u⁻‖²_K");
+            }
+            if self.weight.is_some() {
+                parts.push("the previous step's states");
             }
             parts.join(" and ")
         };

@@ -23,11 +23,13 @@ pub struct Tested {
     pub nu: Vec<usize>,
 }
 
-/// The kept energy's terms besides E: q_a ½dt²‖a‖²_M, q_δ ½‖u − u⁻‖²_K.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The kept energy's terms besides E: q_a ½dt²‖a‖²_M, q_δ ½‖u − u⁻‖²_K; and its levels'
+/// weight θ (x̂ = (1 − θ)·x + θ·x⁻), if not 0.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Terms {
     pub acceleration: bool,
     pub step_before: bool,
+    pub weight: Option<RatFn>,
 }
 
 /// The ansatz, built and (by [`Ansatz::solve`]) solved.
@@ -41,6 +43,8 @@ pub struct Ansatz {
     pub q_a: Option<usize>,
     /// Its coefficient of ½‖u − u⁻‖²_K, with the previous step's displacement u⁻.
     pub q_delta: Option<usize>,
+    /// The weight θ of its levels, x̂ = (1 − θ)·x + θ·x⁻.
+    pub weight: Option<RatFn>,
     pub unknowns: usize,
     pub d_m: Form,
     pub d_k: Form,
@@ -100,6 +104,16 @@ pub fn derive(ir: &SchemeIr) -> Result<Ansatz, NoIdentity> {
         values.iter().all(|v| *v <= 0.0) && values.iter().any(|v| *v < 0.0)
     };
     let mut last = NoIdentity::Inconsistent;
+    let mut attempt =
+        |w: Window, terms: Terms, previous: &[(usize, usize)], s: &Lin| -> Result<Option<Ansatz>, NoIdentity> {
+            let mut a = Ansatz::new(ir, w, terms, previous)?;
+            match a.solve(s, &negative) {
+                Ok(()) if a.solved.iter().all(|v| v.as_ref().is_some_and(Unk::is_known)) => return Ok(Some(a)),
+                Ok(()) => last = NoIdentity::NotUnique,
+                Err(e) => last = e,
+            }
+            Ok(None)
+        };
     // One step first, E before its corrections.
     let tries = [
         (false, false, false),
@@ -112,14 +126,48 @@ pub fn derive(ir: &SchemeIr) -> Result<Ansatz, NoIdentity> {
     for (with_previous, acceleration, step_before) in tries {
         let (w, previous) = if with_previous { (history.clone(), &previous[..]) } else { (window.clone(), &[][..]) };
         let s = shift(ir, &w, previous)?;
-        let mut a = Ansatz::new(ir, w, Terms { acceleration, step_before }, previous)?;
-        match a.solve(&s, &negative) {
-            Ok(()) if a.solved.iter().all(|v| v.as_ref().is_some_and(Unk::is_known)) => return Ok(a),
-            Ok(()) => last = NoIdentity::NotUnique,
-            Err(e) => last = e,
+        if let Some(a) = attempt(w, Terms { acceleration, step_before, weight: None }, previous, &s)? {
+            return Ok(a);
+        }
+    }
+    // A residual that weighs its inertia over the step's start and end (generalized-α): the
+    // previous step's kinematics too, and the kept energy's levels weighted alike.
+    if let Some(theta) = inertia_weight(ir, &window)? {
+        let states = ir.states.len();
+        let ends: Vec<Lin> = (0..states).map(|i| end_level(ir, &window, i)).collect();
+        let two = window.two_steps(states, &ends)?;
+        let one = shift(ir, &window, &[])?;
+        let s = Lin(one.0.iter().chain(&one.0[states..]).cloned().collect());
+        let previous: Vec<(usize, usize)> = (0..states).map(|i| (i, i)).collect();
+        for (acceleration, step_before) in [(false, false), (true, false), (false, true), (true, true)] {
+            let terms = Terms { acceleration, step_before, weight: Some(theta.clone()) };
+            if let Some(a) = attempt(two.clone(), terms, &previous, &s)? {
+                return Ok(a);
+            }
         }
     }
     Err(last)
+}
+
+/// θ where the last stage's residual weighs its inertia as (1 − θ)·mass(a') + θ·mass(a),
+/// θ ≠ 0, between the acceleration's end and start levels.
+fn inertia_weight(ir: &SchemeIr, window: &Window) -> Result<Option<RatFn>, NoIdentity> {
+    let Some(a) = ir.initial.as_ref().map(|i| i.state) else { return Ok(None) };
+    let Some(last) = window.residuals.last() else { return Ok(None) };
+    let (at_start, at_end) = (window.start[a].clone(), end_level(ir, window, a));
+    let (mut start, mut end) = (RatFn::zero(), RatFn::zero());
+    for t in last.iter().filter(|t| t.form == "mass") {
+        match t.args.as_slice() {
+            [x] if *x == at_start => start = start.add(&t.coef)?,
+            [x] if *x == at_end => end = end.add(&t.coef)?,
+            _ => return Ok(None),
+        }
+    }
+    let total = start.add(&end)?;
+    if start.is_zero() || total.is_zero() {
+        return Ok(None);
+    }
+    Ok(Some(start.div(&total)?))
 }
 
 fn unit(n: usize, i: usize) -> Lin {
@@ -129,8 +177,8 @@ fn unit(n: usize, i: usize) -> Lin {
 /// State `i` at the step's end, over the window's free variables.
 fn end_level(ir: &SchemeIr, window: &Window, i: usize) -> Lin {
     match ir.updates[i] {
-        crate::scheme::affine::Quantity::Stage { stage, index } => window.levels[stage][index].clone(),
-        crate::scheme::affine::Quantity::State(j) => unit(window.free.len(), j),
+        crate::scheme::affine::Quantity::Stage { stage, index } => window.levels[window.offset + stage][index].clone(),
+        crate::scheme::affine::Quantity::State(j) => window.start[j].clone(),
     }
 }
 
@@ -144,6 +192,7 @@ impl Ansatz {
     /// are where its start's own start levels go back to.
     pub fn new(ir: &SchemeIr, window: Window, terms: Terms, previous: &[(usize, usize)]) -> Result<Ansatz, NoIdentity> {
         let n = window.free.len();
+        let start = |i: usize| window.start[i].clone();
         let velocity = ir.states.iter().position(|s| s == "v").ok_or(NoIdentity::NoState("velocity `v`"))?;
         let acceleration = ir.initial.as_ref().map(|i| i.state);
         let end = |i: usize| end_level(ir, &window, i);
@@ -154,6 +203,7 @@ impl Ansatz {
         let mut residuals: Vec<(Option<usize>, Vec<ExactTerm>)> =
             window.residuals.iter().enumerate().map(|(k, t)| (Some(k), t.clone())).collect();
         if acceleration.is_some()
+            && window.offset == 0
             && let Some(last) = window.residuals.last()
         {
             let back = |l: &Lin| {
@@ -177,10 +227,13 @@ impl Ansatz {
                 residuals.insert(0, (None, terms));
             }
         }
-        // The displacement levels: the start's, each stage's stiffness argument that is one of
-        // its levels, the end's.
-        let mut levels: Vec<Lin> = before(0).into_iter().chain([unit(n, 0)]).collect();
+        // The displacement levels: the previous step's start's, each stage's stiffness argument
+        // that is one of its levels (the step's start before this step's stages), the end's.
+        let mut levels: Vec<Lin> = before(0).into_iter().collect();
         for (k, terms) in window.residuals.iter().enumerate() {
+            if k == window.offset && levels.last() != Some(&start(0)) {
+                levels.push(start(0));
+            }
             for t in terms.iter().filter(|t| t.form == "stiffness") {
                 if let [arg] = t.args.as_slice()
                     && window.levels[k].contains(arg)
@@ -231,9 +284,25 @@ impl Ansatz {
         // − ΔQ.
         let minus_half = RatFn::constant(crate::scheme::rational::Rat::new(-1, 2)?);
         let half = minus_half.neg()?;
+        // Q's levels weighted as the residual weighs its inertia (generalized-α's α_m):
+        // x̂ = (1 − θ)·x + θ·x⁻, at the end and at the start.
+        let hat = |now: Lin, then: Option<Lin>| -> Res<Lin> {
+            match (&terms.weight, then) {
+                (Some(theta), Some(then)) => {
+                    let mut out = Lin::zero(n);
+                    for p in 0..n {
+                        let a = now.0[p].mul(&RatFn::one().sub(theta)?)?;
+                        out.0[p] = a.add(&then.0[p].mul(theta)?)?;
+                    }
+                    Ok(out)
+                }
+                _ => Ok(now),
+            }
+        };
         let change = |form: &mut Form, s: &Unk, i: usize| -> Res<()> {
-            form.add_product(&s.scale(&minus_half)?, &end(i), &end(i))?;
-            form.add_product(&s.scale(&half)?, &unit(n, i), &unit(n, i))
+            let (at_end, at_start) = (hat(end(i), Some(start(i)))?, hat(start(i), before(i))?);
+            form.add_product(&s.scale(&minus_half)?, &at_end, &at_end)?;
+            form.add_product(&s.scale(&half)?, &at_start, &at_start)
         };
         let one = Unk::constant(RatFn::one(), unknowns);
         change(&mut d_m, &one, velocity)?;
@@ -249,7 +318,7 @@ impl Ansatz {
         // q_δ ½‖u − u⁻‖²_K: ½‖u' − u‖² at the end, ½‖u − u⁻‖² at the start.
         if let (Some(q), Some(u_before)) = (q_delta, before(0)) {
             let s = Unk::unknown(q, unknowns);
-            let (now, then) = (sub(&end(0), &unit(n, 0))?, sub(&unit(n, 0), &u_before)?);
+            let (now, then) = (sub(&end(0), &start(0))?, sub(&start(0), &u_before)?);
             d_k.add_product(&s.scale(&minus_half)?, &now, &now)?;
             d_k.add_product(&s.scale(&half)?, &then, &then)?;
         }
@@ -260,6 +329,7 @@ impl Ansatz {
             residuals,
             q_a,
             q_delta,
+            weight: terms.weight.clone(),
             unknowns,
             d_m,
             d_k,
@@ -559,14 +629,48 @@ mod tests {
     /// HHT-α keeps E + ½dt²(α²/4)‖a‖²_M + ½α(½ − α)‖u − u⁻‖²_K, with the previous step's
     /// displacement u⁻, and dissipates D = α³dt²/4 ‖Δa‖²_M + ½α(½ − α)‖(u' − u) − (u − u⁻)‖²_K,
     /// exactly at symbolic α; so do its variants, which differ in the contact's levels only.
-    /// Generalized-α needs the previous step's kinematics too: refused.
     #[test]
     fn hht_keeps_its_modified_energy() {
         for name in ["hht", "hht_imex", "hht_unweighted"] {
             hht_s_identity(name);
         }
-        let (_, ga) = super::super::library_schemes().into_iter().find(|(n, _)| n == "genalpha").unwrap();
-        assert!(derive(&ga).is_err(), "generalized-α over one step and its start");
+    }
+
+    /// Generalized-α over two steps, its levels weighted by α_m = (2ρ − 1)/(ρ + 1) as its
+    /// residual weighs its inertia: it keeps Ê + ½dt²(1 − ρ)²/(4(1 + ρ)²)‖â‖²_M +
+    /// ½(1 − ρ)²/(2(1 + ρ)²)‖u − u⁻‖²_K and dissipates D = 3(1 − ρ)³/(4(1 + ρ)³)‖Δu − δu‖²_K +
+    /// dt²(1 − ρ)³/(4(1 + ρ)³)‖Δâ‖²_M, exactly at symbolic ρ: the α-method's balance with the
+    /// weighted sequences (Δu = u' − u, δu = u − u⁻, Δâ = (1 − α_m)(a' − a) + α_m(a − a⁻)).
+    #[test]
+    fn generalized_alpha_keeps_its_weighted_energy() {
+        let (ir, a) = derived("genalpha");
+        let (rho, one) = (RatFn::var(0), RatFn::one());
+        let (p, m) = (one.add(&rho).unwrap(), one.sub(&rho).unwrap());
+        let am = r(2, 1).mul(&rho).unwrap().sub(&one).unwrap().div(&p).unwrap();
+        assert!(a.weight.as_ref().expect("weighted levels").sub(&am).unwrap().is_zero());
+        let ratio2 = m.div(&p).unwrap().powi(2).unwrap();
+        assert!(value(&a, a.q_a.unwrap()).sub(&ratio2.div(&r(4, 1)).unwrap()).unwrap().is_zero());
+        assert!(value(&a, a.q_delta.unwrap()).sub(&ratio2.div(&r(2, 1)).unwrap()).unwrap().is_zero());
+        let w = &a.window;
+        let n = w.free.len();
+        let acc = ir.initial.as_ref().unwrap().state;
+        let before = |i: usize| unit(n, i);
+        let (u0, u1, u2) = (before(0), w.start[0].clone(), end_level(&ir, w, 0));
+        let (a0, a1, a2) = (before(acc), w.start[acc].clone(), end_level(&ir, w, acc));
+        let second = sub(&sub(&u2, &u1).unwrap(), &sub(&u1, &u0).unwrap()).unwrap();
+        let ratio3 = m.div(&p).unwrap().powi(3).unwrap();
+        assert_form(&a.d_k, &[(ratio3.mul(&r(3, 4)).unwrap(), second)], "D on K");
+        let weighted = |x: &Lin, y: &Lin| -> Lin {
+            Lin(x
+                .0
+                .iter()
+                .zip(&y.0)
+                .map(|(x, y)| x.mul(&one.sub(&am).unwrap()).unwrap().add(&y.mul(&am).unwrap()).unwrap())
+                .collect())
+        };
+        let da_hat = sub(&weighted(&a2, &a1), &weighted(&a1, &a0)).unwrap();
+        let dt2 = RatFn::var(super::super::poly::DT).powi(2).unwrap();
+        assert_form(&a.d_m, &[(ratio3.mul(&dt2).unwrap().div(&r(4, 1)).unwrap(), da_hat)], "D on M");
     }
 
     /// HHT's identity for `name` (its variants differ in the contact's levels only).

@@ -2,13 +2,15 @@
 //! algebra: the scheme's scalars as rational functions of its params, dt and t ([`exact`]),
 //! over polynomials kept expanded ([`poly`]) so that a coefficient is zero exactly when it is
 //! the zero polynomial ([`ratfn`]); its step with every level and residual argument an exact
-//! combination of the step's free variables ([`window`]); and the derivation by multipliers
-//! ([`engine`], over the quadratic forms of [`forms`]). Derived exactly so far, from the
-//! residuals at a step's ends and stages (and at the previous step's start where they read
-//! it): Newmark's at symbolic β, γ (Krenk's kept energy and dissipation), central
+//! combination of the step's free variables ([`window`]); the derivation by multipliers
+//! ([`engine`], over the quadratic forms of [`forms`]); the dissipation as a sum of squares
+//! and what it proves, at a point and over the params' ranges ([`classify`], with [`factor`]
+//! and the certified signs of [`sign`]); the printing in the scheme's names ([`names`],
+//! [`print`]) and the `claim energy` check ([`claim`]). Derived exactly for every library
+//! scheme: Newmark's at symbolic β, γ (Krenk's kept energy and dissipation), central
 //! differences' (E − dt²/8‖a‖²_M kept), the midpoint family's (D ≡ 0), TR-BDF2's (E kept, for
-//! every gs) and HHT-α's (with ½α(½ − α)‖u − u⁻‖²_K). Generalized-α's needs the previous step's
-//! kinematics: still to come, as are the classification, the printing and the claim's proof.
+//! every gs), HHT-α's (with ½α(½ − α)‖u − u⁻‖²_K) and generalized-α's (over two steps, its
+//! levels weighted by α_m).
 
 pub mod claim;
 pub mod classify;

@@ -177,32 +177,47 @@ pub fn poly(p: &Poly, names: &[String]) -> String {
 /// The step's named levels over its free variables.
 pub struct Levels {
     pub named: Vec<(Lin, String)>,
+    /// The free variables' names, in order.
+    pub free: Vec<String>,
     pub style: Style,
 }
 
 impl Levels {
     pub fn new(ir: &SchemeIr, window: &Window) -> Levels {
         let n = window.free.len();
+        let stages = ir.stages.len();
+        let free: Vec<String> = window
+            .free
+            .iter()
+            .map(|f| match *f {
+                Free::State(s) => ir.states[s].clone(),
+                Free::Unknown(k) => ir.stages[k].quantities[0].clone(),
+                Free::Previous(s) => format!("{}⁻", ir.states[s]),
+                Free::PreviousUnknown(k) => format!("{}⁻", ir.stages[k].quantities[0]),
+            })
+            .collect();
         let mut named: Vec<(Lin, String)> = Vec::new();
         let mut push = |l: Lin, name: String| {
             if !named.iter().any(|(m, _)| *m == l) {
                 named.push((l, name));
             }
         };
-        for (i, f) in window.free.iter().enumerate() {
-            let name = match *f {
-                Free::State(s) => ir.states[s].clone(),
-                Free::Unknown(k) => ir.stages[k].quantities[0].clone(),
-                Free::Previous(s) => format!("{}⁻", ir.states[s]),
-            };
-            push(Lin::unit(n, i), name);
+        // The states at the step's start first: the previous step's end levels are these.
+        for (l, name) in window.start.iter().zip(&ir.states) {
+            push(l.clone(), name.clone());
         }
-        for (k, stage) in ir.stages.iter().enumerate() {
-            for (l, name) in window.levels[k].iter().zip(&stage.quantities) {
-                push(l.clone(), name.clone());
+        for (i, name) in free.iter().enumerate() {
+            push(Lin::unit(n, i), name.clone());
+        }
+        for (k, levels) in window.levels.iter().enumerate() {
+            let (stage, back) = if k < window.offset { (k, "⁻") } else { (k - window.offset, "") };
+            if stage < stages {
+                for (l, name) in levels.iter().zip(&ir.stages[stage].quantities) {
+                    push(l.clone(), format!("{name}{back}"));
+                }
             }
         }
-        Levels { named, style: Style::of(ir) }
+        Levels { named, free, style: Style::of(ir) }
     }
 
     /// A level's name, if it is one.
@@ -292,6 +307,7 @@ pub fn combination(parts: &[(RatFn, String)], style: &Style) -> String {
         return text;
     }
     let over = style.coefficient(&s);
+    let over = if over.contains(['*', '/']) && !over.starts_with('(') { format!("({over})") } else { over };
     if parts.iter().filter(|(c, _)| !c.is_zero()).count() > 1 {
         format!("({text})/{over}")
     } else {
@@ -328,7 +344,7 @@ pub fn cleared(parts: &[(RatFn, String)], style: &Style) -> (String, RatFn) {
 
 /// s with the coefficients times s polynomials with integer coefficients and no common factor,
 /// the first not printed with a minus; 1/c for one coefficient c.
-fn normalizer(parts: &[&(RatFn, String)], style: &Style) -> Res<RatFn> {
+pub fn normalizer(parts: &[&(RatFn, String)], style: &Style) -> Res<RatFn> {
     if let [(c, _)] = parts {
         return c.inv();
     }

@@ -93,8 +93,10 @@ impl<'a> Printer<'a> {
         match stage {
             None => format!("{} at t (the previous step's, at this one's start)", self.last_stage()),
             Some(k) => {
-                let s = &self.ir.stages[k];
-                format!("{} at {}", s.name, self.r(&self.id.ansatz.window.times[k]))
+                let w = &self.id.ansatz.window;
+                let (stage, back) = if k < w.offset { (k, " (the previous step's)") } else { (k - w.offset, "") };
+                let name = self.ir.stages.get(stage).map_or("?", |s| s.name.as_str());
+                format!("{name} at {}{back}", self.r(&w.times[k]))
             }
         }
     }
@@ -105,9 +107,10 @@ impl<'a> Printer<'a> {
 
     fn kept(&self) -> String {
         let (id, u, v) = (self.id, self.state(0), self.velocity());
-        let mut text = format!("½‖{v}‖²_M");
+        let hat = if id.weight.is_some() { "\u{302}" } else { "" };
+        let mut text = format!("½‖{v}{hat}‖²_M");
         if id.elastic {
-            text.push_str(&format!(" + ½‖{u}‖²_K"));
+            text.push_str(&format!(" + ½‖{u}{hat}‖²_K"));
         }
         let mut add = |q: &RatFn, what: String| {
             let c = self.c(q);
@@ -117,10 +120,16 @@ impl<'a> Printer<'a> {
             }
         };
         if let (Some(q), Some(a)) = (&id.acceleration, self.acceleration()) {
-            add(q, format!("½dt²‖{a}‖²_M"));
+            add(q, format!("½dt²‖{a}{hat}‖²_M"));
         }
         if let Some(q) = &id.step_before {
             add(q, format!("½‖{u} - {u}⁻‖²_K"));
+        }
+        if let Some(theta) = &id.weight {
+            text.push_str(&format!(
+                ", x{hat} = (1 - θ)·x + θ·x⁻ with θ = {} (the residual's weight of its inertia)",
+                self.r(theta)
+            ));
         }
         if !id.elastic {
             text.push_str("  (the stiffness is a force of the scheme's own slot: its work is in W)");
@@ -150,14 +159,19 @@ impl<'a> Printer<'a> {
                 Some(x) => of.push(x),
                 None if nu.iter().all(RatFn::is_zero) => of.push((usize::MAX, RatFn::zero())),
                 None => {
-                    // A single increment is the test vector itself, its multiplier the residual's.
-                    let first = match nonzero(&nu)[..] {
-                        [j] => nu[j].clone(),
-                        _ => RatFn::one(),
+                    // A single increment is the test vector itself, its multiplier the residual's;
+                    // several are cleared to coprime polynomial coefficients.
+                    let scale = match nonzero(&nu)[..] {
+                        [j] => nu[j].inv().unwrap_or_else(|_| RatFn::one()),
+                        _ => {
+                            let parts: Vec<(RatFn, String)> = nu.iter().map(|c| (c.clone(), String::new())).collect();
+                            let refs: Vec<&(RatFn, String)> = parts.iter().filter(|(c, _)| !c.is_zero()).collect();
+                            super::names::normalizer(&refs, &self.levels.style).unwrap_or_else(|_| RatFn::one())
+                        }
                     };
-                    let base = nu.iter().map(|c| c.div(&first).unwrap_or_else(|_| c.clone())).collect();
+                    let base = nu.iter().map(|c| c.mul(&scale).unwrap_or_else(|_| c.clone())).collect();
                     bases.push(base);
-                    of.push((bases.len() - 1, first));
+                    of.push((bases.len() - 1, scale.inv().unwrap_or_else(|_| RatFn::one())));
                 }
             }
         }
@@ -179,8 +193,10 @@ impl<'a> Printer<'a> {
         }
     }
 
-    fn work(&self) -> Vec<String> {
-        let (bases, of) = self.weights();
+    /// The test vectors and the work through each (test vector, slot): a named test vector
+    /// (w1, …) carries the common factor of its items, so that they are coprime polynomials.
+    fn groups(&self) -> (Vec<Vec<RatFn>>, Vec<Group>) {
+        let (mut bases, of) = self.weights();
         // Per weight and slot, the items: coefficient, argument text.
         let mut groups: Vec<Group> = Vec::new();
         for (r, (b, c)) in self.id.ansatz.residuals.iter().zip(&of) {
@@ -212,6 +228,34 @@ impl<'a> Printer<'a> {
                 }
             }
         }
+        for (b, base) in bases.iter_mut().enumerate() {
+            if nonzero(base).len() < 2 {
+                continue;
+            }
+            let items: Vec<&(RatFn, String)> =
+                groups.iter().filter(|g| g.0 == b).flat_map(|g| &g.2).filter(|(c, _)| !c.is_zero()).collect();
+            let Ok(s) = super::names::normalizer(&items, &self.levels.style) else { continue };
+            // Signed so that the test vector's first coefficient is positive.
+            let first = base.iter().find(|c| !c.is_zero()).cloned().unwrap_or_else(RatFn::one);
+            let s = match first.div(&s) {
+                Ok(f) if self.negative(&f) => s.neg().unwrap_or(s),
+                _ => s,
+            };
+            let Ok(inv) = s.inv() else { continue };
+            for g in groups.iter_mut().filter(|g| g.0 == b) {
+                for (c, _) in g.2.iter_mut() {
+                    *c = c.mul(&s).unwrap_or_else(|_| c.clone());
+                }
+            }
+            for c in base.iter_mut() {
+                *c = c.mul(&inv).unwrap_or_else(|_| c.clone());
+            }
+        }
+        (bases, groups)
+    }
+
+    fn work(&self) -> Vec<String> {
+        let (bases, groups) = self.groups();
         let mut lines = Vec::new();
         for (i, (b, _, items)) in groups.iter().enumerate() {
             let items: Vec<&(RatFn, String)> = items.iter().filter(|(c, _)| !c.is_zero()).collect();
@@ -258,7 +302,22 @@ impl<'a> Printer<'a> {
         match block {
             Block::Stiffness => self.id.ansatz.levels.clone(),
             Block::Mass => {
-                let mut chain: Vec<Lin> = Vec::new();
+                // The acceleration's previous and start levels first, where the residuals read them.
+                let w = &self.id.ansatz.window;
+                let a = self.ir.initial.as_ref().map_or(0, |i| i.state);
+                let before = w
+                    .free
+                    .iter()
+                    .position(|f| *f == super::window::Free::Previous(a))
+                    .map(|v| Lin::unit(w.free.len(), v));
+                let read = |l: &Lin| {
+                    self.id
+                        .ansatz
+                        .residuals
+                        .iter()
+                        .any(|r| r.terms.iter().any(|t| t.form == "mass" && t.args.first() == Some(l)))
+                };
+                let mut chain: Vec<Lin> = before.into_iter().chain([w.start[a].clone()]).filter(|l| read(l)).collect();
                 for r in &self.id.ansatz.residuals {
                     for t in r.terms.iter().filter(|t| t.form == "mass") {
                         if let [a] = t.args.as_slice()
@@ -316,7 +375,7 @@ impl<'a> Printer<'a> {
     }
 
     fn legend(&self) -> Vec<String> {
-        let (bases, _) = self.weights();
+        let (bases, _) = self.groups();
         let mut out = Vec::new();
         for (b, base) in bases.iter().enumerate() {
             let name = self.weight_name(&bases, b);
@@ -326,8 +385,10 @@ impl<'a> Printer<'a> {
                 out.push(format!("{name} = {}", super::names::combination(&parts, &self.levels.style)));
             }
         }
-        if self.levels.named.iter().any(|(_, n)| n.ends_with('⁻')) {
-            out.push(format!("{}⁻: {} at the previous step's start", self.state(0), self.state(0)));
+        if self.id.ansatz.window.offset > 0 {
+            out.push("x⁻: x at the previous step's start; the identity holds from the second step on".into());
+        } else if self.levels.named.iter().any(|(_, n)| n.ends_with('⁻')) {
+            out.push(format!("{0}⁻: {0} at the previous step's start ({0}⁻ = {0} on the first step)", self.state(0)));
         }
         out
     }

@@ -8,13 +8,15 @@ use super::ratfn::RatFn;
 use crate::scheme::affine::{Affine, Quantity};
 use crate::scheme::ir::SchemeIr;
 
-/// A free variable of a step: a state at its start, a stage's unknown, or a state at the
-/// previous step's start (what the α-methods' residuals read at the step's start).
+/// A free variable of a step: a state at its start, a stage's unknown, a state at the
+/// previous step's start (what the α-methods' residuals read at the step's start), or a stage's
+/// unknown of the previous step (when the window spans it, [`Window::two_steps`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Free {
     State(usize),
     Unknown(usize),
     Previous(usize),
+    PreviousUnknown(usize),
 }
 
 /// Σ coefficient · free variable, one coefficient per variable of the window.
@@ -68,6 +70,11 @@ pub struct Window {
     pub residuals: Vec<Vec<ExactTerm>>,
     /// Per stage, its time.
     pub times: Vec<RatFn>,
+    /// Each state at the step's start: a free variable, or the previous step's end.
+    pub start: Vec<Lin>,
+    /// The index of this step's first stage in `levels`, `residuals` and `times` (those
+    /// before it are the previous step's).
+    pub offset: usize,
 }
 
 impl Window {
@@ -83,8 +90,62 @@ impl Window {
             .iter()
             .map(|r| r.iter().map(|t| ExactTerm { args: t.args.iter().map(grow).collect(), ..t.clone() }).collect())
             .collect();
-        let window = Window { free, levels, residuals, times: self.times.clone() };
+        let start = self.start.iter().map(grow).collect();
+        let window = Window { free, levels, residuals, times: self.times.clone(), start, offset: self.offset };
         (window, (n..n + states.len()).collect())
+    }
+
+    /// The previous step and this one (of a one-step window with `states` states): the free
+    /// variables are the states at the previous step's start, its stages' unknowns and this
+    /// step's; this step starts where the previous one ends (`ends`: each state's end level
+    /// over the one-step window). The previous step's times are one dt back.
+    pub fn two_steps(&self, states: usize, ends: &[Lin]) -> Result<Window, crate::scheme::rational::GiveUp> {
+        let stages = self.free.len() - states;
+        let free: Vec<Free> = (0..states)
+            .map(Free::Previous)
+            .chain((0..stages).map(Free::PreviousUnknown))
+            .chain((0..stages).map(Free::Unknown))
+            .collect();
+        let n = free.len();
+        // The previous step: states → Previous, unknowns → PreviousUnknown.
+        let back = |l: &Lin| Lin(l.0.iter().cloned().chain((0..stages).map(|_| RatFn::zero())).collect());
+        let start: Vec<Lin> = ends.iter().map(back).collect();
+        // This step: state i → the previous step's end of i, unknown k → Unknown(k).
+        let now = |l: &Lin| -> Result<Lin, crate::scheme::rational::GiveUp> {
+            let mut out = Lin::zero(n);
+            for (i, c) in l.0[..states].iter().enumerate() {
+                out.add_scaled(c, &start[i])?;
+            }
+            for (k, c) in l.0[states..].iter().enumerate() {
+                out.add_scaled(c, &Lin::unit(n, states + stages + k))?;
+            }
+            Ok(out)
+        };
+        let dt = RatFn::var(super::poly::DT);
+        let mut levels: Vec<Vec<Lin>> = self.levels.iter().map(|s| s.iter().map(back).collect()).collect();
+        let mut residuals: Vec<Vec<ExactTerm>> = Vec::new();
+        for r in &self.residuals {
+            let mut terms = Vec::new();
+            for t in r {
+                let args = t.args.iter().map(back).collect();
+                terms.push(ExactTerm { args, time: t.time.sub(&dt)?, ..t.clone() });
+            }
+            residuals.push(terms);
+        }
+        let mut times: Vec<RatFn> = self.times.iter().map(|t| t.sub(&dt)).collect::<Result<_, _>>()?;
+        for s in &self.levels {
+            levels.push(s.iter().map(now).collect::<Result<_, _>>()?);
+        }
+        for r in &self.residuals {
+            let mut terms = Vec::new();
+            for t in r {
+                let args = t.args.iter().map(now).collect::<Result<_, _>>()?;
+                terms.push(ExactTerm { args, ..t.clone() });
+            }
+            residuals.push(terms);
+        }
+        times.extend(self.times.iter().cloned());
+        Ok(Window { free, levels, residuals, times, start, offset: self.levels.len() })
     }
 }
 
@@ -133,7 +194,8 @@ pub fn window(ir: &SchemeIr) -> Result<Window, Refusal> {
         residuals.push(terms);
         times.push(exact.of(&ir.graph, stage.time)?);
     }
-    Ok(Window { free, levels, residuals, times })
+    let start = (0..ir.states.len()).map(|i| Lin::unit(n, i)).collect();
+    Ok(Window { free, levels, residuals, times, start, offset: 0 })
 }
 
 #[cfg(test)]
