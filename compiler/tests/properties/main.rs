@@ -3,6 +3,7 @@
 //! their derivatives (the tensor functions also their identities).
 
 mod derivative;
+mod energy_identity;
 mod friction_builtins;
 mod no_panic;
 mod points;
