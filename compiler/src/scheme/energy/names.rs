@@ -52,9 +52,11 @@ pub fn ratfn_in(r: &RatFn, names: &[String], region: Option<&Region>) -> String 
         (true, _) => 1,
         (false, true) => 2,
     });
-    // A negative constant left goes into a factor of odd power (1 - gam rather than -(gam - 1)).
+    // A negative constant left goes into a factor of odd power (1 - gam rather than -(gam - 1)),
+    // unless the factor is proved ≥ 0 over the region.
+    let stays_signed = |p: &Poly| region.is_some_and(|r| r.sign(p).is_ok_and(|s| s.nonnegative));
     if constant.signum() < 0
-        && let Some((p, _)) = num.iter_mut().find(|(p, e)| e % 2 == 1 && p.terms().count() > 1)
+        && let Some((p, _)) = num.iter_mut().find(|(p, e)| e % 2 == 1 && p.terms().count() > 1 && !stays_signed(p))
     {
         let e = 1;
         flip(p, e, &mut constant);
@@ -79,7 +81,7 @@ pub fn ratfn_in(r: &RatFn, names: &[String], region: Option<&Region>) -> String 
 }
 
 /// How coefficients are shown: the params' names, the region whose signs orient factors, and
-/// the point (the defaults) whose signs decide what is written with a minus in front.
+/// the point (the defaults) whose values orient a combination.
 #[derive(Clone, Debug, Default)]
 pub struct Style {
     pub params: Vec<String>,
@@ -105,9 +107,9 @@ impl Style {
         parenthesised(self.ratfn(r))
     }
 
-    /// Whether `r` is negative at the style's point (dt = 1): shown as −(−r).
+    /// Whether `r` is written with a minus in front.
     pub fn negative(&self, r: &RatFn) -> bool {
-        !r.is_zero() && r.eval(&self.at, 1.0, 0.0) < 0.0
+        self.ratfn(r).starts_with('-')
     }
 }
 
@@ -303,16 +305,17 @@ pub fn solve(l: &Lin, basis: &[Lin]) -> Res<Option<Vec<RatFn>>> {
 /// `((1 - gs)*(um - u) - gs*(u' - um))/(1 - gs)`.
 pub fn combination(parts: &[(RatFn, String)], style: &Style) -> String {
     let (text, s) = cleared(parts, style);
+    // A negative denominator is written as a sign in front.
+    let (minus, s) = if style.ratfn(&s).starts_with('-') { ("-", s.neg().unwrap_or(s)) } else { ("", s) };
+    let several = parts.iter().filter(|(c, _)| !c.is_zero()).count() > 1;
+    let body =
+        if several && (!minus.is_empty() || s.as_constant() != Some(Rat::ONE)) { format!("({text})") } else { text };
     if s.as_constant() == Some(Rat::ONE) {
-        return text;
+        return format!("{minus}{body}");
     }
     let over = style.coefficient(&s);
     let over = if over.contains(['*', '/']) && !over.starts_with('(') { format!("({over})") } else { over };
-    if parts.iter().filter(|(c, _)| !c.is_zero()).count() > 1 {
-        format!("({text})/{over}")
-    } else {
-        format!("{text}/{over}")
-    }
+    format!("{minus}{body}/{over}")
 }
 
 /// s·Σ c_i·name_i as text, and s: the common denominator that makes every coefficient a
@@ -328,9 +331,11 @@ pub fn cleared(parts: &[(RatFn, String)], style: &Style) -> (String, RatFn) {
         let c = c.mul(&s).unwrap_or_else(|_| c.clone());
         let alone = parts.len() == 1 && c.as_constant() == Some(Rat::ONE);
         let name = if name.contains(' ') && !alone { format!("({name})") } else { name.clone() };
-        let negative = style.negative(&c);
-        let c = if negative { c.neg().unwrap_or(c) } else { c };
-        let magnitude = style.coefficient(&c);
+        let text = style.coefficient(&c);
+        let (negative, magnitude) = match text.strip_prefix('-') {
+            Some(rest) => (true, rest.to_string()),
+            None => (false, text),
+        };
         let text = if magnitude == "1" { name } else { format!("{magnitude}*{name}") };
         match (i, negative) {
             (0, false) => out.push_str(&text),
@@ -343,7 +348,7 @@ pub fn cleared(parts: &[(RatFn, String)], style: &Style) -> (String, RatFn) {
 }
 
 /// s with the coefficients times s polynomials with integer coefficients and no common factor,
-/// the first not printed with a minus; 1/c for one coefficient c.
+/// summing to a positive value at the defaults; 1/c for one coefficient c.
 pub fn normalizer(parts: &[&(RatFn, String)], style: &Style) -> Res<RatFn> {
     if let [(c, _)] = parts {
         return c.inv();
@@ -359,7 +364,12 @@ pub fn normalizer(parts: &[&(RatFn, String)], style: &Style) -> Res<RatFn> {
         g = g.mul(&RatFn::poly(p.clone()).powi(least as i32)?)?;
     }
     let s = s.div(&g)?;
-    if style.negative(&parts[0].0.mul(&s)?) { s.neg() } else { Ok(s) }
+    // Signed so that the coefficients sum to a positive value at the defaults.
+    let mut sum = 0.0;
+    for (c, _) in parts {
+        sum += c.mul(&s)?.eval(&style.at, 1.0, 0.0);
+    }
+    if sum < 0.0 { s.neg() } else { Ok(s) }
 }
 
 /// s with every coefficient times s a polynomial with integer coefficients: the product of

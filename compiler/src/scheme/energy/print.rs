@@ -72,7 +72,12 @@ impl<'a> Printer<'a> {
         out
     }
 
-    /// Whether `r` is negative at the defaults (and dt = 1): its sign is shown outside.
+    /// Whether `r` is negative at the defaults (dt = 1).
+    fn below_zero(&self, r: &RatFn) -> bool {
+        r.eval(&self.levels.style.at, 1.0, 0.0) < 0.0
+    }
+
+    /// Whether `r` is written with a minus in front: its sign is shown outside.
     fn negative(&self, r: &RatFn) -> bool {
         self.levels.style.negative(r)
     }
@@ -235,11 +240,22 @@ impl<'a> Printer<'a> {
             let items: Vec<&(RatFn, String)> =
                 groups.iter().filter(|g| g.0 == b).flat_map(|g| &g.2).filter(|(c, _)| !c.is_zero()).collect();
             let Ok(s) = super::names::normalizer(&items, &self.levels.style) else { continue };
-            // Signed so that the test vector's first coefficient is positive.
-            let first = base.iter().find(|c| !c.is_zero()).cloned().unwrap_or_else(RatFn::one);
-            let s = match first.div(&s) {
-                Ok(f) if self.negative(&f) => s.neg().unwrap_or(s),
-                _ => s,
+            // Signed so that the work of the loads (a slot applied to a time alone) comes in
+            // with a positive first coefficient, or else the test vector's first is positive.
+            let load = groups
+                .iter()
+                .filter(|g| g.0 == b)
+                .find(|g| self.ir.slots.iter().any(|u| u.name == g.1 && u.fields == 0));
+            let s = match load.and_then(|g| g.2.iter().find(|(c, _)| !c.is_zero())) {
+                Some((c, _)) if self.below_zero(&c.mul(&s).unwrap_or_else(|_| c.clone())) => s.neg().unwrap_or(s),
+                Some(_) => s,
+                None => {
+                    let first = base.iter().find(|c| !c.is_zero()).cloned().unwrap_or_else(RatFn::one);
+                    match first.div(&s) {
+                        Ok(f) if self.below_zero(&f) => s.neg().unwrap_or(s),
+                        _ => s,
+                    }
+                }
             };
             let Ok(inv) = s.inv() else { continue };
             for g in groups.iter_mut().filter(|g| g.0 == b) {
@@ -262,9 +278,11 @@ impl<'a> Printer<'a> {
             if items.is_empty() {
                 continue;
             }
-            // The bracket's sign out front when its first coefficient is negative (at the
-            // defaults), each item's where its own is.
-            let negative = self.negative(&items[0].0);
+            // The bracket's sign out front when its coefficients sum to a negative value at the
+            // defaults (a contact force's work against the motion), each item's where it is
+            // written with a minus.
+            let defaults: Vec<f64> = self.ir.params.iter().map(|p| p.default).collect();
+            let negative = items.iter().map(|(c, _)| c.eval(&defaults, 1.0, 0.0)).sum::<f64>() < 0.0;
             let mut inside = String::new();
             for (k, (c, item)) in items.iter().enumerate() {
                 let c = if negative { c.neg().unwrap_or_else(|_| c.clone()) } else { c.clone() };
@@ -349,11 +367,18 @@ impl<'a> Printer<'a> {
                         (c, format!("{} - {}", self.levels.vector(&chain[j + 1]), self.levels.vector(&chain[j])))
                     })
                     .collect();
-                cleared(&parts, &self.levels.style)
+                // A square is even: its vector is written with a positive first term.
+                let (text, scale) = cleared(&parts, &self.levels.style);
+                if text.starts_with('-') {
+                    let negated: Vec<(RatFn, String)> =
+                        parts.iter().map(|(c, n)| (c.neg().unwrap_or_else(|_| c.clone()), n.clone())).collect();
+                    cleared(&negated, &self.levels.style)
+                } else {
+                    (text, scale)
+                }
             }
             None => (self.levels.vector(&s.vector), RatFn::one()),
         };
-        let text = text.strip_prefix('-').map(str::to_string).unwrap_or(text);
         let coef = s.coef.div(&scale.powi(2).unwrap_or_else(|_| RatFn::one())).unwrap_or_else(|_| s.coef.clone());
         (coef, format!("‖{text}‖²_{}", s.block.letter()))
     }
@@ -370,8 +395,16 @@ impl<'a> Printer<'a> {
                 n[p].1
             );
         }
-        let parts: Vec<String> = d.squares.iter().map(|s| self.described(s)).collect();
-        if parts.is_empty() { "0".into() } else { parts.join(" + ") }
+        let mut out = String::new();
+        for (i, s) in d.squares.iter().enumerate() {
+            let text = self.described(s);
+            match (i, text.strip_prefix('-')) {
+                (0, _) => out.push_str(&text),
+                (_, Some(rest)) => out.push_str(&format!(" - {rest}")),
+                (_, None) => out.push_str(&format!(" + {text}")),
+            }
+        }
+        if out.is_empty() { "0".into() } else { out }
     }
 
     fn legend(&self) -> Vec<String> {

@@ -78,8 +78,9 @@ impl Region {
         let vars: Vec<Var> = boxes.iter().map(|(v, _)| *v).collect();
         let mut sign = Sign { nonnegative: true, nonpositive: true, negative_at: None };
         self.decide(&rest, &vars, lo, hi, DEPTH, &mut sign, &boxes)?;
+        // p = (−m)·(−rest) with −m ≥ 0: p has the sign of the negated rest; its witnesses are
+        // looked for on p itself.
         if flip {
-            std::mem::swap(&mut sign.nonnegative, &mut sign.nonpositive);
             sign.negative_at = None;
         }
         if sign.negative_at.is_none() && !sign.nonnegative {
