@@ -473,10 +473,26 @@ impl FilesInUse {
         Ok(self.scheme_ir()?.and_then(|ir| ir.energy))
     }
 
-    /// Both, from one reading of the scheme's file.
+    /// What the scheme's energy identity proves of the law its file claims, at the params in
+    /// use (`verify --scheme` shows it beside the law it samples).
+    pub fn scheme_energy_proof(&self) -> Result<Option<String>, CaseError> {
+        let params = self.forms.params.scheme_values(self.scheme.params());
+        Ok(self.scheme_ir()?.and_then(|ir| {
+            let law = ir.energy?;
+            Some(crate::compiler::scheme::energy::claim::verdict(&ir, law, &params))
+        }))
+    }
+
+    /// Both, from one reading of the scheme's file, the law as a run holds the scheme to it at
+    /// the params in use: the claim where its energy identity proves it there (or does not
+    /// decide), else the law the identity proves, or none.
     pub fn scheme_claims_and_law(&self) -> Result<ClaimsAndLaw, CaseError> {
         let params = self.forms.params.scheme_values(self.scheme.params());
-        Ok(self.scheme_ir()?.map_or((Vec::new(), None), |ir| (ir.claims_at(&params), ir.energy)))
+        Ok(self.scheme_ir()?.map_or((Vec::new(), None), |ir| {
+            let law =
+                ir.energy.and_then(|claimed| crate::compiler::scheme::energy::claim::law_at(&ir, claimed, &params));
+            (ir.claims_at(&params), law)
+        }))
     }
 
     /// The scheme's compiled file (none for a scheme compiled by a crate of its own: there is

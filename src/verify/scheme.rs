@@ -98,6 +98,8 @@ pub struct SchemeVerification {
     pub stability_limit: Option<f64>,
     /// The energy law the file claims.
     pub energy_law: Option<String>,
+    /// What the scheme's derived energy identity proves of that law at these params.
+    pub energy_proof: Option<String>,
     pub verdicts: Vec<Verdict>,
 }
 
@@ -226,6 +228,7 @@ pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVe
         disc_setting,
         stability_limit,
         energy_law: law.map(|l| l.name().to_string()),
+        energy_proof: in_use.scheme_energy_proof()?,
         verdicts,
     })
 }
@@ -430,6 +433,12 @@ impl SchemeVerification {
                 );
             }
             s.push('\n');
+        }
+        if let (Some(law), Some(proof)) = (&self.energy_law, &self.energy_proof) {
+            let _ = writeln!(
+                s,
+                "The claim `energy = {law}` by the scheme's energy identity (`signorini emit --stage energy`) at these params: {proof}.\n"
+            );
         }
         let _ = writeln!(s, "## Oscillator ü + u = 0\n\n| Δt | \\|u(10) − cos 10\\| |\n|---|---|");
         for (dt, e) in &self.oscillator {

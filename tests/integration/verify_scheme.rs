@@ -123,3 +123,32 @@ fn damping_applied_explicitly_costs_an_order_on_the_damped_oscillator() {
     let damped = explicit.verdicts.iter().find(|v| v.claim == "order (damped)").unwrap();
     assert!(!damped.holds && !explicit.holds(), "{:?}", explicit.verdicts);
 }
+
+/// Newmark with γ = 0.6 that claims to dissipate: its energy identity proves the claim where
+/// β = γ/2 and refutes it at β = 1/4 (an acceleration square of negative coefficient), and the
+/// oscillator's sampling agrees both times.
+const DISSIPATIVE_NEWMARK: &str = "
+scheme newmark_damped(beta = 0.3 in (0, 1/2], gam = 0.6 in [1/2, 1]) {
+  uses mass, stiffness, contact, load
+  state u, v, a
+  claim energy = dissipative
+  initial a: mass(a) + stiffness(u) + contact(u) == load(t)
+  unknown u'
+  relate u' = u + dt*v + dt^2/2*((1 - 2*beta)*a + 2*beta*a')
+  relate v' = v + dt*((1 - gam)*a + gam*a')
+  residual mass(a') + stiffness(u') + contact(u') == load(t + dt)
+}
+";
+
+#[test]
+fn the_energy_law_proved_and_the_energy_law_sampled_agree() {
+    let path = write("newmark_damped.wf", DISSIPATIVE_NEWMARK);
+    let methods = Methods { scheme: path, ..Methods::default() };
+    let v = scheme::run(&methods, &mut |_| {}).unwrap();
+    assert_eq!(v.energy_proof.as_deref(), Some("proved"));
+    assert!(v.holds(), "{:?}", v.verdicts);
+    let v = scheme::run(&methods.set("beta", 0.25), &mut |_| {}).unwrap();
+    let proof = v.energy_proof.clone().unwrap();
+    assert!(proof.starts_with("refuted") && proof.contains("‖a' - a‖²_M"), "{proof}");
+    assert!(!v.holds(), "the oscillator gains energy at ωΔt = 10: {:?}", v.verdicts);
+}

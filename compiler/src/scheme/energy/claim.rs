@@ -49,3 +49,49 @@ pub fn check(ir: &SchemeIr, law: EnergyLaw, span: Span) -> Option<Diagnostic> {
         ),
     )
 }
+
+/// The energy law a run at `params` holds `ir` to, from its claim `claimed`: the claim where the
+/// identity proves it or does not decide it there; where it refutes it, the law it proves
+/// instead (Newmark claims `conserving` at its defaults and dissipates with gam > 1/2), or none.
+pub fn law_at(ir: &SchemeIr, claimed: EnergyLaw, params: &[f64]) -> Option<EnergyLaw> {
+    let Ok(id) = Identity::derive(ir) else { return Some(claimed) };
+    let shown = |_: &super::classify::Square| String::new();
+    match id.proves(claimed, params, &shown) {
+        Ok(Proof::Holds | Proof::Undecided(_)) | Err(_) => Some(claimed),
+        Ok(Proof::Fails(_)) => {
+            EnergyLaw::ALL.into_iter().find(|&law| law != claimed && id.proves(law, params, &shown) == Ok(Proof::Holds))
+        }
+    }
+}
+
+/// What the identity says of `law` at `params`, in a sentence: proved, refuted (why),
+/// undecided (why), or why there is no identity.
+pub fn verdict(ir: &SchemeIr, law: EnergyLaw, params: &[f64]) -> String {
+    let id = match Identity::derive(ir) {
+        Ok(id) => id,
+        Err(e) => return format!("no energy identity: {}", super::why(ir, &e)),
+    };
+    let printer = Printer::new(ir, &id);
+    match id.proves(law, params, &|s| printer.described(s)) {
+        Ok(Proof::Holds) => "proved".into(),
+        Ok(Proof::Fails(why)) => format!("refuted: {why}"),
+        Ok(Proof::Undecided(why)) => format!("undecided: {why}"),
+        Err(_) => "undecided: the exact coefficients overflow".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Newmark claims `conserving` at β = ¼, γ = ½; a run at γ = 0.6 is held to `dissipative`
+    /// where β = γ/2 proves it, and to no law where β = ¼ makes D indefinite.
+    #[test]
+    fn a_run_is_held_to_the_law_its_params_prove() {
+        let (_, ir) = super::super::library_schemes().into_iter().find(|(n, _)| n == "newmark").unwrap();
+        let claimed = ir.energy.expect("newmark claims an energy law");
+        assert_eq!(law_at(&ir, claimed, &[0.25, 0.5]), Some(EnergyLaw::Conserving));
+        assert_eq!(law_at(&ir, claimed, &[0.3, 0.6]), Some(EnergyLaw::Dissipative));
+        assert_eq!(law_at(&ir, claimed, &[0.25, 0.6]), None);
+    }
+}

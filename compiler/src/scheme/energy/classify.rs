@@ -8,7 +8,7 @@ use super::engine::Ansatz;
 use super::forms::Form;
 use super::poly::DT;
 use super::ratfn::RatFn;
-use super::sign::{Interval, Region, Sign};
+use super::sign::{Region, Sign};
 use super::window::Lin;
 use crate::check::EnergyLaw;
 use crate::scheme::ir::SchemeIr;
@@ -202,24 +202,6 @@ fn value_at(r: &RatFn, params: &[f64]) -> Res<Value> {
     } else {
         Value::Positive
     })
-}
-
-/// The params' declared ranges, exactly where they are finite small rationals.
-pub fn region(ir: &SchemeIr) -> Region {
-    Region(
-        ir.params
-            .iter()
-            .map(|p| {
-                let r = p.range?;
-                Some(Interval {
-                    lo: Rat::from_f64(r.lo)?,
-                    lo_closed: r.lo_closed,
-                    hi: Rat::from_f64(r.hi)?,
-                    hi_closed: r.hi_closed,
-                })
-            })
-            .collect(),
-    )
 }
 
 /// The sign of `r` over `region` (dt > 0): factor by factor where each factor's is certified,

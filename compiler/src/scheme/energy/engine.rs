@@ -149,19 +149,28 @@ pub fn derive(ir: &SchemeIr) -> Result<Ansatz, NoIdentity> {
     Err(last)
 }
 
-/// θ where the last stage's residual weighs its inertia as (1 − θ)·mass(a') + θ·mass(a),
-/// θ ≠ 0, between the acceleration's end and start levels.
+/// θ where the last stage's residual weighs its inertia as (1 − θ)·mass(a') + θ·mass(a)
+/// (in one term or two), θ ≠ 0, between the acceleration's end and start levels.
 fn inertia_weight(ir: &SchemeIr, window: &Window) -> Result<Option<RatFn>, NoIdentity> {
     let Some(a) = ir.initial.as_ref().map(|i| i.state) else { return Ok(None) };
     let Some(last) = window.residuals.last() else { return Ok(None) };
     let (at_start, at_end) = (window.start[a].clone(), end_level(ir, window, a));
     let (mut start, mut end) = (RatFn::zero(), RatFn::zero());
     for t in last.iter().filter(|t| t.form == "mass") {
-        match t.args.as_slice() {
-            [x] if *x == at_start => start = start.add(&t.coef)?,
-            [x] if *x == at_end => end = end.add(&t.coef)?,
-            _ => return Ok(None),
+        // Its argument as x·a' + y·a (`mass((1 - am)*a' + am*a)` as well as two terms).
+        let [arg] = t.args.as_slice() else { return Ok(None) };
+        let Some(c) = super::forms::solve(arg, &[at_end.clone(), at_start.clone()])? else { return Ok(None) };
+        let back = Lin(at_end
+            .0
+            .iter()
+            .zip(&at_start.0)
+            .map(|(e, s)| e.mul(&c[0])?.add(&s.mul(&c[1])?))
+            .collect::<Res<_>>()?);
+        if back != *arg && !sub(&back, arg)?.0.iter().all(RatFn::is_zero) {
+            return Ok(None);
         }
+        end = end.add(&t.coef.mul(&c[0])?)?;
+        start = start.add(&t.coef.mul(&c[1])?)?;
     }
     let total = start.add(&end)?;
     if start.is_zero() || total.is_zero() {
@@ -175,7 +184,7 @@ fn unit(n: usize, i: usize) -> Lin {
 }
 
 /// State `i` at the step's end, over the window's free variables.
-fn end_level(ir: &SchemeIr, window: &Window, i: usize) -> Lin {
+pub fn end_level(ir: &SchemeIr, window: &Window, i: usize) -> Lin {
     match ir.updates[i] {
         crate::scheme::affine::Quantity::Stage { stage, index } => window.levels[window.offset + stage][index].clone(),
         crate::scheme::affine::Quantity::State(j) => window.start[j].clone(),

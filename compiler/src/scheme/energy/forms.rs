@@ -111,6 +111,35 @@ impl Form {
     }
 }
 
+/// The coefficients c with l = Σ c_i·basis_i, when there are (exact elimination; a free
+/// coefficient is 0).
+pub fn solve(l: &Lin, basis: &[Lin]) -> Res<Option<Vec<RatFn>>> {
+    let m = basis.len();
+    let mut equations: Vec<Unk> = (0..l.0.len())
+        .map(|row| -> Res<Unk> { Ok(Unk { c0: l.0[row].neg()?, c: basis.iter().map(|b| b.0[row].clone()).collect() }) })
+        .collect::<Res<_>>()?;
+    let mut value: Vec<Option<Unk>> = vec![None; m];
+    while let Some(e) = equations.pop() {
+        let Some(k) = (0..m).find(|&k| !e.c[k].is_zero()) else {
+            if e.c0.is_zero() {
+                continue;
+            }
+            return Ok(None);
+        };
+        let mut others = e.clone();
+        others.c[k] = RatFn::zero();
+        let v = others.scale(&e.c[k].inv()?.neg()?)?;
+        for r in equations.iter_mut() {
+            *r = r.substitute(k, &v)?;
+        }
+        for s in value.iter_mut().flatten() {
+            *s = s.substitute(k, &v)?;
+        }
+        value[k] = Some(v);
+    }
+    Ok(Some(value.into_iter().map(|v| v.map_or(RatFn::zero(), |v| v.c0)).collect()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

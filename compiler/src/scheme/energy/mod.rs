@@ -20,6 +20,7 @@ pub mod factor;
 pub mod forms;
 pub mod names;
 pub mod poly;
+pub mod poly_factors;
 pub mod print;
 pub mod ratfn;
 pub mod sign;

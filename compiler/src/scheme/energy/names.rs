@@ -94,7 +94,7 @@ impl Style {
         Style {
             params: ir.params.iter().map(|p| p.name.clone()).collect(),
             at: ir.params.iter().map(|p| p.default).collect(),
-            region: Some(super::classify::region(ir)),
+            region: Some(Region::of(ir)),
         }
     }
 
@@ -244,7 +244,7 @@ impl Levels {
                 return combination(&[(c, na.clone())], &self.style);
             }
             for (b, nb) in &named[i + 1..] {
-                if let Ok(Some(c)) = solve(l, &[a.clone(), b.clone()]) {
+                if let Ok(Some(c)) = super::forms::solve(l, &[a.clone(), b.clone()]) {
                     return combination(&[(c[0].clone(), na.clone()), (c[1].clone(), nb.clone())], &self.style);
                 }
             }
@@ -271,38 +271,8 @@ fn back_equal(l: &Lin, a: &Lin, c: &RatFn) -> bool {
     l.0.iter().zip(&a.0).all(|(x, y)| y.mul(c).and_then(|p| x.sub(&p)).is_ok_and(|d| d.is_zero()))
 }
 
-/// The coefficients c with l = Σ c_i·basis_i, when there are (exact elimination; a free
-/// coefficient is 0).
-pub fn solve(l: &Lin, basis: &[Lin]) -> Res<Option<Vec<RatFn>>> {
-    use super::forms::Unk;
-    let m = basis.len();
-    let mut equations: Vec<Unk> = (0..l.0.len())
-        .map(|row| -> Res<Unk> { Ok(Unk { c0: l.0[row].neg()?, c: basis.iter().map(|b| b.0[row].clone()).collect() }) })
-        .collect::<Res<_>>()?;
-    let mut value: Vec<Option<Unk>> = vec![None; m];
-    while let Some(e) = equations.pop() {
-        let Some(k) = (0..m).find(|&k| !e.c[k].is_zero()) else {
-            if e.c0.is_zero() {
-                continue;
-            }
-            return Ok(None);
-        };
-        let mut others = e.clone();
-        others.c[k] = RatFn::zero();
-        let v = others.scale(&e.c[k].inv()?.neg()?)?;
-        for r in equations.iter_mut() {
-            *r = r.substitute(k, &v)?;
-        }
-        for s in value.iter_mut().flatten() {
-            *s = s.substitute(k, &v)?;
-        }
-        value[k] = Some(v);
-    }
-    Ok(Some(value.into_iter().map(|v| v.map_or(RatFn::zero(), |v| v.c0)).collect()))
-}
-
 /// Σ c_i·name_i, its coefficients cleared of their common denominator: `(u + u')/2`,
-/// `((1 - gs)*(um - u) - gs*(u' - um))/(1 - gs)`.
+/// `((gs - 1)*(um - u) + gs*(u' - um))/(gs - 1)`.
 pub fn combination(parts: &[(RatFn, String)], style: &Style) -> String {
     let (text, s) = cleared(parts, style);
     // A negative denominator is written as a sign in front.
@@ -427,6 +397,6 @@ mod tests {
             (RatFn::one(), "um - u".into()),
             (gam.neg().unwrap().div(&RatFn::one().sub(&gam).unwrap()).unwrap(), "u' - um".into()),
         ];
-        assert_eq!(combination(&parts, &style), "((1 - gam)*(um - u) - gam*(u' - um))/(1 - gam)");
+        assert_eq!(combination(&parts, &style), "((gam - 1)*(um - u) + gam*(u' - um))/(gam - 1)");
     }
 }

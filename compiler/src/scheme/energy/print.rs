@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use super::classify::{Block, Identity, Proof, Square, region, sign_over};
+use super::classify::{Block, Identity, Proof, Square, sign_over};
 use super::names::{Levels, cleared};
 use super::ratfn::RatFn;
 use super::sign::{Interval, Region};
@@ -34,7 +34,7 @@ pub struct Printer<'a> {
 
 impl<'a> Printer<'a> {
     pub fn new(ir: &'a SchemeIr, id: &'a Identity) -> Printer<'a> {
-        Printer { ir, id, levels: Levels::new(ir, &id.ansatz.window), region: region(ir) }
+        Printer { ir, id, levels: Levels::new(ir, &id.ansatz.window), region: Region::of(ir) }
     }
 
     /// A coefficient in the scheme's names.
@@ -320,7 +320,7 @@ impl<'a> Printer<'a> {
         match block {
             Block::Stiffness => self.id.ansatz.levels.clone(),
             Block::Mass => {
-                // The acceleration's previous and start levels first, where the residuals read them.
+                // The acceleration's previous and start levels first, where the window has them.
                 let w = &self.id.ansatz.window;
                 let a = self.ir.initial.as_ref().map_or(0, |i| i.state);
                 let before = w
@@ -328,14 +328,7 @@ impl<'a> Printer<'a> {
                     .iter()
                     .position(|f| *f == super::window::Free::Previous(a))
                     .map(|v| Lin::unit(w.free.len(), v));
-                let read = |l: &Lin| {
-                    self.id
-                        .ansatz
-                        .residuals
-                        .iter()
-                        .any(|r| r.terms.iter().any(|t| t.form == "mass" && t.args.first() == Some(l)))
-                };
-                let mut chain: Vec<Lin> = before.into_iter().chain([w.start[a].clone()]).filter(|l| read(l)).collect();
+                let mut chain: Vec<Lin> = before.into_iter().chain([w.start[a].clone()]).collect();
                 for r in &self.id.ansatz.residuals {
                     for t in r.terms.iter().filter(|t| t.form == "mass") {
                         if let [a] = t.args.as_slice()
@@ -345,19 +338,41 @@ impl<'a> Printer<'a> {
                         }
                     }
                 }
+                let end = super::engine::end_level(self.ir, w, a);
+                if !chain.contains(&end) {
+                    chain.push(end);
+                }
                 chain
             }
         }
     }
 
+    /// The chain's levels that a square's vector reads, in order: an increment is named by
+    /// consecutive levels the vector needs, levels it does not are skipped.
+    fn chain_for(&self, s: &Square) -> Vec<Lin> {
+        let mut chain = self.chain(s.block);
+        // Drop an entry while the vector stays a combination of the increments left: the
+        // combinations first, the named levels after.
+        for named in [false, true] {
+            let mut k = 0;
+            while k < chain.len() && chain.len() > 2 {
+                let mut fewer = chain.clone();
+                fewer.remove(k);
+                let keep = self.levels.name(&chain[k]).is_some() != named;
+                if !keep && super::forms::solve(&s.vector, &increments(&fewer)).ok().flatten().is_some() {
+                    chain = fewer;
+                } else {
+                    k += 1;
+                }
+            }
+        }
+        chain
+    }
+
     /// A square as coefficient·‖combination of increments‖²_B.
     fn square(&self, s: &Square) -> (RatFn, String) {
-        let chain = self.chain(s.block);
-        let increments: Vec<Lin> = chain
-            .windows(2)
-            .filter_map(|w| Some(Lin(w[1].0.iter().zip(&w[0].0).map(|(a, b)| a.sub(b).ok()).collect::<Option<_>>()?)))
-            .collect();
-        let named = super::names::solve(&s.vector, &increments).ok().flatten();
+        let chain = self.chain_for(s);
+        let named = super::forms::solve(&s.vector, &increments(&chain)).ok().flatten();
         let (text, scale) = match named {
             Some(c) => {
                 let parts: Vec<(RatFn, String)> = c
@@ -535,6 +550,14 @@ fn without_positive_parts(r: &RatFn) -> RatFn {
         out = out.div(&RatFn::poly(p.clone()).powi(*e as i32).unwrap_or_else(|_| RatFn::one())).unwrap_or(out);
     }
     out
+}
+
+/// The differences of consecutive levels.
+fn increments(chain: &[Lin]) -> Vec<Lin> {
+    chain
+        .windows(2)
+        .filter_map(|w| Some(Lin(w[1].0.iter().zip(&w[0].0).map(|(a, b)| a.sub(b).ok()).collect::<Option<_>>()?)))
+        .collect()
 }
 
 fn proportional(nu: &[RatFn], base: &[RatFn]) -> Option<RatFn> {

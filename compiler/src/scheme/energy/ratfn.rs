@@ -118,7 +118,12 @@ impl RatFn {
         if self.num.is_zero() {
             return Err(GiveUp);
         }
-        RatFn { num: self.den_product()?, den: vec![self.num.clone()] }.reduced()
+        // The numerator's factors become the denominator's, each on its own, so that a later
+        // numerator they divide cancels them one by one.
+        let (mut pieces, mut constant) = (Vec::new(), Rat::ONE);
+        super::poly_factors::split(&self.num, &mut pieces, &mut constant)?;
+        let den = pieces.into_iter().flat_map(|(p, e)| std::iter::repeat_n(p, e as usize)).collect();
+        RatFn { num: self.den_product()?.scale(constant.inv()?)?, den }.reduced()
     }
 
     pub fn div(&self, o: &RatFn) -> Res<RatFn> {

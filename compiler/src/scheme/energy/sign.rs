@@ -43,6 +43,24 @@ pub struct Sign {
 const DEPTH: u32 = 8;
 
 impl Region {
+    /// The params' declared ranges, exactly where they are finite small rationals.
+    pub fn of(ir: &crate::scheme::ir::SchemeIr) -> Region {
+        Region(
+            ir.params
+                .iter()
+                .map(|p| {
+                    let r = p.range?;
+                    Some(Interval {
+                        lo: Rat::from_f64(r.lo)?,
+                        lo_closed: r.lo_closed,
+                        hi: Rat::from_f64(r.hi)?,
+                        hi_closed: r.hi_closed,
+                    })
+                })
+                .collect(),
+        )
+    }
+
     /// The sign of `p` (in params and dt, dt read only as a monomial factor) over the region.
     pub fn sign(&self, p: &Poly) -> Res<Sign> {
         let vars = p.vars();
