@@ -13,6 +13,7 @@ mod deformed_contact;
 mod disc;
 mod elements;
 mod energy_guard;
+mod energy_identity;
 mod finite_strain;
 mod friction;
 mod friction_laws;

@@ -8,8 +8,9 @@
 use std::path::Path;
 
 use proptest::prelude::*;
-use signorini_compiler::scheme::energy::classify::{Block, Identity};
-use signorini_compiler::scheme::energy::window::{Free, Lin};
+use signorini_compiler::scheme::energy::classify::Identity;
+use signorini_compiler::scheme::energy::evaluate::Operators;
+use signorini_compiler::scheme::energy::window::Free;
 use signorini_compiler::scheme::{Affine, Quantity, SchemeIr, Term, eval_all};
 
 const N: usize = 3;
@@ -221,17 +222,6 @@ fn run(s: &SchemeIr, sys: &System, params: &[f64], dt: f64, u0: V, v0: V, steps:
     Some(out)
 }
 
-/// Σ c_p x_p over the window's free variables.
-fn at(l: &Lin, x: &[V], params: &[f64], dt: f64, t: f64) -> V {
-    let mut out = [0.0; N];
-    for (c, xp) in l.0.iter().zip(x) {
-        if !c.is_zero() {
-            out = add(&out, xp, c.eval(params, dt, t));
-        }
-    }
-    out
-}
-
 /// The kept energy at a step boundary from the states there and one step before.
 fn kept(s: &SchemeIr, id: &Identity, sys: &System, params: &[f64], dt: f64, now: &[V], then: &[V]) -> f64 {
     let theta = id.weight.as_ref().map_or(0.0, |w| w.eval(params, dt, 0.0));
@@ -252,7 +242,26 @@ fn kept(s: &SchemeIr, id: &Identity, sys: &System, params: &[f64], dt: f64, now:
     e
 }
 
-/// The identity's closure |Ẽ' − Ẽ − W + D| on step `n` of `steps`, its scale, and D.
+impl Operators for System {
+    fn mass(&self, x: &[f64]) -> Vec<f64> {
+        mul(&self.m, &vector(x)).to_vec()
+    }
+    fn stiffness(&self, x: &[f64]) -> Vec<f64> {
+        mul(&self.k, &vector(x)).to_vec()
+    }
+    fn apply(&self, slot: &str, args: &[Vec<f64>], t: f64) -> Vec<f64> {
+        let args: Vec<V> = args.iter().map(|a| vector(a)).collect();
+        System::apply(self, slot, &args, t).to_vec()
+    }
+}
+
+fn vector(x: &[f64]) -> V {
+    std::array::from_fn(|i| x[i])
+}
+
+/// The identity's closure |Ẽ' − Ẽ − W + D| on step `n` of `steps`, its scale, and D: the kept
+/// energies from the stepped states themselves, the work and the dissipation from the identity
+/// (whose own kept energies must agree).
 fn closure(
     s: &SchemeIr,
     id: &Identity,
@@ -262,9 +271,8 @@ fn closure(
     steps: &[Step],
     n: usize,
 ) -> (f64, f64, f64) {
-    let w = &id.ansatz.window;
-    let x: Vec<V> = w
-        .free
+    let x: Vec<Vec<f64>> = id
+        .free()
         .iter()
         .map(|f| match *f {
             Free::State(i) => steps[n].start[i],
@@ -272,36 +280,22 @@ fn closure(
             Free::Previous(i) => steps[n - 1].start[i],
             Free::PreviousUnknown(k) => steps[n - 1].unknowns[k],
         })
+        .map(|v| v.to_vec())
         .collect();
-    let t = n as f64 * dt;
+    let b = id.balance(s, sys, params, dt, n as f64 * dt, &x);
     let (e1, e0) = (
         kept(s, id, sys, params, dt, &steps[n + 1].start, &steps[n].start),
         kept(s, id, sys, params, dt, &steps[n].start, &steps[n - 1].start),
     );
-    let mut work = 0.0;
-    for r in &id.ansatz.residuals {
-        let mut test = [0.0; N];
-        for (j, inc) in id.ansatz.increments.iter().enumerate() {
-            let nu = id.ansatz.solved[r.nu[j]].as_ref().unwrap().c0.eval(params, dt, t);
-            test = add(&test, &at(inc, &x, params, dt, t), nu);
-        }
-        for term in r.terms.iter().filter(|t| t.form != "mass" && t.form != "stiffness") {
-            let args: Vec<V> = term.args.iter().map(|a| at(a, &x, params, dt, t)).collect();
-            let f = sys.apply(&term.form, &args, term.time.eval(params, dt, t));
-            work -= term.coef.eval(params, dt, t) * dot(&test, &f);
-        }
-    }
-    let mut d = 0.0;
-    for sq in &id.dissipation.squares {
-        let y = at(&sq.vector, &x, params, dt, t);
-        let b = match sq.block {
-            Block::Mass => &sys.m,
-            Block::Stiffness => &sys.k,
-        };
-        d += sq.coef.eval(params, dt, t) * dot(&y, &mul(b, &y));
-    }
-    let scale = e0.abs() + e1.abs() + work.abs() + d.abs();
-    ((e1 - e0 - work + d).abs(), scale, d)
+    let scale = e0.abs() + e1.abs() + b.work.abs() + b.dissipation.abs();
+    assert!(
+        (b.kept_after - e1).abs() + (b.kept_before - e0).abs() <= 1e-10 * (1.0 + scale),
+        "{}: the identity's kept energies {} → {} against the states' {e0} → {e1}",
+        s.name,
+        b.kept_before,
+        b.kept_after
+    );
+    ((e1 - e0 - b.work + b.dissipation).abs(), scale, b.dissipation)
 }
 
 fn library() -> Vec<SchemeIr> {

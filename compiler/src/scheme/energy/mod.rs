@@ -15,6 +15,7 @@
 pub mod claim;
 pub mod classify;
 pub mod engine;
+pub mod evaluate;
 pub mod exact;
 pub mod factor;
 pub mod forms;
