@@ -320,15 +320,19 @@ impl<'a> Printer<'a> {
         match block {
             Block::Stiffness => self.id.ansatz.levels.clone(),
             Block::Mass => {
-                // The acceleration's previous and start levels first, where the window has them.
+                // The acceleration's (else the velocity's) previous and start levels first,
+                // where the window has them, then the mass terms' arguments, then its end.
                 let w = &self.id.ansatz.window;
-                let a = self.ir.initial.as_ref().map_or(0, |i| i.state);
+                let state = match &self.ir.initial {
+                    Some(i) => i.state,
+                    None => self.ir.states.iter().position(|s| s == "v").unwrap_or(0),
+                };
                 let before = w
                     .free
                     .iter()
-                    .position(|f| *f == super::window::Free::Previous(a))
+                    .position(|f| *f == super::window::Free::Previous(state))
                     .map(|v| Lin::unit(w.free.len(), v));
-                let mut chain: Vec<Lin> = before.into_iter().chain([w.start[a].clone()]).collect();
+                let mut chain: Vec<Lin> = before.into_iter().chain([w.start[state].clone()]).collect();
                 for r in &self.id.ansatz.residuals {
                     for t in r.terms.iter().filter(|t| t.form == "mass") {
                         if let [a] = t.args.as_slice()
@@ -338,7 +342,7 @@ impl<'a> Printer<'a> {
                         }
                     }
                 }
-                let end = super::engine::end_level(self.ir, w, a);
+                let end = super::engine::end_level(self.ir, w, state);
                 if !chain.contains(&end) {
                     chain.push(end);
                 }
@@ -496,8 +500,10 @@ impl<'a> Printer<'a> {
         format!("{} ≥ 0: {verdict}", self.r(&shown))
     }
 
+    /// A witness: the params, then dt where it has one more coordinate.
     fn point(&self, at: &[super::super::rational::Rat]) -> String {
-        self.ir.params.iter().zip(at).map(|(p, v)| format!("{} = {}", p.name, rat(*v))).collect::<Vec<_>>().join(", ")
+        let names = self.ir.params.iter().map(|p| p.name.as_str()).chain(["dt"]);
+        names.zip(at).map(|(n, v)| format!("{n} = {}", rat(*v))).collect::<Vec<_>>().join(", ")
     }
 
     fn at_defaults(&self) -> Vec<String> {

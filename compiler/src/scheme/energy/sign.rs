@@ -35,7 +35,8 @@ pub struct Sign {
     pub nonnegative: bool,
     /// Proved ≤ 0 everywhere in the region.
     pub nonpositive: bool,
-    /// A point of the region where it is < 0 (the params in order), if one was found.
+    /// A point of the region where it is < 0 (the params in order, then dt where the sign
+    /// depends on it), if one was found.
     pub negative_at: Option<Vec<Rat>>,
 }
 
@@ -69,15 +70,23 @@ impl Region {
         }
         // dt only as a factor dt^k of every term: its sign is the rest's.
         let (monomial, rest) = p.monomial_content();
-        if rest.reads(DT) {
-            return Ok(Sign::default());
-        }
         let mut boxes = Vec::new();
         for &v in vars.iter().filter(|&&v| v != DT) {
             match self.0.get(v as usize).copied().flatten() {
                 Some(i) => boxes.push((v, i)),
                 None => return Ok(Sign::default()),
             }
+        }
+        // dt other than as a factor: no certificate, a witness looked for at dt from 1/100 to
+        // 100 (after the params, as one more coordinate).
+        if rest.reads(DT) {
+            for dt in [Rat::new(1, 100)?, Rat::new(1, 10)?, Rat::ONE, Rat::int(10), Rat::int(100)] {
+                if let Some(mut at) = self.search(p, &boxes, dt)?.negative_at {
+                    at.push(dt);
+                    return Ok(Sign { negative_at: Some(at), ..Sign::default() });
+                }
+            }
+            return Ok(Sign::default());
         }
         // The monomial's params: their sign on the box, folded into the rest's.
         let mut flip = false;
@@ -86,7 +95,7 @@ impl Region {
             if e % 2 == 1 && i.lo.signum() < 0 {
                 if i.hi.signum() > 0 {
                     // A monomial that changes sign: no certificate, perhaps a witness.
-                    return self.search(p, &boxes);
+                    return self.search(p, &boxes, Rat::ONE);
                 }
                 flip = !flip;
             }
@@ -102,7 +111,7 @@ impl Region {
             sign.negative_at = None;
         }
         if sign.negative_at.is_none() && !sign.nonnegative {
-            return Ok(Sign { negative_at: self.search(p, &boxes)?.negative_at, ..sign });
+            return Ok(Sign { negative_at: self.search(p, &boxes, Rat::ONE)?.negative_at, ..sign });
         }
         Ok(sign)
     }
@@ -179,8 +188,9 @@ impl Region {
             .collect()
     }
 
-    /// A grid over the region (9 points a side, open ends moved in) for a point where p < 0.
-    fn search(&self, p: &Poly, boxes: &[(Var, Interval)]) -> Res<Sign> {
+    /// A grid over the region (9 points a side, open ends moved in), at `dt`, for a point where
+    /// p < 0.
+    fn search(&self, p: &Poly, boxes: &[(Var, Interval)], dt: Rat) -> Res<Sign> {
         let sides: Vec<Vec<Rat>> = boxes
             .iter()
             .map(|(_, i)| {
@@ -201,7 +211,7 @@ impl Region {
             let at: Vec<Rat> = index.iter().enumerate().map(|(k, &j)| sides[k][j]).collect();
             let value = p.eval_exact(&|v| {
                 if v == DT {
-                    return Rat::ONE;
+                    return dt;
                 }
                 boxes.iter().position(|(w, _)| *w == v).map_or(Rat::ZERO, |k| at[k])
             })?;
@@ -323,5 +333,16 @@ mod tests {
             .mul(&Poly::var(1).scale(Rat::int(2)).unwrap().sub(&Poly::one()).unwrap())
             .unwrap();
         assert!(newmark_region().sign(&q).unwrap().nonnegative);
+    }
+
+    #[test]
+    fn a_sign_that_depends_on_dt_is_refuted_at_a_step() {
+        // 2dt − 1 < 0 for dt < 1/2: the witness's last coordinate is that dt.
+        let p = Poly::var(DT).scale(Rat::int(2)).unwrap().sub(&Poly::one()).unwrap();
+        let s = newmark_region().sign(&p).unwrap();
+        assert!(!s.nonnegative && !s.nonpositive);
+        let at = s.negative_at.expect("a witness");
+        assert_eq!(at.len(), 3);
+        assert!(at[2].mul(Rat::int(2)).unwrap().sub(Rat::ONE).unwrap().signum() < 0);
     }
 }
