@@ -74,7 +74,7 @@ pub const CODES: &[(&str, &str)] = &[
     ("E0819", "scheme: an unknown claim, or one that is not a function of the parameters"),
     ("E0820", "scheme: a state read at the start of a step that nothing sets at the start of the run"),
     ("E0821", "scheme: an energy claim its derived energy identity refutes"),
-    ("E0822", "scheme: no energy identity can be derived for it"),
+    ("E0822", "scheme: `emit --stage energy` derives no energy identity for it"),
     ("E0901", "problem: no mesh"),
     ("E0905", "problem: a Dirichlet condition on a contact region"),
     ("E0906", "problem: a `set` name that more than one file in use declares (qualify it: `material.rho`)"),
@@ -85,11 +85,16 @@ pub const CODES: &[(&str, &str)] = &[
     ("W0004", "problem: a coef set that no file in use reads (warning)"),
     ("W0005", "scheme: a state (other than the displacement and `v`) that is never read (warning)"),
     ("W0006", "a tangent divides by an expression that is zero where pos/neg clips it: 0/0 there (warning)"),
+    ("W0007", "scheme: an energy claim no energy identity can be derived for: verify only samples it (warning)"),
 ];
 
 /// Codes reported when a problem is bound to the files of a run (the facade's bad-input corpus
 /// exercises them; the compiler's own corpus cannot, as the files in use are not known there).
 pub const BINDING_CODES: &[&str] = &["E0906", "W0004"];
+
+/// Codes a stage other than `check` reports (`emit --stage energy`; the facade's bad-input
+/// corpus exercises them).
+pub const STAGE_CODES: &[&str] = &["E0822"];
 
 /// The meaning of a diagnostic code, from [`CODES`].
 pub fn describe(code: &str) -> Option<&'static str> {

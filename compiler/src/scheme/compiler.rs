@@ -95,7 +95,10 @@ impl<'a> Compiler<'a> {
         if let Some((law, span)) = energy
             && let Some(d) = super::energy::claim::check(&ir, law, span)
         {
-            return Err(vec![d]);
+            if d.is_error() {
+                return Err(vec![d]);
+            }
+            self.warnings.push(d);
         }
         Ok(ir)
     }

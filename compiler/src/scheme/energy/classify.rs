@@ -96,40 +96,108 @@ impl Identity {
         Ok(Identity { ansatz, dissipation: Dissipation { squares, cross }, acceleration, step_before, elastic, weight })
     }
 
-    /// Whether the kept energy is E itself at `params`.
-    fn keeps_e_at(&self, params: &[f64]) -> Res<bool> {
+    /// Whether the kept energy is E itself at `params`: none where that is not decided.
+    fn keeps_e_at(&self, params: &[f64]) -> Res<Option<bool>> {
+        let mut keeps = Some(true);
         for c in self.acceleration.iter().chain(&self.step_before).chain(&self.weight) {
-            if value_at(c, params)? != Value::Zero {
-                return Ok(false);
+            match value_at(c, params)? {
+                Some(Value::Zero) => {}
+                Some(_) => return Ok(Some(false)),
+                None => keeps = None,
             }
         }
-        Ok(true)
+        Ok(keeps)
+    }
+
+    /// D at `params`: its squares, each with its coefficient's value there, or where it takes
+    /// both signs. Exactly where the params are small rationals (D's blocks factored again with
+    /// the params put in, so that a pivot that vanishes there does not hide a square), else from
+    /// the squares in floating point.
+    fn at(&self, params: &[f64]) -> Res<AtPoint> {
+        let exact: Option<Vec<Rat>> = params.iter().map(|&p| Rat::from_f64(p)).collect();
+        if let Some(exact) = exact
+            && let Ok(at) = self.at_exactly(&exact)
+        {
+            return Ok(at);
+        }
+        // Floating point (irrational params, or exact values too large): the squares' signs.
+        let mut squares = Vec::new();
+        for s in &self.dissipation.squares {
+            squares.push((s.clone(), value_at(&s.coef, params)?));
+        }
+        Ok(AtPoint { squares, cross: self.dissipation.cross.map(|(b, ..)| b), undefined: false })
+    }
+
+    /// [`Identity::at`] at exact params; each square shown as the symbolic square of the same
+    /// sign there where there is one (the identity's own, with its coefficient in the params).
+    fn at_exactly(&self, exact: &[Rat]) -> Res<AtPoint> {
+        let mut squares = Vec::new();
+        for (block, form) in [(Block::Stiffness, &self.ansatz.d_k), (Block::Mass, &self.ansatz.d_m)] {
+            let mut entries = Vec::new();
+            for e in &form.entries {
+                match e.c0.at_params(exact)? {
+                    Some(v) => entries.push(super::forms::Unk::constant(v, 0)),
+                    None => return Ok(AtPoint { squares: Vec::new(), cross: None, undefined: true }),
+                }
+            }
+            let (mine, cross) = ldl(&Form { n: form.n, entries }, block)?;
+            if cross.is_some() {
+                return Ok(AtPoint { squares: Vec::new(), cross: Some(block), undefined: false });
+            }
+            for s in mine {
+                let value = sign_in_dt(&s.coef)?;
+                let symbolic = self.dissipation.squares.iter().find(|q| {
+                    q.block == s.block
+                        && q.coef
+                            .at_params(exact)
+                            .ok()
+                            .flatten()
+                            .is_some_and(|c| sign_in_dt(&c).ok().flatten() == value)
+                });
+                squares.push((symbolic.cloned().unwrap_or(s), value));
+            }
+        }
+        Ok(AtPoint { squares, cross: None, undefined: false })
     }
 
     /// What the identity proves of `law` at `params` (E conserved: D ≡ 0 and the kept energy
     /// E; E dissipated: D ⪰ 0 and the kept energy E); `shown` prints a square of D.
     pub fn proves(&self, law: EnergyLaw, params: &[f64], shown: &dyn Fn(&Square) -> String) -> Res<Proof> {
-        if let Some((block, ..)) = self.dissipation.cross {
+        let d = self.at(params)?;
+        if d.undefined {
+            return Ok(Proof::Undecided("D is not defined at these params (a denominator of it vanishes)".into()));
+        }
+        if let Some(block) = d.cross {
             return Ok(Proof::Fails(format!(
-                "D's part on {} has a zero diagonal entry beside a non-zero one: it takes both signs",
+                "D's part on {} has a zero diagonal entry beside a non-zero one at these params: it takes both signs",
                 block.letter()
             )));
         }
         let mut positive = None;
-        for s in &self.dissipation.squares {
-            match value_at(&s.coef, params)? {
-                Value::Negative => {
+        let mut undecided = None;
+        for (s, value) in &d.squares {
+            match value {
+                Some(Value::Negative) => {
                     return Ok(Proof::Fails(format!(
                         "D has the term {} with a negative coefficient at these params: a step along it, with the \
                          loads that make it one, gains energy beyond their work",
                         shown(s)
                     )));
                 }
-                Value::Positive if positive.is_none() => positive = Some(s),
+                Some(Value::Positive) if positive.is_none() => positive = Some(s),
+                None if undecided.is_none() => undecided = Some(s),
                 _ => {}
             }
         }
-        let keeps_e = self.keeps_e_at(params)?;
+        if let Some(s) = undecided {
+            return Ok(Proof::Undecided(format!(
+                "D's term {} has a coefficient whose sign at these params depends on dt, or is not defined there",
+                shown(s)
+            )));
+        }
+        let Some(keeps_e) = self.keeps_e_at(params)? else {
+            return Ok(Proof::Undecided("whether the energy kept is E depends on dt at these params".into()));
+        };
         let correction = || {
             let mut parts = Vec::new();
             if self.acceleration.is_some() {
@@ -168,39 +236,64 @@ impl Identity {
     }
 }
 
-/// `r`'s value at `params` for every dt > 0 it was sampled at (dt = 1/100, 1, 100): exactly
-/// where the params are small rationals, else in floating point to a relative 1e-12.
-fn value_at(r: &RatFn, params: &[f64]) -> Res<Value> {
+/// D at a point of the params: its squares with their coefficients' signs there (none where
+/// not decided), or the block where it takes both signs.
+struct AtPoint {
+    squares: Vec<(Square, Option<Value>)>,
+    cross: Option<Block>,
+    /// A denominator of D vanishes at the point.
+    undefined: bool,
+}
+
+/// The sign for every dt > 0 of a rational function of dt alone: decided where dt enters as
+/// a power only, none otherwise.
+fn sign_in_dt(r: &RatFn) -> Res<Option<Value>> {
     if r.is_zero() {
-        return Ok(Value::Zero);
+        return Ok(Some(Value::Zero));
+    }
+    let f = super::factor::factor(r)?;
+    let dt_power = |p: &super::poly::Poly| p.terms().count() == 1 && p.vars().iter().all(|&v| v == DT);
+    if !f.num.iter().chain(&f.den).all(|(p, _)| dt_power(p)) {
+        return Ok(None);
+    }
+    Ok(Some(if f.constant.signum() < 0 { Value::Negative } else { Value::Positive }))
+}
+
+/// `r`'s value at `params` for every dt > 0: exactly where the params are small rationals and
+/// dt enters as a power only; else in floating point (to a relative 1e-12) where `r` does not
+/// read dt but as a power. None where that does not decide it (dt or t otherwise, a value not
+/// defined there).
+fn value_at(r: &RatFn, params: &[f64]) -> Res<Option<Value>> {
+    if r.is_zero() {
+        return Ok(Some(Value::Zero));
+    }
+    if r.reads(super::poly::TIME) {
+        return Ok(None);
     }
     let exact: Option<Vec<Rat>> = params.iter().map(|&p| Rat::from_f64(p)).collect();
-    let mut seen = Vec::new();
-    for dt in [Rat::new(1, 100)?, Rat::ONE, Rat::int(100)] {
-        let v = match &exact {
-            Some(p)
-                if let Ok(v) =
-                    r.eval_exact(&|v| if v == DT { dt } else { p.get(v as usize).copied().unwrap_or(Rat::ZERO) }) =>
-            {
-                match v {
-                    Some(v) => v.signum(),
-                    None => continue,
-                }
-            }
-            _ => {
-                let v = r.eval(params, dt.to_f64(), 0.0);
-                let scale = r.numerator().terms().map(|(_, c)| c.to_f64().abs()).sum::<f64>().max(1.0);
-                if v.abs() <= 1e-12 * scale { 0 } else { v.signum() as i128 }
-            }
+    if let Some(p) = exact
+        && let Ok(at) = r.at_params(&p)
+    {
+        return match at {
+            Some(v) => sign_in_dt(&v),
+            None => Ok(None),
         };
-        seen.push(v);
     }
-    Ok(if seen.iter().any(|&s| s < 0) {
-        Value::Negative
-    } else if seen.iter().all(|&s| s == 0) {
-        Value::Zero
+    // Floating point: only where dt is a factor of every term.
+    let f = super::factor::factor(r)?;
+    if f.num.iter().chain(&f.den).any(|(p, _)| p.reads(DT) && !(p.terms().count() == 1 && p.vars() == [DT])) {
+        return Ok(None);
+    }
+    let v = r.eval(params, 1.0, 0.0);
+    let scale = r.numerator().terms().map(|(_, c)| c.to_f64().abs()).sum::<f64>().max(1.0);
+    Ok(if !v.is_finite() {
+        None
+    } else if v.abs() <= 1e-12 * scale {
+        Some(Value::Zero)
+    } else if v < 0.0 {
+        Some(Value::Negative)
     } else {
-        Value::Positive
+        Some(Value::Positive)
     })
 }
 
@@ -211,21 +304,23 @@ pub fn sign_over(r: &RatFn, region: &Region) -> Res<Sign> {
     let mut negative = f.constant.signum() < 0;
     let mut certified = true;
     for (p, e) in f.num.iter().chain(&f.den) {
-        let s = region.sign(p)?;
         if e % 2 == 0 {
             continue;
         }
+        let s = region.sign(p)?;
         match (s.nonnegative, s.nonpositive) {
             (true, _) => {}
             (false, true) => negative = !negative,
             (false, false) => certified = false,
         }
     }
+    if certified && !negative {
+        return Ok(Sign { nonnegative: true, nonpositive: false, negative_at: None });
+    }
     let whole = region.sign(&r.sign_polynomial()?)?;
     if certified {
-        // A witness where it is negative, when it is.
-        let negative_at = if negative { whole.negative_at } else { None };
-        return Ok(Sign { nonnegative: !negative, nonpositive: negative, negative_at });
+        // A witness where it is negative.
+        return Ok(Sign { nonnegative: false, nonpositive: true, negative_at: whole.negative_at });
     }
     Ok(whole)
 }

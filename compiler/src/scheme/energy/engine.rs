@@ -63,6 +63,8 @@ pub enum NoIdentity {
     NotUnique,
     /// A scalar of the scheme is no rational function of its params.
     NotRational(super::exact::Refusal),
+    /// A coefficient of the step depends on the time t (only a load's time may).
+    ReadsTime,
     /// Rational overflow.
     Overflow,
 }
@@ -79,6 +81,15 @@ impl From<GiveUp> for NoIdentity {
 /// identity holds exactly whatever they choose).
 pub fn derive(ir: &SchemeIr) -> Result<Ansatz, NoIdentity> {
     let window = super::window::window(ir).map_err(NoIdentity::NotRational)?;
+    // A coefficient that changes with t would differ between the step and the previous one the
+    // identity reads: only the times a load is applied at may depend on t.
+    let t = super::poly::TIME;
+    let reads_time = |l: &Lin| l.0.iter().any(|c| c.reads(t));
+    if window.levels.iter().flatten().any(reads_time)
+        || window.residuals.iter().flatten().any(|term| term.coef.reads(t) || term.args.iter().any(reads_time))
+    {
+        return Err(NoIdentity::ReadsTime);
+    }
     // With the previous step's displacement and the states its residual reads at the start.
     let read: Vec<usize> = (0..ir.states.len())
         .filter(|&i| {

@@ -42,6 +42,9 @@ pub fn why(ir: &crate::scheme::ir::SchemeIr, e: &engine::NoIdentity) -> String {
             crate::scheme::print::scalar(&ir.graph, r.node),
             r.why
         ),
+        ReadsTime => "a coefficient of its step depends on the time t: the identity needs the step's coefficients \
+                      the same from step to step (a load may be applied at any time)"
+            .into(),
         Overflow => "its exact coefficients overflow 128-bit rationals".into(),
     }
 }

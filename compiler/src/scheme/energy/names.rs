@@ -227,11 +227,6 @@ impl Levels {
         self.named.iter().find(|(m, _)| m == l).map(|(_, n)| n.as_str())
     }
 
-    /// `l` − `m` as "(l - m)", with the levels' names.
-    pub fn difference(&self, l: &Lin, m: &Lin) -> String {
-        format!("({} - {})", self.vector(l), self.vector(m))
-    }
-
     /// A vector: a level's name, or the shortest combination of one or two levels found, or
     /// its expansion over the free variables.
     pub fn vector(&self, l: &Lin) -> String {
@@ -250,11 +245,7 @@ impl Levels {
             }
         }
         let parts: Vec<(RatFn, String)> =
-            l.0.iter()
-                .zip(&self.named)
-                .filter(|(c, _)| !c.is_zero())
-                .map(|(c, (_, n))| (c.clone(), n.clone()))
-                .collect();
+            l.0.iter().zip(&self.free).filter(|(c, _)| !c.is_zero()).map(|(c, n)| (c.clone(), n.clone())).collect();
         combination(&parts, &self.style)
     }
 }

@@ -84,16 +84,22 @@ fn rational_roots(p: &Poly, v: Var) -> Res<Vec<Poly>> {
     let (Some(low), Some(high)) = (c.first().and_then(Poly::as_constant), c.last().and_then(Poly::as_constant)) else {
         return Ok(Vec::new());
     };
+    // Divisors up to √n each; coefficients beyond 10⁸ are not enumerated.
     let divisors = |n: i128| -> Vec<i128> {
         let n = n.abs();
-        if n == 0 || n > 1_000_000 {
+        if n == 0 || n > 100_000_000 {
             return Vec::new();
         }
-        (1..=n).filter(|d| n % d == 0).collect()
+        let mut out: Vec<i128> =
+            (1..).take_while(|d| d * d <= n).filter(|d| n % d == 0).flat_map(|d| [d, n / d]).collect();
+        out.sort_unstable();
+        out.dedup();
+        out
     };
+    let (lows, highs) = (divisors(low.numer()), divisors(high.numer()));
     let mut out = Vec::new();
-    for n in divisors(low.numer()) {
-        for q in divisors(high.numer()) {
+    for &n in &lows {
+        for &q in &highs {
             for n in [n, -n] {
                 if gcd(n, q) != 1 {
                     continue;

@@ -405,13 +405,13 @@ impl<'a> Printer<'a> {
     fn dissipation(&self) -> String {
         let d = &self.id.dissipation;
         if let Some((block, p, q)) = d.cross {
-            let n = &self.levels.named;
+            let n = &self.levels.free;
             return format!(
-                "indefinite for every param: its part on {} pairs {} with {} and has no square of {}",
+                "indefinite: its part on {} pairs {} with {} and has no square of {}",
                 block.letter(),
-                n[p].1,
-                n[q].1,
-                n[p].1
+                n[p],
+                n[q],
+                n[p]
             );
         }
         let mut out = String::new();
@@ -473,8 +473,9 @@ impl<'a> Printer<'a> {
         }
         for (q, what) in [(&self.id.acceleration, "acceleration"), (&self.id.step_before, "step")] {
             if let Some(q) = q {
+                let hat = if self.id.weight.is_some() { "\u{302}" } else { "" };
                 let what = match what {
-                    "acceleration" => format!("½dt²‖{}‖²_M", self.acceleration().unwrap_or("a")),
+                    "acceleration" => format!("½dt²‖{}{hat}‖²_M", self.acceleration().unwrap_or("a")),
                     _ => format!("½‖{0} - {0}⁻‖²_K", self.state(0)),
                 };
                 out.push(format!("  Ẽ ⪰ 0 in its term {what}: {}", self.condition(q)));

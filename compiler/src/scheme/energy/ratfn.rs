@@ -152,6 +152,28 @@ impl RatFn {
         Ok(Some(self.num.eval_exact(value)?.mul(d.inv()?)?))
     }
 
+    /// It with the params (variables 0..) given exact values: a function of dt and t alone;
+    /// none where its denominator vanishes there.
+    pub fn at_params(&self, params: &[Rat]) -> Res<Option<RatFn>> {
+        let put = |p: &Poly| -> Res<Poly> {
+            let mut out = p.clone();
+            for (i, v) in params.iter().enumerate() {
+                out = out.substitute(i as super::poly::Var, &Poly::constant(*v))?;
+            }
+            Ok(out)
+        };
+        let num = put(&self.num)?;
+        let mut den = Vec::new();
+        for f in &self.den {
+            let f = put(f)?;
+            if f.is_zero() {
+                return Ok(None);
+            }
+            den.push(f);
+        }
+        Ok(Some(RatFn { num, den }.reduced()?))
+    }
+
     /// num · Π den: of the same sign wherever it is defined.
     pub fn sign_polynomial(&self) -> Res<Poly> {
         self.num.mul(&self.den_product()?)

@@ -106,9 +106,15 @@ impl Region {
         let mut sign = Sign { nonnegative: true, nonpositive: true, negative_at: None };
         self.decide(&rest, &vars, lo, hi, DEPTH, &mut sign, &boxes)?;
         // p = (−m)·(−rest) with −m ≥ 0: p has the sign of the negated rest; its witnesses are
-        // looked for on p itself.
-        if flip {
-            sign.negative_at = None;
+        // looked for on p itself (below).
+        // A witness is one only where p itself is negative (a corner of the rest may sit where
+        // the monomial vanishes).
+        if let Some(at) = &sign.negative_at {
+            let value =
+                p.eval_exact(&|v| if v == DT { Rat::ONE } else { at.get(v as usize).copied().unwrap_or(Rat::ZERO) })?;
+            if flip || value.signum() >= 0 {
+                sign.negative_at = None;
+            }
         }
         if sign.negative_at.is_none() && !sign.nonnegative {
             return Ok(Sign { negative_at: self.search(p, &boxes, Rat::ONE)?.negative_at, ..sign });
@@ -188,20 +194,23 @@ impl Region {
             .collect()
     }
 
-    /// A grid over the region (9 points a side, open ends moved in), at `dt`, for a point where
-    /// p < 0.
+    /// A grid over the region (9 points a side for up to 3 params, fewer beyond; open ends
+    /// moved in), at `dt`, for a point where p < 0.
     fn search(&self, p: &Poly, boxes: &[(Var, Interval)], dt: Rat) -> Res<Sign> {
+        // At most about 4096 points: 9 a side for up to 3 params, fewer beyond.
+        let per_side = (4096f64.powf(1.0 / boxes.len().max(1) as f64).floor() as usize).clamp(2, 9);
+        let last = per_side as i128 - 1;
         let sides: Vec<Vec<Rat>> = boxes
             .iter()
             .map(|(_, i)| {
-                (0..=8)
+                (0..=last)
                     .map(|k| {
                         let k = match k {
-                            0 if !i.lo_closed => Rat::new(1, 64),
-                            8 if !i.hi_closed => Rat::new(511, 64),
-                            k => Ok(Rat::int(k)),
+                            0 if !i.lo_closed => Rat::new(1, 64 * last),
+                            k if k == last && !i.hi_closed => Rat::new(64 * last - 1, 64 * last),
+                            k => Rat::new(k, last),
                         }?;
-                        i.lo.add(i.hi.sub(i.lo)?.mul(k.mul(Rat::new(1, 8)?)?)?)
+                        i.lo.add(i.hi.sub(i.lo)?.mul(k)?)
                     })
                     .collect::<Res<Vec<Rat>>>()
             })
@@ -225,7 +234,7 @@ impl Region {
                     return Ok(Sign::default());
                 }
                 index[k] += 1;
-                if index[k] < 9 {
+                if index[k] < per_side {
                     break;
                 }
                 index[k] = 0;
@@ -261,8 +270,17 @@ fn bernstein(p: &Poly, vars: &[Var], lo: &[Rat], hi: &[Rat]) -> Res<(Vec<Rat>, V
         }
         all
     };
-    let binomial =
-        |n: u32, k: u32| -> Rat { Rat::int((0..k).fold(1i128, |b, i| b * (n - i) as i128 / (i + 1) as i128)) };
+    let binomial = |n: u32, k: u32| -> Res<Rat> {
+        let mut b = 1i128;
+        for i in 0..k {
+            b = b.checked_mul((n - i) as i128).ok_or(super::super::rational::GiveUp)? / (i + 1) as i128;
+        }
+        Ok(Rat::int(b))
+    };
+    // Beyond about 4096 coefficients a box is left undecided (its cost grows as their square).
+    if degrees.iter().map(|&d| d as usize + 1).product::<usize>() > 4096 {
+        return Err(super::super::rational::GiveUp);
+    }
     let mut coefficients = Vec::new();
     let mut corners = Vec::new();
     for i in indices(&degrees) {
@@ -273,7 +291,7 @@ fn bernstein(p: &Poly, vars: &[Var], lo: &[Rat], hi: &[Rat]) -> Res<(Vec<Rat>, V
                 continue;
             }
             for (k, (&ik, &jk)) in i.iter().zip(&j).enumerate() {
-                w = w.mul(binomial(ik, jk))?.mul(binomial(degrees[k], jk).inv()?)?;
+                w = w.mul(binomial(ik, jk)?)?.mul(binomial(degrees[k], jk)?.inv()?)?;
             }
             b = b.add(w)?;
         }
