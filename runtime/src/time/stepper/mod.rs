@@ -233,6 +233,16 @@ impl<'a> Stepper<'a> {
         })
     }
 
+    /// The residual of the form bound to `slot` at `fields` and time `t`, as the scheme's
+    /// residuals apply it (none for a slot the stepper does not bind): what a derived energy
+    /// identity evaluates its work and dissipation with.
+    pub fn apply(&self, slot: &str, fields: &[&[f64]], t: f64) -> Option<Vec<f64>> {
+        let form = self.forms.get(slot)?;
+        let mut out = vec![0.0; self.asm.size()];
+        form.residual(self.asm, fields, t, &mut out);
+        Some(out)
+    }
+
     /// The scheme's description (states, stages, slots).
     /// The lower half of the mesh's pattern (in reverse Cuthill–McKee order) that the stages'
     /// symmetric matrices are stored on, when they are: for other symmetric products on the
