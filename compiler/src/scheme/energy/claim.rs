@@ -55,7 +55,12 @@ pub fn check(ir: &SchemeIr, law: EnergyLaw, span: Span) -> Option<Diagnostic> {
 /// identity proves it or does not decide it there; where it refutes it, the law it proves
 /// instead (Newmark claims `conserving` at its defaults and dissipates with gam > 1/2), or none.
 pub fn law_at(ir: &SchemeIr, claimed: EnergyLaw, params: &[f64]) -> Option<EnergyLaw> {
-    let Ok(id) = Identity::derive(ir) else { return Some(claimed) };
+    law_by(Identity::derive(ir).ok().as_ref(), claimed, params)
+}
+
+/// As [`law_at`], from the scheme's identity already derived (none: there is none).
+pub fn law_by(id: Option<&Identity>, claimed: EnergyLaw, params: &[f64]) -> Option<EnergyLaw> {
+    let Some(id) = id else { return Some(claimed) };
     let shown = |_: &super::classify::Square| String::new();
     match id.proves(claimed, params, &shown) {
         Ok(Proof::Holds | Proof::Undecided(_)) | Err(_) => Some(claimed),

@@ -237,10 +237,22 @@ impl<'a> Stepper<'a> {
     /// residuals apply it (none for a slot the stepper does not bind): what a derived energy
     /// identity evaluates its work and dissipation with.
     pub fn apply(&self, slot: &str, fields: &[&[f64]], t: f64) -> Option<Vec<f64>> {
-        let form = self.forms.get(slot)?;
         let mut out = vec![0.0; self.asm.size()];
-        form.residual(self.asm, fields, t, &mut out);
-        Some(out)
+        self.apply_into(slot, fields, t, &mut out).then_some(out)
+    }
+
+    /// As [`Stepper::apply`], into `out` (zeroed first); false for a slot it does not bind.
+    pub fn apply_into(&self, slot: &str, fields: &[&[f64]], t: f64, out: &mut [f64]) -> bool {
+        let Some(form) = self.forms.get(slot) else { return false };
+        out.fill(0.0);
+        form.residual(self.asm, fields, t, out);
+        true
+    }
+
+    /// Whether the form bound to `slot` changes with time other than through its fields (none
+    /// for a slot the stepper does not bind).
+    pub fn time_dependent(&self, slot: &str) -> Option<bool> {
+        self.forms.get(slot).map(|f| f.time_dependent())
     }
 
     /// The scheme's description (states, stages, slots).
