@@ -43,16 +43,16 @@ pub enum CaseError {
     Failed { t: f64, cause: String },
     /// The energy grew past what a stable scheme allows.
     #[error(
-        "stopped at t = {at}: the energy E_aug = W(u) + ½vᵀMv + contact energy = {energy:.6e} (W the stored energy: ½uᵀKu for a linear material) exceeds E_aug(0) + the work of the loads = {bound:.6e} by {:.1} % of the problem's energy scale {scale:.4e} (the largest of |E_aug(0)|, the work and the kinetic energy reached); the tolerance is {:.1} %{law}: the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Δt beyond a conditionally stable scheme's limit (an explicit scheme, an explicit contact term), Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt, a contact parameter so large (γ0 or ε ≳ 1e12 × E) that the contact rows' round-off swamps the solve, or degenerate cells. Results up to the last good step are written; --energy-tolerance sets the tolerance (0 turns this check off)",
-        100.0 * (energy - bound) / scale,
-        100.0 * tolerance,
+        "stopped at t = {at}: the energy E_aug = W(u) + ½vᵀMv + contact energy = {energy:.6e} (W the stored energy: ½uᵀKu for a linear material) exceeds E_aug(0) + the work of the loads = {bound:.6e} by {} % of the problem's energy scale {scale:.4e} (the largest of |E_aug(0)|, the work and the kinetic energy reached); the tolerance is {} %{law}: the discrete problem is unstable.\n  Params: {params}.\n  Likely causes: Δt beyond a conditionally stable scheme's limit (an explicit scheme, an explicit contact term), Nitsche with γ0 too small for its θ (coercivity), a penalty too stiff for Δt, a contact parameter so large (γ0 or ε ≳ 1e12 × E) that the contact rows' round-off swamps the solve, or degenerate cells. Results up to the last good step are written; --energy-tolerance sets the tolerance (0 turns this check off)",
+        percent(100.0 * (energy - bound) / scale),
+        percent(100.0 * tolerance),
         at = at(.t)
     )]
     BlowUp { t: f64, energy: f64, bound: f64, scale: f64, tolerance: f64, law: String, params: String },
     /// The potential energy went negative: the contact law is not coercive for its params.
     #[error(
-        "stopped at t = {at}: the potential energy W(u) + contact energy = {potential:.6e} is negative, beyond {:.1} % of the problem's energy scale {scale:.4e}: the discrete problem is not stable. Most likely the contact law is not coercive for these params (Nitsche θ = 1 or 0 with γ0 too small against the material's stiffness; θ = −1 is coercive for any γ0), and the motion grows without bound while E_aug is kept; otherwise the steps' solutions diverge (an iterative solve that is not accurate enough: try --solver direct).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
-        100.0 * tolerance,
+        "stopped at t = {at}: the potential energy W(u) + contact energy = {potential:.6e} is negative, beyond {} % of the problem's energy scale {scale:.4e}: the discrete problem is not stable. Most likely the contact law is not coercive for these params (Nitsche θ = 1 or 0 with γ0 too small against the material's stiffness; θ = −1 is coercive for any γ0), and the motion grows without bound while E_aug is kept; otherwise the steps' solutions diverge (an iterative solve that is not accurate enough: try --solver direct).\n  Params: {params}.\n  Results up to the last good step are written; --energy-tolerance 0 turns this check off",
+        percent(100.0 * tolerance),
         at = at(.t)
     )]
     NotCoercive { t: f64, potential: f64, scale: f64, tolerance: f64, params: String },
@@ -86,6 +86,12 @@ pub enum CaseError {
     /// SIGINT or SIGTERM.
     #[error("interrupted at t = {at}: results up to there are written", at = at(.t))]
     Interrupted { t: f64 },
+}
+
+/// A percentage in a message: one decimal, or two significant digits below 0.1 % (a tolerance
+/// of 1e-7 % is not "0.0 %").
+fn percent(x: f64) -> String {
+    if x == 0.0 || x.abs() >= 0.1 || !x.is_finite() { format!("{x:.1}") } else { format!("{x:.1e}") }
 }
 
 /// A time in a message: six significant digits (`t = 4.475`, not `4.4750000000000005`).

@@ -36,7 +36,7 @@ pub const FILE: &str = "checkpoint.bin";
 pub const LOG: &str = "checkpoint.log";
 const MAGIC: &[u8; 8] = b"SIGNCKPT";
 /// The layout of the file; a checkpoint of another layout is refused.
-const FORMAT: u32 = 4;
+const FORMAT: u32 = 5;
 
 /// What a run must share with the checkpoint it resumes: (what, value) pairs, compared one by
 /// one so that a refusal names what differs.
@@ -67,10 +67,14 @@ pub struct DriverState {
     /// The largest kinetic energy so far and the largest growth (the guard's scale and record).
     pub energy_kinetic: f64,
     pub energy_growth: f64,
-    /// The lowest E_aug − W so far (a dissipative scheme's bound).
+    /// The energy the steps made so far (net of allowances) and the least it was (a
+    /// dissipative scheme's bound).
+    pub energy_made: f64,
     pub energy_lowest: f64,
-    /// A conserving scheme's allowance so far, and its active set after the last step.
-    pub energy_allowance: f64,
+    /// E_aug and the work of the loads at the last step's end.
+    pub energy_last: f64,
+    pub energy_external: f64,
+    /// The active set after the last step (a conserving scheme's).
     pub energy_switches: Vec<bool>,
     /// The scheme's states, then the previous time level when a law reads it (`prev`).
     pub states: Vec<Vec<f64>>,
@@ -363,8 +367,10 @@ mod tests {
             energy_u0: vec![0.0, 1.0],
             energy_kinetic: 0.5,
             energy_growth: 0.0,
-            energy_lowest: 1.5,
-            energy_allowance: 0.0,
+            energy_made: 0.25,
+            energy_lowest: -1.5,
+            energy_last: 2.0,
+            energy_external: 0.5,
             energy_switches: vec![true],
             states: vec![vec![f64::NAN, -0.0, 1e-300], vec![f64::INFINITY, 2.0, 3.0]],
             periodic: true,

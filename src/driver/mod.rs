@@ -88,8 +88,23 @@ impl Methods {
     }
 }
 
-/// A scheme file's numeric claims at the params in use, and its energy law.
-pub type ClaimsAndLaw = (Vec<(String, f64)>, Option<crate::compiler::scheme::EnergyLaw>);
+/// What a run holds its scheme to ([`FilesInUse::scheme_energy`]); empty for a scheme compiled
+/// by a crate of its own (there is no source to read).
+#[derive(Default)]
+pub struct SchemeEnergy {
+    /// The numeric claims at the params in use (`claim cfl = ...`).
+    pub claims: Vec<(String, f64)>,
+    pub law: Option<crate::compiler::scheme::EnergyLaw>,
+    /// The energy identity derived from the file, when there is one.
+    pub identity: Option<SchemeIdentity>,
+}
+
+/// A scheme's derived energy identity, with its file and the params in use.
+pub struct SchemeIdentity {
+    pub ir: crate::compiler::scheme::SchemeIr,
+    pub identity: crate::compiler::scheme::energy::classify::Identity,
+    pub params: Vec<f64>,
+}
 
 /// A scheme, compiled or loaded from a file.
 pub enum SchemeSource {
@@ -483,16 +498,18 @@ impl FilesInUse {
         }))
     }
 
-    /// Both, from one reading of the scheme's file, the law as a run holds the scheme to it at
-    /// the params in use: the claim where its energy identity proves it there (or does not
-    /// decide), else the law the identity proves, or none.
-    pub fn scheme_claims_and_law(&self) -> Result<ClaimsAndLaw, CaseError> {
+    /// From one reading of the scheme's file: its numeric claims at the params in use, the law
+    /// a run holds the scheme to there (the claim where its energy identity proves it there or
+    /// does not decide, else the law the identity proves, or none), and the identity itself.
+    pub fn scheme_energy(&self) -> Result<SchemeEnergy, CaseError> {
+        use crate::compiler::scheme::energy::{claim, classify::Identity};
         let params = self.forms.params.scheme_values(self.scheme.params());
-        Ok(self.scheme_ir()?.map_or((Vec::new(), None), |ir| {
-            let law =
-                ir.energy.and_then(|claimed| crate::compiler::scheme::energy::claim::law_at(&ir, claimed, &params));
-            (ir.claims_at(&params), law)
-        }))
+        let Some(ir) = self.scheme_ir()? else { return Ok(SchemeEnergy::default()) };
+        let identity = Identity::derive(&ir).ok();
+        let law = ir.energy.and_then(|claimed| claim::law_by(identity.as_ref(), claimed, &params));
+        let claims = ir.claims_at(&params);
+        let identity = identity.map(|identity| SchemeIdentity { ir, identity, params });
+        Ok(SchemeEnergy { claims, law, identity })
     }
 
     /// The scheme's compiled file (none for a scheme compiled by a crate of its own: there is

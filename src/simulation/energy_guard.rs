@@ -1,14 +1,17 @@
-//! The energy guard: after every step, E_aug = W(u) + ½vᵀMv + the contact law's energy (W the
-//! stored energy, ½uᵀKu for a linear material) against
-//! E_aug(0) + the work done on the body so far (the loads', the held dofs' reactions', a moving
-//! obstacle's, the contact law's own, less what its friction took), with the allowance the scheme's energy law gives; a
-//! growth beyond the tolerance, a negative potential energy, or a law's own work beyond the
-//! energy from outside stops the run (docs/mathematics.md §5).
+//! The energy guard: after every step, what the steps made of E_aug = W(u) + ½vᵀMv + the
+//! contact law's energy (W the stored energy, ½uᵀKu for a linear material) beyond the work done
+//! on the body (the loads', the held dofs' reactions', a moving obstacle's, the contact law's
+//! own, less what its friction took), less the allowance the scheme's energy law gives; where
+//! the scheme's energy identity measures the step ([`super::ledger`]), its kept energy and the
+//! loads' work with its weights. A growth beyond the tolerance, a negative potential energy, or
+//! a law's own work beyond the energy from outside stops the run (docs/mathematics.md §5).
 
 use std::borrow::Cow;
 
 use super::Operators;
+use super::ledger::Exact;
 use crate::compiler::scheme::EnergyLaw;
+use crate::error::CaseError;
 use crate::guard::ENERGY_TOLERANCE;
 use crate::runtime::fem::bound::{BoundForm, BoundFunctional};
 
@@ -32,9 +35,11 @@ impl Ended<'_> {
     }
 }
 
-/// The energy guard: the growth of E_aug = W(u) + ½vᵀMv + the contact law's
-/// `contact_energy(u)` beyond E_aug(0) + the work of the loads, over the problem's energy scale
-/// (the largest of |E_aug(0)|, the work's magnitude so far, and the kinetic energy reached).
+/// The energy guard: what the steps made of E_aug = W(u) + ½vᵀMv + the contact law's
+/// `contact_energy(u)` beyond what the work of the loads brought (and the law's own work), over
+/// the problem's energy scale (the largest of |E_aug(0)|, the work's magnitude so far, and the
+/// kinetic energy reached). A step measured by the scheme's energy identity ([`Exact`]) counts
+/// the change of its kept energy Ẽ_aug against the loads' work with the scheme's weights.
 pub(super) struct EnergyWatch {
     pub(super) initial: f64,
     pub(super) u0: Vec<f64>,
@@ -51,18 +56,20 @@ pub(super) struct EnergyWatch {
     pub(super) kinetic: f64,
     /// The largest growth over the scale so far (the summary's `energy_growth`).
     pub(super) growth: f64,
-    /// The lowest E_aug − W so far (a dissipative scheme's bound: what it lost stays lost).
+    /// The energy the steps made so far, net of the allowances (the sum of [`Made`]).
+    pub(super) made: f64,
+    /// The least `made` so far (a dissipative scheme's bound: what it lost stays lost).
     pub(super) lowest: f64,
-    /// A conserving scheme's allowance so far: on each step whose active set changed, the
-    /// larger of `contact_jump` before and after it.
-    pub(super) allowance: f64,
+    /// E_aug and the work of the loads (E_aug's measure) at the end of the step before.
+    pub(super) last: f64,
+    pub(super) external: f64,
     /// The active set after the previous step (a conserving scheme's).
     pub(super) switches: Vec<bool>,
 }
 
 /// An energy above what the guard allows.
 pub(super) struct Grown {
-    /// E_aug and E_aug(0) + W.
+    /// E_aug and what the guard allows it.
     pub(super) energy: f64,
     pub(super) bound: f64,
     pub(super) scale: f64,
@@ -77,6 +84,48 @@ pub(super) enum Cause {
     Negative(f64),
     /// The law's own work beyond the energy from outside.
     LawWork { work: f64, outside: f64 },
+}
+
+impl Grown {
+    /// The error that stops a run whose energy the guard refused at `t`.
+    pub(super) fn stop(
+        self,
+        t: f64,
+        tolerance: f64,
+        params: &str,
+        law: Option<EnergyLaw>,
+        by_identity: bool,
+    ) -> CaseError {
+        let params = params.to_string();
+        match self.cause {
+            Cause::Negative(potential) => CaseError::NotCoercive { t, potential, scale: self.scale, tolerance, params },
+            Cause::LawWork { work, outside } => CaseError::LawWork { t, work, outside, params },
+            Cause::Growth => CaseError::BlowUp {
+                t,
+                energy: self.energy,
+                bound: self.bound,
+                scale: self.scale,
+                tolerance,
+                law: law.map_or_else(
+                    || " (the scheme claims no energy law)".to_string(),
+                    |l| format!(" beyond what a {} scheme allows", l.name()),
+                ) + if by_identity {
+                    ", measured by its energy identity (`signorini emit SCHEME.wf --stage energy`: its kept energy Ẽ and the loads' work with its weights)"
+                } else {
+                    ""
+                },
+                params,
+            },
+        }
+    }
+}
+
+/// One step's work besides the loads': the contact law's own (`contact_work`) and what its
+/// friction took (`friction_work`).
+#[derive(Clone, Copy, Default)]
+pub(super) struct StepWork {
+    pub(super) law: f64,
+    pub(super) friction: f64,
 }
 
 impl EnergyWatch {
@@ -94,8 +143,10 @@ impl EnergyWatch {
             dissipated: 0.0,
             kinetic,
             growth: 0.0,
-            lowest: initial,
-            allowance: 0.0,
+            made: 0.0,
+            lowest: 0.0,
+            last: initial,
+            external: 0.0,
             // The first level's previous level is itself (as the stepper's is).
             switches: ops.contact_switches(u, u, t),
         }
@@ -157,28 +208,53 @@ impl EnergyWatch {
             Self::value(&ops.contact_energy, ops, &mid, t + h) - Self::value(&ops.contact_energy, ops, &mid, t);
     }
 
-    /// After each accepted step: the energy, and whether it grew beyond what `law` allows by
-    /// more than `tolerance` × the scale. Without a law, E_aug − W may not exceed its initial
-    /// value. A conserving scheme's E_aug may also jump on the steps where points enter or leave
-    /// contact, by at most the energy of their contact stress (docs/mathematics.md §5:
-    /// (1/2γ)(pⁿ)² or (1/2γ)(pⁿ⁺¹)²), which the law gives as `contact_jump`: on each such step
-    /// the larger of its values before and after is added to what is allowed. A dissipative scheme's
-    /// E_aug − W may not exceed the lowest value it reached. The kinetic energy of this step
-    /// joins the scale only once the step passes (a blow-up's own motion does not widen its
-    /// bound).
+    /// After each accepted step: the energy, and whether what the steps made of it so far
+    /// exceeds what `law` allows by more than `tolerance` × the scale.
+    ///
+    /// A step makes the change of E_aug less the work of the loads and the law's own work (plus
+    /// what friction took, under an energy law: that energy left for good). Measured by the
+    /// scheme's identity (`exact`), the change is that of Ẽ_aug and the loads' work is the
+    /// identity's. Without a law, the steps may make nothing; a dissipative scheme may not
+    /// make again what it lost (the bound is the least reached). A conserving scheme may also
+    /// make energy on the steps where points enter or leave contact, by at most the energy of
+    /// their contact stress (docs/mathematics.md §5: (1/2γ)(pⁿ)² or (1/2γ)(pⁿ⁺¹)²), which the
+    /// law gives as `contact_jump`: by the identity, what the step made up to that bound; else
+    /// the bound itself. The kinetic energy of this step joins the scale only once the step
+    /// passes (a blow-up's own motion does not widen its bound).
     pub(super) fn check(
         &mut self,
         ops: &Operators,
         step: &Ended,
         tolerance: f64,
         law: Option<EnergyLaw>,
+        taken: (StepWork, Option<Exact>),
     ) -> Option<Grown> {
+        let (own, exact) = taken;
         let u = &step.states[0];
         let kinetic = ops.kinetic(Some(&step.velocity()));
         let potential = ops.elastic(u) + Self::contact(ops, u, step.t);
         let energy = potential + kinetic;
-        let (switches, allowance) = self.allowance(ops, step, law);
-        let (work, bound, scale) = self.balance(ops, u, law, allowance);
+        let external = self.external_work(ops, u);
+        let friction = if law.is_some() { own.friction } else { 0.0 };
+        let made = match &exact {
+            Some(e) => e.after() - e.before() - e.balance.loads,
+            None => energy - self.last - (external - self.external),
+        } - own.law
+            + friction;
+        let (switches, jump) = self.jump(ops, step, law);
+        let allowed = match (jump, &exact) {
+            (None, _) => 0.0,
+            (Some(jump), Some(_)) => made.clamp(0.0, jump),
+            (Some(jump), None) => jump,
+        };
+        let total = self.made + made - allowed;
+        self.work = self.work.max(external.abs());
+        let scale = self.initial.abs().max(self.work).max(self.kinetic).max(f64::MIN_POSITIVE);
+        let excess = match law {
+            Some(EnergyLaw::Dissipative) => total - self.lowest,
+            _ => total,
+        };
+        let bound = energy - excess;
         // The law's own work (Nitsche θ ≠ 1) is part of the balance, but it may not drive the
         // motion: beyond the energy that came from outside (initially and by the loads), the
         // balance would hold while the motion grows without bound.
@@ -186,7 +262,7 @@ impl EnergyWatch {
         if tolerance > 0.0 && self.law_work.abs() > outside {
             return Some(Grown { energy, bound, scale, cause: Cause::LawWork { work: self.law_work, outside } });
         }
-        let growth = (energy - bound) / scale;
+        let growth = excess / scale;
         // NaN compares false: a non-finite energy is a growth beyond any tolerance.
         self.growth = if growth.is_finite() { self.growth.max(growth) } else { f64::INFINITY };
         if tolerance > 0.0 && (growth > tolerance || growth.is_nan()) {
@@ -204,53 +280,36 @@ impl EnergyWatch {
             self.kinetic = self.kinetic.max(kinetic);
         }
         self.switches = switches;
-        self.allowance = allowance;
-        self.lowest = self.lowest.min(energy - work);
+        self.made = total;
+        self.lowest = self.lowest.min(total);
+        self.last = energy;
+        self.external = external;
         None
     }
 
-    /// A conserving scheme's allowance, which grows on the steps where the active set changes
-    /// (see [`EnergyWatch::check`]), and the contact switches at the step's end.
-    fn allowance(&self, ops: &Operators, step: &Ended, law: Option<EnergyLaw>) -> (Vec<bool>, f64) {
+    /// A conserving scheme's bound on what a step may make where the active set changes (see
+    /// [`EnergyWatch::check`]; none on other steps and under other laws), and the contact
+    /// switches at the step's end.
+    fn jump(&self, ops: &Operators, step: &Ended, law: Option<EnergyLaw>) -> (Vec<bool>, Option<f64>) {
         let (u, before, t, h) = (&step.states[0], step.before, step.t, step.h);
-        match law {
-            Some(EnergyLaw::Conserving) => {
-                let switches = ops.contact_switches(u, before, t);
-                let jump = if switches != self.switches {
-                    let value = |x: &[f64], at: f64| Self::value(&ops.contact_jump, ops, x, at);
-                    value(u, t).max(value(before, t - h))
-                } else {
-                    0.0
-                };
-                (switches, self.allowance + jump)
-            }
-            _ => (Vec::new(), 0.0),
+        if law != Some(EnergyLaw::Conserving) {
+            return (Vec::new(), None);
         }
+        let switches = ops.contact_switches(u, before, t);
+        let jump = (switches != self.switches).then(|| {
+            let value = |x: &[f64], at: f64| Self::value(&ops.contact_jump, ops, x, at);
+            value(u, t).max(value(before, t - h))
+        });
+        (switches, jump)
     }
 
-    /// The energy balance at the step's end: the work that entered (net of what friction took,
-    /// under an energy law), the bound on E_aug that `law` sets, and the scale growths are
-    /// measured in (which the largest external work so far joins).
-    fn balance(&mut self, ops: &Operators, u: &[f64], law: Option<EnergyLaw>, allowance: f64) -> (f64, f64, f64) {
-        // The work summed step by step (a varying load's, the held dofs', a moving obstacle's),
-        // a constant load's from u(0), and the law's own.
+    /// The work of the loads from the start to `u`: summed step by step (a varying load's, the
+    /// held dofs', a moving obstacle's), a constant load's from u(0).
+    fn external_work(&self, ops: &Operators, u: &[f64]) -> f64 {
         let constant: f64 = match ops.varying_load {
             Some(_) => 0.0,
             None => ops.load.iter().zip(u.iter().zip(&self.u0)).map(|(l, (a, b))| l * (a - b)).sum(),
         };
-        let external = self.varying_work + constant;
-        self.work = self.work.max(external.abs());
-        let scale = self.initial.abs().max(self.work).max(self.kinetic).max(f64::MIN_POSITIVE);
-        // What friction took counts where the scheme claims an energy law: an implicit scheme,
-        // whose friction is the new level's, as `friction_work` measures it. An explicit
-        // contact term applies the level before's, and its bound stays E_aug(0) + W.
-        let dissipated = if law.is_some() { self.dissipated } else { 0.0 };
-        let work = external + self.law_work - dissipated;
-        let bound = match law {
-            Some(EnergyLaw::Conserving) => self.initial + work + allowance,
-            Some(EnergyLaw::Dissipative) => self.lowest + work,
-            None => self.initial + work,
-        };
-        (work, bound, scale)
+        self.varying_work + constant
     }
 }

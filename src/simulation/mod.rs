@@ -22,12 +22,13 @@ use crate::runtime::time::scheme::StageView;
 use crate::runtime::time::stepper::{StepError, StepReport, Stepper};
 
 mod energy_guard;
+mod ledger;
 pub mod operators;
 mod snapshots;
 pub mod stability;
 pub mod statics;
 
-use energy_guard::{Cause, Ended, EnergyWatch, Grown};
+use energy_guard::{Ended, EnergyWatch, StepWork};
 use operators::Parts;
 pub use operators::{AxisMean, Energies, Operators, resultant};
 pub use snapshots::Snapshots;
@@ -96,6 +97,8 @@ pub struct Simulation<'m> {
     /// Whether the scheme applies a mass: without, each step is an equilibrium of its own and
     /// no energy is watched.
     pub inertia: bool,
+    /// The scheme's energy identity, where it measures the run's steps for the energy guard.
+    ledger: Option<ledger::Ledger>,
 }
 
 /// One finished step, as the observer sees it.
@@ -162,14 +165,16 @@ impl<'m> Simulation<'m> {
         if !inertia {
             guard.energy_tolerance = 0.0;
         }
-        let (claims, law) = in_use.scheme_claims_and_law()?;
-        let (stable, tracker) = match claims.into_iter().find(|(c, _)| c == "cfl") {
+        let energy = in_use.scheme_energy()?;
+        let ledger = ledger::Ledger::new(energy.identity.filter(|_| inertia), &ops, &stepper);
+        let law = energy.law;
+        let (stable, tracker) = match energy.claims.into_iter().find(|(c, _)| c == "cfl") {
             Some((_, cfl)) => {
                 (Some(stability::estimate(&ops, coefs, &held, cfl)?), stability::Tracker::new(&ops, coefs, &held, cfl)?)
             }
             None => (None, None),
         };
-        Ok(Simulation { stepper, ops, states, v_index, guard, params, law, stable, tracker, inertia })
+        Ok(Simulation { stepper, ops, states, v_index, guard, params, law, stable, tracker, inertia, ledger })
     }
 
     /// Sets the displacement and solves the scheme's initial problem (the acceleration).
@@ -245,7 +250,7 @@ impl<'m> Simulation<'m> {
                 let units = full >> at.level;
                 let h = span.dt * units as f64 / full as f64;
                 let t = span.t0 + (k as f64 + done as f64 / full as f64) * span.dt;
-                let (result, start, stages_seen, clock) = self.attempt(watch.stage, &intermediate, t, h, max_cuts);
+                let (result, start, seen, clock) = self.attempt(watch.stage, &intermediate, t, h, max_cuts);
                 let report = match result {
                     Ok(report) => report,
                     Err(e) => match at.cut(e, t, h, max_cuts, &mut outcome) {
@@ -261,7 +266,7 @@ impl<'m> Simulation<'m> {
                 at.accepted += 1;
                 let whole = done == full;
                 let t_end = if whole { span.t0 + (k + 1) as f64 * span.dt } else { t + h };
-                let taken = Taken { k, whole, t, h, t_end, start: &start, stages_seen, report: &report };
+                let taken = Taken { k, whole, t, h, t_end, start, seen, report: &report };
                 let (energy, outcome, control) = (&mut energy, &mut outcome, &mut *control);
                 let mut walk = Walk { at: &mut at, energy, outcome, control, crash_at };
                 if let Some(stop) = self.accept(&mut walk, span.steps, taken, watch.step)? {
@@ -291,16 +296,21 @@ impl<'m> Simulation<'m> {
         taken: Taken,
         on_step: &mut OnStep,
     ) -> Result<Option<CaseError>, CaseError> {
-        let Taken { k, whole, t, h, t_end, start, stages_seen, report } = taken;
+        let Taken { k, whole, t, h, t_end, start, seen, report } = taken;
         let due = Due::at(walk.control, k, steps, whole)?;
         let mut record = due.record.then(Vec::new);
         let (ops, states, v_index) = (&self.ops, &self.states, self.v_index);
-        add_work(walk.energy, ops, Interval { start, states, v_index, t, h }, stages_seen);
+        let own = add_work(walk.energy, ops, Interval { start: &start, states, v_index, t, h }, seen.stages);
+        let exact = self.ledger.as_ref().and_then(|l| {
+            let start = start.saved.as_deref()?;
+            l.balance((ops, &self.stepper), start, &seen.unknowns, states, t, h)
+        });
         // Checked before the observer sees the step: the outputs end at the last good one.
         let ended = Ended { states, v_index, before: &start.before, h, t: t_end };
         let tolerance = self.guard.energy_tolerance;
-        if let Some(grown) = walk.energy.check(ops, &ended, tolerance, self.law) {
-            return Ok(Some(energy_stop(grown, t_end, tolerance, &self.params, self.law)));
+        if let Some(grown) = walk.energy.check(ops, &ended, tolerance, self.law, (own, exact)) {
+            let by_identity = exact.is_some();
+            return Ok(Some(grown.stop(t_end, tolerance, &self.params, self.law, by_identity)));
         }
         walk.outcome.energy_growth = walk.energy.growth;
         let (before, previous) = (&start.before, start.before_previous.as_deref());
@@ -335,18 +345,21 @@ impl<'m> Simulation<'m> {
         t: f64,
         h: f64,
         max_cuts: usize,
-    ) -> (Result<StepReport, StepError>, Start, Vec<StageSeen>, Instant) {
-        let Simulation { stepper, ops, states, v_index, .. } = self;
-        let start = Start::of(states, stepper, *v_index, ops, max_cuts);
+    ) -> (Result<StepReport, StepError>, Start, Seen, Instant) {
+        let Simulation { stepper, ops, states, v_index, ledger, .. } = self;
+        let start = Start::of(states, stepper, *v_index, ops, max_cuts > 0 || ledger.is_some());
         let clock = Instant::now();
-        let mut stages_seen: Vec<StageSeen> = Vec::new();
+        let mut seen = Seen::default();
         let result = stepper.step_observed(states, t, h, &mut |stage| {
+            if ledger.is_some() {
+                seen.unknowns.push(stage.values[0].clone());
+            }
             if intermediate.iter().any(|name| name == stage.name) {
                 on_stage(ops, stage, *v_index, &start.before);
                 if !ops.held.is_empty()
                     && let Some(u) = stage.value_of("u")
                 {
-                    stages_seen.push((stage.time, u.to_vec(), stage.value_of("v").map(<[f64]>::to_vec)));
+                    seen.stages.push((stage.time, u.to_vec(), stage.value_of("v").map(<[f64]>::to_vec)));
                 }
             }
         });
@@ -365,7 +378,7 @@ impl<'m> Simulation<'m> {
         {
             states.clone_from_slice(saved);
         }
-        (result, start, stages_seen, clock)
+        (result, start, seen, clock)
     }
 
     /// Writes a due checkpoint. After a periodic one (not an interrupt's) the stepper forgets
@@ -413,8 +426,10 @@ impl<'m> Simulation<'m> {
             dissipated: saved.energy_dissipated,
             kinetic: saved.energy_kinetic,
             growth: saved.energy_growth,
+            made: saved.energy_made,
             lowest: saved.energy_lowest,
-            allowance: saved.energy_allowance,
+            last: saved.energy_last,
+            external: saved.energy_external,
             switches: saved.energy_switches.clone(),
         };
         outcome.resumed = Some(Resumed { step: saved.steps_done, bit_for_bit: saved.periodic });
@@ -454,13 +469,21 @@ struct Taken<'s> {
     t: f64,
     h: f64,
     t_end: f64,
-    start: &'s Start,
-    stages_seen: Vec<StageSeen>,
+    start: Start,
+    seen: Seen,
     report: &'s StepReport,
 }
 
 /// An intermediate stage's time, displacement and velocity (if the scheme has one).
 type StageSeen = (f64, Vec<f64>, Option<Vec<f64>>);
+
+/// What a step showed of its stages: the intermediate ones' (for the held dofs' work), and every
+/// stage's unknown (for the energy identity).
+#[derive(Default)]
+struct Seen {
+    stages: Vec<StageSeen>,
+    unknowns: Vec<Vec<f64>>,
+}
 
 /// Where a run is: the nominal steps done before it (from a checkpoint), the steps accepted,
 /// how many times Δt is halved now, and the steps accepted since it last changed.
@@ -523,8 +546,10 @@ impl Cursor {
             energy_u0: energy.u0.clone(),
             energy_kinetic: energy.kinetic,
             energy_growth: energy.growth,
+            energy_made: energy.made,
             energy_lowest: energy.lowest,
-            energy_allowance: energy.allowance,
+            energy_last: energy.last,
+            energy_external: energy.external,
             energy_switches: energy.switches.clone(),
             states: states.iter().map(Vec::as_slice).chain(previous).map(<[f64]>::to_vec).collect(),
             periodic,
@@ -532,7 +557,8 @@ impl Cursor {
     }
 }
 
-/// What a step keeps of its start: the states for a retry (when a cut may follow), the
+/// What a step keeps of its start: the states (for a retry when a cut may follow, and the
+/// energy identity's free variables), the
 /// displacement, the level a law's `prev` read, and the velocity when held dofs take the
 /// change of velocity over the step into their reaction.
 struct Start {
@@ -543,9 +569,9 @@ struct Start {
 }
 
 impl Start {
-    fn of(states: &[Vec<f64>], stepper: &Stepper, v_index: Option<usize>, ops: &Operators, max_cuts: usize) -> Self {
+    fn of(states: &[Vec<f64>], stepper: &Stepper, v_index: Option<usize>, ops: &Operators, keep: bool) -> Self {
         Start {
-            saved: (max_cuts > 0).then(|| states.to_vec()),
+            saved: keep.then(|| states.to_vec()),
             before: states[0].clone(),
             before_previous: stepper.previous().map(<[f64]>::to_vec),
             v_before: v_index.filter(|_| !ops.held.is_empty()).map(|i| states[i].clone()),
@@ -583,8 +609,8 @@ struct Interval<'s> {
 
 /// Adds the step's work to the energy watch: a varying load's, the held dofs' (over each
 /// sub-interval between the step's stages), a moving obstacle's, the law's own, and what
-/// friction dissipated.
-fn add_work(energy: &mut EnergyWatch, ops: &Operators, step: Interval, mut stages_seen: Vec<StageSeen>) {
+/// friction dissipated; returns the step's part of the last two.
+fn add_work(energy: &mut EnergyWatch, ops: &Operators, step: Interval, mut stages_seen: Vec<StageSeen>) -> StepWork {
     let Interval { start, states, v_index, t, h } = step;
     let before = &start.before;
     if let Some(load) = &ops.varying_load {
@@ -605,33 +631,16 @@ fn add_work(energy: &mut EnergyWatch, ops: &Operators, step: Interval, mut stage
     if ops.probe.as_ref().is_some_and(|p| p.time_dependent()) {
         energy.obstacle_work(ops, before, &states[0], t, h);
     }
+    let mut own = StepWork::default();
     if let Some(work) = &ops.contact_work {
-        energy.law_work += work.value(ops.asm, &[&states[0], before], t + 0.5 * h);
+        own.law = work.value(ops.asm, &[&states[0], before], t + 0.5 * h);
+        energy.law_work += own.law;
     }
     if let Some(work) = &ops.friction_work {
-        energy.dissipated += work.value(ops.asm, &[&states[0], before], t + h);
+        own.friction = work.value(ops.asm, &[&states[0], before], t + h);
+        energy.dissipated += own.friction;
     }
-}
-
-/// The error that stops a run whose energy the guard refused at `t`.
-fn energy_stop(grown: Grown, t: f64, tolerance: f64, params: &str, law: Option<EnergyLaw>) -> CaseError {
-    let params = params.to_string();
-    match grown.cause {
-        Cause::Negative(potential) => CaseError::NotCoercive { t, potential, scale: grown.scale, tolerance, params },
-        Cause::LawWork { work, outside } => CaseError::LawWork { t, work, outside, params },
-        Cause::Growth => CaseError::BlowUp {
-            t,
-            energy: grown.energy,
-            bound: grown.bound,
-            scale: grown.scale,
-            tolerance,
-            law: law.map_or_else(
-                || " (the scheme claims no energy law)".to_string(),
-                |l| format!(" beyond what a {} scheme allows", l.name()),
-            ),
-            params,
-        },
-    }
+    own
 }
 
 /// What a case does with each intermediate stage: the operators, the stage's quantities, the

@@ -131,7 +131,7 @@ impl Energies {
 
     /// xᵀAx for A the stiffness (`which` 0) or the mass (1): the last value again for the
     /// same x, else from A's lower half when there is one, else from `a`.
-    fn quad(&self, which: usize, a: &Matrix, x: &[f64]) -> f64 {
+    pub fn quad(&self, which: usize, a: &Matrix, x: &[f64]) -> f64 {
         let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
         if let Some((kept, value)) = &last[which]
             && kept.as_slice() == x

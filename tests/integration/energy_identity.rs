@@ -190,8 +190,22 @@ fn every_identity_closes_through_a_penalty_impact() {
                     Free::PreviousUnknown(k) => run[n][ends[k]].clone(),
                 })
                 .collect();
-            let b = id.balance(&s, &Bound(&stepper, n as f64 * dt), &params, dt, n as f64 * dt, &x);
+            let ops = Bound(&stepper, n as f64 * dt);
+            let b = id.balance(&s, &ops, &params, dt, n as f64 * dt, &x);
             worst = worst.max(b.gap().abs() / (1.0 + b.scale()));
+            // Ẽ of the states the run holds (what the energy guard reads) is the identity's at
+            // the step's ends, where Ẽ is kept at one level.
+            if let (Some(before), Some(after)) =
+                (id.kept_at(&s, &ops, &params, dt, &run[n]), id.kept_at(&s, &ops, &params, dt, &run[n + 1]))
+            {
+                let scale = 1.0 + b.scale();
+                assert!(
+                    (before - b.kept_before).abs() <= 1e-12 * scale,
+                    "{name}: Ẽ {before} against {}",
+                    b.kept_before
+                );
+                assert!((after - b.kept_after).abs() <= 1e-12 * scale, "{name}: Ẽ' {after} against {}", b.kept_after);
+            }
         }
         // Newton solves these steps to round-off: about 1e-15 of the scale is what is seen.
         assert!(worst <= 1e-10, "{name}: the identity misses by {worst:e} of its scale");

@@ -461,8 +461,7 @@ fn split(opts: &Options, pf: &ProblemFile, in_use: &FilesInUse) -> Result<bool, 
     {
         return Ok(false);
     }
-    let (claims, _) = in_use.scheme_claims_and_law()?;
-    Ok(!claims.iter().any(|(c, _)| c == "cfl"))
+    Ok(!in_use.scheme_energy()?.claims.iter().any(|(c, _)| c == "cfl"))
 }
 
 fn mpi(e: crate::runtime::linalg::LinalgError) -> CaseError {
