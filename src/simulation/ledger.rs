@@ -38,7 +38,7 @@ impl Exact {
 /// The scheme's identity, for a run it measures.
 pub(super) struct Ledger {
     scheme: SchemeIdentity,
-    /// The loads applied last, and a buffer for the other slots.
+    /// The loads applied last, and the last slot applied to fields ([`Kept`]).
     kept: Mutex<Kept>,
     /// The last step's size, and Ẽ and the potential energies at its end: the next step's start
     /// at the same size (Ẽ reads dt).
