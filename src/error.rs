@@ -38,6 +38,12 @@ pub enum CaseError {
         at = at(.t)
     )]
     Stopped { t: f64, cuts: usize, dt: f64, cause: String, history: String },
+    /// An adaptive run's step control needed a step below its minimum.
+    #[error(
+        "stopped at t = {at}: the step size control needs Δt = {dt:.3e}, below the minimum {dt_min:.3e}: {cause}\n  results up to the last accepted step are written; a larger --adaptive tolerance, or a smaller --dt-min",
+        at = at(.t)
+    )]
+    StepTooSmall { t: f64, dt: f64, dt_min: f64, cause: String },
     /// A step failed in a way no smaller Δt mends.
     #[error("stopped at t = {at}: {cause}\n  results up to the last good step are written", at = at(.t))]
     Failed { t: f64, cause: String },

@@ -56,6 +56,9 @@ pub struct SchemeDesc {
     pub stages: List<StageDesc>,
     /// The level each state takes at the end of a step.
     pub updates: List<Level>,
+    /// The step's local error (`estimate`), over its levels at the step's end (the states at
+    /// its start and every stage's quantities); none when the scheme declares none.
+    pub estimate: Option<Combination>,
     /// Length of the coefficient array.
     pub coefficients: usize,
 }

@@ -36,7 +36,7 @@ pub const FILE: &str = "checkpoint.bin";
 pub const LOG: &str = "checkpoint.log";
 const MAGIC: &[u8; 8] = b"SIGNCKPT";
 /// The layout of the file; a checkpoint of another layout is refused.
-const FORMAT: u32 = 5;
+const FORMAT: u32 = 6;
 
 /// What a run must share with the checkpoint it resumes: (what, value) pairs, compared one by
 /// one so that a refusal names what differs.
@@ -80,6 +80,8 @@ pub struct DriverState {
     pub states: Vec<Vec<f64>>,
     /// Written every N steps (resumes bit for bit), or on an interrupt (to round-off).
     pub periodic: bool,
+    /// An adaptive run's time, step controller and counts.
+    pub adaptive: Option<crate::simulation::step_control::AdaptiveState>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -374,6 +376,12 @@ mod tests {
             energy_switches: vec![true],
             states: vec![vec![f64::NAN, -0.0, 1e-300], vec![f64::INFINITY, 2.0, 3.0]],
             periodic: true,
+            adaptive: Some(crate::simulation::step_control::AdaptiveState {
+                t: 0.3,
+                controller: crate::simulation::step_control::Controller { h: 0.1, error: 0.5, rejected: true },
+                steps: Default::default(),
+                bracket: Some(0.35),
+            }),
         }
     }
 

@@ -283,6 +283,8 @@ pub struct ProblemArgs {
     /// disc and the sphere start in exact free fall there).
     #[arg(long, allow_hyphen_values = true)]
     pub(super) t_start: Option<f64>,
+    #[command(flatten)]
+    pub(super) steps: StepArgs,
     /// Directory for series.csv, summary.json and the problem's figure (NAME.png).
     #[arg(long)]
     pub(super) out: Option<PathBuf>,
@@ -306,6 +308,31 @@ pub struct ProblemArgs {
     /// subdirectory per run).
     #[arg(long)]
     pub(super) all: bool,
+}
+
+/// Adaptive time steps (default: the problem's `run adaptive = ...`, else fixed steps).
+#[derive(clap::Args, Clone, Copy)]
+pub struct StepArgs {
+    /// Adaptive steps: each step's local error (the scheme's `estimate`) at most TOL times the
+    /// largest displacement; --dt is then the first step.
+    #[arg(long, value_name = "TOL", allow_hyphen_values = true)]
+    pub(super) adaptive: Option<f64>,
+    /// The smallest adaptive step (default: --dt × 1e-6); below it the run stops.
+    #[arg(long, value_name = "DT", allow_hyphen_values = true)]
+    pub(super) dt_min: Option<f64>,
+    /// The largest adaptive step (default: a tenth of the run).
+    #[arg(long, value_name = "DT", allow_hyphen_values = true)]
+    pub(super) dt_max: Option<f64>,
+    /// A first contact or release is landed on to within this (default: --dt / 20).
+    #[arg(long, value_name = "DT", allow_hyphen_values = true)]
+    pub(super) event_dt: Option<f64>,
+}
+
+impl StepArgs {
+    pub(super) fn options(self) -> crate::problem::run::StepOptions {
+        let StepArgs { adaptive, dt_min, dt_max, event_dt } = self;
+        crate::problem::run::StepOptions { adaptive, dt_min, dt_max, event_dt }
+    }
 }
 
 /// Checkpoint and restart of a time-stepping case.

@@ -24,6 +24,7 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
         opts.dt = a.dt;
         opts.t_start = a.t_start;
         opts.t_end = a.t_end;
+        opts.steps = a.steps.options();
         opts.cell_size = a.methods.cell_size;
         opts.newton.solver = a.solver;
         opts.petsc_options = a.petsc_options;
@@ -49,6 +50,7 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
         dt: a.dt,
         t_start: a.t_start,
         t_end: a.t_end,
+        steps: a.steps.options(),
         newton: crate::runtime::nonlinear::newton::NewtonOptions {
             solver: a.solver,
             line_search: a.methods.line_search,

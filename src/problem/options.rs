@@ -24,6 +24,8 @@ pub struct Options {
     pub dt: Option<f64>,
     pub t_start: Option<f64>,
     pub t_end: Option<f64>,
+    /// Adaptive steps, over the problem's `run adaptive = ...`.
+    pub steps: StepOptions,
     pub newton: NewtonOptions,
     /// Options for PETSc's solvers (`-ksp_rtol 1e-8 -pc_type hypre`), over the defaults of the
     /// `petsc` solver.
@@ -69,6 +71,7 @@ impl Options {
             dt: None,
             t_start: None,
             t_end: None,
+            steps: StepOptions::default(),
             newton: NewtonOptions::default(),
             petsc_options: None,
             out: None,
@@ -82,9 +85,20 @@ impl Options {
     }
 }
 
-/// The run's times (Δt, start, end): the problem's `run` line under the options.
+/// Adaptive steps as the options ask for them (none: the problem's `run` line decides).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepOptions {
+    pub adaptive: Option<f64>,
+    pub dt_min: Option<f64>,
+    pub dt_max: Option<f64>,
+    pub event_dt: Option<f64>,
+}
+
+/// The run's times (Δt, start, end): the problem's `run` line under the options; with
+/// adaptive steps, Δt is the first step.
 pub struct Times {
     pub dt: f64,
     pub t_start: f64,
     pub t_end: f64,
+    pub adaptive: Option<crate::simulation::step_control::Adaptive>,
 }

@@ -33,6 +33,7 @@ pub(super) fn identity(
         ("dt", format!("{:?}", s.dt)),
         ("t_start", format!("{:?}", s.t_start)),
         ("t_end", format!("{:?}", s.t_end)),
+        ("adaptive steps", format!("{:?}", s.adaptive)),
         ("Newton options", format!("{:?}", opts.newton)),
         ("checkpoint period", opts.checkpoint_every.to_string()),
     ];

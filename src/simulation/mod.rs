@@ -21,12 +21,14 @@ use crate::runtime::nonlinear::statics::Constraints;
 use crate::runtime::time::scheme::StageView;
 use crate::runtime::time::stepper::{StepError, StepReport, Stepper};
 
+pub mod adaptive;
 mod energy_guard;
 mod ledger;
 pub mod operators;
 mod snapshots;
 pub mod stability;
 pub mod statics;
+pub mod step_control;
 
 use energy_guard::{Ended, EnergyWatch, StepWork};
 use operators::Parts;
@@ -99,6 +101,8 @@ pub struct Simulation<'m> {
     pub inertia: bool,
     /// The scheme's energy identity, where it measures the run's steps for the energy guard.
     ledger: Option<ledger::Ledger>,
+    /// The order the scheme claims (2 if none): an adaptive run's error model.
+    order: f64,
 }
 
 /// One finished step, as the observer sees it.
@@ -168,13 +172,14 @@ impl<'m> Simulation<'m> {
         let energy = in_use.scheme_energy()?;
         let ledger = ledger::Ledger::new(energy.identity.filter(|_| inertia), &ops, &stepper);
         let law = energy.law;
+        let order = energy.claims.iter().find(|(c, _)| c == "order").map_or(2.0, |(_, o)| *o);
         let (stable, tracker) = match energy.claims.into_iter().find(|(c, _)| c == "cfl") {
             Some((_, cfl)) => {
                 (Some(stability::estimate(&ops, coefs, &held, cfl)?), stability::Tracker::new(&ops, coefs, &held, cfl)?)
             }
             None => (None, None),
         };
-        Ok(Simulation { stepper, ops, states, v_index, guard, params, law, stable, tracker, inertia, ledger })
+        Ok(Simulation { stepper, ops, states, v_index, guard, params, law, stable, tracker, inertia, ledger, order })
     }
 
     /// Sets the displacement and solves the scheme's initial problem (the acceleration).
@@ -237,6 +242,11 @@ impl<'m> Simulation<'m> {
         // this accepted step (and its checkpoint, if one is due). Read once, not every step.
         let crash_at: Option<usize> = std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok());
         if let Some((saved, _)) = &control.resume {
+            if saved.adaptive.is_some() {
+                return Err(CaseError::Option(
+                    "the checkpoint is of an adaptive run: resume it with --adaptive".into(),
+                ));
+            }
             (at, energy) = self.resume(saved, &mut outcome)?;
         }
         // A nonlinear stiffness's tangent at the first state, which may be strained.
@@ -268,7 +278,7 @@ impl<'m> Simulation<'m> {
                 let t_end = if whole { span.t0 + (k + 1) as f64 * span.dt } else { t + h };
                 let taken = Taken { k, whole, t, h, t_end, start, seen, report: &report };
                 let (energy, outcome, control) = (&mut energy, &mut outcome, &mut *control);
-                let mut walk = Walk { at: &mut at, energy, outcome, control, crash_at };
+                let mut walk = Walk { at: &mut at, energy, outcome, control, crash_at, adaptive: None };
                 if let Some(stop) = self.accept(&mut walk, span.steps, taken, watch.step)? {
                     outcome.stopped = Some(stop);
                     break 'steps;
@@ -319,7 +329,8 @@ impl<'m> Simulation<'m> {
         if let Some(record) = record {
             let previous = self.stepper.previous();
             let cuts = walk.outcome.cuts;
-            let driver = walk.at.driver_state(k + 1, cuts, walk.energy, states, previous, !due.interrupted);
+            let mut driver = walk.at.driver_state(k + 1, cuts, walk.energy, states, previous, !due.interrupted);
+            driver.adaptive = walk.adaptive.clone();
             // The outputs up to here are still written.
             if let Err(e) = self.checkpoint(walk.control, driver, record) {
                 return Ok(Some(e));
@@ -460,6 +471,8 @@ struct Walk<'w> {
     energy: &'w mut EnergyWatch,
     outcome: &'w mut Outcome,
     control: &'w mut Control,
+    /// An adaptive run's state after this step, for its checkpoint.
+    adaptive: Option<adaptive::AdaptiveState>,
 }
 
 /// An accepted step of nominal step `k` (`whole` when it ends one): from `t` by `h` to `t_end`.
@@ -553,6 +566,7 @@ impl Cursor {
             energy_switches: energy.switches.clone(),
             states: states.iter().map(Vec::as_slice).chain(previous).map(<[f64]>::to_vec).collect(),
             periodic,
+            adaptive: None,
         }
     }
 }
@@ -664,11 +678,20 @@ pub struct Outcome {
     pub resumed: Option<Resumed>,
     /// The energy guard's largest growth of E_aug beyond E_aug(0) + work, over the energy scale.
     pub energy_growth: f64,
+    /// An adaptive run's steps.
+    pub adaptive: Option<adaptive::Steps>,
 }
 
 impl Outcome {
     fn new(steps: usize) -> Self {
-        Outcome { step_seconds: Vec::with_capacity(steps), cuts: 0, stopped: None, resumed: None, energy_growth: 0.0 }
+        Outcome {
+            step_seconds: Vec::with_capacity(steps),
+            cuts: 0,
+            stopped: None,
+            resumed: None,
+            energy_growth: 0.0,
+            adaptive: None,
+        }
     }
 }
 

@@ -272,3 +272,27 @@ impl Verification {
         md
     }
 }
+
+#[cfg(test)]
+mod estimates {
+    use crate::driver::Methods;
+
+    /// Each library scheme's `estimate` is its local error in u to leading order on the
+    /// oscillator: the ratio tends to 1 as O(Δt). Midpoint, the hybrid scheme and
+    /// energy–momentum carry no acceleration between steps and declare none.
+    #[test]
+    fn every_library_estimate_is_the_local_error() {
+        for scheme in crate::driver::all_schemes() {
+            let m = Methods { scheme: scheme.to_string(), ..Default::default() };
+            let ratios: Vec<Option<f64>> =
+                [1e-2, 1e-3].iter().map(|&h| super::oscillator::estimate_ratio(&m, h).unwrap()).collect();
+            match ratios[..] {
+                [Some(r2), Some(r3)] => {
+                    assert!((r3 - 1.0).abs() < 2e-3, "{scheme}: {ratios:?}");
+                    assert!((r3 - 1.0).abs() < 0.2 * (r2 - 1.0).abs(), "{scheme}: not O(Δt): {ratios:?}");
+                }
+                _ => assert!(["midpoint", "hybrid", "energy_momentum"].contains(&scheme), "{scheme} has no estimate"),
+            }
+        }
+    }
+}

@@ -181,3 +181,24 @@ pub fn oscillator_energies(methods: &Methods, dt: f64, steps: usize) -> Result<V
         Ok(out)
     })?
 }
+
+/// The scheme's `estimate` over the true local error of one step of `dt` on the oscillator from
+/// the exact states at t = 1/2 (u = cos t, v = −sin t, the scheme's initial problem for a): 1
+/// where the estimate is asymptotically exact; none for a scheme that declares no estimate.
+pub fn estimate_ratio(methods: &Methods, dt: f64) -> Result<Option<f64>, CaseError> {
+    with_oscillator(methods, |st| -> Result<Option<f64>, CaseError> {
+        if !st.estimate_steps() {
+            return Ok(None);
+        }
+        let t0 = 0.5f64;
+        let mut states: Vec<Vec<f64>> = st.desc().states.iter().map(|_| vec![0.0; 2]).collect();
+        states[0][0] = t0.cos();
+        if let Some(v) = st.desc().states.iter().position(|s| *s == "v") {
+            states[v][0] = -t0.sin();
+        }
+        st.initialize(&mut states, t0)?;
+        st.step(&mut states, t0, dt)?;
+        let error = states[0][0] - (t0 + dt).cos();
+        Ok(st.estimate().map(|e| e[0] / error))
+    })?
+}

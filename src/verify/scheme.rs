@@ -12,7 +12,9 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::oscillator::{damped_oscillator_error, oscillator_energies, oscillator_error, spectral_radius, step_map};
+use super::oscillator::{
+    damped_oscillator_error, estimate_ratio, oscillator_energies, oscillator_error, spectral_radius, step_map,
+};
 use super::time::{BAR_STEPS, BarOrder, OSCILLATOR_STEPS, bar_orders, last_order};
 use crate::cases::{bar, disc};
 use crate::compiler::scheme::EnergyLaw;
@@ -36,6 +38,11 @@ const RHO_TOLERANCE: f64 = 1e-3;
 const RHO_UNSTABLE: f64 = 1e-8;
 /// A measured stability limit agrees with a claimed `cfl` within this fraction.
 const CFL_TOLERANCE: f64 = 1e-3;
+/// The steps at which the `estimate` is set against one step's true local error.
+const ESTIMATE_STEPS: [f64; 3] = [0.1, 0.01, 0.001];
+/// An estimate within this factor of the true local error at the smallest of them steers an
+/// adaptive run to within its cube root of the tolerance.
+const ESTIMATE_FACTOR: f64 = 2.0;
 /// An energy law holds on the oscillator to this fraction of E₀ (round-off over 1000 steps).
 const ENERGY_LAW_TOLERANCE: f64 = 1e-10;
 
@@ -79,6 +86,9 @@ pub struct SchemeVerification {
     pub damped_oscillator: Vec<(f64, f64)>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub damped_order: Option<f64>,
+    /// (Δt, the `estimate` over one step's true local error in u) on the oscillator from the
+    /// exact states; empty for a scheme that declares no estimate.
+    pub estimate: Vec<(f64, f64)>,
     pub bar_orders: Vec<BarOrder>,
     pub rho_infinity: f64,
     pub spectrum: Vec<SpectrumPoint>,
@@ -141,6 +151,10 @@ pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVe
         Vec::new()
     };
     let damped_order = (!damped_oscillator.is_empty()).then(|| last_order(&damped_oscillator));
+    let estimate: Vec<(f64, f64)> = ESTIMATE_STEPS
+        .iter()
+        .filter_map(|&dt| estimate_ratio(methods, dt).map(|r| r.map(|r| (dt, r))).transpose())
+        .collect::<Result<_, CaseError>>()?;
     let rho_infinity = spectral_radius(methods, 1e12)?;
     progress(&format!("{scheme}: spectrum"));
     let own = spectrum(methods)?;
@@ -205,7 +219,11 @@ pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVe
         Some(law) => Some((law, energy_law_defect(methods, law)?)),
         None => None,
     };
-    let verdicts = verdicts(&claims, oscillator_order, damped_order, rho_infinity, stability_limit, energy_law)?;
+    let mut verdicts = verdicts(&claims, oscillator_order, damped_order, rho_infinity, stability_limit, energy_law)?;
+    if let Some(&(_, ratio)) = estimate.last() {
+        let holds = (1.0 / ESTIMATE_FACTOR..=ESTIMATE_FACTOR).contains(&ratio);
+        verdicts.push(Verdict { claim: "estimate / local error".into(), claimed: 1.0, measured: ratio, holds });
+    }
     Ok(SchemeVerification {
         scheme,
         params,
@@ -214,6 +232,7 @@ pub fn run(methods: &Methods, progress: &mut dyn FnMut(&str)) -> Result<SchemeVe
         oscillator_order,
         damped_oscillator,
         damped_order,
+        estimate,
         bar_orders,
         rho_infinity,
         spectrum: own,
@@ -467,6 +486,21 @@ impl SchemeVerification {
             }
             None => {
                 let _ = writeln!(s, "The scheme applies no damping slot: the damped oscillator is not measured.");
+            }
+        }
+        match self.estimate.is_empty() {
+            false => {
+                let _ = writeln!(
+                    s,
+                    "\nThe `estimate` over the true local error of u after one step from the exact states at t = 1/2 (1 where it is asymptotically exact):\n\n| Δt | ratio |\n|---|---|"
+                );
+                for (dt, r) in &self.estimate {
+                    let _ = writeln!(s, "| {dt} | {r:.6} |");
+                }
+                s.push('\n');
+            }
+            true => {
+                let _ = writeln!(s, "The scheme declares no `estimate`: it cannot run with adaptive steps.");
             }
         }
         match (self.energy_step_max, self.energy_drift) {

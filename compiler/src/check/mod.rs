@@ -310,7 +310,7 @@ fn declare(prog: &mut Unit, files: &[(FileId, ast::File)], diags: &mut Vec<Diagn
                     });
                     Global::Form(prog.forms.len() - 1)
                 }
-                ast::Item::Scheme { name, params, uses, states, lets, initial, claims, stages, span } => {
+                ast::Item::Scheme { name, params, uses, states, lets, initial, claims, estimates, stages, span } => {
                     prog.scheme_defs.push(SchemeDef {
                         name: name.clone(),
                         params: params.clone(),
@@ -319,6 +319,7 @@ fn declare(prog: &mut Unit, files: &[(FileId, ast::File)], diags: &mut Vec<Diagn
                         lets: lets.clone(),
                         initial: initial.clone(),
                         claims: claims.clone(),
+                        estimates: estimates.clone(),
                         stages: stages.clone(),
                         span: *span,
                     });

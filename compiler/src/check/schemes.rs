@@ -21,6 +21,7 @@ pub struct SchemeDef {
     pub lets: Vec<(Ident, Expr)>,
     pub initial: Option<ast::Initial>,
     pub claims: Vec<(Ident, Expr)>,
+    pub estimates: Vec<Expr>,
     pub stages: Vec<ast::Stage>,
     pub span: Span,
 }

@@ -83,15 +83,16 @@ fn slot_use(u: &SlotUse) -> String {
 
 /// `SchemeDesc { ... }`.
 pub fn scheme(d: &SchemeDesc) -> String {
-    let SchemeDesc { name, uses, states, initial, stages, updates, coefficients } = d;
+    let SchemeDesc { name, uses, states, initial, stages, updates, estimate, coefficients } = d;
     let initial = match initial {
         Some(InitialDesc { state, terms }) => {
             format!("Some(InitialDesc {{ state: {state}, terms: {} }})", list(terms, term))
         }
         None => "None".into(),
     };
+    let estimate = estimate.as_ref().map_or("None".to_string(), |c| format!("Some({})", combination(c)));
     format!(
-        "SchemeDesc {{ name: {}, uses: {}, states: {}, initial: {initial}, stages: {}, updates: {}, coefficients: {coefficients} }}",
+        "SchemeDesc {{ name: {}, uses: {}, states: {}, initial: {initial}, stages: {}, updates: {}, estimate: {estimate}, coefficients: {coefficients} }}",
         text(name),
         list(uses, slot_use),
         list(states, |s| text(s)),

@@ -67,6 +67,7 @@ impl<'a> Compiler<'a> {
         let initial = def.initial.as_ref().and_then(|i| self.initial(i));
         let stages = self.stages();
         let updates = self.updates(&stages);
+        let estimate = if self.diags.is_empty() { self.estimate() } else { None };
         schemes::initial_values(def, self.warnings, &mut self.diags);
         let complete = self.diags.is_empty();
         let slots = self
@@ -89,6 +90,7 @@ impl<'a> Compiler<'a> {
             initial,
             stages,
             updates,
+            estimate,
             claims,
             energy: energy.map(|(law, _)| law),
         };
@@ -203,6 +205,55 @@ impl<'a> Compiler<'a> {
             }
         }
         updates
+    }
+
+    /// `estimate EXPR`: one per scheme (E0823), a combination of the step's levels (E0824)
+    /// that reads at least one quantity the step computes (E0825), compiled in the scope the
+    /// last stage leaves: the states at the step's start and every stage's quantities.
+    fn estimate(&mut self) -> Option<Affine> {
+        let def = self.def;
+        let (first, rest) = def.estimates.split_first()?;
+        if let Some(second) = rest.first() {
+            self.error(
+                Diagnostic::error("E0823", "a scheme has one `estimate`", second.span, "a second estimate")
+                    .with_label(first.span, "the first")
+                    .with_help("combine them into one expression of the step's levels"),
+            );
+            return None;
+        }
+        match self.value(first)? {
+            Value::Scalar(_) => {
+                self.error(
+                    Diagnostic::error(
+                        "E0824",
+                        "an estimate is a combination of the step's levels",
+                        first.span,
+                        "this is a scalar",
+                    )
+                    .with_help(
+                        "e.g. `estimate dt^2*(beta - 1/6)*(a' - a)`: the local error of u' (Zienkiewicz and Xie)",
+                    ),
+                );
+                None
+            }
+            Value::Vector(a) if a.known.iter().all(|(q, _)| matches!(q, Quantity::State(_))) => {
+                let states: Vec<String> = def.states.iter().map(|s| format!("`{}'`", s.name)).collect();
+                self.error(
+                    Diagnostic::error(
+                        "E0825",
+                        "the estimate reads nothing the step computes",
+                        first.span,
+                        "only the states at the step's start",
+                    )
+                    .with_help(format!(
+                        "a local error compares the step's new levels ({}, a stage's quantities) with each other or with the start",
+                        states.join(", ")
+                    )),
+                );
+                None
+            }
+            Value::Vector(a) => Some(a),
+        }
     }
 
     /// `claim NAME = EXPR`: a known property, a scalar of the params (not of t or dt); and

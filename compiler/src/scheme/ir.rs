@@ -61,6 +61,9 @@ pub struct SchemeIr {
     pub stages: Vec<StageIr>,
     /// For each state, the quantity holding its value at the end of the step.
     pub updates: Vec<Quantity>,
+    /// `estimate EXPR`: the step's local error as a combination of its levels (the states at
+    /// its start and every stage's quantities), for an adaptive run's step control.
+    pub estimate: Option<Affine>,
     /// The author's claims (`claim order = 2`): name and value, a function of the params.
     pub claims: Vec<(String, NodeId)>,
     /// `claim energy = conserving | dissipative`: the energy law the run's guard applies.

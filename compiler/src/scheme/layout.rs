@@ -205,6 +205,12 @@ pub fn layout(s: &SchemeIr, sources: &SourceMap) -> Layout {
             }
         })
         .collect();
+    let estimate = s.estimate.as_ref().map(|e| {
+        parts.push("the estimate".into());
+        let named = |_: &Affine| None;
+        let names = Names { part: parts.len() - 1, unknown: "", named: &named, level: &level };
+        n.combination(g, e, &names, Some("the estimate"))
+    });
     let uses = s
         .slots
         .iter()
@@ -221,6 +227,7 @@ pub fn layout(s: &SchemeIr, sources: &SourceMap) -> Layout {
         initial,
         stages,
         updates: s.updates.iter().map(|&q| q.into()).collect(),
+        estimate,
         coefficients: n.order.len(),
     };
     let uses = n.uses.iter().map(|u| described(u, &parts)).collect();

@@ -56,6 +56,9 @@ fn print_as_is(s: &SchemeIr) -> String {
     let updates: Vec<String> =
         s.updates.iter().enumerate().map(|(i, q)| format!("{} ← {}", s.states[i], names(*q))).collect();
     let _ = writeln!(out, "  update {}", updates.join(", "));
+    if let Some(e) = &s.estimate {
+        let _ = writeln!(out, "  estimate {}", affine(&s.graph, e, "", &names));
+    }
     out
 }
 
@@ -92,6 +95,9 @@ fn coefficients(s: &SchemeIr) -> Vec<NodeId> {
         for t in &st.terms {
             term(t, &mut out);
         }
+    }
+    if let Some(e) = &s.estimate {
+        out.extend(e.known.iter().map(|(_, c)| *c));
     }
     out
 }

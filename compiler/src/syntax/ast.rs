@@ -194,6 +194,8 @@ pub enum Item {
         initial: Option<Initial>,
         /// `claim NAME = EXPR`: properties the author states (`order`, `rho_inf`).
         claims: Vec<(Ident, Expr)>,
+        /// `estimate EXPR`: the step's local error (one per scheme; more is E0823).
+        estimates: Vec<Expr>,
         stages: Vec<Stage>,
         span: Span,
     },

@@ -32,7 +32,7 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 let ps: Vec<_> = params.iter().map(|p| p.name.as_str()).collect();
                 out.push_str(&format!("{head}fn {}({}) = {}\n", name.name, ps.join(", "), expr(body)));
             }
-            Item::Scheme { name, params, uses, states, lets, initial, claims, stages, .. } => {
+            Item::Scheme { name, params, uses, states, lets, initial, claims, estimates, stages, .. } => {
                 let ps: Vec<String> =
                     params.iter().map(|p| format!("{} = {}", p.name.name, expr(&p.default))).collect();
                 out.push_str(&format!("{head}scheme {}({})\n", name.name, ps.join(", ")));
@@ -45,6 +45,9 @@ pub fn print_file(file: &File, sources: &SourceMap) -> String {
                 }
                 for (n, v) in claims {
                     out.push_str(&format!("  claim {} = {}\n", n.name, expr(v)));
+                }
+                for e in estimates {
+                    out.push_str(&format!("  estimate {}\n", expr(e)));
                 }
                 if let Some(i) = initial {
                     out.push_str(&format!(

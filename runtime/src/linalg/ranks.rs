@@ -64,6 +64,17 @@ pub fn sum(x: f64) -> Result<f64, LinalgError> {
     Ok(x)
 }
 
+/// The largest of each process's `x` (exact: the same bits on every process). Collective.
+pub fn max(x: f64) -> Result<f64, LinalgError> {
+    if world().1 == 1 {
+        return Ok(x);
+    }
+    #[cfg(feature = "petsc")]
+    return Ok(crate::linalg::petsc::ranks::gather(x)?.into_iter().fold(x, f64::max));
+    #[cfg(not(feature = "petsc"))]
+    Ok(x)
+}
+
 /// The sum of each process's `count` (exact). Collective.
 pub fn total(count: u64) -> Result<u64, LinalgError> {
     if world().1 == 1 {

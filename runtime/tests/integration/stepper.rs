@@ -111,6 +111,7 @@ const DESC: SchemeDesc = SchemeDesc {
         ]),
     }]),
     updates: Borrowed(&[Level::Stage(0, 0), Level::Stage(0, 1), Level::Stage(0, 2)]),
+    estimate: None,
     coefficients: 12,
 };
 

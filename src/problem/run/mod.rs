@@ -17,7 +17,7 @@ use super::dirichlet::{Held, dirichlet};
 use super::expr::{Exprs, PointFn};
 use super::observe::{Observer, Sources, State};
 use super::options::Times;
-pub use super::options::{Chosen, Options};
+pub use super::options::{Chosen, Options, StepOptions};
 pub use super::outputs::Run;
 use super::outputs::write_outputs;
 use super::reference::bound_reference;
@@ -43,23 +43,28 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
     }
     bound(opts, |pf, params, ex, in_use, read_mesh| {
         if pf.problem().run_static.is_some() {
-            if opts.dt.is_some() || opts.t_end.is_some() || opts.t_start.is_some() {
+            if opts.dt.is_some()
+                || opts.t_end.is_some()
+                || opts.t_start.is_some()
+                || opts.steps != StepOptions::default()
+            {
                 return Err(CaseError::Option(format!(
-                    "{} is static (`run static`): it takes no --dt, --t-end or --t-start",
+                    "{} is static (`run static`): it takes no --dt, --t-end, --t-start or --adaptive",
                     pf.file
                 )));
             }
-            let times = Times { dt: f64::NAN, t_start: 0.0, t_end: 0.0 };
+            let times = Times { dt: f64::NAN, t_start: 0.0, t_end: 0.0, adaptive: None };
             return simulate(opts, pf, params, ex, in_use, &times, read_mesh);
         }
         let given = super::bind::settings(pf, ex, &pf.problem().run)?;
         let setting = |name: &str, over: Option<f64>, default: f64| {
             over.or_else(|| given.iter().find(|(n, _)| n == name).map(|(_, v)| *v)).unwrap_or(default)
         };
-        let times = Times {
+        let mut times = Times {
             dt: setting("dt", opts.dt, f64::NAN),
             t_start: setting("t_start", opts.t_start, 0.0),
             t_end: setting("t_end", opts.t_end, f64::NAN),
+            adaptive: None,
         };
         let positive = |x: f64| x > 0.0 && x.is_finite();
         if !positive(times.dt) || !positive(times.t_end) || times.t_end / times.dt > 1e7 {
@@ -71,8 +76,50 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
         if !(times.t_start >= 0.0 && times.t_start < times.t_end) {
             return Err(CaseError::Option(format!("--t-start must be in [0, t_end), not {}", times.t_start)));
         }
+        times.adaptive = adaptive(opts.steps, &setting, &times)?;
         simulate(opts, pf, params, ex, in_use, &times, read_mesh)
     })
+}
+
+/// Adaptive steps, when the options or the problem's `run` line ask for them: each bound a
+/// positive number (dt_min ≤ dt_max).
+fn adaptive(
+    steps: StepOptions,
+    setting: &dyn Fn(&str, Option<f64>, f64) -> f64,
+    times: &Times,
+) -> Result<Option<crate::simulation::step_control::Adaptive>, CaseError> {
+    let tolerance = setting("adaptive", steps.adaptive, f64::NAN);
+    let given = |name: &str, over: Option<f64>| !setting(name, over, f64::NAN).is_nan();
+    if tolerance.is_nan() {
+        if let Some(name) = [("dt_min", steps.dt_min), ("dt_max", steps.dt_max), ("event_dt", steps.event_dt)]
+            .iter()
+            .find(|(n, o)| given(n, *o))
+            .map(|(n, _)| n)
+        {
+            return Err(CaseError::Option(format!(
+                "`{name}` bounds adaptive steps: give --adaptive TOL (or the problem's `run adaptive = TOL`) too"
+            )));
+        }
+        return Ok(None);
+    }
+    let positive = |name: &str, x: f64| match x > 0.0 && x.is_finite() {
+        true => Ok(x),
+        false => Err(CaseError::Option(format!(
+            "--{} (or the problem's `run {name} = ...`) must be a positive number, not {x}",
+            name.replace('_', "-")
+        ))),
+    };
+    let span = times.t_end - times.t_start;
+    let a = crate::simulation::step_control::Adaptive {
+        tolerance: positive("adaptive", tolerance)?,
+        dt_min: positive("dt_min", setting("dt_min", steps.dt_min, times.dt * 1e-6))?,
+        dt_max: positive("dt_max", setting("dt_max", steps.dt_max, span / 10.0))?,
+        event: positive("event_dt", setting("event_dt", steps.event_dt, times.dt / 20.0))?,
+    };
+    if a.dt_min > a.dt_max {
+        return Err(CaseError::Option(format!("--dt-min {} exceeds --dt-max {}", a.dt_min, a.dt_max)));
+    }
+    Ok(Some(a))
 }
 
 fn simulate(

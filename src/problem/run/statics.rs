@@ -33,7 +33,14 @@ pub(super) fn run(
     let state = State { newton, ..State::new(t0, &solution.u, &initial) };
     let (first, switches) = row(observer, ops, state);
     snapshots.write(ops, 0, t0, &solution.u, &vec![0.0; asm.size()])?;
-    let outcome = Outcome { step_seconds: vec![seconds], cuts: 0, stopped: None, resumed: None, energy_growth: 0.0 };
+    let outcome = Outcome {
+        step_seconds: vec![seconds],
+        cuts: 0,
+        stopped: None,
+        resumed: None,
+        energy_growth: 0.0,
+        adaptive: None,
+    };
     let rows = Rows { series: vec![first], switches: vec![switches], iterations: vec![newton], ..Rows::default() };
     Ok(Stepped {
         rows,

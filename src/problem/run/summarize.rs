@@ -101,6 +101,24 @@ fn cost(req: &Request, ran: &Ran, put: &mut Put) {
     put("linear_solves", counters.solves.into());
     put("peak_memory_bytes", json(&crate::resources::peak_memory()));
     put("step_cuts", outcome.cuts.into());
+    // An adaptive run's steps: accepted, taken again (for their error, to land on an event,
+    // after a failed Newton), the events landed on, and the step sizes' range.
+    if let (Some(steps), Some(asked)) = (&outcome.adaptive, &req.times.adaptive) {
+        put(
+            "adaptive",
+            serde_json::json!({
+                "tolerance": asked.tolerance,
+                "accepted": steps.accepted,
+                "rejected": steps.rejected(),
+                "rejected_for_error": steps.rejected_error,
+                "rejected_for_event": steps.rejected_event,
+                "failed": steps.failed,
+                "events": steps.events,
+                "dt_min": steps.dt_min,
+                "dt_max": steps.dt_max,
+            }),
+        );
+    }
     // A run without inertia (static, or a scheme without `mass`) watches no energy.
     if sim.is_some_and(|s| s.inertia) {
         put("energy_growth", json(&outcome.energy_growth));

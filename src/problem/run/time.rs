@@ -10,6 +10,7 @@ use crate::problem::observe::{Observer, State};
 use crate::problem::resume::Record;
 use crate::runtime::fem::mesh::Mesh;
 use crate::runtime::time::scheme::StageView;
+use crate::simulation::adaptive::Interval;
 use crate::simulation::{Operators, Simulation, Snapshots, Span, Step, Watch};
 
 /// The initial fields a time run starts from.
@@ -84,9 +85,16 @@ pub(super) fn run(
         }
         Ok(())
     };
-    let span = Span { t0, dt, steps };
     let watch = Watch { stage: &mut on_stage, step: &mut on_step };
-    let outcome = sim.run(span, req.opts.progress && req.writes, control, watch)?;
+    let progress = req.opts.progress && req.writes;
+    let outcome = match req.times.adaptive {
+        Some(adaptive) => {
+            let span = Interval { t0, t_end: req.times.t_end, dt };
+            sim.run_adaptive(span, adaptive, progress, control, watch)?
+        }
+        None => sim.run(Span { t0, dt, steps }, progress, control, watch)?,
+    };
+    let steps = outcome.adaptive.as_ref().map_or(steps, |s| s.accepted);
     rows.stages = stages.into_inner();
     let last = (rows.series.last().map_or(t0, |r| r.0), sim.states[0].clone());
     let search = sim.stepper.search_cost();

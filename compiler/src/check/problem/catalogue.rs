@@ -90,6 +90,10 @@ pub const RUN_SETTINGS: &[(&str, &str)] = &[
     ("dt", "the time step"),
     ("t_end", "the end time"),
     ("t_start", "the start time (initial fields are evaluated there)"),
+    ("adaptive", "adaptive steps: the local error allowed per step, relative to the largest displacement"),
+    ("dt_min", "the smallest adaptive step (default: dt × 1e-6)"),
+    ("dt_max", "the largest adaptive step (default: a tenth of the run)"),
+    ("event_dt", "an adaptive run lands on a first contact or a release to within this (default: dt / 20)"),
 ];
 
 /// The roles a problem binds files to (`bind scheme = hybrid`): the scheme, the contact law,

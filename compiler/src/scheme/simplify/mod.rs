@@ -95,6 +95,9 @@ pub fn scheme(s: &mut SchemeIr) {
             t.map_coefs(g, &mut f);
         }
     }
+    if let Some(e) = &mut s.estimate {
+        e.map_coefs(g, &mut f);
+    }
 }
 
 fn agrees(g: &Graph, a: NodeId, b: NodeId, params: &[f64]) -> bool {

@@ -144,6 +144,7 @@ impl Builder {
         let (mut params, mut states, mut initial, mut lets) = (Vec::new(), Vec::new(), None, Vec::new());
         let mut uses = Vec::new();
         let mut claims = Vec::new();
+        let mut estimates = Vec::new();
         let mut stages: Vec<Stage> = Vec::new();
         // Items outside `stage` blocks form one implicit stage at t + dt.
         let mut implicit = Stage::default();
@@ -188,6 +189,7 @@ impl Builder {
                     let name = self.ident(it.next().expect("claim name"));
                     claims.push((name, self.expr(it.next().expect("claim value"))?));
                 }
+                Rule::estimate_decl => estimates.push(self.expr(p.into_inner().next().expect("estimate"))?),
                 _ => self.stage_item(&mut implicit, p)?,
             }
         }
@@ -212,7 +214,7 @@ impl Builder {
                 return Err(Box::new(d));
             }
         }
-        Ok(Item::Scheme { name, params, uses, states, lets, initial, claims, stages, span })
+        Ok(Item::Scheme { name, params, uses, states, lets, initial, claims, estimates, stages, span })
     }
 
     /// The params of a scheme or a problem: `name = default in RANGE, ...`.

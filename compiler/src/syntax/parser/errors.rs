@@ -159,6 +159,7 @@ const RESERVED: &[&str] = &[
     "unknown",
     "new",
     "claim",
+    "estimate",
     "relate",
     "residual",
     "stage",
@@ -282,11 +283,12 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         | Rule::unknown_decl
         | Rule::new_decl
         | Rule::claim_decl
+        | Rule::estimate_decl
         | Rule::relate_decl
         | Rule::residual_decl
         | Rule::stage_block
         | Rule::initial_decl => {
-            "a scheme item (`uses`, `state`, `unknown`, `new`, `relate`, `residual`, `stage`, `initial`, `let`, `claim`)"
+            "a scheme item (`uses`, `state`, `unknown`, `new`, `relate`, `residual`, `stage`, `initial`, `let`, `claim`, `estimate`)"
         }
         Rule::scheme_params | Rule::scheme_param => "parameters",
         Rule::mesh_decl

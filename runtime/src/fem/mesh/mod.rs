@@ -213,6 +213,11 @@ impl Mesh {
         }
     }
 
+    /// The smallest cell's size (infinite for a mesh without cells).
+    pub fn smallest_cell(&self) -> f64 {
+        (0..self.num_cells()).map(|c| self.cell_size(c)).fold(f64::INFINITY, f64::min)
+    }
+
     /// Chooses what `h` means, and computes it for every cell.
     pub fn set_cell_size(&mut self, rule: CellSize) {
         self.cell_size = rule;

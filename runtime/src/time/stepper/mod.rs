@@ -133,6 +133,9 @@ pub struct Stepper<'a> {
     /// Vectors of the problem's size no longer in use (states replaced, bases, products), for
     /// the next step: a step allocates none once the first has run.
     pool: Pool,
+    /// The last step's local error (the scheme's `estimate`), when asked for: see
+    /// [`Stepper::estimate`].
+    estimate: Option<Vec<f64>>,
 }
 
 struct StageCache {
@@ -230,6 +233,7 @@ impl<'a> Stepper<'a> {
             reads_previous,
             previous: None,
             pool: Pool::default(),
+            estimate: None,
         })
     }
 
@@ -395,6 +399,20 @@ impl<'a> Stepper<'a> {
         self.previous = Some(previous);
     }
 
+    /// Has every step from now on evaluate the scheme's `estimate` (false: none declared).
+    pub fn estimate_steps(&mut self) -> bool {
+        if self.desc.estimate.is_some() && self.estimate.is_none() {
+            self.estimate = Some(vec![0.0; self.asm.size()]);
+        }
+        self.estimate.is_some()
+    }
+
+    /// The local error of the last step taken (its `estimate` combination of the step's levels),
+    /// once [`Stepper::estimate_steps`] asked for it.
+    pub fn estimate(&self) -> Option<&[f64]> {
+        self.estimate.as_deref()
+    }
+
     /// Drops the stages' factorizations, constant operators and loads: the next step runs as in
     /// a new stepper (see [`crate::nonlinear::newton::Newton::forget`]).
     pub fn forget(&mut self) {
@@ -448,6 +466,11 @@ impl<'a> Stepper<'a> {
             let time = self.coefs.get(stage.time).copied().unwrap_or(t + dt);
             observe(&StageView { name: &stage.name, time, quantities: &stage.quantities, values: &values });
             quantities.push(values);
+        }
+        if let (Some(c), Some(mut e)) = (&desc.estimate, self.estimate.take()) {
+            let reference = Level::State(0);
+            self.combine(c, &Levels { states, quantities: &quantities, reference }, None, &mut e);
+            self.estimate = Some(e);
         }
         // A stage quantity that becomes one state only is moved there, not copied.
         let uses = |level: &Level| desc.updates.iter().filter(|l| *l == level).count();
