@@ -3,7 +3,7 @@
 //! displacement's units; a PI controller (Gustafsson 1991) chooses the next step from it, a step
 //! whose error exceeds the tolerance is taken again smaller, and a step across which the contact
 //! set becomes empty or non-empty (a first contact, a release) is bisected until it is no longer
-//! than the event tolerance, so that the run lands on the event. docs/mathematics.md §6.
+//! than the event tolerance, so that the run lands on the event. docs/mathematics.md §5 (adaptive steps).
 
 use super::energy_guard::EnergyWatch;
 pub use super::step_control::{Adaptive, AdaptiveState, Controller, Steps};
@@ -64,7 +64,9 @@ impl Simulation<'_> {
                 CaseError::Option("the checkpoint is of a run with fixed steps: resume it without --adaptive".into())
             })?;
         }
-        let mut touching = self.touching(&self.states[0].clone(), span.t0, None)?;
+        // The previous level, as the step that ended here saw its end (a law's `prev`).
+        let previous = self.stepper.previous().map(<[f64]>::to_vec);
+        let mut touching = self.touching(&self.states[0].clone(), state.t, previous.as_deref())?;
         let length = span.t_end - span.t0;
         while span.t_end - state.t > 1e-12 * length {
             bar.tick(((state.t - span.t0) / length * PROGRESS_TICKS as f64) as usize);
@@ -98,9 +100,10 @@ impl Simulation<'_> {
             // A step across an event is bisected down to the event tolerance; one across which
             // the contact set changes is accepted at that size whatever its estimate, which
             // assumes a smooth solution.
-            let verdict = if event && h > adaptive.event {
+            let landing = adaptive.event.max(adaptive.dt_min);
+            let verdict = if event && h > landing {
                 Verdict::Event
-            } else if err > 1.0 && !(changed && h <= adaptive.event) {
+            } else if err > 1.0 && !(changed && h <= landing) {
                 Verdict::Error
             } else {
                 Verdict::Accept
@@ -113,7 +116,7 @@ impl Simulation<'_> {
                     Verdict::Event => {
                         state.steps.rejected_event += 1;
                         state.bracket = Some(t + h);
-                        state.controller.h = 0.5 * h;
+                        state.controller.h = (0.5 * h).max(adaptive.dt_min);
                     }
                     _ => {
                         state.steps.rejected_error += 1;

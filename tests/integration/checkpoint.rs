@@ -281,3 +281,12 @@ fn restarts_through_step_cuts_have_the_bits_of_an_uninterrupted_run() {
     assert!(std::fs::read_to_string(run.join("summary.json")).unwrap().contains("\"resumed\""));
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// An adaptive run (issue 56): the checkpoint keeps the step controller (the time, the next
+/// step, the last error, a pending event's bracket), so a resumed run takes the same steps.
+#[test]
+fn killed_and_resumed_adaptive_discs_have_the_bits_of_an_uninterrupted_one() {
+    let mut args = RUN.to_vec();
+    args.extend_from_slice(&["--adaptive", "1e-4"]);
+    kill_and_resume("adaptive", &args);
+}

@@ -1,6 +1,7 @@
 //! The facade's integration tests, in one binary (a binary per file spent most of `cargo
 //! test` linking): the CLI, problems, schemes, references and the report, end to end.
 
+mod adaptive;
 mod assembly;
 mod bad_inputs;
 mod bar;

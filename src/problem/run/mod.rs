@@ -88,9 +88,10 @@ fn adaptive(
     setting: &dyn Fn(&str, Option<f64>, f64) -> f64,
     times: &Times,
 ) -> Result<Option<crate::simulation::step_control::Adaptive>, CaseError> {
+    // A value given on the command line counts, NaN included (refused below).
+    let given = |name: &str, over: Option<f64>| over.is_some() || !setting(name, None, f64::NAN).is_nan();
     let tolerance = setting("adaptive", steps.adaptive, f64::NAN);
-    let given = |name: &str, over: Option<f64>| !setting(name, over, f64::NAN).is_nan();
-    if tolerance.is_nan() {
+    if !given("adaptive", steps.adaptive) {
         if let Some(name) = [("dt_min", steps.dt_min), ("dt_max", steps.dt_max), ("event_dt", steps.event_dt)]
             .iter()
             .find(|(n, o)| given(n, *o))
