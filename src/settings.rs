@@ -41,6 +41,27 @@ pub struct Bench {
     /// `bench balls`: the two-body problem timed against its size, and the options of each run.
     pub balls: String,
     pub balls_options: Vec<String>,
+    /// `bench adaptive`: problems run with fixed and with adaptive steps side by side.
+    pub adaptive: Vec<AdaptiveBench>,
+}
+
+/// One problem of `bench adaptive`: the adaptive run's tolerance, the options of every run, the
+/// summary keys compared, and either a reference run's options (fine fixed steps: its values
+/// stand for the exact ones, so each run's difference from it is its time discretization's
+/// error) or the fixed run taken at the adaptive run's number of steps (keys that are errors
+/// against an exact solution already).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AdaptiveBench {
+    pub problem: String,
+    pub tolerance: f64,
+    #[serde(default)]
+    pub options: Vec<String>,
+    pub compare: Vec<String>,
+    #[serde(default)]
+    pub reference: Option<Vec<String>>,
+    #[serde(default)]
+    pub same_steps: bool,
 }
 
 #[derive(Debug, Deserialize)]

@@ -1,5 +1,6 @@
 //! `signorini bench ...`: timings with medians of repeated runs, written as JSON.
 
+pub mod adaptive;
 pub mod assemble;
 pub mod balls;
 pub mod bandwidth;

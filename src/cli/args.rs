@@ -140,6 +140,14 @@ pub enum BenchCommand {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
+    /// Each problem of forms/library.toml's `[[bench.adaptive]]` with its fixed steps and with
+    /// adaptive ones side by side (steps, factorizations, the compared summary keys against a
+    /// fine fixed-step reference run, or the fixed run at as many steps): a few minutes.
+    Adaptive {
+        /// Directory for bench_adaptive.json, bench_adaptive.md and the runs.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
     /// The facing-point search of contact between bodies against the number of facets (about
     /// 10³, 10⁴, 10⁵ in 2D and 3D): building its R-tree and the queries, per n log n.
     Search {

@@ -1,5 +1,5 @@
-//! `bench assemble`, `bench disc`, `bench sphere`, `bench balls`, `bench search`: the benchmarks run and their JSON
-//! written.
+//! `bench assemble`, `bench disc`, `bench sphere`, `bench balls`, `bench search`, `bench adaptive`:
+//! the benchmarks run and their JSON written.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -49,6 +49,19 @@ pub(super) fn disc(meshes: &[PathBuf], repeats: usize, out: &Path) -> ExitCode {
         }
     };
     write_bench(&out.join("bench_disc.json"), &report)
+}
+
+pub(super) fn adaptive(out: &Path) -> ExitCode {
+    let report = match crate::bench::adaptive::adaptive(out, &mut |table| println!("{table}")) {
+        Ok(r) => r,
+        Err(e) => return fail(e),
+    };
+    let tables: Vec<String> = report.comparisons.iter().map(crate::bench::adaptive::table).collect();
+    let md = out.join("bench_adaptive.md");
+    if let Err(source) = std::fs::write(&md, tables.join("\n")) {
+        return fail(crate::error::CaseError::Write { path: md.display().to_string(), source });
+    }
+    write_bench(&out.join("bench_adaptive.json"), &report)
 }
 
 pub(super) fn balls(max_dofs: usize, out: &Path) -> ExitCode {

@@ -176,6 +176,7 @@ fn dispatch(cli: Cli) -> ExitCode {
         }
         Command::Bench { what: BenchCommand::Search { repeats, out } } => bench::search(repeats, &out),
         Command::Bench { what: BenchCommand::Balls { max_dofs, out } } => bench::balls(max_dofs, &out),
+        Command::Bench { what: BenchCommand::Adaptive { out } } => bench::adaptive(&out),
     }
 }
 

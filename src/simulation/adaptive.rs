@@ -42,6 +42,13 @@ impl Simulation<'_> {
         }
         // An explicit scheme's step is also bounded by its critical step.
         let dt_max = self.stable.map_or(adaptive.dt_max, |s| adaptive.dt_max.min(s.dt));
+        if dt_max < adaptive.dt_min {
+            return Err(CaseError::Option(format!(
+                "--adaptive: scheme `{}` is stable up to Δt_c = {dt_max:.4e}, below --dt-min {}",
+                self.stepper.desc().name,
+                adaptive.dt_min
+            )));
+        }
         let adaptive = Adaptive { dt_max, ..adaptive };
         let k = self.order + 1.0;
         let floor = self.ops.asm.mesh().smallest_cell();
@@ -137,19 +144,22 @@ impl Simulation<'_> {
             let t_end = if span.t_end - (t + h) <= 1e-12 * length { span.t_end } else { t + h };
             let index = at.accepted - 1;
             let taken = Taken { k: index, whole: true, t, h, t_end, start, seen, report: &report };
-            let walk = (&mut at, &mut energy, &mut outcome, &mut *control, crash_at);
-            let stop = self.accept_adaptive(walk, &state, taken, watch.step)?;
-            state.t = t_end;
-            state.steps.accepted(h);
+            // The state after this step, which its checkpoint (if one is due) keeps.
+            let mut next = state.clone();
+            next.t = t_end;
+            next.steps.accepted(h);
             if event {
-                state.steps.events += 1;
-                state.bracket = None;
-                state.controller.restart();
+                next.steps.events += 1;
+                next.bracket = None;
+                next.controller.restart();
             }
-            state.controller.accepted(h, err, k);
-            if state.bracket.is_some_and(|b| b <= t_end) {
-                state.bracket = None;
+            next.controller.accepted(h, err, k);
+            if next.bracket.is_some_and(|b| b <= t_end) {
+                next.bracket = None;
             }
+            let walk = (&mut at, &mut energy, &mut outcome, &mut *control, crash_at);
+            let stop = self.accept_adaptive(walk, &next, taken, watch.step)?;
+            state = next;
             touching = after;
             if let Some(stop) = stop {
                 outcome.stopped = Some(stop);
@@ -161,20 +171,16 @@ impl Simulation<'_> {
         Ok(outcome)
     }
 
-    /// The accepted step through [`Simulation::accept`], with the controller's state in the
-    /// checkpoint it may write.
+    /// The accepted step through [`Simulation::accept`], `next` the run's state after it (for
+    /// the checkpoint it may write).
     fn accept_adaptive(
         &mut self,
         (at, energy, outcome, control, crash_at): Walked,
-        state: &AdaptiveState,
+        next: &AdaptiveState,
         taken: Taken,
         on_step: &mut super::OnStep,
     ) -> Result<Option<CaseError>, CaseError> {
-        // The checkpoint records the state after this step.
-        let mut after = state.clone();
-        after.t = taken.t_end;
-        after.steps.accepted(taken.h);
-        let mut walk = Walk { at, energy, outcome, control, crash_at, adaptive: Some(after) };
+        let mut walk = Walk { at, energy, outcome, control, crash_at, adaptive: Some(next.clone()) };
         self.accept(&mut walk, usize::MAX, taken, on_step)
     }
 

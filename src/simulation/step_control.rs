@@ -9,7 +9,7 @@ const SAFETY: f64 = 0.9;
 const SHRINK: f64 = 0.2;
 const GROW: f64 = 5.0;
 /// Growth by less than this factor keeps the step (Hairer and Wanner's Radau5 does so too).
-const KEEP: f64 = 1.2;
+const KEEP: f64 = 1.05;
 /// The PI controller's exponents times the local error's order k (Hairer and Wanner, vol. II,
 /// §IV.2: kI = 0.3/k, kP = 0.4/k).
 const INTEGRAL: f64 = 0.3;

@@ -90,6 +90,13 @@ fn the_disc_on_one_two_and_three_processes_agrees_with_the_serial_run() {
     agree(&["disc", "--t-start", "6", "--t-end", "8"], "disc");
 }
 
+/// Adaptive steps: every process takes the serial run's steps (the error and the contact set
+/// are the same on each), so the rows line up.
+#[test]
+fn an_adaptive_disc_on_one_two_and_three_processes_agrees_with_the_serial_run() {
+    agree(&["disc", "--t-start", "6", "--t-end", "8", "--adaptive", "1e-3"], "disc-adaptive");
+}
+
 #[test]
 fn the_sphere_on_one_two_and_three_processes_agrees_with_the_serial_run() {
     agree(&["sphere", "--t-start", "6.3", "--t-end", "6.45"], "sphere");
