@@ -22,6 +22,7 @@ use crate::runtime::time::scheme::StageView;
 use crate::runtime::time::stepper::{StepError, StepReport, Stepper};
 
 pub mod adaptive;
+mod cursor;
 mod energy_guard;
 mod ledger;
 pub mod operators;
@@ -30,6 +31,7 @@ pub mod stability;
 pub mod statics;
 pub mod step_control;
 
+use cursor::Cursor;
 use energy_guard::{Ended, EnergyWatch, StepWork};
 use operators::Parts;
 pub use operators::{AxisMean, Energies, Operators, resultant};
@@ -498,79 +500,6 @@ struct Seen {
     unknowns: Vec<Vec<f64>>,
 }
 
-/// Where a run is: the nominal steps done before it (from a checkpoint), the steps accepted,
-/// how many times Δt is halved now, and the steps accepted since it last changed.
-#[derive(Clone, Copy, Default)]
-struct Cursor {
-    first: usize,
-    accepted: usize,
-    level: usize,
-    streak: usize,
-}
-
-impl Cursor {
-    /// After a failed step: None to retry it with Δt halved, or why the run stops (a law whose
-    /// derivative is 0/0 is so at any Δt: no cut helps; nor one beyond `max_cuts`).
-    fn cut(&mut self, e: StepError, t: f64, h: f64, max_cuts: usize, outcome: &mut Outcome) -> Option<CaseError> {
-        if let StepError::NonFiniteTangent { .. } = e {
-            return Some(CaseError::Failed { t, cause: e.to_string() });
-        }
-        if self.level < max_cuts {
-            self.level += 1;
-            self.streak = 0;
-            outcome.cuts += 1;
-            tracing::warn!(t, dt = h / 2.0, "step failed ({e}); retrying with Δt halved");
-            return None;
-        }
-        Some(CaseError::Stopped { t, cuts: self.level, dt: h, cause: e.to_string(), history: history(&e) })
-    }
-
-    /// After an accepted step of `units`: Δt doubles back after two accepted steps that end on
-    /// a multiple of the doubled size, so that the run returns to the nominal time levels.
-    fn accept(&mut self, done: u64, units: u64) {
-        self.streak += 1;
-        if self.level > 0 && self.streak >= 2 && done.is_multiple_of(2 * units) {
-            self.level -= 1;
-            self.streak = 0;
-        }
-    }
-
-    /// The driver's part of a checkpoint after `steps_done` nominal steps.
-    fn driver_state(
-        &self,
-        steps_done: usize,
-        cuts: usize,
-        energy: &EnergyWatch,
-        states: &[Vec<f64>],
-        previous: Option<&[f64]>,
-        periodic: bool,
-    ) -> crate::checkpoint::DriverState {
-        crate::checkpoint::DriverState {
-            steps_done,
-            accepted: self.accepted,
-            level: self.level,
-            streak: self.streak,
-            cuts,
-            energy_initial: energy.initial,
-            energy_work: energy.work,
-            energy_varying_work: energy.varying_work,
-            energy_law_work: energy.law_work,
-            energy_dissipated: energy.dissipated,
-            energy_u0: energy.u0.clone(),
-            energy_kinetic: energy.kinetic,
-            energy_growth: energy.growth,
-            energy_made: energy.made,
-            energy_lowest: energy.lowest,
-            energy_last: energy.last,
-            energy_external: energy.external,
-            energy_switches: energy.switches.clone(),
-            states: states.iter().map(Vec::as_slice).chain(previous).map(<[f64]>::to_vec).collect(),
-            periodic,
-            adaptive: None,
-        }
-    }
-}
-
 /// What a step keeps of its start: the states (for a retry when a cut may follow, and the
 /// energy identity's free variables), the
 /// displacement, the level a law's `prev` read, and the velocity when held dofs take the
@@ -703,13 +632,4 @@ pub struct Resumed {
     /// From a periodic checkpoint (the bits of an uninterrupted run), or from one written on an
     /// interrupt without periodic ones (agrees to round-off).
     pub bit_for_bit: bool,
-}
-
-/// The residual history of a failed Newton, for the stop message.
-/// Newton's iterations of the last attempt, as a line of the stop's message (none when the step
-/// failed otherwise: an inverted cell).
-fn history(e: &crate::runtime::time::stepper::StepError) -> String {
-    use crate::runtime::time::stepper::StepError;
-    let StepError::Newton { source, .. } = e else { return String::new() };
-    format!("  Newton: {}\n", source.report().describe())
 }
