@@ -278,6 +278,16 @@ impl SummaryKeys {
                             let row = rows.iter().find(|row| arg(&args[1], row) > 0.0)?;
                             arg(a, row)
                         }
+                        Reduce::Integral => {
+                            let points: Vec<(f64, f64)> =
+                                rows.iter().map(|row| (row.0, arg(a, row))).filter(|(_, v)| !v.is_nan()).collect();
+                            points.windows(2).fold(0.0, |s, w| s + 0.5 * (w[1].0 - w[0].0) * (w[0].1 + w[1].1))
+                        }
+                        Reduce::Crest => {
+                            let points: Vec<(f64, f64)> =
+                                rows.iter().map(|row| (row.0, arg(a, row))).filter(|(_, v)| !v.is_nan()).collect();
+                            crest(&points)?
+                        }
                         Reduce::AtMax => {
                             let mut best: Option<(f64, &(f64, Vec<f64>))> = None;
                             for row in rows {
@@ -301,6 +311,22 @@ impl SummaryKeys {
         }
         out
     }
+}
+
+/// The largest of the values (t, f), refined by the parabola through it and its neighbours:
+/// the peak of a smooth f between two rows, exact for a quadratic one (the largest value itself
+/// at the first or last row, or where the parabola does not open downwards). None without rows.
+fn crest(points: &[(f64, f64)]) -> Option<f64> {
+    let (i, &(t1, f1)) = points.iter().enumerate().max_by(|a, b| a.1.1.total_cmp(&b.1.1))?;
+    let (Some(&(t0, f0)), Some(&(t2, f2))) = (i.checked_sub(1).and_then(|j| points.get(j)), points.get(i + 1)) else {
+        return Some(f1);
+    };
+    // f = f1 + b·s + c·s² with s = t − t1, through the three rows.
+    let (s0, s2) = (t0 - t1, t2 - t1);
+    let (d0, d2) = ((f0 - f1) / s0, (f2 - f1) / s2);
+    let c = (d2 - d0) / (s2 - s0);
+    let b = d2 - c * s2;
+    Some(if c < 0.0 { f1 - b * b / (4.0 * c) } else { f1 })
 }
 
 /// `e` with each reducer call replaced by a placeholder; the calls are collected.
@@ -394,4 +420,18 @@ pub fn applies(pf: &ProblemFile, ex: &mut Exprs, files: &crate::driver::params::
         out.push(when.holds(&mut holds.into_iter()));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod crest_tests {
+    /// Exact on a parabola sampled at uneven times; the largest sample at an end stays.
+    #[test]
+    fn the_crest_of_a_parabola_is_its_vertex() {
+        let f = |t: f64| 2.0 - 3.0 * (t - 0.37) * (t - 0.37);
+        let points: Vec<(f64, f64)> = [0.0, 0.1, 0.3, 0.45, 0.8, 1.0].iter().map(|&t| (t, f(t))).collect();
+        assert!((super::crest(&points).unwrap() - 2.0).abs() < 1e-12);
+        let rising: Vec<(f64, f64)> = [0.0, 0.1, 0.2].iter().map(|&t| (t, t)).collect();
+        assert_eq!(super::crest(&rising), Some(0.2));
+        assert_eq!(super::crest(&[]), None);
+    }
 }

@@ -145,8 +145,8 @@ mod tests {
         assert_eq!(ctl.h, 0.45);
         ctl.accepted(0.45, 1e-6, 3.0);
         assert_eq!(ctl.h, 0.45 * GROW);
-        let mut steady = Controller { h: 1.0, error: 0.2, rejected: false };
-        steady.accepted(1.0, 0.2, 3.0);
+        let mut steady = Controller { h: 1.0, error: 0.3, rejected: false };
+        steady.accepted(1.0, 0.3, 3.0);
         assert_eq!(steady.h, 1.0, "a growth below {KEEP} keeps the step");
     }
 }

@@ -260,6 +260,10 @@ pub enum SummaryReducer {
     First,
     /// The first argument at the first row where the second is largest (NaN rows left out).
     AtMax,
+    /// The trapezoidal rule over the rows in t.
+    Integral,
+    /// The largest value, refined by the parabola through its row and the two beside it in t.
+    Crest,
 }
 
 /// A summary reducer's row of the catalogue: what it is, its name, how it is written, its
@@ -294,6 +298,20 @@ pub const SUMMARY_REDUCERS: &[Reducer] = {
         r(Sum, "sum", "sum(EXPR)", "the sum over the rows, in order", (1, 1)),
         r(First, "first", "first(EXPR, WHEN)", "EXPR at the first row where WHEN > 0 (null if none)", (2, 2)),
         r(AtMax, "at_max", "at_max(EXPR, OF)", "EXPR at the first row where OF is largest", (2, 2)),
+        r(
+            Integral,
+            "integral",
+            "integral(EXPR)",
+            "the integral over t by the trapezoidal rule on the rows (an L² norm that steps of any size weigh alike)",
+            (1, 1),
+        ),
+        r(
+            Crest,
+            "crest",
+            "crest(EXPR)",
+            "the largest value, refined by the parabola through its row and the rows beside it in t (a peak between rows)",
+            (1, 1),
+        ),
     ]
 };
 
