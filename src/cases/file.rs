@@ -32,6 +32,11 @@ struct CaseFile {
     t_end: Option<Spanned<f64>>,
     /// Problems: the start time (the problem's default otherwise).
     t_start: Option<Spanned<f64>>,
+    /// Adaptive steps (`--adaptive`, `--dt-min`, `--dt-max`, `--event-dt`).
+    adaptive: Option<Spanned<f64>>,
+    dt_min: Option<Spanned<f64>>,
+    dt_max: Option<Spanned<f64>>,
+    event_dt: Option<Spanned<f64>>,
     out: Option<Spanned<String>>,
     /// A Gmsh file instead of the problem's mesh.
     mesh: Option<Spanned<String>>,
@@ -214,6 +219,12 @@ pub fn parse(text: &str, path: &Path) -> Result<crate::problem::run::Options, Ca
         .as_ref()
         .map(|_| r.number(&parsed.t_start, "t_start", |x| x >= 0.0, "0 or positive", 0.0))
         .transpose()?;
+    opts.steps = crate::problem::run::StepOptions {
+        adaptive: positive(&parsed.adaptive, "adaptive")?,
+        dt_min: positive(&parsed.dt_min, "dt_min")?,
+        dt_max: positive(&parsed.dt_max, "dt_max")?,
+        event_dt: positive(&parsed.event_dt, "event_dt")?,
+    };
     if let Some(s) = &parsed.solver {
         opts.newton.solver = crate::runtime::linalg::Solver::parse(s.get_ref()).map_err(|e| r.error(s, "solver", e))?;
     }

@@ -80,7 +80,7 @@ fn mistakes_are_reported_with_their_line() {
         (
             "other_case.toml",
             "case = \"disc\"\nne = 5\n",
-            ":2: unknown field `ne`, expected one of `case`, `scheme`, `contact`, `material`, `forms`, `params`, `mass`, `cell_size`, `dt`, `t_end`, `t_start`, `out`, `mesh`, `max_step_cuts`, `energy_tolerance`, `allow_unstable_dt`, `solver`, `petsc_options`; nor a param of problem `disc` (its params: h)",
+            ":2: unknown field `ne`, expected one of `case`, `scheme`, `contact`, `material`, `forms`, `params`, `mass`, `cell_size`, `dt`, `t_end`, `t_start`, `adaptive`, `dt_min`, `dt_max`, `event_dt`, `out`, `mesh`, `max_step_cuts`, `energy_tolerance`, `allow_unstable_dt`, `solver`, `petsc_options`; nor a param of problem `disc` (its params: h)",
         ),
         (
             "name.toml",
@@ -134,4 +134,25 @@ fn a_case_file_runs_a_problem_file_with_its_params() {
     let (code, err) = signorini(&["run", bad.to_str().unwrap()]);
     assert_eq!(code, 1);
     assert!(err.contains("bad_problem.toml:1: `case`") && err.contains("did you mean `sphere`?"), "{err}");
+}
+
+/// Adaptive steps from a case file (issue 56): its keys are the run settings'; a tolerance that
+/// is not positive fails with the key's line.
+#[test]
+fn a_case_file_asks_for_adaptive_steps() {
+    let path = write(
+        "adaptive.toml",
+        "case = \"disc\"\nh = 2\nt_end = 8.5\nadaptive = 1e-3\nevent_dt = 2e-3\nout = \"adaptive-out\"\n",
+    );
+    let (code, err) = signorini(&["run", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let dir = path.parent().unwrap().join("adaptive-out");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["adaptive"]["tolerance"], 1e-3);
+    assert!(s["adaptive"]["events"].as_u64().unwrap() >= 1, "{}", s["adaptive"]);
+    let bad = write("adaptive_bad.toml", "case = \"disc\"\nh = 2\n\nadaptive = -1\n");
+    let (code, err) = signorini(&["run", bad.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(err.contains("adaptive_bad.toml:4") && err.contains("`adaptive`"), "{err}");
 }
