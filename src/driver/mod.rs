@@ -211,6 +211,17 @@ pub fn all_schemes() -> Vec<&'static str> {
     scheme_names(&Methods::default())
 }
 
+/// The library's schemes that declare an `estimate` (that can run with adaptive steps).
+pub fn estimating_schemes() -> Vec<&'static str> {
+    all_schemes()
+        .into_iter()
+        .filter(|&name| {
+            let methods = Methods { scheme: name.to_string(), ..Methods::default() };
+            library_scheme(&methods).is_some_and(|u| u.desc.estimate.is_some())
+        })
+        .collect()
+}
+
 fn unknown(what: &str, name: &str, known: &[&str]) -> CaseError {
     let hint = crate::compiler::check::suggest_name(name, known.iter().copied())
         .map_or(String::new(), |s| format!("; did you mean `{s}`?"));

@@ -36,8 +36,9 @@ impl Simulation<'_> {
     ) -> Result<Outcome, CaseError> {
         if !self.stepper.estimate_steps() {
             return Err(CaseError::Option(format!(
-                "--adaptive: scheme `{}` declares no `estimate` (its local error as a combination of its levels, e.g. `estimate dt^2*(beta - 1/6)*(a' - a)` for Newmark); the library's newmark, hht, genalpha, central and trbdf2 declare one",
-                self.stepper.desc().name
+                "--adaptive: scheme `{}` declares no `estimate` (its local error as a combination of its levels, e.g. `estimate dt^2*(beta - 1/6)*(a' - a)` for Newmark); the library's {} declare one",
+                self.stepper.desc().name,
+                crate::driver::estimating_schemes().join(", ")
             )));
         }
         // An explicit scheme's step is also bounded by its critical step.
@@ -52,8 +53,7 @@ impl Simulation<'_> {
         let adaptive = Adaptive { dt_max, ..adaptive };
         let k = self.order + 1.0;
         let floor = self.ops.asm.mesh().smallest_cell();
-        let intermediate: Vec<String> =
-            self.stepper.desc().stages.iter().rev().skip(1).map(|s| s.name.to_string()).collect();
+        let intermediate = self.intermediate_stages();
         let mut outcome = Outcome::new(0);
         let mut bar = crate::progress::Progress::new(PROGRESS_TICKS, progress);
         let mut energy = EnergyWatch::new(&self.ops, &self.states, self.v_index, span.t0);
@@ -64,7 +64,7 @@ impl Simulation<'_> {
             steps: Steps::default(),
             bracket: None,
         };
-        let crash_at: Option<usize> = std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok());
+        let crash_at = super::crash_after_step();
         if let Some((saved, _)) = &control.resume {
             (at, energy) = self.resume(saved, &mut outcome)?;
             state = saved.adaptive.clone().ok_or_else(|| {
@@ -73,7 +73,7 @@ impl Simulation<'_> {
         }
         // The previous level, as the step that ended here saw its end (a law's `prev`).
         let previous = self.stepper.previous().map(<[f64]>::to_vec);
-        let mut touching = self.touching(&self.states[0].clone(), state.t, previous.as_deref())?;
+        let mut touching = self.touching(&self.states[0], state.t, previous.as_deref())?;
         let length = span.t_end - span.t0;
         while span.t_end - state.t > 1e-12 * length {
             bar.tick(((state.t - span.t0) / length * PROGRESS_TICKS as f64) as usize);
@@ -91,17 +91,15 @@ impl Simulation<'_> {
                     state.controller.h = h * AFTER_FAILURE;
                     state.controller.rejected = true;
                     tracing::warn!(t, dt = state.controller.h, "step failed ({e}); retrying with a smaller Δt");
-                    if state.controller.h < adaptive.dt_min {
-                        let cause = format!("Newton failed: {e}");
-                        outcome.stopped =
-                            Some(CaseError::StepTooSmall { t, dt: state.controller.h, dt_min: adaptive.dt_min, cause });
+                    if let Some(stop) = too_small(t, state.controller.h, &adaptive, || format!("Newton failed: {e}")) {
+                        outcome.stopped = Some(stop);
                         break;
                     }
                     continue;
                 }
             };
             let err = self.local_error(&start, adaptive.tolerance, floor)?;
-            let after = self.touching(&self.states[0].clone(), t + h, Some(&start.before))?;
+            let after = self.touching(&self.states[0], t + h, Some(&start.before))?;
             let event = after.any != touching.any;
             let changed = after.switches != touching.switches;
             // A step across an event is bisected down to the event tolerance; one across which
@@ -130,11 +128,9 @@ impl Simulation<'_> {
                         state.controller.rejected(h, err, k);
                     }
                 }
-                if state.controller.h < adaptive.dt_min {
-                    let cause =
-                        format!("the local error estimate is {} × the tolerance", crate::numbers::readable(err));
-                    outcome.stopped =
-                        Some(CaseError::StepTooSmall { t, dt: state.controller.h, dt_min: adaptive.dt_min, cause });
+                let cause = || format!("the local error estimate is {} × the tolerance", crate::numbers::readable(err));
+                if let Some(stop) = too_small(t, state.controller.h, &adaptive, cause) {
+                    outcome.stopped = Some(stop);
                     break;
                 }
                 continue;
@@ -225,6 +221,11 @@ enum Verdict {
 struct Touching {
     switches: Vec<bool>,
     any: bool,
+}
+
+/// Why the run stops at t, when the step the controller asks for, h, is below the minimum.
+fn too_small(t: f64, h: f64, adaptive: &Adaptive, cause: impl FnOnce() -> String) -> Option<CaseError> {
+    (h < adaptive.dt_min).then(|| CaseError::StepTooSmall { t, dt: h, dt_min: adaptive.dt_min, cause: cause() })
 }
 
 /// The next step to try: the controller's, within the bounds, not beyond a pending event's

@@ -231,8 +231,7 @@ impl<'m> Simulation<'m> {
         watch: Watch,
     ) -> Result<Outcome, CaseError> {
         self.check_stable(span.dt)?;
-        let intermediate: Vec<String> =
-            self.stepper.desc().stages.iter().rev().skip(1).map(|s| s.name.to_string()).collect();
+        let intermediate = self.intermediate_stages();
         let mut outcome = Outcome::new(span.steps);
         let mut bar = crate::progress::Progress::new(span.steps, progress);
         let mut energy = EnergyWatch::new(&self.ops, &self.states, self.v_index, span.t0);
@@ -240,9 +239,7 @@ impl<'m> Simulation<'m> {
         let max_cuts = self.guard.max_step_cuts.min(MAX_STEP_CUTS);
         let full: u64 = 1 << max_cuts;
         let mut at = Cursor::default();
-        // Fault injection for the restart tests: the process aborts, as if killed, right after
-        // this accepted step (and its checkpoint, if one is due). Read once, not every step.
-        let crash_at: Option<usize> = std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok());
+        let crash_at = crash_after_step();
         if let Some((saved, _)) = &control.resume {
             if saved.adaptive.is_some() {
                 return Err(CaseError::Option(
@@ -297,6 +294,11 @@ impl<'m> Simulation<'m> {
         }
         bar.finish();
         Ok(outcome)
+    }
+
+    /// The stages before the last, whose quantities the observers measure too.
+    fn intermediate_stages(&self) -> Vec<String> {
+        self.stepper.desc().stages.iter().rev().skip(1).map(|s| s.name.to_string()).collect()
     }
 
     /// After an accepted step: the energy guard, the observer, the checkpoint if one is due;
@@ -449,6 +451,12 @@ impl<'m> Simulation<'m> {
         stepper.forget();
         Ok((at, energy))
     }
+}
+
+/// Fault injection for the restart tests: the process aborts, as if killed, right after this
+/// accepted step (and its checkpoint, if one is due). Read once per run, not every step.
+fn crash_after_step() -> Option<usize> {
+    std::env::var("SIGNORINI_CRASH_AFTER_STEP").ok().and_then(|s| s.parse().ok())
 }
 
 /// The steps a run takes: `steps` nominal steps of `dt` from `t0`.
