@@ -14,6 +14,10 @@ pub enum CaseError {
     /// A case file problem, with file and line.
     #[error("{0}")]
     CaseFile(String),
+    /// A .wf file that does not check (or a problem's line its binding refuses): the
+    /// diagnostics rendered as the compiler prints them, and located.
+    #[error("{}", .0.rendered.trim_end())]
+    Wf(crate::compiler::Failure),
     /// Files that check but lack what a run needs of them (a nonlinear stiffness without its
     /// stored energy).
     #[error("the files in use: {0}")]

@@ -14,7 +14,7 @@
 //!   the files given by path, [`forms`] for the compiled library, [`settings`] for
 //!   forms/library.toml);
 //! - the run's error ([`error`]), its step guard ([`guard`]), [`references`], and the outputs
-//!   ([`output`], [`numbers`], [`plot`], [`vtu`], [`progress`], [`interrupt`], [`resources`]).
+//!   ([`output`], [`numbers`], [`plot`], [`vtu`], [`progress`], [`interrupt`], [`resources`]), and where the library's files are ([`library_dir`]).
 
 // Generated code names the runtime `::signorini::runtime`, also inside this crate.
 extern crate self as signorini;
@@ -33,6 +33,7 @@ pub mod forms;
 pub mod guard;
 pub mod interpret;
 pub mod interrupt;
+pub mod library_dir;
 pub mod numbers;
 pub mod output;
 pub mod plot;

@@ -201,6 +201,57 @@ impl Diagnostic {
     }
 }
 
+/// A diagnostic for a reader other than a terminal (the Python API, an editor): its texts and
+/// where its primary span starts and ends, as 1-based lines and columns (in characters), with
+/// the rendering the command line prints.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Located {
+    pub severity: Severity,
+    pub code: &'static str,
+    pub message: String,
+    pub file: std::path::PathBuf,
+    pub line: usize,
+    pub column: usize,
+    pub end_line: usize,
+    pub end_column: usize,
+    /// The primary span's label.
+    pub label: String,
+    pub notes: Vec<String>,
+    pub help: Option<String>,
+    pub rendered: String,
+}
+
+impl Diagnostic {
+    /// The diagnostic with its position read off `sources`.
+    pub fn locate(&self, sources: &SourceMap) -> Located {
+        let span = self.primary.span;
+        let known = span.file < sources.len();
+        let at = |offset: usize| if known { sources.line_col(span.file, offset) } else { (0, 0) };
+        let ((line, column), (end_line, end_column)) = (at(span.start), at(span.end));
+        Located {
+            severity: self.severity,
+            code: self.code,
+            message: self.message.clone(),
+            file: if known { sources.path(span.file).to_path_buf() } else { Default::default() },
+            line,
+            column,
+            end_line,
+            end_column,
+            label: self.primary.message.clone(),
+            notes: self.notes.clone(),
+            help: self.help.clone(),
+            rendered: self.render(sources),
+        }
+    }
+}
+
+impl Severity {
+    /// `error` or `warning`, as the rendering says it.
+    pub fn word(self) -> &'static str {
+        severity_word(self)
+    }
+}
+
 fn severity_word(s: Severity) -> &'static str {
     match s {
         Severity::Error => "error",

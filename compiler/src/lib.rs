@@ -19,7 +19,7 @@ pub mod scheme;
 pub mod source;
 pub mod syntax;
 
-pub use diagnostic::{Diagnostic, Severity, render_all};
+pub use diagnostic::{Diagnostic, Located, Severity, render_all};
 pub use pipeline::{
     Checked, Compiled, Expansion, Failure, Stage, check_file, check_path, check_text, compile, compile_text,
     compile_to_rust, expand,

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use crate::check::{self, SchemeDef, load};
 use crate::codegen;
-use crate::diagnostic::{self, Diagnostic, render_all};
+use crate::diagnostic::{self, Diagnostic, Located, render_all};
 use crate::ir::{self, DimIr};
 use crate::program::Program;
 use crate::scheme::{self, SchemeIr};
@@ -18,6 +18,8 @@ use crate::syntax::ast;
 pub struct Failure {
     /// Human-readable, with file:line:col and carets.
     pub rendered: String,
+    /// The diagnostics behind it, located (none for an I/O problem).
+    pub diagnostics: Vec<Located>,
 }
 
 impl std::fmt::Display for Failure {
@@ -28,7 +30,12 @@ impl std::fmt::Display for Failure {
 
 impl Failure {
     fn internal(e: impl std::fmt::Display) -> Failure {
-        Failure { rendered: format!("error: {e}\n") }
+        Failure { rendered: format!("error: {e}\n"), diagnostics: Vec::new() }
+    }
+
+    /// The diagnostics, rendered and located.
+    pub fn of(diags: &[Diagnostic], sources: &SourceMap) -> Failure {
+        Failure { rendered: render_all(diags, sources), diagnostics: diags.iter().map(|d| d.locate(sources)).collect() }
     }
 }
 
@@ -121,7 +128,7 @@ impl Compiled {
                         Err(why) => {
                             let message = format!("no energy identity for scheme `{}`", s.name);
                             let d = Diagnostic::error("E0822", message, s.span, why);
-                            return Err(Failure { rendered: render_all(&[d], &prog.sources) });
+                            return Err(Failure::of(&[d], &prog.sources));
                         }
                     }
                 }
@@ -245,7 +252,7 @@ fn front(loaded: load::Loaded, diags: Vec<Diagnostic>) -> Result<(Program, ast::
 
 fn finish(front: Result<(Program, ast::File), (Vec<Diagnostic>, SourceMap)>) -> Result<Compiled, Failure> {
     match front {
-        Err((diags, sources)) => Err(Failure { rendered: render_all(&diags, &sources) }),
+        Err((diags, sources)) => Err(Failure::of(&diags, &sources)),
         Ok((program, ast)) => {
             let warnings = render_all(&program.warnings, &program.sources);
             Ok(Compiled { program, ast, warnings })

@@ -13,7 +13,7 @@ pub mod args;
 mod bench;
 mod compare;
 mod files;
-mod list;
+pub mod list;
 mod problem_params;
 mod run;
 mod summary;
@@ -49,6 +49,79 @@ impl Cli {
             .get_matches_from(problem_params::as_options(std::env::args_os().collect()));
         Self::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
     }
+}
+
+/// One run as `signorini run ARGS...` asks for it, read as the command line reads it (its
+/// checks and messages, a problem's params as options), for a host other than the shell (the
+/// Python API): a problem or a case file. `--all` runs many and is refused.
+pub fn run_options(args: &[String]) -> Result<crate::problem::run::Options, String> {
+    use clap::{CommandFactory, FromArgMatches};
+    let argv: Vec<std::ffi::OsString> =
+        ["signorini", "run"].iter().map(|s| s.into()).chain(args.iter().map(|a| a.into())).collect();
+    let matches =
+        negative_values(Cli::command()).try_get_matches_from(problem_params::as_options(argv)).map_err(clap_message)?;
+    let cli = Cli::from_arg_matches(&matches).map_err(clap_message)?;
+    let Command::Run { file: Some(file), args } = cli.command else {
+        return Err("name a problem, a problem file or a case file".into());
+    };
+    if args.all {
+        return Err("`--all` runs every scheme and contact law and prints a table: run them one by one".into());
+    }
+    if file.extension().is_some_and(|e| e == "toml") {
+        return run::case_options(&file, cli.force).map_err(|e| e.to_string());
+    }
+    run::options(&file.to_string_lossy(), *args, cli.force)
+}
+
+/// The scheme and files `signorini verify --scheme ... ARGS` names (`--scheme`, `--contact`,
+/// `--param`, ...), read as the command line reads them.
+pub fn verify_methods(args: &[String]) -> Result<crate::driver::Methods, String> {
+    use clap::{CommandFactory, FromArgMatches};
+    let argv: Vec<std::ffi::OsString> =
+        ["signorini", "verify"].iter().map(|s| s.into()).chain(args.iter().map(|a| a.into())).collect();
+    let matches = negative_values(Cli::command()).try_get_matches_from(argv).map_err(clap_message)?;
+    let cli = Cli::from_arg_matches(&matches).map_err(clap_message)?;
+    match cli.command {
+        Command::Verify { methods, .. } if methods.scheme.is_some() => methods.to_methods(),
+        _ => Err("name the scheme to verify".into()),
+    }
+}
+
+/// clap's message without its usage lines and `error: `: a host shows its own call.
+fn clap_message(e: clap::Error) -> String {
+    let text = e.render().to_string();
+    text.split("\n\nUsage:").next().unwrap_or_default().trim_end().trim_start_matches("error: ").to_string()
+}
+
+/// An option of `signorini run`: its long name, whether it takes a value and may be repeated,
+/// and its help (a host that maps its own arguments onto them checks names against these).
+pub struct RunOption {
+    pub name: String,
+    pub takes_value: bool,
+    pub repeated: bool,
+    pub help: String,
+}
+
+/// The options of `signorini run`, `--force` among them.
+pub fn run_option_list() -> Vec<RunOption> {
+    use clap::CommandFactory;
+    let cmd = Cli::command();
+    let force = cmd.get_arguments().filter(|a| a.get_id() == "force");
+    let run = cmd.find_subcommand("run").map(|r| r.get_arguments().cloned().collect::<Vec<_>>()).unwrap_or_default();
+    force
+        .cloned()
+        .chain(run)
+        .filter_map(|a| {
+            let name = a.get_long()?.to_string();
+            let action = a.get_action();
+            Some(RunOption {
+                name,
+                takes_value: action.takes_values(),
+                repeated: matches!(action, clap::ArgAction::Append),
+                help: a.get_help().map(ToString::to_string).unwrap_or_default(),
+            })
+        })
+        .collect()
 }
 
 fn negative_values(cmd: clap::Command) -> clap::Command {

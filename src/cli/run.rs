@@ -11,37 +11,44 @@ use crate::driver::{Methods, Setting};
 use crate::simulation::MassChoice;
 
 pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
+    if !a.all {
+        return match options(problem, a, super::force()) {
+            Ok(opts) => finish(crate::problem::run::run(&opts)),
+            Err(e) => fail(e),
+        };
+    }
     let methods = match a.methods.to_methods() {
         Ok(s) => s,
         Err(e) => return fail(e),
     };
-    if a.all {
-        if a.checkpoint.checkpoint_every > 0 || a.checkpoint.resume.is_some() {
-            return fail("--all runs many cases: it takes no --checkpoint-every or --resume");
-        }
-        let mut opts = crate::problem::run::Options::new(problem);
-        opts.mesh = a.mesh;
-        opts.dt = a.dt;
-        opts.t_start = a.t_start;
-        opts.t_end = a.t_end;
-        opts.steps = a.steps.options();
-        opts.cell_size = a.methods.cell_size;
-        opts.newton.solver = a.solver;
-        opts.petsc_options = a.petsc_options;
-        opts.newton.line_search = a.methods.line_search;
-        opts.vtu_every = a.vtu_every;
-        opts.chosen.material = a.methods.material.is_some();
-        opts.out = match out_dir(a.out) {
-            Ok(dir) => dir,
-            Err(e) => return fail(e),
-        };
-        return all(opts, methods);
+    if a.checkpoint.checkpoint_every > 0 || a.checkpoint.resume.is_some() {
+        return fail("--all runs many cases: it takes no --checkpoint-every or --resume");
     }
-    let (out, fresh) = match a.checkpoint.out(a.out) {
-        Ok(out) => out,
+    let mut opts = crate::problem::run::Options::new(problem);
+    opts.mesh = a.mesh;
+    opts.dt = a.dt;
+    opts.t_start = a.t_start;
+    opts.t_end = a.t_end;
+    opts.steps = a.steps.options();
+    opts.cell_size = a.methods.cell_size;
+    opts.newton.solver = a.solver;
+    opts.petsc_options = a.petsc_options;
+    opts.newton.line_search = a.methods.line_search;
+    opts.vtu_every = a.vtu_every;
+    opts.chosen.material = a.methods.material.is_some();
+    opts.out = match out_dir(a.out) {
+        Ok(dir) => dir,
         Err(e) => return fail(e),
     };
-    let opts = crate::problem::run::Options {
+    all(opts, methods)
+}
+
+/// The options of one run of `problem` (not `--all`) as the command line asks for them, its
+/// output directory to be prepared with `force` when the run starts.
+pub(super) fn options(problem: &str, a: ProblemArgs, force: bool) -> Result<crate::problem::run::Options, String> {
+    let methods = a.methods.to_methods()?;
+    let (out, fresh) = a.checkpoint.out(a.out)?;
+    Ok(crate::problem::run::Options {
         problem: problem.to_string(),
         methods,
         mass: a.mass,
@@ -59,7 +66,7 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
         },
         petsc_options: a.petsc_options,
         out,
-        out_fresh: fresh.then(super::force),
+        out_fresh: fresh.then_some(force),
         vtu_every: a.vtu_every,
         progress: true,
         checkpoint_every: a.checkpoint.checkpoint_every,
@@ -69,8 +76,8 @@ pub(super) fn problem(problem: &str, a: ProblemArgs) -> ExitCode {
             contact: a.methods.contact.is_some(),
             material: a.methods.material.is_some(),
         },
-    };
-    finish(crate::problem::run::run(&opts))
+        keep_fields: false,
+    })
 }
 
 /// `run PROBLEM --all`: every scheme × contact law × mass matrix, one line each with the
@@ -139,18 +146,22 @@ fn all(base: crate::problem::run::Options, methods: Methods) -> ExitCode {
 }
 
 pub(super) fn case_file(file: &Path) -> ExitCode {
-    use crate::cases::file;
-    match file::read(file) {
-        Ok(mut opts) => {
-            // Prepared when the run starts (a refused case writes nothing).
-            opts.out = Some(opts.out.take().unwrap_or_else(|| file::default_out(file)));
-            opts.out_fresh = Some(super::force());
-            opts.progress = true;
-            finish(crate::problem::run::run(&opts))
-        }
+    match case_options(file, super::force()) {
+        Ok(opts) => finish(crate::problem::run::run(&opts)),
         Err(e) => {
             super::print_error(e);
             ExitCode::FAILURE
         }
     }
+}
+
+/// A case file's options; its output directory (`results/STEM` unless it names one) is
+/// prepared with `force` when the run starts (a refused case writes nothing).
+pub(super) fn case_options(file: &Path, force: bool) -> Result<crate::problem::run::Options, crate::error::CaseError> {
+    use crate::cases::file;
+    let mut opts = file::read(file)?;
+    opts.out = Some(opts.out.take().unwrap_or_else(|| file::default_out(file)));
+    opts.out_fresh = Some(force);
+    opts.progress = true;
+    Ok(opts)
 }

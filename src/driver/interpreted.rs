@@ -10,6 +10,7 @@ use crate::compiler::scheme::layout::{Layout, layout};
 use crate::compiler::scheme::{SchemeIr, scheme_leaf};
 use crate::compiler::{check_path, describe, docs};
 use crate::driver::sources::LibraryLoader;
+use crate::error::CaseError;
 use crate::runtime::descriptors::{ParamInfo, SchemeDesc, check_param};
 use crate::runtime::library::LibraryError;
 use crate::runtime::time::scheme::TimeScheme;
@@ -42,21 +43,25 @@ impl TimeScheme for Running {
 }
 
 /// Compiles the scheme file at `path` (its only scheme, or the one named `name`).
-pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, String> {
-    let (prog, warnings) = check_path(path, &LibraryLoader).map_err(|f| f.rendered)?;
+pub fn load(path: &Path, name: Option<&str>) -> Result<Interpreted, CaseError> {
+    let (prog, warnings) = check_path(path, &LibraryLoader).map_err(CaseError::Wf)?;
     if !warnings.is_empty() {
         eprint!("{warnings}");
     }
     let s: &SchemeIr = match (name, prog.schemes.as_slice()) {
-        (_, []) => return Err(format!("{} declares no scheme", path.display())),
+        (_, []) => return Err(CaseError::CaseFile(format!("{} declares no scheme", path.display()))),
         (None, [one]) => one,
         (Some(n), all) => all.iter().find(|s| s.name == n).ok_or_else(|| {
             let names: Vec<&str> = all.iter().map(|s| s.name.as_str()).collect();
-            format!("{} has no scheme `{n}` (it has: {})", path.display(), names.join(", "))
+            CaseError::CaseFile(format!("{} has no scheme `{n}` (it has: {})", path.display(), names.join(", ")))
         })?,
         (None, all) => {
             let names: Vec<&str> = all.iter().map(|s| s.name.as_str()).collect();
-            return Err(format!("{} declares several schemes ({}): name one", path.display(), names.join(", ")));
+            return Err(CaseError::CaseFile(format!(
+                "{} declares several schemes ({}): name one",
+                path.display(),
+                names.join(", ")
+            )));
         }
     };
     let Layout { desc, coefficients, .. } = layout(s, &prog.sources);

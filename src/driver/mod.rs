@@ -235,9 +235,7 @@ fn unknown(what: &str, name: &str, known: &[&str]) -> CaseError {
 pub fn scheme(methods: &Methods) -> Result<SchemeSource, CaseError> {
     if is_path(&methods.scheme) {
         let path = Path::new(&methods.scheme);
-        return interpreted::load(path, None)
-            .map(|i| SchemeSource::Interpreted(Box::new(i)))
-            .map_err(CaseError::CaseFile);
+        return interpreted::load(path, None).map(|i| SchemeSource::Interpreted(Box::new(i)));
     }
     library_scheme(methods)
         .map(SchemeSource::Compiled)
@@ -276,11 +274,12 @@ fn interpret_bound(
     roles: &[(String, PathBuf)],
 ) -> Result<sources::Interpreted, CaseError> {
     sources::interpret(path, roles).map_err(|e| {
-        CaseError::CaseFile(format!(
-            "{} with the run's material `{}` bound to its `import {MATERIAL_ROLE} = ...`:\n{e}",
+        let context = format!(
+            "{} with the run's material `{}` bound to its `import {MATERIAL_ROLE} = ...`:\n",
             path.display(),
             material.file()
-        ))
+        );
+        CaseError::Wf(crate::compiler::Failure { rendered: context + &e.rendered, ..e })
     })
 }
 
@@ -297,7 +296,7 @@ fn form_units_with_pairs(methods: &Methods) -> Result<(Vec<FormSource>, usize, V
             Some(u) => FormSource::Compiled(u),
             None => sources::interpret(Path::new(name), &[])
                 .map(|i| FormSource::Interpreted(Box::new(i)))
-                .map_err(CaseError::CaseFile)?,
+                .map_err(CaseError::Wf)?,
         },
         name => library_forms(methods, name, "")
             .map(FormSource::Compiled)
@@ -312,12 +311,12 @@ fn form_units_with_pairs(methods: &Methods) -> Result<(Vec<FormSource>, usize, V
             }
             return sources::interpret(path, &roles)
                 .map(|i| FormSource::Interpreted(Box::new(i)))
-                .map_err(CaseError::CaseFile);
+                .map_err(CaseError::Wf);
         }
         match library_forms(methods, name, prefix) {
             Some(u) => with_roles(u, &material, &roles),
             None => match sources::library_pair(name) {
-                Some(pair) => pair.map(|i| FormSource::Interpreted(Box::new(i))).map_err(CaseError::CaseFile),
+                Some(pair) => pair.map(|i| FormSource::Interpreted(Box::new(i))).map_err(CaseError::Wf),
                 None => Err(unknown(what, name, known)),
             },
         }
@@ -359,7 +358,7 @@ fn form_units_with_pairs(methods: &Methods) -> Result<(Vec<FormSource>, usize, V
         place(&mut units, u);
     }
     for (name, text) in &methods.generated {
-        let u = sources::interpret_text(name, text).map_err(CaseError::CaseFile)?;
+        let u = sources::interpret_text(name, text).map_err(CaseError::Wf)?;
         units.push(FormSource::Interpreted(Box::new(u)));
     }
     Ok((units, contact_index, groups))
@@ -384,7 +383,7 @@ fn unlocated(a: &params::Unmatched) -> CaseError {
 /// A path that is one of the library's own files (compiled already).
 fn library_file(path: &Path) -> Option<&'static Unit> {
     let stem = path.file_stem()?.to_string_lossy().into_owned();
-    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("forms").join(format!("{stem}.wf"));
+    let here = crate::library_dir::forms().join(format!("{stem}.wf"));
     let same = std::fs::canonicalize(path).ok()? == std::fs::canonicalize(here).ok()?;
     if same { LIBRARY.iter().copied().find(|u| u.name == stem && u.forms.is_some()) } else { None }
 }
@@ -541,7 +540,7 @@ impl FilesInUse {
             SchemeSource::Interpreted(i) => vec![check_path(Path::new(&i.file), &sources::LibraryLoader)],
         };
         for compiled in programs {
-            let (program, _) = compiled.map_err(|f| CaseError::Option(f.rendered))?;
+            let (program, _) = compiled.map_err(CaseError::Wf)?;
             if let Some(ir) = program.schemes.into_iter().find(|s| s.name == name) {
                 return Ok(Some(ir));
             }

@@ -56,8 +56,7 @@ pub fn names_pair_law(methods: &Methods, name: &str) -> Result<bool, CaseError> 
             return Ok(false);
         }
         // Checked without its warnings: the run reads it again and prints them then.
-        let (program, _) =
-            crate::compiler::check_path(path, &sources::LibraryLoader).map_err(|f| CaseError::CaseFile(f.rendered))?;
+        let (program, _) = crate::compiler::check_path(path, &sources::LibraryLoader).map_err(CaseError::Wf)?;
         return Ok(crate::interpret::Library::new(&program).is_pair_law());
     }
     if library_forms(methods, name, "contact_").is_some() {

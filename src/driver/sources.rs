@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::compiler::{check_path, describe, module_name};
+use crate::compiler::{Failure, check_path, describe, module_name};
 use crate::interpret::Library;
 use crate::runtime::descriptors::{ParamInfo, SlotInfo};
 use crate::runtime::fem::kernel::Coef;
@@ -36,8 +36,8 @@ pub struct Interpreted {
 }
 
 /// Checks and lowers a form file given by path, with `roles` bound to files (role, path).
-pub fn interpret(path: &Path, roles: &[(String, PathBuf)]) -> Result<Interpreted, String> {
-    let (prog, warnings) = check_path(path, &BoundLoader { roles }).map_err(|f| f.rendered)?;
+pub fn interpret(path: &Path, roles: &[(String, PathBuf)]) -> Result<Interpreted, Failure> {
+    let (prog, warnings) = check_path(path, &BoundLoader { roles })?;
     if !warnings.is_empty() {
         eprint!("{warnings}");
     }
@@ -66,13 +66,13 @@ fn roles_of(prog: &crate::compiler::Program) -> Vec<(String, String)> {
 }
 
 /// Checks and lowers a form file the run writes itself (`name` is how messages name it).
-pub fn interpret_text(name: &str, text: &str) -> Result<Interpreted, String> {
+pub fn interpret_text(name: &str, text: &str) -> Result<Interpreted, Failure> {
     interpret_source(name, text, true)
 }
 
 /// A contact pair law of the library (`forms/pairs/`) by its file stem (`pair_penalty`),
 /// checked and lowered from the text built in.
-pub fn library_pair(name: &str) -> Option<Result<Interpreted, String>> {
+pub fn library_pair(name: &str) -> Option<Result<Interpreted, Failure>> {
     let (stem, text) = crate::forms::PAIR_SOURCES.iter().find(|(stem, _)| *stem == name)?;
     Some(interpret_source(&format!("forms/pairs/{stem}.wf"), text, false).map(|i| Interpreted { library: true, ..i }))
 }
@@ -82,10 +82,10 @@ pub fn pair_names() -> Vec<&'static str> {
     crate::forms::PAIR_SOURCES.iter().map(|(stem, _)| *stem).collect()
 }
 
-fn interpret_source(name: &str, text: &str, generated: bool) -> Result<Interpreted, String> {
+fn interpret_source(name: &str, text: &str, generated: bool) -> Result<Interpreted, Failure> {
     let path = Path::new(name);
     let prog = crate::compiler::pipeline::check_text(path, text, &LibraryLoader)
-        .map_err(|(diags, sources)| crate::compiler::render_all(&diags, &sources))?;
+        .map_err(|(diags, sources)| Failure::of(&diags, &sources))?;
     Ok(Interpreted {
         name: module_name(path),
         file: name.to_string(),

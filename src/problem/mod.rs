@@ -56,7 +56,7 @@ impl ProblemFile {
 
     /// Renders a diagnostic at the file's text.
     pub fn render(&self, d: crate::compiler::Diagnostic) -> CaseError {
-        CaseError::CaseFile(crate::compiler::render_all(&[d], &self.program.unit.sources).trim_end().to_string())
+        CaseError::Wf(crate::compiler::Failure::of(&[d], &self.program.unit.sources))
     }
 }
 
@@ -85,7 +85,7 @@ pub fn load(name: &str) -> Result<ProblemFile, CaseError> {
                 known.join(", ")
             )));
         };
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("forms/problems");
+        let dir = crate::library_dir::forms().join("problems");
         (format!("forms/problems/{stem}.wf"), dir, text.to_string())
     };
     let checked = if is_path {
@@ -93,9 +93,7 @@ pub fn load(name: &str) -> Result<ProblemFile, CaseError> {
     } else {
         check_text(Path::new(&file), &text, &MemLoader::default())
     };
-    let unit = checked.map_err(|(diags, sources)| {
-        CaseError::CaseFile(crate::compiler::render_all(&diags, &sources).trim_end().to_string())
-    })?;
+    let unit = checked.map_err(|(diags, sources)| CaseError::Wf(crate::compiler::Failure::of(&diags, &sources)))?;
     let count = unit.unit.problems.len();
     if count != 1 {
         return Err(CaseError::CaseFile(format!("{file}: a problem file declares one problem, this one {count}")));

@@ -42,6 +42,9 @@ pub struct Options {
     /// The roles the user chose explicitly (`--scheme`, ...): the problem's `bind` lines give
     /// the others.
     pub chosen: Chosen,
+    /// The run's last state and its mesh are kept in its [`Run`](super::outputs::Run) (for
+    /// a host that reads them: the Python API).
+    pub keep_fields: bool,
 }
 
 /// Which of the methods' files the user chose; a problem's `bind` replaces the library's
@@ -81,6 +84,7 @@ impl Options {
             checkpoint_every: 0,
             resume: false,
             chosen: Chosen::default(),
+            keep_fields: false,
         }
     }
 }

@@ -26,6 +26,17 @@ pub struct Run {
     /// Newton's report (each stage's residuals) of every step this process took: none for the
     /// initial row, nor for the steps before a resume.
     pub newton: Vec<crate::runtime::time::stepper::StepReport>,
+    /// The last state and the mesh, when the options keep them (`keep_fields`).
+    pub fields: Option<Box<Fields>>,
+}
+
+/// A run's last state, with its mesh: u and v by node, `mesh.dim()` values each.
+pub struct Fields {
+    pub t: f64,
+    pub u: Vec<f64>,
+    /// None for a static problem, and a scheme without a velocity state.
+    pub v: Option<Vec<f64>>,
+    pub mesh: Option<crate::runtime::fem::mesh::Mesh>,
 }
 
 impl Run {

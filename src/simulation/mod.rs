@@ -340,6 +340,18 @@ impl<'m> Simulation<'m> {
                 return Ok(Some(e));
             }
         }
+        // A stop asked for while the step was shown (a host's watcher of the rows) ends the run
+        // here, unless the stop's own checkpoint is due, which the next step writes. One
+        // process only: the processes of an MPI run agree on a stop in `Due::at`.
+        let own_checkpoint = walk.control.every == 0 && walk.control.dir.is_some();
+        if whole
+            && !due.interrupted
+            && !own_checkpoint
+            && crate::runtime::linalg::ranks::world().1 == 1
+            && crate::interrupt::requested()
+        {
+            return Ok(Some(CaseError::Interrupted { t: t_end }));
+        }
         // Fault injection for the restart tests (`Walk::crash_at`).
         if walk.crash_at == Some(walk.at.accepted) {
             std::process::abort();

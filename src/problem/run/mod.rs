@@ -18,8 +18,8 @@ use super::expr::{Exprs, PointFn};
 use super::observe::{Observer, Sources, State};
 use super::options::Times;
 pub use super::options::{Chosen, Options, StepOptions};
-pub use super::outputs::Run;
 use super::outputs::write_outputs;
+pub use super::outputs::{Fields, Run};
 use super::reference::bound_reference;
 use super::resolve::bound;
 use super::resume::identity;
@@ -38,10 +38,42 @@ use crate::simulation::statics::StaticProblem;
 use crate::simulation::{Operators, Outcome, Problem, Simulation, Snapshots};
 
 pub fn run(opts: &Options) -> Result<Run, CaseError> {
+    run_watched(opts, None).map_err(|s| s.error)
+}
+
+/// A run that stopped before its end (an interrupt, a step that failed, an energy that grew):
+/// why, and the rows it measured up to there.
+pub struct Stopped {
+    pub error: CaseError,
+    pub run: Option<Box<Run>>,
+}
+
+impl From<CaseError> for Stopped {
+    fn from(error: CaseError) -> Stopped {
+        Stopped { error, run: None }
+    }
+}
+
+/// A row as a run measures it, shown to a [`Watcher`] as the run goes.
+pub struct Seen<'a> {
+    pub t: f64,
+    /// Every column's name, in the order of `values`.
+    pub columns: &'a [String],
+    pub values: &'a [f64],
+    /// The run's end time.
+    pub t_end: f64,
+}
+
+/// Sees each row of a time run as it is measured; `false` stops the run after that step, as
+/// SIGINT does (its results up to there written, [`CaseError::Interrupted`]).
+pub type Watcher<'w> = dyn Fn(&Seen) -> bool + 'w;
+
+/// [`run`], showing each row to `watcher`; a run that stops early keeps its rows.
+pub fn run_watched(opts: &Options, watcher: Option<&Watcher>) -> Result<Run, Stopped> {
     if let Some(options) = &opts.petsc_options {
         crate::runtime::linalg::set_petsc_options(options).map_err(|e| CaseError::Option(e.to_string()))?;
     }
-    bound(opts, |pf, params, ex, in_use, read_mesh| {
+    let ran = bound(opts, |pf, params, ex, in_use, read_mesh| {
         if pf.problem().run_static.is_some() {
             if opts.dt.is_some()
                 || opts.t_end.is_some()
@@ -54,7 +86,7 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
                 )));
             }
             let times = Times { dt: f64::NAN, t_start: 0.0, t_end: 0.0, adaptive: None };
-            return simulate(opts, pf, params, ex, in_use, &times, read_mesh);
+            return Ok(simulate(opts, pf, params, ex, in_use, &times, read_mesh, watcher));
         }
         let given = super::bind::settings(pf, ex, &pf.problem().run)?;
         let setting = |name: &str, over: Option<f64>, default: f64| {
@@ -77,8 +109,9 @@ pub fn run(opts: &Options) -> Result<Run, CaseError> {
             return Err(CaseError::Option(format!("--t-start must be in [0, t_end), not {}", times.t_start)));
         }
         times.adaptive = adaptive(opts.steps, &setting, &times)?;
-        simulate(opts, pf, params, ex, in_use, &times, read_mesh)
-    })
+        Ok(simulate(opts, pf, params, ex, in_use, &times, read_mesh, watcher))
+    });
+    ran?
 }
 
 /// Adaptive steps, when the options or the problem's `run` line ask for them: each bound a
@@ -123,6 +156,7 @@ fn adaptive(
     Ok(Some(a))
 }
 
+#[allow(clippy::too_many_arguments)]
 fn simulate(
     opts: &Options,
     pf: &ProblemFile,
@@ -131,10 +165,11 @@ fn simulate(
     in_use: &FilesInUse,
     times: &Times,
     read_mesh: Option<super::bind::ReadMesh>,
-) -> Result<Run, CaseError> {
+    watcher: Option<&Watcher>,
+) -> Result<Run, Stopped> {
     let clock = Instant::now();
     let writes = crate::runtime::linalg::ranks::writes();
-    let req = Request { opts, pf, params, in_use, times, writes };
+    let req = Request { opts, pf, params, in_use, times, writes, watcher };
     let (mesh, mesh_label) = super::bind::mesh(pf, ex, opts.mesh.as_deref(), opts.cell_size, read_mesh)?;
     // Under mpirun each process assembles the cells around the nodes it owns, where it can.
     let ownership = match split(opts, pf, in_use)? {
@@ -212,12 +247,22 @@ fn simulate(
         snapshots.finish()?;
     }
     let ran = Ran { stepped, sized, runner: &runner, wall: clock.elapsed().as_secs_f64() };
-    finish(&req, ran, observing, out.as_ref())
+    let mut run = finish(&req, ran, observing, out.as_ref());
+    if opts.keep_fields
+        && let Some(r) = match &mut run {
+            Ok(r) => Some(r),
+            Err(Stopped { run, .. }) => run.as_deref_mut(),
+        }
+        && let Some(fields) = &mut r.fields
+    {
+        fields.mesh = Some(mesh.clone());
+    }
+    run
 }
 
 /// The run's summary and rows, written to `out` with the reference's figures; the run's error
 /// after them if it stopped early.
-fn finish(req: &Request, ran: Ran, observing: Observing, out: Option<&PathBuf>) -> Result<Run, CaseError> {
+fn finish(req: &Request, ran: Ran, observing: Observing, out: Option<&PathBuf>) -> Result<Run, Stopped> {
     let summary = summarize::summary(req, &ran, &observing);
     let Stepped { rows, outcome, last, .. } = ran.stepped;
     let run = Run {
@@ -227,6 +272,10 @@ fn finish(req: &Request, ran: Ran, observing: Observing, out: Option<&PathBuf>) 
         switches: rows.switches,
         stages: rows.stages,
         newton: rows.newton,
+        fields: req
+            .opts
+            .keep_fields
+            .then(|| Box::new(Fields { t: last.0, u: last.1.clone(), v: last.2.clone(), mesh: None })),
     };
     if let Some(dir) = out {
         write_outputs(dir, req.pf, &run, &observing.shown)?;
@@ -239,7 +288,7 @@ fn finish(req: &Request, ran: Ran, observing: Observing, out: Option<&PathBuf>) 
             .map_err(|source| CaseError::Write { path: dir.display().to_string(), source })?;
     }
     match outcome.stopped {
-        Some(e) => Err(e),
+        Some(error) => Err(Stopped { error, run: Some(Box::new(run)) }),
         None => Ok(run),
     }
 }
@@ -253,6 +302,8 @@ pub(super) struct Request<'a> {
     pub times: &'a Times,
     /// This process writes the results (rank 0, or the only one).
     pub writes: bool,
+    /// Sees each row as it is measured.
+    pub watcher: Option<&'a Watcher<'a>>,
 }
 
 /// The size of the run's discrete problem, for its summary.
@@ -451,8 +502,9 @@ pub(super) struct Stepped {
     pub outcome: Outcome,
     pub counters: Counters,
     pub steps: usize,
-    /// The time and displacement of the last state (the reference's figures read it).
-    pub last: (f64, Vec<f64>),
+    /// The time, displacement and velocity (if the scheme has one) of the last state (the
+    /// reference's figures read it).
+    pub last: (f64, Vec<f64>, Option<Vec<f64>>),
     /// What the contact pairs' search and assembly cost the solves.
     pub search: crate::runtime::fem::search_cost::SearchCost,
 }

@@ -47,7 +47,7 @@ pub(super) fn run(
         outcome,
         counters: solution.counters,
         steps: 0,
-        last: (t0, solution.u),
+        last: (t0, solution.u, None),
         search: solution.search,
     })
 }

@@ -29,6 +29,8 @@ pub(super) fn run(
     control: &mut Control,
     start: Start,
 ) -> Result<Stepped, CaseError> {
+    let columns: Vec<String> = observer.names().map(str::to_string).collect();
+    let watch = req.watcher.map(|w| (w, columns.as_slice()));
     let (t0, dt) = (req.times.t_start, req.times.dt);
     let u0 = settle(req, sim, bound, &start)?;
     sim.initialize_at(t0, u0, start.v0)?;
@@ -40,6 +42,7 @@ pub(super) fn run(
             let u0 = &sim.states[0];
             let first = State { v: sim.velocity(), ..State::new(t0, u0, u0) };
             let (values, switches) = row(observer, &sim.ops, first);
+            show(watch, &values, req.times.t_end);
             rows = Rows { series: vec![values], switches: vec![switches], iterations: vec![0], ..Rows::default() };
             let v = velocity(&sim.states, sim.v_index, &sim.states[0], dt);
             snapshots.write(&sim.ops, 0, t0, &sim.states[0], &v)?;
@@ -74,6 +77,7 @@ pub(super) fn run(
             stage: false,
         };
         let (values, active) = row(observer, ops, state);
+        show(watch, &values, req.times.t_end);
         rows.series.push(values);
         rows.switches.push(active);
         rows.iterations.push(step.report.iterations());
@@ -96,9 +100,18 @@ pub(super) fn run(
     };
     let steps = outcome.adaptive.as_ref().map_or(steps, |s| s.accepted);
     rows.stages = stages.into_inner();
-    let last = (rows.series.last().map_or(t0, |r| r.0), sim.states[0].clone());
+    let last = (rows.series.last().map_or(t0, |r| r.0), sim.states[0].clone(), sim.velocity().map(<[f64]>::to_vec));
     let search = sim.stepper.search_cost();
     Ok(Stepped { rows, outcome, counters: sim.stepper.counters(), steps, last, search })
+}
+
+/// Shows a row to the watcher, if any; one that says stop asks the run to stop after the step.
+fn show(watch: Option<(&super::Watcher, &[String])>, (t, values): &(f64, Vec<f64>), t_end: f64) {
+    if let Some((watcher, columns)) = watch
+        && !watcher(&super::Seen { t: *t, columns, values, t_end })
+    {
+        crate::interrupt::request();
+    }
 }
 
 /// The displacement the run starts from: u₀, or with `initial u = settled(GUESS)` the static
