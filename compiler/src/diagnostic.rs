@@ -309,6 +309,27 @@ mod tests {
     use super::CODES;
 
     #[test]
+    fn a_located_diagnostic_points_at_its_span_in_lines_and_characters() {
+        // Two-byte characters before the mistake: columns count characters, not bytes.
+        let text = "// é é é\nparam a = 1 in [0, 2]\nform m(u; v) = int(Omega) aa * dot(u, v)\n";
+        let path = std::path::Path::new("located.wf");
+        let Err((diags, sources)) = crate::check_text(path, text, &crate::MemLoader::default()) else {
+            panic!("the file should not check")
+        };
+        let d = diags.iter().find(|d| d.code == "E0101").expect("an unknown name");
+        let at = d.locate(&sources);
+        assert_eq!((at.line, at.column, at.end_line, at.end_column), (3, 27, 3, 29));
+        let line = text.lines().nth(at.line - 1).unwrap();
+        let chars: String = line.chars().skip(at.column - 1).take(at.end_column - at.column).collect();
+        assert_eq!(chars, "aa");
+        assert_eq!(at.file, path);
+        assert!(at.rendered.contains("located.wf:3:27"), "{}", at.rendered);
+        let failure = crate::Failure::of(&diags, &sources);
+        assert_eq!(failure.diagnostics.len(), diags.len());
+        assert_eq!(failure.rendered, super::render_all(&diags, &sources));
+    }
+
+    #[test]
     fn the_catalogue_is_sorted_and_has_no_duplicates() {
         for w in CODES.windows(2) {
             assert!(w[0].0 < w[1].0, "{} before {}", w[0].0, w[1].0);

@@ -10,8 +10,15 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The crates' source roots, relative to the workspace.
-const CRATES: [&str; 6] =
-    ["src", "runtime/src", "compiler/src", "compiler/macros/src", "compiler/generated/src", "descriptors/src"];
+const CRATES: [&str; 7] = [
+    "src",
+    "runtime/src",
+    "compiler/src",
+    "compiler/macros/src",
+    "compiler/generated/src",
+    "descriptors/src",
+    "python/src",
+];
 
 type Module = Vec<String>;
 
