@@ -36,7 +36,7 @@ fn a_watcher_sees_every_row_and_stops_the_run_after_the_step_it_says_stop() {
         Err(s) => s,
     };
     signorini::interrupt::clear();
-    assert!(matches!(stopped.error, CaseError::Interrupted { t } if t >= 0.1 && t < 0.11), "{}", stopped.error);
+    assert!(matches!(stopped.error, CaseError::Interrupted { t } if (0.1..0.11).contains(&t)), "{}", stopped.error);
     let partial = stopped.run.expect("the rows up to the stop");
     let last = partial.rows.last().unwrap().0;
     // The row the watcher said stop at is the last one: its rows are a prefix of the whole run's.
