@@ -51,8 +51,12 @@ pub fn unlocated(py: Python<'_>, file: &std::path::Path, message: &str) -> PyRes
     Ok(out.unbind())
 }
 
-/// A compiler failure as `Failure("wf", ...)`.
+/// A compiler failure as `Failure("wf", ...)`; one without diagnostics (a file that cannot be
+/// read) as `Failure("option", ...)`.
 pub fn wf_failure(f: WfFailure) -> PyErr {
+    if f.diagnostics.is_empty() {
+        return Failure::new_err(("option", f.rendered.trim_end().trim_start_matches("error: ").to_string()));
+    }
     Python::attach(|py| match diagnostics(py, &f) {
         Ok(list) => Failure::new_err(("wf", f.rendered.trim_end().to_string(), list)),
         Err(e) => e,

@@ -74,10 +74,8 @@ fn check(py: Python<'_>, path: std::path::PathBuf) -> PyResult<(Vec<Py<PyDict>>,
     use signorini::compiler;
     let compiled = match compiler::compile(&path, &signorini::driver::sources::LibraryLoader) {
         Ok(c) => c,
-        // A file that cannot be read has no diagnostic to locate.
-        Err(f) if f.diagnostics.is_empty() => {
-            return Err(Failure::new_err(("option", f.rendered.trim_end().trim_start_matches("error: ").to_string())));
-        }
+        // A file that cannot be read has no diagnostic to locate: an error of its own.
+        Err(f) if f.diagnostics.is_empty() => return Err(wf_failure(f)),
         Err(f) => return Ok((failure::diagnostics(py, &f)?, None)),
     };
     let sources = &compiled.program.unit.sources;
@@ -104,25 +102,14 @@ fn check(py: Python<'_>, path: std::path::PathBuf) -> PyResult<(Vec<Py<PyDict>>,
 #[pyfunction]
 #[pyo3(signature = (path, stage="scheme", dim=2))]
 fn emit(path: std::path::PathBuf, stage: &str, dim: usize) -> PyResult<String> {
-    use signorini::compiler::{self, Stage};
-    let stage = match stage {
-        "ast" => Stage::Ast,
-        "ir" => Stage::Ir,
-        "scheme" => Stage::Scheme,
-        "rust" => Stage::Rust,
-        "energy" => Stage::Energy,
-        other => {
-            return Err(Failure::new_err((
-                "option",
-                format!("`{other}` is not a stage (ast, ir, scheme, rust, energy)"),
-            )));
-        }
-    };
+    let stage = signorini::cli::Stage::named(stage).map_err(|e| Failure::new_err(("option", e)))?;
     if !(1..=3).contains(&dim) {
         return Err(Failure::new_err(("option", format!("dim must be 1, 2 or 3, not {dim}"))));
     }
-    let compiled = compiler::compile(&path, &signorini::driver::sources::LibraryLoader).map_err(wf_failure)?;
-    compiled.print(stage, dim).map_err(wf_failure)
+    // The warnings go where the command line's go: stderr.
+    let (text, warnings) = signorini::cli::stage_text(&path, stage, dim).map_err(wf_failure)?;
+    eprint!("{warnings}");
+    Ok(text)
 }
 
 /// The library: schemes, contact laws, form files, problems and references, as JSON.

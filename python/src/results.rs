@@ -55,16 +55,14 @@ pub fn run(py: Python<'_>, r: &Run) -> PyResult<Py<PyDict>> {
 
 fn fields<'py>(py: Python<'py>, f: &Fields) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
-    let dim = f.mesh.as_ref().map_or(1, Mesh::dim);
+    let dim = f.mesh.dim();
     out.set_item("t", f.t)?;
     out.set_item("u", array(py, f.u.clone(), Some(dim))?)?;
     match &f.v {
         Some(v) => out.set_item("v", array(py, v.clone(), Some(dim))?)?,
         None => out.set_item("v", py.None())?,
     }
-    if let Some(m) = &f.mesh {
-        out.set_item("mesh", mesh(py, m)?)?;
-    }
+    out.set_item("mesh", mesh(py, &f.mesh)?)?;
     Ok(out)
 }
 

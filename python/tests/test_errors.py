@@ -118,3 +118,9 @@ def test_a_run_that_fails_keeps_its_rows(run_cli):
     assert isinstance(e.value, RuntimeError) and message(err) == e.value.message
     partial = e.value.partial
     assert isinstance(partial, signorini.Run) and 1 < len(partial.series["t"]) < 101
+
+
+def test_emit_of_a_missing_file_is_bad_input_not_a_wf_error():
+    with pytest.raises(signorini.InputError) as e:
+        signorini.emit("missing.wf")
+    assert not isinstance(e.value, signorini.WfError) and "missing.wf" in e.value.message

@@ -382,3 +382,17 @@ pub enum Stage {
     /// proves over the params' ranges and at the defaults.
     Energy,
 }
+
+impl Stage {
+    /// The stage `--stage NAME` names, or why none does.
+    pub fn named(name: &str) -> Result<Stage, String> {
+        Stage::from_str(name, false).map_err(|_| {
+            let names: Vec<String> = Stage::value_variants()
+                .iter()
+                .filter_map(|s| s.to_possible_value())
+                .map(|v| v.get_name().to_string())
+                .collect();
+            format!("`{name}` is not a stage ({})", names.join(", "))
+        })
+    }
+}

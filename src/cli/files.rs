@@ -62,15 +62,9 @@ fn quadrature_degrees(file: &Path, compiled: &compiler::Compiled) -> String {
     out
 }
 
-pub(super) fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
-    let compiled = match compiler::compile(file, &crate::driver::sources::LibraryLoader) {
-        Ok(c) => c,
-        Err(e) => {
-            eprint!("{e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    eprint!("{}", compiled.warnings);
+/// A compilation stage of `file` as `emit` prints it, with the file's rendered warnings.
+pub fn stage_text(file: &Path, stage: Stage, dim: usize) -> Result<(String, String), compiler::Failure> {
+    let compiled = compiler::compile(file, &crate::driver::sources::LibraryLoader)?;
     let stage = match stage {
         Stage::Ast => compiler::Stage::Ast,
         Stage::Ir => compiler::Stage::Ir,
@@ -78,9 +72,13 @@ pub(super) fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
         Stage::Rust => compiler::Stage::Rust,
         Stage::Energy => compiler::Stage::Energy,
     };
-    let out = compiled.print(stage, dim);
-    match out {
-        Ok(text) => {
+    Ok((compiled.print(stage, dim)?, compiled.warnings))
+}
+
+pub(super) fn emit(file: &Path, stage: Stage, dim: usize) -> ExitCode {
+    match stage_text(file, stage, dim) {
+        Ok((text, warnings)) => {
+            eprint!("{warnings}");
             print!("{text}");
             ExitCode::SUCCESS
         }

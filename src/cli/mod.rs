@@ -20,6 +20,7 @@ mod summary;
 mod verify;
 
 pub use args::{BenchCommand, Command, MeshCommand, Stage};
+pub use files::stage_text;
 
 #[derive(Parser)]
 #[command(
@@ -55,12 +56,7 @@ impl Cli {
 /// checks and messages, a problem's params as options), for a host other than the shell (the
 /// Python API): a problem or a case file. `--all` runs many and is refused.
 pub fn run_options(args: &[String]) -> Result<crate::problem::run::Options, String> {
-    use clap::{CommandFactory, FromArgMatches};
-    let argv: Vec<std::ffi::OsString> =
-        ["signorini", "run"].iter().map(|s| s.into()).chain(args.iter().map(|a| a.into())).collect();
-    let matches =
-        negative_values(Cli::command()).try_get_matches_from(problem_params::as_options(argv)).map_err(clap_message)?;
-    let cli = Cli::from_arg_matches(&matches).map_err(clap_message)?;
+    let cli = parse("run", args)?;
     let Command::Run { file: Some(file), args } = cli.command else {
         return Err("name a problem, a problem file or a case file".into());
     };
@@ -76,21 +72,24 @@ pub fn run_options(args: &[String]) -> Result<crate::problem::run::Options, Stri
 /// The scheme and files `signorini verify --scheme ... ARGS` names (`--scheme`, `--contact`,
 /// `--param`, ...), read as the command line reads them.
 pub fn verify_methods(args: &[String]) -> Result<crate::driver::Methods, String> {
-    use clap::{CommandFactory, FromArgMatches};
-    let argv: Vec<std::ffi::OsString> =
-        ["signorini", "verify"].iter().map(|s| s.into()).chain(args.iter().map(|a| a.into())).collect();
-    let matches = negative_values(Cli::command()).try_get_matches_from(argv).map_err(clap_message)?;
-    let cli = Cli::from_arg_matches(&matches).map_err(clap_message)?;
-    match cli.command {
+    match parse("verify", args)?.command {
         Command::Verify { methods, .. } if methods.scheme.is_some() => methods.to_methods(),
         _ => Err("name the scheme to verify".into()),
     }
 }
 
-/// clap's message without its usage lines and `error: `: a host shows its own call.
-fn clap_message(e: clap::Error) -> String {
-    let text = e.render().to_string();
-    text.split("\n\nUsage:").next().unwrap_or_default().trim_end().trim_start_matches("error: ").to_string()
+/// `signorini SUBCOMMAND ARGS...` read as [`Cli::parse_args`] reads a command line; an error is
+/// clap's message without its usage lines and `error: ` (a host shows its own call).
+fn parse(subcommand: &str, args: &[String]) -> Result<Cli, String> {
+    use clap::{CommandFactory, FromArgMatches};
+    let message = |e: clap::Error| {
+        let text = e.render().to_string();
+        text.split("\n\nUsage:").next().unwrap_or_default().trim_end().trim_start_matches("error: ").to_string()
+    };
+    let argv = ["signorini", subcommand].iter().map(|s| s.into()).chain(args.iter().map(|a| a.into())).collect();
+    let matches =
+        negative_values(Cli::command()).try_get_matches_from(problem_params::as_options(argv)).map_err(message)?;
+    Cli::from_arg_matches(&matches).map_err(message)
 }
 
 /// An option of `signorini run`: its long name, whether it takes a value and may be repeated,

@@ -36,7 +36,7 @@ pub struct Fields {
     pub u: Vec<f64>,
     /// None for a static problem, and a scheme without a velocity state.
     pub v: Option<Vec<f64>>,
-    pub mesh: Option<crate::runtime::fem::mesh::Mesh>,
+    pub mesh: crate::runtime::fem::mesh::Mesh,
 }
 
 impl Run {

@@ -247,35 +247,22 @@ fn simulate(
         snapshots.finish()?;
     }
     let ran = Ran { stepped, sized, runner: &runner, wall: clock.elapsed().as_secs_f64() };
-    let mut run = finish(&req, ran, observing, out.as_ref());
-    if opts.keep_fields
-        && let Some(r) = match &mut run {
-            Ok(r) => Some(r),
-            Err(Stopped { run, .. }) => run.as_deref_mut(),
-        }
-        && let Some(fields) = &mut r.fields
-    {
-        fields.mesh = Some(mesh.clone());
-    }
-    run
+    finish(&req, ran, observing, out.as_ref(), &mesh)
 }
 
 /// The run's summary and rows, written to `out` with the reference's figures; the run's error
 /// after them if it stopped early.
-fn finish(req: &Request, ran: Ran, observing: Observing, out: Option<&PathBuf>) -> Result<Run, Stopped> {
+fn finish(req: &Request, ran: Ran, observing: Observing, out: Option<&PathBuf>, mesh: &Mesh) -> Result<Run, Stopped> {
     let summary = summarize::summary(req, &ran, &observing);
     let Stepped { rows, outcome, last, .. } = ran.stepped;
-    let run = Run {
+    let mut run = Run {
         summary,
         columns: observing.columns,
         rows: rows.series,
         switches: rows.switches,
         stages: rows.stages,
         newton: rows.newton,
-        fields: req
-            .opts
-            .keep_fields
-            .then(|| Box::new(Fields { t: last.0, u: last.1.clone(), v: last.2.clone(), mesh: None })),
+        fields: None,
     };
     if let Some(dir) = out {
         write_outputs(dir, req.pf, &run, &observing.shown)?;
@@ -286,6 +273,10 @@ fn finish(req: &Request, ran: Ran, observing: Observing, out: Option<&PathBuf>) 
             .observer
             .write_reference(dir, ran.runner.ops(), &last.1, last.0)
             .map_err(|source| CaseError::Write { path: dir.display().to_string(), source })?;
+    }
+    if req.opts.keep_fields {
+        let (t, u, v) = last;
+        run.fields = Some(Box::new(Fields { t, u, v, mesh: mesh.clone() }));
     }
     match outcome.stopped {
         Some(error) => Err(Stopped { error, run: Some(Box::new(run)) }),
